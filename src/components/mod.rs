@@ -1,1 +1,10 @@
-//! components
+//! Reusable parts that systems compose: distributions, vertex caches, bounded
+//! FIFOs, swap chains, system-task noise, preemptible processors and
+//! state-time accounting.
+
+pub mod distribution;
+pub mod fifo;
+pub mod noise;
+pub mod preemptible;
+pub mod state_clock;
+pub mod swap_chain;

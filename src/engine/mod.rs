@@ -1,1 +1,13 @@
-//! engine
+//! The discrete-event kernel: integer-picosecond time, the `(time, sequence)`
+//! ordered event queue, the run loop with per-kind counters and stop
+//! conditions, and named RNG streams. It knows nothing of GPUs.
+
+pub mod queue;
+pub mod rng;
+pub mod sim;
+pub mod time;
+
+pub use queue::EventQueue;
+pub use rng::{RngStreams, StreamRng};
+pub use sim::{Control, EngineError, EventKind, Limits, Model, RunStats, Scheduler, StopReason, run};
+pub use time::{Duration, PS_PER_MS, PS_PER_NS, PS_PER_S, PS_PER_US, Time, TimeError};

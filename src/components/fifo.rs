@@ -1,0 +1,143 @@
+//! A bounded FIFO between a producer and a consumer, limited in entries or in
+//! bytes. It models the CPU->GPU command buffer of paper 000 §4.4 (a full
+//! buffer blocks the driver: CPU idle; an empty one starves the GPU) and the
+//! small triangle FIFO between the geometry and fragment stages (§4.5.1).
+//!
+//! Capacity 0 is a rendezvous: an entry may enter only when the FIFO is empty,
+//! and the producer stays blocked until the consumer has taken it. An entry
+//! larger than the whole capacity enters only when the FIFO is empty, so a
+//! big batch can never deadlock.
+
+use std::collections::VecDeque;
+
+/// What the capacity counts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FifoUnit {
+    /// Entries (commands, triangles).
+    Entries,
+    /// Bytes.
+    Bytes,
+}
+
+/// A bounded FIFO of `T`, each entry with a weight (1 entry or its bytes).
+#[derive(Debug, Clone)]
+pub struct BoundedFifo<T> {
+    items: VecDeque<(T, u64)>,
+    capacity: u64,
+    used: u64,
+    max_used: u64,
+}
+
+impl<T> BoundedFifo<T> {
+    /// An empty FIFO of the given capacity (in the unit its weights use).
+    pub fn new(capacity: u64) -> Self {
+        BoundedFifo {
+            items: VecDeque::new(),
+            capacity,
+            used: 0,
+            max_used: 0,
+        }
+    }
+
+    /// The capacity.
+    pub fn capacity(&self) -> u64 {
+        self.capacity
+    }
+
+    /// Entries held.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    /// True when empty.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    /// Weight held (entries or bytes).
+    #[inline]
+    pub fn used(&self) -> u64 {
+        self.used
+    }
+
+    /// The largest weight ever held.
+    pub fn max_used(&self) -> u64 {
+        self.max_used
+    }
+
+    /// Whether an entry of `weight` may enter now.
+    #[inline]
+    pub fn can_push(&self, weight: u64) -> bool {
+        self.items.is_empty() || self.used.saturating_add(weight) <= self.capacity
+    }
+
+    /// Whether the producer of the last entry must stay blocked until the
+    /// consumer takes entries (rendezvous or an over-sized entry).
+    #[inline]
+    pub fn over_capacity(&self) -> bool {
+        self.used > self.capacity
+    }
+
+    /// Adds an entry; the caller checks [`BoundedFifo::can_push`] first.
+    #[inline]
+    pub fn push(&mut self, item: T, weight: u64) {
+        debug_assert!(self.can_push(weight));
+        self.used += weight;
+        self.max_used = self.max_used.max(self.used);
+        self.items.push_back((item, weight));
+    }
+
+    /// Takes the oldest entry.
+    #[inline]
+    pub fn pop(&mut self) -> Option<T> {
+        let (item, w) = self.items.pop_front()?;
+        self.used -= w;
+        Some(item)
+    }
+
+    /// The oldest entry, without taking it.
+    pub fn front(&self) -> Option<&T> {
+        self.items.front().map(|(t, _)| t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bounded_by_weight() {
+        let mut f = BoundedFifo::new(10);
+        assert!(f.can_push(6));
+        f.push('a', 6);
+        assert!(f.can_push(4));
+        assert!(!f.can_push(5));
+        f.push('b', 4);
+        assert_eq!(f.used(), 10);
+        assert_eq!(f.pop(), Some('a'));
+        assert_eq!(f.used(), 4);
+        assert!(!f.over_capacity());
+    }
+
+    #[test]
+    fn zero_capacity_is_a_rendezvous() {
+        let mut f = BoundedFifo::new(0);
+        assert!(f.can_push(1));
+        f.push(1, 1);
+        assert!(f.over_capacity());
+        assert!(!f.can_push(1));
+        f.pop();
+        assert!(f.can_push(1));
+    }
+
+    #[test]
+    fn oversized_entry_enters_when_empty() {
+        let mut f = BoundedFifo::new(2);
+        f.push(1, 5);
+        assert!(f.over_capacity());
+        assert!(!f.can_push(1));
+    }
+}

@@ -1,0 +1,133 @@
+//! System-task noise (paper 000 §4.2): work of the operating system or the
+//! driver that preempts the rendering thread or the GPU's command processing.
+//! Periodic tasks (period, phase, jitter; e.g. the scheduler tick the paper
+//! suspects: about 0.5 ms every 2-3 frames) and random tasks (Poisson
+//! arrivals at a rate) with durations from any [`Dist`].
+
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::components::distribution::{Dist, DistError};
+use crate::engine::{Duration, StreamRng, Time, TimeError};
+
+/// Which unit a task preempts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NoiseTarget {
+    /// The application's rendering thread on the CPU.
+    Cpu,
+    /// The GPU driver's command processing (stalls the GPU front end).
+    Gpu,
+}
+
+/// When a task arrives.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Arrivals {
+    /// At `phase + k * period + U[0, jitter)`.
+    Periodic {
+        /// Period.
+        period: Duration,
+        /// Offset of the first arrival.
+        phase: Duration,
+        /// Uniform random delay added to each arrival.
+        jitter: Duration,
+    },
+    /// Poisson process with mean inter-arrival `mean_gap`.
+    Poisson {
+        /// Mean time between arrivals (1 / rate).
+        mean_gap: Duration,
+    },
+}
+
+/// One source of system tasks, with its own RNG stream.
+#[derive(Debug, Clone)]
+pub struct NoiseSource {
+    /// Name (also names its RNG stream).
+    pub name: String,
+    /// What it preempts.
+    pub target: NoiseTarget,
+    /// Arrival process.
+    pub arrivals: Arrivals,
+    /// Task duration.
+    pub duration: Dist<Duration>,
+    rng: StreamRng,
+    k: u64,
+}
+
+/// Errors of a noise source's parameters.
+#[derive(Debug, thiserror::Error)]
+pub enum NoiseError {
+    /// Period or mean gap of zero would schedule infinitely many tasks.
+    #[error("system task {name:?}: {what} must be greater than zero")]
+    Zero {
+        /// Source name.
+        name: String,
+        /// Which parameter.
+        what: &'static str,
+    },
+    /// The duration distribution is invalid.
+    #[error("system task {name:?}: duration: {source}")]
+    Duration {
+        /// Source name.
+        name: String,
+        /// Why.
+        source: DistError,
+    },
+}
+
+impl NoiseSource {
+    /// A validated source drawing from `rng`.
+    pub fn new(
+        name: String,
+        target: NoiseTarget,
+        arrivals: Arrivals,
+        duration: Dist<Duration>,
+        rng: StreamRng,
+    ) -> Result<Self, NoiseError> {
+        match &arrivals {
+            Arrivals::Periodic { period, .. } if period.0 == 0 => {
+                return Err(NoiseError::Zero { name, what: "period" });
+            }
+            Arrivals::Poisson { mean_gap } if mean_gap.0 == 0 => {
+                return Err(NoiseError::Zero { name, what: "1/rate" });
+            }
+            _ => {}
+        }
+        duration
+            .validate()
+            .map_err(|source| NoiseError::Duration { name: name.clone(), source })?;
+        Ok(NoiseSource { name, target, arrivals, duration, rng, k: 0 })
+    }
+
+    /// The next arrival after the previous one (the first call gives the first).
+    pub fn next_arrival(&mut self, prev: Time) -> Result<Time, TimeError> {
+        let k = self.k;
+        self.k += 1;
+        match self.arrivals {
+            Arrivals::Periodic { period, phase, jitter } => {
+                let base = period
+                    .checked_mul(k)
+                    .and_then(|d| d.checked_add(phase))
+                    .ok_or_else(|| TimeError::Overflow {
+                        context: format!("scheduling system task {:?}", self.name),
+                        at: Time::ZERO,
+                        by: period,
+                    })?;
+                let j = if jitter.0 > 0 { self.rng.random_range(0..jitter.0) } else { 0 };
+                // Arrivals never go back before the previous one.
+                let t = Time::ZERO.add(base, "scheduling a system task")?.add(Duration(j), "jitter")?;
+                Ok(t.max(prev))
+            }
+            Arrivals::Poisson { mean_gap } => {
+                let u: f64 = self.rng.random::<f64>();
+                let gap = -(1.0 - u).ln() * mean_gap.0 as f64;
+                prev.add(Duration::from_ps_f64(gap), "scheduling a random system task")
+            }
+        }
+    }
+
+    /// Draws a task duration.
+    pub fn draw_duration(&mut self) -> Duration {
+        Duration::from_ps_f64(self.duration.sample(&mut self.rng))
+    }
+}

@@ -1,0 +1,179 @@
+//! The swap chain and display: images the GPU renders into, presented with
+//! vsync in one of three modes (paper 004 §4.2: with double buffering and
+//! vsync, a frame that misses a refresh waits for the next one, so the frame
+//! rate snaps to refresh/1, refresh/2, ...).
+//!
+//! - `fifo`: presented frames queue and each vertical blank shows the oldest;
+//!   the GPU waits for a free image (classic double/triple buffering).
+//! - `mailbox`: a newly presented frame replaces a queued one (the replaced
+//!   frame is dropped and its image freed); each vertical blank shows it.
+//! - `immediate` (or vsync off): a presented frame is shown at once (tearing).
+//!
+//! One image is always the front buffer being scanned out; `buffers` counts
+//! all images, so double buffering leaves one image to render into.
+
+use std::collections::VecDeque;
+
+/// How presented frames reach the screen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PresentMode {
+    /// Queue; one frame per vertical blank; never drops.
+    Fifo,
+    /// Newest replaces the queued frame; shown at the vertical blank.
+    Mailbox,
+    /// Shown at once, no waiting for vertical blank.
+    Immediate,
+}
+
+/// A frame identifier (its index).
+pub type FrameId = u64;
+
+/// The images and what is on screen.
+#[derive(Debug, Clone)]
+pub struct SwapChain {
+    mode: PresentMode,
+    free: u32,
+    queued: VecDeque<FrameId>,
+    front: Option<FrameId>,
+}
+
+/// What a present or a vertical blank did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Flip {
+    /// The frame that became visible now, if any.
+    pub shown: Option<FrameId>,
+    /// A frame discarded without ever being shown (mailbox), if any.
+    pub dropped: Option<FrameId>,
+    /// Whether an image became free (a waiting GPU may acquire it).
+    pub freed: bool,
+}
+
+impl SwapChain {
+    /// A chain of `buffers` images (>= 2) in `mode`.
+    pub fn new(buffers: u32, mode: PresentMode) -> Self {
+        debug_assert!(buffers >= 2);
+        SwapChain {
+            mode,
+            free: buffers - 1,
+            queued: VecDeque::new(),
+            front: None,
+        }
+    }
+
+    /// The present mode.
+    pub fn mode(&self) -> PresentMode {
+        self.mode
+    }
+
+    /// Takes a free image to render into; false if none is free.
+    #[inline]
+    pub fn acquire(&mut self) -> bool {
+        if self.free > 0 {
+            self.free -= 1;
+            true
+        } else {
+            false
+        }
+    }
+
+    /// Frames waiting for a vertical blank.
+    pub fn queued(&self) -> usize {
+        self.queued.len()
+    }
+
+    /// The frame on screen.
+    pub fn front(&self) -> Option<FrameId> {
+        self.front
+    }
+
+    /// The GPU finished rendering `frame` into its image and presents it.
+    pub fn present(&mut self, frame: FrameId) -> Flip {
+        match self.mode {
+            PresentMode::Immediate => {
+                // The old front image (at start-up the blank one) is freed.
+                self.front = Some(frame);
+                self.free += 1;
+                Flip {
+                    shown: Some(frame),
+                    dropped: None,
+                    freed: true,
+                }
+            }
+            PresentMode::Fifo => {
+                self.queued.push_back(frame);
+                Flip::default()
+            }
+            PresentMode::Mailbox => {
+                let dropped = self.queued.pop_front();
+                self.queued.push_back(frame);
+                if dropped.is_some() {
+                    self.free += 1;
+                }
+                Flip {
+                    shown: None,
+                    dropped,
+                    freed: dropped.is_some(),
+                }
+            }
+        }
+    }
+
+    /// A vertical blank: the oldest queued frame (if any) becomes the front
+    /// buffer and the old front image is freed.
+    pub fn vblank(&mut self) -> Flip {
+        if self.mode == PresentMode::Immediate {
+            return Flip::default();
+        }
+        match self.queued.pop_front() {
+            Some(f) => {
+                self.front = Some(f);
+                self.free += 1;
+                Flip {
+                    shown: Some(f),
+                    dropped: None,
+                    freed: true,
+                }
+            }
+            None => Flip::default(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn double_buffered_fifo_blocks_until_vblank() {
+        let mut s = SwapChain::new(2, PresentMode::Fifo);
+        assert!(s.acquire());
+        assert!(!s.acquire());
+        s.present(0);
+        assert!(!s.acquire());
+        let f = s.vblank();
+        assert_eq!(f.shown, Some(0));
+        assert!(s.acquire());
+    }
+
+    #[test]
+    fn mailbox_replaces_and_drops() {
+        let mut s = SwapChain::new(3, PresentMode::Mailbox);
+        assert!(s.acquire());
+        s.present(0);
+        assert!(s.acquire());
+        let f = s.present(1);
+        assert_eq!(f.dropped, Some(0));
+        assert!(s.acquire());
+        assert_eq!(s.vblank().shown, Some(1));
+    }
+
+    #[test]
+    fn immediate_shows_at_once() {
+        let mut s = SwapChain::new(2, PresentMode::Immediate);
+        assert!(s.acquire());
+        assert_eq!(s.present(7).shown, Some(7));
+        assert!(s.acquire());
+        assert_eq!(s.vblank(), Flip::default());
+    }
+}

@@ -1,0 +1,295 @@
+//! Reading model files: TOML text -> table -> `--set` patches -> typed,
+//! validated configuration. Every error names the file, the key path, the
+//! line where the key stands (when it came from the file) and, for a
+//! misspelt key, the closest valid one.
+
+use std::path::{Path, PathBuf};
+
+use serde::de::DeserializeOwned;
+
+/// Where a model came from and its text.
+#[derive(Debug, Clone)]
+pub struct ModelSource {
+    /// A file path, or `<embedded default>`.
+    pub name: String,
+    /// The TOML text.
+    pub text: String,
+    /// Directory relative paths inside the model resolve against.
+    pub base_dir: PathBuf,
+}
+
+/// Errors of reading and validating model files.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The file could not be read.
+    #[error("cannot read model file {path}: {source}")]
+    Io {
+        /// The path.
+        path: String,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The text is not valid TOML.
+    #[error("{file}: malformed TOML: {message}")]
+    Syntax {
+        /// File name.
+        file: String,
+        /// The parser's message (it names line and column).
+        message: String,
+    },
+    /// A `--set key=value` could not be applied.
+    #[error("--set {assignment:?}: {reason}")]
+    Set {
+        /// The assignment as given.
+        assignment: String,
+        /// Why.
+        reason: String,
+    },
+    /// A key is unknown or its value is invalid.
+    #[error("{file}{}: key `{key}`: {message}{}", line.map(|l| format!(":{l}")).unwrap_or_default(), suggestion.as_ref().map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default())]
+    Invalid {
+        /// File name.
+        file: String,
+        /// Dotted key path.
+        key: String,
+        /// 1-based line in the file, when the key stands there.
+        line: Option<usize>,
+        /// What is wrong.
+        message: String,
+        /// The closest valid key, for a misspelt one.
+        suggestion: Option<String>,
+    },
+}
+
+impl ModelSource {
+    /// Reads a model file.
+    pub fn from_file(path: &Path) -> Result<ModelSource, ConfigError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| ConfigError::Io { path: path.display().to_string(), source })?;
+        Ok(ModelSource {
+            name: path.display().to_string(),
+            text,
+            base_dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        })
+    }
+
+    /// A model given as text (the embedded default, tests).
+    pub fn from_text(name: &str, text: &str) -> ModelSource {
+        ModelSource { name: name.to_string(), text: text.to_string(), base_dir: PathBuf::from(".") }
+    }
+
+    /// Parses the text into a TOML table.
+    pub fn table(&self) -> Result<toml::Table, ConfigError> {
+        self.text.parse::<toml::Table>().map_err(|e| ConfigError::Syntax {
+            file: self.name.clone(),
+            message: e.to_string().trim().to_string(),
+        })
+    }
+
+    /// 1-based line of the dotted `key` in the text, if it stands there (or
+    /// of the closest enclosing table that does).
+    pub fn line_of(&self, key: &str) -> Option<usize> {
+        let doc = toml_edit::Document::parse(self.text.as_str()).ok()?;
+        let parts: Vec<&str> = key.split('.').collect();
+        find_item(doc.as_item(), &parts, None).map(|s| line_at(&self.text, s.start))
+    }
+}
+
+type Span = Option<std::ops::Range<usize>>;
+
+fn find_item(item: &toml_edit::Item, parts: &[&str], span: Span) -> Span {
+    let Some((first, rest)) = parts.split_first() else {
+        return span;
+    };
+    match item {
+        toml_edit::Item::Table(t) => match t.get_key_value(first) {
+            Some((k, v)) => find_item(v, rest, k.span().or(v.span()).or(span)),
+            None => t.span().or(span),
+        },
+        toml_edit::Item::ArrayOfTables(a) => match first.parse::<usize>().ok().and_then(|i| a.get(i)) {
+            Some(t) => find_item(&toml_edit::Item::Table(t.clone()), rest, t.span().or(span)),
+            None => span,
+        },
+        toml_edit::Item::Value(v) => find_value(v, parts, span),
+        toml_edit::Item::None => span,
+    }
+}
+
+fn find_value(v: &toml_edit::Value, parts: &[&str], span: Span) -> Span {
+    let Some((first, rest)) = parts.split_first() else {
+        return span;
+    };
+    match v {
+        toml_edit::Value::InlineTable(t) => match t.get_key_value(first) {
+            Some((k, v2)) => find_item(v2, rest, k.span().or(v2.span()).or(span)),
+            None => span,
+        },
+        toml_edit::Value::Array(a) => match first.parse::<usize>().ok().and_then(|i| a.get(i)) {
+            Some(v2) => find_value(v2, rest, v2.span().or(span)),
+            None => span,
+        },
+        _ => span,
+    }
+}
+
+fn line_at(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
+}
+
+/// Applies `key.path=value` to `table`. The value is read as TOML (numbers,
+/// booleans, strings in quotes, arrays, inline tables); anything that is not
+/// valid TOML is taken as a plain string, so `--set workload.gpu=17ms` works.
+pub fn apply_set(table: &mut toml::Table, assignment: &str) -> Result<(), ConfigError> {
+    let err = |reason: &str| ConfigError::Set { assignment: assignment.to_string(), reason: reason.to_string() };
+    let (key, raw) = assignment.split_once('=').ok_or_else(|| err("expected key=value"))?;
+    let key = key.trim();
+    if key.is_empty() || key.split('.').any(|p| p.trim().is_empty()) {
+        return Err(err("empty key"));
+    }
+    let raw = raw.trim();
+    let value = match format!("v = {raw}").parse::<toml::Table>() {
+        Ok(mut t) => t.remove("v").unwrap_or(toml::Value::String(raw.to_string())),
+        Err(_) => toml::Value::String(raw.to_string()),
+    };
+    set_dotted(table, key, value).map_err(|r| err(&r))
+}
+
+/// Sets `value` at dotted `key` in `table`, creating intermediate tables.
+/// A numeric part indexes into an array (`workload.groups.0.count`).
+pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
+    let parts: Vec<&str> = key.split('.').map(str::trim).collect();
+    let mut cur: &mut toml::Table = table;
+    for (i, part) in parts.iter().enumerate() {
+        let last = i + 1 == parts.len();
+        if last {
+            cur.insert(part.to_string(), value);
+            return Ok(());
+        }
+        let next_is_index = parts[i + 1].parse::<usize>().is_ok();
+        let entry = cur
+            .entry(part.to_string())
+            .or_insert_with(|| if next_is_index { toml::Value::Array(vec![]) } else { toml::Value::Table(toml::Table::new()) });
+        match entry {
+            toml::Value::Table(t) => cur = t,
+            toml::Value::Array(a) if next_is_index => {
+                let idx: usize = parts[i + 1].parse().unwrap_or(0);
+                let path = parts[..=i + 1].join(".");
+                let n = a.len();
+                let elem = a
+                    .get_mut(idx)
+                    .ok_or_else(|| format!("`{path}`: index {idx} is out of range (array has {n} entries)"))?;
+                if i + 2 == parts.len() {
+                    *elem = value;
+                    return Ok(());
+                }
+                match elem {
+                    toml::Value::Table(t) => {
+                        // Skip the index part on the next iteration.
+                        return set_dotted(t, &parts[i + 2..].join("."), value);
+                    }
+                    _ => return Err(format!("`{path}` is not a table")),
+                }
+            }
+            _ => return Err(format!("`{}` is not a table", parts[..=i].join("."))),
+        }
+    }
+    Ok(())
+}
+
+/// Deserializes `table` into `T`, turning serde's errors into
+/// [`ConfigError::Invalid`] with key path, line and suggestion.
+pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) -> Result<T, ConfigError> {
+    let de = table.clone();
+    serde_path_to_error::deserialize::<_, T>(de).map_err(|e| {
+        let path = e.path().to_string();
+        let message = e.inner().to_string();
+        let message = message.trim().to_string();
+        // serde says: unknown field `refesh`, expected one of `refresh`, `vsync`
+        let (key, suggestion) = match unknown_field(&message) {
+            Some((bad, expected)) => {
+                let key = if path == "." || path.is_empty() { bad.clone() } else { format!("{path}.{bad}") };
+                let best = expected
+                    .iter()
+                    .map(|c| (strsim::jaro_winkler(&bad, c), c))
+                    .filter(|(s, _)| *s > 0.7)
+                    .max_by(|a, b| a.0.total_cmp(&b.0))
+                    .map(|(_, c)| c.clone());
+                (key, best)
+            }
+            None => (if path == "." { "(top level)".into() } else { path }, None),
+        };
+        invalid(src, &key, message, suggestion)
+    })
+}
+
+/// Builds an [`ConfigError::Invalid`] for `key`, finding its line.
+pub fn invalid(src: &ModelSource, key: &str, message: String, suggestion: Option<String>) -> ConfigError {
+    ConfigError::Invalid { file: src.name.clone(), key: key.to_string(), line: src.line_of(key), message, suggestion }
+}
+
+fn unknown_field(msg: &str) -> Option<(String, Vec<String>)> {
+    let rest = msg.strip_prefix("unknown field `").or_else(|| msg.strip_prefix("unknown variant `"))?;
+    let (bad, rest) = rest.split_once('`')?;
+    let expected: Vec<String> = rest.split('`').skip(1).step_by(2).map(str::to_string).collect();
+    Some((bad.to_string(), expected))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde::Deserialize;
+
+    #[derive(Deserialize, Debug)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Display {
+        refresh: String,
+        vsync: bool,
+    }
+    #[derive(Deserialize, Debug)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct M {
+        display: Display,
+    }
+
+    #[test]
+    fn unknown_key_has_line_and_suggestion() {
+        let src = ModelSource::from_text("m.toml", "# model\n[display]\nrefesh = \"60Hz\"\nvsync = true\n");
+        let t = src.table().unwrap();
+        let e = deserialize::<M>(&t, &src).unwrap_err().to_string();
+        assert!(e.contains("m.toml:3"), "{e}");
+        assert!(e.contains("display.refesh"), "{e}");
+        assert!(e.contains("did you mean `refresh`"), "{e}");
+    }
+
+    #[test]
+    fn wrong_type_names_key_and_line() {
+        let src = ModelSource::from_text("m.toml", "[display]\nrefresh = \"60Hz\"\nvsync = 3\n");
+        let e = deserialize::<M>(&src.table().unwrap(), &src).unwrap_err().to_string();
+        assert!(e.contains("display.vsync") && e.contains(":3"), "{e}");
+    }
+
+    #[test]
+    fn malformed_toml_is_reported() {
+        let src = ModelSource::from_text("m.toml", "[display\nrefresh = 1");
+        let e = src.table().unwrap_err().to_string();
+        assert!(e.contains("m.toml") && e.contains("line 1"), "{e}");
+    }
+
+    #[test]
+    fn set_patches_nested_keys() {
+        let mut t: toml::Table = "[display]\nvsync = true\n[[g]]\nn = 1\n".parse().unwrap();
+        apply_set(&mut t, "display.vsync=false").unwrap();
+        apply_set(&mut t, "display.refresh=60Hz").unwrap();
+        apply_set(&mut t, "a.b.c=3").unwrap();
+        apply_set(&mut t, "g.0.n=5").unwrap();
+        assert_eq!(t["display"]["vsync"], toml::Value::Boolean(false));
+        assert_eq!(t["display"]["refresh"], toml::Value::String("60Hz".into()));
+        assert_eq!(t["a"]["b"]["c"], toml::Value::Integer(3));
+        assert_eq!(t["g"][0]["n"], toml::Value::Integer(5));
+        assert!(apply_set(&mut t, "novalue").is_err());
+        assert!(apply_set(&mut t, "g.3.n=1").is_err());
+        assert!(apply_set(&mut t, "display.vsync.x=1").is_err());
+    }
+}
