@@ -51,6 +51,14 @@ impl<V: Quantity> Dist<V> {
             Dist::Lognormal { median, sigma } => median.to_f64() * (0.5 * sigma * sigma).exp(),
         }
     }
+    /// variance
+    pub fn variance(&self) -> f64 {
+        match self {
+            Dist::Const { .. } => 0.0,
+            Dist::Uniform { min, max } => (max.to_f64() - min.to_f64()).powi(2) / 12.0,
+            Dist::Lognormal { median, sigma } => { let s2 = sigma * sigma; (s2.exp() - 1.0) * (2.0 * median.to_f64().ln() + s2).exp() }
+        }
+    }
     /// E max
     pub fn expected_max_with(&self, a: f64) -> f64 {
         match self {

@@ -8,3 +8,4 @@ pub mod noise;
 pub mod preemptible;
 pub mod state_clock;
 pub mod swap_chain;
+pub mod vertex_cache;

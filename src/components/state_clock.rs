@@ -50,6 +50,16 @@ impl<const N: usize> StateClock<N> {
         spent
     }
 
+    /// Closes the current interval at `now` without changing state (to
+    /// split accounting at a frame boundary); returns its length.
+    #[inline]
+    pub fn split(&mut self, now: Time) -> Duration {
+        let spent = now.since(self.since);
+        self.totals[self.state] += spent.0;
+        self.since = now;
+        spent
+    }
+
     /// Totals per state as of `now` (the current state counted up to `now`).
     pub fn totals_at(&self, now: Time) -> [u64; N] {
         let mut t = self.totals;

@@ -1,1 +1,5 @@
-//! scene
+//! Workloads: meshes, generators, OBJ files, synthetic scenes.
+pub mod config;
+pub mod generators;
+pub mod mesh;
+pub mod presets;

@@ -1,1 +1,2 @@
-//! stats
+//! Statistics: summaries, quantiles, confidence intervals.
+pub mod quantile;

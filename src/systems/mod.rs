@@ -1,1 +1,2 @@
-//! systems
+//! Simulated systems, each composed from components and driven by the engine.
+pub mod frame_pipeline;

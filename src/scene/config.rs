@@ -1,0 +1,123 @@
+//! Scene descriptions: groups of objects sharing a mesh, their states, their
+//! screen-space triangle sizes, and the draw order (paper 000 §4.5.2: state
+//! sorting, Table 2; depth order and early-z, Table 3).
+
+use serde::{Deserialize, Serialize};
+
+use crate::components::distribution::Dist;
+use crate::config::Bytes;
+
+fn yes() -> bool {
+    true
+}
+
+/// Order in which objects are drawn relative to depth (early-z efficiency).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DepthOrder {
+    /// Nearest first: only the front layer is shaded.
+    FrontToBack,
+    /// Farthest first: every layer is shaded.
+    BackToFront,
+    /// Unsorted: layer k of d is shaded with probability 1/k.
+    Random,
+}
+
+/// Order in which objects are submitted relative to their state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StateOrder {
+    /// As listed (instances of a group interleave their states).
+    AsListed,
+    /// Sorted by shader, texture, material (paper 000 Table 2).
+    Sorted,
+}
+
+/// A scene of objects.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneWorkload {
+    /// Optional synthetic scene after paper 000 Table 5: city, terrain, forest.
+    #[serde(default)]
+    pub preset: Option<String>,
+    /// Fraction of the preset's objects and triangles (1.0 = paper size).
+    #[serde(default = "one")]
+    pub scale: f64,
+    /// Average surfaces per pixel.
+    #[serde(default = "one")]
+    pub depth_complexity: f64,
+    /// Depth order of drawing.
+    #[serde(default = "random_order")]
+    pub depth_order: DepthOrder,
+    /// State order of drawing.
+    #[serde(default = "as_listed")]
+    pub state_order: StateOrder,
+    /// Object groups (added after the preset's groups).
+    #[serde(default)]
+    pub groups: Vec<ObjectGroup>,
+}
+
+fn one() -> f64 {
+    1.0
+}
+fn random_order() -> DepthOrder {
+    DepthOrder::Random
+}
+fn as_listed() -> StateOrder {
+    StateOrder::AsListed
+}
+
+/// A mesh: generated, loaded, or described only by its statistics.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum MeshRef {
+    /// A generator or file spec: `grid:64x64`, `strip:8x8`, `random:T:V:SEED`, `file.obj`, `file.idx`.
+    Spec(String),
+    /// Statistics only: triangle count and transformed vertices per triangle.
+    Stats {
+        /// Triangles.
+        triangles: u64,
+        /// Actually transformed vertices per triangle (0..=3).
+        acmr: f64,
+    },
+}
+
+/// `count` objects sharing a mesh, with states cycled over the instances.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectGroup {
+    /// Name, for traces and errors.
+    pub name: String,
+    /// Instances.
+    #[serde(default = "one_u64")]
+    pub count: u64,
+    /// The mesh.
+    pub mesh: MeshRef,
+    /// Indexed draws go through the vertex cache; non-indexed ones transform 3 vertices per triangle.
+    #[serde(default = "yes")]
+    pub indexed: bool,
+    /// Screen-space triangle area in pixels.
+    pub triangle_pixels: Dist<f64>,
+    /// Distinct shaders cycled over the instances.
+    #[serde(default = "one_u64")]
+    pub shaders: u64,
+    /// Distinct textures cycled over the instances.
+    #[serde(default = "one_u64")]
+    pub textures: u64,
+    /// Distinct materials cycled over the instances.
+    #[serde(default = "one_u64")]
+    pub materials: u64,
+    /// Each instance sets its own transformation matrix.
+    #[serde(default = "yes")]
+    pub matrix_per_object: bool,
+    /// Dynamic geometry uploaded per instance per frame.
+    #[serde(default)]
+    pub geometry_upload: Bytes,
+    /// Texture data uploaded per instance per frame.
+    #[serde(default)]
+    pub texture_upload: Bytes,
+}
+
+fn one_u64() -> u64 {
+    1
+}

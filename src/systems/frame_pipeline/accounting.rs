@@ -1,0 +1,220 @@
+//! Time accounting: after every event each unit's state is derived from the
+//! model and its [`StateClock`] advanced, so CPU busy + wait, GPU busy + idle
+//! and the bottleneck shares each add up to the elapsed time exactly. The same
+//! transitions become Perfetto spans when tracing.
+//!
+//! Bottleneck attribution (the unit limiting progress at each instant):
+//! GPU waiting for a swap image -> display (vsync); fragment busy with the
+//! geometry stage blocked or idle -> fragment; geometry busy with the
+//! fragment stage idle -> geometry; both busy -> the one the triangle FIFO
+//! leans towards (at least half full: fragment); front end preempted ->
+//! system; front end processing -> GPU front end; GPU idle -> the CPU (or
+//! system, when a system task holds the CPU); after the last frame is
+//! submitted and drawn -> display.
+
+use crate::components::state_clock::StateClock;
+use crate::engine::Time;
+
+use super::model::{CpuPhase, FramePipeline, FrontPhase};
+
+/// CPU states.
+pub const CPU_STATES: [&str; 5] = ["work", "system task", "wait: command FIFO full", "wait: frames in flight", "idle"];
+/// GPU front-end states.
+pub const FRONT_STATES: [&str; 6] = ["busy", "starved", "wait: swap image", "wait: pipeline drain", "wait: geometry", "system task"];
+/// Geometry-stage states.
+pub const GEOM_STATES: [&str; 3] = ["busy", "blocked: triangle FIFO full", "idle"];
+/// Fragment-stage states.
+pub const FRAG_STATES: [&str; 2] = ["busy", "idle"];
+/// Bottleneck units.
+pub const BOTTLENECKS: [&str; 6] = ["cpu", "system", "gpu_front_end", "geometry", "fragment", "display"];
+
+/// Trace tracks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Track {
+    /// CPU thread.
+    Cpu = 0,
+    /// GPU front end.
+    Front = 1,
+    /// Geometry stage.
+    Geometry = 2,
+    /// Fragment stage.
+    Fragment = 3,
+}
+
+/// A span on a track.
+#[derive(Debug, Clone, Copy)]
+pub struct Span {
+    /// Track.
+    pub track: Track,
+    /// Index into the track's state names.
+    pub state: u8,
+    /// Start.
+    pub start: Time,
+    /// End.
+    pub end: Time,
+}
+
+/// Recorded timeline for the trace output.
+#[derive(Debug, Default, Clone)]
+pub struct TraceLog {
+    /// Spans, per track in time order.
+    pub spans: Vec<Span>,
+    /// Command FIFO fill (time, used).
+    pub command_fifo: Vec<(Time, u64)>,
+    /// Triangle FIFO fill (time, entries).
+    pub triangle_fifo: Vec<(Time, u64)>,
+}
+
+/// Clocks and per-frame attribution.
+#[derive(Debug, Clone)]
+pub struct Accounting {
+    /// CPU clock.
+    pub cpu: StateClock<5>,
+    /// Front-end clock.
+    pub front: StateClock<6>,
+    /// Geometry clock.
+    pub geom: StateClock<3>,
+    /// Fragment clock.
+    pub frag: StateClock<2>,
+    /// GPU busy (index 0) / idle (1).
+    pub gpu: StateClock<2>,
+    /// Bottleneck clock.
+    pub bottleneck: StateClock<6>,
+    cpu_frame: u64,
+    gpu_frame: Option<u64>,
+    /// Timeline, when tracing.
+    pub trace: Option<TraceLog>,
+}
+
+impl Accounting {
+    /// Fresh clocks (everything idle at time zero).
+    pub fn new(trace: bool) -> Self {
+        Accounting {
+            cpu: StateClock::new(4),
+            front: StateClock::new(1),
+            geom: StateClock::new(2),
+            frag: StateClock::new(1),
+            gpu: StateClock::new(1),
+            bottleneck: StateClock::new(0),
+            cpu_frame: 0,
+            gpu_frame: None,
+            trace: trace.then(TraceLog::default),
+        }
+    }
+}
+
+fn set_traced<const N: usize>(clock: &mut StateClock<N>, now: Time, state: usize, track: Track, trace: &mut Option<TraceLog>, idle: usize) -> (usize, u64) {
+    let old = clock.state();
+    let since = clock.since();
+    let spent = clock.set(now, state);
+    if let Some(t) = trace {
+        if old != state && old != idle && spent.0 > 0 {
+            t.spans.push(Span { track, state: old as u8, start: since, end: now });
+        }
+    }
+    (old, spent.0)
+}
+
+impl FramePipeline {
+    /// Derives every unit's state at `now` and advances the clocks.
+    pub(super) fn account(&mut self, now: Time) {
+        let cpu_state = if self.cpu.in_system() {
+            1
+        } else {
+            match self.cpu_phase {
+                CpuPhase::Running | CpuPhase::Ready | CpuPhase::NextFrame => 0,
+                CpuPhase::Push(_) | CpuPhase::Rendezvous => 2,
+                CpuPhase::WaitFrames => 3,
+                CpuPhase::Finished => 4,
+            }
+        };
+        let front_state = if self.front.in_system() {
+            5
+        } else {
+            match self.front_phase {
+                FrontPhase::Running(_) => 0,
+                FrontPhase::Idle => 1,
+                FrontPhase::WaitImage(_) => 2,
+                FrontPhase::WaitDrain(_) => 3,
+                FrontPhase::Handoff(_) => 4,
+            }
+        };
+        let geom_state = if self.geom_busy {
+            0
+        } else if self.geom_held.is_some() {
+            1
+        } else {
+            2
+        };
+        let frag_state = if self.frag_busy { 0 } else { 1 };
+        let gpu_busy = front_state == 0 || geom_state == 0 || frag_state == 0;
+        let bottleneck = if front_state == 2 {
+            5
+        } else if frag_state == 0 && geom_state != 0 {
+            4
+        } else if geom_state == 0 && frag_state != 0 {
+            3
+        } else if geom_state == 0 && frag_state == 0 {
+            let depth = self.tri_fifo.capacity().max(1);
+            if self.tri_fifo.len() as u64 * 2 >= depth { 4 } else { 3 }
+        } else if front_state == 5 {
+            1
+        } else if front_state == 0 {
+            2
+        } else if cpu_state == 1 {
+            1
+        } else if cpu_state == 4 {
+            5
+        } else {
+            0
+        };
+
+        let a = &mut self.acct;
+        // CPU: attribute the closing interval to the frame it belonged to.
+        let (old, spent) = set_traced(&mut a.cpu, now, cpu_state, Track::Cpu, &mut a.trace, 4);
+        let mut attribute_cpu = |old: usize, spent: u64, frame: u64| {
+            if let Some(r) = self.records.get_mut(frame as usize) {
+                match old {
+                    0 | 1 => r.cpu_busy += spent,
+                    2 | 3 => r.cpu_wait += spent,
+                    _ => {}
+                }
+            }
+        };
+        attribute_cpu(old, spent, a.cpu_frame);
+        if self.cpu_frame != a.cpu_frame {
+            let st = a.cpu.state();
+            let spent = a.cpu.split(now).0;
+            attribute_cpu(st, spent, a.cpu_frame);
+            a.cpu_frame = self.cpu_frame;
+        }
+        set_traced(&mut a.front, now, front_state, Track::Front, &mut a.trace, 1);
+        set_traced(&mut a.geom, now, geom_state, Track::Geometry, &mut a.trace, 2);
+        set_traced(&mut a.frag, now, frag_state, Track::Fragment, &mut a.trace, 1);
+        a.bottleneck.set(now, bottleneck);
+        // GPU busy per frame (the frame the front end is on).
+        let gpu_state = if gpu_busy { 0 } else { 1 };
+        let old = a.gpu.state();
+        let spent = a.gpu.set(now, gpu_state).0;
+        let frame_changed = self.gpu_frame != a.gpu_frame && self.gpu_frame.is_some();
+        let spent = if frame_changed && old == gpu_state { spent + a.gpu.split(now).0 } else { spent };
+        if old == 0 {
+            if let Some(r) = a.gpu_frame.and_then(|f| self.records.get_mut(f as usize)) {
+                r.gpu_busy += spent;
+            }
+        }
+        if self.gpu_frame.is_some() {
+            a.gpu_frame = self.gpu_frame;
+        }
+        if let Some(t) = &mut a.trace {
+            let used = self.fifo.used();
+            if t.command_fifo.last().map(|l| l.1) != Some(used) {
+                t.command_fifo.push((now, used));
+            }
+            let n = self.tri_fifo.len() as u64;
+            if t.triangle_fifo.last().map(|l| l.1) != Some(n) {
+                t.triangle_fifo.push((now, n));
+            }
+        }
+    }
+}

@@ -1,0 +1,117 @@
+//! Closed forms for the geometry -> triangle FIFO -> fragment pipeline of one
+//! draw call (the `draw` fidelity), from the same parameters the `triangle`
+//! fidelity simulates.
+//!
+//! Paper 000 §4.5.1: because the FIFO between the stages is small, the
+//! stages overlap only when neighbouring triangles are balanced; the draw's
+//! time lies between max(G, F) and G + F. The approximation used here: a
+//! FIFO of depth D lets the stages balance work over windows of w = D + 1
+//! triangles, so
+//!
+//!   T = (n / w) * E[max(w * g, F_w)]
+//!
+//! with g the mean geometry time per triangle and F_w the fragment time of w
+//! triangles. For w = 1 the expectation is exact for the size distribution
+//! (E[max(g, c X)]); for w > 1, F_w is taken as normal (central limit). T is
+//! then kept inside [max(G + f, g + F), G + F] (the first triangle's geometry
+//! and the last one's fragments cannot overlap anything). Draws are
+//! simulated back to back; overlap between draws is not modelled, which is
+//! part of the error the fidelity experiment measures.
+
+use crate::components::distribution::Dist;
+use crate::engine::Duration;
+
+/// Times of one draw.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DrawTimes {
+    /// Geometry-stage busy time.
+    pub geometry: Duration,
+    /// Fragment-stage busy time.
+    pub fragment: Duration,
+    /// Time from the draw's start to its last fragment.
+    pub total: Duration,
+}
+
+fn normal_pdf(z: f64) -> f64 {
+    (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt()
+}
+
+fn normal_cdf(z: f64) -> f64 {
+    0.5 * statrs::function::erf::erfc(-z / std::f64::consts::SQRT_2)
+}
+
+/// E[max(a, X)] for X ~ Normal(m, s^2).
+pub fn expected_max_normal(a: f64, m: f64, s: f64) -> f64 {
+    if s <= 0.0 || !s.is_finite() {
+        return a.max(m);
+    }
+    let z = (a - m) / s;
+    a * normal_cdf(z) + m * (1.0 - normal_cdf(z)) + s * normal_pdf(z)
+}
+
+/// The draw's times: `n` triangles, total geometry time `geometry`, triangle
+/// areas from `pixels`, `cost_per_pixel` picoseconds, FIFO depth `depth`.
+pub fn draw_times(n: u64, geometry: Duration, pixels: &Dist<f64>, cost_per_pixel: f64, depth: u32) -> DrawTimes {
+    if n == 0 {
+        return DrawTimes { geometry, fragment: Duration::ZERO, total: geometry };
+    }
+    let g_total = geometry.0 as f64;
+    let mean_px = pixels.mean();
+    let f_mean = mean_px * cost_per_pixel;
+    let f_total = n as f64 * f_mean;
+    let g = g_total / n as f64;
+    let w = (depth as u64 + 1).min(n) as f64;
+    let windowed = if cost_per_pixel <= 0.0 {
+        g_total
+    } else if w <= 1.0 {
+        n as f64 * cost_per_pixel * pixels.expected_max_with(g / cost_per_pixel)
+    } else {
+        let var = pixels.variance();
+        let s = cost_per_pixel * (w * var).sqrt();
+        (n as f64 / w) * expected_max_normal(w * g, w * f_mean, s)
+    };
+    let lower = (g_total + f_mean).max(g + f_total).min(g_total + f_total);
+    let upper = g_total + f_total;
+    let total = if windowed.is_finite() { windowed.clamp(lower, upper) } else { upper };
+    let fragment = Duration::from_ps_f64(f_total);
+    let total = Duration::from_ps_f64(total).max(geometry).max(fragment);
+    DrawTimes { geometry, fragment, total }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn balanced_constant_triangles_overlap() {
+        // 1000 triangles, g = 10 ps, f = 10 ps each: deep FIFO -> max + fill.
+        let t = draw_times(1000, Duration(10_000), &Dist::Const { value: 10.0 }, 1.0, 1000);
+        assert_eq!(t.total, Duration(10_010));
+    }
+
+    #[test]
+    fn bimodal_triangles_with_one_slot_tend_to_sum() {
+        // Half the triangles tiny, half huge: with w = 1, T = sum of max per triangle.
+        let px = Dist::Uniform { min: 0.0, max: 0.0 };
+        let t = draw_times(10, Duration(100), &px, 1.0, 0);
+        assert_eq!(t.total, Duration(100));
+    }
+
+    #[test]
+    fn between_max_and_sum() {
+        let px = Dist::Lognormal { median: 10.0, sigma: 1.5 };
+        for depth in [0, 1, 4, 16, 256] {
+            let t = draw_times(5000, Duration(5000 * 30), &px, 3.0, depth);
+            let lo = t.geometry.max(t.fragment);
+            let hi = Duration(t.geometry.0 + t.fragment.0);
+            assert!(t.total >= lo && t.total <= hi, "{depth}: {t:?}");
+        }
+    }
+
+    #[test]
+    fn expected_max_normal_limits() {
+        assert!((expected_max_normal(0.0, 0.0, 1.0) - normal_pdf(0.0)).abs() < 1e-12);
+        assert_eq!(expected_max_normal(5.0, 1.0, 0.0), 5.0);
+        assert!((expected_max_normal(-100.0, 3.0, 1.0) - 3.0).abs() < 1e-9);
+    }
+}

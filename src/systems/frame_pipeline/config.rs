@@ -1,0 +1,370 @@
+//! The frame pipeline's model file: every cost and capacity of the CPU
+//! thread, command FIFO, GPU stages, display and system noise, plus the
+//! workload. Durations carry units (`"1.85us"`); unknown keys are errors.
+//!
+//! The cost structure follows paper 000 §4 (RT = ETsystem + max(ETcpu,
+//! ETgpu), with CPU non-rendering, rendering and memory-management terms and
+//! GPU per-frame, per-primitive-group, per-vertex and per-fragment terms).
+
+use serde::{Deserialize, Serialize};
+
+use crate::components::distribution::Dist;
+use crate::components::fifo::FifoUnit;
+use crate::components::noise::NoiseTarget;
+use crate::components::swap_chain::PresentMode;
+use crate::components::vertex_cache::CachePolicy;
+use crate::config::{Bandwidth, Bytes, Rate};
+pub use crate::scene::config::SceneWorkload;
+use crate::engine::Duration;
+
+/// How finely the GPU's geometry and fragment work is simulated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Fidelity {
+    /// Each triangle travels geometry -> FIFO -> fragment as events.
+    Triangle,
+    /// One closed form per draw call from the same parameters.
+    Draw,
+}
+
+/// The whole model.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FramePipelineConfig {
+    /// Always `"frame_pipeline"`.
+    #[serde(default = "default_system")]
+    pub system: String,
+    /// A one-line description.
+    #[serde(default)]
+    pub description: String,
+    /// Simulation fidelity.
+    #[serde(default = "default_fidelity")]
+    pub fidelity: Fidelity,
+    /// Run length and seed.
+    #[serde(default)]
+    pub run: RunConfig,
+    /// The application/driver thread.
+    #[serde(default)]
+    pub cpu: CpuConfig,
+    /// The bus uploads cross.
+    #[serde(default)]
+    pub bus: BusConfig,
+    /// CPU -> GPU command buffer.
+    #[serde(default)]
+    pub command_fifo: CommandFifoConfig,
+    /// The GPU.
+    #[serde(default)]
+    pub gpu: GpuConfig,
+    /// Swap chain and display.
+    #[serde(default)]
+    pub display: DisplayConfig,
+    /// System tasks.
+    #[serde(default)]
+    pub noise: NoiseConfig,
+    /// What is rendered.
+    pub workload: WorkloadConfig,
+}
+
+fn default_system() -> String {
+    "frame_pipeline".into()
+}
+fn default_fidelity() -> Fidelity {
+    Fidelity::Triangle
+}
+
+/// Run length.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RunConfig {
+    /// Frames to simulate (each ends displayed or dropped).
+    pub frames: u64,
+    /// Leading frames left out of the metrics.
+    pub warmup_frames: u64,
+    /// Master seed of all RNG streams.
+    pub seed: u64,
+    /// Optional cap on handled events (a safety net for huge models).
+    pub max_events: Option<u64>,
+}
+
+impl Default for RunConfig {
+    fn default() -> Self {
+        RunConfig { frames: 600, warmup_frames: 0, seed: 1, max_events: None }
+    }
+}
+
+/// Costs of a state change by kind (paper 000 §4.5: shader > texture >
+/// material > matrix).
+#[derive(Debug, Clone, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct StateCosts {
+    /// Vertex/fragment program bind.
+    pub shader: Duration,
+    /// Texture bind.
+    pub texture: Duration,
+    /// Material parameters.
+    pub material: Duration,
+    /// Transformation matrix.
+    pub matrix: Duration,
+}
+
+/// The CPU thread's costs.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CpuConfig {
+    /// Reading input at the start of a frame.
+    pub input_sampling: Duration,
+    /// Non-rendering work per frame (AI, physics, ...).
+    pub non_render: Dist<Duration>,
+    /// Traversal and culling per object.
+    pub per_object: Duration,
+    /// Driver cost per draw call.
+    pub per_draw: Duration,
+    /// Driver cost per state change.
+    pub state_change: StateCosts,
+    /// API cost of the clear command.
+    pub clear: Duration,
+    /// API cost of the swap (present) command.
+    pub swap: Duration,
+    /// Frames the CPU may run ahead of the GPU (frames in flight, >= 1).
+    pub max_frames_ahead: u32,
+}
+
+impl Default for CpuConfig {
+    fn default() -> Self {
+        CpuConfig {
+            input_sampling: Duration::ZERO,
+            non_render: Dist::Const { value: Duration::ZERO },
+            per_object: Duration::ZERO,
+            per_draw: Duration::ZERO,
+            state_change: StateCosts::default(),
+            clear: Duration::ZERO,
+            swap: Duration::ZERO,
+            max_frames_ahead: 2,
+        }
+    }
+}
+
+/// The bus uploads cross (paper 000 §4.3.1 memory management).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BusConfig {
+    /// Copy bandwidth from main memory to GPU-visible memory.
+    pub bandwidth: Bandwidth,
+}
+
+impl Default for BusConfig {
+    fn default() -> Self {
+        BusConfig { bandwidth: Bandwidth::parse("4GB/s").expect("valid literal") }
+    }
+}
+
+/// Command sizes, for byte-limited FIFOs.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CommandBytes {
+    /// A draw call.
+    pub draw: Bytes,
+    /// A state change.
+    pub state: Bytes,
+    /// Clear.
+    pub clear: Bytes,
+    /// Swap.
+    pub swap: Bytes,
+    /// An upload command (the data itself goes over the bus).
+    pub upload: Bytes,
+}
+
+impl Default for CommandBytes {
+    fn default() -> Self {
+        CommandBytes { draw: Bytes(32), state: Bytes(16), clear: Bytes(16), swap: Bytes(16), upload: Bytes(32) }
+    }
+}
+
+/// The CPU -> GPU command buffer (paper 000 §4.4).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CommandFifoConfig {
+    /// Capacity in `unit`s; 0 = rendezvous (the CPU waits until the GPU takes each batch).
+    pub capacity: u64,
+    /// What the capacity counts.
+    pub unit: FifoUnit,
+    /// Command sizes (used when `unit = "bytes"`).
+    pub bytes: CommandBytes,
+}
+
+impl Default for CommandFifoConfig {
+    fn default() -> Self {
+        CommandFifoConfig { capacity: 1024, unit: FifoUnit::Entries, bytes: CommandBytes::default() }
+    }
+}
+
+/// The GPU.
+#[derive(Debug, Clone, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct GpuConfig {
+    /// Front-end cost per command.
+    pub command: Duration,
+    /// Front-end cost per state change.
+    pub state_change: StateCosts,
+    /// Clearing the frame buffer.
+    pub clear: Duration,
+    /// The swap at the end of a frame.
+    pub swap: Duration,
+    /// Vertex processing.
+    pub geometry: GeometryConfig,
+    /// Rasterization and fragment processing.
+    pub fragment: FragmentConfig,
+}
+
+/// The geometry stage: index fetch -> vertex cache -> vertex shader per
+/// actually transformed vertex -> triangle setup (paper 000 §4.5).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GeometryConfig {
+    /// Per index fetched.
+    pub index_fetch: Duration,
+    /// Per actually transformed vertex.
+    pub vertex_shader: Duration,
+    /// Per triangle.
+    pub triangle_setup: Duration,
+    /// Post-transform vertex cache.
+    pub vertex_cache: CachePolicy,
+}
+
+impl Default for GeometryConfig {
+    fn default() -> Self {
+        GeometryConfig {
+            index_fetch: Duration::ZERO,
+            vertex_shader: Duration::ZERO,
+            triangle_setup: Duration::ZERO,
+            vertex_cache: CachePolicy::Fifo(24),
+        }
+    }
+}
+
+/// The fragment stage and the triangle FIFO in front of it (§4.5.1).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FragmentConfig {
+    /// Triangles the FIFO between geometry and fragment holds (0 = direct hand-off).
+    pub fifo_depth: u32,
+    /// Per shaded fragment.
+    pub per_fragment: Duration,
+    /// Per fragment rejected by the early depth test.
+    pub per_rejected_fragment: Duration,
+}
+
+impl Default for FragmentConfig {
+    fn default() -> Self {
+        FragmentConfig { fifo_depth: 16, per_fragment: Duration::ZERO, per_rejected_fragment: Duration::ZERO }
+    }
+}
+
+/// Swap chain and display (paper 004 §4.2).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DisplayConfig {
+    /// Refresh rate.
+    pub refresh: Rate,
+    /// Wait for vertical blank (false = `immediate`, whatever `present_mode` says).
+    pub vsync: bool,
+    /// Swap-chain images (2 = double, 3 = triple buffering).
+    pub buffers: u32,
+    /// How presented frames reach the screen.
+    pub present_mode: PresentMode,
+}
+
+impl Default for DisplayConfig {
+    fn default() -> Self {
+        DisplayConfig {
+            refresh: Rate::parse("60Hz").expect("valid literal"),
+            vsync: true,
+            buffers: 2,
+            present_mode: PresentMode::Fifo,
+        }
+    }
+}
+
+/// System tasks (paper 000 §4.2).
+#[derive(Debug, Clone, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct NoiseConfig {
+    /// Master switch.
+    #[serde(default = "yes")]
+    pub enabled: bool,
+    /// Periodic tasks.
+    pub periodic: Vec<PeriodicTask>,
+    /// Random (Poisson) tasks.
+    pub random: Vec<RandomTask>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// A periodic system task.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PeriodicTask {
+    /// Name (names its RNG stream).
+    pub name: String,
+    /// Switch.
+    #[serde(default = "yes")]
+    pub enabled: bool,
+    /// What it preempts.
+    #[serde(default = "cpu_target")]
+    pub target: NoiseTarget,
+    /// Period.
+    pub period: Duration,
+    /// First arrival.
+    #[serde(default)]
+    pub phase: Duration,
+    /// Uniform random delay of each arrival, in [0, jitter).
+    #[serde(default)]
+    pub jitter: Duration,
+    /// Duration of each task.
+    pub duration: Dist<Duration>,
+}
+
+/// A task arriving at random (Poisson).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RandomTask {
+    /// Name (names its RNG stream).
+    pub name: String,
+    /// Switch.
+    #[serde(default = "yes")]
+    pub enabled: bool,
+    /// What it preempts.
+    #[serde(default = "cpu_target")]
+    pub target: NoiseTarget,
+    /// Mean arrival rate.
+    pub rate: Rate,
+    /// Duration of each task (e.g. lognormal or pareto).
+    pub duration: Dist<Duration>,
+}
+
+fn cpu_target() -> NoiseTarget {
+    NoiseTarget::Cpu
+}
+
+/// What is rendered each frame.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum WorkloadConfig {
+    /// Fixed CPU and GPU time per frame, for teaching and checks.
+    Fixed(FixedWorkload),
+    /// Objects with meshes, states and screen-space triangle sizes.
+    Scene(SceneWorkload),
+}
+
+/// A fixed per-frame workload.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FixedWorkload {
+    /// CPU time per frame (after input sampling and non-rendering work).
+    pub cpu: Dist<Duration>,
+    /// GPU time per frame (run on the GPU front end as one command).
+    pub gpu: Dist<Duration>,
+}
+

@@ -1,0 +1,156 @@
+//! The CPU thread (paper 000 §4.3-4.4, Figure 4): per frame it waits until
+//! fewer than `max_frames_ahead` frames are in flight, samples input, runs
+//! non-rendering work, then issues clear, one batch per object (traversal,
+//! driver cost per draw and per state change, uploads over the bus) and the
+//! swap, pushing each into the command FIFO. A full FIFO blocks it.
+
+use crate::engine::{Duration, Scheduler, Time};
+
+use super::model::{Command, CpuPhase, Ev, FramePipeline, PipelineError, Program};
+use super::records::FrameRecord;
+
+/// One step of the CPU thread's frame.
+#[derive(Debug, Clone, Copy)]
+enum Op {
+    Input,
+    NonRender,
+    Clear,
+    Fixed,
+    Draw(u32),
+    Swap,
+}
+
+impl FramePipeline {
+    fn op_at(&self, op: u32) -> Op {
+        match op {
+            0 => Op::Input,
+            1 => Op::NonRender,
+            2 => Op::Clear,
+            _ => {
+                let k = op - 3;
+                let body = match &self.program {
+                    Program::Fixed { .. } => 1,
+                    Program::Scene(s) => s.draws.len() as u32,
+                };
+                match (&self.program, k < body) {
+                    (Program::Fixed { .. }, true) => Op::Fixed,
+                    (Program::Scene(_), true) => Op::Draw(k),
+                    (_, false) => Op::Swap,
+                }
+            }
+        }
+    }
+
+    fn op_work(&mut self, op: Op) -> Duration {
+        let c = &self.cfg.cpu;
+        match op {
+            Op::Input => c.input_sampling,
+            Op::NonRender => Duration::from_ps_f64(c.non_render.sample(&mut self.non_render_rng)),
+            Op::Clear => c.clear,
+            Op::Swap => c.swap,
+            Op::Fixed => match &mut self.program {
+                Program::Fixed { cpu, cpu_rng, .. } => Duration::from_ps_f64(cpu.sample(cpu_rng)),
+                Program::Scene(_) => Duration::ZERO,
+            },
+            Op::Draw(k) => match &self.program {
+                Program::Scene(sc) => sc.draws[k as usize].cpu,
+                Program::Fixed { .. } => Duration::ZERO,
+            },
+        }
+    }
+
+    /// The phase after operation `cpu_op`'s work is done.
+    fn cpu_after_work(&mut self, now: Time) -> CpuPhase {
+        let frame = self.cpu_frame;
+        match self.op_at(self.cpu_op) {
+            Op::Input => {
+                self.records[frame as usize].input = now;
+                self.cpu_advance(now)
+            }
+            Op::NonRender => self.cpu_advance(now),
+            Op::Clear => CpuPhase::Push(Command::Clear { frame }),
+            Op::Fixed => {
+                let gpu = match &mut self.program {
+                    Program::Fixed { gpu, gpu_rng, .. } => Duration::from_ps_f64(gpu.sample(gpu_rng)),
+                    Program::Scene(_) => Duration::ZERO,
+                };
+                CpuPhase::Push(Command::Fixed { frame, gpu })
+            }
+            Op::Draw(k) => CpuPhase::Push(Command::Draw { frame, draw: k }),
+            Op::Swap => CpuPhase::Push(Command::Swap { frame }),
+        }
+    }
+
+    /// After a completed push or an operation without command: next
+    /// operation, or the end of the frame after the swap.
+    fn cpu_advance(&mut self, now: Time) -> CpuPhase {
+        if let Op::Swap = self.op_at(self.cpu_op) {
+            self.records[self.cpu_frame as usize].present = now;
+            self.cpu_frame += 1;
+            self.cpu_op = 0;
+            CpuPhase::NextFrame
+        } else {
+            self.cpu_op += 1;
+            CpuPhase::Ready
+        }
+    }
+
+    /// The running operation's work finished.
+    pub(super) fn cpu_op_done(&mut self, now: Time) {
+        debug_assert_eq!(self.cpu_phase, CpuPhase::Running);
+        self.cpu_phase = self.cpu_after_work(now);
+    }
+
+    /// Advances the CPU thread as far as it can go now. Returns whether
+    /// anything changed.
+    pub(super) fn cpu_step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, PipelineError> {
+        let mut progressed = false;
+        loop {
+            match self.cpu_phase {
+                CpuPhase::NextFrame | CpuPhase::WaitFrames => {
+                    if self.cpu_frame >= self.frames_total {
+                        self.cpu_phase = CpuPhase::Finished;
+                        return Ok(true);
+                    }
+                    if self.records.len() as u64 == self.cpu_frame {
+                        self.records.push(FrameRecord::new(self.cpu_frame, now));
+                    }
+                    if self.cpu_frame - self.gpu_completed >= self.cfg.cpu.max_frames_ahead as u64 {
+                        let changed = self.cpu_phase != CpuPhase::WaitFrames;
+                        self.cpu_phase = CpuPhase::WaitFrames;
+                        return Ok(progressed || changed);
+                    }
+                    self.cpu_op = 0;
+                    self.cpu_phase = CpuPhase::Ready;
+                }
+                CpuPhase::Ready => {
+                    let work = self.op_work(self.op_at(self.cpu_op));
+                    if work.0 > 0 || self.cpu.in_system() {
+                        let w = self.cpu.start_job(now, work)?;
+                        Self::schedule_wake(s, w, true);
+                        self.cpu_phase = CpuPhase::Running;
+                        return Ok(true);
+                    }
+                    self.cpu_phase = self.cpu_after_work(now);
+                }
+                CpuPhase::Push(c) => {
+                    let w = self.command_weight(&c);
+                    if !self.fifo.can_push(w) {
+                        return Ok(progressed);
+                    }
+                    self.fifo.push(c, w);
+                    self.commands_issued += 1;
+                    self.cpu_phase = if self.fifo.over_capacity() { CpuPhase::Rendezvous } else { self.cpu_advance(now) };
+                }
+                CpuPhase::Rendezvous => {
+                    if self.fifo.over_capacity() {
+                        return Ok(progressed);
+                    }
+                    self.cpu_phase = self.cpu_advance(now);
+                }
+                CpuPhase::Running | CpuPhase::Finished => return Ok(progressed),
+            }
+            progressed = true;
+        }
+    }
+}

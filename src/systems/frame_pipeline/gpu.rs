@@ -1,0 +1,231 @@
+//! The GPU: front end (command processing and state changes), geometry stage
+//! (index fetch -> post-transform vertex cache -> vertex shader per actually
+//! transformed vertex -> triangle setup), a small triangle FIFO, and the
+//! fragment stage (paper 000 §4.5). At `triangle` fidelity every triangle is
+//! an event in both stages, so the bottleneck can move inside one draw
+//! (§4.5.1); at `draw` fidelity each draw is one closed form
+//! ([`super::closed_form`]).
+
+use crate::engine::{Duration, Scheduler, Time};
+
+use super::closed_form::draw_times;
+use super::config::Fidelity;
+use super::model::{ActiveDraw, Command, Ev, FramePipeline, FrontPhase, PipelineError, Program};
+
+impl FramePipeline {
+    /// True when no triangle is anywhere between front end and fragment output.
+    pub(super) fn pipeline_drained(&self) -> bool {
+        self.geom_draw.is_none() && self.geom_held.is_none() && self.tri_fifo.is_empty() && !self.frag_busy && !self.geom_busy
+    }
+
+    /// Advances the front end as far as it can go now. Returns whether
+    /// anything changed.
+    pub(super) fn front_step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, PipelineError> {
+        let mut progressed = false;
+        loop {
+            match self.front_phase {
+                FrontPhase::Idle => {
+                    let Some(c) = self.fifo.pop() else {
+                        return Ok(progressed);
+                    };
+                    self.commands_executed += 1;
+                    self.front_phase = self.front_begin(now, c, s)?;
+                }
+                FrontPhase::WaitImage(c) => {
+                    if !self.chain.acquire() {
+                        return Ok(progressed);
+                    }
+                    self.front_phase = self.front_start_clear(now, c, s)?;
+                }
+                FrontPhase::WaitDrain(c) => {
+                    if !self.pipeline_drained() {
+                        return Ok(progressed);
+                    }
+                    let work = self.cfg.gpu.swap.checked_add(self.cfg.gpu.command).unwrap_or(Duration(u64::MAX));
+                    self.front_phase = self.front_job(now, c, work, s)?;
+                }
+                FrontPhase::Handoff(c) => {
+                    if self.geom_draw.is_some() {
+                        return Ok(progressed);
+                    }
+                    if let Command::Draw { draw, .. } = c {
+                        self.geom_start_draw(now, draw, s)?;
+                    }
+                    self.front_phase = FrontPhase::Idle;
+                }
+                FrontPhase::Running(_) => return Ok(progressed),
+            }
+            progressed = true;
+        }
+    }
+
+    fn front_begin(&mut self, now: Time, c: Command, s: &mut Scheduler<Ev>) -> Result<FrontPhase, PipelineError> {
+        let cmd_cost = self.cfg.gpu.command;
+        match c {
+            Command::Clear { .. } => {
+                if self.chain.acquire() {
+                    self.front_start_clear(now, c, s)
+                } else {
+                    Ok(FrontPhase::WaitImage(c))
+                }
+            }
+            Command::Fixed { gpu, .. } => {
+                let work = gpu.checked_add(cmd_cost).unwrap_or(Duration(u64::MAX));
+                self.front_job(now, c, work, s)
+            }
+            Command::Draw { draw, .. } => {
+                let work = match &self.program {
+                    Program::Scene(sc) => sc.draws[draw as usize].front,
+                    Program::Fixed { .. } => Duration::ZERO,
+                };
+                self.front_job(now, c, work, s)
+            }
+            Command::Swap { .. } => Ok(FrontPhase::WaitDrain(c)),
+        }
+    }
+
+    fn front_start_clear(&mut self, now: Time, c: Command, s: &mut Scheduler<Ev>) -> Result<FrontPhase, PipelineError> {
+        if let Command::Clear { frame } = c {
+            self.gpu_frame = Some(frame);
+            self.records[frame as usize].gpu_start = Some(now);
+        }
+        let work = self.cfg.gpu.clear.checked_add(self.cfg.gpu.command).unwrap_or(Duration(u64::MAX));
+        self.front_job(now, c, work, s)
+    }
+
+    /// Runs `work` for command `c` on the (preemptible) front end; zero work
+    /// completes at once.
+    fn front_job(&mut self, now: Time, c: Command, work: Duration, s: &mut Scheduler<Ev>) -> Result<FrontPhase, PipelineError> {
+        if work.0 > 0 || self.front.in_system() {
+            let w = self.front.start_job(now, work)?;
+            Self::schedule_wake(s, w, false);
+            return Ok(FrontPhase::Running(c));
+        }
+        self.front_after(now, c)
+    }
+
+    /// The running command's work finished.
+    pub(super) fn front_command_done(&mut self, now: Time) -> Result<(), PipelineError> {
+        if let FrontPhase::Running(c) = self.front_phase {
+            self.front_phase = self.front_after(now, c)?;
+        }
+        Ok(())
+    }
+
+    fn front_after(&mut self, now: Time, c: Command) -> Result<FrontPhase, PipelineError> {
+        Ok(match c {
+            Command::Draw { .. } => FrontPhase::Handoff(c),
+            Command::Swap { frame } => {
+                self.frame_completed(now, frame)?;
+                FrontPhase::Idle
+            }
+            Command::Clear { .. } | Command::Fixed { .. } => FrontPhase::Idle,
+        })
+    }
+
+    fn geom_start_draw(&mut self, now: Time, draw: u32, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+        let Program::Scene(sc) = &self.program else {
+            return Ok(());
+        };
+        let d = &sc.draws[draw as usize];
+        let mesh = &sc.meshes[d.mesh as usize];
+        let triangles = mesh.triangles;
+        self.geom_draw = Some(ActiveDraw { draw, next: 0, triangles });
+        match self.cfg.fidelity {
+            Fidelity::Triangle => self.geom_next_triangle(now, s),
+            Fidelity::Draw => {
+                let g = &sc.groups[d.group as usize];
+                let t = draw_times(triangles, mesh.geometry_time, &g.pixels, g.cost_per_pixel, self.cfg.gpu.fragment.fifo_depth);
+                if t.geometry.0 > 0 {
+                    self.geom_busy = true;
+                    s.after(t.geometry, Ev::DrawGeometry, "draw geometry")?;
+                }
+                let frag_start = t.total.saturating_sub(t.fragment);
+                if frag_start.0 > 0 {
+                    s.after(frag_start, Ev::DrawFragmentStart, "draw fragment start")?;
+                } else {
+                    self.frag_busy = true;
+                }
+                s.after(t.total, Ev::DrawDone, "draw")?;
+                Ok(())
+            }
+        }
+    }
+
+    /// `draw` fidelity: the draw's last fragment is done.
+    pub(super) fn draw_done(&mut self) {
+        self.geom_busy = false;
+        self.frag_busy = false;
+        self.geom_draw = None;
+    }
+
+    /// Starts the next triangle of the current draw, or finishes the draw.
+    fn geom_next_triangle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+        let Some(a) = self.geom_draw else {
+            return Ok(());
+        };
+        if a.next >= a.triangles {
+            self.geom_draw = None;
+            return Ok(());
+        }
+        let Program::Scene(sc) = &self.program else {
+            return Ok(());
+        };
+        let mesh = &sc.meshes[sc.draws[a.draw as usize].mesh as usize];
+        let geo = &self.cfg.gpu.geometry;
+        let tv = mesh.misses.of(a.next, a.triangles);
+        let fetch = if mesh.indices > 0 { 3 * geo.index_fetch.0 } else { 0 };
+        let g = Duration(fetch + tv * geo.vertex_shader.0 + geo.triangle_setup.0);
+        self.geom_busy = true;
+        s.at(now.add(g, "geometry of a triangle")?, Ev::GeomTriangle);
+        Ok(())
+    }
+
+    /// `triangle` fidelity: a triangle left the geometry stage.
+    pub(super) fn geom_triangle_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+        self.geom_busy = false;
+        let Some(a) = self.geom_draw.as_mut() else {
+            return Ok(());
+        };
+        a.next += 1;
+        let draw = a.draw;
+        let Program::Scene(sc) = &self.program else {
+            return Ok(());
+        };
+        let g = &sc.groups[sc.draws[draw as usize].group as usize];
+        let px = g.pixels.sample(&mut self.pixel_rng);
+        let f = Duration::from_ps_f64(px * g.cost_per_pixel);
+        if !self.frag_busy && self.tri_fifo.is_empty() {
+            self.frag_start(now, f, s)?;
+        } else if self.tri_fifo.len() < self.tri_fifo.capacity() as usize {
+            self.tri_fifo.push(f, 1);
+        } else {
+            self.geom_held = Some(f);
+            return Ok(());
+        }
+        self.geom_next_triangle(now, s)
+    }
+
+    fn frag_start(&mut self, now: Time, f: Duration, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+        self.frag_busy = true;
+        s.at(now.add(f, "fragments of a triangle")?, Ev::FragTriangle);
+        Ok(())
+    }
+
+    /// `triangle` fidelity: the fragment stage finished a triangle.
+    pub(super) fn frag_triangle_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+        self.frag_busy = false;
+        if let Some(f) = self.tri_fifo.pop() {
+            self.frag_start(now, f, s)?;
+        }
+        if let Some(f) = self.geom_held.take() {
+            if self.frag_busy {
+                self.tri_fifo.push(f, 1);
+            } else {
+                self.frag_start(now, f, s)?;
+            }
+            self.geom_next_triangle(now, s)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,2 @@
+//! frame pipeline
+pub mod config;

@@ -1,0 +1,489 @@
+//! The frame-pipeline system as a kernel [`Model`]: a CPU thread feeds a
+//! bounded command FIFO; the GPU's front end, geometry stage, triangle FIFO
+//! and fragment stage execute it; a swap chain and display show the frames;
+//! system tasks preempt the CPU thread or the GPU's command processing.
+//!
+//! Follows paper 000 §3-4 and Figure 4 (CPU and GPU working in parallel
+//! through the command buffer; idle time when it is full or empty) and paper
+//! 004 §4.2 (vsync and double buffering). The event handlers live in
+//! `cpu.rs`, `gpu.rs` and `display.rs`; time accounting in `accounting.rs`.
+
+use crate::components::distribution::Dist;
+use crate::components::fifo::{BoundedFifo, FifoUnit};
+use crate::components::noise::{Arrivals, NoiseSource, NoiseTarget};
+use crate::components::preemptible::{Preemptible, Wake};
+use crate::components::swap_chain::{PresentMode, SwapChain};
+use crate::engine::{Control, Duration, EngineError, EventKind, Model, RngStreams, Scheduler, StreamRng, Time, TimeError};
+
+use super::accounting::Accounting;
+use super::config::{Fidelity, FramePipelineConfig, WorkloadConfig};
+use super::records::FrameRecord;
+use super::workload::SceneProgram;
+
+/// Events of the frame pipeline.
+#[derive(Debug, Clone, Copy)]
+pub enum Ev {
+    /// The CPU thread's current work item finished (tag guards preemption).
+    CpuDone {
+        /// Generation tag.
+        tag: u32,
+    },
+    /// The GPU front end's current command finished.
+    FrontDone {
+        /// Generation tag.
+        tag: u32,
+    },
+    /// The geometry stage finished a triangle (`triangle` fidelity).
+    GeomTriangle,
+    /// The fragment stage finished a triangle (`triangle` fidelity).
+    FragTriangle,
+    /// The geometry part of a draw ended (`draw` fidelity).
+    DrawGeometry,
+    /// The fragment part of a draw began (`draw` fidelity).
+    DrawFragmentStart,
+    /// A draw ended (`draw` fidelity).
+    DrawDone,
+    /// Vertical blank.
+    Vblank,
+    /// A system task arrives.
+    NoiseArrive {
+        /// Index of the noise source.
+        source: u16,
+    },
+    /// The running system task on a unit ends.
+    NoiseEnd {
+        /// Which unit.
+        target: NoiseTarget,
+    },
+}
+
+impl EventKind for Ev {
+    const NAMES: &'static [&'static str] = &[
+        "cpu_work",
+        "gpu_front_end",
+        "geometry_triangle",
+        "fragment_triangle",
+        "draw_geometry",
+        "draw_fragment_start",
+        "draw_done",
+        "vblank",
+        "noise_arrival",
+        "noise_end",
+    ];
+    #[inline]
+    fn kind(&self) -> usize {
+        match self {
+            Ev::CpuDone { .. } => 0,
+            Ev::FrontDone { .. } => 1,
+            Ev::GeomTriangle => 2,
+            Ev::FragTriangle => 3,
+            Ev::DrawGeometry => 4,
+            Ev::DrawFragmentStart => 5,
+            Ev::DrawDone => 6,
+            Ev::Vblank => 7,
+            Ev::NoiseArrive { .. } => 8,
+            Ev::NoiseEnd { .. } => 9,
+        }
+    }
+}
+
+/// Errors of building or running the frame pipeline.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// Kernel error (time overflow).
+    #[error(transparent)]
+    Engine(#[from] EngineError),
+    /// A model value the simulator cannot use.
+    #[error("{key}: {message}")]
+    Invalid {
+        /// Dotted key.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The pipeline stopped making progress (a model bug, reported rather than hung).
+    #[error("the simulation stalled at {at} with {resolved} of {frames} frames done: {state}")]
+    Stalled {
+        /// When.
+        at: Time,
+        /// Frames done.
+        resolved: u64,
+        /// Frames asked for.
+        frames: u64,
+        /// A description of the units' states.
+        state: String,
+    },
+}
+
+impl From<TimeError> for PipelineError {
+    fn from(e: TimeError) -> Self {
+        PipelineError::Engine(EngineError::Time(e))
+    }
+}
+
+/// A command in the CPU -> GPU FIFO.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Command {
+    /// Clear (needs a free swap-chain image).
+    Clear {
+        /// Frame.
+        frame: u64,
+    },
+    /// Fixed GPU work.
+    Fixed {
+        /// Frame.
+        frame: u64,
+        /// GPU time.
+        gpu: Duration,
+    },
+    /// A draw batch (state changes, uploads, draw).
+    Draw {
+        /// Frame.
+        frame: u64,
+        /// Index into the scene's draws.
+        draw: u32,
+    },
+    /// End of frame: drain the pipeline and present.
+    Swap {
+        /// Frame.
+        frame: u64,
+    },
+}
+
+/// The workload as the simulation consumes it.
+#[derive(Debug)]
+pub enum Program {
+    /// Fixed CPU and GPU time per frame.
+    Fixed {
+        /// CPU time.
+        cpu: Dist<Duration>,
+        /// GPU time.
+        gpu: Dist<Duration>,
+        /// Stream for the CPU part.
+        cpu_rng: StreamRng,
+        /// Stream for the GPU part.
+        gpu_rng: StreamRng,
+    },
+    /// A compiled scene.
+    Scene(SceneProgram),
+}
+
+/// What the CPU thread is doing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CpuPhase {
+    /// About to start frame `cpu_frame` (transient).
+    NextFrame,
+    /// Blocked: too many frames in flight.
+    WaitFrames,
+    /// About to run operation `cpu_op` (transient).
+    Ready,
+    /// Running operation `cpu_op` (possibly preempted).
+    Running,
+    /// Must push this command; at rest this means the FIFO is full.
+    Push(Command),
+    /// Pushed into a FIFO beyond its capacity (rendezvous): waits until taken.
+    Rendezvous,
+    /// All frames submitted.
+    Finished,
+}
+
+/// What the GPU front end is doing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrontPhase {
+    /// Waiting for commands (starved when at rest).
+    Idle,
+    /// A clear waits for a free swap-chain image.
+    WaitImage(Command),
+    /// A swap waits for the pipeline to drain.
+    WaitDrain(Command),
+    /// Processing a command (possibly preempted).
+    Running(Command),
+    /// A draw waits for the geometry stage to take it.
+    Handoff(Command),
+}
+
+/// The frame pipeline's full state.
+pub struct FramePipeline {
+    pub(super) cfg: FramePipelineConfig,
+    pub(super) program: Program,
+    pub(super) frames_total: u64,
+    // CPU thread
+    pub(super) cpu: Preemptible,
+    pub(super) cpu_phase: CpuPhase,
+    pub(super) cpu_frame: u64,
+    pub(super) cpu_op: u32,
+    pub(super) non_render_rng: StreamRng,
+    pub(super) fifo: BoundedFifo<Command>,
+    pub(super) commands_issued: u64,
+    pub(super) commands_executed: u64,
+    // GPU
+    pub(super) front: Preemptible,
+    pub(super) front_phase: FrontPhase,
+    pub(super) gpu_frame: Option<u64>,
+    pub(super) gpu_completed: u64,
+    pub(super) geom_draw: Option<ActiveDraw>,
+    pub(super) geom_busy: bool,
+    pub(super) geom_held: Option<Duration>,
+    pub(super) tri_fifo: BoundedFifo<Duration>,
+    pub(super) frag_busy: bool,
+    pub(super) pixel_rng: StreamRng,
+    // display
+    pub(super) chain: SwapChain,
+    pub(super) refresh: Duration,
+    pub(super) vblanks: u64,
+    pub(super) repeated_refreshes: u64,
+    pub(super) last_display: Option<Time>,
+    pub(super) resolved: u64,
+    // noise
+    pub(super) noise: Vec<NoiseSource>,
+    // results
+    pub(super) records: Vec<FrameRecord>,
+    pub(super) acct: Accounting,
+}
+
+/// A draw in the geometry stage.
+#[derive(Debug, Clone, Copy)]
+pub struct ActiveDraw {
+    /// Index into the scene's draws.
+    pub draw: u32,
+    /// Next triangle.
+    pub next: u64,
+    /// Triangles.
+    pub triangles: u64,
+}
+
+impl FramePipeline {
+    /// Builds the system from a validated model and its compiled workload.
+    pub fn new(cfg: FramePipelineConfig, scene: Option<SceneProgram>, trace: bool) -> Result<Self, PipelineError> {
+        let streams = RngStreams::new(cfg.run.seed);
+        let program = match (&cfg.workload, scene) {
+            (WorkloadConfig::Fixed(f), _) => Program::Fixed {
+                cpu: f.cpu.clone(),
+                gpu: f.gpu.clone(),
+                cpu_rng: streams.stream("workload.cpu"),
+                gpu_rng: streams.stream("workload.gpu"),
+            },
+            (WorkloadConfig::Scene(_), Some(s)) => Program::Scene(s),
+            (WorkloadConfig::Scene(_), None) => {
+                return Err(PipelineError::Invalid { key: "workload".into(), message: "scene not compiled".into() });
+            }
+        };
+        let mut noise = Vec::new();
+        if cfg.noise.enabled {
+            for (i, p) in cfg.noise.periodic.iter().enumerate().filter(|(_, p)| p.enabled) {
+                let src = NoiseSource::new(
+                    p.name.clone(),
+                    p.target,
+                    Arrivals::Periodic { period: p.period, phase: p.phase, jitter: p.jitter },
+                    p.duration.clone(),
+                    streams.stream(&format!("noise.{}", p.name)),
+                )
+                .map_err(|e| PipelineError::Invalid { key: format!("noise.periodic.{i}"), message: e.to_string() })?;
+                noise.push(src);
+            }
+            for (i, r) in cfg.noise.random.iter().enumerate().filter(|(_, r)| r.enabled) {
+                let src = NoiseSource::new(
+                    r.name.clone(),
+                    r.target,
+                    Arrivals::Poisson { mean_gap: r.rate.period },
+                    r.duration.clone(),
+                    streams.stream(&format!("noise.{}", r.name)),
+                )
+                .map_err(|e| PipelineError::Invalid { key: format!("noise.random.{i}"), message: e.to_string() })?;
+                noise.push(src);
+            }
+        }
+        let mode = if cfg.display.vsync { cfg.display.present_mode } else { PresentMode::Immediate };
+        let fifo_cap = cfg.command_fifo.capacity;
+        let frames_total = cfg.run.frames;
+        Ok(FramePipeline {
+            refresh: cfg.display.refresh.period,
+            chain: SwapChain::new(cfg.display.buffers, mode),
+            tri_fifo: BoundedFifo::new(cfg.gpu.fragment.fifo_depth as u64),
+            non_render_rng: streams.stream("cpu.non_render"),
+            pixel_rng: streams.stream("fragment.pixels"),
+            program,
+            frames_total,
+            cpu: Preemptible::new(),
+            cpu_phase: CpuPhase::NextFrame,
+            cpu_frame: 0,
+            cpu_op: 0,
+            fifo: BoundedFifo::new(fifo_cap),
+            commands_issued: 0,
+            commands_executed: 0,
+            front: Preemptible::new(),
+            front_phase: FrontPhase::Idle,
+            gpu_frame: None,
+            gpu_completed: 0,
+            geom_draw: None,
+            geom_busy: false,
+            geom_held: None,
+            frag_busy: false,
+            vblanks: 0,
+            repeated_refreshes: 0,
+            last_display: None,
+            resolved: 0,
+            noise,
+            records: Vec::with_capacity(frames_total.min(1 << 24) as usize),
+            acct: Accounting::new(trace),
+            cfg,
+        })
+    }
+
+    /// Schedules the first events. Call once before running.
+    pub fn start(&mut self, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+        if self.frames_total == 0 {
+            return Ok(());
+        }
+        if self.chain.mode() != PresentMode::Immediate {
+            s.at(Time::ZERO, Ev::Vblank);
+        }
+        for i in 0..self.noise.len() {
+            let t = self.noise[i].next_arrival(Time::ZERO)?;
+            s.at(t, Ev::NoiseArrive { source: i as u16 });
+        }
+        self.settle(Time::ZERO, s)?;
+        self.account(Time::ZERO);
+        Ok(())
+    }
+
+    /// The weight of a command in the FIFO's unit.
+    pub(super) fn command_weight(&self, c: &Command) -> u64 {
+        let b = &self.cfg.command_fifo.bytes;
+        match self.cfg.command_fifo.unit {
+            FifoUnit::Entries => match c {
+                Command::Draw { draw, .. } => self.scene().map(|s| s.draws[*draw as usize].commands as u64).unwrap_or(1),
+                _ => 1,
+            },
+            FifoUnit::Bytes => match c {
+                Command::Clear { .. } => b.clear.0,
+                Command::Swap { .. } => b.swap.0,
+                Command::Fixed { .. } => b.draw.0,
+                Command::Draw { draw, .. } => self.scene().map(|s| s.draws[*draw as usize].bytes).unwrap_or(b.draw.0),
+            },
+        }
+    }
+
+    pub(super) fn scene(&self) -> Option<&SceneProgram> {
+        match &self.program {
+            Program::Scene(s) => Some(s),
+            Program::Fixed { .. } => None,
+        }
+    }
+
+    /// The fidelity.
+    pub fn fidelity(&self) -> Fidelity {
+        self.cfg.fidelity
+    }
+
+    /// Commands pushed by the CPU and commands executed by the GPU.
+    pub fn command_counts(&self) -> (u64, u64) {
+        (self.commands_issued, self.commands_executed)
+    }
+
+    /// Frames displayed or dropped so far.
+    pub fn resolved(&self) -> u64 {
+        self.resolved
+    }
+
+    /// Whether all asked-for frames are done.
+    pub fn done(&self) -> bool {
+        self.resolved >= self.frames_total
+    }
+
+    /// A one-line description of the units' states (for stall reports).
+    pub fn describe(&self) -> String {
+        format!(
+            "cpu {:?} (frame {}, op {}), command fifo {}/{}, front end {:?}, geometry {:?} busy={} held={}, fragment busy={}, frames completed {}, queued for display {}",
+            self.cpu_phase,
+            self.cpu_frame,
+            self.cpu_op,
+            self.fifo.used(),
+            self.fifo.capacity(),
+            self.front_phase,
+            self.geom_draw,
+            self.geom_busy,
+            self.geom_held.is_some(),
+            self.frag_busy,
+            self.gpu_completed,
+            self.chain.queued()
+        )
+    }
+
+    /// Lets the CPU thread and the front end make every step they can now.
+    fn settle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+        loop {
+            let a = self.cpu_step(now, s)?;
+            let b = self.front_step(now, s)?;
+            if !a && !b {
+                return Ok(());
+            }
+        }
+    }
+
+    pub(super) fn schedule_wake(s: &mut Scheduler<Ev>, w: Wake, cpu: bool) {
+        if let Wake::JobAt(t, tag) = w {
+            s.at(t, if cpu { Ev::CpuDone { tag } } else { Ev::FrontDone { tag } });
+        }
+    }
+
+    fn noise_arrive(&mut self, now: Time, source: u16, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+        let src = &mut self.noise[source as usize];
+        let d = src.draw_duration();
+        let target = src.target;
+        let next = src.next_arrival(now)?;
+        s.at(next, Ev::NoiseArrive { source });
+        let unit = match target {
+            NoiseTarget::Cpu => &mut self.cpu,
+            NoiseTarget::Gpu => &mut self.front,
+        };
+        if let Some(end) = unit.task_arrives(now, d)? {
+            s.at(end, Ev::NoiseEnd { target });
+        }
+        Ok(())
+    }
+
+    fn noise_end(&mut self, now: Time, target: NoiseTarget, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+        let unit = match target {
+            NoiseTarget::Cpu => &mut self.cpu,
+            NoiseTarget::Gpu => &mut self.front,
+        };
+        let (next, wake) = unit.task_ends(now)?;
+        if let Some(end) = next {
+            s.at(end, Ev::NoiseEnd { target });
+        }
+        Self::schedule_wake(s, wake, target == NoiseTarget::Cpu);
+        Ok(())
+    }
+}
+
+impl Model for FramePipeline {
+    type Event = Ev;
+    type Error = PipelineError;
+
+    fn handle(&mut self, now: Time, ev: Ev, s: &mut Scheduler<Ev>) -> Result<Control, PipelineError> {
+        match ev {
+            Ev::CpuDone { tag } => {
+                if self.cpu.complete(tag) {
+                    self.cpu_op_done(now);
+                }
+            }
+            Ev::FrontDone { tag } => {
+                if self.front.complete(tag) {
+                    self.front_command_done(now)?;
+                }
+            }
+            Ev::GeomTriangle => self.geom_triangle_done(now, s)?,
+            Ev::FragTriangle => self.frag_triangle_done(now, s)?,
+            Ev::DrawGeometry => self.geom_busy = false,
+            Ev::DrawFragmentStart => self.frag_busy = true,
+            Ev::DrawDone => self.draw_done(),
+            Ev::Vblank => self.vblank(now, s)?,
+            Ev::NoiseArrive { source } => self.noise_arrive(now, source, s)?,
+            Ev::NoiseEnd { target } => self.noise_end(now, target, s)?,
+        }
+        self.settle(now, s)?;
+        self.account(now);
+        Ok(if self.done() { Control::Stop } else { Control::Continue })
+    }
+}

@@ -1,0 +1,377 @@
+//! Compiles a model's workload into what the simulation consumes: the list
+//! of draws in submission order with their CPU and GPU front-end costs, the
+//! meshes' per-triangle transformed-vertex counts, and per-group fragment
+//! costs. Only what the scene uses is built: no vertex-cache simulation for
+//! non-indexed draws or at `draw` fidelity beyond the totals, no upload work
+//! for scenes without uploads.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use crate::components::distribution::Dist;
+use crate::components::vertex_cache::CachePolicy;
+use crate::engine::Duration;
+use crate::scene::config::{DepthOrder, MeshRef, SceneWorkload, StateOrder};
+use crate::scene::generators::mesh_from_spec;
+use crate::scene::presets::{PRESETS, preset_groups};
+
+use super::config::{Fidelity, FramePipelineConfig};
+
+/// Errors while building the workload.
+#[derive(Debug, thiserror::Error)]
+pub enum WorkloadError {
+    /// A key has a value the simulator cannot use.
+    #[error("{key}: {message}")]
+    Invalid {
+        /// Dotted key path.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+fn invalid(key: impl Into<String>, message: impl Into<String>) -> WorkloadError {
+    WorkloadError::Invalid { key: key.into(), message: message.into() }
+}
+
+/// How many vertices each triangle of a mesh transforms.
+#[derive(Debug, Clone)]
+pub enum Misses {
+    /// Simulated through the vertex cache, one count per triangle.
+    PerTriangle(Vec<u8>),
+    /// Statistics only: `transformed` spread evenly over the triangles
+    /// (error diffusion, so every prefix is as even as possible).
+    Spread {
+        /// Total transformed vertices.
+        transformed: u64,
+    },
+    /// The same count for every triangle (non-indexed: 3; no cache: 3).
+    Constant(u8),
+}
+
+impl Misses {
+    /// Transformed vertices of triangle `t` out of `n`.
+    #[inline]
+    pub fn of(&self, t: u64, n: u64) -> u64 {
+        match self {
+            Misses::PerTriangle(v) => v[t as usize] as u64,
+            Misses::Spread { transformed } => {
+                let a = (t as u128 * *transformed as u128) / n as u128;
+                let b = ((t + 1) as u128 * *transformed as u128) / n as u128;
+                (b - a) as u64
+            }
+            Misses::Constant(c) => *c as u64,
+        }
+    }
+}
+
+/// A mesh as the geometry stage sees it.
+#[derive(Debug, Clone)]
+pub struct MeshInfo {
+    /// Name or spec.
+    pub name: String,
+    /// Triangles.
+    pub triangles: u64,
+    /// Actually transformed vertices.
+    pub transformed: u64,
+    /// Indices fetched (0 for non-indexed draws).
+    pub indices: u64,
+    /// Per-triangle transformed counts (only built at `triangle` fidelity).
+    pub misses: Misses,
+    /// Geometry-stage time of one draw of the mesh.
+    pub geometry_time: Duration,
+}
+
+/// A group's fragment-stage parameters.
+#[derive(Debug, Clone)]
+pub struct GroupInfo {
+    /// Name.
+    pub name: String,
+    /// Screen-space triangle area, pixels.
+    pub pixels: Dist<f64>,
+    /// Expected fragment cost per covered pixel, picoseconds (early-z folded in).
+    pub cost_per_pixel: f64,
+}
+
+/// One draw call with the commands that precede it.
+#[derive(Debug, Clone)]
+pub struct DrawItem {
+    /// Index into [`SceneProgram::groups`].
+    pub group: u32,
+    /// Index into [`SceneProgram::meshes`].
+    pub mesh: u32,
+    /// CPU time before the batch is pushed (traversal, driver, uploads).
+    pub cpu: Duration,
+    /// GPU front-end time for the batch.
+    pub front: Duration,
+    /// Commands in the batch (state changes + upload + draw).
+    pub commands: u32,
+    /// Bytes of the batch.
+    pub bytes: u64,
+}
+
+/// Scene statistics per frame, reported in the summary.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct SceneStats {
+    /// Objects drawn.
+    pub objects: u64,
+    /// Triangles.
+    pub triangles: u64,
+    /// Actually transformed vertices.
+    pub transformed_vertices: u64,
+    /// Shader changes.
+    pub shader_changes: u64,
+    /// Texture changes.
+    pub texture_changes: u64,
+    /// Material changes.
+    pub material_changes: u64,
+    /// Matrix changes.
+    pub matrix_changes: u64,
+    /// Bytes uploaded over the bus.
+    pub upload_bytes: u64,
+    /// Probability that a fragment passes early-z.
+    pub early_z_pass: f64,
+}
+
+/// A compiled scene.
+#[derive(Debug, Clone)]
+pub struct SceneProgram {
+    /// Draws in submission order.
+    pub draws: Vec<DrawItem>,
+    /// Meshes.
+    pub meshes: Vec<MeshInfo>,
+    /// Groups.
+    pub groups: Vec<GroupInfo>,
+    /// Per-frame statistics.
+    pub stats: SceneStats,
+}
+
+/// Probability that a fragment is shaded (passes early-z) given the depth
+/// complexity `d` and the draw order: front-to-back 1/d, back-to-front 1,
+/// random H(d)/d (the k-th of d surfaces drawn in random order is the nearest
+/// so far with probability 1/k; H is the harmonic number, extended to real d
+/// by H(d) = digamma(d+1) + Euler's gamma).
+pub fn early_z_pass(order: DepthOrder, d: f64) -> f64 {
+    match order {
+        DepthOrder::FrontToBack => 1.0 / d,
+        DepthOrder::BackToFront => 1.0,
+        DepthOrder::Random => {
+            let h = statrs::function::gamma::digamma(d + 1.0) + 0.577_215_664_901_532_9;
+            (h / d).clamp(0.0, 1.0)
+        }
+    }
+}
+
+fn mul(d: Duration, n: u64, key: &str) -> Result<Duration, WorkloadError> {
+    d.checked_mul(n).ok_or_else(|| invalid(key, "cost x count overflows the 64-bit picosecond range"))
+}
+fn add(a: Duration, b: Duration, key: &str) -> Result<Duration, WorkloadError> {
+    a.checked_add(b).ok_or_else(|| invalid(key, "sum of costs overflows the 64-bit picosecond range"))
+}
+
+/// Compiles the scene workload of `cfg`.
+pub fn compile_scene(cfg: &FramePipelineConfig, scene: &SceneWorkload, base_dir: &Path) -> Result<SceneProgram, WorkloadError> {
+    if !(scene.depth_complexity.is_finite() && scene.depth_complexity >= 1.0) {
+        return Err(invalid("workload.depth_complexity", format!("must be a number >= 1, got {}", scene.depth_complexity)));
+    }
+    if !(scene.scale.is_finite() && scene.scale > 0.0) {
+        return Err(invalid("workload.scale", format!("must be a number > 0, got {}", scene.scale)));
+    }
+    let mut groups_cfg = Vec::new();
+    if let Some(p) = &scene.preset {
+        let g = preset_groups(p, scene.scale)
+            .ok_or_else(|| invalid("workload.preset", format!("unknown preset {p:?} (known: {})", PRESETS.join(", "))))?;
+        groups_cfg.extend(g);
+    }
+    groups_cfg.extend(scene.groups.iter().cloned());
+
+    let pass = early_z_pass(scene.depth_order, scene.depth_complexity);
+    let frag = &cfg.gpu.fragment;
+    let cost_per_pixel = pass * frag.per_fragment.0 as f64 + (1.0 - pass) * frag.per_rejected_fragment.0 as f64;
+    let geo = &cfg.gpu.geometry;
+    let need_per_triangle = cfg.fidelity == Fidelity::Triangle;
+
+    let mut meshes: Vec<MeshInfo> = Vec::new();
+    let mut mesh_ids: HashMap<(String, bool), u32> = HashMap::new();
+    let mut groups = Vec::new();
+    // (group, mesh, shader, texture, material, matrix, uploads)
+    let mut objects: Vec<(u32, u32, u64, u64, u64, bool, u64, u64)> = Vec::new();
+    let (mut shader_base, mut texture_base, mut material_base) = (0u64, 0u64, 0u64);
+
+    for (gi, g) in groups_cfg.iter().enumerate() {
+        let key = if gi >= groups_cfg.len() - scene.groups.len() {
+            format!("workload.groups.{}", gi - (groups_cfg.len() - scene.groups.len()))
+        } else {
+            format!("workload.preset ({})", g.name)
+        };
+        g.triangle_pixels
+            .validate()
+            .map_err(|e| invalid(format!("{key}.triangle_pixels"), e.to_string()))?;
+        for (what, v) in [("shaders", g.shaders), ("textures", g.textures), ("materials", g.materials)] {
+            if v == 0 {
+                return Err(invalid(format!("{key}.{what}"), "must be at least 1"));
+            }
+        }
+        let mesh_key = (format!("{:?}", g.mesh), g.indexed);
+        let mesh_id = match mesh_ids.get(&mesh_key) {
+            Some(&id) => id,
+            None => {
+                let info = build_mesh(&g.mesh, g.indexed, &geo.vertex_cache, need_per_triangle, base_dir, &key)?;
+                let geometry_time = add(
+                    add(mul(geo.index_fetch, info.indices, &key)?, mul(geo.vertex_shader, info.transformed, &key)?, &key)?,
+                    mul(geo.triangle_setup, info.triangles, &key)?,
+                    &key,
+                )?;
+                meshes.push(MeshInfo { geometry_time, ..info });
+                let id = (meshes.len() - 1) as u32;
+                mesh_ids.insert(mesh_key, id);
+                id
+            }
+        };
+        groups.push(GroupInfo { name: g.name.clone(), pixels: g.triangle_pixels.clone(), cost_per_pixel });
+        for i in 0..g.count {
+            objects.push((
+                gi as u32,
+                mesh_id,
+                shader_base + i % g.shaders,
+                texture_base + i % g.textures,
+                material_base + i % g.materials,
+                g.matrix_per_object,
+                g.geometry_upload.0,
+                g.texture_upload.0,
+            ));
+        }
+        shader_base += g.shaders;
+        texture_base += g.textures;
+        material_base += g.materials;
+    }
+    if scene.state_order == StateOrder::Sorted {
+        objects.sort_by_key(|o| (o.2, o.3, o.4));
+    }
+
+    let cpu = &cfg.cpu;
+    let gpu = &cfg.gpu;
+    let bytes = &cfg.command_fifo.bytes;
+    let mut stats = SceneStats { early_z_pass: pass, ..Default::default() };
+    let mut draws = Vec::with_capacity(objects.len());
+    let mut prev: Option<(u64, u64, u64)> = None;
+    for o in &objects {
+        let (group, mesh, sh, tx, mt, matrix, geo_up, tex_up) = *o;
+        let changed = [
+            prev.is_none_or(|p| p.0 != sh),
+            prev.is_none_or(|p| p.1 != tx),
+            prev.is_none_or(|p| p.2 != mt),
+            matrix,
+        ];
+        prev = Some((sh, tx, mt));
+        let cpu_costs = [cpu.state_change.shader, cpu.state_change.texture, cpu.state_change.material, cpu.state_change.matrix];
+        let gpu_costs = [gpu.state_change.shader, gpu.state_change.texture, gpu.state_change.material, gpu.state_change.matrix];
+        let mut c = add(cpu.per_object, cpu.per_draw, "cpu")?;
+        let mut f = Duration::ZERO;
+        let mut commands = 1u32;
+        let mut b = bytes.draw.0;
+        for k in 0..4 {
+            if changed[k] {
+                c = add(c, cpu_costs[k], "cpu.state_change")?;
+                f = add(f, gpu_costs[k], "gpu.state_change")?;
+                commands += 1;
+                b += bytes.state.0;
+            }
+        }
+        stats.shader_changes += changed[0] as u64;
+        stats.texture_changes += changed[1] as u64;
+        stats.material_changes += changed[2] as u64;
+        stats.matrix_changes += changed[3] as u64;
+        let up = geo_up.saturating_add(tex_up);
+        if up > 0 {
+            c = add(c, cfg.bus.bandwidth.transfer_time(up), "bus.bandwidth")?;
+            commands += 1;
+            b += bytes.upload.0;
+            stats.upload_bytes += up;
+        }
+        f = add(f, mul(gpu.command, commands as u64, "gpu.command")?, "gpu.command")?;
+        let m = &meshes[mesh as usize];
+        stats.objects += 1;
+        stats.triangles += m.triangles;
+        stats.transformed_vertices += m.transformed;
+        draws.push(DrawItem { group, mesh, cpu: c, front: f, commands, bytes: b });
+    }
+    Ok(SceneProgram { draws, meshes, groups, stats })
+}
+
+fn build_mesh(
+    mesh: &MeshRef,
+    indexed: bool,
+    policy: &CachePolicy,
+    per_triangle: bool,
+    base_dir: &Path,
+    key: &str,
+) -> Result<MeshInfo, WorkloadError> {
+    match mesh {
+        MeshRef::Stats { triangles, acmr } => {
+            if !(acmr.is_finite() && (0.0..=3.0).contains(acmr)) {
+                return Err(invalid(format!("{key}.mesh.acmr"), format!("must be between 0 and 3, got {acmr}")));
+            }
+            let (transformed, misses) = if indexed {
+                let tv = (*acmr * *triangles as f64).round() as u64;
+                (tv, Misses::Spread { transformed: tv })
+            } else {
+                (triangles.saturating_mul(3), Misses::Constant(3))
+            };
+            Ok(MeshInfo {
+                name: format!("{triangles} triangles, acmr {acmr}"),
+                triangles: *triangles,
+                transformed,
+                indices: if indexed { triangles.saturating_mul(3) } else { 0 },
+                misses,
+                geometry_time: Duration::ZERO,
+            })
+        }
+        MeshRef::Spec(spec) => {
+            let m = mesh_from_spec(spec, base_dir).map_err(|e| invalid(format!("{key}.mesh"), e.to_string()))?;
+            let triangles = m.triangles();
+            if !indexed || *policy == CachePolicy::None {
+                return Ok(MeshInfo {
+                    name: spec.clone(),
+                    triangles,
+                    transformed: triangles * 3,
+                    indices: if indexed { m.cache_stats(&CachePolicy::None).indices } else { 0 },
+                    misses: Misses::Constant(3),
+                    geometry_time: Duration::ZERO,
+                });
+            }
+            let (transformed, misses, indices) = if per_triangle {
+                let v = m.misses_per_triangle(policy);
+                let tv = v.iter().map(|&x| x as u64).sum();
+                let idx = m.cache_stats(&CachePolicy::None).indices;
+                (tv, Misses::PerTriangle(v), idx)
+            } else {
+                let s = m.cache_stats(policy);
+                (s.transformed, Misses::Spread { transformed: s.transformed }, s.indices)
+            };
+            Ok(MeshInfo { name: spec.clone(), triangles, transformed, indices, misses, geometry_time: Duration::ZERO })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn early_z_orders() {
+        assert_eq!(early_z_pass(DepthOrder::FrontToBack, 4.0), 0.25);
+        assert_eq!(early_z_pass(DepthOrder::BackToFront, 4.0), 1.0);
+        let r = early_z_pass(DepthOrder::Random, 4.0);
+        assert!((r - (1.0 + 0.5 + 1.0 / 3.0 + 0.25) / 4.0).abs() < 1e-9, "{r}");
+        assert!((early_z_pass(DepthOrder::Random, 1.0) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn spread_misses_sum_exactly() {
+        let m = Misses::Spread { transformed: 1861 };
+        let n = 1000;
+        assert_eq!((0..n).map(|t| m.of(t, n)).sum::<u64>(), 1861);
+        assert!((0..n).all(|t| m.of(t, n) <= 2));
+    }
+}
