@@ -1,1 +1,4 @@
-//! components
+//! Reusable parts that simulated systems are composed from.
+
+pub mod distribution;
+pub mod vertex_cache;
