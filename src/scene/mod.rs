@@ -1,1 +1,3 @@
-//! scene
+//! Workloads: meshes, mesh generators, OBJ/index files, synthetic scenes.
+
+pub mod mesh;
