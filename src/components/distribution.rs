@@ -271,8 +271,13 @@ impl<V: Quantity> Dist<V> {
                 chosen.map_or(0.0, |p| p.dist.sample(rng))
             }
         };
-        // `max` discards NaN; the clamp keeps heavy tails finite.
-        x.max(0.0).min(f64::MAX)
+        // Guards against NaN from unvalidated parameters; the clamp keeps
+        // heavy tails finite.
+        if x.is_nan() {
+            0.0
+        } else {
+            x.clamp(0.0, f64::MAX)
+        }
     }
 
     /// The mean (base unit); infinite where it does not exist (Pareto with
@@ -527,10 +532,10 @@ impl<'de, V: Quantity> Visitor<'de> for DistVisitor<V> {
                 other => return Err(de::Error::unknown_field(other, FIELDS)),
             };
             r.map_err(de::Error::custom)?;
-            if let Some(name) = FIELDS.iter().find(|f| **f == key) {
-                if *name != "kind" {
-                    seen.push(name);
-                }
+            if let Some(name) = FIELDS.iter().find(|f| **f == key)
+                && *name != "kind"
+            {
+                seen.push(name);
             }
         }
         let kind = kind.ok_or_else(|| {
