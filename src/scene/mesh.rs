@@ -142,7 +142,7 @@ impl Mesh {
     /// Checks indices against the vertex count and the topology's rules.
     pub fn validate(&self) -> Result<(), MeshError> {
         let list = self.topology == Topology::TriangleList;
-        if list && self.indices.len() % 3 != 0 {
+        if list && !self.indices.len().is_multiple_of(3) {
             return Err(MeshError::NotMultipleOfThree {
                 name: self.name.clone(),
                 count: self.indices.len(),
