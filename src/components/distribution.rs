@@ -517,6 +517,7 @@ impl<'de, V: Quantity> Visitor<'de> for DistVisitor<V> {
         let (mut sigma, mut shape) = (None::<f64>, None::<f64>);
         let mut parts: Option<Vec<MixturePart<V>>> = None;
         let mut seen: Vec<&'static str> = Vec::new();
+        let mut unknown: Option<String> = None;
         while let Some(key) = map.next_key::<String>()? {
             let r = match key.as_str() {
                 "kind" => put(&mut kind, "kind", map.next_value()?),
@@ -529,7 +530,14 @@ impl<'de, V: Quantity> Visitor<'de> for DistVisitor<V> {
                 "scale" => put(&mut scale, "scale", map.next_value()?),
                 "shape" => put(&mut shape, "shape", map.next_value()?),
                 "parts" => put(&mut parts, "parts", map.next_value()?),
-                other => return Err(de::Error::unknown_field(other, FIELDS)),
+                other => {
+                    // Reported once the kind is known, with that kind's fields.
+                    map.next_value::<de::IgnoredAny>()?;
+                    if unknown.is_none() {
+                        unknown = Some(other.to_string());
+                    }
+                    Ok(())
+                }
             };
             r.map_err(de::Error::custom)?;
             if let Some(name) = FIELDS.iter().find(|f| **f == key)
@@ -545,7 +553,10 @@ impl<'de, V: Quantity> Visitor<'de> for DistVisitor<V> {
             ))
         })?;
         let allowed = fields_of(&kind).ok_or_else(|| de::Error::unknown_variant(&kind, KINDS))?;
-        if let Some(extra) = seen.iter().find(|f| !allowed.contains(f)) {
+        let extra = unknown
+            .as_deref()
+            .or_else(|| seen.iter().find(|f| !allowed.contains(f)).copied());
+        if let Some(extra) = extra {
             return Err(de::Error::custom(format!(
                 "unknown field `{extra}` for kind `{kind}`, expected {}",
                 allowed
