@@ -123,3 +123,39 @@ fn strip_to_list_alternates_winding() {
     let again = l.to_triangle_list();
     assert_eq!(again, l);
 }
+
+mod props {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn strip_indices() -> impl Strategy<Value = Vec<u32>> {
+        prop::collection::vec(prop_oneof![9 => 0u32..12, 1 => Just(RESTART)], 0..80)
+    }
+
+    fn policies() -> impl Strategy<Value = CachePolicy> {
+        prop_oneof![
+            Just(CachePolicy::None),
+            (1u32..10).prop_map(CachePolicy::Fifo),
+            (1u32..10).prop_map(CachePolicy::Lru),
+        ]
+    }
+
+    proptest! {
+        #[test]
+        fn strip_miss_accounting(indices in strip_indices(), p in policies()) {
+            let m = Mesh { name: "p".into(), topology: Topology::TriangleStrip, indices, vertex_count: 12 };
+            m.validate().unwrap();
+            let per = m.misses_per_triangle(&p);
+            let s = m.cache_stats(&p);
+            prop_assert_eq!(per.len() as u64, m.triangles());
+            prop_assert_eq!(s.triangles, m.triangles());
+            prop_assert_eq!(s.indices, m.index_count());
+            prop_assert_eq!(per.iter().map(|&x| u64::from(x)).sum::<u64>(), s.transformed);
+            prop_assert!(s.transformed <= s.indices);
+            prop_assert!(s.transformed >= s.unique_vertices);
+            let l = m.to_triangle_list();
+            prop_assert_eq!(l.triangles(), m.triangles());
+            prop_assert_eq!(l.unique_vertices(), m.unique_vertices());
+        }
+    }
+}
