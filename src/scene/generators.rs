@@ -1,16 +1,376 @@
-//! PLACEHOLDER (replaced by the scene branch's full version at merge).
+//! Mesh workloads from a spec string: synthetic grids, strips and random
+//! meshes, or index buffers loaded from `.obj` and `.idx` files.
+//!
+//! The grid family exercises the post-transform vertex cache of paper 000
+//! (sections 2 and 4.5): the same triangles drawn row by row, shuffled, or
+//! reordered by [`optimize_vertex_cache`] give very different numbers of
+//! actually transformed vertices.
+//!
+//! Grid vertices are numbered row-major: vertex `(i, j)` (column `i` in
+//! `0..=W`, row `j` in `0..=H`) has id `j * (W + 1) + i`. Quad `(i, j)` with
+//! corners `a = (i, j)`, `b = (i+1, j)`, `c = (i, j+1)`, `d = (i+1, j+1)` is
+//! the two counter-clockwise triangles `a b c` and `c b d`.
+
+use std::io::BufRead;
 use std::path::Path;
-use super::mesh::{Mesh, Topology};
-/// err
-#[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-pub struct MeshError(pub String);
-/// spec
-pub fn mesh_from_spec(spec: &str, _base: &Path) -> Result<Mesh, MeshError> {
-    let r = spec.strip_prefix("grid:").ok_or_else(|| MeshError(format!("unknown mesh {spec}")))?;
-    let (w, h) = r.split_once('x').ok_or_else(|| MeshError("bad".into()))?;
-    let (w, h): (u32, u32) = (w.parse().map_err(|_| MeshError("bad".into()))?, h.parse().map_err(|_| MeshError("bad".into()))?);
-    let mut idx = vec![];
-    for y in 0..h { for x in 0..w { let a = y*(w+1)+x; let b=a+1; let c=a+w+1; let d=c+1; idx.extend([a,b,c,b,d,c]); } }
-    Ok(Mesh { name: spec.into(), topology: Topology::TriangleList, indices: idx, vertex_count: (w+1)*(h+1) })
+
+use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+use super::mesh::{Mesh, MeshError, RESTART, Topology};
+use super::optimize::optimize_vertex_cache;
+
+/// The most indices a generated mesh may have.
+pub const MAX_INDICES: u64 = 1 << 31;
+
+/// Builds a mesh from a spec (see the module docs and [`MeshError::UnknownGenerator`]
+/// for the forms). File paths are relative to `base_dir` unless absolute.
+pub fn mesh_from_spec(spec: &str, base_dir: &Path) -> Result<Mesh, MeshError> {
+    let spec = spec.trim();
+    let lower = spec.to_ascii_lowercase();
+    if lower.ends_with(".obj") || lower.ends_with(".idx") {
+        let path = Path::new(spec);
+        let path = if path.is_absolute() {
+            path.to_path_buf()
+        } else {
+            base_dir.join(path)
+        };
+        if !path.exists() {
+            return Err(MeshError::FileNotFound(path));
+        }
+        return if lower.ends_with(".obj") {
+            load_obj(&path, spec)
+        } else {
+            load_idx(&path, spec)
+        };
+    }
+    let parts: Vec<&str> = spec.split(':').collect();
+    let unknown = || MeshError::UnknownGenerator(spec.to_string());
+    match parts.as_slice() {
+        ["grid", size] => {
+            let (w, h) = parse_size(size, spec)?;
+            Ok(grid(w, h, spec))
+        }
+        ["grid", size, "shuffled", seed] => {
+            let (w, h) = parse_size(size, spec)?;
+            let seed = parse_num::<u64>(seed, "seed", spec)?;
+            let mut mesh = grid(w, h, spec);
+            shuffle_triangles(&mut mesh.indices, seed);
+            Ok(mesh)
+        }
+        ["grid", size, "optimized"] => {
+            let (w, h) = parse_size(size, spec)?;
+            let mut mesh = grid(w, h, spec);
+            mesh.indices = optimize_vertex_cache(&mesh.indices, mesh.vertex_count);
+            Ok(mesh)
+        }
+        ["strip", size] => {
+            let (w, h) = parse_size(size, spec)?;
+            Ok(strip(w, h, spec))
+        }
+        ["random", t, v, seed] => {
+            let t = parse_num::<u64>(t, "triangle count", spec)?;
+            let v = parse_num::<u32>(v, "vertex count", spec)?;
+            let seed = parse_num::<u64>(seed, "seed", spec)?;
+            nonzero(t, "triangle count", spec)?;
+            nonzero(u64::from(v), "vertex count", spec)?;
+            check_indices(t.checked_mul(3), spec)?;
+            Ok(random(t, v, seed, spec))
+        }
+        _ => Err(unknown()),
+    }
 }
+
+fn parse_num<T: std::str::FromStr>(
+    s: &str,
+    field: &'static str,
+    spec: &str,
+) -> Result<T, MeshError> {
+    s.trim().parse().map_err(|_| MeshError::BadNumber {
+        field,
+        value: s.to_string(),
+        spec: spec.to_string(),
+    })
+}
+
+fn nonzero(x: u64, field: &'static str, spec: &str) -> Result<(), MeshError> {
+    if x == 0 {
+        Err(MeshError::ZeroSize {
+            field,
+            spec: spec.to_string(),
+        })
+    } else {
+        Ok(())
+    }
+}
+
+fn check_indices(count: Option<u64>, spec: &str) -> Result<(), MeshError> {
+    match count {
+        Some(n) if n <= MAX_INDICES => Ok(()),
+        _ => Err(MeshError::TooLarge {
+            spec: spec.to_string(),
+        }),
+    }
+}
+
+/// Parses `WxH` and checks that a grid of that size fits the index limit
+/// (the limit also keeps every vertex id below [`RESTART`]).
+fn parse_size(s: &str, spec: &str) -> Result<(u32, u32), MeshError> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| MeshError::BadNumber {
+            field: "size (WxH)",
+            value: s.to_string(),
+            spec: spec.to_string(),
+        })?;
+    let w = parse_num::<u32>(w, "width", spec)?;
+    let h = parse_num::<u32>(h, "height", spec)?;
+    nonzero(u64::from(w), "width", spec)?;
+    nonzero(u64::from(h), "height", spec)?;
+    // A list needs 6 indices per quad; a strip fewer.
+    check_indices(
+        u64::from(w)
+            .checked_mul(u64::from(h))
+            .and_then(|q| q.checked_mul(6)),
+        spec,
+    )?;
+    Ok((w, h))
+}
+
+/// `W x H` quads, row by row, two triangles each.
+fn grid(w: u32, h: u32, name: &str) -> Mesh {
+    let row = w + 1;
+    let mut indices = Vec::with_capacity(6 * w as usize * h as usize);
+    for j in 0..h {
+        for i in 0..w {
+            let a = j * row + i;
+            let (b, c) = (a + 1, a + row);
+            let d = c + 1;
+            indices.extend_from_slice(&[a, b, c, c, b, d]);
+        }
+    }
+    Mesh {
+        name: name.to_string(),
+        topology: Topology::TriangleList,
+        indices,
+        vertex_count: row * (h + 1),
+    }
+}
+
+/// The grid as one strip per row of quads, rows separated by restarts.
+fn strip(w: u32, h: u32, name: &str) -> Mesh {
+    let row = w + 1;
+    let mut indices = Vec::with_capacity((2 * row as usize + 1) * h as usize);
+    for j in 0..h {
+        if j > 0 {
+            indices.push(RESTART);
+        }
+        for i in 0..row {
+            // Top then bottom vertex: the first triangle (i,j+1) (i,j) (i+1,j+1)
+            // is counter-clockwise like the list's.
+            indices.push((j + 1) * row + i);
+            indices.push(j * row + i);
+        }
+    }
+    Mesh {
+        name: name.to_string(),
+        topology: Topology::TriangleStrip,
+        indices,
+        vertex_count: row * (h + 1),
+    }
+}
+
+/// Shuffles whole triangles of a list, deterministically from `seed`.
+fn shuffle_triangles(indices: &mut Vec<u32>, seed: u64) {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let mut tris: Vec<[u32; 3]> = indices
+        .chunks_exact(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect();
+    tris.shuffle(&mut rng);
+    *indices = tris.into_iter().flatten().collect();
+}
+
+/// `t` triangles with vertices uniform over `0..v`.
+fn random(t: u64, v: u32, seed: u64, name: &str) -> Mesh {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let indices = (0..3 * t).map(|_| rng.random_range(0..v)).collect();
+    Mesh {
+        name: name.to_string(),
+        topology: Topology::TriangleList,
+        indices,
+        vertex_count: v,
+    }
+}
+
+/// A reader that counts the lines it has handed out, so tobj's parse errors
+/// can be given a line number.
+struct LineCounter<R> {
+    inner: R,
+    newlines: usize,
+    mid_line: bool,
+}
+
+impl<R: BufRead> std::io::Read for LineCounter<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.count(&buf[..n]);
+        Ok(n)
+    }
+}
+
+impl<R> LineCounter<R> {
+    fn count(&mut self, bytes: &[u8]) {
+        if let Some(&last) = bytes.last() {
+            self.newlines += bytes.iter().filter(|&&b| b == b'\n').count();
+            self.mid_line = last != b'\n';
+        }
+    }
+
+    /// The line being parsed when an error occurred.
+    fn current_line(&self) -> usize {
+        self.newlines + usize::from(self.mid_line)
+    }
+}
+
+impl<R: BufRead> BufRead for LineCounter<R> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        self.inner.fill_buf()
+    }
+    fn consume(&mut self, amt: usize) {
+        if let Ok(buf) = self.inner.fill_buf() {
+            let consumed = &buf[..amt.min(buf.len())];
+            if let Some(&last) = consumed.last() {
+                self.newlines += consumed.iter().filter(|&&b| b == b'\n').count();
+                self.mid_line = last != b'\n';
+            }
+        }
+        self.inner.consume(amt);
+    }
+}
+
+/// Loads an OBJ file's faces, triangulated, all models concatenated.
+/// tobj's `single_index` gives one vertex per distinct position/texcoord/
+/// normal combination, as a GPU vertex buffer would hold them.
+fn load_obj(path: &Path, name: &str) -> Result<Mesh, MeshError> {
+    let file = std::fs::File::open(path).map_err(|source| MeshError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut reader = LineCounter {
+        inner: std::io::BufReader::new(file),
+        newlines: 0,
+        mid_line: false,
+    };
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    let loaded = tobj::load_obj_buf(&mut reader, &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    });
+    let (models, _materials) = loaded.map_err(|e| {
+        use tobj::LoadError as L;
+        // Errors found while parsing a line; the others come at the end of
+        // an object, where the line would mislead.
+        let per_line = matches!(
+            e,
+            L::UnrecognizedCharacter
+                | L::PositionParseError
+                | L::ScalingByZeroError
+                | L::ColorParseError
+                | L::NormalParseError
+                | L::TexcoordParseError
+                | L::FaceParseError
+                | L::InvalidObjectName
+                | L::InvalidPolygon
+                | L::ReadError
+        );
+        MeshError::Obj {
+            path: path.to_path_buf(),
+            line: per_line.then(|| reader.current_line()),
+            message: e.to_string(),
+        }
+    })?;
+    let mut indices = Vec::new();
+    let mut offset = 0u64;
+    for model in &models {
+        let base = u32::try_from(offset).ok().filter(|b| *b < RESTART);
+        let Some(base) = base else {
+            return Err(too_big_obj(path));
+        };
+        for &i in &model.mesh.indices {
+            match base.checked_add(i).filter(|x| *x < RESTART) {
+                Some(x) => indices.push(x),
+                None => return Err(too_big_obj(path)),
+            }
+        }
+        offset += (model.mesh.positions.len() / 3) as u64;
+    }
+    let vertex_count = u32::try_from(offset).map_err(|_| too_big_obj(path))?;
+    finish_file(path, name, indices, vertex_count)
+}
+
+fn too_big_obj(path: &Path) -> MeshError {
+    MeshError::Obj {
+        path: path.to_path_buf(),
+        line: None,
+        message: "more vertices than 32-bit indices can address".into(),
+    }
+}
+
+/// Loads whitespace-separated triangle-list indices (`#` starts a comment).
+fn load_idx(path: &Path, name: &str) -> Result<Mesh, MeshError> {
+    let text = std::fs::read_to_string(path).map_err(|source| MeshError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut indices = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let content = line.split('#').next().unwrap_or("");
+        for token in content.split_whitespace() {
+            match token.parse::<u32>() {
+                Ok(i) if i != RESTART => indices.push(i),
+                _ => {
+                    return Err(MeshError::IdxToken {
+                        path: path.to_path_buf(),
+                        line: n + 1,
+                        token: token.to_string(),
+                    });
+                }
+            }
+        }
+    }
+    if !indices.len().is_multiple_of(3) {
+        return Err(MeshError::NotMultipleOfThree {
+            name: path.display().to_string(),
+            count: indices.len(),
+        });
+    }
+    let vertex_count = indices.iter().max().map_or(0, |m| m + 1);
+    finish_file(path, name, indices, vertex_count)
+}
+
+fn finish_file(
+    path: &Path,
+    name: &str,
+    indices: Vec<u32>,
+    vertex_count: u32,
+) -> Result<Mesh, MeshError> {
+    if indices.len() < 3 {
+        return Err(MeshError::Empty(path.display().to_string()));
+    }
+    let mesh = Mesh {
+        name: name.to_string(),
+        topology: Topology::TriangleList,
+        indices,
+        vertex_count,
+    };
+    mesh.validate()?;
+    Ok(mesh)
+}
+
+#[cfg(test)]
+mod tests;
