@@ -1,1 +1,3 @@
 //! stats
+pub mod ci;
+pub mod quantile;
