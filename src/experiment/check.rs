@@ -25,10 +25,19 @@ pub struct CheckOutcome {
 }
 
 /// Evaluate one check.
-pub fn evaluate(path: &str, point: &str, measured: Option<f64>, expect: f64, tolerance: Tolerance) -> CheckOutcome {
+pub fn evaluate(
+    path: &str,
+    point: &str,
+    measured: Option<f64>,
+    expect: f64,
+    tolerance: Tolerance,
+) -> CheckOutcome {
     let (allowed, tolerance_text) = match tolerance {
         Tolerance::Absolute(t) => (t, format!("±{}", format_range_number(t))),
-        Tolerance::Relative(t) => (t * expect.abs(), format!("±{}%", format_range_number(t * 100.0))),
+        Tolerance::Relative(t) => (
+            t * expect.abs(),
+            format!("±{}%", format_range_number(t * 100.0)),
+        ),
     };
     let passed = measured.is_some_and(|m| m.is_finite() && (m - expect).abs() <= allowed);
     CheckOutcome {

@@ -107,7 +107,9 @@ pub(crate) fn compute(exp: &Experiment, inp: &DerivedInputs<'_>) -> Vec<Vec<Opti
             exp.derived
                 .iter()
                 .map(|d| match &d.kind {
-                    DerivedKind::IntervalWidth { column: c, level } => interval_width(column(p.index, c), *level),
+                    DerivedKind::IntervalWidth { column: c, level } => {
+                        interval_width(column(p.index, c), *level)
+                    }
                     DerivedKind::QuantileWidthFromMin { column: c, level } => {
                         quantile_width_from_min(column(p.index, c), *level)
                     }

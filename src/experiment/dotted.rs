@@ -8,7 +8,11 @@ use super::ExperimentError;
 ///
 /// Keys are split on every `.`; quoted segments are not supported. Fails
 /// when a segment is empty or an intermediate key holds a non-table value.
-pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), ExperimentError> {
+pub fn set_dotted(
+    table: &mut toml::Table,
+    key: &str,
+    value: toml::Value,
+) -> Result<(), ExperimentError> {
     let err = |message: String| ExperimentError::Patch {
         key: key.to_string(),
         message,
@@ -64,13 +68,17 @@ pub fn json_number(root: &serde_json::Value, path: &str) -> Result<Option<f64>, 
                     format!("`{}`", walked.join("."))
                 };
                 let keys = match cur {
-                    serde_json::Value::Object(m) => m.keys().cloned().collect::<Vec<_>>().join(", "),
+                    serde_json::Value::Object(m) => {
+                        m.keys().cloned().collect::<Vec<_>>().join(", ")
+                    }
                     _ => String::new(),
                 };
                 return Err(if keys.is_empty() {
                     format!("metric path `{path}` not found: {at} has no key `{part}`")
                 } else {
-                    format!("metric path `{path}` not found: {at} has no key `{part}` (it has: {keys})")
+                    format!(
+                        "metric path `{path}` not found: {at} has no key `{part}` (it has: {keys})"
+                    )
                 });
             }
         }
@@ -91,7 +99,12 @@ mod tests {
     fn set_dotted_creates_and_replaces() {
         let mut t: toml::Table = "[display]\nbuffers = 2\nvsync = true\n".parse().unwrap();
         set_dotted(&mut t, "display.buffers", toml::Value::Integer(3)).unwrap();
-        set_dotted(&mut t, "workload.gpu.mean", toml::Value::String("10ms".into())).unwrap();
+        set_dotted(
+            &mut t,
+            "workload.gpu.mean",
+            toml::Value::String("10ms".into()),
+        )
+        .unwrap();
         set_dotted(&mut t, "top", toml::Value::Float(1.5)).unwrap();
         assert_eq!(t["display"]["buffers"].as_integer(), Some(3));
         assert_eq!(t["display"]["vsync"].as_bool(), Some(true));
@@ -103,7 +116,11 @@ mod tests {
     fn set_dotted_rejects_bad_keys() {
         let mut t: toml::Table = "a = 1\n".parse().unwrap();
         let e = set_dotted(&mut t, "a.b", toml::Value::Integer(1)).unwrap_err();
-        assert!(e.to_string().contains("`a` is not a table (it is of type integer)"), "{e}");
+        assert!(
+            e.to_string()
+                .contains("`a` is not a table (it is of type integer)"),
+            "{e}"
+        );
         assert!(set_dotted(&mut t, "x..y", toml::Value::Integer(1)).is_err());
         assert!(set_dotted(&mut t, "", toml::Value::Integer(1)).is_err());
         // Nothing half-applied for the rejected keys.
@@ -118,7 +135,14 @@ mod tests {
         assert_eq!(json_number(&v, "metrics.ft.p99").unwrap(), None);
         assert_eq!(json_number(&v, "metrics.ok").unwrap(), Some(1.0));
         let e = json_number(&v, "metrics.ft.p50").unwrap_err();
-        assert!(e.contains("`metrics.ft` has no key `p50`") && e.contains("mean"), "{e}");
-        assert!(json_number(&v, "metrics").unwrap_err().contains("not a number"));
+        assert!(
+            e.contains("`metrics.ft` has no key `p50`") && e.contains("mean"),
+            "{e}"
+        );
+        assert!(
+            json_number(&v, "metrics")
+                .unwrap_err()
+                .contains("not a number")
+        );
     }
 }

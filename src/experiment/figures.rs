@@ -2,7 +2,9 @@
 
 use std::path::Path;
 
-use crate::plot::{Histogram, LinePlot, PlotError, Scatter, ScatterPoint, Series, histogram, line_plot, scatter};
+use crate::plot::{
+    Histogram, LinePlot, PlotError, Scatter, ScatterPoint, Series, histogram, line_plot, scatter,
+};
 
 use super::run::PointResult;
 use super::spec::{Experiment, PlotKind, PlotSpec};
@@ -91,13 +93,19 @@ pub(crate) fn draw(
                 },
             )
         }
-        PlotKind::Histogram { column, bins, filter } => {
+        PlotKind::Histogram {
+            column,
+            bins,
+            filter,
+        } => {
             let c = columns.iter().position(|k| k == column);
             let values = points
                 .iter()
                 .filter(|p| p.matches(filter))
                 .map(|p| {
-                    let v = c.and_then(|c| pooled.get(p.index)?.get(c).cloned()).unwrap_or_default();
+                    let v = c
+                        .and_then(|c| pooled.get(p.index)?.get(c).cloned())
+                        .unwrap_or_default();
                     (p.label(), v)
                 })
                 .collect();

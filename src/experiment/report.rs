@@ -25,6 +25,24 @@ pub(crate) fn fmt_num(v: f64) -> String {
     format!("{v:.digits$}")
 }
 
+/// A number with up to six significant digits, for checks.
+pub(crate) fn fmt_precise(v: f64) -> String {
+    if !v.is_finite() || v == 0.0 {
+        return fmt_num(v);
+    }
+    let a = v.abs();
+    if !(1e-3..1e9).contains(&a) {
+        return format!("{v:.5e}");
+    }
+    let digits = (5 - a.log10().floor() as i32).clamp(0, 8) as usize;
+    let s = format!("{v:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 /// `mean ± half-width` (just the mean when no interval exists).
 pub(crate) fn mean_pm(c: &MeanCi) -> String {
     if c.n == 0 {
@@ -83,7 +101,10 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
         }
     }
     if !exp.sweeps.is_empty() {
-        let _ = writeln!(s, "\nSweeps (cartesian product, first varies slowest):\n\n| key | values |\n|---|---|");
+        let _ = writeln!(
+            s,
+            "\nSweeps (cartesian product, first varies slowest):\n\n| key | values |\n|---|---|"
+        );
         for sw in &exp.sweeps {
             let vals: Vec<String> = sw.values.iter().map(value_text).collect();
             let _ = writeln!(s, "| `{}` | {} |", sw.key, cell(&vals.join(", ")));
@@ -97,7 +118,11 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
             .map(|k| format!("`{k}`"))
             .chain(extra.iter().cloned())
             .collect();
-        let cols = if cols.is_empty() { vec!["point".to_string()] } else { cols };
+        let cols = if cols.is_empty() {
+            vec!["point".to_string()]
+        } else {
+            cols
+        };
         format!("| {} |\n|{}\n", cols.join(" | "), "---|".repeat(cols.len()))
     };
     let key_cells = |p: &super::run::PointResult| -> Vec<String> {
@@ -151,7 +176,11 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
             let _ = writeln!(s, "- `{}`: {what}", d.name);
         }
         s.push('\n');
-        let names: Vec<String> = exp.derived.iter().map(|d| format!("`{}`", d.name)).collect();
+        let names: Vec<String> = exp
+            .derived
+            .iter()
+            .map(|d| format!("`{}`", d.name))
+            .collect();
         s.push_str(&head(&names));
         for p in &r.points {
             let mut row = key_cells(p);
@@ -174,8 +203,8 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
                 "| `{}` | {} | {} | {} | {} | {} |",
                 c.path,
                 cell(&c.point),
-                opt(c.measured),
-                fmt_num(c.expect),
+                c.measured.map(fmt_precise).unwrap_or_else(|| "n/a".into()),
+                fmt_precise(c.expect),
                 c.tolerance_text,
                 if c.passed { "PASS" } else { "**FAIL**" }
             );

@@ -12,8 +12,8 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use super::sweep::{Sweep, expand_range, values_match};
 use super::ExperimentError;
+use super::sweep::{Sweep, expand_range, values_match};
 
 /// Where the base model of an experiment comes from.
 #[derive(Debug, Clone, PartialEq)]
@@ -209,7 +209,8 @@ impl Experiment {
         }
         for d in &self.derived {
             match &d.kind {
-                DerivedKind::IntervalWidth { column, .. } | DerivedKind::QuantileWidthFromMin { column, .. } => {
+                DerivedKind::IntervalWidth { column, .. }
+                | DerivedKind::QuantileWidthFromMin { column, .. } => {
                     cols.insert(column.clone());
                 }
                 _ => {}
@@ -267,7 +268,10 @@ impl Experiment {
 
     /// The base model: a clone of `default_model` for `model = "default"`,
     /// else the TOML file named by `model` (relative to the experiment file).
-    pub fn resolve_model(&self, default_model: &toml::Table) -> Result<toml::Table, ExperimentError> {
+    pub fn resolve_model(
+        &self,
+        default_model: &toml::Table,
+    ) -> Result<toml::Table, ExperimentError> {
         match &self.model {
             ModelSource::Default => Ok(default_model.clone()),
             ModelSource::File(path) => {
@@ -275,10 +279,11 @@ impl Experiment {
                     path: path.clone(),
                     source,
                 })?;
-                text.parse::<toml::Table>().map_err(|e| ExperimentError::Parse {
-                    file: path.clone(),
-                    message: e.to_string(),
-                })
+                text.parse::<toml::Table>()
+                    .map_err(|e| ExperimentError::Parse {
+                        file: path.clone(),
+                        message: e.to_string(),
+                    })
             }
         }
     }
@@ -445,10 +450,16 @@ impl Validator<'_> {
             return Err(self.err("name", "must not be empty"));
         }
         if raw.replications < 1 || raw.replications > i64::from(u32::MAX) {
-            return Err(self.err("replications", format!("must be at least 1, got {}", raw.replications)));
+            return Err(self.err(
+                "replications",
+                format!("must be at least 1, got {}", raw.replications),
+            ));
         }
         if !(raw.confidence > 0.0 && raw.confidence < 1.0) {
-            return Err(self.err("confidence", format!("must be in (0, 1), got {}", raw.confidence)));
+            return Err(self.err(
+                "confidence",
+                format!("must be in (0, 1), got {}", raw.confidence),
+            ));
         }
         let model = if raw.model == "default" {
             ModelSource::Default
@@ -465,7 +476,10 @@ impl Validator<'_> {
         for (i, s) in raw.sweep.into_iter().enumerate() {
             let key = format!("sweep[{i}]");
             if s.key.split('.').any(|p| p.trim().is_empty()) {
-                return Err(self.err(format!("{key}.key"), format!("`{}` is not a dotted key", s.key)));
+                return Err(self.err(
+                    format!("{key}.key"),
+                    format!("`{}` is not a dotted key", s.key),
+                ));
             }
             if sweeps.iter().any(|o| o.key == s.key) {
                 return Err(self.err(format!("{key}.key"), format!("`{}` is swept twice", s.key)));
@@ -481,24 +495,29 @@ impl Validator<'_> {
                     }
                     Sweep::from_values(s.key, values)
                 }
-                (None, Some(r)) => expand_range(s.key, &r).map_err(|m| self.err(format!("{key}.range"), m))?,
+                (None, Some(r)) => {
+                    expand_range(s.key, &r).map_err(|m| self.err(format!("{key}.range"), m))?
+                }
             };
             sweeps.push(sweep);
         }
         let find_sweep = |k: &str| sweeps.iter().find(|s| s.key == k);
-        let filter = |key: &str, t: &toml::Table| -> Result<Vec<(String, toml::Value)>, ExperimentError> {
-            let mut flat = Vec::new();
-            flatten("", t, &mut flat);
-            for (k, v) in &flat {
-                let Some(s) = find_sweep(k) else {
-                    return Err(self.err(key, format!("`{k}` is not a sweep key")));
-                };
-                if !s.values.iter().any(|sv| values_match(sv, v)) {
-                    return Err(self.err(key, format!("`{k}` = {v} is not one of the swept values")));
+        let filter =
+            |key: &str, t: &toml::Table| -> Result<Vec<(String, toml::Value)>, ExperimentError> {
+                let mut flat = Vec::new();
+                flatten("", t, &mut flat);
+                for (k, v) in &flat {
+                    let Some(s) = find_sweep(k) else {
+                        return Err(self.err(key, format!("`{k}` is not a sweep key")));
+                    };
+                    if !s.values.iter().any(|sv| values_match(sv, v)) {
+                        return Err(
+                            self.err(key, format!("`{k}` = {v} is not one of the swept values"))
+                        );
+                    }
                 }
-            }
-            Ok(flat)
-        };
+                Ok(flat)
+            };
 
         let mut metrics: Vec<Metric> = Vec::new();
         for (i, m) in raw.metric.into_iter().enumerate() {
@@ -506,7 +525,10 @@ impl Validator<'_> {
                 return Err(self.err(format!("metric[{i}].path"), "must not be empty"));
             }
             if metrics.iter().any(|o| o.path == m.path) {
-                return Err(self.err(format!("metric[{i}].path"), format!("`{}` is listed twice", m.path)));
+                return Err(self.err(
+                    format!("metric[{i}].path"),
+                    format!("`{}` is listed twice", m.path),
+                ));
             }
             metrics.push(Metric {
                 label: m.label.unwrap_or_else(|| m.path.clone()),
@@ -520,18 +542,25 @@ impl Validator<'_> {
             if d.name.trim().is_empty() {
                 return Err(self.err(format!("derived[{i}].name"), "must not be empty"));
             }
-            if derived.iter().any(|o| o.name == d.name) || metrics.iter().any(|m| m.path == d.name) {
+            if derived.iter().any(|o| o.name == d.name) || metrics.iter().any(|m| m.path == d.name)
+            {
                 return Err(self.err(&key, format!("name `{}` is already used", d.name)));
             }
-            let need_column = || d.column.clone().ok_or_else(|| self.err(&key, format!("kind `{}` needs `column`", d.kind)));
+            let need_column = || {
+                d.column
+                    .clone()
+                    .ok_or_else(|| self.err(&key, format!("kind `{}` needs `column`", d.kind)))
+            };
             let need_ref = || -> Result<Vec<(String, toml::Value)>, ExperimentError> {
-                let r = d
-                    .reference
-                    .as_ref()
-                    .ok_or_else(|| self.err(&key, format!("kind `{}` needs `reference`", d.kind)))?;
+                let r = d.reference.as_ref().ok_or_else(|| {
+                    self.err(&key, format!("kind `{}` needs `reference`", d.kind))
+                })?;
                 let r = filter(&format!("{key}.reference"), r)?;
                 if r.is_empty() {
-                    return Err(self.err(format!("{key}.reference"), "must name at least one sweep key"));
+                    return Err(self.err(
+                        format!("{key}.reference"),
+                        "must name at least one sweep key",
+                    ));
                 }
                 Ok(r)
             };
@@ -541,20 +570,31 @@ impl Validator<'_> {
                     if !(level > 0.0 && level < 1.0) {
                         return Err(self.err(format!("{key}.level"), "must be in (0, 1)"));
                     }
-                    DerivedKind::IntervalWidth { column: need_column()?, level }
+                    DerivedKind::IntervalWidth {
+                        column: need_column()?,
+                        level,
+                    }
                 }
                 "quantile_width_from_min" => {
                     let level = d.level.ok_or_else(|| self.err(&key, "needs `level`"))?;
                     if !(level > 0.0 && level <= 1.0) {
                         return Err(self.err(format!("{key}.level"), "must be in (0, 1]"));
                     }
-                    DerivedKind::QuantileWidthFromMin { column: need_column()?, level }
+                    DerivedKind::QuantileWidthFromMin {
+                        column: need_column()?,
+                        level,
+                    }
                 }
                 "relative_error" => DerivedKind::RelativeError {
-                    path: d.path.clone().ok_or_else(|| self.err(&key, "kind `relative_error` needs `path`"))?,
+                    path: d
+                        .path
+                        .clone()
+                        .ok_or_else(|| self.err(&key, "kind `relative_error` needs `path`"))?,
                     reference: need_ref()?,
                 },
-                "speedup" => DerivedKind::Speedup { reference: need_ref()? },
+                "speedup" => DerivedKind::Speedup {
+                    reference: need_ref()?,
+                },
                 other => {
                     return Err(self.err(
                         format!("{key}.kind"),
@@ -570,30 +610,42 @@ impl Validator<'_> {
         let mut plots: Vec<PlotSpec> = Vec::new();
         for (i, p) in raw.plot.into_iter().enumerate() {
             let key = format!("plot[{i}] ({})", p.file);
-            if p.file.is_empty()
-                || p.file.contains(['/', '\\'])
-                || p.file == "."
-                || p.file == ".."
+            if p.file.is_empty() || p.file.contains(['/', '\\']) || p.file == "." || p.file == ".."
             {
-                return Err(self.err(format!("{key}.file"), "must be a plain file name without directory or extension"));
+                return Err(self.err(
+                    format!("{key}.file"),
+                    "must be a plain file name without directory or extension",
+                ));
             }
             if plots.iter().any(|o| o.file == p.file) {
                 return Err(self.err(format!("{key}.file"), "is used by two plots"));
             }
             let kind = match p.kind.as_str() {
                 "line" => {
-                    let x = p.x.clone().ok_or_else(|| self.err(&key, "kind `line` needs `x` (a sweep key)"))?;
+                    let x =
+                        p.x.clone()
+                            .ok_or_else(|| self.err(&key, "kind `line` needs `x` (a sweep key)"))?;
                     if find_sweep(&x).is_none() {
-                        return Err(self.err(format!("{key}.x"), format!("`{x}` is not a sweep key")));
+                        return Err(
+                            self.err(format!("{key}.x"), format!("`{x}` is not a sweep key"))
+                        );
                     }
                     let y = p.y.map(OneOrMany::into_vec).unwrap_or_default();
                     if y.is_empty() || y.iter().any(|s| s.trim().is_empty()) {
                         return Err(self.err(format!("{key}.y"), "needs one or more metric paths"));
                     }
-                    PlotKind::Line { x, y, log_x: p.log_x, log_y: p.log_y }
+                    PlotKind::Line {
+                        x,
+                        y,
+                        log_x: p.log_x,
+                        log_y: p.log_y,
+                    }
                 }
                 "histogram" => {
-                    let column = p.column.clone().ok_or_else(|| self.err(&key, "kind `histogram` needs `column`"))?;
+                    let column = p
+                        .column
+                        .clone()
+                        .ok_or_else(|| self.err(&key, "kind `histogram` needs `column`"))?;
                     let bins = p.bins.unwrap_or(50);
                     if !(1..=100_000).contains(&bins) {
                         return Err(self.err(format!("{key}.bins"), "must be between 1 and 100000"));
@@ -602,15 +654,31 @@ impl Validator<'_> {
                         Some(t) => filter(&format!("{key}.where"), t)?,
                         None => Vec::new(),
                     };
-                    PlotKind::Histogram { column, bins: bins as usize, filter: f }
+                    PlotKind::Histogram {
+                        column,
+                        bins: bins as usize,
+                        filter: f,
+                    }
                 }
                 "scatter" => {
-                    let x = p.x.clone().ok_or_else(|| self.err(&key, "kind `scatter` needs `x` (a metric path)"))?;
+                    let x = p.x.clone().ok_or_else(|| {
+                        self.err(&key, "kind `scatter` needs `x` (a metric path)")
+                    })?;
                     let y = match p.y.map(OneOrMany::into_vec) {
                         Some(v) if v.len() == 1 => v.into_iter().next().unwrap_or_default(),
-                        _ => return Err(self.err(format!("{key}.y"), "kind `scatter` needs exactly one `y` metric path")),
+                        _ => {
+                            return Err(self.err(
+                                format!("{key}.y"),
+                                "kind `scatter` needs exactly one `y` metric path",
+                            ));
+                        }
                     };
-                    PlotKind::Scatter { x, y, log_x: p.log_x, log_y: p.log_y }
+                    PlotKind::Scatter {
+                        x,
+                        y,
+                        log_x: p.log_x,
+                        log_y: p.log_y,
+                    }
                 }
                 other => {
                     return Err(self.err(
@@ -627,7 +695,13 @@ impl Validator<'_> {
                 PlotKind::Histogram { column, .. } => (column.clone(), "density".into()),
                 PlotKind::Scatter { x, y, .. } => (x.clone(), y.clone()),
             };
-            let label = |p: &str| metrics.iter().find(|m| m.path == p).map(|m| m.label.clone()).unwrap_or_else(|| p.to_string());
+            let label = |p: &str| {
+                metrics
+                    .iter()
+                    .find(|m| m.path == p)
+                    .map(|m| m.label.clone())
+                    .unwrap_or_else(|| p.to_string())
+            };
             plots.push(PlotSpec {
                 title: p.title.unwrap_or_else(|| raw.name.clone()),
                 x_label: p.x_label.unwrap_or_else(|| label(&dx)),
@@ -646,7 +720,11 @@ impl Validator<'_> {
             let tolerance = match (c.tolerance, c.rel_tolerance) {
                 (Some(t), None) => Tolerance::Absolute(t),
                 (None, Some(t)) => Tolerance::Relative(t),
-                _ => return Err(self.err(&key, "give exactly one of `tolerance` and `rel_tolerance`")),
+                _ => {
+                    return Err(
+                        self.err(&key, "give exactly one of `tolerance` and `rel_tolerance`")
+                    );
+                }
             };
             let (Tolerance::Absolute(t) | Tolerance::Relative(t)) = tolerance;
             if !(t >= 0.0 && t.is_finite()) {
@@ -684,7 +762,11 @@ impl Validator<'_> {
 /// Flatten nested tables into `(dotted key, value)` pairs, in table order.
 fn flatten(prefix: &str, t: &toml::Table, out: &mut Vec<(String, toml::Value)>) {
     for (k, v) in t {
-        let key = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
+        let key = if prefix.is_empty() {
+            k.clone()
+        } else {
+            format!("{prefix}.{k}")
+        };
         match v {
             toml::Value::Table(inner) => flatten(&key, inner, out),
             other => out.push((key, other.clone())),

@@ -49,8 +49,15 @@ pub(crate) fn widen(lo: f64, hi: f64, pad: f64) -> (f64, f64) {
 
 /// A compact tick label for an axis coordinate (`log` undoes `log10`).
 pub(crate) fn tick_label(v: f64, log: bool) -> String {
-    let v = if log { 10f64.powf(v) } else { v };
-    format_number(v)
+    if log {
+        // Two significant digits: 1, 1.6, 2.5, 4, 6.3, 10, ...
+        let x = 10f64.powf(v);
+        let magnitude = x.abs().log10().floor();
+        let scale = 10f64.powf(magnitude - 1.0);
+        format_number((x / scale).round() * scale)
+    } else {
+        format_number(v)
+    }
 }
 
 /// A compact human-readable number: plain with up to 4 decimals, or
@@ -108,5 +115,7 @@ mod tests {
         assert_eq!(format_number(10.0), "10");
         assert_eq!(format_number(1e-5), "1.00e-5");
         assert_eq!(tick_label(2.0, true), "100");
+        assert_eq!(tick_label(0.2, true), "1.6");
+        assert_eq!(tick_label(-0.8, true), "0.16");
     }
 }

@@ -4,6 +4,7 @@ use std::path::Path;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::PlotError;
 use super::axis::{omitted_note, padded_range, tick_label, to_axis};
@@ -47,8 +48,6 @@ fn draw<DB: DrawingBackend>(
 ) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let xr = padded_range(pts.iter().map(|p| p.1));
-    // Extra room on the right for labels.
-    let xr = (xr.0, xr.1 + (xr.1 - xr.0) * 0.1);
     let yr = padded_range(pts.iter().map(|p| p.2));
     let mut chart = ChartBuilder::on(root)
         .caption(&s.title, (FAMILY, 24))
@@ -70,12 +69,20 @@ fn draw<DB: DrawingBackend>(
         .y_label_formatter(&fy)
         .draw()
         .map_err(e)?;
+    // Labels of points in the right part of the plot go to their left.
+    let flip_at = xr.0 + (xr.1 - xr.0) * 0.6;
     chart
         .draw_series(pts.iter().map(|&(i, x, y)| {
             let c = color(i);
+            let (offset, h) = if x > flip_at {
+                ((-8, -8), HPos::Right)
+            } else {
+                ((8, -8), HPos::Left)
+            };
+            let font = TextStyle::from((FAMILY, 13).into_font()).pos(Pos::new(h, VPos::Bottom));
             EmptyElement::at((x, y))
                 + Circle::new((0, 0), 5, c.filled())
-                + Text::new(s.points[i].label.clone(), (8, -8), (FAMILY, 13).into_font())
+                + Text::new(s.points[i].label.clone(), offset, font)
         }))
         .map_err(e)?;
     draw_notes(root, notes)

@@ -28,7 +28,8 @@ pub struct MeanCi {
 /// The two-sided Student's t critical value for `level` (e.g. 0.95) and
 /// `df` degrees of freedom, or `None` when it is undefined.
 pub fn t_critical(level: f64, df: f64) -> Option<f64> {
-    if !(level > 0.0 && level < 1.0) || !(df > 0.0) || !df.is_finite() {
+    let valid = level > 0.0 && level < 1.0 && df > 0.0 && df.is_finite();
+    if !valid {
         return None;
     }
     let t = StudentsT::new(0.0, 1.0, df).ok()?;
