@@ -366,7 +366,7 @@ fn results_do_not_depend_on_scheduling() {
         .num_threads(1)
         .build()
         .unwrap();
-    pool.install(|| run_experiment(&exp, &base_model(), &Fake::default(), b.path(), false))
+    pool.install(|| run_experiment(&exp, &base_model(), &Fake::default(), b.path(), true))
         .unwrap();
     assert_eq!(read(a.path(), "points.csv"), read(b.path(), "points.csv"));
     assert_eq!(read(a.path(), "runs.csv"), read(b.path(), "runs.csv"));
