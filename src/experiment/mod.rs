@@ -1,1 +1,83 @@
-//! experiment
+//! Experiments: parameter sweeps over a model, replicated with several seeds,
+//! summarised with confidence intervals, checked against reference values,
+//! plotted and written up.
+//!
+//! An experiment file (`experiments/*.toml`) names a base model, fixed
+//! `[set]` overrides, `[[sweep]]`s whose cartesian product gives the points,
+//! `[[metric]]`s (dotted paths into each run's JSON summary), `[[plot]]`s,
+//! `[[derived]]` values and `[[check]]`s. [`load_experiment`] validates it;
+//! [`run_experiment`] runs every (point, seed) pair through a [`Runner`] in
+//! parallel and writes `runs.csv`, `points.csv`, the plots and `report.md`.
+//!
+//! The simulator is reached only through the [`Runner`] trait.
+//!
+//! # File format
+//!
+//! ```toml
+//! name = "vsync-quantization"
+//! description = "one paragraph shown in the report"
+//! model = "default"      # or a model file relative to this file
+//! replications = 5       # seeds per point (default 1)
+//! base_seed = 1          # seeds base_seed .. base_seed + replications - 1 (default 1)
+//! confidence = 0.95      # Student's t intervals (default 0.95)
+//! [set]                  # fixed overrides; nested tables flatten to dotted keys
+//! "workload.kind" = "fixed"
+//! [[sweep]]              # cartesian product in file order, first varies slowest
+//! key = "workload.gpu"
+//! range = { from = 10, to = 40, steps = 31, format = "{}ms" }   # or values = [...]
+//! [[sweep]]
+//! key = "display.buffers"
+//! values = [2, 3]
+//! [[metric]]
+//! path = "metrics.display_interval_ms.mean"
+//! label = "display interval (ms)"
+//! [[plot]]               # kind = "line" | "histogram" | "scatter"
+//! file = "interval"      # interval.svg + interval.png
+//! kind = "line"
+//! x = "workload.gpu"     # a sweep key; one series per value of the other keys
+//! y = ["metrics.display_interval_ms.mean"]   # metric paths or derived names
+//! # histogram: column = "FrameTime", bins = 80, optional where = { key = value }
+//! # scatter: x and y are metric paths or derived names; log_x / log_y
+//! [[derived]]            # interval_width | quantile_width_from_min | relative_error | speedup
+//! name = "c99"
+//! kind = "interval_width"
+//! column = "FrameTime"
+//! level = 0.99
+//! [[check]]
+//! path = "metrics.display_interval_ms.mean"   # or a derived name
+//! where = { "workload.gpu" = "17ms", "display.buffers" = 2 }
+//! expect = 33.333
+//! tolerance = 0.05       # absolute; or rel_tolerance = 0.01
+//! ```
+//!
+//! Outputs in the output directory: `runs.csv` (one row per point and seed),
+//! `points.csv` (per point: `<path>:mean`, `:ci_low`, `:ci_high`, `:n` for
+//! every tracked path, then derived values), `<file>.svg`/`.png` per plot,
+//! and `report.md`.
+
+mod check;
+mod derived;
+mod dotted;
+mod error;
+mod figures;
+mod report;
+mod run;
+mod runner;
+mod spec;
+mod sweep;
+mod tables;
+
+#[cfg(test)]
+mod tests;
+
+pub use check::CheckOutcome;
+pub use derived::{interval_width, quantile_width_from_min, relative_error, speedup};
+pub use dotted::{json_number, json_path, set_dotted};
+pub use error::ExperimentError;
+pub use run::{ExperimentResult, PathStat, PointResult, RunRecord, point_model, run_experiment};
+pub use runner::{FrameTable, RunOutput, Runner};
+pub use spec::{
+    Check, Derived, DerivedKind, Experiment, Metric, ModelSource, PlotKind, PlotSpec, Tolerance,
+    load_experiment, parse_experiment,
+};
+pub use sweep::{Point, Sweep, expand_points, numeric_coord, value_text, values_match};

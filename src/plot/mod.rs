@@ -1,1 +1,30 @@
-//! plot
+//! Plots written as SVG and PNG side by side.
+//!
+//! A small API shared by the experiment runner and other code:
+//! [`line_plot`], [`histogram`] and [`scatter`] each take a base path without
+//! extension and write `<base>.svg` and `<base>.png` (1024x640). Text is
+//! drawn with the embedded DejaVu Sans font, so no system fonts are needed.
+//!
+//! All plots tolerate awkward data: empty inputs, a single point and
+//! identical values (degenerate axis ranges are widened), and NaN or infinite
+//! values (dropped, with a note drawn on the plot). On log axes, values that
+//! are not positive are dropped in the same way.
+
+mod axis;
+mod error;
+mod font;
+mod histogram;
+mod line;
+mod output;
+mod palette;
+mod scatter;
+
+pub use error::PlotError;
+pub use histogram::{Histogram, histogram};
+pub use line::{LinePlot, Series, line_plot};
+pub use scatter::{Scatter, ScatterPoint, scatter};
+
+/// Width of written plots in pixels.
+pub const WIDTH: u32 = 1024;
+/// Height of written plots in pixels.
+pub const HEIGHT: u32 = 640;

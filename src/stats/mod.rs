@@ -1,2 +1,4 @@
 //! Statistics: summaries, quantiles, confidence intervals.
+
+pub mod ci;
 pub mod quantile;

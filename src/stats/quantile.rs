@@ -1,29 +1,150 @@
-//! PLACEHOLDER (replaced by the exp branch's version at merge).
-/// Summary.
-#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+//! Order-statistic summaries: count, mean, quantiles, extremes, spread.
+//!
+//! Quantiles use linear interpolation between order statistics, which is
+//! numpy's default (`method = "linear"`, type 7 of Hyndman and Fan).
+
+use serde::Serialize;
+
+/// A compact summary of a sample. Never contains NaN: an empty sample gives
+/// `count = 0` and every other field `0.0`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Summary {
-    /// n
+    /// Number of values used (NaN inputs are dropped).
     pub count: u64,
-    /// mean
+    /// Arithmetic mean.
     pub mean: f64,
-    /// p50
+    /// Median (0.5 quantile).
     pub p50: f64,
-    /// p99
+    /// 0.99 quantile.
     pub p99: f64,
-    /// min
+    /// Smallest value.
     pub min: f64,
-    /// max
+    /// Largest value.
     pub max: f64,
-    /// std
+    /// Sample standard deviation (divisor `n - 1`); `0.0` when `n < 2`.
     pub std: f64,
 }
+
 impl Summary {
-    /// of
-    pub fn of(v: &[f64]) -> Summary {
-        if v.is_empty() { return Summary::default(); }
-        let mut s = v.to_vec(); s.sort_by(|a, b| a.total_cmp(b));
-        let n = s.len() as f64; let mean = s.iter().sum::<f64>() / n;
-        let q = |p: f64| { let x = p * (n - 1.0); let i = x.floor() as usize; let j = (i + 1).min(s.len() - 1); s[i] + (s[j] - s[i]) * (x - i as f64) };
-        Summary { count: s.len() as u64, mean, p50: q(0.5), p99: q(0.99), min: s[0], max: s[s.len()-1], std: (s.iter().map(|x| (x-mean).powi(2)).sum::<f64>() / n).sqrt() }
+    /// Summarise `values`. NaN values are ignored; an empty (or all-NaN)
+    /// sample gives the all-zero summary with `count = 0`.
+    pub fn of(values: &[f64]) -> Summary {
+        let mut sorted: Vec<f64> = values.iter().copied().filter(|v| !v.is_nan()).collect();
+        if sorted.is_empty() {
+            return Summary {
+                count: 0,
+                mean: 0.0,
+                p50: 0.0,
+                p99: 0.0,
+                min: 0.0,
+                max: 0.0,
+                std: 0.0,
+            };
+        }
+        sorted.sort_by(f64::total_cmp);
+        let n = sorted.len();
+        let mean = sorted.iter().sum::<f64>() / n as f64;
+        let std = if n < 2 {
+            0.0
+        } else {
+            let ss: f64 = sorted.iter().map(|v| (v - mean) * (v - mean)).sum();
+            (ss / (n - 1) as f64).sqrt()
+        };
+        Summary {
+            count: n as u64,
+            mean,
+            p50: quantile(&sorted, 0.5),
+            p99: quantile(&sorted, 0.99),
+            min: sorted[0],
+            max: sorted[n - 1],
+            std,
+        }
+    }
+}
+
+/// The `q` quantile of an ascending-sorted slice, interpolating linearly
+/// between the order statistics at ranks `floor(h)` and `ceil(h)` with
+/// `h = (n - 1) * q` (numpy's default).
+///
+/// `q` is clamped to `[0, 1]` (a NaN `q` counts as 0). An empty slice gives
+/// `0.0`. The slice must already be sorted; this is not checked.
+pub fn quantile(sorted: &[f64], q: f64) -> f64 {
+    let n = sorted.len();
+    if n == 0 {
+        return 0.0;
+    }
+    let q = if q.is_nan() { 0.0 } else { q.clamp(0.0, 1.0) };
+    let h = (n - 1) as f64 * q;
+    let lo = h.floor() as usize;
+    let hi = (lo + 1).min(n - 1);
+    let frac = h - lo as f64;
+    let (a, b) = (sorted[lo], sorted[hi]);
+    if frac == 0.0 || a == b {
+        a
+    } else {
+        a + frac * (b - a)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() < 1e-9
+    }
+
+    #[test]
+    fn quantile_matches_numpy_linear() {
+        let s = [1.0, 2.0, 3.0, 4.0];
+        // numpy.quantile([1,2,3,4], [0, .25, .5, .9, 1]) = 1, 1.75, 2.5, 3.7, 4
+        assert!(close(quantile(&s, 0.0), 1.0));
+        assert!(close(quantile(&s, 0.25), 1.75));
+        assert!(close(quantile(&s, 0.5), 2.5));
+        assert!(close(quantile(&s, 0.9), 3.7));
+        assert!(close(quantile(&s, 1.0), 4.0));
+    }
+
+    #[test]
+    fn quantile_edge_cases() {
+        assert_eq!(quantile(&[], 0.5), 0.0);
+        assert_eq!(quantile(&[7.0], 0.99), 7.0);
+        assert_eq!(quantile(&[1.0, 2.0], -1.0), 1.0);
+        assert_eq!(quantile(&[1.0, 2.0], 2.0), 2.0);
+        assert_eq!(quantile(&[1.0, 2.0], f64::NAN), 1.0);
+    }
+
+    #[test]
+    fn summary_of_known_data() {
+        let v: Vec<f64> = (1..=100).map(f64::from).collect();
+        let s = Summary::of(&v);
+        assert_eq!(s.count, 100);
+        assert!(close(s.mean, 50.5));
+        assert!(close(s.p50, 50.5));
+        // numpy.quantile(range(1,101), .99) = 99.01
+        assert!(close(s.p99, 99.01));
+        assert_eq!((s.min, s.max), (1.0, 100.0));
+        // sample std of 1..=100 = sqrt(841.666..)
+        assert!(close(s.std, (100.0f64 * 101.0 / 12.0).sqrt()));
+    }
+
+    #[test]
+    fn summary_of_empty_is_zero_not_nan() {
+        let s = Summary::of(&[]);
+        assert_eq!(s.count, 0);
+        for f in [s.mean, s.p50, s.p99, s.min, s.max, s.std] {
+            assert_eq!(f, 0.0);
+        }
+        let s = Summary::of(&[f64::NAN]);
+        assert_eq!(s.count, 0);
+        assert_eq!(s.mean, 0.0);
+    }
+
+    #[test]
+    fn summary_unsorted_input_and_single_value() {
+        let s = Summary::of(&[3.0, 1.0, 2.0]);
+        assert_eq!((s.min, s.p50, s.max), (1.0, 2.0, 3.0));
+        let s = Summary::of(&[5.0]);
+        assert_eq!((s.count, s.mean, s.std, s.p99), (1, 5.0, 0.0, 5.0));
     }
 }

@@ -1,0 +1,72 @@
+//! Errors from loading and running experiments.
+
+use std::path::PathBuf;
+
+use crate::plot::PlotError;
+
+/// Why an experiment could not be loaded or run.
+#[derive(Debug, thiserror::Error)]
+pub enum ExperimentError {
+    /// A file could not be read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file concerned.
+        path: PathBuf,
+        /// The underlying I/O error.
+        source: std::io::Error,
+    },
+    /// A TOML file did not parse (syntax, unknown key, wrong type).
+    #[error("{}: {message}", file.display())]
+    Parse {
+        /// The file concerned.
+        file: PathBuf,
+        /// The parser's message (it names the key and line).
+        message: String,
+    },
+    /// An experiment file parsed but is not valid.
+    #[error("{}: `{key}`: {message}", file.display())]
+    Invalid {
+        /// The experiment file.
+        file: PathBuf,
+        /// Which entry is wrong, e.g. `sweep[1].range`.
+        key: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// A dotted-key patch could not be applied to a model.
+    #[error("cannot set `{key}`: {message}")]
+    Patch {
+        /// The dotted key.
+        key: String,
+        /// Why it could not be set.
+        message: String,
+    },
+    /// The simulator failed for one run, or its output lacked something.
+    #[error("run failed at point {point} ({label}), seed {seed}: {message}")]
+    Run {
+        /// Index of the point (0-based, in expansion order).
+        point: usize,
+        /// The point's sweep assignments, e.g. `workload.gpu=17ms, display.buffers=2`.
+        label: String,
+        /// The seed of the failed run.
+        seed: u64,
+        /// The runner's message.
+        message: String,
+    },
+    /// A CSV output file could not be written.
+    #[error("writing {}: {message}", path.display())]
+    Csv {
+        /// The CSV file.
+        path: PathBuf,
+        /// The writer's message.
+        message: String,
+    },
+    /// A plot could not be written.
+    #[error("plot `{file}`: {source}")]
+    Plot {
+        /// The plot's `file` name from the experiment.
+        file: String,
+        /// The plotting error.
+        source: PlotError,
+    },
+}

@@ -1,0 +1,242 @@
+//! `report.md`: setup, per-metric tables, derived values, checks, timing
+//! and links to the plots.
+
+use std::fmt::Write;
+
+use crate::stats::ci::MeanCi;
+
+use super::run::ExperimentResult;
+use super::spec::{DerivedKind, Experiment, ModelSource, PlotKind};
+use super::sweep::value_text;
+
+/// A number with about four significant digits.
+pub(crate) fn fmt_num(v: f64) -> String {
+    if !v.is_finite() {
+        return v.to_string();
+    }
+    if v == 0.0 {
+        return "0".into();
+    }
+    let a = v.abs();
+    if !(1e-3..1e6).contains(&a) {
+        return format!("{v:.3e}");
+    }
+    let digits = (3 - a.log10().floor() as i32).clamp(0, 6) as usize;
+    format!("{v:.digits$}")
+}
+
+/// A number with up to six significant digits, for checks.
+pub(crate) fn fmt_precise(v: f64) -> String {
+    if !v.is_finite() || v == 0.0 {
+        return fmt_num(v);
+    }
+    let a = v.abs();
+    if !(1e-3..1e9).contains(&a) {
+        return format!("{v:.5e}");
+    }
+    let digits = (5 - a.log10().floor() as i32).clamp(0, 8) as usize;
+    let s = format!("{v:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// `mean ± half-width` (just the mean when no interval exists).
+pub(crate) fn mean_pm(c: &MeanCi) -> String {
+    if c.n == 0 {
+        "n/a".into()
+    } else if c.has_interval {
+        format!("{} ± {}", fmt_num(c.mean), fmt_num(c.half_width))
+    } else {
+        format!("{} (n={})", fmt_num(c.mean), c.n)
+    }
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map(fmt_num).unwrap_or_else(|| "n/a".into())
+}
+
+fn filter_text(f: &[(String, toml::Value)]) -> String {
+    f.iter()
+        .map(|(k, v)| format!("{k}={}", value_text(v)))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Escape `|` so text fits in a Markdown table cell.
+fn cell(s: &str) -> String {
+    s.replace('|', "\\|")
+}
+
+/// Render the report of a finished experiment.
+pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# {}\n", exp.name);
+    if !exp.description.trim().is_empty() {
+        let _ = writeln!(s, "{}\n", exp.description.trim());
+    }
+
+    let _ = writeln!(s, "## Setup\n");
+    let model = match &exp.model {
+        ModelSource::Default => "the embedded default model".to_string(),
+        ModelSource::File(p) => format!("`{}`", p.display()),
+    };
+    let _ = writeln!(s, "- model: {model}");
+    let seeds = exp.seeds();
+    let _ = writeln!(
+        s,
+        "- replications: {} per point (seeds {}..={})",
+        exp.replications,
+        seeds.first().copied().unwrap_or(exp.base_seed),
+        seeds.last().copied().unwrap_or(exp.base_seed)
+    );
+    let _ = writeln!(s, "- confidence: {}% (Student's t)", exp.confidence * 100.0);
+    let _ = writeln!(s, "- points: {}, runs: {}", r.points.len(), r.runs.len());
+    if !exp.set.is_empty() {
+        let _ = writeln!(s, "\nFixed settings:\n\n| key | value |\n|---|---|");
+        for (k, v) in &exp.set {
+            let _ = writeln!(s, "| `{k}` | {} |", cell(&v.to_string()));
+        }
+    }
+    if !exp.sweeps.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nSweeps (cartesian product, first varies slowest):\n\n| key | values |\n|---|---|"
+        );
+        for sw in &exp.sweeps {
+            let vals: Vec<String> = sw.values.iter().map(value_text).collect();
+            let _ = writeln!(s, "| `{}` | {} |", sw.key, cell(&vals.join(", ")));
+        }
+    }
+
+    let keys: Vec<&str> = exp.sweeps.iter().map(|s| s.key.as_str()).collect();
+    let head = |extra: &[String]| {
+        let cols: Vec<String> = keys
+            .iter()
+            .map(|k| format!("`{k}`"))
+            .chain(extra.iter().cloned())
+            .collect();
+        let cols = if cols.is_empty() {
+            vec!["point".to_string()]
+        } else {
+            cols
+        };
+        format!("| {} |\n|{}\n", cols.join(" | "), "---|".repeat(cols.len()))
+    };
+    let key_cells = |p: &super::run::PointResult| -> Vec<String> {
+        if p.assignments.is_empty() {
+            vec![cell(&p.label)]
+        } else {
+            p.assignments.iter().map(|(_, v)| cell(v)).collect()
+        }
+    };
+
+    let _ = writeln!(s, "\n## Results\n");
+    let level = format!("{}%", exp.confidence * 100.0);
+    for m in &exp.metrics {
+        let _ = writeln!(s, "### {} (`{}`)\n", m.label, m.path);
+        s.push_str(&head(&[format!("mean ± {level} CI"), "n".into()]));
+        for p in &r.points {
+            let mut row = key_cells(p);
+            match p.stat(&m.path) {
+                Some(c) => {
+                    row.push(mean_pm(c));
+                    row.push(c.n.to_string());
+                }
+                None => row.extend(["n/a".to_string(), "0".to_string()]),
+            }
+            let _ = writeln!(s, "| {} |", row.join(" | "));
+        }
+        s.push('\n');
+    }
+
+    if !exp.derived.is_empty() {
+        let _ = writeln!(s, "## Derived values\n");
+        for d in &exp.derived {
+            let what = match &d.kind {
+                DerivedKind::IntervalWidth { column, level } => format!(
+                    "width of the central {}% interval of per-frame `{column}` (pooled over replications)",
+                    level * 100.0
+                ),
+                DerivedKind::QuantileWidthFromMin { column, level } => format!(
+                    "{}% quantile minus minimum of per-frame `{column}` (pooled over replications)",
+                    level * 100.0
+                ),
+                DerivedKind::RelativeError { path, reference } => format!(
+                    "|mean `{path}` − reference| / |reference|, reference at {}",
+                    filter_text(reference)
+                ),
+                DerivedKind::Speedup { reference } => format!(
+                    "reference `wall_seconds` / this `wall_seconds`, reference at {}",
+                    filter_text(reference)
+                ),
+            };
+            let _ = writeln!(s, "- `{}`: {what}", d.name);
+        }
+        s.push('\n');
+        let names: Vec<String> = exp
+            .derived
+            .iter()
+            .map(|d| format!("`{}`", d.name))
+            .collect();
+        s.push_str(&head(&names));
+        for p in &r.points {
+            let mut row = key_cells(p);
+            row.extend(p.derived.iter().map(|d| opt(d.1)));
+            let _ = writeln!(s, "| {} |", row.join(" | "));
+        }
+        s.push('\n');
+    }
+
+    if !r.checks.is_empty() {
+        let _ = writeln!(
+            s,
+            "## Checks\n\n{} of {} passed.\n\n| value | point | measured | expected | tolerance | result |\n|---|---|---|---|---|---|",
+            r.checks.len() - r.checks_failed,
+            r.checks.len()
+        );
+        for c in &r.checks {
+            let _ = writeln!(
+                s,
+                "| `{}` | {} | {} | {} | {} | {} |",
+                c.path,
+                cell(&c.point),
+                c.measured.map(fmt_precise).unwrap_or_else(|| "n/a".into()),
+                fmt_precise(c.expect),
+                c.tolerance_text,
+                if c.passed { "PASS" } else { "**FAIL**" }
+            );
+        }
+        s.push('\n');
+    }
+
+    let _ = writeln!(s, "## Timing\n");
+    let _ = writeln!(s, "- experiment wall time: {:.3} s", r.wall_seconds);
+    let _ = writeln!(
+        s,
+        "- summed simulation wall time: {:.3} s over {} runs\n",
+        r.sim_wall_seconds,
+        r.runs.len()
+    );
+
+    if !exp.plots.is_empty() {
+        let _ = writeln!(s, "## Plots\n");
+        for p in &exp.plots {
+            let kind = match p.kind {
+                PlotKind::Line { .. } => "line",
+                PlotKind::Histogram { .. } => "histogram",
+                PlotKind::Scatter { .. } => "scatter",
+            };
+            let _ = writeln!(
+                s,
+                "### {}\n\n![{}]({f}.svg)\n\n{kind} plot: [{f}.svg]({f}.svg), [{f}.png]({f}.png)\n",
+                p.title,
+                p.title,
+                f = p.file
+            );
+        }
+    }
+    s
+}

@@ -1,0 +1,410 @@
+//! Running an experiment: patch the model per point, run every (point,
+//! seed) job in parallel, aggregate, and write CSVs, plots and the report.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::stats::ci::{MeanCi, mean_ci};
+
+use super::check::{CheckOutcome, evaluate};
+use super::derived::{DerivedInputs, compute};
+use super::dotted::{json_number, set_dotted};
+use super::runner::Runner;
+use super::spec::Experiment;
+use super::sweep::{Point, expand_points};
+use super::{ExperimentError, figures, report, tables};
+
+/// The numbers read from one run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunRecord {
+    /// Point index.
+    pub point: usize,
+    /// Seed.
+    pub seed: u64,
+    /// One value per [`Experiment::tracked_paths`] entry (`None`: JSON null).
+    pub values: Vec<Option<f64>>,
+    /// The summary's `wall_seconds`, or the measured call time if absent.
+    pub wall_seconds: f64,
+}
+
+/// Replication statistics of one summary path at one point.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PathStat {
+    /// Dotted summary path.
+    pub path: String,
+    /// Mean and confidence interval over the replications.
+    pub ci: MeanCi,
+}
+
+/// Aggregated results of one point.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PointResult {
+    /// Position in expansion order.
+    pub index: usize,
+    /// `key=value, ...` label.
+    pub label: String,
+    /// `(sweep key, value as text)` pairs.
+    pub assignments: Vec<(String, String)>,
+    /// One entry per tracked path.
+    pub stats: Vec<PathStat>,
+    /// `(name, value)` per derived value (`None`: undefined here).
+    pub derived: Vec<(String, Option<f64>)>,
+}
+
+impl PointResult {
+    /// The replication statistics of `path`, if tracked.
+    pub fn stat(&self, path: &str) -> Option<&MeanCi> {
+        self.stats.iter().find(|s| s.path == path).map(|s| &s.ci)
+    }
+
+    /// The replication mean of `path` (`None` if untracked or no values).
+    pub fn mean(&self, path: &str) -> Option<f64> {
+        self.stat(path).filter(|c| c.n > 0).map(|c| c.mean)
+    }
+
+    /// A derived value by name.
+    pub fn derived_value(&self, name: &str) -> Option<f64> {
+        self.derived.iter().find(|d| d.0 == name).and_then(|d| d.1)
+    }
+
+    /// A derived value if `name` is one, else the mean of the path `name`.
+    pub fn value(&self, name: &str) -> Option<f64> {
+        if self.derived.iter().any(|d| d.0 == name) {
+            self.derived_value(name)
+        } else {
+            self.mean(name)
+        }
+    }
+}
+
+/// Everything an experiment produced.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ExperimentResult {
+    /// Experiment name.
+    pub name: String,
+    /// The summary paths tracked, in the order of `PointResult::stats`.
+    pub paths: Vec<String>,
+    /// Per-point aggregates, in point order.
+    pub points: Vec<PointResult>,
+    /// Every run, sorted by point then seed.
+    pub runs: Vec<RunRecord>,
+    /// Check outcomes, in file order (one per matching point).
+    pub checks: Vec<CheckOutcome>,
+    /// How many checks failed.
+    pub checks_failed: usize,
+    /// Wall time of the whole experiment, in seconds.
+    pub wall_seconds: f64,
+    /// Sum of the runs' `wall_seconds`.
+    pub sim_wall_seconds: f64,
+    /// Files written, relative to the output directory.
+    pub files: Vec<PathBuf>,
+}
+
+impl ExperimentResult {
+    /// A short plain-text table: one line per point with each metric's mean
+    /// and half-width, then the check tally.
+    pub fn table(&self, exp: &Experiment) -> String {
+        let mut out = String::new();
+        for p in &self.points {
+            let cells: Vec<String> = exp
+                .metrics
+                .iter()
+                .map(|m| match p.stat(&m.path) {
+                    Some(c) => format!("{} = {}", m.label, report::mean_pm(c)),
+                    None => format!("{} = n/a", m.label),
+                })
+                .collect();
+            out.push_str(&format!("{}: {}\n", p.label, cells.join("; ")));
+        }
+        if !self.checks.is_empty() {
+            out.push_str(&format!(
+                "checks: {} passed, {} failed\n",
+                self.checks.len() - self.checks_failed,
+                self.checks_failed
+            ));
+        }
+        out
+    }
+}
+
+/// What one job returns.
+struct JobOutput {
+    record: RunRecord,
+    /// Frame columns in `Experiment::frame_columns` order.
+    frames: Vec<Vec<f64>>,
+}
+
+/// The model for `point`: `base` with `[set]` then the point's sweep values applied.
+pub fn point_model(
+    exp: &Experiment,
+    base: &toml::Table,
+    point: &Point,
+) -> Result<toml::Table, ExperimentError> {
+    let mut model = base.clone();
+    for (k, v) in exp.set.iter().chain(&point.assignments) {
+        set_dotted(&mut model, k, v.clone())?;
+    }
+    Ok(model)
+}
+
+/// Run `exp` on `base_model` through `runner`, writing `runs.csv`,
+/// `points.csv`, the plots and `report.md` into `out_dir` (created if needed).
+///
+/// Jobs run in parallel; results are ordered by point and seed, so output
+/// files do not depend on thread scheduling. If a run fails, the runs that
+/// finished are still written to `runs.csv` and the first failure (in point,
+/// seed order) is returned, naming the point and seed.
+pub fn run_experiment(
+    exp: &Experiment,
+    base_model: &toml::Table,
+    runner: &dyn Runner,
+    out_dir: &Path,
+    progress: bool,
+) -> Result<ExperimentResult, ExperimentError> {
+    let started = Instant::now();
+    let points = expand_points(exp);
+    let paths = exp.tracked_paths();
+    let columns = exp.frame_columns();
+    let want_frames = !columns.is_empty();
+    let models = points
+        .iter()
+        .map(|p| point_model(exp, base_model, p))
+        .collect::<Result<Vec<_>, _>>()?;
+    std::fs::create_dir_all(out_dir).map_err(|source| ExperimentError::Io {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+
+    let seeds = exp.seeds();
+    let jobs: Vec<(usize, u64)> = points
+        .iter()
+        .flat_map(|p| seeds.iter().map(move |&s| (p.index, s)))
+        .collect();
+    let bar = progress_bar(jobs.len() as u64, progress);
+    let results: Vec<Result<JobOutput, ExperimentError>> = jobs
+        .par_iter()
+        .map(|&(pi, seed)| {
+            let r = run_job(
+                runner,
+                &models[pi],
+                &points[pi],
+                seed,
+                &paths,
+                &columns,
+                want_frames,
+            );
+            bar.inc(1);
+            r
+        })
+        .collect();
+    bar.finish_and_clear();
+
+    let mut outputs = Vec::with_capacity(results.len());
+    let mut first_error = None;
+    for r in results {
+        match r {
+            Ok(o) => outputs.push(o),
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    let runs: Vec<RunRecord> = outputs.iter().map(|o| o.record.clone()).collect();
+    tables::write_runs(&out_dir.join("runs.csv"), exp, &points, &paths, &runs)?;
+    if let Some(e) = first_error {
+        return Err(e);
+    }
+
+    // Aggregate per point (jobs are in point, seed order).
+    let n_paths = paths.len();
+    let mut point_stats: Vec<Vec<MeanCi>> = Vec::with_capacity(points.len());
+    let mut pooled: Vec<Vec<Vec<f64>>> = vec![vec![Vec::new(); columns.len()]; points.len()];
+    for p in &points {
+        let mine: Vec<&JobOutput> = outputs
+            .iter()
+            .filter(|o| o.record.point == p.index)
+            .collect();
+        let stats = (0..n_paths)
+            .map(|k| {
+                let vals: Vec<f64> = mine.iter().filter_map(|o| o.record.values[k]).collect();
+                mean_ci(&vals, exp.confidence)
+            })
+            .collect();
+        point_stats.push(stats);
+        for o in &mine {
+            for (c, col) in o.frames.iter().enumerate() {
+                pooled[p.index][c].extend_from_slice(col);
+            }
+        }
+    }
+    let means: Vec<Vec<Option<f64>>> = point_stats
+        .iter()
+        .map(|s| s.iter().map(|c| (c.n > 0).then_some(c.mean)).collect())
+        .collect();
+    let derived = compute(
+        exp,
+        &DerivedInputs {
+            points: &points,
+            means: &means,
+            paths: &paths,
+            frames: &pooled,
+            frame_columns: &columns,
+        },
+    );
+    let point_results: Vec<PointResult> = points
+        .iter()
+        .map(|p| PointResult {
+            index: p.index,
+            label: p.label(),
+            assignments: p
+                .assignments
+                .iter()
+                .map(|(k, v)| (k.clone(), super::sweep::value_text(v)))
+                .collect(),
+            stats: paths
+                .iter()
+                .zip(&point_stats[p.index])
+                .map(|(path, ci)| PathStat {
+                    path: path.clone(),
+                    ci: *ci,
+                })
+                .collect(),
+            derived: exp
+                .derived
+                .iter()
+                .zip(&derived[p.index])
+                .map(|(d, v)| (d.name.clone(), *v))
+                .collect(),
+        })
+        .collect();
+    let mut files = vec![PathBuf::from("runs.csv")];
+    tables::write_points(&out_dir.join("points.csv"), exp, &points, &point_results)?;
+    files.push(PathBuf::from("points.csv"));
+
+    let mut checks = Vec::new();
+    for c in &exp.checks {
+        for p in points.iter().filter(|p| p.matches(&c.filter)) {
+            let pr = &point_results[p.index];
+            checks.push(evaluate(
+                &c.path,
+                &pr.label,
+                pr.value(&c.path),
+                c.expect,
+                c.tolerance,
+            ));
+        }
+    }
+    let checks_failed = checks.iter().filter(|c| !c.passed).count();
+
+    for plot in &exp.plots {
+        figures::draw(
+            exp,
+            plot,
+            &points,
+            &point_results,
+            &pooled,
+            &columns,
+            out_dir,
+        )
+        .map_err(|source| ExperimentError::Plot {
+            file: plot.file.clone(),
+            source,
+        })?;
+        files.push(PathBuf::from(format!("{}.svg", plot.file)));
+        files.push(PathBuf::from(format!("{}.png", plot.file)));
+    }
+
+    let mut result = ExperimentResult {
+        name: exp.name.clone(),
+        paths,
+        points: point_results,
+        sim_wall_seconds: runs.iter().map(|r| r.wall_seconds).sum(),
+        runs,
+        checks,
+        checks_failed,
+        wall_seconds: 0.0,
+        files,
+    };
+    result.wall_seconds = started.elapsed().as_secs_f64();
+    let report_path = out_dir.join("report.md");
+    std::fs::write(&report_path, report::render(exp, &result)).map_err(|source| {
+        ExperimentError::Io {
+            path: report_path,
+            source,
+        }
+    })?;
+    result.files.push(PathBuf::from("report.md"));
+    Ok(result)
+}
+
+fn progress_bar(len: u64, show: bool) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    if let Ok(style) = ProgressStyle::with_template(
+        "{bar:40} {pos}/{len} runs [{elapsed_precise} < {eta_precise}]",
+    ) {
+        bar.set_style(style);
+    }
+    bar
+}
+
+fn run_job(
+    runner: &dyn Runner,
+    model: &toml::Table,
+    point: &Point,
+    seed: u64,
+    paths: &[String],
+    columns: &[String],
+    want_frames: bool,
+) -> Result<JobOutput, ExperimentError> {
+    let fail = |message: String| ExperimentError::Run {
+        point: point.index,
+        label: point.label(),
+        seed,
+        message,
+    };
+    let t0 = Instant::now();
+    let out = runner.run(model, seed, want_frames).map_err(fail)?;
+    let measured = t0.elapsed().as_secs_f64();
+    let wall_seconds = match json_number(&out.summary, "wall_seconds") {
+        Ok(Some(w)) => w,
+        _ => measured,
+    };
+    let values = paths
+        .iter()
+        .map(|p| match json_number(&out.summary, p) {
+            Err(_) if p == "wall_seconds" => Ok(Some(wall_seconds)),
+            r => r,
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(fail)?;
+    let mut frames = Vec::with_capacity(columns.len());
+    if want_frames {
+        let table = out.frames.as_ref().ok_or_else(|| {
+            fail("the runner returned no per-frame data although it was requested".into())
+        })?;
+        for c in columns {
+            frames.push(table.column(c).ok_or_else(|| {
+                fail(format!(
+                    "frame column `{c}` not found (columns: {})",
+                    table.columns.join(", ")
+                ))
+            })?);
+        }
+    }
+    Ok(JobOutput {
+        record: RunRecord {
+            point: point.index,
+            seed,
+            values,
+            wall_seconds,
+        },
+        frames,
+    })
+}

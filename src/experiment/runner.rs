@@ -1,0 +1,39 @@
+//! The interface through which experiments reach the simulator.
+
+/// Runs the simulator for one fully patched model and one seed.
+///
+/// Implemented by the simulator crate layer; experiments call it from several
+/// threads at once, hence `Sync`.
+pub trait Runner: Sync {
+    /// Run one model (a fully patched TOML table) with one seed. `want_frames`
+    /// asks for per-frame columns too.
+    fn run(&self, model: &toml::Table, seed: u64, want_frames: bool) -> Result<RunOutput, String>;
+}
+
+/// What one run produced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOutput {
+    /// The run summary, e.g. `{"seed": 1, "wall_seconds": 0.01, "metrics": {...}}`;
+    /// metrics are addressed by dotted paths into it.
+    pub summary: serde_json::Value,
+    /// Per-frame data, present when requested.
+    pub frames: Option<FrameTable>,
+}
+
+/// Per-frame data: named columns, one row per frame.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FrameTable {
+    /// Column names, e.g. `FrameTime`.
+    pub columns: Vec<String>,
+    /// Rows, each with one value per column.
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl FrameTable {
+    /// The values of column `name`, or `None` if there is no such column.
+    /// Rows too short to hold the column are skipped.
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let i = self.columns.iter().position(|c| c == name)?;
+        Some(self.rows.iter().filter_map(|r| r.get(i).copied()).collect())
+    }
+}

@@ -1,0 +1,197 @@
+//! Sweeps and their expansion into experiment points.
+
+use super::Experiment;
+use super::spec::RawRange;
+
+/// One swept key and the values it takes, in order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sweep {
+    /// Dotted model key.
+    pub key: String,
+    /// The values written into the model.
+    pub values: Vec<toml::Value>,
+    /// A numeric x coordinate per value, for line plots: the number itself,
+    /// the range number before formatting, the leading number of a string
+    /// such as `"12ms"`, or else the value's index.
+    pub coords: Vec<f64>,
+}
+
+impl Sweep {
+    /// A sweep over explicit `values`.
+    pub fn from_values(key: String, values: Vec<toml::Value>) -> Sweep {
+        let coords = values
+            .iter()
+            .enumerate()
+            .map(|(i, v)| numeric_coord(v).unwrap_or(i as f64))
+            .collect();
+        Sweep {
+            key,
+            values,
+            coords,
+        }
+    }
+}
+
+/// The number a sweep value stands for: integers and floats as such, and the
+/// leading decimal number of a string (`"12.5ms"` -> 12.5).
+pub fn numeric_coord(v: &toml::Value) -> Option<f64> {
+    match v {
+        toml::Value::Integer(i) => Some(*i as f64),
+        toml::Value::Float(f) if f.is_finite() => Some(*f),
+        toml::Value::String(s) => {
+            let s = s.trim();
+            let end = s
+                .char_indices()
+                .take_while(|&(i, c)| {
+                    c.is_ascii_digit() || c == '.' || ((c == '-' || c == '+') && i == 0)
+                })
+                .map(|(i, c)| i + c.len_utf8())
+                .last()?;
+            s[..end].parse::<f64>().ok().filter(|f| f.is_finite())
+        }
+        _ => None,
+    }
+}
+
+/// Whether a sweep value matches a filter value: numbers compare by value
+/// (`2` matches `2.0`), everything else by equality.
+pub fn values_match(a: &toml::Value, b: &toml::Value) -> bool {
+    let num = |v: &toml::Value| match v {
+        toml::Value::Integer(i) => Some(*i as f64),
+        toml::Value::Float(f) => Some(*f),
+        _ => None,
+    };
+    match (num(a), num(b)) {
+        (Some(x), Some(y)) => x == y,
+        _ => a == b,
+    }
+}
+
+/// A value as shown in CSV cells, labels and the report: strings without
+/// quotes, everything else in TOML syntax.
+pub fn value_text(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => s.clone(),
+        toml::Value::Float(f) => format_range_number(*f),
+        other => other.to_string(),
+    }
+}
+
+/// A range number as text: up to 9 decimals, trailing zeros removed, so that
+/// `10.000000000000002` prints as `10`.
+pub fn format_range_number(x: f64) -> String {
+    let s = format!("{x:.9}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.to_string() }
+}
+
+/// Expand `range = { from, to, steps, format }` into a sweep: `steps`
+/// evenly spaced numbers from `from` to `to` inclusive. With `format`, each
+/// number replaces the `{}` in it and the value is a string; without, the
+/// value is the number (an integer when `from` and `to` are integers and
+/// every step lands on an integer).
+pub(crate) fn expand_range(key: String, r: &RawRange) -> Result<Sweep, String> {
+    let num = |v: &toml::Value, name: &str| match v {
+        toml::Value::Integer(i) => Ok((*i as f64, true)),
+        toml::Value::Float(f) if f.is_finite() => Ok((*f, false)),
+        other => Err(format!("`{name}` must be a number, got {other}")),
+    };
+    let (from, from_int) = num(&r.from, "from")?;
+    let (to, to_int) = num(&r.to, "to")?;
+    if r.steps < 1 || r.steps > 1_000_000 {
+        return Err(format!(
+            "`steps` must be between 1 and 1000000, got {}",
+            r.steps
+        ));
+    }
+    if let Some(f) = &r.format
+        && !f.contains("{}")
+    {
+        return Err(format!("`format` must contain `{{}}`, got \"{f}\""));
+    }
+    let steps = r.steps as usize;
+    let numbers: Vec<f64> = (0..steps)
+        .map(|i| {
+            if steps == 1 {
+                from
+            } else {
+                from + (to - from) * i as f64 / (steps - 1) as f64
+            }
+        })
+        .collect();
+    let integral = from_int && to_int && numbers.iter().all(|x| (x - x.round()).abs() < 1e-9);
+    let values = numbers
+        .iter()
+        .map(|&x| match &r.format {
+            Some(f) => toml::Value::String(f.replacen("{}", &format_range_number(x), 1)),
+            None if integral => toml::Value::Integer(x.round() as i64),
+            None => toml::Value::Float(x),
+        })
+        .collect();
+    Ok(Sweep {
+        key,
+        values,
+        coords: numbers,
+    })
+}
+
+/// One combination of sweep values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// Position in expansion order (0-based).
+    pub index: usize,
+    /// `(sweep key, value)` for every sweep, in file order.
+    pub assignments: Vec<(String, toml::Value)>,
+    /// Index into each sweep's values.
+    pub value_indices: Vec<usize>,
+}
+
+impl Point {
+    /// `key=value, key=value` (or `(single point)` with no sweeps).
+    pub fn label(&self) -> String {
+        if self.assignments.is_empty() {
+            return "(single point)".into();
+        }
+        self.assignments
+            .iter()
+            .map(|(k, v)| format!("{k}={}", value_text(v)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// Whether the point satisfies every `key = value` of `filter`.
+    pub fn matches(&self, filter: &[(String, toml::Value)]) -> bool {
+        filter.iter().all(|(k, v)| {
+            self.assignments
+                .iter()
+                .any(|(pk, pv)| pk == k && values_match(pv, v))
+        })
+    }
+}
+
+/// The cartesian product of all sweeps in file order, the first sweep
+/// varying slowest. No sweeps give one point.
+pub fn expand_points(exp: &Experiment) -> Vec<Point> {
+    let total: usize = exp.sweeps.iter().map(|s| s.values.len()).product();
+    (0..total)
+        .map(|index| {
+            let mut rem = index;
+            let mut value_indices = vec![0; exp.sweeps.len()];
+            for (i, s) in exp.sweeps.iter().enumerate().rev() {
+                value_indices[i] = rem % s.values.len();
+                rem /= s.values.len();
+            }
+            let assignments = exp
+                .sweeps
+                .iter()
+                .zip(&value_indices)
+                .map(|(s, &vi)| (s.key.clone(), s.values[vi].clone()))
+                .collect();
+            Point {
+                index,
+                assignments,
+                value_indices,
+            }
+        })
+        .collect()
+}

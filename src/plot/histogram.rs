@@ -1,0 +1,233 @@
+//! Density histograms of one or more groups of values over shared bins.
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::PlotError;
+use super::axis::{omitted_note, tick_label, widen};
+use super::font::FAMILY;
+use super::output::{draw_notes, render_both};
+use super::palette::color;
+
+/// A histogram description: each group gets its own colour; all groups share
+/// the same bins; the y axis is probability density (each group integrates
+/// to 1).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Histogram {
+    /// Title above the plot.
+    pub title: String,
+    /// X axis description (the y axis is "density").
+    pub x_label: String,
+    /// `(group name, values)` pairs.
+    pub values: Vec<(String, Vec<f64>)>,
+    /// Number of bins (0 is treated as 1).
+    pub bins: usize,
+}
+
+/// Binned groups: shared edges and per-group densities.
+struct Binned {
+    lo: f64,
+    width: f64,
+    groups: Vec<(String, Vec<f64>)>,
+}
+
+fn bin(h: &Histogram) -> (Binned, usize) {
+    let bins = h.bins.max(1);
+    let mut dropped = 0;
+    let finite: Vec<(String, Vec<f64>)> = h
+        .values
+        .iter()
+        .map(|(name, v)| {
+            let f: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+            dropped += v.len() - f.len();
+            (name.clone(), f)
+        })
+        .collect();
+    let all = finite.iter().flat_map(|g| g.1.iter().copied());
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in all {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if !lo.is_finite() {
+        (lo, hi) = (0.0, 1.0);
+    } else if hi <= lo {
+        (lo, hi) = widen(lo, hi, 0.0);
+    }
+    let width = (hi - lo) / bins as f64;
+    let groups = finite
+        .into_iter()
+        .map(|(name, v)| {
+            let mut counts = vec![0u64; bins];
+            for x in &v {
+                let i = (((x - lo) / width) as usize).min(bins - 1);
+                counts[i] += 1;
+            }
+            let n = v.len().max(1) as f64;
+            (
+                name,
+                counts.iter().map(|&c| c as f64 / (n * width)).collect(),
+            )
+        })
+        .collect();
+    (Binned { lo, width, groups }, dropped)
+}
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    h: &Histogram,
+    b: &Binned,
+    notes: &[String],
+) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let bins = h.bins.max(1);
+    let hi = b.lo + b.width * bins as f64;
+    let ymax = b
+        .groups
+        .iter()
+        .flat_map(|g| g.1.iter().copied())
+        .fold(0.0f64, f64::max);
+    let ymax = if ymax > 0.0 && ymax.is_finite() {
+        ymax * 1.08
+    } else {
+        1.0
+    };
+    let pad = (hi - b.lo) * 0.02;
+    let mut chart = ChartBuilder::on(root)
+        .caption(&h.title, (FAMILY, 24))
+        .margin(20)
+        .x_label_area_size(55)
+        .y_label_area_size(75)
+        .build_cartesian_2d((b.lo - pad)..(hi + pad), 0.0..ymax)
+        .map_err(e)?;
+    let f = |v: &f64| tick_label(*v, false);
+    chart
+        .configure_mesh()
+        .x_desc(h.x_label.as_str())
+        .y_desc("density")
+        .label_style((FAMILY, 14))
+        .axis_desc_style((FAMILY, 16))
+        .x_label_formatter(&f)
+        .y_label_formatter(&f)
+        .draw()
+        .map_err(e)?;
+    let mut any_legend = false;
+    for (gi, (name, dens)) in b.groups.iter().enumerate() {
+        let c = color(gi);
+        chart
+            .draw_series(dens.iter().enumerate().map(|(i, &d)| {
+                let x0 = b.lo + b.width * i as f64;
+                Rectangle::new([(x0, 0.0), (x0 + b.width, d)], c.mix(0.3).filled())
+            }))
+            .map_err(e)?;
+        let mut outline = Vec::with_capacity(2 * dens.len() + 2);
+        outline.push((b.lo, 0.0));
+        for (i, &d) in dens.iter().enumerate() {
+            let x0 = b.lo + b.width * i as f64;
+            outline.push((x0, d));
+            outline.push((x0 + b.width, d));
+        }
+        outline.push((hi, 0.0));
+        let s = chart
+            .draw_series(LineSeries::new(outline, c.stroke_width(2)))
+            .map_err(e)?;
+        if !name.is_empty() {
+            any_legend = true;
+            s.label(name.as_str()).legend(move |(x, y)| {
+                Rectangle::new([(x, y - 5), (x + 20, y + 5)], c.mix(0.6).filled())
+            });
+        }
+    }
+    if any_legend {
+        chart
+            .configure_series_labels()
+            .label_font((FAMILY, 14))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(e)?;
+    }
+    draw_notes(root, notes)
+}
+
+/// Write `h` to `<base>.svg` and `<base>.png`.
+pub fn histogram(base: &Path, h: &Histogram) -> Result<(), PlotError> {
+    let (binned, dropped) = bin(h);
+    let mut notes: Vec<String> = omitted_note(dropped, false).into_iter().collect();
+    if h.values.iter().all(|g| g.1.is_empty()) {
+        notes.push("note: no data".into());
+    }
+    render_both(
+        base,
+        |r| draw(r, h, &binned, &notes),
+        |r| draw(r, h, &binned, &notes),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::output::test_support::assert_plot_files;
+    use super::*;
+
+    fn hist(values: Vec<(String, Vec<f64>)>, bins: usize) -> Histogram {
+        Histogram {
+            title: "h".into(),
+            x_label: "frame time (ms)".into(),
+            values,
+            bins,
+        }
+    }
+
+    #[test]
+    fn densities_integrate_to_one() {
+        let h = hist(vec![("a".into(), vec![0.0, 1.0, 1.0, 2.0, 3.0, 4.0])], 4);
+        let (b, dropped) = bin(&h);
+        assert_eq!(dropped, 0);
+        let total: f64 = b.groups[0].1.iter().map(|d| d * b.width).sum();
+        assert!((total - 1.0).abs() < 1e-12);
+        // bins [0,1) [1,2) [2,3) [3,4]: counts 1,2,1,2
+        let counts: Vec<f64> = b.groups[0].1.iter().map(|d| d * b.width * 6.0).collect();
+        assert_eq!(
+            counts.iter().map(|c| c.round() as u32).collect::<Vec<_>>(),
+            vec![1, 2, 1, 2]
+        );
+    }
+
+    #[test]
+    fn writes_files_for_normal_and_degenerate_data() {
+        let dir = tempfile::tempdir().unwrap();
+        let cases = vec![
+            (
+                "two",
+                hist(
+                    vec![
+                        ("a".into(), (0..500).map(|i| (i % 37) as f64).collect()),
+                        (
+                            "b".into(),
+                            (0..300).map(|i| 10.0 + (i % 11) as f64).collect(),
+                        ),
+                    ],
+                    30,
+                ),
+            ),
+            ("empty", hist(vec![], 10)),
+            ("empty_group", hist(vec![("a".into(), vec![])], 10)),
+            ("same", hist(vec![("a".into(), vec![3.0; 10])], 0)),
+            (
+                "nan",
+                hist(
+                    vec![("a".into(), vec![f64::NAN, 1.0, f64::INFINITY, 2.0])],
+                    5,
+                ),
+            ),
+        ];
+        for (name, h) in cases {
+            let base = dir.path().join(name);
+            histogram(&base, &h).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_plot_files(&base);
+        }
+    }
+}

@@ -1,0 +1,259 @@
+//! Line plots: one or more series with optional confidence-interval bars.
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::PlotError;
+use super::axis::{omitted_note, padded_range, tick_label, to_axis};
+use super::font::FAMILY;
+use super::output::{draw_notes, render_both};
+use super::palette::color;
+
+/// One named series of a [`LinePlot`].
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Series {
+    /// Legend entry (empty: no legend entry).
+    pub name: String,
+    /// `(x, y)` points; drawn in ascending `x` order.
+    pub points: Vec<(f64, f64)>,
+    /// Optional `(low, high)` interval per point, same length as `points`,
+    /// drawn as vertical error bars.
+    pub ci: Option<Vec<(f64, f64)>>,
+}
+
+/// A line plot description.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LinePlot {
+    /// Title above the plot.
+    pub title: String,
+    /// X axis description.
+    pub x_label: String,
+    /// Y axis description.
+    pub y_label: String,
+    /// The series, each in its own colour.
+    pub series: Vec<Series>,
+    /// Logarithmic x axis.
+    pub log_x: bool,
+    /// Logarithmic y axis.
+    pub log_y: bool,
+}
+
+/// A series mapped to axis coordinates.
+struct Prepared {
+    name: String,
+    points: Vec<(f64, f64)>,
+    /// `(x, low, y, high)` per point that has an interval.
+    bars: Vec<(f64, f64, f64, f64)>,
+}
+
+fn prepare(plot: &LinePlot) -> (Vec<Prepared>, usize) {
+    let mut dropped = 0;
+    let mut out = Vec::new();
+    for s in &plot.series {
+        let mut rows = Vec::new();
+        for (i, &(x, y)) in s.points.iter().enumerate() {
+            match (to_axis(x, plot.log_x), to_axis(y, plot.log_y)) {
+                (Some(ax), Some(ay)) => {
+                    let ci = s.ci.as_ref().and_then(|c| c.get(i)).and_then(|&(lo, hi)| {
+                        Some((to_axis(lo, plot.log_y)?, to_axis(hi, plot.log_y)?))
+                    });
+                    rows.push((ax, ay, ci));
+                }
+                _ => dropped += 1,
+            }
+        }
+        rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+        out.push(Prepared {
+            name: s.name.clone(),
+            points: rows.iter().map(|r| (r.0, r.1)).collect(),
+            bars: rows
+                .iter()
+                .filter_map(|r| r.2.map(|(lo, hi)| (r.0, lo.min(r.1), r.1, hi.max(r.1))))
+                .collect(),
+        });
+    }
+    (out, dropped)
+}
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    plot: &LinePlot,
+    series: &[Prepared],
+    notes: &[String],
+) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let xr = padded_range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
+    let yr = padded_range(series.iter().flat_map(|s| {
+        s.points
+            .iter()
+            .map(|p| p.1)
+            .chain(s.bars.iter().flat_map(|b| [b.1, b.3]))
+    }));
+    let mut chart = ChartBuilder::on(root)
+        .caption(&plot.title, (FAMILY, 24))
+        .margin(20)
+        .x_label_area_size(55)
+        .y_label_area_size(75)
+        .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
+        .map_err(e)?;
+    let (log_x, log_y) = (plot.log_x, plot.log_y);
+    let fx = move |v: &f64| tick_label(*v, log_x);
+    let fy = move |v: &f64| tick_label(*v, log_y);
+    chart
+        .configure_mesh()
+        .x_desc(plot.x_label.as_str())
+        .y_desc(plot.y_label.as_str())
+        .label_style((FAMILY, 14))
+        .axis_desc_style((FAMILY, 16))
+        .x_label_formatter(&fx)
+        .y_label_formatter(&fy)
+        .draw()
+        .map_err(e)?;
+    let mut any_legend = false;
+    for (i, s) in series.iter().enumerate() {
+        let c = color(i);
+        let line = chart
+            .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
+            .map_err(e)?;
+        if !s.name.is_empty() {
+            any_legend = true;
+            line.label(s.name.as_str()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+            });
+        }
+        chart
+            .draw_series(s.points.iter().map(|&p| Circle::new(p, 3, c.filled())))
+            .map_err(e)?;
+        chart
+            .draw_series(
+                s.bars.iter().map(|&(x, lo, y, hi)| {
+                    ErrorBar::new_vertical(x, lo, y, hi, c.stroke_width(1), 8)
+                }),
+            )
+            .map_err(e)?;
+    }
+    if any_legend {
+        chart
+            .configure_series_labels()
+            .label_font((FAMILY, 14))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()
+            .map_err(e)?;
+    }
+    draw_notes(root, notes)
+}
+
+/// Write `plot` to `<base>.svg` and `<base>.png`.
+pub fn line_plot(base: &Path, plot: &LinePlot) -> Result<(), PlotError> {
+    let (series, dropped) = prepare(plot);
+    let mut notes: Vec<String> = omitted_note(dropped, plot.log_x || plot.log_y)
+        .into_iter()
+        .collect();
+    if series.iter().all(|s| s.points.is_empty()) {
+        notes.push("note: no data".into());
+    }
+    render_both(
+        base,
+        |r| draw(r, plot, &series, &notes),
+        |r| draw(r, plot, &series, &notes),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::output::test_support::assert_plot_files;
+    use super::*;
+
+    fn plot(series: Vec<Series>) -> LinePlot {
+        LinePlot {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            series,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn writes_svg_and_png() {
+        let dir = tempfile::tempdir().unwrap();
+        let base = dir.path().join("line");
+        let p = plot(vec![
+            Series {
+                name: "a".into(),
+                points: vec![(1.0, 2.0), (2.0, 3.0), (3.0, 2.5)],
+                ci: Some(vec![(1.5, 2.5), (2.8, 3.2), (2.0, 3.0)]),
+            },
+            Series {
+                name: "b".into(),
+                points: vec![(3.0, 1.0), (1.0, 1.5)],
+                ci: None,
+            },
+        ]);
+        line_plot(&base, &p).unwrap();
+        assert_plot_files(&base);
+    }
+
+    #[test]
+    fn robust_to_degenerate_data() {
+        let dir = tempfile::tempdir().unwrap();
+        let cases = vec![
+            ("empty", plot(vec![])),
+            ("empty_series", plot(vec![Series::default()])),
+            (
+                "single",
+                plot(vec![Series {
+                    name: "s".into(),
+                    points: vec![(1.0, 1.0)],
+                    ci: None,
+                }]),
+            ),
+            (
+                "same",
+                plot(vec![Series {
+                    name: "s".into(),
+                    points: vec![(0.0, 0.0), (0.0, 0.0)],
+                    ci: Some(vec![(0.0, 0.0)]),
+                }]),
+            ),
+            (
+                "nan",
+                plot(vec![Series {
+                    name: "s".into(),
+                    points: vec![(f64::NAN, 1.0), (1.0, f64::INFINITY), (2.0, 2.0)],
+                    ci: None,
+                }]),
+            ),
+            (
+                "log",
+                LinePlot {
+                    log_x: true,
+                    log_y: true,
+                    ..plot(vec![Series {
+                        name: "s".into(),
+                        points: vec![(0.0, 1.0), (10.0, 100.0), (1000.0, 0.1)],
+                        ci: Some(vec![(-1.0, 2.0), (50.0, 150.0), (0.05, 0.2)]),
+                    }])
+                },
+            ),
+        ];
+        for (name, p) in cases {
+            let base = dir.path().join(name);
+            line_plot(&base, &p).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_plot_files(&base);
+        }
+    }
+
+    #[test]
+    fn dotted_base_name_keeps_its_dot() {
+        let dir = tempfile::tempdir().unwrap();
+        let base = dir.path().join("sub").join("a.b");
+        line_plot(&base, &plot(vec![])).unwrap();
+        assert!(dir.path().join("sub/a.b.svg").exists());
+        assert!(dir.path().join("sub/a.b.png").exists());
+    }
+}
