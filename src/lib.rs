@@ -11,6 +11,7 @@
 //! - [`stats`], [`output`], [`plot`], [`experiment`]: results and studies.
 #![warn(missing_docs)]
 
+pub mod bench;
 pub mod components;
 pub mod config;
 pub mod engine;

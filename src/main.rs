@@ -1,3 +1,383 @@
-fn main() {
-    println!("Hello, world!");
+//! The `rendersim` command line: glue over the library. Arguments are turned
+//! into a model table here; all logic lives in the library.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use serde_json::json;
+
+use rendersim::config::{ModelSource, apply_set};
+use rendersim::output::files::write_atomic;
+use rendersim::systems::{DEFAULT_MODEL, SystemRun, run_model};
+
+#[derive(Parser)]
+#[command(
+    name = "rendersim",
+    version,
+    about = "Discrete-event simulator of GPU rendering pipelines and latency"
+)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Run one model (the embedded default when MODEL is omitted).
+    Run {
+        /// Model file (TOML).
+        model: Option<PathBuf>,
+        /// Override a model key: --set display.buffers=3 (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        sets: Vec<String>,
+        /// Master seed (overrides run.seed).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Frames to simulate (overrides run.frames).
+        #[arg(long)]
+        frames: Option<u64>,
+        /// Print the JSON summary.
+        #[arg(long)]
+        json: bool,
+        /// Write summary.json, frames.csv and model.toml into DIR.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Write a Chrome/Perfetto trace to FILE.
+        #[arg(long, value_name = "FILE")]
+        trace: Option<PathBuf>,
+    },
+    /// Run an experiment file: sweeps, replications, plots, report.
+    Experiment {
+        /// Experiment file (TOML).
+        file: PathBuf,
+        /// Output directory (default out/<experiment name>).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Hide the progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Isolate the bottleneck (paper 004 §4.1): reduce CPU, geometry and raster load in turn.
+    Isolate {
+        /// Model file (TOML); the default model when omitted.
+        model: Option<PathBuf>,
+        /// Override a model key (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        sets: Vec<String>,
+        /// Load factor for the reduced subsystem.
+        #[arg(long, default_value_t = 0.5)]
+        factor: f64,
+        /// Keep vsync on (by default it is switched off so quantization does not hide changes).
+        #[arg(long)]
+        keep_vsync: bool,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Simulate a post-transform vertex cache over a mesh's index buffer.
+    Vcache {
+        /// Mesh: grid:WxH[:shuffled:SEED|:optimized], strip:WxH, random:T:V:SEED, FILE.obj, FILE.idx.
+        mesh: String,
+        /// Cache policy: none, fifo:N, lru:N.
+        #[arg(long)]
+        policy: String,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Speed benchmarks, printed as ratios against baselines measured in the same run.
+    Bench {
+        /// Which: kernel, pipeline, hour, all.
+        #[arg(default_value = "all")]
+        which: String,
+        /// Scale the work down (0.01 .. 1) for a quick check.
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match dispatch(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn dispatch(cli: Cli) -> Result<()> {
+    match cli.cmd {
+        Cmd::Run {
+            model,
+            sets,
+            seed,
+            frames,
+            json,
+            out,
+            trace,
+        } => cmd_run(model, sets, seed, frames, json, out, trace),
+        Cmd::Experiment { file, out, quiet } => cmd_experiment(&file, out, quiet),
+        Cmd::Isolate {
+            model,
+            sets,
+            factor,
+            keep_vsync,
+            json,
+        } => cmd_isolate(model, sets, factor, keep_vsync, json),
+        Cmd::Vcache { mesh, policy, json } => cmd_vcache(&mesh, &policy, json),
+        Cmd::Bench { which, scale } => {
+            rendersim::bench::run_cli(&which, scale).map_err(anyhow::Error::msg)
+        }
+    }
+}
+
+fn load_source(model: Option<&Path>) -> Result<ModelSource> {
+    Ok(match model {
+        Some(p) => ModelSource::from_file(p)?,
+        None => ModelSource::from_text("<embedded default model>", DEFAULT_MODEL),
+    })
+}
+
+fn model_table(
+    src: &ModelSource,
+    sets: &[String],
+    seed: Option<u64>,
+    frames: Option<u64>,
+) -> Result<toml::Table> {
+    let mut t = src.table()?;
+    for s in sets {
+        apply_set(&mut t, s)?;
+    }
+    if let Some(seed) = seed {
+        apply_set(&mut t, &format!("run.seed={seed}"))?;
+    }
+    if let Some(f) = frames {
+        apply_set(&mut t, &format!("run.frames={f}"))?;
+        let warm = t
+            .get("run")
+            .and_then(|r| r.get("warmup_frames"))
+            .and_then(|w| w.as_integer())
+            .unwrap_or(0);
+        if f > 0 && warm as u64 >= f {
+            eprintln!(
+                "note: run.warmup_frames = {warm} is not less than --frames {f}; using {} warm-up frames",
+                f / 10
+            );
+            apply_set(&mut t, &format!("run.warmup_frames={}", f / 10))?;
+        }
+    }
+    Ok(t)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn cmd_run(
+    model: Option<PathBuf>,
+    sets: Vec<String>,
+    seed: Option<u64>,
+    frames: Option<u64>,
+    json: bool,
+    out: Option<PathBuf>,
+    trace: Option<PathBuf>,
+) -> Result<()> {
+    let src = load_source(model.as_deref())?;
+    let table = model_table(&src, &sets, seed, frames)?;
+    let mut run = run_model(&src, &table, trace.is_some())?;
+    run.summary_mut()["model"] = json!(src.name);
+    if let Some(dir) = &out {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create output directory {}", dir.display()))?;
+        let summary = serde_json::to_string_pretty(run.summary())?;
+        write_atomic(&dir.join("summary.json"), |w| {
+            w.write_all(summary.as_bytes())
+        })
+        .with_context(|| format!("writing {}", dir.join("summary.json").display()))?;
+        write_atomic(&dir.join("frames.csv"), |w| run.write_frames_csv(w))
+            .with_context(|| format!("writing {}", dir.join("frames.csv").display()))?;
+        let resolved = run.resolved_model(&src.base_dir);
+        write_atomic(&dir.join("model.toml"), |w| {
+            w.write_all(resolved.as_bytes())
+        })
+        .with_context(|| format!("writing {}", dir.join("model.toml").display()))?;
+    }
+    if let Some(path) = &trace {
+        write_atomic(path, |w| run.write_trace(w).map(|_| ()))
+            .with_context(|| format!("writing trace {}", path.display()))?;
+    }
+    if json {
+        println!("{}", serde_json::to_string_pretty(run.summary())?);
+    } else {
+        print_human(&run);
+    }
+    Ok(())
+}
+
+fn print_human(run: &SystemRun) {
+    let s = run.summary();
+    let m = &s["metrics"];
+    let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+    println!(
+        "{} ({}), {} frames, seed {}",
+        s["model"].as_str().unwrap_or(""),
+        s["fidelity"].as_str().unwrap_or(""),
+        s["frames"],
+        s["seed"]
+    );
+    for (name, key) in [
+        ("frame time", "frame_time_ms"),
+        ("display interval", "display_interval_ms"),
+        ("display latency", "display_latency_ms"),
+        ("GPU time", "gpu_time_ms"),
+    ] {
+        let v = &m[key];
+        println!(
+            "  {name:<18} mean {:>8.3} ms   p50 {:>8.3}   p99 {:>8.3}   max {:>8.3}",
+            f(&v["mean"]),
+            f(&v["p50"]),
+            f(&v["p99"]),
+            f(&v["max"])
+        );
+    }
+    println!(
+        "  CPU busy {:.1}%   GPU busy {:.1}%   repeated refreshes {}   dropped frames {}",
+        100.0 * f(&m["cpu_busy_fraction"]),
+        100.0 * f(&m["gpu_busy_fraction"]),
+        m["repeated_refreshes"],
+        m["dropped_frames"]
+    );
+    if let Some(b) = m["bottleneck"].as_object() {
+        let mut v: Vec<(&String, f64)> = b.iter().map(|(k, v)| (k, f(v))).collect();
+        v.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let parts: Vec<String> = v
+            .iter()
+            .filter(|x| x.1 > 0.0005)
+            .map(|(k, x)| format!("{k} {:.1}%", 100.0 * x))
+            .collect();
+        println!("  bottleneck: {}", parts.join(", "));
+    }
+    let a = &m["analytic"];
+    println!(
+        "  analytic per frame: CPU {:.3} ms, GPU front end {:.3} ms, geometry {:.3} ms, fragment {:.3} ms",
+        f(&a["cpu_ms"]),
+        f(&a["gpu_front_end_ms"]),
+        f(&a["geometry_ms"]),
+        f(&a["fragment_ms"])
+    );
+    println!(
+        "  {} events in {:.3} s wall ({:.2} M events/s), {:.3} s simulated",
+        s["events"]["total"],
+        f(&s["wall_seconds"]),
+        f(&s["events_per_second"]) / 1e6,
+        f(&s["simulated_seconds"])
+    );
+}
+
+fn cmd_experiment(file: &Path, out: Option<PathBuf>, quiet: bool) -> Result<()> {
+    use rendersim::experiment::{
+        ModelSource as ExpModel, SimRunner, load_experiment, run_experiment,
+    };
+    let exp = load_experiment(file)?;
+    let default = ModelSource::from_text("<embedded default model>", DEFAULT_MODEL).table()?;
+    let base = exp.resolve_model(&default)?;
+    let (name, base_dir) = match &exp.model {
+        ExpModel::Default => ("<embedded default model>".to_string(), PathBuf::from(".")),
+        ExpModel::File(p) => (
+            p.display().to_string(),
+            p.parent().map(Path::to_path_buf).unwrap_or_default(),
+        ),
+    };
+    let out = out.unwrap_or_else(|| PathBuf::from("out").join(&exp.name));
+    std::fs::create_dir_all(&out)
+        .with_context(|| format!("cannot create output directory {}", out.display()))?;
+    let runner = SimRunner { name, base_dir };
+    let result = run_experiment(&exp, &base, &runner, &out, !quiet)?;
+    println!("{}", result.table(&exp));
+    println!(
+        "experiment {:?}: {} points, {:.2} s wall ({:.2} s of simulation); results in {}",
+        exp.name,
+        result.points.len(),
+        result.wall_seconds,
+        result.sim_wall_seconds,
+        out.display()
+    );
+    if result.checks_failed > 0 {
+        bail!(
+            "{} reference check(s) failed; see {}",
+            result.checks_failed,
+            out.join("report.md").display()
+        );
+    }
+    Ok(())
+}
+
+fn cmd_isolate(
+    model: Option<PathBuf>,
+    sets: Vec<String>,
+    factor: f64,
+    keep_vsync: bool,
+    json: bool,
+) -> Result<()> {
+    let src = load_source(model.as_deref())?;
+    let table = model_table(&src, &sets, None, None)?;
+    let cfg: rendersim::systems::frame_pipeline::FramePipelineConfig =
+        rendersim::config::deserialize(&table, &src)?;
+    let iso = rendersim::systems::frame_pipeline::isolate::isolate(
+        &cfg,
+        &src.base_dir,
+        factor,
+        keep_vsync,
+    )?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&iso)?);
+        return Ok(());
+    }
+    println!(
+        "bottleneck isolation (load x{factor}, vsync {}):",
+        if keep_vsync { "on" } else { "off" }
+    );
+    for v in &iso.variants {
+        println!(
+            "  {:<9} frame time {:>9.3} ms  ({:+.1}%)",
+            v.name,
+            v.frame_time_ms,
+            100.0 * v.change
+        );
+    }
+    println!(
+        "  => bottleneck: {}   ({:.2} s wall)",
+        iso.bottleneck, iso.wall_seconds
+    );
+    Ok(())
+}
+
+fn cmd_vcache(mesh: &str, policy: &str, json: bool) -> Result<()> {
+    let policy: rendersim::components::vertex_cache::CachePolicy = policy
+        .parse()
+        .map_err(|e| anyhow::anyhow!("--policy {policy:?}: {e}"))?;
+    let start = std::time::Instant::now();
+    let m = rendersim::scene::generators::mesh_from_spec(mesh, Path::new("."))?;
+    let s = m.cache_stats(&policy);
+    let secs = start.elapsed().as_secs_f64();
+    let out = json!({
+        "mesh": mesh, "policy": policy.to_string(), "indices": s.indices, "triangles": s.triangles,
+        "unique_vertices": s.unique_vertices, "transformed": s.transformed, "acmr": s.acmr(), "atvr": s.atvr(),
+        "wall_seconds": secs,
+    });
+    if json {
+        println!("{}", serde_json::to_string_pretty(&out)?);
+    } else {
+        println!(
+            "{mesh} under {policy}: {} triangles, {} indices, {} unique vertices, {} transformed; ACMR {:.4}, ATVR {:.4}",
+            s.triangles,
+            s.indices,
+            s.unique_vertices,
+            s.transformed,
+            s.acmr(),
+            s.atvr()
+        );
+    }
+    Ok(())
 }

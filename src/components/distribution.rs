@@ -389,23 +389,29 @@ impl<V: Quantity> Dist<V> {
     /// (`k >= 0` expected; a negative `k` yields a distribution that fails
     /// [`validate`](Self::validate)).
     pub fn scaled(&self, k: f64) -> Dist<f64> {
+        self.scaled_as(k)
+    }
+
+    /// The distribution of `k * X` in another quantity type (for example a
+    /// duration distribution scaled by a factor stays a duration one).
+    pub fn scaled_as<W: Quantity>(&self, k: f64) -> Dist<W> {
         match self {
             Dist::Const { value } => Dist::Const {
-                value: k * value.to_f64(),
+                value: W::from_f64(k * value.to_f64()),
             },
             Dist::Uniform { min, max } => Dist::Uniform {
-                min: k * min.to_f64(),
-                max: k * max.to_f64(),
+                min: W::from_f64(k * min.to_f64()),
+                max: W::from_f64(k * max.to_f64()),
             },
             Dist::Exponential { mean } => Dist::Exponential {
-                mean: k * mean.to_f64(),
+                mean: W::from_f64(k * mean.to_f64()),
             },
             Dist::Lognormal { median, sigma } => Dist::Lognormal {
-                median: k * median.to_f64(),
+                median: W::from_f64(k * median.to_f64()),
                 sigma: *sigma,
             },
             Dist::Pareto { scale, shape } => Dist::Pareto {
-                scale: k * scale.to_f64(),
+                scale: W::from_f64(k * scale.to_f64()),
                 shape: *shape,
             },
             Dist::Mixture { parts } => Dist::Mixture {
@@ -413,7 +419,7 @@ impl<V: Quantity> Dist<V> {
                     .iter()
                     .map(|p| MixturePart {
                         weight: p.weight,
-                        dist: p.dist.scaled(k),
+                        dist: p.dist.scaled_as(k),
                     })
                     .collect(),
             },

@@ -86,17 +86,31 @@ impl NoiseSource {
     ) -> Result<Self, NoiseError> {
         match &arrivals {
             Arrivals::Periodic { period, .. } if period.0 == 0 => {
-                return Err(NoiseError::Zero { name, what: "period" });
+                return Err(NoiseError::Zero {
+                    name,
+                    what: "period",
+                });
             }
             Arrivals::Poisson { mean_gap } if mean_gap.0 == 0 => {
-                return Err(NoiseError::Zero { name, what: "1/rate" });
+                return Err(NoiseError::Zero {
+                    name,
+                    what: "1/rate",
+                });
             }
             _ => {}
         }
-        duration
-            .validate()
-            .map_err(|source| NoiseError::Duration { name: name.clone(), source })?;
-        Ok(NoiseSource { name, target, arrivals, duration, rng, k: 0 })
+        duration.validate().map_err(|source| NoiseError::Duration {
+            name: name.clone(),
+            source,
+        })?;
+        Ok(NoiseSource {
+            name,
+            target,
+            arrivals,
+            duration,
+            rng,
+            k: 0,
+        })
     }
 
     /// The next arrival after the previous one (the first call gives the first).
@@ -104,7 +118,11 @@ impl NoiseSource {
         let k = self.k;
         self.k += 1;
         match self.arrivals {
-            Arrivals::Periodic { period, phase, jitter } => {
+            Arrivals::Periodic {
+                period,
+                phase,
+                jitter,
+            } => {
                 let base = period
                     .checked_mul(k)
                     .and_then(|d| d.checked_add(phase))
@@ -113,15 +131,24 @@ impl NoiseSource {
                         at: Time::ZERO,
                         by: period,
                     })?;
-                let j = if jitter.0 > 0 { self.rng.random_range(0..jitter.0) } else { 0 };
+                let j = if jitter.0 > 0 {
+                    self.rng.random_range(0..jitter.0)
+                } else {
+                    0
+                };
                 // Arrivals never go back before the previous one.
-                let t = Time::ZERO.add(base, "scheduling a system task")?.add(Duration(j), "jitter")?;
+                let t = Time::ZERO
+                    .add(base, "scheduling a system task")?
+                    .add(Duration(j), "jitter")?;
                 Ok(t.max(prev))
             }
             Arrivals::Poisson { mean_gap } => {
                 let u: f64 = self.rng.random::<f64>();
                 let gap = -(1.0 - u).ln() * mean_gap.0 as f64;
-                prev.add(Duration::from_ps_f64(gap), "scheduling a random system task")
+                prev.add(
+                    Duration::from_ps_f64(gap),
+                    "scheduling a random system task",
+                )
             }
         }
     }

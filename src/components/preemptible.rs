@@ -128,7 +128,9 @@ mod tests {
     #[test]
     fn preemption_delays_the_job_by_the_task() {
         let mut p = Preemptible::new();
-        let Wake::JobAt(end, g0) = p.start_job(Time(0), Duration(100)).unwrap() else { panic!() };
+        let Wake::JobAt(end, g0) = p.start_job(Time(0), Duration(100)).unwrap() else {
+            panic!()
+        };
         assert_eq!(end, Time(100));
         let t_end = p.task_arrives(Time(30), Duration(50)).unwrap().unwrap();
         assert_eq!(t_end, Time(80));

@@ -64,8 +64,10 @@ pub enum ConfigError {
 impl ModelSource {
     /// Reads a model file.
     pub fn from_file(path: &Path) -> Result<ModelSource, ConfigError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| ConfigError::Io { path: path.display().to_string(), source })?;
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
         Ok(ModelSource {
             name: path.display().to_string(),
             text,
@@ -75,15 +77,21 @@ impl ModelSource {
 
     /// A model given as text (the embedded default, tests).
     pub fn from_text(name: &str, text: &str) -> ModelSource {
-        ModelSource { name: name.to_string(), text: text.to_string(), base_dir: PathBuf::from(".") }
+        ModelSource {
+            name: name.to_string(),
+            text: text.to_string(),
+            base_dir: PathBuf::from("."),
+        }
     }
 
     /// Parses the text into a TOML table.
     pub fn table(&self) -> Result<toml::Table, ConfigError> {
-        self.text.parse::<toml::Table>().map_err(|e| ConfigError::Syntax {
-            file: self.name.clone(),
-            message: e.to_string().trim().to_string(),
-        })
+        self.text
+            .parse::<toml::Table>()
+            .map_err(|e| ConfigError::Syntax {
+                file: self.name.clone(),
+                message: e.to_string().trim().to_string(),
+            })
     }
 
     /// 1-based line of the dotted `key` in the text, if it stands there (or
@@ -106,10 +114,12 @@ fn find_item(item: &toml_edit::Item, parts: &[&str], span: Span) -> Span {
             Some((k, v)) => find_item(v, rest, k.span().or(v.span()).or(span)),
             None => t.span().or(span),
         },
-        toml_edit::Item::ArrayOfTables(a) => match first.parse::<usize>().ok().and_then(|i| a.get(i)) {
-            Some(t) => find_item(&toml_edit::Item::Table(t.clone()), rest, t.span().or(span)),
-            None => span,
-        },
+        toml_edit::Item::ArrayOfTables(a) => {
+            match first.parse::<usize>().ok().and_then(|i| a.get(i)) {
+                Some(t) => find_item(&toml_edit::Item::Table(t.clone()), rest, t.span().or(span)),
+                None => span,
+            }
+        }
         toml_edit::Item::Value(v) => find_value(v, parts, span),
         toml_edit::Item::None => span,
     }
@@ -133,22 +143,33 @@ fn find_value(v: &toml_edit::Value, parts: &[&str], span: Span) -> Span {
 }
 
 fn line_at(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
+    text[..offset.min(text.len())]
+        .bytes()
+        .filter(|&b| b == b'\n')
+        .count()
+        + 1
 }
 
 /// Applies `key.path=value` to `table`. The value is read as TOML (numbers,
 /// booleans, strings in quotes, arrays, inline tables); anything that is not
 /// valid TOML is taken as a plain string, so `--set workload.gpu=17ms` works.
 pub fn apply_set(table: &mut toml::Table, assignment: &str) -> Result<(), ConfigError> {
-    let err = |reason: &str| ConfigError::Set { assignment: assignment.to_string(), reason: reason.to_string() };
-    let (key, raw) = assignment.split_once('=').ok_or_else(|| err("expected key=value"))?;
+    let err = |reason: &str| ConfigError::Set {
+        assignment: assignment.to_string(),
+        reason: reason.to_string(),
+    };
+    let (key, raw) = assignment
+        .split_once('=')
+        .ok_or_else(|| err("expected key=value"))?;
     let key = key.trim();
     if key.is_empty() || key.split('.').any(|p| p.trim().is_empty()) {
         return Err(err("empty key"));
     }
     let raw = raw.trim();
     let value = match format!("v = {raw}").parse::<toml::Table>() {
-        Ok(mut t) => t.remove("v").unwrap_or(toml::Value::String(raw.to_string())),
+        Ok(mut t) => t
+            .remove("v")
+            .unwrap_or(toml::Value::String(raw.to_string())),
         Err(_) => toml::Value::String(raw.to_string()),
     };
     set_dotted(table, key, value).map_err(|r| err(&r))
@@ -166,18 +187,22 @@ pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Res
             return Ok(());
         }
         let next_is_index = parts[i + 1].parse::<usize>().is_ok();
-        let entry = cur
-            .entry(part.to_string())
-            .or_insert_with(|| if next_is_index { toml::Value::Array(vec![]) } else { toml::Value::Table(toml::Table::new()) });
+        let entry = cur.entry(part.to_string()).or_insert_with(|| {
+            if next_is_index {
+                toml::Value::Array(vec![])
+            } else {
+                toml::Value::Table(toml::Table::new())
+            }
+        });
         match entry {
             toml::Value::Table(t) => cur = t,
             toml::Value::Array(a) if next_is_index => {
                 let idx: usize = parts[i + 1].parse().unwrap_or(0);
                 let path = parts[..=i + 1].join(".");
                 let n = a.len();
-                let elem = a
-                    .get_mut(idx)
-                    .ok_or_else(|| format!("`{path}`: index {idx} is out of range (array has {n} entries)"))?;
+                let elem = a.get_mut(idx).ok_or_else(|| {
+                    format!("`{path}`: index {idx} is out of range (array has {n} entries)")
+                })?;
                 if i + 2 == parts.len() {
                     *elem = value;
                     return Ok(());
@@ -198,7 +223,10 @@ pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Res
 
 /// Deserializes `table` into `T`, turning serde's errors into
 /// [`ConfigError::Invalid`] with key path, line and suggestion.
-pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) -> Result<T, ConfigError> {
+pub fn deserialize<T: DeserializeOwned>(
+    table: &toml::Table,
+    src: &ModelSource,
+) -> Result<T, ConfigError> {
     let de = table.clone();
     serde_path_to_error::deserialize::<_, T>(de).map_err(|e| {
         let path = e.path().to_string();
@@ -207,7 +235,11 @@ pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) 
         // serde says: unknown field `refesh`, expected one of `refresh`, `vsync`
         let (key, suggestion) = match unknown_field(&message) {
             Some((bad, expected)) => {
-                let key = if path == "." || path.is_empty() { bad.clone() } else { format!("{path}.{bad}") };
+                let key = if path == "." || path.is_empty() {
+                    bad.clone()
+                } else {
+                    format!("{path}.{bad}")
+                };
                 let best = expected
                     .iter()
                     .map(|c| (strsim::jaro_winkler(&bad, c), c))
@@ -216,21 +248,46 @@ pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) 
                     .map(|(_, c)| c.clone());
                 (key, best)
             }
-            None => (if path == "." { "(top level)".into() } else { path }, None),
+            None => (
+                if path == "." {
+                    "(top level)".into()
+                } else {
+                    path
+                },
+                None,
+            ),
         };
         invalid(src, &key, message, suggestion)
     })
 }
 
 /// Builds an [`ConfigError::Invalid`] for `key`, finding its line.
-pub fn invalid(src: &ModelSource, key: &str, message: String, suggestion: Option<String>) -> ConfigError {
-    ConfigError::Invalid { file: src.name.clone(), key: key.to_string(), line: src.line_of(key), message, suggestion }
+pub fn invalid(
+    src: &ModelSource,
+    key: &str,
+    message: String,
+    suggestion: Option<String>,
+) -> ConfigError {
+    ConfigError::Invalid {
+        file: src.name.clone(),
+        key: key.to_string(),
+        line: src.line_of(key),
+        message,
+        suggestion,
+    }
 }
 
 fn unknown_field(msg: &str) -> Option<(String, Vec<String>)> {
-    let rest = msg.strip_prefix("unknown field `").or_else(|| msg.strip_prefix("unknown variant `"))?;
+    let rest = msg
+        .strip_prefix("unknown field `")
+        .or_else(|| msg.strip_prefix("unknown variant `"))?;
     let (bad, rest) = rest.split_once('`')?;
-    let expected: Vec<String> = rest.split('`').skip(1).step_by(2).map(str::to_string).collect();
+    let expected: Vec<String> = rest
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .map(str::to_string)
+        .collect();
     Some((bad.to_string(), expected))
 }
 
@@ -255,7 +312,10 @@ mod tests {
 
     #[test]
     fn unknown_key_has_line_and_suggestion() {
-        let src = ModelSource::from_text("m.toml", "# model\n[display]\nrefesh = \"60Hz\"\nvsync = true\n");
+        let src = ModelSource::from_text(
+            "m.toml",
+            "# model\n[display]\nrefesh = \"60Hz\"\nvsync = true\n",
+        );
         let t = src.table().unwrap();
         let e = deserialize::<M>(&t, &src).unwrap_err().to_string();
         assert!(e.contains("m.toml:3"), "{e}");
@@ -266,7 +326,9 @@ mod tests {
     #[test]
     fn wrong_type_names_key_and_line() {
         let src = ModelSource::from_text("m.toml", "[display]\nrefresh = \"60Hz\"\nvsync = 3\n");
-        let e = deserialize::<M>(&src.table().unwrap(), &src).unwrap_err().to_string();
+        let e = deserialize::<M>(&src.table().unwrap(), &src)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("display.vsync") && e.contains(":3"), "{e}");
     }
 

@@ -31,7 +31,11 @@ pub struct UnitError {
 }
 
 fn unit_err(what: &'static str, text: &str, reason: impl Into<String>) -> UnitError {
-    UnitError { what, text: text.to_string(), reason: reason.into() }
+    UnitError {
+        what,
+        text: text.to_string(),
+        reason: reason.into(),
+    }
 }
 
 fn split_number(t: &str) -> (&str, &str) {
@@ -56,28 +60,51 @@ impl Rate {
             _ => {
                 return Duration::parse(t)
                     .map_err(|_| {
-                        unit_err("rate", text, "use a frequency like \"60Hz\" or a period like \"16.7ms\"")
+                        unit_err(
+                            "rate",
+                            text,
+                            "use a frequency like \"60Hz\" or a period like \"16.7ms\"",
+                        )
                     })
                     .and_then(|p| {
                         if p.0 == 0 {
-                            Err(unit_err("rate", text, "the period must be greater than zero"))
+                            Err(unit_err(
+                                "rate",
+                                text,
+                                "the period must be greater than zero",
+                            ))
                         } else {
-                            Ok(Rate { period: p, text: t.to_string() })
+                            Ok(Rate {
+                                period: p,
+                                text: t.to_string(),
+                            })
                         }
                     });
             }
         };
         // f = num * mult Hz; period = 1e12 / f ps. Work in milli-hertz.
-        let milli_hz = parse_scaled_decimal(num, 1000 * mult).map_err(|r| unit_err("rate", text, r))?;
+        let milli_hz =
+            parse_scaled_decimal(num, 1000 * mult).map_err(|r| unit_err("rate", text, r))?;
         if milli_hz == 0 {
-            return Err(unit_err("rate", text, "the frequency must be greater than zero"));
+            return Err(unit_err(
+                "rate",
+                text,
+                "the frequency must be greater than zero",
+            ));
         }
         let num = PS_PER_S as u128 * 1000;
         let period = (num + milli_hz as u128 / 2) / milli_hz as u128;
         if period == 0 {
-            return Err(unit_err("rate", text, "frequency too high for picosecond resolution"));
+            return Err(unit_err(
+                "rate",
+                text,
+                "frequency too high for picosecond resolution",
+            ));
         }
-        Ok(Rate { period: Duration(period as u64), text: t.to_string() })
+        Ok(Rate {
+            period: Duration(period as u64),
+            text: t.to_string(),
+        })
     }
 
     /// Frequency in Hz, for printing.
@@ -100,7 +127,11 @@ impl Bandwidth {
         let t = text.trim();
         let (num, unit) = split_number(t);
         let Some(unit) = unit.strip_suffix("/s") else {
-            return Err(unit_err("bandwidth", text, "use bytes or bits per second, e.g. \"4GB/s\" or \"2Gbit/s\""));
+            return Err(unit_err(
+                "bandwidth",
+                text,
+                "use bytes or bits per second, e.g. \"4GB/s\" or \"2Gbit/s\"",
+            ));
         };
         let (scale_num, scale_den): (u128, u128) = match unit {
             "B" => (1, 1),
@@ -119,11 +150,14 @@ impl Bandwidth {
                 return Err(unit_err(
                     "bandwidth",
                     text,
-                    format!("unknown unit {unit:?}/s (use B, kB, MB, GB, KiB, MiB, GiB, bit, Mbit or Gbit per second)"),
+                    format!(
+                        "unknown unit {unit:?}/s (use B, kB, MB, GB, KiB, MiB, GiB, bit, Mbit or Gbit per second)"
+                    ),
                 ));
             }
         };
-        let milli = parse_scaled_decimal(num, 1000).map_err(|r| unit_err("bandwidth", text, r))? as u128;
+        let milli =
+            parse_scaled_decimal(num, 1000).map_err(|r| unit_err("bandwidth", text, r))? as u128;
         let v = milli
             .checked_mul(scale_num)
             .ok_or_else(|| unit_err("bandwidth", text, "too large"))?
@@ -131,7 +165,10 @@ impl Bandwidth {
         if v == 0 {
             return Err(unit_err("bandwidth", text, "must be greater than zero"));
         }
-        Ok(Bandwidth { milli_bytes_per_s: v, text: t.to_string() })
+        Ok(Bandwidth {
+            milli_bytes_per_s: v,
+            text: t.to_string(),
+        })
     }
 
     /// Time to move `bytes` (rounded to the nearest picosecond; saturates).
@@ -164,9 +201,17 @@ impl Bytes {
             "KiB" => 1 << 10,
             "MiB" => 1 << 20,
             "GiB" => 1 << 30,
-            _ => return Err(unit_err("size", text, format!("unknown unit {unit:?} (use B, kB, MB, GB, KiB, MiB, GiB)"))),
+            _ => {
+                return Err(unit_err(
+                    "size",
+                    text,
+                    format!("unknown unit {unit:?} (use B, kB, MB, GB, KiB, MiB, GiB)"),
+                ));
+            }
         };
-        parse_scaled_decimal(num, scale).map(Bytes).map_err(|r| unit_err("size", text, r))
+        parse_scaled_decimal(num, scale)
+            .map(Bytes)
+            .map_err(|r| unit_err("size", text, r))
     }
 }
 
@@ -211,12 +256,24 @@ macro_rules! string_serde {
     };
 }
 
-string_serde!(Rate, "a rate like \"60Hz\" or a period like \"16.7ms\"", Rate::parse, |r: &Rate, s: S| s
-    .serialize_str(&r.text));
-string_serde!(Bandwidth, "a bandwidth like \"4GB/s\"", Bandwidth::parse, |b: &Bandwidth, s: S| s
-    .serialize_str(&b.text));
-string_serde!(Bytes, "a size in bytes like 4096 or \"64KiB\"", Bytes::parse, |b: &Bytes, s: S| s
-    .serialize_u64(b.0));
+string_serde!(
+    Rate,
+    "a rate like \"60Hz\" or a period like \"16.7ms\"",
+    Rate::parse,
+    |r: &Rate, s: S| s.serialize_str(&r.text)
+);
+string_serde!(
+    Bandwidth,
+    "a bandwidth like \"4GB/s\"",
+    Bandwidth::parse,
+    |b: &Bandwidth, s: S| s.serialize_str(&b.text)
+);
+string_serde!(
+    Bytes,
+    "a size in bytes like 4096 or \"64KiB\"",
+    Bytes::parse,
+    |b: &Bytes, s: S| s.serialize_u64(b.0)
+);
 
 #[cfg(test)]
 mod tests {
@@ -224,10 +281,16 @@ mod tests {
 
     #[test]
     fn rates() {
-        assert_eq!(Rate::parse("60Hz").unwrap().period, Duration(16_666_666_667));
+        assert_eq!(
+            Rate::parse("60Hz").unwrap().period,
+            Duration(16_666_666_667)
+        );
         assert_eq!(Rate::parse("1Hz").unwrap().period, Duration(PS_PER_S));
         assert_eq!(Rate::parse("1kHz").unwrap().period, Duration::ms(1));
-        assert_eq!(Rate::parse("16.7ms").unwrap().period, Duration(16_700_000_000));
+        assert_eq!(
+            Rate::parse("16.7ms").unwrap().period,
+            Duration(16_700_000_000)
+        );
         for bad in ["0Hz", "-60Hz", "60", "fast", "NaNHz", "0ms"] {
             assert!(Rate::parse(bad).is_err(), "{bad}");
         }

@@ -225,19 +225,31 @@ mod tests {
     impl Model for Clock {
         type Event = Ev;
         type Error = EngineError;
-        fn handle(&mut self, now: Time, e: Ev, s: &mut Scheduler<Ev>) -> Result<Control, EngineError> {
+        fn handle(
+            &mut self,
+            now: Time,
+            e: Ev,
+            s: &mut Scheduler<Ev>,
+        ) -> Result<Control, EngineError> {
             self.seen.push(now);
             if let Ev::Tick = e {
                 s.after(Duration(10), Ev::Tock, "tock")?;
                 s.after(Duration(20), Ev::Tick, "tick")?;
             }
-            Ok(if self.seen.len() >= self.stop_after { Control::Stop } else { Control::Continue })
+            Ok(if self.seen.len() >= self.stop_after {
+                Control::Stop
+            } else {
+                Control::Continue
+            })
         }
     }
 
     #[test]
     fn counts_kinds_and_stops() {
-        let mut m = Clock { seen: vec![], stop_after: 7 };
+        let mut m = Clock {
+            seen: vec![],
+            stop_after: 7,
+        };
         let mut s = Scheduler::new();
         s.at(Time(0), Ev::Tick);
         let st = run(&mut m, &mut s, Limits::default()).unwrap();
@@ -249,24 +261,49 @@ mod tests {
 
     #[test]
     fn time_limit_and_event_limit() {
-        let mut m = Clock { seen: vec![], stop_after: usize::MAX };
+        let mut m = Clock {
+            seen: vec![],
+            stop_after: usize::MAX,
+        };
         let mut s = Scheduler::new();
         s.at(Time(0), Ev::Tick);
-        let st = run(&mut m, &mut s, Limits { until: Some(Time(100)), max_events: None }).unwrap();
+        let st = run(
+            &mut m,
+            &mut s,
+            Limits {
+                until: Some(Time(100)),
+                max_events: None,
+            },
+        )
+        .unwrap();
         assert_eq!(st.stopped_by, StopReason::TimeLimit);
         assert!(m.seen.iter().all(|t| t.0 <= 100));
         let mut s = Scheduler::new();
         s.at(Time(0), Ev::Tick);
-        let st = run(&mut m, &mut s, Limits { until: None, max_events: Some(5) }).unwrap();
+        let st = run(
+            &mut m,
+            &mut s,
+            Limits {
+                until: None,
+                max_events: Some(5),
+            },
+        )
+        .unwrap();
         assert_eq!((st.events, st.stopped_by), (5, StopReason::EventLimit));
     }
 
     #[test]
     fn overflow_surfaces_as_error() {
-        let mut m = Clock { seen: vec![], stop_after: usize::MAX };
+        let mut m = Clock {
+            seen: vec![],
+            stop_after: usize::MAX,
+        };
         let mut s = Scheduler::new();
         s.at(Time(u64::MAX - 15), Ev::Tick);
         let e = run(&mut m, &mut s, Limits::default()).unwrap_err();
-        assert!(matches!(e, EngineError::Time(TimeError::Overflow { .. })), "{e}");
+        assert!(
+            matches!(e, EngineError::Time(TimeError::Overflow { .. })),
+            "{e}"
+        );
     }
 }

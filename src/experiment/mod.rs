@@ -63,6 +63,7 @@ mod figures;
 mod report;
 mod run;
 mod runner;
+mod sim_runner;
 mod spec;
 mod sweep;
 mod tables;
@@ -76,6 +77,7 @@ pub use dotted::{json_number, json_path, set_dotted};
 pub use error::ExperimentError;
 pub use run::{ExperimentResult, PathStat, PointResult, RunRecord, point_model, run_experiment};
 pub use runner::{FrameTable, RunOutput, Runner};
+pub use sim_runner::SimRunner;
 pub use spec::{
     Check, Derived, DerivedKind, Experiment, Metric, ModelSource, PlotKind, PlotSpec, Tolerance,
     load_experiment, parse_experiment,

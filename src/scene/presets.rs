@@ -23,19 +23,25 @@ fn scaled(n: u64, scale: f64) -> u64 {
 /// The object groups of preset `name` at `scale` (fraction of the paper's
 /// object count), or `None` for an unknown name.
 pub fn preset_groups(name: &str, scale: f64) -> Option<Vec<ObjectGroup>> {
-    let group = |name: &str, count: u64, tris: u64, acmr: f64, pixels: Dist<f64>, tex: u64, mat: u64| ObjectGroup {
-        name: name.to_string(),
-        count,
-        mesh: MeshRef::Stats { triangles: tris, acmr },
-        indexed: true,
-        triangle_pixels: pixels,
-        shaders: 1,
-        textures: tex,
-        materials: mat,
-        matrix_per_object: true,
-        geometry_upload: Bytes(0),
-        texture_upload: Bytes(0),
-    };
+    let group =
+        |name: &str, count: u64, tris: u64, acmr: f64, pixels: Dist<f64>, tex: u64, mat: u64| {
+            ObjectGroup {
+                name: name.to_string(),
+                count,
+                mesh: MeshRef::Stats {
+                    triangles: tris,
+                    acmr,
+                },
+                indexed: true,
+                triangle_pixels: pixels,
+                shaders: 1,
+                textures: tex,
+                materials: mat,
+                matrix_per_object: true,
+                geometry_upload: Bytes(0),
+                texture_upload: Bytes(0),
+            }
+        };
     Some(match name {
         // 3,453,465 / 5609 = 616 triangles per building.
         "city" => vec![group(
@@ -43,19 +49,36 @@ pub fn preset_groups(name: &str, scale: f64) -> Option<Vec<ObjectGroup>> {
             scaled(5609, scale),
             616,
             1.86,
-            Dist::Lognormal { median: 20.0, sigma: 1.5 },
+            Dist::Lognormal {
+                median: 20.0,
+                sigma: 1.5,
+            },
             88,
             3,
         )],
         // One 86,400-triangle terrain mesh, strips adapted to the cache.
-        "terrain" => vec![group("terrain", 1, scaled(86_400, scale), 0.99, Dist::Lognormal { median: 8.0, sigma: 0.8 }, 1, 1)],
+        "terrain" => vec![group(
+            "terrain",
+            1,
+            scaled(86_400, scale),
+            0.99,
+            Dist::Lognormal {
+                median: 8.0,
+                sigma: 0.8,
+            },
+            1,
+            1,
+        )],
         // 579,644 / 157 = 3692 triangles per tree; strongly varying sizes.
         "forest" => vec![group(
             "trees",
             scaled(157, scale),
             3692,
             1.78,
-            Dist::Lognormal { median: 6.0, sigma: 2.0 },
+            Dist::Lognormal {
+                median: 6.0,
+                sigma: 2.0,
+            },
             2,
             2,
         )],

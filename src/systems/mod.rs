@@ -1,2 +1,145 @@
-//! Simulated systems, each composed from components and driven by the engine.
+//! Simulated systems, each composed from components and driven by the
+//! engine. A model file's top-level `system` key picks one (default
+//! `frame_pipeline`); [`run_model`] is the one entry point the CLI and the
+//! experiment runner use.
+
 pub mod frame_pipeline;
+
+use std::io::Write;
+
+use serde_json::Value;
+
+use crate::config::{ConfigError, ModelSource, deserialize, invalid};
+
+/// The embedded default model (`models/default.toml`).
+pub const DEFAULT_MODEL: &str = include_str!("../../models/default.toml");
+
+/// Errors of running any system.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// The model file is wrong.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// The frame pipeline failed while running.
+    #[error(transparent)]
+    Pipeline(frame_pipeline::PipelineError),
+}
+
+/// The result of running one model.
+#[derive(Debug)]
+pub enum SystemRun {
+    /// A frame-pipeline run.
+    FramePipeline(Box<frame_pipeline::PipelineRun>),
+}
+
+/// Reads `--set` patches into the model's table.
+pub fn patched_table(src: &ModelSource, sets: &[String]) -> Result<toml::Table, ConfigError> {
+    let mut t = src.table()?;
+    for s in sets {
+        crate::config::apply_set(&mut t, s)?;
+    }
+    Ok(t)
+}
+
+/// Builds and runs the system a model describes.
+pub fn run_model(
+    src: &ModelSource,
+    table: &toml::Table,
+    trace: bool,
+) -> Result<SystemRun, SimError> {
+    let system = table
+        .get("system")
+        .and_then(|v| v.as_str())
+        .unwrap_or("frame_pipeline");
+    match system {
+        "frame_pipeline" => {
+            let cfg: frame_pipeline::FramePipelineConfig = deserialize(table, src)?;
+            match frame_pipeline::run_pipeline(cfg, &src.base_dir, trace) {
+                Ok(r) => Ok(SystemRun::FramePipeline(Box::new(r))),
+                Err(frame_pipeline::PipelineError::Invalid { key, message }) => {
+                    Err(SimError::Config(invalid(src, &key, message, None)))
+                }
+                Err(e) => Err(SimError::Pipeline(e)),
+            }
+        }
+        other => Err(SimError::Config(invalid(
+            src,
+            "system",
+            format!("unknown system {other:?} (known: frame_pipeline)"),
+            None,
+        ))),
+    }
+}
+
+impl SystemRun {
+    /// The JSON summary.
+    pub fn summary(&self) -> &Value {
+        match self {
+            SystemRun::FramePipeline(r) => &r.summary,
+        }
+    }
+
+    /// Mutable summary (the CLI adds the model's name).
+    pub fn summary_mut(&mut self) -> &mut Value {
+        match self {
+            SystemRun::FramePipeline(r) => &mut r.summary,
+        }
+    }
+
+    /// Writes the per-frame table as CSV.
+    pub fn write_frames_csv(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        match self {
+            SystemRun::FramePipeline(r) => frame_pipeline::records::write_frames_csv(&r.records, w),
+        }
+    }
+
+    /// The per-frame table (columns and rows), for experiments.
+    pub fn frame_table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
+        match self {
+            SystemRun::FramePipeline(r) => (
+                frame_pipeline::records::COLUMNS
+                    .iter()
+                    .map(|s| s.to_string())
+                    .collect(),
+                frame_pipeline::records::frame_rows(&r.records)
+                    .into_iter()
+                    .map(|row| row.to_vec())
+                    .collect(),
+            ),
+        }
+    }
+
+    /// The fully resolved model as TOML (runnable again); relative mesh
+    /// file paths are made absolute against `base_dir`.
+    pub fn resolved_model(&self, base_dir: &std::path::Path) -> String {
+        match self {
+            SystemRun::FramePipeline(r) => {
+                let mut cfg = r.config.clone();
+                if let frame_pipeline::config::WorkloadConfig::Scene(s) = &mut cfg.workload {
+                    for g in &mut s.groups {
+                        if let crate::scene::config::MeshRef::Spec(spec) = &mut g.mesh {
+                            let p = std::path::Path::new(spec.as_str());
+                            if (spec.ends_with(".obj") || spec.ends_with(".idx")) && p.is_relative()
+                            {
+                                let abs = base_dir.join(p);
+                                *spec = abs.canonicalize().unwrap_or(abs).display().to_string();
+                            }
+                        }
+                    }
+                }
+                let body = toml::to_string(&cfg)
+                    .unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
+                format!(
+                    "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
+                )
+            }
+        }
+    }
+
+    /// Writes a Chrome/Perfetto trace, if the run recorded one.
+    pub fn write_trace(&self, w: &mut dyn Write) -> std::io::Result<bool> {
+        match self {
+            SystemRun::FramePipeline(r) => crate::output::trace::write_pipeline_trace(r, w),
+        }
+    }
+}

@@ -18,15 +18,35 @@ use crate::engine::Time;
 use super::model::{CpuPhase, FramePipeline, FrontPhase};
 
 /// CPU states.
-pub const CPU_STATES: [&str; 5] = ["work", "system task", "wait: command FIFO full", "wait: frames in flight", "idle"];
+pub const CPU_STATES: [&str; 5] = [
+    "work",
+    "system task",
+    "wait: command FIFO full",
+    "wait: frames in flight",
+    "idle",
+];
 /// GPU front-end states.
-pub const FRONT_STATES: [&str; 6] = ["busy", "starved", "wait: swap image", "wait: pipeline drain", "wait: geometry", "system task"];
+pub const FRONT_STATES: [&str; 6] = [
+    "busy",
+    "starved",
+    "wait: swap image",
+    "wait: pipeline drain",
+    "wait: geometry",
+    "system task",
+];
 /// Geometry-stage states.
 pub const GEOM_STATES: [&str; 3] = ["busy", "blocked: triangle FIFO full", "idle"];
 /// Fragment-stage states.
 pub const FRAG_STATES: [&str; 2] = ["busy", "idle"];
 /// Bottleneck units.
-pub const BOTTLENECKS: [&str; 6] = ["cpu", "system", "gpu_front_end", "geometry", "fragment", "display"];
+pub const BOTTLENECKS: [&str; 6] = [
+    "cpu",
+    "system",
+    "gpu_front_end",
+    "geometry",
+    "fragment",
+    "display",
+];
 
 /// Trace tracks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -103,13 +123,25 @@ impl Accounting {
     }
 }
 
-fn set_traced<const N: usize>(clock: &mut StateClock<N>, now: Time, state: usize, track: Track, trace: &mut Option<TraceLog>, idle: usize) -> (usize, u64) {
+fn set_traced<const N: usize>(
+    clock: &mut StateClock<N>,
+    now: Time,
+    state: usize,
+    track: Track,
+    trace: &mut Option<TraceLog>,
+    idle: usize,
+) -> (usize, u64) {
     let old = clock.state();
     let since = clock.since();
     let spent = clock.set(now, state);
     if let Some(t) = trace {
         if old != state && old != idle && spent.0 > 0 {
-            t.spans.push(Span { track, state: old as u8, start: since, end: now });
+            t.spans.push(Span {
+                track,
+                state: old as u8,
+                start: since,
+                end: now,
+            });
         }
     }
     (old, spent.0)
@@ -156,7 +188,11 @@ impl FramePipeline {
             3
         } else if geom_state == 0 && frag_state == 0 {
             let depth = self.tri_fifo.capacity().max(1);
-            if self.tri_fifo.len() as u64 * 2 >= depth { 4 } else { 3 }
+            if self.tri_fifo.len() as u64 * 2 >= depth {
+                4
+            } else {
+                3
+            }
         } else if front_state == 5 {
             1
         } else if front_state == 0 {
@@ -188,16 +224,41 @@ impl FramePipeline {
             attribute_cpu(st, spent, a.cpu_frame);
             a.cpu_frame = self.cpu_frame;
         }
-        set_traced(&mut a.front, now, front_state, Track::Front, &mut a.trace, 1);
-        set_traced(&mut a.geom, now, geom_state, Track::Geometry, &mut a.trace, 2);
-        set_traced(&mut a.frag, now, frag_state, Track::Fragment, &mut a.trace, 1);
+        set_traced(
+            &mut a.front,
+            now,
+            front_state,
+            Track::Front,
+            &mut a.trace,
+            1,
+        );
+        set_traced(
+            &mut a.geom,
+            now,
+            geom_state,
+            Track::Geometry,
+            &mut a.trace,
+            2,
+        );
+        set_traced(
+            &mut a.frag,
+            now,
+            frag_state,
+            Track::Fragment,
+            &mut a.trace,
+            1,
+        );
         a.bottleneck.set(now, bottleneck);
         // GPU busy per frame (the frame the front end is on).
         let gpu_state = if gpu_busy { 0 } else { 1 };
         let old = a.gpu.state();
         let spent = a.gpu.set(now, gpu_state).0;
         let frame_changed = self.gpu_frame != a.gpu_frame && self.gpu_frame.is_some();
-        let spent = if frame_changed && old == gpu_state { spent + a.gpu.split(now).0 } else { spent };
+        let spent = if frame_changed && old == gpu_state {
+            spent + a.gpu.split(now).0
+        } else {
+            spent
+        };
         if old == 0 {
             if let Some(r) = a.gpu_frame.and_then(|f| self.records.get_mut(f as usize)) {
                 r.gpu_busy += spent;

@@ -51,9 +51,19 @@ pub fn expected_max_normal(a: f64, m: f64, s: f64) -> f64 {
 
 /// The draw's times: `n` triangles, total geometry time `geometry`, triangle
 /// areas from `pixels`, `cost_per_pixel` picoseconds, FIFO depth `depth`.
-pub fn draw_times(n: u64, geometry: Duration, pixels: &Dist<f64>, cost_per_pixel: f64, depth: u32) -> DrawTimes {
+pub fn draw_times(
+    n: u64,
+    geometry: Duration,
+    pixels: &Dist<f64>,
+    cost_per_pixel: f64,
+    depth: u32,
+) -> DrawTimes {
     if n == 0 {
-        return DrawTimes { geometry, fragment: Duration::ZERO, total: geometry };
+        return DrawTimes {
+            geometry,
+            fragment: Duration::ZERO,
+            total: geometry,
+        };
     }
     let g_total = geometry.0 as f64;
     let mean_px = pixels.mean();
@@ -72,10 +82,18 @@ pub fn draw_times(n: u64, geometry: Duration, pixels: &Dist<f64>, cost_per_pixel
     };
     let lower = (g_total + f_mean).max(g + f_total).min(g_total + f_total);
     let upper = g_total + f_total;
-    let total = if windowed.is_finite() { windowed.clamp(lower, upper) } else { upper };
+    let total = if windowed.is_finite() {
+        windowed.clamp(lower, upper)
+    } else {
+        upper
+    };
     let fragment = Duration::from_ps_f64(f_total);
     let total = Duration::from_ps_f64(total).max(geometry).max(fragment);
-    DrawTimes { geometry, fragment, total }
+    DrawTimes {
+        geometry,
+        fragment,
+        total,
+    }
 }
 
 #[cfg(test)]
@@ -85,7 +103,13 @@ mod tests {
     #[test]
     fn balanced_constant_triangles_overlap() {
         // 1000 triangles, g = 10 ps, f = 10 ps each: deep FIFO -> max + fill.
-        let t = draw_times(1000, Duration(10_000), &Dist::Const { value: 10.0 }, 1.0, 1000);
+        let t = draw_times(
+            1000,
+            Duration(10_000),
+            &Dist::Const { value: 10.0 },
+            1.0,
+            1000,
+        );
         assert_eq!(t.total, Duration(10_010));
     }
 
@@ -99,7 +123,10 @@ mod tests {
 
     #[test]
     fn between_max_and_sum() {
-        let px = Dist::Lognormal { median: 10.0, sigma: 1.5 };
+        let px = Dist::Lognormal {
+            median: 10.0,
+            sigma: 1.5,
+        };
         for depth in [0, 1, 4, 16, 256] {
             let t = draw_times(5000, Duration(5000 * 30), &px, 3.0, depth);
             let lo = t.geometry.max(t.fragment);

@@ -14,8 +14,8 @@ use crate::components::noise::NoiseTarget;
 use crate::components::swap_chain::PresentMode;
 use crate::components::vertex_cache::CachePolicy;
 use crate::config::{Bandwidth, Bytes, Rate};
-pub use crate::scene::config::SceneWorkload;
 use crate::engine::Duration;
+pub use crate::scene::config::SceneWorkload;
 
 /// How finely the GPU's geometry and fragment work is simulated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -88,7 +88,12 @@ pub struct RunConfig {
 
 impl Default for RunConfig {
     fn default() -> Self {
-        RunConfig { frames: 600, warmup_frames: 0, seed: 1, max_events: None }
+        RunConfig {
+            frames: 600,
+            warmup_frames: 0,
+            seed: 1,
+            max_events: None,
+        }
     }
 }
 
@@ -133,7 +138,9 @@ impl Default for CpuConfig {
     fn default() -> Self {
         CpuConfig {
             input_sampling: Duration::ZERO,
-            non_render: Dist::Const { value: Duration::ZERO },
+            non_render: Dist::Const {
+                value: Duration::ZERO,
+            },
             per_object: Duration::ZERO,
             per_draw: Duration::ZERO,
             state_change: StateCosts::default(),
@@ -154,7 +161,9 @@ pub struct BusConfig {
 
 impl Default for BusConfig {
     fn default() -> Self {
-        BusConfig { bandwidth: Bandwidth::parse("4GB/s").expect("valid literal") }
+        BusConfig {
+            bandwidth: Bandwidth::parse("4GB/s").expect("valid literal"),
+        }
     }
 }
 
@@ -176,7 +185,13 @@ pub struct CommandBytes {
 
 impl Default for CommandBytes {
     fn default() -> Self {
-        CommandBytes { draw: Bytes(32), state: Bytes(16), clear: Bytes(16), swap: Bytes(16), upload: Bytes(32) }
+        CommandBytes {
+            draw: Bytes(32),
+            state: Bytes(16),
+            clear: Bytes(16),
+            swap: Bytes(16),
+            upload: Bytes(32),
+        }
     }
 }
 
@@ -194,7 +209,11 @@ pub struct CommandFifoConfig {
 
 impl Default for CommandFifoConfig {
     fn default() -> Self {
-        CommandFifoConfig { capacity: 1024, unit: FifoUnit::Entries, bytes: CommandBytes::default() }
+        CommandFifoConfig {
+            capacity: 1024,
+            unit: FifoUnit::Entries,
+            bytes: CommandBytes::default(),
+        }
     }
 }
 
@@ -256,7 +275,11 @@ pub struct FragmentConfig {
 
 impl Default for FragmentConfig {
     fn default() -> Self {
-        FragmentConfig { fifo_depth: 16, per_fragment: Duration::ZERO, per_rejected_fragment: Duration::ZERO }
+        FragmentConfig {
+            fifo_depth: 16,
+            per_fragment: Duration::ZERO,
+            per_rejected_fragment: Duration::ZERO,
+        }
     }
 }
 
@@ -367,4 +390,3 @@ pub struct FixedWorkload {
     /// GPU time per frame (run on the GPU front end as one command).
     pub gpu: Dist<Duration>,
 }
-

@@ -71,7 +71,9 @@ impl FramePipeline {
             Op::Clear => CpuPhase::Push(Command::Clear { frame }),
             Op::Fixed => {
                 let gpu = match &mut self.program {
-                    Program::Fixed { gpu, gpu_rng, .. } => Duration::from_ps_f64(gpu.sample(gpu_rng)),
+                    Program::Fixed { gpu, gpu_rng, .. } => {
+                        Duration::from_ps_f64(gpu.sample(gpu_rng))
+                    }
                     Program::Scene(_) => Duration::ZERO,
                 };
                 CpuPhase::Push(Command::Fixed { frame, gpu })
@@ -103,7 +105,11 @@ impl FramePipeline {
 
     /// Advances the CPU thread as far as it can go now. Returns whether
     /// anything changed.
-    pub(super) fn cpu_step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, PipelineError> {
+    pub(super) fn cpu_step(
+        &mut self,
+        now: Time,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<bool, PipelineError> {
         let mut progressed = false;
         loop {
             match self.cpu_phase {
@@ -140,7 +146,11 @@ impl FramePipeline {
                     }
                     self.fifo.push(c, w);
                     self.commands_issued += 1;
-                    self.cpu_phase = if self.fifo.over_capacity() { CpuPhase::Rendezvous } else { self.cpu_advance(now) };
+                    self.cpu_phase = if self.fifo.over_capacity() {
+                        CpuPhase::Rendezvous
+                    } else {
+                        self.cpu_advance(now)
+                    };
                 }
                 CpuPhase::Rendezvous => {
                     if self.fifo.over_capacity() {

@@ -15,12 +15,20 @@ use super::model::{ActiveDraw, Command, Ev, FramePipeline, FrontPhase, PipelineE
 impl FramePipeline {
     /// True when no triangle is anywhere between front end and fragment output.
     pub(super) fn pipeline_drained(&self) -> bool {
-        self.geom_draw.is_none() && self.geom_held.is_none() && self.tri_fifo.is_empty() && !self.frag_busy && !self.geom_busy
+        self.geom_draw.is_none()
+            && self.geom_held.is_none()
+            && self.tri_fifo.is_empty()
+            && !self.frag_busy
+            && !self.geom_busy
     }
 
     /// Advances the front end as far as it can go now. Returns whether
     /// anything changed.
-    pub(super) fn front_step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, PipelineError> {
+    pub(super) fn front_step(
+        &mut self,
+        now: Time,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<bool, PipelineError> {
         let mut progressed = false;
         loop {
             match self.front_phase {
@@ -41,7 +49,12 @@ impl FramePipeline {
                     if !self.pipeline_drained() {
                         return Ok(progressed);
                     }
-                    let work = self.cfg.gpu.swap.checked_add(self.cfg.gpu.command).unwrap_or(Duration(u64::MAX));
+                    let work = self
+                        .cfg
+                        .gpu
+                        .swap
+                        .checked_add(self.cfg.gpu.command)
+                        .unwrap_or(Duration(u64::MAX));
                     self.front_phase = self.front_job(now, c, work, s)?;
                 }
                 FrontPhase::Handoff(c) => {
@@ -59,7 +72,12 @@ impl FramePipeline {
         }
     }
 
-    fn front_begin(&mut self, now: Time, c: Command, s: &mut Scheduler<Ev>) -> Result<FrontPhase, PipelineError> {
+    fn front_begin(
+        &mut self,
+        now: Time,
+        c: Command,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<FrontPhase, PipelineError> {
         let cmd_cost = self.cfg.gpu.command;
         match c {
             Command::Clear { .. } => {
@@ -84,18 +102,34 @@ impl FramePipeline {
         }
     }
 
-    fn front_start_clear(&mut self, now: Time, c: Command, s: &mut Scheduler<Ev>) -> Result<FrontPhase, PipelineError> {
+    fn front_start_clear(
+        &mut self,
+        now: Time,
+        c: Command,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<FrontPhase, PipelineError> {
         if let Command::Clear { frame } = c {
             self.gpu_frame = Some(frame);
             self.records[frame as usize].gpu_start = Some(now);
         }
-        let work = self.cfg.gpu.clear.checked_add(self.cfg.gpu.command).unwrap_or(Duration(u64::MAX));
+        let work = self
+            .cfg
+            .gpu
+            .clear
+            .checked_add(self.cfg.gpu.command)
+            .unwrap_or(Duration(u64::MAX));
         self.front_job(now, c, work, s)
     }
 
     /// Runs `work` for command `c` on the (preemptible) front end; zero work
     /// completes at once.
-    fn front_job(&mut self, now: Time, c: Command, work: Duration, s: &mut Scheduler<Ev>) -> Result<FrontPhase, PipelineError> {
+    fn front_job(
+        &mut self,
+        now: Time,
+        c: Command,
+        work: Duration,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<FrontPhase, PipelineError> {
         if work.0 > 0 || self.front.in_system() {
             let w = self.front.start_job(now, work)?;
             Self::schedule_wake(s, w, false);
@@ -123,19 +157,34 @@ impl FramePipeline {
         })
     }
 
-    fn geom_start_draw(&mut self, now: Time, draw: u32, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    fn geom_start_draw(
+        &mut self,
+        now: Time,
+        draw: u32,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), PipelineError> {
         let Program::Scene(sc) = &self.program else {
             return Ok(());
         };
         let d = &sc.draws[draw as usize];
         let mesh = &sc.meshes[d.mesh as usize];
         let triangles = mesh.triangles;
-        self.geom_draw = Some(ActiveDraw { draw, next: 0, triangles });
+        self.geom_draw = Some(ActiveDraw {
+            draw,
+            next: 0,
+            triangles,
+        });
         match self.cfg.fidelity {
             Fidelity::Triangle => self.geom_next_triangle(now, s),
             Fidelity::Draw => {
                 let g = &sc.groups[d.group as usize];
-                let t = draw_times(triangles, mesh.geometry_time, &g.pixels, g.cost_per_pixel, self.cfg.gpu.fragment.fifo_depth);
+                let t = draw_times(
+                    triangles,
+                    mesh.geometry_time,
+                    &g.pixels,
+                    g.cost_per_pixel,
+                    self.cfg.gpu.fragment.fifo_depth,
+                );
                 if t.geometry.0 > 0 {
                     self.geom_busy = true;
                     s.after(t.geometry, Ev::DrawGeometry, "draw geometry")?;
@@ -160,7 +209,11 @@ impl FramePipeline {
     }
 
     /// Starts the next triangle of the current draw, or finishes the draw.
-    fn geom_next_triangle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    fn geom_next_triangle(
+        &mut self,
+        now: Time,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), PipelineError> {
         let Some(a) = self.geom_draw else {
             return Ok(());
         };
@@ -174,7 +227,11 @@ impl FramePipeline {
         let mesh = &sc.meshes[sc.draws[a.draw as usize].mesh as usize];
         let geo = &self.cfg.gpu.geometry;
         let tv = mesh.misses.of(a.next, a.triangles);
-        let fetch = if mesh.indices > 0 { 3 * geo.index_fetch.0 } else { 0 };
+        let fetch = if mesh.indices > 0 {
+            3 * geo.index_fetch.0
+        } else {
+            0
+        };
         let g = Duration(fetch + tv * geo.vertex_shader.0 + geo.triangle_setup.0);
         self.geom_busy = true;
         s.at(now.add(g, "geometry of a triangle")?, Ev::GeomTriangle);
@@ -182,7 +239,11 @@ impl FramePipeline {
     }
 
     /// `triangle` fidelity: a triangle left the geometry stage.
-    pub(super) fn geom_triangle_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    pub(super) fn geom_triangle_done(
+        &mut self,
+        now: Time,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), PipelineError> {
         self.geom_busy = false;
         let Some(a) = self.geom_draw.as_mut() else {
             return Ok(());
@@ -206,14 +267,23 @@ impl FramePipeline {
         self.geom_next_triangle(now, s)
     }
 
-    fn frag_start(&mut self, now: Time, f: Duration, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    fn frag_start(
+        &mut self,
+        now: Time,
+        f: Duration,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), PipelineError> {
         self.frag_busy = true;
         s.at(now.add(f, "fragments of a triangle")?, Ev::FragTriangle);
         Ok(())
     }
 
     /// `triangle` fidelity: the fragment stage finished a triangle.
-    pub(super) fn frag_triangle_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    pub(super) fn frag_triangle_done(
+        &mut self,
+        now: Time,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), PipelineError> {
         self.frag_busy = false;
         if let Some(f) = self.tri_fifo.pop() {
             self.frag_start(now, f, s)?;

@@ -1,2 +1,28 @@
-//! frame pipeline
+//! The single-GPU frame pipeline (paper 000 §3-4, Figure 4; paper 004 §4):
+//! CPU thread -> command FIFO -> GPU front end -> geometry -> triangle FIFO
+//! -> fragment -> swap chain -> display, with system-task noise.
+//!
+//! - `config`: the model file;
+//! - `workload`: compiling scenes into draws and meshes;
+//! - `model`: the kernel model (state and event dispatch);
+//! - `cpu`, `gpu`, `display`: the units' event handlers;
+//! - `closed_form`: the `draw`-fidelity formula;
+//! - `accounting`: state clocks, bottleneck attribution, trace timeline;
+//! - `records`: per-frame records and the PresentMon-style table;
+//! - `run`: validate, build, run, summarize.
+
+pub mod accounting;
+pub mod closed_form;
 pub mod config;
+mod cpu;
+mod display;
+mod gpu;
+pub mod isolate;
+pub mod model;
+pub mod records;
+pub mod run;
+pub mod workload;
+
+pub use config::{Fidelity, FramePipelineConfig};
+pub use model::{FramePipeline, PipelineError};
+pub use run::{PipelineRun, run_pipeline, validate};

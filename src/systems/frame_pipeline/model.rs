@@ -13,7 +13,10 @@ use crate::components::fifo::{BoundedFifo, FifoUnit};
 use crate::components::noise::{Arrivals, NoiseSource, NoiseTarget};
 use crate::components::preemptible::{Preemptible, Wake};
 use crate::components::swap_chain::{PresentMode, SwapChain};
-use crate::engine::{Control, Duration, EngineError, EventKind, Model, RngStreams, Scheduler, StreamRng, Time, TimeError};
+use crate::engine::{
+    Control, Duration, EngineError, EventKind, Model, RngStreams, Scheduler, StreamRng, Time,
+    TimeError,
+};
 
 use super::accounting::Accounting;
 use super::config::{Fidelity, FramePipelineConfig, WorkloadConfig};
@@ -254,7 +257,11 @@ pub struct ActiveDraw {
 
 impl FramePipeline {
     /// Builds the system from a validated model and its compiled workload.
-    pub fn new(cfg: FramePipelineConfig, scene: Option<SceneProgram>, trace: bool) -> Result<Self, PipelineError> {
+    pub fn new(
+        cfg: FramePipelineConfig,
+        scene: Option<SceneProgram>,
+        trace: bool,
+    ) -> Result<Self, PipelineError> {
         let streams = RngStreams::new(cfg.run.seed);
         let program = match (&cfg.workload, scene) {
             (WorkloadConfig::Fixed(f), _) => Program::Fixed {
@@ -265,35 +272,66 @@ impl FramePipeline {
             },
             (WorkloadConfig::Scene(_), Some(s)) => Program::Scene(s),
             (WorkloadConfig::Scene(_), None) => {
-                return Err(PipelineError::Invalid { key: "workload".into(), message: "scene not compiled".into() });
+                return Err(PipelineError::Invalid {
+                    key: "workload".into(),
+                    message: "scene not compiled".into(),
+                });
             }
         };
         let mut noise = Vec::new();
         if cfg.noise.enabled {
-            for (i, p) in cfg.noise.periodic.iter().enumerate().filter(|(_, p)| p.enabled) {
+            for (i, p) in cfg
+                .noise
+                .periodic
+                .iter()
+                .enumerate()
+                .filter(|(_, p)| p.enabled)
+            {
                 let src = NoiseSource::new(
                     p.name.clone(),
                     p.target,
-                    Arrivals::Periodic { period: p.period, phase: p.phase, jitter: p.jitter },
+                    Arrivals::Periodic {
+                        period: p.period,
+                        phase: p.phase,
+                        jitter: p.jitter,
+                    },
                     p.duration.clone(),
                     streams.stream(&format!("noise.{}", p.name)),
                 )
-                .map_err(|e| PipelineError::Invalid { key: format!("noise.periodic.{i}"), message: e.to_string() })?;
+                .map_err(|e| PipelineError::Invalid {
+                    key: format!("noise.periodic.{i}"),
+                    message: e.to_string(),
+                })?;
                 noise.push(src);
             }
-            for (i, r) in cfg.noise.random.iter().enumerate().filter(|(_, r)| r.enabled) {
+            for (i, r) in cfg
+                .noise
+                .random
+                .iter()
+                .enumerate()
+                .filter(|(_, r)| r.enabled)
+            {
                 let src = NoiseSource::new(
                     r.name.clone(),
                     r.target,
-                    Arrivals::Poisson { mean_gap: r.rate.period },
+                    Arrivals::Poisson {
+                        mean_gap: r.rate.period,
+                    },
                     r.duration.clone(),
                     streams.stream(&format!("noise.{}", r.name)),
                 )
-                .map_err(|e| PipelineError::Invalid { key: format!("noise.random.{i}"), message: e.to_string() })?;
+                .map_err(|e| PipelineError::Invalid {
+                    key: format!("noise.random.{i}"),
+                    message: e.to_string(),
+                })?;
                 noise.push(src);
             }
         }
-        let mode = if cfg.display.vsync { cfg.display.present_mode } else { PresentMode::Immediate };
+        let mode = if cfg.display.vsync {
+            cfg.display.present_mode
+        } else {
+            PresentMode::Immediate
+        };
         let fifo_cap = cfg.command_fifo.capacity;
         let frames_total = cfg.run.frames;
         Ok(FramePipeline {
@@ -352,14 +390,20 @@ impl FramePipeline {
         let b = &self.cfg.command_fifo.bytes;
         match self.cfg.command_fifo.unit {
             FifoUnit::Entries => match c {
-                Command::Draw { draw, .. } => self.scene().map(|s| s.draws[*draw as usize].commands as u64).unwrap_or(1),
+                Command::Draw { draw, .. } => self
+                    .scene()
+                    .map(|s| s.draws[*draw as usize].commands as u64)
+                    .unwrap_or(1),
                 _ => 1,
             },
             FifoUnit::Bytes => match c {
                 Command::Clear { .. } => b.clear.0,
                 Command::Swap { .. } => b.swap.0,
                 Command::Fixed { .. } => b.draw.0,
-                Command::Draw { draw, .. } => self.scene().map(|s| s.draws[*draw as usize].bytes).unwrap_or(b.draw.0),
+                Command::Draw { draw, .. } => self
+                    .scene()
+                    .map(|s| s.draws[*draw as usize].bytes)
+                    .unwrap_or(b.draw.0),
             },
         }
     }
@@ -423,11 +467,23 @@ impl FramePipeline {
 
     pub(super) fn schedule_wake(s: &mut Scheduler<Ev>, w: Wake, cpu: bool) {
         if let Wake::JobAt(t, tag) = w {
-            s.at(t, if cpu { Ev::CpuDone { tag } } else { Ev::FrontDone { tag } });
+            s.at(
+                t,
+                if cpu {
+                    Ev::CpuDone { tag }
+                } else {
+                    Ev::FrontDone { tag }
+                },
+            );
         }
     }
 
-    fn noise_arrive(&mut self, now: Time, source: u16, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    fn noise_arrive(
+        &mut self,
+        now: Time,
+        source: u16,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), PipelineError> {
         let src = &mut self.noise[source as usize];
         let d = src.draw_duration();
         let target = src.target;
@@ -443,7 +499,12 @@ impl FramePipeline {
         Ok(())
     }
 
-    fn noise_end(&mut self, now: Time, target: NoiseTarget, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    fn noise_end(
+        &mut self,
+        now: Time,
+        target: NoiseTarget,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), PipelineError> {
         let unit = match target {
             NoiseTarget::Cpu => &mut self.cpu,
             NoiseTarget::Gpu => &mut self.front,
@@ -461,7 +522,12 @@ impl Model for FramePipeline {
     type Event = Ev;
     type Error = PipelineError;
 
-    fn handle(&mut self, now: Time, ev: Ev, s: &mut Scheduler<Ev>) -> Result<Control, PipelineError> {
+    fn handle(
+        &mut self,
+        now: Time,
+        ev: Ev,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<Control, PipelineError> {
         match ev {
             Ev::CpuDone { tag } => {
                 if self.cpu.complete(tag) {
@@ -484,6 +550,10 @@ impl Model for FramePipeline {
         }
         self.settle(now, s)?;
         self.account(now);
-        Ok(if self.done() { Control::Stop } else { Control::Continue })
+        Ok(if self.done() {
+            Control::Stop
+        } else {
+            Control::Continue
+        })
     }
 }

@@ -15,6 +15,8 @@
 //! - `MsBetweenDisplayChange`: this frame's appearance to the previous one's;
 //! - `Dropped`: 1 if the frame was never shown.
 
+use std::io::Write;
+
 use crate::engine::{PS_PER_MS, Time};
 
 /// One frame's timeline.
@@ -110,10 +112,16 @@ pub fn frame_rows(records: &[FrameRecord]) -> Vec<[f64; 14]> {
             ms(end.since(r.start).0),
             ms(r.cpu_busy),
             ms(r.cpu_wait),
-            r.gpu_start.map(|g| ms(g.since(r.start).0)).unwrap_or(f64::NAN),
+            r.gpu_start
+                .map(|g| ms(g.since(r.start).0))
+                .unwrap_or(f64::NAN),
             gpu_time,
             ms(r.gpu_busy),
-            if gpu_time.is_nan() { f64::NAN } else { gpu_time - ms(r.gpu_busy) },
+            if gpu_time.is_nan() {
+                f64::NAN
+            } else {
+                gpu_time - ms(r.gpu_busy)
+            },
             until,
             latency,
             between,

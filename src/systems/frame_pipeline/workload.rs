@@ -31,7 +31,10 @@ pub enum WorkloadError {
 }
 
 fn invalid(key: impl Into<String>, message: impl Into<String>) -> WorkloadError {
-    WorkloadError::Invalid { key: key.into(), message: message.into() }
+    WorkloadError::Invalid {
+        key: key.into(),
+        message: message.into(),
+    }
 }
 
 /// How many vertices each triangle of a mesh transforms.
@@ -163,31 +166,48 @@ pub fn early_z_pass(order: DepthOrder, d: f64) -> f64 {
 }
 
 fn mul(d: Duration, n: u64, key: &str) -> Result<Duration, WorkloadError> {
-    d.checked_mul(n).ok_or_else(|| invalid(key, "cost x count overflows the 64-bit picosecond range"))
+    d.checked_mul(n)
+        .ok_or_else(|| invalid(key, "cost x count overflows the 64-bit picosecond range"))
 }
 fn add(a: Duration, b: Duration, key: &str) -> Result<Duration, WorkloadError> {
-    a.checked_add(b).ok_or_else(|| invalid(key, "sum of costs overflows the 64-bit picosecond range"))
+    a.checked_add(b)
+        .ok_or_else(|| invalid(key, "sum of costs overflows the 64-bit picosecond range"))
 }
 
 /// Compiles the scene workload of `cfg`.
-pub fn compile_scene(cfg: &FramePipelineConfig, scene: &SceneWorkload, base_dir: &Path) -> Result<SceneProgram, WorkloadError> {
+pub fn compile_scene(
+    cfg: &FramePipelineConfig,
+    scene: &SceneWorkload,
+    base_dir: &Path,
+) -> Result<SceneProgram, WorkloadError> {
     if !(scene.depth_complexity.is_finite() && scene.depth_complexity >= 1.0) {
-        return Err(invalid("workload.depth_complexity", format!("must be a number >= 1, got {}", scene.depth_complexity)));
+        return Err(invalid(
+            "workload.depth_complexity",
+            format!("must be a number >= 1, got {}", scene.depth_complexity),
+        ));
     }
     if !(scene.scale.is_finite() && scene.scale > 0.0) {
-        return Err(invalid("workload.scale", format!("must be a number > 0, got {}", scene.scale)));
+        return Err(invalid(
+            "workload.scale",
+            format!("must be a number > 0, got {}", scene.scale),
+        ));
     }
     let mut groups_cfg = Vec::new();
     if let Some(p) = &scene.preset {
-        let g = preset_groups(p, scene.scale)
-            .ok_or_else(|| invalid("workload.preset", format!("unknown preset {p:?} (known: {})", PRESETS.join(", "))))?;
+        let g = preset_groups(p, scene.scale).ok_or_else(|| {
+            invalid(
+                "workload.preset",
+                format!("unknown preset {p:?} (known: {})", PRESETS.join(", ")),
+            )
+        })?;
         groups_cfg.extend(g);
     }
     groups_cfg.extend(scene.groups.iter().cloned());
 
     let pass = early_z_pass(scene.depth_order, scene.depth_complexity);
     let frag = &cfg.gpu.fragment;
-    let cost_per_pixel = pass * frag.per_fragment.0 as f64 + (1.0 - pass) * frag.per_rejected_fragment.0 as f64;
+    let cost_per_pixel =
+        pass * frag.per_fragment.0 as f64 + (1.0 - pass) * frag.per_rejected_fragment.0 as f64;
     let geo = &cfg.gpu.geometry;
     let need_per_triangle = cfg.fidelity == Fidelity::Triangle;
 
@@ -200,14 +220,21 @@ pub fn compile_scene(cfg: &FramePipelineConfig, scene: &SceneWorkload, base_dir:
 
     for (gi, g) in groups_cfg.iter().enumerate() {
         let key = if gi >= groups_cfg.len() - scene.groups.len() {
-            format!("workload.groups.{}", gi - (groups_cfg.len() - scene.groups.len()))
+            format!(
+                "workload.groups.{}",
+                gi - (groups_cfg.len() - scene.groups.len())
+            )
         } else {
             format!("workload.preset ({})", g.name)
         };
         g.triangle_pixels
             .validate()
             .map_err(|e| invalid(format!("{key}.triangle_pixels"), e.to_string()))?;
-        for (what, v) in [("shaders", g.shaders), ("textures", g.textures), ("materials", g.materials)] {
+        for (what, v) in [
+            ("shaders", g.shaders),
+            ("textures", g.textures),
+            ("materials", g.materials),
+        ] {
             if v == 0 {
                 return Err(invalid(format!("{key}.{what}"), "must be at least 1"));
             }
@@ -216,19 +243,37 @@ pub fn compile_scene(cfg: &FramePipelineConfig, scene: &SceneWorkload, base_dir:
         let mesh_id = match mesh_ids.get(&mesh_key) {
             Some(&id) => id,
             None => {
-                let info = build_mesh(&g.mesh, g.indexed, &geo.vertex_cache, need_per_triangle, base_dir, &key)?;
+                let info = build_mesh(
+                    &g.mesh,
+                    g.indexed,
+                    &geo.vertex_cache,
+                    need_per_triangle,
+                    base_dir,
+                    &key,
+                )?;
                 let geometry_time = add(
-                    add(mul(geo.index_fetch, info.indices, &key)?, mul(geo.vertex_shader, info.transformed, &key)?, &key)?,
+                    add(
+                        mul(geo.index_fetch, info.indices, &key)?,
+                        mul(geo.vertex_shader, info.transformed, &key)?,
+                        &key,
+                    )?,
                     mul(geo.triangle_setup, info.triangles, &key)?,
                     &key,
                 )?;
-                meshes.push(MeshInfo { geometry_time, ..info });
+                meshes.push(MeshInfo {
+                    geometry_time,
+                    ..info
+                });
                 let id = (meshes.len() - 1) as u32;
                 mesh_ids.insert(mesh_key, id);
                 id
             }
         };
-        groups.push(GroupInfo { name: g.name.clone(), pixels: g.triangle_pixels.clone(), cost_per_pixel });
+        groups.push(GroupInfo {
+            name: g.name.clone(),
+            pixels: g.triangle_pixels.clone(),
+            cost_per_pixel,
+        });
         for i in 0..g.count {
             objects.push((
                 gi as u32,
@@ -252,7 +297,10 @@ pub fn compile_scene(cfg: &FramePipelineConfig, scene: &SceneWorkload, base_dir:
     let cpu = &cfg.cpu;
     let gpu = &cfg.gpu;
     let bytes = &cfg.command_fifo.bytes;
-    let mut stats = SceneStats { early_z_pass: pass, ..Default::default() };
+    let mut stats = SceneStats {
+        early_z_pass: pass,
+        ..Default::default()
+    };
     let mut draws = Vec::with_capacity(objects.len());
     let mut prev: Option<(u64, u64, u64)> = None;
     for o in &objects {
@@ -264,8 +312,18 @@ pub fn compile_scene(cfg: &FramePipelineConfig, scene: &SceneWorkload, base_dir:
             matrix,
         ];
         prev = Some((sh, tx, mt));
-        let cpu_costs = [cpu.state_change.shader, cpu.state_change.texture, cpu.state_change.material, cpu.state_change.matrix];
-        let gpu_costs = [gpu.state_change.shader, gpu.state_change.texture, gpu.state_change.material, gpu.state_change.matrix];
+        let cpu_costs = [
+            cpu.state_change.shader,
+            cpu.state_change.texture,
+            cpu.state_change.material,
+            cpu.state_change.matrix,
+        ];
+        let gpu_costs = [
+            gpu.state_change.shader,
+            gpu.state_change.texture,
+            gpu.state_change.material,
+            gpu.state_change.matrix,
+        ];
         let mut c = add(cpu.per_object, cpu.per_draw, "cpu")?;
         let mut f = Duration::ZERO;
         let mut commands = 1u32;
@@ -289,14 +347,30 @@ pub fn compile_scene(cfg: &FramePipelineConfig, scene: &SceneWorkload, base_dir:
             b += bytes.upload.0;
             stats.upload_bytes += up;
         }
-        f = add(f, mul(gpu.command, commands as u64, "gpu.command")?, "gpu.command")?;
+        f = add(
+            f,
+            mul(gpu.command, commands as u64, "gpu.command")?,
+            "gpu.command",
+        )?;
         let m = &meshes[mesh as usize];
         stats.objects += 1;
         stats.triangles += m.triangles;
         stats.transformed_vertices += m.transformed;
-        draws.push(DrawItem { group, mesh, cpu: c, front: f, commands, bytes: b });
+        draws.push(DrawItem {
+            group,
+            mesh,
+            cpu: c,
+            front: f,
+            commands,
+            bytes: b,
+        });
     }
-    Ok(SceneProgram { draws, meshes, groups, stats })
+    Ok(SceneProgram {
+        draws,
+        meshes,
+        groups,
+        stats,
+    })
 }
 
 fn build_mesh(
@@ -310,7 +384,10 @@ fn build_mesh(
     match mesh {
         MeshRef::Stats { triangles, acmr } => {
             if !(acmr.is_finite() && (0.0..=3.0).contains(acmr)) {
-                return Err(invalid(format!("{key}.mesh.acmr"), format!("must be between 0 and 3, got {acmr}")));
+                return Err(invalid(
+                    format!("{key}.mesh.acmr"),
+                    format!("must be between 0 and 3, got {acmr}"),
+                ));
             }
             let (transformed, misses) = if indexed {
                 let tv = (*acmr * *triangles as f64).round() as u64;
@@ -322,20 +399,29 @@ fn build_mesh(
                 name: format!("{triangles} triangles, acmr {acmr}"),
                 triangles: *triangles,
                 transformed,
-                indices: if indexed { triangles.saturating_mul(3) } else { 0 },
+                indices: if indexed {
+                    triangles.saturating_mul(3)
+                } else {
+                    0
+                },
                 misses,
                 geometry_time: Duration::ZERO,
             })
         }
         MeshRef::Spec(spec) => {
-            let m = mesh_from_spec(spec, base_dir).map_err(|e| invalid(format!("{key}.mesh"), e.to_string()))?;
+            let m = mesh_from_spec(spec, base_dir)
+                .map_err(|e| invalid(format!("{key}.mesh"), e.to_string()))?;
             let triangles = m.triangles();
             if !indexed || *policy == CachePolicy::None {
                 return Ok(MeshInfo {
                     name: spec.clone(),
                     triangles,
                     transformed: triangles * 3,
-                    indices: if indexed { m.cache_stats(&CachePolicy::None).indices } else { 0 },
+                    indices: if indexed {
+                        m.cache_stats(&CachePolicy::None).indices
+                    } else {
+                        0
+                    },
                     misses: Misses::Constant(3),
                     geometry_time: Duration::ZERO,
                 });
@@ -347,9 +433,22 @@ fn build_mesh(
                 (tv, Misses::PerTriangle(v), idx)
             } else {
                 let s = m.cache_stats(policy);
-                (s.transformed, Misses::Spread { transformed: s.transformed }, s.indices)
+                (
+                    s.transformed,
+                    Misses::Spread {
+                        transformed: s.transformed,
+                    },
+                    s.indices,
+                )
             };
-            Ok(MeshInfo { name: spec.clone(), triangles, transformed, indices, misses, geometry_time: Duration::ZERO })
+            Ok(MeshInfo {
+                name: spec.clone(),
+                triangles,
+                transformed,
+                indices,
+                misses,
+                geometry_time: Duration::ZERO,
+            })
         }
     }
 }
@@ -363,7 +462,10 @@ mod tests {
         assert_eq!(early_z_pass(DepthOrder::FrontToBack, 4.0), 0.25);
         assert_eq!(early_z_pass(DepthOrder::BackToFront, 4.0), 1.0);
         let r = early_z_pass(DepthOrder::Random, 4.0);
-        assert!((r - (1.0 + 0.5 + 1.0 / 3.0 + 0.25) / 4.0).abs() < 1e-9, "{r}");
+        assert!(
+            (r - (1.0 + 0.5 + 1.0 / 3.0 + 0.25) / 4.0).abs() < 1e-9,
+            "{r}"
+        );
         assert!((early_z_pass(DepthOrder::Random, 1.0) - 1.0).abs() < 1e-12);
     }
 

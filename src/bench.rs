@@ -1,0 +1,222 @@
+//! Speed benchmarks behind `rendersim bench` (and `cargo bench`): each prints
+//! its rate next to a baseline measured in the same run, as a ratio.
+//!
+//! - `kernel`: the classic hold model (a fixed population of pending events;
+//!   each handled event schedules one more at a random later time) through
+//!   the engine, against a bare `BinaryHeap` loop doing the same work.
+//! - `pipeline`: one frame of about one million triangles at `triangle`
+//!   fidelity against the same frame at `draw` fidelity.
+//! - `hour`: one simulated hour of the default (noisy, 60 Hz) model at `draw`
+//!   fidelity.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+use std::time::Instant;
+
+use rand::Rng;
+
+use crate::config::{ModelSource, apply_set};
+use crate::engine::{
+    Control, Duration, EngineError, EventKind, Limits, Model, RngStreams, Scheduler, StreamRng,
+    Time, run,
+};
+use crate::systems::{DEFAULT_MODEL, run_model};
+
+/// Hold-model event.
+#[derive(Debug, Clone, Copy)]
+pub struct Hold;
+
+impl EventKind for Hold {
+    const NAMES: &'static [&'static str] = &["hold"];
+    #[inline]
+    fn kind(&self) -> usize {
+        0
+    }
+}
+
+struct HoldModel {
+    rng: StreamRng,
+}
+
+impl Model for HoldModel {
+    type Event = Hold;
+    type Error = EngineError;
+    #[inline]
+    fn handle(
+        &mut self,
+        now: Time,
+        ev: Hold,
+        s: &mut Scheduler<Hold>,
+    ) -> Result<Control, EngineError> {
+        let d = self.rng.random_range(1..2_000_000u64);
+        s.at(Time(now.0 + d), ev);
+        Ok(Control::Continue)
+    }
+}
+
+/// Result of the kernel benchmark.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct KernelBench {
+    /// Pending events.
+    pub population: usize,
+    /// Events handled.
+    pub events: u64,
+    /// Engine events per second.
+    pub engine_events_per_s: f64,
+    /// Bare heap loop events per second.
+    pub bare_events_per_s: f64,
+    /// engine / bare.
+    pub ratio: f64,
+}
+
+/// Hold model with `population` pending events, `events` handled.
+pub fn kernel(population: usize, events: u64) -> KernelBench {
+    let streams = RngStreams::new(7);
+    // Engine.
+    let mut sched = Scheduler::new();
+    let mut init = streams.stream("init");
+    for _ in 0..population {
+        sched.at(Time(init.random_range(0..2_000_000u64)), Hold);
+    }
+    let mut m = HoldModel {
+        rng: streams.stream("hold"),
+    };
+    let t = Instant::now();
+    let st = run(
+        &mut m,
+        &mut sched,
+        Limits {
+            until: None,
+            max_events: Some(events),
+        },
+    )
+    .expect("hold model cannot overflow");
+    let engine_s = t.elapsed().as_secs_f64();
+    assert_eq!(st.events, events);
+    // Bare loop: the same work on a BinaryHeap of (time, seq).
+    let mut heap: BinaryHeap<Reverse<(u64, u64)>> = BinaryHeap::with_capacity(64);
+    let mut init = streams.stream("init");
+    let mut seq = 0u64;
+    for _ in 0..population {
+        heap.push(Reverse((init.random_range(0..2_000_000u64), seq)));
+        seq += 1;
+    }
+    let mut rng = streams.stream("hold");
+    let t = Instant::now();
+    let mut last = 0u64;
+    for _ in 0..events {
+        let Reverse((time, _)) = heap.pop().expect("population > 0");
+        last = last.max(time);
+        let d = rng.random_range(1..2_000_000u64);
+        heap.push(Reverse((time + d, seq)));
+        seq += 1;
+    }
+    let bare_s = t.elapsed().as_secs_f64();
+    std::hint::black_box(last);
+    let e = events as f64;
+    KernelBench {
+        population,
+        events,
+        engine_events_per_s: e / engine_s,
+        bare_events_per_s: e / bare_s,
+        ratio: (e / engine_s) / (e / bare_s),
+    }
+}
+
+fn run_default_with(sets: &[&str]) -> Result<(serde_json::Value, f64), String> {
+    let src = ModelSource::from_text("<embedded default model>", DEFAULT_MODEL);
+    let mut t = src.table().map_err(|e| e.to_string())?;
+    for s in sets {
+        apply_set(&mut t, s).map_err(|e| e.to_string())?;
+    }
+    let start = Instant::now();
+    let r = run_model(&src, &t, false).map_err(|e| e.to_string())?;
+    Ok((r.summary().clone(), start.elapsed().as_secs_f64()))
+}
+
+/// One frame of `grid:WxW` (2 W^2 triangles) at both fidelities: (triangle
+/// seconds, draw seconds, triangle events).
+pub fn pipeline(w: u32) -> Result<(f64, f64, u64, f64, f64), String> {
+    let mesh = format!(
+        "workload.groups=[{{name=\"big\", mesh=\"grid:{w}x{w}\", triangle_pixels={{kind=\"lognormal\", median=4.0, sigma=1.0}}}}]"
+    );
+    let common = [
+        "run.frames=1",
+        "run.warmup_frames=0",
+        "noise.enabled=false",
+        mesh.as_str(),
+    ];
+    let mut tri: Vec<&str> = common.to_vec();
+    tri.push("fidelity=\"triangle\"");
+    let (s_tri, w_tri) = run_default_with(&tri)?;
+    let mut draw: Vec<&str> = common.to_vec();
+    draw.push("fidelity=\"draw\"");
+    let (s_draw, w_draw) = run_default_with(&draw)?;
+    let ft = |s: &serde_json::Value| {
+        s["metrics"]["gpu_time_ms"]["mean"]
+            .as_f64()
+            .unwrap_or(f64::NAN)
+    };
+    Ok((
+        w_tri,
+        w_draw,
+        s_tri["events"]["total"].as_u64().unwrap_or(0),
+        ft(&s_tri),
+        ft(&s_draw),
+    ))
+}
+
+/// Prints the benchmarks for the CLI.
+pub fn run_cli(which: &str, scale: f64) -> Result<(), String> {
+    if !(scale > 0.0 && scale <= 1.0) {
+        return Err(format!("--scale must be in (0, 1], got {scale}"));
+    }
+    let all = which == "all";
+    if !matches!(which, "all" | "kernel" | "pipeline" | "hour") {
+        return Err(format!(
+            "unknown benchmark {which:?} (kernel, pipeline, hour, all)"
+        ));
+    }
+    if all || which == "kernel" {
+        for pop in [1_000usize, 100_000] {
+            let k = kernel(pop, (20_000_000.0 * scale) as u64);
+            println!(
+                "kernel hold model, {} pending: engine {:.2} M events/s, bare BinaryHeap {:.2} M events/s, ratio {:.3}",
+                k.population,
+                k.engine_events_per_s / 1e6,
+                k.bare_events_per_s / 1e6,
+                k.ratio
+            );
+        }
+    }
+    if all || which == "pipeline" {
+        let w = ((707.0 * scale.sqrt()) as u32).max(2);
+        let (t_tri, t_draw, events, g_tri, g_draw) = pipeline(w)?;
+        println!(
+            "pipeline, one frame of grid:{w}x{w} ({} triangles): triangle fidelity {:.3} s ({} events), draw fidelity {:.5} s, speed-up {:.0}x; GPU time {:.3} ms vs {:.3} ms ({:+.2}%)",
+            2 * w as u64 * w as u64,
+            t_tri,
+            events,
+            t_draw,
+            t_tri / t_draw,
+            g_tri,
+            g_draw,
+            100.0 * (g_draw - g_tri) / g_tri
+        );
+    }
+    if all || which == "hour" {
+        let frames = (216_000.0 * scale) as u64;
+        let f = format!("run.frames={frames}");
+        let (s, wall) = run_default_with(&["fidelity=\"draw\"", f.as_str()])?;
+        println!(
+            "one {:.0}-second run of the default model at draw fidelity ({} frames, noise on): {:.3} s wall, {} events ({:.2} M events/s)",
+            s["simulated_seconds"].as_f64().unwrap_or(0.0),
+            frames,
+            wall,
+            s["events"]["total"],
+            s["events_per_second"].as_f64().unwrap_or(0.0) / 1e6
+        );
+    }
+    let _ = Duration::ZERO;
+    Ok(())
+}

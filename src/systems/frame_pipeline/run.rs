@@ -1,0 +1,293 @@
+//! Building and running the frame pipeline from a model, and its summary.
+
+use std::path::Path;
+
+use serde_json::{Value, json};
+
+use crate::engine::{Duration, Limits, PS_PER_MS, RunStats, Scheduler, StopReason, run};
+use crate::stats::quantile::Summary;
+
+use super::accounting::{
+    BOTTLENECKS, CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES, TraceLog,
+};
+use super::config::{FramePipelineConfig, WorkloadConfig};
+use super::model::{FramePipeline, PipelineError};
+use super::records::{FrameRecord, frame_rows};
+use super::workload::{SceneProgram, compile_scene};
+
+/// Everything a run produced.
+#[derive(Debug)]
+pub struct PipelineRun {
+    /// The model as simulated.
+    pub config: FramePipelineConfig,
+    /// Kernel statistics.
+    pub stats: RunStats,
+    /// Per-frame records.
+    pub records: Vec<FrameRecord>,
+    /// The JSON summary.
+    pub summary: Value,
+    /// Timeline, when asked for.
+    pub trace: Option<TraceLog>,
+    /// Refresh period (for trace output).
+    pub refresh: Duration,
+}
+
+fn bad(key: &str, message: impl Into<String>) -> PipelineError {
+    PipelineError::Invalid {
+        key: key.to_string(),
+        message: message.into(),
+    }
+}
+
+/// Checks values serde cannot (ranges, distributions).
+pub fn validate(cfg: &FramePipelineConfig) -> Result<(), PipelineError> {
+    if cfg.system != "frame_pipeline" {
+        return Err(bad(
+            "system",
+            format!("expected \"frame_pipeline\", got {:?}", cfg.system),
+        ));
+    }
+    if !(2..=16).contains(&cfg.display.buffers) {
+        return Err(bad(
+            "display.buffers",
+            format!(
+                "must be between 2 and 16 swap-chain images, got {}",
+                cfg.display.buffers
+            ),
+        ));
+    }
+    if cfg.cpu.max_frames_ahead == 0 {
+        return Err(bad(
+            "cpu.max_frames_ahead",
+            "must be at least 1 (the frame being submitted)",
+        ));
+    }
+    if cfg.run.frames > 0 && cfg.run.warmup_frames >= cfg.run.frames {
+        return Err(bad(
+            "run.warmup_frames",
+            format!("must be less than run.frames ({})", cfg.run.frames),
+        ));
+    }
+    cfg.cpu
+        .non_render
+        .validate()
+        .map_err(|e| bad("cpu.non_render", e.to_string()))?;
+    if let WorkloadConfig::Fixed(f) = &cfg.workload {
+        f.cpu
+            .validate()
+            .map_err(|e| bad("workload.cpu", e.to_string()))?;
+        f.gpu
+            .validate()
+            .map_err(|e| bad("workload.gpu", e.to_string()))?;
+    }
+    for (i, p) in cfg.noise.periodic.iter().enumerate() {
+        p.duration
+            .validate()
+            .map_err(|e| bad(&format!("noise.periodic.{i}.duration"), e.to_string()))?;
+        if p.period.0 == 0 {
+            return Err(bad(
+                &format!("noise.periodic.{i}.period"),
+                "must be greater than zero",
+            ));
+        }
+    }
+    for (i, r) in cfg.noise.random.iter().enumerate() {
+        r.duration
+            .validate()
+            .map_err(|e| bad(&format!("noise.random.{i}.duration"), e.to_string()))?;
+    }
+    Ok(())
+}
+
+/// Validates, builds and runs the model.
+pub fn run_pipeline(
+    cfg: FramePipelineConfig,
+    base_dir: &Path,
+    trace: bool,
+) -> Result<PipelineRun, PipelineError> {
+    validate(&cfg)?;
+    let scene = match &cfg.workload {
+        WorkloadConfig::Scene(s) => {
+            Some(compile_scene(&cfg, s, base_dir).map_err(|e| match e {
+                super::workload::WorkloadError::Invalid { key, message } => {
+                    PipelineError::Invalid { key, message }
+                }
+            })?)
+        }
+        WorkloadConfig::Fixed(_) => None,
+    };
+    let analytic = analytic_terms(&cfg, scene.as_ref());
+    let scene_stats = scene.as_ref().map(|s| s.stats.clone());
+    let mut model = FramePipeline::new(cfg, scene, trace)?;
+    let mut sched = Scheduler::new();
+    model.start(&mut sched)?;
+    let limits = Limits {
+        until: None,
+        max_events: model.cfg.run.max_events,
+    };
+    let stats = run(&mut model, &mut sched, limits)?;
+    if stats.stopped_by == StopReason::Exhausted && !model.done() {
+        return Err(PipelineError::Stalled {
+            at: stats.end_time,
+            resolved: model.resolved(),
+            frames: model.frames_total,
+            state: model.describe(),
+        });
+    }
+    let summary = summarize(&model, &stats, analytic, scene_stats);
+    let refresh = model.refresh;
+    let trace = model.acct.trace.take();
+    Ok(PipelineRun {
+        stats,
+        summary,
+        trace,
+        refresh,
+        records: std::mem::take(&mut model.records),
+        config: model.cfg,
+    })
+}
+
+fn ms(ps: u64) -> f64 {
+    ps as f64 / PS_PER_MS as f64
+}
+
+/// Expected per-frame terms of paper 000 §4.1: ET_cpu, and ET_gpu split into
+/// front end, geometry and fragment, with max and sum of the last two.
+fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProgram>) -> Value {
+    let c = &cfg.cpu;
+    let base_cpu = (c.input_sampling.0 + c.clear.0 + c.swap.0) as f64 + c.non_render.mean();
+    let base_front = (cfg.gpu.clear.0 + cfg.gpu.swap.0 + 2 * cfg.gpu.command.0) as f64;
+    let (cpu, front, geo, frag) = match (&cfg.workload, scene) {
+        (WorkloadConfig::Fixed(f), _) => (
+            base_cpu + f.cpu.mean(),
+            base_front + f.gpu.mean() + cfg.gpu.command.0 as f64,
+            0.0,
+            0.0,
+        ),
+        (WorkloadConfig::Scene(_), Some(s)) => {
+            let cpu: f64 = s.draws.iter().map(|d| d.cpu.0 as f64).sum();
+            let front: f64 = s.draws.iter().map(|d| d.front.0 as f64).sum();
+            let geo: f64 = s
+                .draws
+                .iter()
+                .map(|d| s.meshes[d.mesh as usize].geometry_time.0 as f64)
+                .sum();
+            let frag: f64 = s
+                .draws
+                .iter()
+                .map(|d| {
+                    let g = &s.groups[d.group as usize];
+                    s.meshes[d.mesh as usize].triangles as f64 * g.pixels.mean() * g.cost_per_pixel
+                })
+                .sum();
+            (base_cpu + cpu, base_front + front, geo, frag)
+        }
+        _ => (base_cpu, base_front, 0.0, 0.0),
+    };
+    let p = PS_PER_MS as f64;
+    json!({
+        "cpu_ms": cpu / p,
+        "gpu_front_end_ms": front / p,
+        "geometry_ms": geo / p,
+        "fragment_ms": frag / p,
+        "gpu_max_ms": (front + geo.max(frag)) / p,
+        "gpu_sum_ms": (front + geo + frag) / p,
+        "frame_max_ms": cpu.max(front + geo.max(frag)) / p,
+        "frame_sum_ms": cpu.max(front + geo + frag) / p,
+    })
+}
+
+fn summary_json(v: &[f64]) -> Value {
+    let v: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    let s = Summary::of(&v);
+    json!({"count": s.count, "mean": s.mean, "p50": s.p50, "p99": s.p99, "min": s.min, "max": s.max, "std": s.std})
+}
+
+fn states_json(names: &[&str], totals: &[u64]) -> Value {
+    Value::Object(
+        names
+            .iter()
+            .zip(totals)
+            .map(|(n, t)| (n.to_string(), json!(ms(*t))))
+            .collect(),
+    )
+}
+
+fn summarize(
+    m: &FramePipeline,
+    stats: &RunStats,
+    analytic: Value,
+    scene: Option<super::workload::SceneStats>,
+) -> Value {
+    let end = stats.end_time;
+    let elapsed = end.0.max(1) as f64;
+    let warm = m.cfg.run.warmup_frames as usize;
+    let rows = frame_rows(&m.records);
+    let col = |i: usize| -> Vec<f64> { rows.iter().skip(warm).map(|r| r[i]).collect() };
+    let cpu = m.acct.cpu.totals_at(end);
+    let front = m.acct.front.totals_at(end);
+    let geom = m.acct.geom.totals_at(end);
+    let frag = m.acct.frag.totals_at(end);
+    let gpu = m.acct.gpu.totals_at(end);
+    let bott = m.acct.bottleneck.totals_at(end);
+    let displayed = m.records.iter().filter(|r| r.displayed.is_some()).count();
+    let dropped = m.records.iter().filter(|r| r.dropped).count();
+    let refreshes = if m.chain.mode() == crate::components::swap_chain::PresentMode::Immediate {
+        end.0 / m.refresh.0
+    } else {
+        m.vblanks
+    };
+    let by_kind: serde_json::Map<String, Value> = stats
+        .kind_names
+        .iter()
+        .zip(&stats.by_kind)
+        .map(|(n, c)| (n.to_string(), json!(c)))
+        .collect();
+    let (issued, executed) = m.command_counts();
+    let mut out = json!({
+        "system": "frame_pipeline",
+        "description": m.cfg.description,
+        "fidelity": m.cfg.fidelity,
+        "seed": m.cfg.run.seed,
+        "frames": m.cfg.run.frames,
+        "frames_simulated": m.records.len(),
+        "warmup_frames": m.cfg.run.warmup_frames,
+        "events": {"total": stats.events, "by_kind": by_kind},
+        "wall_seconds": stats.wall_seconds,
+        "events_per_second": if stats.wall_seconds > 0.0 { stats.events as f64 / stats.wall_seconds } else { 0.0 },
+        "simulated_seconds": end.0 as f64 / 1e12,
+        "stopped_by": stats.stopped_by,
+        "metrics": {
+            "frame_time_ms": summary_json(&col(2)),
+            "display_interval_ms": summary_json(&col(11)),
+            "display_latency_ms": summary_json(&col(10)),
+            "until_displayed_ms": summary_json(&col(9)),
+            "gpu_time_ms": summary_json(&col(6)),
+            "cpu_busy_ms": summary_json(&col(3)),
+            "gpu_busy_ms": summary_json(&col(7)),
+            "cpu_busy_fraction": (cpu[0] + cpu[1]) as f64 / elapsed,
+            "cpu_wait_fraction": (cpu[2] + cpu[3]) as f64 / elapsed,
+            "gpu_busy_fraction": gpu[0] as f64 / elapsed,
+            "gpu_idle_fraction": gpu[1] as f64 / elapsed,
+            "refreshes": refreshes,
+            "repeated_refreshes": m.repeated_refreshes,
+            "repeated_refresh_fraction": if refreshes > 0 { m.repeated_refreshes as f64 / refreshes as f64 } else { 0.0 },
+            "displayed_frames": displayed,
+            "dropped_frames": dropped,
+            "bottleneck": Value::Object(BOTTLENECKS.iter().zip(bott).map(|(n, t)| (n.to_string(), json!(t as f64 / elapsed))).collect()),
+            "states_ms": {
+                "cpu": states_json(&CPU_STATES, &cpu),
+                "gpu_front_end": states_json(&FRONT_STATES, &front),
+                "geometry": states_json(&GEOM_STATES, &geom),
+                "fragment": states_json(&FRAG_STATES, &frag),
+                "gpu": states_json(&["busy", "idle"], &gpu),
+            },
+            "commands": {"issued": issued, "executed": executed, "fifo_max_used": m.fifo.max_used()},
+            "analytic": analytic,
+        },
+    });
+    if let Some(s) = scene {
+        out["scene"] = serde_json::to_value(s).unwrap_or(Value::Null);
+    }
+    out
+}
