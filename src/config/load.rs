@@ -97,6 +97,9 @@ impl ModelSource {
     /// 1-based line of the dotted `key` in the text, if it stands there (or
     /// of the closest enclosing table that does).
     pub fn line_of(&self, key: &str) -> Option<usize> {
+        if self.text.trim().is_empty() {
+            return None;
+        }
         let doc = toml_edit::Document::parse(self.text.as_str()).ok()?;
         let parts: Vec<&str> = key.split('.').collect();
         find_item(doc.as_item(), &parts, None).map(|s| line_at(&self.text, s.start))
