@@ -145,7 +145,7 @@ impl FramePipeline {
                         return Ok(progressed);
                     }
                     self.fifo.push(c, w);
-                    self.commands_issued += 1;
+                    self.commands_issued += self.command_count(&c);
                     self.cpu_phase = if self.fifo.over_capacity() {
                         CpuPhase::Rendezvous
                     } else {

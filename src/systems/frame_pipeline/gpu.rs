@@ -36,7 +36,7 @@ impl FramePipeline {
                     let Some(c) = self.fifo.pop() else {
                         return Ok(progressed);
                     };
-                    self.commands_executed += 1;
+                    self.commands_executed += self.command_count(&c);
                     self.front_phase = self.front_begin(now, c, s)?;
                 }
                 FrontPhase::WaitImage(c) => {

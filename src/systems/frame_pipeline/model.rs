@@ -408,6 +408,18 @@ impl FramePipeline {
         }
     }
 
+    /// Commands in a FIFO entry (a draw batch holds its state changes and
+    /// upload with the draw).
+    pub(super) fn command_count(&self, c: &Command) -> u64 {
+        match c {
+            Command::Draw { draw, .. } => self
+                .scene()
+                .map(|s| s.draws[*draw as usize].commands as u64)
+                .unwrap_or(1),
+            _ => 1,
+        }
+    }
+
     pub(super) fn scene(&self) -> Option<&SceneProgram> {
         match &self.program {
             Program::Scene(s) => Some(s),

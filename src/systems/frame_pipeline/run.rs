@@ -30,6 +30,29 @@ pub struct PipelineRun {
     pub trace: Option<TraceLog>,
     /// Refresh period (for trace output).
     pub refresh: Duration,
+    /// Exact time per state of every unit, picoseconds (for conservation checks).
+    pub clocks: ClockTotals,
+    /// Commands pushed by the CPU and executed by the GPU.
+    pub commands: (u64, u64),
+}
+
+/// Exact per-state totals of every unit's clock at the end of the run.
+#[derive(Debug, Clone)]
+pub struct ClockTotals {
+    /// CPU: work, system, wait FIFO, wait frames, idle.
+    pub cpu: [u64; 5],
+    /// Front end states.
+    pub front: [u64; 6],
+    /// Geometry: busy, blocked, idle.
+    pub geometry: [u64; 3],
+    /// Fragment: busy, idle.
+    pub fragment: [u64; 2],
+    /// GPU: busy, idle.
+    pub gpu: [u64; 2],
+    /// Bottleneck shares.
+    pub bottleneck: [u64; 6],
+    /// Elapsed simulated time.
+    pub elapsed: u64,
 }
 
 fn bad(key: &str, message: impl Into<String>) -> PipelineError {
@@ -136,12 +159,26 @@ pub fn run_pipeline(
     }
     let summary = summarize(&model, &stats, analytic, scene_stats);
     let refresh = model.refresh;
+    let end = stats.end_time;
+    let a = &model.acct;
+    let clocks = ClockTotals {
+        cpu: a.cpu.totals_at(end),
+        front: a.front.totals_at(end),
+        geometry: a.geom.totals_at(end),
+        fragment: a.frag.totals_at(end),
+        gpu: a.gpu.totals_at(end),
+        bottleneck: a.bottleneck.totals_at(end),
+        elapsed: end.0,
+    };
+    let commands = model.command_counts();
     let trace = model.acct.trace.take();
     Ok(PipelineRun {
         stats,
         summary,
         trace,
         refresh,
+        clocks,
+        commands,
         records: std::mem::take(&mut model.records),
         config: model.cfg,
     })

@@ -1,0 +1,79 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use rendersim::config::{ModelSource, apply_set};
+use rendersim::systems::frame_pipeline::PipelineRun;
+use rendersim::systems::{SystemRun, run_model};
+use serde_json::Value;
+
+/// Runs a model given as TOML text with `--set`-style patches.
+pub fn try_run(text: &str, sets: &[&str]) -> Result<PipelineRun, String> {
+    let src = ModelSource::from_text("test.toml", text);
+    let mut t = src.table().map_err(|e| e.to_string())?;
+    for s in sets {
+        apply_set(&mut t, s).map_err(|e| e.to_string())?;
+    }
+    match run_model(&src, &t, false).map_err(|e| e.to_string())? {
+        SystemRun::FramePipeline(r) => Ok(*r),
+    }
+}
+
+/// Runs and panics with the error on failure.
+pub fn run(text: &str, sets: &[&str]) -> PipelineRun {
+    try_run(text, sets).unwrap_or_else(|e| panic!("run failed: {e}"))
+}
+
+/// A metric by dotted path.
+pub fn metric(r: &PipelineRun, path: &str) -> f64 {
+    let mut v: &Value = &r.summary;
+    for p in path.split('.') {
+        v = &v[p];
+    }
+    v.as_f64()
+        .unwrap_or_else(|| panic!("{path} is not a number: {v}"))
+}
+
+/// The fixed teaching model.
+pub const FIXED: &str = include_str!("../../models/fixed.toml");
+/// The default model.
+pub const DEFAULT: &str = include_str!("../../models/default.toml");
+
+/// A scene model with one group, no noise, vsync off, plain costs.
+pub fn scene_model(group: &str) -> String {
+    format!(
+        r#"
+fidelity = "triangle"
+[run]
+frames = 3
+[display]
+vsync = false
+[noise]
+enabled = false
+[gpu.geometry]
+vertex_shader = "1ns"
+[gpu.fragment]
+per_fragment = "1ns"
+fifo_depth = 16
+[workload]
+kind = "scene"
+depth_order = "back_to_front"
+[[workload.groups]]
+{group}
+"#
+    )
+}
+
+/// Walks a JSON value and returns the paths of nulls (NaN becomes null).
+pub fn null_paths(v: &Value, path: &str, out: &mut Vec<String>) {
+    match v {
+        Value::Null => out.push(path.to_string()),
+        Value::Object(m) => m
+            .iter()
+            .for_each(|(k, x)| null_paths(x, &format!("{path}.{k}"), out)),
+        Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .for_each(|(i, x)| null_paths(x, &format!("{path}[{i}]"), out)),
+        _ => {}
+    }
+}

@@ -1,0 +1,131 @@
+//! Display and latency oracles: vsync quantization with double and triple
+//! buffering (paper 004 §4.2), mailbox, immediate, and render-ahead latency.
+
+mod common;
+use common::{FIXED, metric, run};
+
+const REFRESH_MS: f64 = 1000.0 / 60.0;
+
+#[test]
+fn double_buffered_fifo_shows_a_17ms_frame_every_two_refreshes() {
+    let r = run(FIXED, &["display.buffers=2"]);
+    let iv = metric(&r, "metrics.display_interval_ms.mean");
+    assert!((iv - 2.0 * REFRESH_MS).abs() < 1e-6, "{iv}");
+    assert_eq!(
+        metric(&r, "metrics.display_interval_ms.max"),
+        metric(&r, "metrics.display_interval_ms.p50")
+    );
+    let rep = metric(&r, "metrics.repeated_refresh_fraction");
+    assert!((rep - 0.5).abs() < 0.01, "{rep}");
+}
+
+#[test]
+fn triple_buffering_tracks_the_gpu_and_repeats_one_refresh_in_fifty() {
+    for mode in ["fifo", "mailbox"] {
+        let r = run(
+            FIXED,
+            &[
+                "display.buffers=3",
+                &format!("display.present_mode=\"{mode}\""),
+                "run.frames=1200",
+            ],
+        );
+        let iv = metric(&r, "metrics.display_interval_ms.mean");
+        assert!((iv - 17.0).abs() < 0.05, "{mode}: {iv}");
+        let rep = metric(&r, "metrics.repeated_refresh_fraction");
+        let expect = 1.0 - REFRESH_MS / 17.0;
+        assert!((rep - expect).abs() < 0.002, "{mode}: {rep} vs {expect}");
+        assert_eq!(metric(&r, "metrics.dropped_frames"), 0.0);
+    }
+}
+
+#[test]
+fn mailbox_drops_frames_produced_faster_than_refresh() {
+    let r = run(
+        FIXED,
+        &[
+            "display.buffers=3",
+            "display.present_mode=\"mailbox\"",
+            "workload.gpu=\"5ms\"",
+            "workload.cpu=\"1ms\"",
+        ],
+    );
+    assert!((metric(&r, "metrics.display_interval_ms.mean") - REFRESH_MS).abs() < 1e-6);
+    let dropped = metric(&r, "metrics.dropped_frames");
+    let frames = metric(&r, "frames");
+    // About 3.33 frames per refresh: roughly 70% of them never shown.
+    assert!(
+        (dropped / frames - (1.0 - 5.0 / REFRESH_MS)).abs() < 0.03,
+        "{dropped}"
+    );
+    // FIFO with the same load never drops and runs at refresh rate.
+    let f = run(
+        FIXED,
+        &[
+            "display.buffers=3",
+            "workload.gpu=\"5ms\"",
+            "workload.cpu=\"1ms\"",
+        ],
+    );
+    assert_eq!(metric(&f, "metrics.dropped_frames"), 0.0);
+    assert!((metric(&f, "metrics.frame_time_ms.mean") - REFRESH_MS).abs() < 0.01);
+}
+
+#[test]
+fn immediate_present_shows_frames_as_they_complete() {
+    let r = run(FIXED, &["display.vsync=false"]);
+    assert!((metric(&r, "metrics.display_interval_ms.mean") - 17.0).abs() < 1e-9);
+    assert_eq!(
+        r.stats.by_kind[r
+            .stats
+            .kind_names
+            .iter()
+            .position(|k| *k == "vblank")
+            .unwrap()],
+        0,
+        "no vblank events when nothing waits for them"
+    );
+}
+
+#[test]
+fn render_ahead_adds_one_gpu_frame_of_latency_per_frame_in_flight() {
+    let lat: Vec<f64> = (1..=5)
+        .map(|n| {
+            metric(
+                &run(
+                    FIXED,
+                    &["display.vsync=false", &format!("cpu.max_frames_ahead={n}")],
+                ),
+                "metrics.display_latency_ms.mean",
+            )
+        })
+        .collect();
+    // One frame in flight: CPU and GPU run one after the other.
+    assert!((lat[0] - 22.0).abs() < 1e-9, "{lat:?}");
+    for w in lat[1..].windows(2) {
+        assert!((w[1] - w[0] - 17.0).abs() < 1e-9, "{lat:?}");
+    }
+}
+
+#[test]
+fn refresh_extremes_one_hertz_and_one_kilohertz() {
+    let slow = run(
+        FIXED,
+        &[
+            "display.refresh=\"1Hz\"",
+            "run.frames=12",
+            "run.warmup_frames=2",
+        ],
+    );
+    assert!((metric(&slow, "metrics.display_interval_ms.mean") - 1000.0).abs() < 1e-9);
+    // Every frame appears exactly on a 1 s boundary.
+    assert!(
+        slow.records
+            .iter()
+            .filter_map(|r| r.displayed)
+            .all(|t| t.0 % 1_000_000_000_000 == 0)
+    );
+    let fast = run(FIXED, &["display.refresh=\"1000Hz\""]);
+    let iv = metric(&fast, "metrics.display_interval_ms.mean");
+    assert!((17.0..=18.0).contains(&iv), "{iv}");
+}

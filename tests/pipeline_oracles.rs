@@ -1,0 +1,205 @@
+//! Pipeline oracles: geometry and fragment stages with a small FIFO between
+//! them (paper 000 §4.5.1: time between max and sum of the two terms), the
+//! draw-fidelity closed form against the triangle simulation, early-z draw
+//! orders, and "build only what a scene uses".
+
+mod common;
+use common::{DEFAULT, FIXED, metric, run, scene_model};
+use rendersim::systems::frame_pipeline::records::write_frames_csv;
+
+/// 20,000 triangles, 1 ns of geometry each; 1% of them cover 100 px (100 ns
+/// of fragments), the rest 0.001 px. G = 20 us, F = 20.02 us.
+fn bimodal(depth: u32) -> String {
+    scene_model(&format!(
+        r#"name = "mix"
+mesh = {{ triangles = 20000, acmr = 1.0 }}
+triangle_pixels = {{ kind = "mixture", parts = [ {{ weight = 0.99, dist = 0.001 }}, {{ weight = 0.01, dist = 100.0 }} ] }}"#
+    ))
+    .replace("fifo_depth = 16", &format!("fifo_depth = {depth}"))
+}
+
+#[test]
+fn fifo_depth_moves_frame_time_from_sum_to_max_monotonically() {
+    // Totals over the run, in picoseconds: the realized geometry and
+    // fragment busy times (the sampled sizes, not their expectation).
+    let mut times = vec![];
+    let mut bounds = (0.0, 0.0);
+    for depth in [0u32, 1, 2, 4, 16, 64, 256, 1024, 100_000] {
+        let r = run(&bimodal(depth), &["run.frames=2"]);
+        let g = r.clocks.geometry[0] as f64;
+        let f = r.clocks.fragment[0] as f64;
+        bounds = (g.max(f), g + f);
+        times.push(r.clocks.gpu[0] as f64);
+    }
+    let (max, sum) = bounds;
+    assert!(
+        times.windows(2).all(|w| w[1] <= w[0] + 1e-12),
+        "not monotone: {times:?}"
+    );
+    assert!(
+        (times[0] - sum).abs() / sum < 0.03,
+        "one-slot time {} vs sum {sum}",
+        times[0]
+    );
+    let last = *times.last().unwrap();
+    assert!(
+        (last - max).abs() / max < 0.03,
+        "deep-FIFO time {last} vs max {max}"
+    );
+    for t in &times {
+        assert!(
+            *t >= max * 0.999 && *t <= sum * 1.001,
+            "{t} outside [{max}, {sum}]"
+        );
+    }
+}
+
+#[test]
+fn draw_fidelity_matches_triangle_fidelity_where_its_assumptions_hold() {
+    // Uniform triangles, deep FIFO: both give max(G, F) plus fill.
+    let m = scene_model(
+        r#"name = "g"
+mesh = "grid:64x64"
+triangle_pixels = 3.0"#,
+    );
+    let tri = run(&m, &["fidelity=\"triangle\""]);
+    let draw = run(&m, &["fidelity=\"draw\""]);
+    let (a, b) = (
+        metric(&tri, "metrics.gpu_time_ms.mean"),
+        metric(&draw, "metrics.gpu_time_ms.mean"),
+    );
+    assert!((a - b).abs() / a < 0.01, "triangle {a} vs draw {b}");
+    // The draw fidelity schedules no per-triangle events.
+    let k = |r: &rendersim::systems::frame_pipeline::PipelineRun, name: &str| {
+        r.stats.by_kind[r.stats.kind_names.iter().position(|n| *n == name).unwrap()]
+    };
+    assert_eq!(k(&draw, "geometry_triangle"), 0);
+    assert_eq!(k(&tri, "geometry_triangle"), 3 * 64 * 64 * 2);
+    assert!(draw.stats.events * 100 < tri.stats.events);
+}
+
+#[test]
+fn draw_fidelity_also_lies_between_max_and_sum() {
+    for depth in [0u32, 1, 8, 64] {
+        let r = run(&bimodal(depth), &["fidelity=\"draw\"", "run.frames=2"]);
+        let g = metric(&r, "metrics.analytic.geometry_ms");
+        let f = metric(&r, "metrics.analytic.fragment_ms");
+        let t = metric(&r, "metrics.gpu_time_ms.mean");
+        assert!(
+            t >= g.max(f) * 0.999 && t <= (g + f) * 1.001,
+            "depth {depth}: {t} not in [{}, {}]",
+            g.max(f),
+            g + f
+        );
+    }
+}
+
+#[test]
+fn front_to_back_shades_fewer_fragments_than_back_to_front() {
+    let m = |order: &str| {
+        scene_model(
+            r#"name = "g"
+mesh = "grid:32x32"
+triangle_pixels = 50.0"#,
+        )
+        .replace(
+            "depth_order = \"back_to_front\"",
+            &format!("depth_order = \"{order}\"\ndepth_complexity = 4.0"),
+        )
+    };
+    let t = |o: &str| metric(&run(&m(o), &[]), "metrics.analytic.fragment_ms");
+    let (f2b, rnd, b2f) = (t("front_to_back"), t("random"), t("back_to_front"));
+    assert!((f2b / b2f - 0.25).abs() < 1e-9, "{f2b} {b2f}");
+    assert!((rnd / b2f - (1.0 + 0.5 + 1.0 / 3.0 + 0.25) / 4.0).abs() < 1e-9);
+}
+
+fn csv(r: &rendersim::systems::frame_pipeline::PipelineRun) -> String {
+    let mut v = vec![];
+    write_frames_csv(&r.records, &mut v).unwrap();
+    String::from_utf8(v).unwrap()
+}
+
+#[test]
+fn unused_parts_are_not_built_and_zero_cost_parts_change_nothing() {
+    // Noise off: no noise events. Zero-length tasks: identical frames.
+    let off = run(
+        DEFAULT,
+        &[
+            "noise.enabled=false",
+            "run.frames=20",
+            "run.warmup_frames=0",
+            "fidelity=\"draw\"",
+        ],
+    );
+    assert_eq!(
+        off.stats.by_kind[8] + off.stats.by_kind[9],
+        0,
+        "{:?}",
+        off.stats.by_kind
+    );
+    let zero = run(
+        DEFAULT,
+        &[
+            "noise.periodic.0.duration=\"0ms\"",
+            "noise.random.0.duration=\"0ms\"",
+            "run.frames=20",
+            "run.warmup_frames=0",
+            "fidelity=\"draw\"",
+        ],
+    );
+    assert!(zero.stats.by_kind[8] > 0);
+    assert_eq!(csv(&off), csv(&zero));
+    // Uploads that take no time and no GPU time: same frames as none.
+    let base = [
+        "noise.enabled=false",
+        "run.frames=5",
+        "run.warmup_frames=0",
+        "gpu.command=\"0ms\"",
+        "command_fifo.capacity=100000",
+    ];
+    let plain = run(DEFAULT, &base);
+    let mut with_up = base.to_vec();
+    with_up.extend([
+        "workload.groups.1.geometry_upload=1",
+        "bus.bandwidth=\"1000TB/s\"",
+    ]);
+    let up = run(DEFAULT, &with_up);
+    assert_eq!(csv(&plain), csv(&up));
+    assert!(
+        up.commands.0 > plain.commands.0,
+        "upload commands are issued"
+    );
+    // Non-indexed draws skip the cache: same as an indexed draw with no cache and free index fetch.
+    let g = |extra: &str| {
+        scene_model(&format!(
+            "name = \"g\"\nmesh = \"grid:16x16\"\ntriangle_pixels = 2.0\n{extra}"
+        ))
+    };
+    let ni = run(&g("indexed = false"), &[]);
+    let none = run(&g(""), &["gpu.geometry.vertex_cache=\"none\""]);
+    assert_eq!(csv(&ni), csv(&none));
+    // A fixed workload has no geometry or fragment events at all.
+    let f = run(FIXED, &[]);
+    assert_eq!(f.stats.by_kind[2..7].iter().sum::<u64>(), 0);
+}
+
+#[test]
+fn vertex_cache_changes_geometry_time_by_actually_transformed_vertices() {
+    let g = |mesh: &str| {
+        scene_model(&format!(
+            "name = \"g\"\nmesh = \"{mesh}\"\ntriangle_pixels = 0.0"
+        ))
+    };
+    let shuffled = run(&g("grid:32x32:shuffled:3"), &[]);
+    let optimized = run(&g("grid:32x32:optimized"), &[]);
+    let tv = |r: &rendersim::systems::frame_pipeline::PipelineRun| {
+        r.summary["scene"]["transformed_vertices"].as_u64().unwrap() as f64
+    };
+    let geo = |r: &rendersim::systems::frame_pipeline::PipelineRun| {
+        metric(r, "metrics.analytic.geometry_ms")
+    };
+    assert!(tv(&optimized) < 0.5 * tv(&shuffled));
+    // 1 ns per transformed vertex, nothing else.
+    assert!((geo(&shuffled) - tv(&shuffled) * 1e-6).abs() < 1e-9);
+    assert!((geo(&optimized) - tv(&optimized) * 1e-6).abs() < 1e-9);
+}
