@@ -153,6 +153,12 @@ fn model_table(
         apply_set(&mut t, s)?;
     }
     if let Some(seed) = seed {
+        if seed > i64::MAX as u64 {
+            bail!(
+                "--seed {seed}: must be at most {} (model files hold 64-bit signed integers)",
+                i64::MAX
+            );
+        }
         apply_set(&mut t, &format!("run.seed={seed}"))?;
     }
     if let Some(f) = frames {

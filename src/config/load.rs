@@ -94,8 +94,8 @@ impl ModelSource {
             })
     }
 
-    /// 1-based line of the dotted `key` in the text, if it stands there (or
-    /// of the closest enclosing table that does).
+    /// 1-based line of the dotted `key` in the text, if it stands there
+    /// (a key given only with `--set` has none).
     pub fn line_of(&self, key: &str) -> Option<usize> {
         if self.text.trim().is_empty() {
             return None;
@@ -115,7 +115,7 @@ fn find_item(item: &toml_edit::Item, parts: &[&str], span: Span) -> Span {
     match item {
         toml_edit::Item::Table(t) => match t.get_key_value(first) {
             Some((k, v)) => find_item(v, rest, k.span().or(v.span()).or(span)),
-            None => t.span().or(span),
+            None => None,
         },
         toml_edit::Item::ArrayOfTables(a) => {
             match first.parse::<usize>().ok().and_then(|i| a.get(i)) {
@@ -135,13 +135,13 @@ fn find_value(v: &toml_edit::Value, parts: &[&str], span: Span) -> Span {
     match v {
         toml_edit::Value::InlineTable(t) => match t.get_key_value(first) {
             Some((k, v2)) => find_item(v2, rest, k.span().or(v2.span()).or(span)),
-            None => span,
+            None => None,
         },
         toml_edit::Value::Array(a) => match first.parse::<usize>().ok().and_then(|i| a.get(i)) {
             Some(v2) => find_value(v2, rest, v2.span().or(span)),
-            None => span,
+            None => None,
         },
-        _ => span,
+        _ => None,
     }
 }
 
@@ -232,14 +232,35 @@ pub fn deserialize<T: DeserializeOwned>(
 ) -> Result<T, ConfigError> {
     let de = table.clone();
     serde_path_to_error::deserialize::<_, T>(de).map_err(|e| {
-        let path = e.path().to_string();
+        let mut path = e.path().to_string();
         let message = e.inner().to_string();
-        let message = message.trim().to_string();
+        // toml appends "in `key`" lines; the key path is reported separately.
+        let mut message: String = message
+            .lines()
+            .filter(|l| !l.starts_with("in `"))
+            .collect::<Vec<_>>()
+            .join(" ")
+            .trim()
+            .to_string();
+        // A nested deserializer reports its own sub-path as "at `a.b`: ...".
+        if let Some(rest) = message.strip_prefix("at `") {
+            if let Some((sub, msg)) = rest.split_once("`: ") {
+                path = if path == "." || path.is_empty() {
+                    sub.to_string()
+                } else {
+                    format!("{path}.{sub}")
+                };
+                message = msg.to_string();
+            }
+        }
         // serde says: unknown field `refesh`, expected one of `refresh`, `vsync`
         let (key, suggestion) = match unknown_field(&message) {
             Some((bad, expected)) => {
+                // The path may or may not already end with the unknown key.
                 let key = if path == "." || path.is_empty() {
                     bad.clone()
+                } else if path == bad || path.ends_with(&format!(".{bad}")) {
+                    path.clone()
                 } else {
                     format!("{path}.{bad}")
                 };

@@ -9,6 +9,10 @@ use super::runner::{FrameTable, RunOutput, Runner};
 
 /// Runs models with the simulator; relative paths inside models resolve
 /// against `base_dir`.
+///
+/// Per-frame data leave out the warm-up frames (`run.warmup_frames`, as the
+/// summary reports them), so that histograms and derived frame statistics
+/// describe the same frames as the summary's metrics.
 #[derive(Debug, Clone)]
 pub struct SimRunner {
     /// Name used in error messages.
@@ -27,13 +31,87 @@ impl Runner for SimRunner {
             base_dir: self.base_dir.clone(),
         };
         let run = run_model(&src, &table, false).map_err(|e| e.to_string())?;
+        let warmup = run
+            .summary()
+            .get("warmup_frames")
+            .and_then(serde_json::Value::as_u64)
+            .unwrap_or(0);
         let frames = want_frames.then(|| {
             let (columns, rows) = run.frame_table();
-            FrameTable { columns, rows }
+            without_warmup(FrameTable { columns, rows }, warmup)
         });
         Ok(RunOutput {
             summary: run.summary().clone(),
             frames,
         })
+    }
+}
+
+/// `table` without the rows of frames before `warmup` (by the `Frame`
+/// column; by row position when there is no such column).
+pub(crate) fn without_warmup(mut table: FrameTable, warmup: u64) -> FrameTable {
+    if warmup == 0 {
+        return table;
+    }
+    match table.columns.iter().position(|c| c == "Frame") {
+        Some(i) => table
+            .rows
+            .retain(|r| r.get(i).is_none_or(|&f| f.is_nan() || f >= warmup as f64)),
+        None => {
+            let n = (warmup as usize).min(table.rows.len());
+            table.rows.drain(..n);
+        }
+    }
+    table
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(frames: &[f64]) -> FrameTable {
+        FrameTable {
+            columns: vec!["Frame".into(), "FrameTime".into()],
+            rows: frames.iter().map(|&f| vec![f, 10.0 + f]).collect(),
+        }
+    }
+
+    #[test]
+    fn warmup_rows_are_dropped_by_frame_index() {
+        let t = without_warmup(table(&[0.0, 1.0, 2.0, 3.0]), 2);
+        assert_eq!(t.column("Frame").unwrap(), vec![2.0, 3.0]);
+        assert_eq!(t.column("FrameTime").unwrap(), vec![12.0, 13.0]);
+        assert_eq!(without_warmup(table(&[0.0, 1.0]), 0).rows.len(), 2);
+        assert!(without_warmup(table(&[0.0, 1.0]), 5).rows.is_empty());
+        let no_index = FrameTable {
+            columns: vec!["FrameTime".into()],
+            rows: vec![vec![1.0], vec![2.0], vec![3.0]],
+        };
+        assert_eq!(
+            without_warmup(no_index, 1).column("FrameTime").unwrap(),
+            vec![2.0, 3.0]
+        );
+    }
+
+    #[test]
+    fn simulator_frames_match_the_summary_frames() {
+        let text = "system = \"frame_pipeline\"\n\
+                    [run]\nframes = 30\nwarmup_frames = 5\n\
+                    [noise]\nenabled = false\n\
+                    [workload]\nkind = \"fixed\"\ncpu = \"2ms\"\ngpu = \"5ms\"\n";
+        let model: toml::Table = text.parse().unwrap();
+        let runner = SimRunner {
+            name: "test".into(),
+            base_dir: PathBuf::from("."),
+        };
+        let out = runner.run(&model, 1, true).unwrap();
+        let frames = out.frames.unwrap();
+        let index = frames.column("Frame").unwrap();
+        assert_eq!(index.len(), 25);
+        assert_eq!(index[0], 5.0);
+        let count = crate::experiment::json_number(&out.summary, "metrics.frame_time_ms.count")
+            .unwrap()
+            .unwrap();
+        assert_eq!(count as usize, frames.column("FrameTime").unwrap().len());
     }
 }

@@ -371,8 +371,9 @@ fn cpu_target() -> NoiseTarget {
     NoiseTarget::Cpu
 }
 
-/// What is rendered each frame.
-#[derive(Debug, Clone, Serialize, Deserialize)]
+/// What is rendered each frame. Written as a table with `kind = "fixed"` or
+/// `kind = "scene"` and that kind's keys.
+#[derive(Debug, Clone, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum WorkloadConfig {
     /// Fixed CPU and GPU time per frame, for teaching and checks.
@@ -389,4 +390,46 @@ pub struct FixedWorkload {
     pub cpu: Dist<Duration>,
     /// GPU time per frame (run on the GPU front end as one command).
     pub gpu: Dist<Duration>,
+}
+
+impl<'de> Deserialize<'de> for WorkloadConfig {
+    /// By hand rather than serde's internally tagged enums, so an error deep
+    /// inside keeps its key path (reported as "at `a.b`: ..." and joined to
+    /// the outer path by the model loader).
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let mut t = toml::Table::deserialize(d)?;
+        let kind = match t.remove("kind") {
+            Some(toml::Value::String(k)) => k,
+            Some(other) => {
+                return Err(D::Error::custom(format!(
+                    "at `kind`: expected \"fixed\" or \"scene\", got {other}"
+                )));
+            }
+            None => {
+                return Err(D::Error::custom(
+                    "missing field `kind` (\"fixed\" or \"scene\")",
+                ));
+            }
+        };
+        fn inner<T: serde::de::DeserializeOwned, E: Error>(t: toml::Table) -> Result<T, E> {
+            serde_path_to_error::deserialize::<_, T>(t).map_err(|e| {
+                let path = e.path().to_string();
+                let msg = e.inner().to_string();
+                let msg = msg.lines().next().unwrap_or_default().to_string();
+                if path == "." || path.is_empty() {
+                    E::custom(msg)
+                } else {
+                    E::custom(format!("at `{path}`: {msg}"))
+                }
+            })
+        }
+        match kind.as_str() {
+            "fixed" => inner(t).map(WorkloadConfig::Fixed),
+            "scene" => inner(t).map(WorkloadConfig::Scene),
+            other => Err(D::Error::custom(format!(
+                "at `kind`: unknown workload kind {other:?} (expected \"fixed\" or \"scene\")"
+            ))),
+        }
+    }
 }

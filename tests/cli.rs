@@ -1,0 +1,291 @@
+//! The command line: outputs, reproducibility from the output folder, and
+//! clear errors (file, key, line, suggestion; non-zero exit; no panic; no
+//! earlier results lost).
+
+use std::path::Path;
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_rendersim"))
+}
+
+fn run_ok(args: &[&str]) -> String {
+    let o = bin().args(args).output().unwrap();
+    assert!(
+        o.status.success(),
+        "{args:?} failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8(o.stdout).unwrap()
+}
+
+/// Runs and expects failure with exit code 2 (not a panic's 101); returns stderr.
+fn run_err(args: &[&str]) -> String {
+    let o = bin().args(args).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{args:?}: expected exit 2, stderr: {err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.display().to_string()
+}
+
+const SMALL: &str = r#"
+[run]
+frames = 20
+[noise]
+enabled = false
+[workload]
+kind = "fixed"
+cpu = "2ms"
+gpu = "9ms"
+"#;
+
+#[test]
+fn json_summary_has_the_documented_keys() {
+    let out = run_ok(&["run", "--frames", "12", "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    for k in ["system", "seed", "frames", "wall_seconds"] {
+        assert!(!v[k].is_null(), "{k}");
+    }
+    assert!(v["events"]["total"].as_u64().unwrap() > 0);
+    assert!(v["events"]["by_kind"].is_object());
+    let m = &v["metrics"];
+    for k in ["frame_time_ms", "display_interval_ms", "display_latency_ms"] {
+        for s in ["mean", "p50", "p99", "max"] {
+            assert!(m[k][s].is_number(), "{k}.{s}");
+        }
+    }
+    for k in [
+        "cpu_busy_fraction",
+        "gpu_busy_fraction",
+        "repeated_refreshes",
+        "dropped_frames",
+    ] {
+        assert!(m[k].is_number(), "{k}");
+    }
+    let shares: f64 = m["bottleneck"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|x| x.as_f64().unwrap())
+        .sum();
+    assert!((shares - 1.0).abs() < 1e-9, "{shares}");
+}
+
+#[test]
+fn out_dir_reruns_to_the_same_frames_and_trace_is_valid() {
+    let d = tempfile::tempdir().unwrap();
+    let a = d.path().join("a");
+    let b = d.path().join("b");
+    let trace = d.path().join("t.json");
+    run_ok(&[
+        "run",
+        "--frames",
+        "15",
+        "--seed",
+        "5",
+        "--set",
+        "display.buffers=3",
+        "--out",
+        a.to_str().unwrap(),
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    for f in ["summary.json", "frames.csv", "model.toml"] {
+        assert!(a.join(f).exists(), "{f}");
+    }
+    let csv = std::fs::read_to_string(a.join("frames.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    for col in [
+        "FrameTime",
+        "MsCPUBusy",
+        "MsCPUWait",
+        "MsGPULatency",
+        "MsGPUTime",
+        "MsGPUBusy",
+        "MsGPUWait",
+        "MsUntilDisplayed",
+        "DisplayLatency",
+        "MsBetweenDisplayChange",
+        "Dropped",
+    ] {
+        assert!(
+            header.split(',').any(|c| c == col),
+            "{col} missing in {header}"
+        );
+    }
+    // The resolved model alone reproduces the run.
+    run_ok(&[
+        "run",
+        a.join("model.toml").to_str().unwrap(),
+        "--out",
+        b.to_str().unwrap(),
+    ]);
+    assert_eq!(csv, std::fs::read_to_string(b.join("frames.csv")).unwrap());
+    // Trace: valid JSON; spans on one track never overlap.
+    let t: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&trace).unwrap()).unwrap();
+    let ev = t["traceEvents"].as_array().unwrap();
+    let mut by_tid: std::collections::BTreeMap<i64, Vec<(f64, f64)>> = Default::default();
+    for e in ev.iter().filter(|e| e["ph"] == "X") {
+        let ts = e["ts"].as_f64().unwrap();
+        by_tid
+            .entry(e["tid"].as_i64().unwrap())
+            .or_default()
+            .push((ts, ts + e["dur"].as_f64().unwrap()));
+    }
+    assert!(by_tid.len() >= 4, "tracks: {:?}", by_tid.keys());
+    for (tid, mut spans) in by_tid {
+        spans.sort_by(|x, y| x.0.total_cmp(&y.0));
+        for w in spans.windows(2) {
+            assert!(w[1].0 >= w[0].1 - 1e-6, "overlap on track {tid}: {w:?}");
+        }
+    }
+    assert!(
+        ev.iter()
+            .any(|e| e["ph"] == "C" && e["name"] == "command FIFO")
+    );
+}
+
+#[test]
+fn unknown_key_names_file_line_and_suggestion() {
+    let d = tempfile::tempdir().unwrap();
+    let m = write(
+        d.path(),
+        "m.toml",
+        &format!("{SMALL}\n[display]\nrefesh = \"60Hz\"\n"),
+    );
+    let e = run_err(&["run", &m]);
+    assert!(
+        e.contains("m.toml:")
+            && e.contains("display.refesh")
+            && e.contains("did you mean `refresh`"),
+        "{e}"
+    );
+    let line = SMALL.lines().count() + 3;
+    assert!(
+        e.contains(&format!(":{line}:")),
+        "expected line {line}: {e}"
+    );
+    let e = run_err(&["run", &m.replace("m.toml", "none.toml")]);
+    assert!(e.contains("none.toml"), "{e}");
+    let e = run_err(&["run", "--set", "display.refesh=60Hz"]);
+    assert!(e.contains("did you mean `refresh`"), "{e}");
+}
+
+#[test]
+fn bad_values_are_named() {
+    let d = tempfile::tempdir().unwrap();
+    let m = write(d.path(), "m.toml", SMALL);
+    for (set, needle) in [
+        ("workload.gpu=\"9 parsecs\"", "workload.gpu"),
+        ("workload.gpu=\"-3ms\"", "negative"),
+        ("workload.gpu=\"NaNms\"", "NaN"),
+        ("workload.gpu=17", "needs a unit"),
+        ("display.refresh=\"0Hz\"", "display.refresh"),
+        ("display.buffers=1", "display.buffers"),
+        ("cpu.max_frames_ahead=0", "cpu.max_frames_ahead"),
+        ("command_fifo.unit=\"lines\"", "command_fifo.unit"),
+        ("gpu.geometry.vertex_cache=\"fifo:0\"", "vertex_cache"),
+        ("system=\"warp\"", "unknown system"),
+    ] {
+        let e = run_err(&["run", &m, "--set", set]);
+        assert!(e.contains(needle), "{set}: {e}");
+    }
+}
+
+#[test]
+fn malformed_files_are_reported_with_their_names() {
+    let d = tempfile::tempdir().unwrap();
+    let m = write(d.path(), "bad.toml", "[run\nframes = 3\n");
+    let e = run_err(&["run", &m]);
+    assert!(e.contains("bad.toml") && e.contains("line 1"), "{e}");
+    write(d.path(), "broken.obj", "v 0 0 0\nv 1 0 0\nf 1 2 x\n");
+    let scene = format!(
+        "{}\n[workload]\nkind = \"scene\"\n[[workload.groups]]\nname = \"o\"\nmesh = \"broken.obj\"\ntriangle_pixels = 1.0\n",
+        "[run]\nframes = 2"
+    );
+    let m = write(d.path(), "scene.toml", &scene);
+    let e = run_err(&["run", &m]);
+    assert!(
+        e.contains("broken.obj") && e.contains("workload.groups.0.mesh"),
+        "{e}"
+    );
+    let e = run_err(&["run", &m, "--set", "workload.groups.0.mesh=\"missing.obj\""]);
+    assert!(e.contains("missing.obj"), "{e}");
+}
+
+#[test]
+fn a_failed_run_keeps_earlier_results() {
+    let d = tempfile::tempdir().unwrap();
+    let m = write(d.path(), "m.toml", SMALL);
+    let out = d.path().join("out");
+    run_ok(&["run", &m, "--out", out.to_str().unwrap()]);
+    let before = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    run_err(&[
+        "run",
+        &m,
+        "--set",
+        "workload.gpu=\"-1ms\"",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        before,
+        std::fs::read_to_string(out.join("summary.json")).unwrap()
+    );
+    assert_eq!(
+        std::fs::read_dir(&out).unwrap().count(),
+        3,
+        "no stray files"
+    );
+}
+
+#[test]
+fn isolate_finds_the_limiting_subsystem() {
+    let d = tempfile::tempdir().unwrap();
+    let m = write(d.path(), "m.toml", SMALL);
+    let out = run_ok(&["isolate", &m, "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["bottleneck"], "gpu", "{v}");
+    let out = run_ok(&["isolate", &m, "--json", "--set", "workload.cpu=\"20ms\""]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["bottleneck"], "cpu", "{v}");
+    let out = run_ok(&[
+        "isolate",
+        "--json",
+        "--set",
+        "fidelity=\"draw\"",
+        "--set",
+        "run.frames=30",
+        "--set",
+        "cpu.non_render=\"0ms\"",
+        "--set",
+        "gpu.fragment.per_fragment=\"20ns\"",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["bottleneck"], "raster", "{v}");
+    run_err(&["isolate", &m, "--factor", "1.5"]);
+}
+
+#[test]
+fn vcache_reports_the_figure_keys() {
+    let out = run_ok(&["vcache", "grid:4x3", "--policy", "fifo:9", "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["triangles"], 24);
+    assert_eq!(v["transformed"], 20);
+    for k in ["policy", "indices", "unique_vertices", "acmr", "atvr"] {
+        assert!(!v[k].is_null(), "{k}");
+    }
+    let e = run_err(&["vcache", "grid:4x3", "--policy", "lfu:3"]);
+    assert!(e.contains("lfu"), "{e}");
+}
