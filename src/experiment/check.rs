@@ -14,14 +14,90 @@ pub struct CheckOutcome {
     pub point: String,
     /// The point's replication mean (or derived value); `None` if it has none.
     pub measured: Option<f64>,
-    /// Expected value.
-    pub expect: f64,
-    /// Allowed absolute deviation (a relative tolerance already multiplied by `|expect|`).
+    /// Expected value (`None` for a check against bounds).
+    pub expect: Option<f64>,
+    /// Allowed absolute deviation (a relative tolerance already multiplied by
+    /// `|expect|`; for bounds, by the larger bound magnitude).
     pub allowed: f64,
     /// The tolerance as written, e.g. `±0.05` or `±1%`.
     pub tolerance_text: String,
-    /// Whether `|measured - expect| <= allowed`.
+    /// What was expected, as shown in the report: the value, or the bounds
+    /// with their paths and values at this point.
+    pub expected_text: String,
+    /// Whether the measured value is within the tolerance of the expected
+    /// value, or within the bounds widened by the tolerance.
     pub passed: bool,
+}
+
+/// A bound of a check against other values of the same point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bound<'a> {
+    /// Its path or derived name.
+    pub path: &'a str,
+    /// Its value at the point (`None`: undefined, the check fails).
+    pub value: Option<f64>,
+}
+
+/// Evaluate a check against bounds: passes when `measured >= low - tol` and
+/// `measured <= high + tol`, the tolerance taken relative to each bound for
+/// a relative tolerance. A missing or non-finite value fails.
+pub fn evaluate_between(
+    path: &str,
+    point: &str,
+    measured: Option<f64>,
+    low: Option<Bound<'_>>,
+    high: Option<Bound<'_>>,
+    tolerance: Tolerance,
+) -> CheckOutcome {
+    let allowed_for = |b: f64| match tolerance {
+        Tolerance::Absolute(t) => t,
+        Tolerance::Relative(t) => t * b.abs(),
+    };
+    let tolerance_text = match tolerance {
+        Tolerance::Absolute(t) => format!("±{}", format_range_number(t)),
+        Tolerance::Relative(t) => format!("±{}% of the bound", format_range_number(t * 100.0)),
+    };
+    let finite = |v: Option<f64>| v.filter(|x| x.is_finite());
+    let m = finite(measured);
+    let ok_low = match low {
+        None => true,
+        Some(b) => matches!((m, finite(b.value)), (Some(m), Some(l)) if m >= l - allowed_for(l)),
+    };
+    let ok_high = match high {
+        None => true,
+        Some(b) => matches!((m, finite(b.value)), (Some(m), Some(h)) if m <= h + allowed_for(h)),
+    };
+    let show = |b: &Bound<'_>| {
+        format!(
+            "`{}` = {}",
+            b.path,
+            b.value
+                .map(super::report::fmt_precise)
+                .unwrap_or_else(|| "n/a".into())
+        )
+    };
+    let expected_text = match (&low, &high) {
+        (Some(l), Some(h)) => format!("between {} and {}", show(l), show(h)),
+        (Some(l), None) => format!("at least {}", show(l)),
+        (None, Some(h)) => format!("at most {}", show(h)),
+        (None, None) => "anything".into(),
+    };
+    let allowed = [low, high]
+        .iter()
+        .flatten()
+        .filter_map(|b| finite(b.value))
+        .map(allowed_for)
+        .fold(0.0, f64::max);
+    CheckOutcome {
+        path: path.to_string(),
+        point: point.to_string(),
+        measured,
+        expect: None,
+        allowed,
+        tolerance_text,
+        expected_text,
+        passed: m.is_some() && ok_low && ok_high,
+    }
 }
 
 /// Evaluate one check.
@@ -44,9 +120,10 @@ pub fn evaluate(
         path: path.to_string(),
         point: point.to_string(),
         measured,
-        expect,
+        expect: Some(expect),
         allowed,
         tolerance_text,
+        expected_text: super::report::fmt_precise(expect),
         passed,
     }
 }
@@ -65,5 +142,41 @@ mod tests {
         assert_eq!(o.tolerance_text, "±1%");
         assert!(!evaluate("m", "p", None, 1.0, Tolerance::Absolute(10.0)).passed);
         assert!(!evaluate("m", "p", Some(f64::NAN), 1.0, Tolerance::Absolute(10.0)).passed);
+    }
+
+    #[test]
+    fn between_bounds() {
+        let b = |path, value| Some(Bound { path, value });
+        let abs = Tolerance::Absolute(0.01);
+        let check = |m: f64, lo: Option<Bound<'static>>, hi: Option<Bound<'static>>| {
+            evaluate_between("t", "p", Some(m), lo, hi, abs).passed
+        };
+        assert!(check(5.0, b("max", Some(4.0)), b("sum", Some(6.0))));
+        assert!(check(4.0, b("max", Some(4.0)), b("sum", Some(6.0))));
+        assert!(check(3.995, b("max", Some(4.0)), b("sum", Some(6.0))));
+        assert!(!check(3.98, b("max", Some(4.0)), b("sum", Some(6.0))));
+        assert!(!check(6.02, b("max", Some(4.0)), b("sum", Some(6.0))));
+        assert!(check(100.0, b("max", Some(4.0)), None));
+        assert!(check(-100.0, None, b("sum", Some(6.0))));
+        // A missing bound or measurement fails.
+        assert!(!check(5.0, b("max", None), b("sum", Some(6.0))));
+        assert!(!evaluate_between("t", "p", None, None, b("sum", Some(6.0)), abs).passed);
+        // Relative tolerance is relative to each bound.
+        let rel = Tolerance::Relative(0.01);
+        let o = evaluate_between("t", "p", Some(101.0), None, b("sum", Some(100.0)), rel);
+        assert!(o.passed);
+        assert_eq!(o.allowed, 1.0);
+        assert_eq!(o.expected_text, "at most `sum` = 100");
+        assert!(!evaluate_between("t", "p", Some(98.0), b("max", Some(100.0)), None, rel).passed);
+        let o = evaluate_between(
+            "t",
+            "p",
+            Some(5.0),
+            b("a", Some(4.0)),
+            b("b", Some(6.5)),
+            abs,
+        );
+        assert_eq!(o.expected_text, "between `a` = 4 and `b` = 6.5");
+        assert_eq!(o.expect, None);
     }
 }

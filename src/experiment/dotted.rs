@@ -6,8 +6,14 @@ use super::ExperimentError;
 /// Set `key` (dot-separated, e.g. `display.buffers`) in `table` to `value`,
 /// creating intermediate tables as needed and replacing any existing value.
 ///
+/// A segment that meets an array (an array of tables such as
+/// `[[workload.groups]]`) is an index into it, counted from 0:
+/// `workload.groups.0.triangle_pixels.median`. The entry must exist; arrays
+/// are never extended.
+///
 /// Keys are split on every `.`; quoted segments are not supported. Fails
-/// when a segment is empty or an intermediate key holds a non-table value.
+/// when a segment is empty, an intermediate key holds a non-table value, or
+/// an array index is not a number or out of range.
 pub fn set_dotted(
     table: &mut toml::Table,
     key: &str,
@@ -21,25 +27,64 @@ pub fn set_dotted(
     if parts.iter().any(|p| p.trim().is_empty()) {
         return Err(err("empty key segment".into()));
     }
-    let (last, parents) = parts.split_last().expect("split yields at least one part");
-    let mut cur = table;
-    for (depth, part) in parents.iter().enumerate() {
-        let entry = cur
-            .entry(part.to_string())
-            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-        cur = match entry {
-            toml::Value::Table(t) => t,
-            other => {
-                return Err(err(format!(
-                    "`{}` is not a table (it is of type {})",
-                    parts[..=depth].join("."),
-                    other.type_str()
-                )));
-            }
-        };
+    // Failures happen only at existing values, before anything new is
+    // created below them, so a rejected key leaves `table` unchanged.
+    let mut root = toml::Value::Table(std::mem::take(table));
+    let result = set_in(&mut root, &parts, 0, value);
+    if let toml::Value::Table(t) = root {
+        *table = t;
     }
-    cur.insert(last.to_string(), value);
-    Ok(())
+    result.map_err(err)
+}
+
+/// Set `parts[done..]` below `cur`, which sits at `parts[..done]`.
+fn set_in(
+    cur: &mut toml::Value,
+    parts: &[&str],
+    done: usize,
+    value: toml::Value,
+) -> Result<(), String> {
+    let part = parts[done];
+    let last = done + 1 == parts.len();
+    let here = || parts[..done].join(".");
+    match cur {
+        toml::Value::Table(t) => {
+            if last {
+                t.insert(part.to_string(), value);
+                return Ok(());
+            }
+            let next = t
+                .entry(part.to_string())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            set_in(next, parts, done + 1, value)
+        }
+        toml::Value::Array(items) => {
+            let len = items.len();
+            let index: usize = part.parse().map_err(|_| {
+                format!(
+                    "`{}` is an array; `{part}` is not an index (0 to {})",
+                    here(),
+                    len.saturating_sub(1)
+                )
+            })?;
+            let slot = items.get_mut(index).ok_or_else(|| {
+                format!(
+                    "`{}` has {len} entries; index {index} is out of range",
+                    here()
+                )
+            })?;
+            if last {
+                *slot = value;
+                return Ok(());
+            }
+            set_in(slot, parts, done + 1, value)
+        }
+        other => Err(format!(
+            "`{}` is not a table (it is of type {})",
+            here(),
+            other.type_str()
+        )),
+    }
 }
 
 /// The JSON value at dotted `path` in `root`, if present.
@@ -125,6 +170,49 @@ mod tests {
         assert!(set_dotted(&mut t, "", toml::Value::Integer(1)).is_err());
         // Nothing half-applied for the rejected keys.
         assert_eq!(t.len(), 1);
+    }
+
+    #[test]
+    fn set_dotted_indexes_arrays_of_tables() {
+        let mut t: toml::Table = "[[workload.groups]]\nname = \"a\"\n\
+             triangle_pixels = { kind = \"lognormal\", median = 8.0, sigma = 0.8 }\n\
+             [[workload.groups]]\nname = \"b\"\nlist = [1, 2]\n"
+            .parse()
+            .unwrap();
+        set_dotted(
+            &mut t,
+            "workload.groups.0.triangle_pixels.median",
+            toml::Value::Float(0.5),
+        )
+        .unwrap();
+        set_dotted(&mut t, "workload.groups.1.count", toml::Value::Integer(4)).unwrap();
+        set_dotted(&mut t, "workload.groups.1.list.1", toml::Value::Integer(7)).unwrap();
+        let groups = t["workload"]["groups"].as_array().unwrap();
+        assert_eq!(groups[0]["triangle_pixels"]["median"].as_float(), Some(0.5));
+        assert_eq!(groups[0]["triangle_pixels"]["sigma"].as_float(), Some(0.8));
+        assert_eq!(groups[0]["name"].as_str(), Some("a"));
+        assert_eq!(groups[1]["count"].as_integer(), Some(4));
+        assert_eq!(
+            groups[1]["list"].as_array().unwrap()[1].as_integer(),
+            Some(7)
+        );
+        let before = t.clone();
+        let e = set_dotted(&mut t, "workload.groups.2.count", toml::Value::Integer(1))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("`workload.groups` has 2 entries; index 2 is out of range"),
+            "{e}"
+        );
+        let e = set_dotted(
+            &mut t,
+            "workload.groups.first.count",
+            toml::Value::Integer(1),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("`first` is not an index"), "{e}");
+        assert_eq!(t, before, "rejected keys change nothing");
     }
 
     #[test]

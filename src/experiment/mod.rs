@@ -48,6 +48,11 @@
 //! where = { "workload.gpu" = "17ms", "display.buffers" = 2 }
 //! expect = 33.333
 //! tolerance = 0.05       # absolute; or rel_tolerance = 0.01
+//! [[check]]              # or bounds from other values of the same point
+//! path = "metrics.gpu_time_ms.mean"
+//! at_least_path = "metrics.analytic.gpu_max_ms"   # either or both
+//! at_most_path = "metrics.analytic.gpu_sum_ms"
+//! rel_tolerance = 0.01   # relative to each bound (or tolerance = absolute)
 //! ```
 //!
 //! Outputs in the output directory: `runs.csv` (one row per point and seed),
@@ -71,7 +76,7 @@ mod tables;
 #[cfg(test)]
 mod tests;
 
-pub use check::CheckOutcome;
+pub use check::{Bound, CheckOutcome, evaluate_between};
 pub use derived::{interval_width, quantile_width_from_min, relative_error, speedup};
 pub use dotted::{json_number, json_path, set_dotted};
 pub use error::ExperimentError;
@@ -79,7 +84,7 @@ pub use run::{ExperimentResult, PathStat, PointResult, RunRecord, point_model, r
 pub use runner::{FrameTable, RunOutput, Runner};
 pub use sim_runner::SimRunner;
 pub use spec::{
-    Check, Derived, DerivedKind, Experiment, Metric, ModelSource, PlotKind, PlotSpec, Tolerance,
-    load_experiment, parse_experiment,
+    Check, Derived, DerivedKind, Expect, Experiment, Metric, ModelSource, PlotKind, PlotSpec,
+    Tolerance, load_experiment, parse_experiment,
 };
 pub use sweep::{Point, Sweep, expand_points, numeric_coord, value_text, values_match};

@@ -204,7 +204,7 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
                 c.path,
                 cell(&c.point),
                 c.measured.map(fmt_precise).unwrap_or_else(|| "n/a".into()),
-                fmt_precise(c.expect),
+                cell(&c.expected_text),
                 c.tolerance_text,
                 if c.passed { "PASS" } else { "**FAIL**" }
             );

@@ -10,11 +10,11 @@ use serde::Serialize;
 
 use crate::stats::ci::{MeanCi, mean_ci};
 
-use super::check::{CheckOutcome, evaluate};
+use super::check::{Bound, CheckOutcome, evaluate, evaluate_between};
 use super::derived::{DerivedInputs, compute};
 use super::dotted::{json_number, set_dotted};
 use super::runner::Runner;
-use super::spec::Experiment;
+use super::spec::{Expect, Experiment};
 use super::sweep::{Point, expand_points};
 use super::{ExperimentError, figures, report, tables};
 
@@ -289,13 +289,29 @@ pub fn run_experiment(
     for c in &exp.checks {
         for p in points.iter().filter(|p| p.matches(&c.filter)) {
             let pr = &point_results[p.index];
-            checks.push(evaluate(
-                &c.path,
-                &pr.label,
-                pr.value(&c.path),
-                c.expect,
-                c.tolerance,
-            ));
+            checks.push(match &c.expect {
+                Expect::Value(v) => {
+                    evaluate(&c.path, &pr.label, pr.value(&c.path), *v, c.tolerance)
+                }
+                Expect::Between { at_least, at_most } => {
+                    let low = at_least.as_deref().map(|path| Bound {
+                        path,
+                        value: pr.value(path),
+                    });
+                    let high = at_most.as_deref().map(|path| Bound {
+                        path,
+                        value: pr.value(path),
+                    });
+                    evaluate_between(
+                        &c.path,
+                        &pr.label,
+                        pr.value(&c.path),
+                        low,
+                        high,
+                        c.tolerance,
+                    )
+                }
+            });
         }
     }
     let checks_failed = checks.iter().filter(|c| !c.passed).count();

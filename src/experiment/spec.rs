@@ -141,15 +141,32 @@ pub enum Tolerance {
     Relative(f64),
 }
 
-/// A reference value to compare against.
+/// What a check compares its value with.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Expect {
+    /// A reference value: `|measured - value| <= tolerance`.
+    Value(f64),
+    /// Bounds taken from other values of the same point (metric paths or
+    /// derived names): `measured >= at_least - tolerance` and
+    /// `measured <= at_most + tolerance`, with a relative tolerance taken
+    /// relative to each bound. At least one bound is given.
+    Between {
+        /// Path or derived name of the lower bound.
+        at_least: Option<String>,
+        /// Path or derived name of the upper bound.
+        at_most: Option<String>,
+    },
+}
+
+/// A reference value (or a pair of bounds) to compare against.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Check {
     /// Metric path or derived name.
     pub path: String,
     /// Sweep key = value; every matching point is checked.
     pub filter: Vec<(String, toml::Value)>,
-    /// Expected value.
-    pub expect: f64,
+    /// Expected value or bounds.
+    pub expect: Expect,
     /// Allowed deviation.
     pub tolerance: Tolerance,
 }
@@ -253,6 +270,9 @@ impl Experiment {
         }
         for c in &self.checks {
             add(&c.path);
+            if let Expect::Between { at_least, at_most } = &c.expect {
+                at_least.iter().chain(at_most).for_each(|b| add(b));
+            }
         }
         out
     }
@@ -408,7 +428,9 @@ struct RawCheck {
     path: String,
     #[serde(rename = "where", default)]
     filter: toml::Table,
-    expect: f64,
+    expect: Option<f64>,
+    at_least_path: Option<String>,
+    at_most_path: Option<String>,
     tolerance: Option<f64>,
     rel_tolerance: Option<f64>,
 }
@@ -730,13 +752,36 @@ impl Validator<'_> {
             if !(t >= 0.0 && t.is_finite()) {
                 return Err(self.err(&key, "tolerance must be a finite number >= 0"));
             }
-            if !c.expect.is_finite() {
-                return Err(self.err(format!("{key}.expect"), "must be finite"));
-            }
+            let bound = |b: Option<String>, name: &str| match b {
+                Some(b) if b.trim().is_empty() => {
+                    Err(self.err(format!("{key}.{name}"), "must not be empty"))
+                }
+                other => Ok(other),
+            };
+            let at_least = bound(c.at_least_path, "at_least_path")?;
+            let at_most = bound(c.at_most_path, "at_most_path")?;
+            let expect = match (c.expect, at_least.is_some() || at_most.is_some()) {
+                (Some(_), true) => {
+                    return Err(self.err(
+                        &key,
+                        "give either `expect` or `at_least_path`/`at_most_path`, not both",
+                    ));
+                }
+                (None, false) => {
+                    return Err(self.err(&key, "needs `expect` or `at_least_path`/`at_most_path`"));
+                }
+                (Some(v), false) => {
+                    if !v.is_finite() {
+                        return Err(self.err(format!("{key}.expect"), "must be finite"));
+                    }
+                    Expect::Value(v)
+                }
+                (None, true) => Expect::Between { at_least, at_most },
+            };
             checks.push(Check {
                 filter: filter(&format!("{key}.where"), &c.filter)?,
                 path: c.path,
-                expect: c.expect,
+                expect,
                 tolerance,
             });
         }

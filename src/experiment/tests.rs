@@ -238,6 +238,20 @@ fn bad_experiment_files() {
         "{e}"
     );
 
+    let e = parse_err(
+        "name = \"x\"\n[[check]]\npath = \"m\"\nexpect = 1.0\nat_most_path = \"s\"\ntolerance = 0.1\n",
+    );
+    assert!(e.contains("not both"), "{e}");
+    let e = parse_err("name = \"x\"\n[[check]]\npath = \"m\"\ntolerance = 0.1\n");
+    assert!(
+        e.contains("needs `expect` or `at_least_path`/`at_most_path`"),
+        "{e}"
+    );
+    let e = parse_err(
+        "name = \"x\"\n[[check]]\npath = \"m\"\nat_least_path = \" \"\ntolerance = 0.1\n",
+    );
+    assert!(e.contains("check[0] (m).at_least_path"), "{e}");
+
     let e = parse_err("name = \"x\"\nconfidence = 1.5\n");
     assert!(e.contains("`confidence`"), "{e}");
 
@@ -576,5 +590,58 @@ fn point_model_applies_set_then_sweep() {
     assert!(
         e.to_string().contains("cannot set `workload.gpu.mean`"),
         "{e}"
+    );
+}
+
+#[test]
+fn checks_against_bounds_from_other_paths() {
+    // Fake: frame_time mean = gpu + noise; display interval = ceil(gpu / 16.67) * 16.67.
+    let exp = parse(
+        r#"
+name = "bounds"
+replications = 2
+[[sweep]]
+key = "workload.gpu"
+values = ["10ms", "20ms"]
+[[derived]]
+name = "frame_err"
+kind = "relative_error"
+path = "metrics.frame_time_ms.mean"
+reference = { "workload.gpu" = "10ms" }
+[[check]]
+path = "metrics.frame_time_ms.mean"
+at_most_path = "metrics.display_interval_ms.mean"
+tolerance = 0.0
+[[check]]
+path = "metrics.display_interval_ms.mean"
+at_least_path = "metrics.frame_time_ms.mean"
+at_most_path = "frame_err"
+rel_tolerance = 0.01
+"#,
+    );
+    assert!(
+        exp.tracked_paths()
+            .contains(&"metrics.display_interval_ms.mean".to_string())
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let res = run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap();
+    assert_eq!(res.checks.len(), 4);
+    // frame time (10, 20) <= interval (16.67, 33.33): both pass.
+    assert!(res.checks[0].passed && res.checks[1].passed);
+    assert_eq!(res.checks[0].expect, None);
+    // interval >= frame time, but not <= frame_err (0 and 1): both fail.
+    assert!(!res.checks[2].passed && !res.checks[3].passed);
+    assert_eq!(res.checks_failed, 2);
+    assert!(
+        res.checks[2]
+            .expected_text
+            .starts_with("between `metrics.frame_time_ms.mean` = 9.995 and `frame_err` = 0"),
+        "{}",
+        res.checks[2].expected_text
+    );
+    let report = read(dir.path(), "report.md");
+    assert!(
+        report.contains("at most `metrics.display_interval_ms.mean` = 16.6617"),
+        "{report}"
     );
 }
