@@ -129,9 +129,7 @@ fn dispatch(cli: Cli) -> Result<()> {
             json,
         } => cmd_isolate(model, sets, factor, keep_vsync, json),
         Cmd::Vcache { mesh, policy, json } => cmd_vcache(&mesh, &policy, json),
-        Cmd::Bench { which, scale } => {
-            rendersim::bench::run_cli(&which, scale).map_err(anyhow::Error::msg)
-        }
+        Cmd::Bench { which, scale } => rendersim::bench::run_cli(&which, scale).map_err(anyhow::Error::msg),
     }
 }
 
@@ -142,12 +140,7 @@ fn load_source(model: Option<&Path>) -> Result<ModelSource> {
     })
 }
 
-fn model_table(
-    src: &ModelSource,
-    sets: &[String],
-    seed: Option<u64>,
-    frames: Option<u64>,
-) -> Result<toml::Table> {
+fn model_table(src: &ModelSource, sets: &[String], seed: Option<u64>, frames: Option<u64>) -> Result<toml::Table> {
     let mut t = src.table()?;
     for s in sets {
         apply_set(&mut t, s)?;
@@ -194,20 +187,15 @@ fn cmd_run(
     let mut run = run_model(&src, &table, trace.is_some())?;
     run.summary_mut()["model"] = json!(src.name);
     if let Some(dir) = &out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("cannot create output directory {}", dir.display()))?;
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
         let summary = serde_json::to_string_pretty(run.summary())?;
-        write_atomic(&dir.join("summary.json"), |w| {
-            w.write_all(summary.as_bytes())
-        })
-        .with_context(|| format!("writing {}", dir.join("summary.json").display()))?;
+        write_atomic(&dir.join("summary.json"), |w| w.write_all(summary.as_bytes()))
+            .with_context(|| format!("writing {}", dir.join("summary.json").display()))?;
         write_atomic(&dir.join("frames.csv"), |w| run.write_frames_csv(w))
             .with_context(|| format!("writing {}", dir.join("frames.csv").display()))?;
         let resolved = run.resolved_model(&src.base_dir);
-        write_atomic(&dir.join("model.toml"), |w| {
-            w.write_all(resolved.as_bytes())
-        })
-        .with_context(|| format!("writing {}", dir.join("model.toml").display()))?;
+        write_atomic(&dir.join("model.toml"), |w| w.write_all(resolved.as_bytes()))
+            .with_context(|| format!("writing {}", dir.join("model.toml").display()))?;
     }
     if let Some(path) = &trace {
         write_atomic(path, |w| run.write_trace(w).map(|_| ()))
@@ -282,9 +270,7 @@ fn print_human(run: &SystemRun) {
 }
 
 fn cmd_experiment(file: &Path, out: Option<PathBuf>, quiet: bool) -> Result<()> {
-    use rendersim::experiment::{
-        ModelSource as ExpModel, SimRunner, load_experiment, run_experiment,
-    };
+    use rendersim::experiment::{ModelSource as ExpModel, SimRunner, load_experiment, run_experiment};
     let exp = load_experiment(file)?;
     let default = ModelSource::from_text("<embedded default model>", DEFAULT_MODEL).table()?;
     let base = exp.resolve_model(&default)?;
@@ -296,8 +282,7 @@ fn cmd_experiment(file: &Path, out: Option<PathBuf>, quiet: bool) -> Result<()> 
         ),
     };
     let out = out.unwrap_or_else(|| PathBuf::from("out").join(&exp.name));
-    std::fs::create_dir_all(&out)
-        .with_context(|| format!("cannot create output directory {}", out.display()))?;
+    std::fs::create_dir_all(&out).with_context(|| format!("cannot create output directory {}", out.display()))?;
     let runner = SimRunner { name, base_dir };
     let result = run_experiment(&exp, &base, &runner, &out, !quiet)?;
     println!("{}", result.table(&exp));
@@ -319,23 +304,11 @@ fn cmd_experiment(file: &Path, out: Option<PathBuf>, quiet: bool) -> Result<()> 
     Ok(())
 }
 
-fn cmd_isolate(
-    model: Option<PathBuf>,
-    sets: Vec<String>,
-    factor: f64,
-    keep_vsync: bool,
-    json: bool,
-) -> Result<()> {
+fn cmd_isolate(model: Option<PathBuf>, sets: Vec<String>, factor: f64, keep_vsync: bool, json: bool) -> Result<()> {
     let src = load_source(model.as_deref())?;
     let table = model_table(&src, &sets, None, None)?;
-    let cfg: rendersim::systems::frame_pipeline::FramePipelineConfig =
-        rendersim::config::deserialize(&table, &src)?;
-    let iso = rendersim::systems::frame_pipeline::isolate::isolate(
-        &cfg,
-        &src.base_dir,
-        factor,
-        keep_vsync,
-    )?;
+    let cfg: rendersim::systems::frame_pipeline::FramePipelineConfig = rendersim::config::deserialize(&table, &src)?;
+    let iso = rendersim::systems::frame_pipeline::isolate::isolate(&cfg, &src.base_dir, factor, keep_vsync)?;
     if json {
         println!("{}", serde_json::to_string_pretty(&iso)?);
         return Ok(());
@@ -352,10 +325,7 @@ fn cmd_isolate(
             100.0 * v.change
         );
     }
-    println!(
-        "  => bottleneck: {}   ({:.2} s wall)",
-        iso.bottleneck, iso.wall_seconds
-    );
+    println!("  => bottleneck: {}   ({:.2} s wall)", iso.bottleneck, iso.wall_seconds);
     Ok(())
 }
 

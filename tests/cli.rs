@@ -23,11 +23,7 @@ fn run_ok(args: &[&str]) -> String {
 fn run_err(args: &[&str]) -> String {
     let o = bin().args(args).output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr).to_string();
-    assert_eq!(
-        o.status.code(),
-        Some(2),
-        "{args:?}: expected exit 2, stderr: {err}"
-    );
+    assert_eq!(o.status.code(), Some(2), "{args:?}: expected exit 2, stderr: {err}");
     assert!(!err.contains("panicked"), "{err}");
     err
 }
@@ -118,10 +114,7 @@ fn out_dir_reruns_to_the_same_frames_and_trace_is_valid() {
         "MsBetweenDisplayChange",
         "Dropped",
     ] {
-        assert!(
-            header.split(',').any(|c| c == col),
-            "{col} missing in {header}"
-        );
+        assert!(header.split(',').any(|c| c == col), "{col} missing in {header}");
     }
     // The resolved model alone reproduces the run.
     run_ok(&[
@@ -132,8 +125,7 @@ fn out_dir_reruns_to_the_same_frames_and_trace_is_valid() {
     ]);
     assert_eq!(csv, std::fs::read_to_string(b.join("frames.csv")).unwrap());
     // Trace: valid JSON; spans on one track never overlap.
-    let t: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&trace).unwrap()).unwrap();
+    let t: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&trace).unwrap()).unwrap();
     let ev = t["traceEvents"].as_array().unwrap();
     let mut by_tid: std::collections::BTreeMap<i64, Vec<(f64, f64)>> = Default::default();
     for e in ev.iter().filter(|e| e["ph"] == "X") {
@@ -150,32 +142,20 @@ fn out_dir_reruns_to_the_same_frames_and_trace_is_valid() {
             assert!(w[1].0 >= w[0].1 - 1e-6, "overlap on track {tid}: {w:?}");
         }
     }
-    assert!(
-        ev.iter()
-            .any(|e| e["ph"] == "C" && e["name"] == "command FIFO")
-    );
+    assert!(ev.iter().any(|e| e["ph"] == "C" && e["name"] == "command FIFO"));
 }
 
 #[test]
 fn unknown_key_names_file_line_and_suggestion() {
     let d = tempfile::tempdir().unwrap();
-    let m = write(
-        d.path(),
-        "m.toml",
-        &format!("{SMALL}\n[display]\nrefesh = \"60Hz\"\n"),
-    );
+    let m = write(d.path(), "m.toml", &format!("{SMALL}\n[display]\nrefesh = \"60Hz\"\n"));
     let e = run_err(&["run", &m]);
     assert!(
-        e.contains("m.toml:")
-            && e.contains("display.refesh")
-            && e.contains("did you mean `refresh`"),
+        e.contains("m.toml:") && e.contains("display.refesh") && e.contains("did you mean `refresh`"),
         "{e}"
     );
     let line = SMALL.lines().count() + 3;
-    assert!(
-        e.contains(&format!(":{line}:")),
-        "expected line {line}: {e}"
-    );
+    assert!(e.contains(&format!(":{line}:")), "expected line {line}: {e}");
     let e = run_err(&["run", &m.replace("m.toml", "none.toml")]);
     assert!(e.contains("none.toml"), "{e}");
     let e = run_err(&["run", "--set", "display.refesh=60Hz"]);
@@ -216,10 +196,7 @@ fn malformed_files_are_reported_with_their_names() {
     );
     let m = write(d.path(), "scene.toml", &scene);
     let e = run_err(&["run", &m]);
-    assert!(
-        e.contains("broken.obj") && e.contains("workload.groups.0.mesh"),
-        "{e}"
-    );
+    assert!(e.contains("broken.obj") && e.contains("workload.groups.0.mesh"), "{e}");
     let e = run_err(&["run", &m, "--set", "workload.groups.0.mesh=\"missing.obj\""]);
     assert!(e.contains("missing.obj"), "{e}");
 }
@@ -239,15 +216,8 @@ fn a_failed_run_keeps_earlier_results() {
         "--out",
         out.to_str().unwrap(),
     ]);
-    assert_eq!(
-        before,
-        std::fs::read_to_string(out.join("summary.json")).unwrap()
-    );
-    assert_eq!(
-        std::fs::read_dir(&out).unwrap().count(),
-        3,
-        "no stray files"
-    );
+    assert_eq!(before, std::fs::read_to_string(out.join("summary.json")).unwrap());
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 3, "no stray files");
 }
 
 #[test]

@@ -7,11 +7,7 @@ use rendersim::systems::frame_pipeline::records::write_frames_csv;
 fn outputs(seed: u64) -> (String, String) {
     let r = run(
         DEFAULT,
-        &[
-            &format!("run.seed={seed}"),
-            "run.frames=12",
-            "run.warmup_frames=2",
-        ],
+        &[&format!("run.seed={seed}"), "run.frames=12", "run.warmup_frames=2"],
     );
     let mut csv = vec![];
     write_frames_csv(&r.records, &mut csv).unwrap();
@@ -19,10 +15,7 @@ fn outputs(seed: u64) -> (String, String) {
     // Wall time is the one field that may differ.
     s["wall_seconds"] = 0.into();
     s["events_per_second"] = 0.into();
-    (
-        String::from_utf8(csv).unwrap(),
-        serde_json::to_string(&s).unwrap(),
-    )
+    (String::from_utf8(csv).unwrap(), serde_json::to_string(&s).unwrap())
 }
 
 #[test]

@@ -54,18 +54,11 @@ fn mailbox_drops_frames_produced_faster_than_refresh() {
     let dropped = metric(&r, "metrics.dropped_frames");
     let frames = metric(&r, "frames");
     // About 3.33 frames per refresh: roughly 70% of them never shown.
-    assert!(
-        (dropped / frames - (1.0 - 5.0 / REFRESH_MS)).abs() < 0.03,
-        "{dropped}"
-    );
+    assert!((dropped / frames - (1.0 - 5.0 / REFRESH_MS)).abs() < 0.03, "{dropped}");
     // FIFO with the same load never drops and runs at refresh rate.
     let f = run(
         FIXED,
-        &[
-            "display.buffers=3",
-            "workload.gpu=\"5ms\"",
-            "workload.cpu=\"1ms\"",
-        ],
+        &["display.buffers=3", "workload.gpu=\"5ms\"", "workload.cpu=\"1ms\""],
     );
     assert_eq!(metric(&f, "metrics.dropped_frames"), 0.0);
     assert!((metric(&f, "metrics.frame_time_ms.mean") - REFRESH_MS).abs() < 0.01);
@@ -76,12 +69,7 @@ fn immediate_present_shows_frames_as_they_complete() {
     let r = run(FIXED, &["display.vsync=false"]);
     assert!((metric(&r, "metrics.display_interval_ms.mean") - 17.0).abs() < 1e-9);
     assert_eq!(
-        r.stats.by_kind[r
-            .stats
-            .kind_names
-            .iter()
-            .position(|k| *k == "vblank")
-            .unwrap()],
+        r.stats.by_kind[r.stats.kind_names.iter().position(|k| *k == "vblank").unwrap()],
         0,
         "no vblank events when nothing waits for them"
     );
@@ -92,10 +80,7 @@ fn render_ahead_adds_one_gpu_frame_of_latency_per_frame_in_flight() {
     let lat: Vec<f64> = (1..=5)
         .map(|n| {
             metric(
-                &run(
-                    FIXED,
-                    &["display.vsync=false", &format!("cpu.max_frames_ahead={n}")],
-                ),
+                &run(FIXED, &["display.vsync=false", &format!("cpu.max_frames_ahead={n}")]),
                 "metrics.display_latency_ms.mean",
             )
         })
@@ -111,11 +96,7 @@ fn render_ahead_adds_one_gpu_frame_of_latency_per_frame_in_flight() {
 fn refresh_extremes_one_hertz_and_one_kilohertz() {
     let slow = run(
         FIXED,
-        &[
-            "display.refresh=\"1Hz\"",
-            "run.frames=12",
-            "run.warmup_frames=2",
-        ],
+        &["display.refresh=\"1Hz\"", "run.frames=12", "run.warmup_frames=2"],
     );
     assert!((metric(&slow, "metrics.display_interval_ms.mean") - 1000.0).abs() < 1e-9);
     // Every frame appears exactly on a 1 s boundary.

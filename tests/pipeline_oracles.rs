@@ -42,15 +42,9 @@ fn fifo_depth_moves_frame_time_from_sum_to_max_monotonically() {
         times[0]
     );
     let last = *times.last().unwrap();
-    assert!(
-        (last - max).abs() / max < 0.03,
-        "deep-FIFO time {last} vs max {max}"
-    );
+    assert!((last - max).abs() / max < 0.03, "deep-FIFO time {last} vs max {max}");
     for t in &times {
-        assert!(
-            *t >= max * 0.999 && *t <= sum * 1.001,
-            "{t} outside [{max}, {sum}]"
-        );
+        assert!(*t >= max * 0.999 && *t <= sum * 1.001, "{t} outside [{max}, {sum}]");
     }
 }
 
@@ -159,16 +153,10 @@ fn unused_parts_are_not_built_and_zero_cost_parts_change_nothing() {
     ];
     let plain = run(DEFAULT, &base);
     let mut with_up = base.to_vec();
-    with_up.extend([
-        "workload.groups.1.geometry_upload=1",
-        "bus.bandwidth=\"1000TB/s\"",
-    ]);
+    with_up.extend(["workload.groups.1.geometry_upload=1", "bus.bandwidth=\"1000TB/s\""]);
     let up = run(DEFAULT, &with_up);
     assert_eq!(csv(&plain), csv(&up));
-    assert!(
-        up.commands.0 > plain.commands.0,
-        "upload commands are issued"
-    );
+    assert!(up.commands.0 > plain.commands.0, "upload commands are issued");
     // Non-indexed draws skip the cache: same as an indexed draw with no cache and free index fetch.
     let g = |extra: &str| {
         scene_model(&format!(
@@ -185,19 +173,13 @@ fn unused_parts_are_not_built_and_zero_cost_parts_change_nothing() {
 
 #[test]
 fn vertex_cache_changes_geometry_time_by_actually_transformed_vertices() {
-    let g = |mesh: &str| {
-        scene_model(&format!(
-            "name = \"g\"\nmesh = \"{mesh}\"\ntriangle_pixels = 0.0"
-        ))
-    };
+    let g = |mesh: &str| scene_model(&format!("name = \"g\"\nmesh = \"{mesh}\"\ntriangle_pixels = 0.0"));
     let shuffled = run(&g("grid:32x32:shuffled:3"), &[]);
     let optimized = run(&g("grid:32x32:optimized"), &[]);
     let tv = |r: &rendersim::systems::frame_pipeline::PipelineRun| {
         r.summary["scene"]["transformed_vertices"].as_u64().unwrap() as f64
     };
-    let geo = |r: &rendersim::systems::frame_pipeline::PipelineRun| {
-        metric(r, "metrics.analytic.geometry_ms")
-    };
+    let geo = |r: &rendersim::systems::frame_pipeline::PipelineRun| metric(r, "metrics.analytic.geometry_ms");
     assert!(tv(&optimized) < 0.5 * tv(&shuffled));
     // 1 ns per transformed vertex, nothing else.
     assert!((geo(&shuffled) - tv(&shuffled) * 1e-6).abs() < 1e-9);

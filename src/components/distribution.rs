@@ -151,20 +151,11 @@ fn phi(x: f64) -> f64 {
 fn check(prefix: &str, name: &str, value: f64, positive: bool) -> Result<(), DistError> {
     let param = || format!("{prefix}{name}");
     if !value.is_finite() {
-        Err(DistError::NotFinite {
-            param: param(),
-            value,
-        })
+        Err(DistError::NotFinite { param: param(), value })
     } else if positive && value <= 0.0 {
-        Err(DistError::NotPositive {
-            param: param(),
-            value,
-        })
+        Err(DistError::NotPositive { param: param(), value })
     } else if value < 0.0 {
-        Err(DistError::Negative {
-            param: param(),
-            value,
-        })
+        Err(DistError::Negative { param: param(), value })
     } else {
         Ok(())
     }
@@ -273,11 +264,7 @@ impl<V: Quantity> Dist<V> {
         };
         // Guards against NaN from unvalidated parameters; the clamp keeps
         // heavy tails finite.
-        if x.is_nan() {
-            0.0
-        } else {
-            x.clamp(0.0, f64::MAX)
-        }
+        if x.is_nan() { 0.0 } else { x.clamp(0.0, f64::MAX) }
     }
 
     /// The mean (base unit); infinite where it does not exist (Pareto with
@@ -439,14 +426,7 @@ fn weighted<V: Quantity>(parts: &[MixturePart<V>], f: impl Fn(&Dist<V>) -> f64) 
 // ---------------------------------------------------------------------------
 // Deserialization: a bare scalar (Const) or a table with `kind`.
 
-const KINDS: &[&str] = &[
-    "const",
-    "uniform",
-    "exponential",
-    "lognormal",
-    "pareto",
-    "mixture",
-];
+const KINDS: &[&str] = &["const", "uniform", "exponential", "lognormal", "pareto", "mixture"];
 const FIELDS: &[&str] = &[
     "kind", "value", "min", "max", "mean", "median", "sigma", "scale", "shape", "parts",
 ];
@@ -495,11 +475,7 @@ impl<'de, V: Quantity> Visitor<'de> for DistVisitor<V> {
     type Value = Dist<V>;
 
     fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        write!(
-            f,
-            "a constant or a table with `kind` = one of {}",
-            KINDS.join(", ")
-        )
+        write!(f, "a constant or a table with `kind` = one of {}", KINDS.join(", "))
     }
 
     fn visit_f64<E: de::Error>(self, v: f64) -> Result<Self::Value, E> {
@@ -517,9 +493,8 @@ impl<'de, V: Quantity> Visitor<'de> for DistVisitor<V> {
 
     fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
         let mut kind: Option<String> = None;
-        let (mut value, mut min, mut max, mut mean, mut median, mut scale) = (
-            None::<V>, None::<V>, None::<V>, None::<V>, None::<V>, None::<V>,
-        );
+        let (mut value, mut min, mut max, mut mean, mut median, mut scale) =
+            (None::<V>, None::<V>, None::<V>, None::<V>, None::<V>, None::<V>);
         let (mut sigma, mut shape) = (None::<f64>, None::<f64>);
         let mut parts: Option<Vec<MixturePart<V>>> = None;
         let mut seen: Vec<&'static str> = Vec::new();
@@ -552,12 +527,8 @@ impl<'de, V: Quantity> Visitor<'de> for DistVisitor<V> {
                 seen.push(name);
             }
         }
-        let kind = kind.ok_or_else(|| {
-            de::Error::custom(format!(
-                "missing field `kind` (one of {})",
-                KINDS.join(", ")
-            ))
-        })?;
+        let kind =
+            kind.ok_or_else(|| de::Error::custom(format!("missing field `kind` (one of {})", KINDS.join(", "))))?;
         let allowed = fields_of(&kind).ok_or_else(|| de::Error::unknown_variant(&kind, KINDS))?;
         let extra = unknown
             .as_deref()
@@ -565,11 +536,7 @@ impl<'de, V: Quantity> Visitor<'de> for DistVisitor<V> {
         if let Some(extra) = extra {
             return Err(de::Error::custom(format!(
                 "unknown field `{extra}` for kind `{kind}`, expected {}",
-                allowed
-                    .iter()
-                    .map(|f| format!("`{f}`"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                allowed.iter().map(|f| format!("`{f}`")).collect::<Vec<_>>().join(", ")
             )));
         }
         fn need<T, E: de::Error>(x: Option<T>, kind: &str, f: &'static str) -> Result<T, E> {

@@ -86,16 +86,10 @@ impl NoiseSource {
     ) -> Result<Self, NoiseError> {
         match &arrivals {
             Arrivals::Periodic { period, .. } if period.0 == 0 => {
-                return Err(NoiseError::Zero {
-                    name,
-                    what: "period",
-                });
+                return Err(NoiseError::Zero { name, what: "period" });
             }
             Arrivals::Poisson { mean_gap } if mean_gap.0 == 0 => {
-                return Err(NoiseError::Zero {
-                    name,
-                    what: "1/rate",
-                });
+                return Err(NoiseError::Zero { name, what: "1/rate" });
             }
             _ => {}
         }
@@ -118,11 +112,7 @@ impl NoiseSource {
         let k = self.k;
         self.k += 1;
         match self.arrivals {
-            Arrivals::Periodic {
-                period,
-                phase,
-                jitter,
-            } => {
+            Arrivals::Periodic { period, phase, jitter } => {
                 let base = period
                     .checked_mul(k)
                     .and_then(|d| d.checked_add(phase))
@@ -145,10 +135,7 @@ impl NoiseSource {
             Arrivals::Poisson { mean_gap } => {
                 let u: f64 = self.rng.random::<f64>();
                 let gap = -(1.0 - u).ln() * mean_gap.0 as f64;
-                prev.add(
-                    Duration::from_ps_f64(gap),
-                    "scheduling a random system task",
-                )
+                prev.add(Duration::from_ps_f64(gap), "scheduling a random system task")
             }
         }
     }

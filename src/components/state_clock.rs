@@ -60,6 +60,14 @@ impl<const N: usize> StateClock<N> {
         spent
     }
 
+    /// Moves `amount` already accounted from state `from` to state `to`
+    /// (for units whose split inside an interval is known only at its end).
+    pub fn transfer(&mut self, from: usize, to: usize, amount: u64) {
+        let a = amount.min(self.totals[from]);
+        self.totals[from] -= a;
+        self.totals[to] += a;
+    }
+
     /// Totals per state as of `now` (the current state counted up to `now`).
     pub fn totals_at(&self, now: Time) -> [u64; N] {
         let mut t = self.totals;

@@ -86,12 +86,10 @@ impl ModelSource {
 
     /// Parses the text into a TOML table.
     pub fn table(&self) -> Result<toml::Table, ConfigError> {
-        self.text
-            .parse::<toml::Table>()
-            .map_err(|e| ConfigError::Syntax {
-                file: self.name.clone(),
-                message: e.to_string().trim().to_string(),
-            })
+        self.text.parse::<toml::Table>().map_err(|e| ConfigError::Syntax {
+            file: self.name.clone(),
+            message: e.to_string().trim().to_string(),
+        })
     }
 
     /// 1-based line of the dotted `key` in the text, if it stands there
@@ -117,12 +115,10 @@ fn find_item(item: &toml_edit::Item, parts: &[&str], span: Span) -> Span {
             Some((k, v)) => find_item(v, rest, k.span().or(v.span()).or(span)),
             None => None,
         },
-        toml_edit::Item::ArrayOfTables(a) => {
-            match first.parse::<usize>().ok().and_then(|i| a.get(i)) {
-                Some(t) => find_item(&toml_edit::Item::Table(t.clone()), rest, t.span().or(span)),
-                None => span,
-            }
-        }
+        toml_edit::Item::ArrayOfTables(a) => match first.parse::<usize>().ok().and_then(|i| a.get(i)) {
+            Some(t) => find_item(&toml_edit::Item::Table(t.clone()), rest, t.span().or(span)),
+            None => span,
+        },
         toml_edit::Item::Value(v) => find_value(v, parts, span),
         toml_edit::Item::None => span,
     }
@@ -146,11 +142,7 @@ fn find_value(v: &toml_edit::Value, parts: &[&str], span: Span) -> Span {
 }
 
 fn line_at(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())]
-        .bytes()
-        .filter(|&b| b == b'\n')
-        .count()
-        + 1
+    text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
 }
 
 /// Applies `key.path=value` to `table`. The value is read as TOML (numbers,
@@ -161,18 +153,14 @@ pub fn apply_set(table: &mut toml::Table, assignment: &str) -> Result<(), Config
         assignment: assignment.to_string(),
         reason: reason.to_string(),
     };
-    let (key, raw) = assignment
-        .split_once('=')
-        .ok_or_else(|| err("expected key=value"))?;
+    let (key, raw) = assignment.split_once('=').ok_or_else(|| err("expected key=value"))?;
     let key = key.trim();
     if key.is_empty() || key.split('.').any(|p| p.trim().is_empty()) {
         return Err(err("empty key"));
     }
     let raw = raw.trim();
     let value = match format!("v = {raw}").parse::<toml::Table>() {
-        Ok(mut t) => t
-            .remove("v")
-            .unwrap_or(toml::Value::String(raw.to_string())),
+        Ok(mut t) => t.remove("v").unwrap_or(toml::Value::String(raw.to_string())),
         Err(_) => toml::Value::String(raw.to_string()),
     };
     set_dotted(table, key, value).map_err(|r| err(&r))
@@ -203,9 +191,9 @@ pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Res
                 let idx: usize = parts[i + 1].parse().unwrap_or(0);
                 let path = parts[..=i + 1].join(".");
                 let n = a.len();
-                let elem = a.get_mut(idx).ok_or_else(|| {
-                    format!("`{path}`: index {idx} is out of range (array has {n} entries)")
-                })?;
+                let elem = a
+                    .get_mut(idx)
+                    .ok_or_else(|| format!("`{path}`: index {idx} is out of range (array has {n} entries)"))?;
                 if i + 2 == parts.len() {
                     *elem = value;
                     return Ok(());
@@ -226,10 +214,7 @@ pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Res
 
 /// Deserializes `table` into `T`, turning serde's errors into
 /// [`ConfigError::Invalid`] with key path, line and suggestion.
-pub fn deserialize<T: DeserializeOwned>(
-    table: &toml::Table,
-    src: &ModelSource,
-) -> Result<T, ConfigError> {
+pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) -> Result<T, ConfigError> {
     let de = table.clone();
     serde_path_to_error::deserialize::<_, T>(de).map_err(|e| {
         let mut path = e.path().to_string();
@@ -272,26 +257,14 @@ pub fn deserialize<T: DeserializeOwned>(
                     .map(|(_, c)| c.clone());
                 (key, best)
             }
-            None => (
-                if path == "." {
-                    "(top level)".into()
-                } else {
-                    path
-                },
-                None,
-            ),
+            None => (if path == "." { "(top level)".into() } else { path }, None),
         };
         invalid(src, &key, message, suggestion)
     })
 }
 
 /// Builds an [`ConfigError::Invalid`] for `key`, finding its line.
-pub fn invalid(
-    src: &ModelSource,
-    key: &str,
-    message: String,
-    suggestion: Option<String>,
-) -> ConfigError {
+pub fn invalid(src: &ModelSource, key: &str, message: String, suggestion: Option<String>) -> ConfigError {
     ConfigError::Invalid {
         file: src.name.clone(),
         key: key.to_string(),
@@ -306,12 +279,7 @@ fn unknown_field(msg: &str) -> Option<(String, Vec<String>)> {
         .strip_prefix("unknown field `")
         .or_else(|| msg.strip_prefix("unknown variant `"))?;
     let (bad, rest) = rest.split_once('`')?;
-    let expected: Vec<String> = rest
-        .split('`')
-        .skip(1)
-        .step_by(2)
-        .map(str::to_string)
-        .collect();
+    let expected: Vec<String> = rest.split('`').skip(1).step_by(2).map(str::to_string).collect();
     Some((bad.to_string(), expected))
 }
 
@@ -336,10 +304,7 @@ mod tests {
 
     #[test]
     fn unknown_key_has_line_and_suggestion() {
-        let src = ModelSource::from_text(
-            "m.toml",
-            "# model\n[display]\nrefesh = \"60Hz\"\nvsync = true\n",
-        );
+        let src = ModelSource::from_text("m.toml", "# model\n[display]\nrefesh = \"60Hz\"\nvsync = true\n");
         let t = src.table().unwrap();
         let e = deserialize::<M>(&t, &src).unwrap_err().to_string();
         assert!(e.contains("m.toml:3"), "{e}");
@@ -350,9 +315,7 @@ mod tests {
     #[test]
     fn wrong_type_names_key_and_line() {
         let src = ModelSource::from_text("m.toml", "[display]\nrefresh = \"60Hz\"\nvsync = 3\n");
-        let e = deserialize::<M>(&src.table().unwrap(), &src)
-            .unwrap_err()
-            .to_string();
+        let e = deserialize::<M>(&src.table().unwrap(), &src).unwrap_err().to_string();
         assert!(e.contains("display.vsync") && e.contains(":3"), "{e}");
     }
 

@@ -68,11 +68,7 @@ impl Rate {
                     })
                     .and_then(|p| {
                         if p.0 == 0 {
-                            Err(unit_err(
-                                "rate",
-                                text,
-                                "the period must be greater than zero",
-                            ))
+                            Err(unit_err("rate", text, "the period must be greater than zero"))
                         } else {
                             Ok(Rate {
                                 period: p,
@@ -83,23 +79,14 @@ impl Rate {
             }
         };
         // f = num * mult Hz; period = 1e12 / f ps. Work in milli-hertz.
-        let milli_hz =
-            parse_scaled_decimal(num, 1000 * mult).map_err(|r| unit_err("rate", text, r))?;
+        let milli_hz = parse_scaled_decimal(num, 1000 * mult).map_err(|r| unit_err("rate", text, r))?;
         if milli_hz == 0 {
-            return Err(unit_err(
-                "rate",
-                text,
-                "the frequency must be greater than zero",
-            ));
+            return Err(unit_err("rate", text, "the frequency must be greater than zero"));
         }
         let num = PS_PER_S as u128 * 1000;
         let period = (num + milli_hz as u128 / 2) / milli_hz as u128;
         if period == 0 {
-            return Err(unit_err(
-                "rate",
-                text,
-                "frequency too high for picosecond resolution",
-            ));
+            return Err(unit_err("rate", text, "frequency too high for picosecond resolution"));
         }
         Ok(Rate {
             period: Duration(period as u64),
@@ -150,14 +137,11 @@ impl Bandwidth {
                 return Err(unit_err(
                     "bandwidth",
                     text,
-                    format!(
-                        "unknown unit {unit:?}/s (use B, kB, MB, GB, KiB, MiB, GiB, bit, Mbit or Gbit per second)"
-                    ),
+                    format!("unknown unit {unit:?}/s (use B, kB, MB, GB, KiB, MiB, GiB, bit, Mbit or Gbit per second)"),
                 ));
             }
         };
-        let milli =
-            parse_scaled_decimal(num, 1000).map_err(|r| unit_err("bandwidth", text, r))? as u128;
+        let milli = parse_scaled_decimal(num, 1000).map_err(|r| unit_err("bandwidth", text, r))? as u128;
         let v = milli
             .checked_mul(scale_num)
             .ok_or_else(|| unit_err("bandwidth", text, "too large"))?
@@ -281,16 +265,10 @@ mod tests {
 
     #[test]
     fn rates() {
-        assert_eq!(
-            Rate::parse("60Hz").unwrap().period,
-            Duration(16_666_666_667)
-        );
+        assert_eq!(Rate::parse("60Hz").unwrap().period, Duration(16_666_666_667));
         assert_eq!(Rate::parse("1Hz").unwrap().period, Duration(PS_PER_S));
         assert_eq!(Rate::parse("1kHz").unwrap().period, Duration::ms(1));
-        assert_eq!(
-            Rate::parse("16.7ms").unwrap().period,
-            Duration(16_700_000_000)
-        );
+        assert_eq!(Rate::parse("16.7ms").unwrap().period, Duration(16_700_000_000));
         for bad in ["0Hz", "-60Hz", "60", "fast", "NaNHz", "0ms"] {
             assert!(Rate::parse(bad).is_err(), "{bad}");
         }

@@ -35,10 +35,7 @@ impl<E> Ord for Scheduled<E> {
     /// Reversed, so that `BinaryHeap` (a max-heap) pops the earliest first.
     #[inline]
     fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .time
-            .cmp(&self.time)
-            .then_with(|| other.seq.cmp(&self.seq))
+        other.time.cmp(&self.time).then_with(|| other.seq.cmp(&self.seq))
     }
 }
 

@@ -83,10 +83,7 @@ mod tests {
             .collect();
         assert_eq!(a, b);
         assert_ne!(a, c);
-        assert_ne!(
-            RngStreams::new(1).seed_of("x"),
-            RngStreams::new(2).seed_of("x")
-        );
+        assert_ne!(RngStreams::new(1).seed_of("x"), RngStreams::new(2).seed_of("x"));
     }
 
     #[test]

@@ -151,11 +151,7 @@ pub struct RunStats {
 }
 
 /// Runs `model` until it stops, the limits are hit or no events are left.
-pub fn run<M: Model>(
-    model: &mut M,
-    sched: &mut Scheduler<M::Event>,
-    limits: Limits,
-) -> Result<RunStats, M::Error> {
+pub fn run<M: Model>(model: &mut M, sched: &mut Scheduler<M::Event>, limits: Limits) -> Result<RunStats, M::Error> {
     let names = <M::Event as EventKind>::NAMES;
     let mut by_kind = vec![0u64; names.len()];
     let mut events = 0u64;
@@ -225,12 +221,7 @@ mod tests {
     impl Model for Clock {
         type Event = Ev;
         type Error = EngineError;
-        fn handle(
-            &mut self,
-            now: Time,
-            e: Ev,
-            s: &mut Scheduler<Ev>,
-        ) -> Result<Control, EngineError> {
+        fn handle(&mut self, now: Time, e: Ev, s: &mut Scheduler<Ev>) -> Result<Control, EngineError> {
             self.seen.push(now);
             if let Ev::Tick = e {
                 s.after(Duration(10), Ev::Tock, "tock")?;
@@ -301,9 +292,6 @@ mod tests {
         let mut s = Scheduler::new();
         s.at(Time(u64::MAX - 15), Ev::Tick);
         let e = run(&mut m, &mut s, Limits::default()).unwrap_err();
-        assert!(
-            matches!(e, EngineError::Time(TimeError::Overflow { .. })),
-            "{e}"
-        );
+        assert!(matches!(e, EngineError::Time(TimeError::Overflow { .. })), "{e}");
     }
 }

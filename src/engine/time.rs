@@ -59,14 +59,11 @@ impl Time {
     /// `self + d`, or an overflow error naming `context`.
     #[inline]
     pub fn add(self, d: Duration, context: &str) -> Result<Time, TimeError> {
-        self.0
-            .checked_add(d.0)
-            .map(Time)
-            .ok_or_else(|| TimeError::Overflow {
-                context: context.to_string(),
-                at: self,
-                by: d,
-            })
+        self.0.checked_add(d.0).map(Time).ok_or_else(|| TimeError::Overflow {
+            context: context.to_string(),
+            at: self,
+            by: d,
+        })
     }
 
     /// The span from `earlier` to `self` (zero if `earlier` is later).
@@ -169,9 +166,7 @@ impl Duration {
             "ns" => PS_PER_NS,
             "ps" => 1,
             _ => {
-                return Err(err(&format!(
-                    "unknown unit {unit:?} (use s, ms, us, ns or ps)"
-                )));
+                return Err(err(&format!("unknown unit {unit:?} (use s, ms, us, ns or ps)")));
             }
         };
         let ps = parse_scaled_decimal(num, scale).map_err(|r| err(&r))?;
@@ -197,9 +192,7 @@ pub fn parse_scaled_decimal(num: &str, scale: u64) -> Result<u64, String> {
     if int_part.is_empty() && frac_part.is_empty() {
         return Err("missing number".into());
     }
-    if !int_part.chars().all(|c| c.is_ascii_digit())
-        || !frac_part.chars().all(|c| c.is_ascii_digit())
-    {
+    if !int_part.chars().all(|c| c.is_ascii_digit()) || !frac_part.chars().all(|c| c.is_ascii_digit()) {
         return Err(format!("{num:?} is not a decimal number"));
     }
     let overflow = || "value too large for 64-bit picoseconds".to_string();
@@ -210,10 +203,7 @@ pub fn parse_scaled_decimal(num: &str, scale: u64) -> Result<u64, String> {
     };
     let mut total: u128 = int.checked_mul(scale as u128).ok_or_else(overflow)?;
     // Fraction: digits d1 d2 ... -> sum d_k * scale / 10^k, rounded at the end.
-    let frac_digits: Vec<u32> = frac_part
-        .chars()
-        .map(|c| c.to_digit(10).unwrap_or(0))
-        .collect();
+    let frac_digits: Vec<u32> = frac_part.chars().map(|c| c.to_digit(10).unwrap_or(0)).collect();
     if !frac_digits.is_empty() {
         let take = frac_digits.len().min(30);
         let mut num_f: u128 = 0;
@@ -244,12 +234,7 @@ impl fmt::Display for Duration {
     /// Exact text that [`Duration::parse`] reads back to the same value.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let v = self.0;
-        let units = [
-            (PS_PER_S, "s"),
-            (PS_PER_MS, "ms"),
-            (PS_PER_US, "us"),
-            (PS_PER_NS, "ns"),
-        ];
+        let units = [(PS_PER_S, "s"), (PS_PER_MS, "ms"), (PS_PER_US, "us"), (PS_PER_NS, "ns")];
         if v == 0 {
             return write!(f, "0s");
         }
@@ -281,10 +266,7 @@ impl<'de> Deserialize<'de> for Duration {
         impl serde::de::Visitor<'_> for V {
             type Value = Duration;
             fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                write!(
-                    f,
-                    "a duration string with a unit, like \"16.7ms\" or \"2us\""
-                )
+                write!(f, "a duration string with a unit, like \"16.7ms\" or \"2us\"")
             }
             fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Duration, E> {
                 Duration::parse(v).map_err(E::custom)
@@ -362,16 +344,7 @@ mod tests {
 
     #[test]
     fn display_round_trips() {
-        for v in [
-            0u64,
-            1,
-            999,
-            1000,
-            1_850_000,
-            16_666_666_667,
-            PS_PER_S * 3600,
-            u64::MAX,
-        ] {
+        for v in [0u64, 1, 999, 1000, 1_850_000, 16_666_666_667, PS_PER_S * 3600, u64::MAX] {
             let d = Duration(v);
             assert_eq!(Duration::parse(&d.to_string()).unwrap(), d, "{d}");
         }
@@ -379,9 +352,7 @@ mod tests {
 
     #[test]
     fn overflow_is_an_error_with_context() {
-        let e = Time(u64::MAX - 1)
-            .add(Duration(5), "scheduling vblank")
-            .unwrap_err();
+        let e = Time(u64::MAX - 1).add(Duration(5), "scheduling vblank").unwrap_err();
         assert!(e.to_string().contains("scheduling vblank"));
     }
 }

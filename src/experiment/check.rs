@@ -71,9 +71,7 @@ pub fn evaluate_between(
         format!(
             "`{}` = {}",
             b.path,
-            b.value
-                .map(super::report::fmt_precise)
-                .unwrap_or_else(|| "n/a".into())
+            b.value.map(super::report::fmt_precise).unwrap_or_else(|| "n/a".into())
         )
     };
     let expected_text = match (&low, &high) {
@@ -101,19 +99,10 @@ pub fn evaluate_between(
 }
 
 /// Evaluate one check.
-pub fn evaluate(
-    path: &str,
-    point: &str,
-    measured: Option<f64>,
-    expect: f64,
-    tolerance: Tolerance,
-) -> CheckOutcome {
+pub fn evaluate(path: &str, point: &str, measured: Option<f64>, expect: f64, tolerance: Tolerance) -> CheckOutcome {
     let (allowed, tolerance_text) = match tolerance {
         Tolerance::Absolute(t) => (t, format!("±{}", format_range_number(t))),
-        Tolerance::Relative(t) => (
-            t * expect.abs(),
-            format!("±{}%", format_range_number(t * 100.0)),
-        ),
+        Tolerance::Relative(t) => (t * expect.abs(), format!("±{}%", format_range_number(t * 100.0))),
     };
     let passed = measured.is_some_and(|m| m.is_finite() && (m - expect).abs() <= allowed);
     CheckOutcome {
@@ -168,14 +157,7 @@ mod tests {
         assert_eq!(o.allowed, 1.0);
         assert_eq!(o.expected_text, "at most `sum` = 100");
         assert!(!evaluate_between("t", "p", Some(98.0), b("max", Some(100.0)), None, rel).passed);
-        let o = evaluate_between(
-            "t",
-            "p",
-            Some(5.0),
-            b("a", Some(4.0)),
-            b("b", Some(6.5)),
-            abs,
-        );
+        let o = evaluate_between("t", "p", Some(5.0), b("a", Some(4.0)), b("b", Some(6.5)), abs);
         assert_eq!(o.expected_text, "between `a` = 4 and `b` = 6.5");
         assert_eq!(o.expect, None);
     }

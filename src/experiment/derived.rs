@@ -60,11 +60,7 @@ fn sorted_finite(values: &[f64]) -> Option<Vec<f64>> {
 
 /// The index of the point equal to `point` except for the `reference`
 /// assignments.
-pub(crate) fn reference_point(
-    exp: &Experiment,
-    point: &Point,
-    reference: &[(String, toml::Value)],
-) -> Option<usize> {
+pub(crate) fn reference_point(exp: &Experiment, point: &Point, reference: &[(String, toml::Value)]) -> Option<usize> {
     let mut index = 0;
     for (si, s) in exp.sweeps.iter().enumerate() {
         let vi = match reference.iter().find(|(k, _)| *k == s.key) {
@@ -107,9 +103,7 @@ pub(crate) fn compute(exp: &Experiment, inp: &DerivedInputs<'_>) -> Vec<Vec<Opti
             exp.derived
                 .iter()
                 .map(|d| match &d.kind {
-                    DerivedKind::IntervalWidth { column: c, level } => {
-                        interval_width(column(p.index, c), *level)
-                    }
+                    DerivedKind::IntervalWidth { column: c, level } => interval_width(column(p.index, c), *level),
                     DerivedKind::QuantileWidthFromMin { column: c, level } => {
                         quantile_width_from_min(column(p.index, c), *level)
                     }

@@ -14,11 +14,7 @@ use super::ExperimentError;
 /// Keys are split on every `.`; quoted segments are not supported. Fails
 /// when a segment is empty, an intermediate key holds a non-table value, or
 /// an array index is not a number or out of range.
-pub fn set_dotted(
-    table: &mut toml::Table,
-    key: &str,
-    value: toml::Value,
-) -> Result<(), ExperimentError> {
+pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), ExperimentError> {
     let err = |message: String| ExperimentError::Patch {
         key: key.to_string(),
         message,
@@ -38,12 +34,7 @@ pub fn set_dotted(
 }
 
 /// Set `parts[done..]` below `cur`, which sits at `parts[..done]`.
-fn set_in(
-    cur: &mut toml::Value,
-    parts: &[&str],
-    done: usize,
-    value: toml::Value,
-) -> Result<(), String> {
+fn set_in(cur: &mut toml::Value, parts: &[&str], done: usize, value: toml::Value) -> Result<(), String> {
     let part = parts[done];
     let last = done + 1 == parts.len();
     let here = || parts[..done].join(".");
@@ -67,12 +58,9 @@ fn set_in(
                     len.saturating_sub(1)
                 )
             })?;
-            let slot = items.get_mut(index).ok_or_else(|| {
-                format!(
-                    "`{}` has {len} entries; index {index} is out of range",
-                    here()
-                )
-            })?;
+            let slot = items
+                .get_mut(index)
+                .ok_or_else(|| format!("`{}` has {len} entries; index {index} is out of range", here()))?;
             if last {
                 *slot = value;
                 return Ok(());
@@ -113,17 +101,13 @@ pub fn json_number(root: &serde_json::Value, path: &str) -> Result<Option<f64>, 
                     format!("`{}`", walked.join("."))
                 };
                 let keys = match cur {
-                    serde_json::Value::Object(m) => {
-                        m.keys().cloned().collect::<Vec<_>>().join(", ")
-                    }
+                    serde_json::Value::Object(m) => m.keys().cloned().collect::<Vec<_>>().join(", "),
                     _ => String::new(),
                 };
                 return Err(if keys.is_empty() {
                     format!("metric path `{path}` not found: {at} has no key `{part}`")
                 } else {
-                    format!(
-                        "metric path `{path}` not found: {at} has no key `{part}` (it has: {keys})"
-                    )
+                    format!("metric path `{path}` not found: {at} has no key `{part}` (it has: {keys})")
                 });
             }
         }
@@ -144,12 +128,7 @@ mod tests {
     fn set_dotted_creates_and_replaces() {
         let mut t: toml::Table = "[display]\nbuffers = 2\nvsync = true\n".parse().unwrap();
         set_dotted(&mut t, "display.buffers", toml::Value::Integer(3)).unwrap();
-        set_dotted(
-            &mut t,
-            "workload.gpu.mean",
-            toml::Value::String("10ms".into()),
-        )
-        .unwrap();
+        set_dotted(&mut t, "workload.gpu.mean", toml::Value::String("10ms".into())).unwrap();
         set_dotted(&mut t, "top", toml::Value::Float(1.5)).unwrap();
         assert_eq!(t["display"]["buffers"].as_integer(), Some(3));
         assert_eq!(t["display"]["vsync"].as_bool(), Some(true));
@@ -162,8 +141,7 @@ mod tests {
         let mut t: toml::Table = "a = 1\n".parse().unwrap();
         let e = set_dotted(&mut t, "a.b", toml::Value::Integer(1)).unwrap_err();
         assert!(
-            e.to_string()
-                .contains("`a` is not a table (it is of type integer)"),
+            e.to_string().contains("`a` is not a table (it is of type integer)"),
             "{e}"
         );
         assert!(set_dotted(&mut t, "x..y", toml::Value::Integer(1)).is_err());
@@ -192,10 +170,7 @@ mod tests {
         assert_eq!(groups[0]["triangle_pixels"]["sigma"].as_float(), Some(0.8));
         assert_eq!(groups[0]["name"].as_str(), Some("a"));
         assert_eq!(groups[1]["count"].as_integer(), Some(4));
-        assert_eq!(
-            groups[1]["list"].as_array().unwrap()[1].as_integer(),
-            Some(7)
-        );
+        assert_eq!(groups[1]["list"].as_array().unwrap()[1].as_integer(), Some(7));
         let before = t.clone();
         let e = set_dotted(&mut t, "workload.groups.2.count", toml::Value::Integer(1))
             .unwrap_err()
@@ -204,13 +179,9 @@ mod tests {
             e.contains("`workload.groups` has 2 entries; index 2 is out of range"),
             "{e}"
         );
-        let e = set_dotted(
-            &mut t,
-            "workload.groups.first.count",
-            toml::Value::Integer(1),
-        )
-        .unwrap_err()
-        .to_string();
+        let e = set_dotted(&mut t, "workload.groups.first.count", toml::Value::Integer(1))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("`first` is not an index"), "{e}");
         assert_eq!(t, before, "rejected keys change nothing");
     }
@@ -223,14 +194,7 @@ mod tests {
         assert_eq!(json_number(&v, "metrics.ft.p99").unwrap(), None);
         assert_eq!(json_number(&v, "metrics.ok").unwrap(), Some(1.0));
         let e = json_number(&v, "metrics.ft.p50").unwrap_err();
-        assert!(
-            e.contains("`metrics.ft` has no key `p50`") && e.contains("mean"),
-            "{e}"
-        );
-        assert!(
-            json_number(&v, "metrics")
-                .unwrap_err()
-                .contains("not a number")
-        );
+        assert!(e.contains("`metrics.ft` has no key `p50`") && e.contains("mean"), "{e}");
+        assert!(json_number(&v, "metrics").unwrap_err().contains("not a number"));
     }
 }

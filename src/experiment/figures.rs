@@ -2,9 +2,7 @@
 
 use std::path::Path;
 
-use crate::plot::{
-    Histogram, LinePlot, PlotError, Scatter, ScatterPoint, Series, histogram, line_plot, scatter,
-};
+use crate::plot::{Histogram, LinePlot, PlotError, Scatter, ScatterPoint, Series, histogram, line_plot, scatter};
 
 use super::run::PointResult;
 use super::spec::{Experiment, PlotKind, PlotSpec};
@@ -22,11 +20,17 @@ pub(crate) fn draw(
 ) -> Result<(), PlotError> {
     let base = out_dir.join(&spec.file);
     match &spec.kind {
-        PlotKind::Line { x, y, log_x, log_y } => {
+        PlotKind::Line {
+            x,
+            y,
+            log_x,
+            log_y,
+            filter,
+        } => {
             let xi = exp.sweeps.iter().position(|s| &s.key == x).unwrap_or(0);
             // Group points by the values of the other sweeps, in first-seen order.
             let mut groups: Vec<(Vec<usize>, Vec<usize>)> = Vec::new();
-            for p in points {
+            for p in points.iter().filter(|p| p.matches(filter)) {
                 let key: Vec<usize> = p
                     .value_indices
                     .iter()
@@ -47,7 +51,7 @@ pub(crate) fn draw(
                         .assignments
                         .iter()
                         .enumerate()
-                        .filter(|&(i, _)| i != xi)
+                        .filter(|&(i, (k, _))| i != xi && !filter.iter().any(|(f, _)| f == k))
                         .map(|(_, (k, v))| format!("{k}={}", value_text(v)))
                         .collect::<Vec<_>>()
                         .join(", ");
@@ -93,19 +97,13 @@ pub(crate) fn draw(
                 },
             )
         }
-        PlotKind::Histogram {
-            column,
-            bins,
-            filter,
-        } => {
+        PlotKind::Histogram { column, bins, filter } => {
             let c = columns.iter().position(|k| k == column);
             let values = points
                 .iter()
                 .filter(|p| p.matches(filter))
                 .map(|p| {
-                    let v = c
-                        .and_then(|c| pooled.get(p.index)?.get(c).cloned())
-                        .unwrap_or_default();
+                    let v = c.and_then(|c| pooled.get(p.index)?.get(c).cloned()).unwrap_or_default();
                     (p.label(), v)
                 })
                 .collect();

@@ -36,6 +36,7 @@
 //! kind = "line"
 //! x = "workload.gpu"     # a sweep key; one series per value of the other keys
 //! y = ["metrics.display_interval_ms.mean"]   # metric paths or derived names
+//! # line: optional where = { key = value } draws only the matching points
 //! # histogram: column = "FrameTime", bins = 80, optional where = { key = value }
 //! # scatter: x and y are metric paths or derived names; log_x / log_y
 //! [[derived]]            # interval_width | quantile_width_from_min | relative_error | speedup
@@ -84,7 +85,7 @@ pub use run::{ExperimentResult, PathStat, PointResult, RunRecord, point_model, r
 pub use runner::{FrameTable, RunOutput, Runner};
 pub use sim_runner::SimRunner;
 pub use spec::{
-    Check, Derived, DerivedKind, Expect, Experiment, Metric, ModelSource, PlotKind, PlotSpec,
-    Tolerance, load_experiment, parse_experiment,
+    Check, Derived, DerivedKind, Expect, Experiment, Metric, ModelSource, PlotKind, PlotSpec, Tolerance,
+    load_experiment, parse_experiment,
 };
 pub use sweep::{Point, Sweep, expand_points, numeric_coord, value_text, values_match};

@@ -176,11 +176,7 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
             let _ = writeln!(s, "- `{}`: {what}", d.name);
         }
         s.push('\n');
-        let names: Vec<String> = exp
-            .derived
-            .iter()
-            .map(|d| format!("`{}`", d.name))
-            .collect();
+        let names: Vec<String> = exp.derived.iter().map(|d| format!("`{}`", d.name)).collect();
         s.push_str(&head(&names));
         for p in &r.points {
             let mut row = key_cells(p);

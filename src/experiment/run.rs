@@ -139,11 +139,7 @@ struct JobOutput {
 }
 
 /// The model for `point`: `base` with `[set]` then the point's sweep values applied.
-pub fn point_model(
-    exp: &Experiment,
-    base: &toml::Table,
-    point: &Point,
-) -> Result<toml::Table, ExperimentError> {
+pub fn point_model(exp: &Experiment, base: &toml::Table, point: &Point) -> Result<toml::Table, ExperimentError> {
     let mut model = base.clone();
     for (k, v) in exp.set.iter().chain(&point.assignments) {
         set_dotted(&mut model, k, v.clone())?;
@@ -188,15 +184,7 @@ pub fn run_experiment(
     let results: Vec<Result<JobOutput, ExperimentError>> = jobs
         .par_iter()
         .map(|&(pi, seed)| {
-            let r = run_job(
-                runner,
-                &models[pi],
-                &points[pi],
-                seed,
-                &paths,
-                &columns,
-                want_frames,
-            );
+            let r = run_job(runner, &models[pi], &points[pi], seed, &paths, &columns, want_frames);
             bar.inc(1);
             r
         })
@@ -224,10 +212,7 @@ pub fn run_experiment(
     let mut point_stats: Vec<Vec<MeanCi>> = Vec::with_capacity(points.len());
     let mut pooled: Vec<Vec<Vec<f64>>> = vec![vec![Vec::new(); columns.len()]; points.len()];
     for p in &points {
-        let mine: Vec<&JobOutput> = outputs
-            .iter()
-            .filter(|o| o.record.point == p.index)
-            .collect();
+        let mine: Vec<&JobOutput> = outputs.iter().filter(|o| o.record.point == p.index).collect();
         let stats = (0..n_paths)
             .map(|k| {
                 let vals: Vec<f64> = mine.iter().filter_map(|o| o.record.values[k]).collect();
@@ -290,9 +275,7 @@ pub fn run_experiment(
         for p in points.iter().filter(|p| p.matches(&c.filter)) {
             let pr = &point_results[p.index];
             checks.push(match &c.expect {
-                Expect::Value(v) => {
-                    evaluate(&c.path, &pr.label, pr.value(&c.path), *v, c.tolerance)
-                }
+                Expect::Value(v) => evaluate(&c.path, &pr.label, pr.value(&c.path), *v, c.tolerance),
                 Expect::Between { at_least, at_most } => {
                     let low = at_least.as_deref().map(|path| Bound {
                         path,
@@ -302,14 +285,7 @@ pub fn run_experiment(
                         path,
                         value: pr.value(path),
                     });
-                    evaluate_between(
-                        &c.path,
-                        &pr.label,
-                        pr.value(&c.path),
-                        low,
-                        high,
-                        c.tolerance,
-                    )
+                    evaluate_between(&c.path, &pr.label, pr.value(&c.path), low, high, c.tolerance)
                 }
             });
         }
@@ -317,18 +293,11 @@ pub fn run_experiment(
     let checks_failed = checks.iter().filter(|c| !c.passed).count();
 
     for plot in &exp.plots {
-        figures::draw(
-            exp,
-            plot,
-            &points,
-            &point_results,
-            &pooled,
-            &columns,
-            out_dir,
-        )
-        .map_err(|source| ExperimentError::Plot {
-            file: plot.file.clone(),
-            source,
+        figures::draw(exp, plot, &points, &point_results, &pooled, &columns, out_dir).map_err(|source| {
+            ExperimentError::Plot {
+                file: plot.file.clone(),
+                source,
+            }
         })?;
         files.push(PathBuf::from(format!("{}.svg", plot.file)));
         files.push(PathBuf::from(format!("{}.png", plot.file)));
@@ -347,11 +316,9 @@ pub fn run_experiment(
     };
     result.wall_seconds = started.elapsed().as_secs_f64();
     let report_path = out_dir.join("report.md");
-    std::fs::write(&report_path, report::render(exp, &result)).map_err(|source| {
-        ExperimentError::Io {
-            path: report_path,
-            source,
-        }
+    std::fs::write(&report_path, report::render(exp, &result)).map_err(|source| ExperimentError::Io {
+        path: report_path,
+        source,
     })?;
     result.files.push(PathBuf::from("report.md"));
     Ok(result)
@@ -362,9 +329,7 @@ fn progress_bar(len: u64, show: bool) -> ProgressBar {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-    if let Ok(style) = ProgressStyle::with_template(
-        "{bar:40} {pos}/{len} runs [{elapsed_precise} < {eta_precise}]",
-    ) {
+    if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} runs [{elapsed_precise} < {eta_precise}]") {
         bar.set_style(style);
     }
     bar
@@ -402,9 +367,10 @@ fn run_job(
         .map_err(fail)?;
     let mut frames = Vec::with_capacity(columns.len());
     if want_frames {
-        let table = out.frames.as_ref().ok_or_else(|| {
-            fail("the runner returned no per-frame data although it was requested".into())
-        })?;
+        let table = out
+            .frames
+            .as_ref()
+            .ok_or_else(|| fail("the runner returned no per-frame data although it was requested".into()))?;
         for c in columns {
             frames.push(table.column(c).ok_or_else(|| {
                 fail(format!(

@@ -87,10 +87,7 @@ mod tests {
             columns: vec!["FrameTime".into()],
             rows: vec![vec![1.0], vec![2.0], vec![3.0]],
         };
-        assert_eq!(
-            without_warmup(no_index, 1).column("FrameTime").unwrap(),
-            vec![2.0, 3.0]
-        );
+        assert_eq!(without_warmup(no_index, 1).column("FrameTime").unwrap(), vec![2.0, 3.0]);
     }
 
     #[test]

@@ -48,6 +48,9 @@ pub enum PlotKind {
         log_x: bool,
         /// Logarithmic y axis.
         log_y: bool,
+        /// `where` filter: only the points with these sweep values are
+        /// drawn (and the filtered keys are left out of the series names).
+        filter: Vec<(String, toml::Value)>,
     },
     /// Per-frame values of `column`, pooled over the replications of each
     /// point, one group per point (optionally only the points matching `filter`).
@@ -226,8 +229,7 @@ impl Experiment {
         }
         for d in &self.derived {
             match &d.kind {
-                DerivedKind::IntervalWidth { column, .. }
-                | DerivedKind::QuantileWidthFromMin { column, .. } => {
+                DerivedKind::IntervalWidth { column, .. } | DerivedKind::QuantileWidthFromMin { column, .. } => {
                     cols.insert(column.clone());
                 }
                 _ => {}
@@ -288,10 +290,7 @@ impl Experiment {
 
     /// The base model: a clone of `default_model` for `model = "default"`,
     /// else the TOML file named by `model` (relative to the experiment file).
-    pub fn resolve_model(
-        &self,
-        default_model: &toml::Table,
-    ) -> Result<toml::Table, ExperimentError> {
+    pub fn resolve_model(&self, default_model: &toml::Table) -> Result<toml::Table, ExperimentError> {
         match &self.model {
             ModelSource::Default => Ok(default_model.clone()),
             ModelSource::File(path) => {
@@ -299,11 +298,10 @@ impl Experiment {
                     path: path.clone(),
                     source,
                 })?;
-                text.parse::<toml::Table>()
-                    .map_err(|e| ExperimentError::Parse {
-                        file: path.clone(),
-                        message: e.to_string(),
-                    })
+                text.parse::<toml::Table>().map_err(|e| ExperimentError::Parse {
+                    file: path.clone(),
+                    message: e.to_string(),
+                })
             }
         }
     }
@@ -472,16 +470,10 @@ impl Validator<'_> {
             return Err(self.err("name", "must not be empty"));
         }
         if raw.replications < 1 || raw.replications > i64::from(u32::MAX) {
-            return Err(self.err(
-                "replications",
-                format!("must be at least 1, got {}", raw.replications),
-            ));
+            return Err(self.err("replications", format!("must be at least 1, got {}", raw.replications)));
         }
         if !(raw.confidence > 0.0 && raw.confidence < 1.0) {
-            return Err(self.err(
-                "confidence",
-                format!("must be in (0, 1), got {}", raw.confidence),
-            ));
+            return Err(self.err("confidence", format!("must be in (0, 1), got {}", raw.confidence)));
         }
         let model = if raw.model == "default" {
             ModelSource::Default
@@ -498,10 +490,7 @@ impl Validator<'_> {
         for (i, s) in raw.sweep.into_iter().enumerate() {
             let key = format!("sweep[{i}]");
             if s.key.split('.').any(|p| p.trim().is_empty()) {
-                return Err(self.err(
-                    format!("{key}.key"),
-                    format!("`{}` is not a dotted key", s.key),
-                ));
+                return Err(self.err(format!("{key}.key"), format!("`{}` is not a dotted key", s.key)));
             }
             if sweeps.iter().any(|o| o.key == s.key) {
                 return Err(self.err(format!("{key}.key"), format!("`{}` is swept twice", s.key)));
@@ -517,29 +506,24 @@ impl Validator<'_> {
                     }
                     Sweep::from_values(s.key, values)
                 }
-                (None, Some(r)) => {
-                    expand_range(s.key, &r).map_err(|m| self.err(format!("{key}.range"), m))?
-                }
+                (None, Some(r)) => expand_range(s.key, &r).map_err(|m| self.err(format!("{key}.range"), m))?,
             };
             sweeps.push(sweep);
         }
         let find_sweep = |k: &str| sweeps.iter().find(|s| s.key == k);
-        let filter =
-            |key: &str, t: &toml::Table| -> Result<Vec<(String, toml::Value)>, ExperimentError> {
-                let mut flat = Vec::new();
-                flatten("", t, &mut flat);
-                for (k, v) in &flat {
-                    let Some(s) = find_sweep(k) else {
-                        return Err(self.err(key, format!("`{k}` is not a sweep key")));
-                    };
-                    if !s.values.iter().any(|sv| values_match(sv, v)) {
-                        return Err(
-                            self.err(key, format!("`{k}` = {v} is not one of the swept values"))
-                        );
-                    }
+        let filter = |key: &str, t: &toml::Table| -> Result<Vec<(String, toml::Value)>, ExperimentError> {
+            let mut flat = Vec::new();
+            flatten("", t, &mut flat);
+            for (k, v) in &flat {
+                let Some(s) = find_sweep(k) else {
+                    return Err(self.err(key, format!("`{k}` is not a sweep key")));
+                };
+                if !s.values.iter().any(|sv| values_match(sv, v)) {
+                    return Err(self.err(key, format!("`{k}` = {v} is not one of the swept values")));
                 }
-                Ok(flat)
-            };
+            }
+            Ok(flat)
+        };
 
         let mut metrics: Vec<Metric> = Vec::new();
         for (i, m) in raw.metric.into_iter().enumerate() {
@@ -547,10 +531,7 @@ impl Validator<'_> {
                 return Err(self.err(format!("metric[{i}].path"), "must not be empty"));
             }
             if metrics.iter().any(|o| o.path == m.path) {
-                return Err(self.err(
-                    format!("metric[{i}].path"),
-                    format!("`{}` is listed twice", m.path),
-                ));
+                return Err(self.err(format!("metric[{i}].path"), format!("`{}` is listed twice", m.path)));
             }
             metrics.push(Metric {
                 label: m.label.unwrap_or_else(|| m.path.clone()),
@@ -564,8 +545,7 @@ impl Validator<'_> {
             if d.name.trim().is_empty() {
                 return Err(self.err(format!("derived[{i}].name"), "must not be empty"));
             }
-            if derived.iter().any(|o| o.name == d.name) || metrics.iter().any(|m| m.path == d.name)
-            {
+            if derived.iter().any(|o| o.name == d.name) || metrics.iter().any(|m| m.path == d.name) {
                 return Err(self.err(&key, format!("name `{}` is already used", d.name)));
             }
             let need_column = || {
@@ -574,15 +554,13 @@ impl Validator<'_> {
                     .ok_or_else(|| self.err(&key, format!("kind `{}` needs `column`", d.kind)))
             };
             let need_ref = || -> Result<Vec<(String, toml::Value)>, ExperimentError> {
-                let r = d.reference.as_ref().ok_or_else(|| {
-                    self.err(&key, format!("kind `{}` needs `reference`", d.kind))
-                })?;
+                let r = d
+                    .reference
+                    .as_ref()
+                    .ok_or_else(|| self.err(&key, format!("kind `{}` needs `reference`", d.kind)))?;
                 let r = filter(&format!("{key}.reference"), r)?;
                 if r.is_empty() {
-                    return Err(self.err(
-                        format!("{key}.reference"),
-                        "must name at least one sweep key",
-                    ));
+                    return Err(self.err(format!("{key}.reference"), "must name at least one sweep key"));
                 }
                 Ok(r)
             };
@@ -614,9 +592,7 @@ impl Validator<'_> {
                         .ok_or_else(|| self.err(&key, "kind `relative_error` needs `path`"))?,
                     reference: need_ref()?,
                 },
-                "speedup" => DerivedKind::Speedup {
-                    reference: need_ref()?,
-                },
+                "speedup" => DerivedKind::Speedup { reference: need_ref()? },
                 other => {
                     return Err(self.err(
                         format!("{key}.kind"),
@@ -632,8 +608,7 @@ impl Validator<'_> {
         let mut plots: Vec<PlotSpec> = Vec::new();
         for (i, p) in raw.plot.into_iter().enumerate() {
             let key = format!("plot[{i}] ({})", p.file);
-            if p.file.is_empty() || p.file.contains(['/', '\\']) || p.file == "." || p.file == ".."
-            {
+            if p.file.is_empty() || p.file.contains(['/', '\\']) || p.file == "." || p.file == ".." {
                 return Err(self.err(
                     format!("{key}.file"),
                     "must be a plain file name without directory or extension",
@@ -648,19 +623,25 @@ impl Validator<'_> {
                         p.x.clone()
                             .ok_or_else(|| self.err(&key, "kind `line` needs `x` (a sweep key)"))?;
                     if find_sweep(&x).is_none() {
-                        return Err(
-                            self.err(format!("{key}.x"), format!("`{x}` is not a sweep key"))
-                        );
+                        return Err(self.err(format!("{key}.x"), format!("`{x}` is not a sweep key")));
                     }
                     let y = p.y.map(OneOrMany::into_vec).unwrap_or_default();
                     if y.is_empty() || y.iter().any(|s| s.trim().is_empty()) {
                         return Err(self.err(format!("{key}.y"), "needs one or more metric paths"));
+                    }
+                    let f = match &p.filter {
+                        Some(t) => filter(&format!("{key}.where"), t)?,
+                        None => Vec::new(),
+                    };
+                    if f.iter().any(|(k, _)| *k == x) {
+                        return Err(self.err(format!("{key}.where"), format!("must not fix the x axis key `{x}`")));
                     }
                     PlotKind::Line {
                         x,
                         y,
                         log_x: p.log_x,
                         log_y: p.log_y,
+                        filter: f,
                     }
                 }
                 "histogram" => {
@@ -683,16 +664,15 @@ impl Validator<'_> {
                     }
                 }
                 "scatter" => {
-                    let x = p.x.clone().ok_or_else(|| {
-                        self.err(&key, "kind `scatter` needs `x` (a metric path)")
-                    })?;
+                    let x =
+                        p.x.clone()
+                            .ok_or_else(|| self.err(&key, "kind `scatter` needs `x` (a metric path)"))?;
                     let y = match p.y.map(OneOrMany::into_vec) {
                         Some(v) if v.len() == 1 => v.into_iter().next().unwrap_or_default(),
                         _ => {
-                            return Err(self.err(
-                                format!("{key}.y"),
-                                "kind `scatter` needs exactly one `y` metric path",
-                            ));
+                            return Err(
+                                self.err(format!("{key}.y"), "kind `scatter` needs exactly one `y` metric path")
+                            );
                         }
                     };
                     PlotKind::Scatter {
@@ -709,8 +689,8 @@ impl Validator<'_> {
                     ));
                 }
             };
-            if p.filter.is_some() && !matches!(kind, PlotKind::Histogram { .. }) {
-                return Err(self.err(format!("{key}.where"), "only histogram plots take `where`"));
+            if p.filter.is_some() && matches!(kind, PlotKind::Scatter { .. }) {
+                return Err(self.err(format!("{key}.where"), "only histogram and line plots take `where`"));
             }
             let (dx, dy) = match &kind {
                 PlotKind::Line { x, y, .. } => (x.clone(), y.first().cloned().unwrap_or_default()),
@@ -743,9 +723,7 @@ impl Validator<'_> {
                 (Some(t), None) => Tolerance::Absolute(t),
                 (None, Some(t)) => Tolerance::Relative(t),
                 _ => {
-                    return Err(
-                        self.err(&key, "give exactly one of `tolerance` and `rel_tolerance`")
-                    );
+                    return Err(self.err(&key, "give exactly one of `tolerance` and `rel_tolerance`"));
                 }
             };
             let (Tolerance::Absolute(t) | Tolerance::Relative(t)) = tolerance;
@@ -753,19 +731,14 @@ impl Validator<'_> {
                 return Err(self.err(&key, "tolerance must be a finite number >= 0"));
             }
             let bound = |b: Option<String>, name: &str| match b {
-                Some(b) if b.trim().is_empty() => {
-                    Err(self.err(format!("{key}.{name}"), "must not be empty"))
-                }
+                Some(b) if b.trim().is_empty() => Err(self.err(format!("{key}.{name}"), "must not be empty")),
                 other => Ok(other),
             };
             let at_least = bound(c.at_least_path, "at_least_path")?;
             let at_most = bound(c.at_most_path, "at_most_path")?;
             let expect = match (c.expect, at_least.is_some() || at_most.is_some()) {
                 (Some(_), true) => {
-                    return Err(self.err(
-                        &key,
-                        "give either `expect` or `at_least_path`/`at_most_path`, not both",
-                    ));
+                    return Err(self.err(&key, "give either `expect` or `at_least_path`/`at_most_path`, not both"));
                 }
                 (None, false) => {
                     return Err(self.err(&key, "needs `expect` or `at_least_path`/`at_most_path`"));

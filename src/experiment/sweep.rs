@@ -24,11 +24,7 @@ impl Sweep {
             .enumerate()
             .map(|(i, v)| numeric_coord(v).unwrap_or(i as f64))
             .collect();
-        Sweep {
-            key,
-            values,
-            coords,
-        }
+        Sweep { key, values, coords }
     }
 }
 
@@ -42,9 +38,7 @@ pub fn numeric_coord(v: &toml::Value) -> Option<f64> {
             let s = s.trim();
             let end = s
                 .char_indices()
-                .take_while(|&(i, c)| {
-                    c.is_ascii_digit() || c == '.' || ((c == '-' || c == '+') && i == 0)
-                })
+                .take_while(|&(i, c)| c.is_ascii_digit() || c == '.' || ((c == '-' || c == '+') && i == 0))
                 .map(|(i, c)| i + c.len_utf8())
                 .last()?;
             s[..end].parse::<f64>().ok().filter(|f| f.is_finite())
@@ -99,10 +93,7 @@ pub(crate) fn expand_range(key: String, r: &RawRange) -> Result<Sweep, String> {
     let (from, from_int) = num(&r.from, "from")?;
     let (to, to_int) = num(&r.to, "to")?;
     if r.steps < 1 || r.steps > 1_000_000 {
-        return Err(format!(
-            "`steps` must be between 1 and 1000000, got {}",
-            r.steps
-        ));
+        return Err(format!("`steps` must be between 1 and 1000000, got {}", r.steps));
     }
     if let Some(f) = &r.format
         && !f.contains("{}")
@@ -161,11 +152,9 @@ impl Point {
 
     /// Whether the point satisfies every `key = value` of `filter`.
     pub fn matches(&self, filter: &[(String, toml::Value)]) -> bool {
-        filter.iter().all(|(k, v)| {
-            self.assignments
-                .iter()
-                .any(|(pk, pv)| pk == k && values_match(pv, v))
-        })
+        filter
+            .iter()
+            .all(|(k, v)| self.assignments.iter().any(|(pk, pv)| pk == k && values_match(pv, v)))
     }
 }
 

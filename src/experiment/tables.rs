@@ -11,11 +11,7 @@ fn num(v: Option<f64>) -> String {
     v.map(|x| x.to_string()).unwrap_or_default()
 }
 
-fn write_rows(
-    path: &Path,
-    header: Vec<String>,
-    rows: Vec<Vec<String>>,
-) -> Result<(), ExperimentError> {
+fn write_rows(path: &Path, header: Vec<String>, rows: Vec<Vec<String>>) -> Result<(), ExperimentError> {
     let err = |e: csv::Error| ExperimentError::Csv {
         path: path.to_path_buf(),
         message: e.to_string(),
@@ -43,21 +39,14 @@ pub(crate) fn write_runs(
     let mut header = vec!["point".to_string()];
     header.extend(exp.sweeps.iter().map(|s| s.key.clone()));
     header.push("seed".into());
-    let shown: Vec<usize> = (0..paths.len())
-        .filter(|&k| paths[k] != "wall_seconds")
-        .collect();
+    let shown: Vec<usize> = (0..paths.len()).filter(|&k| paths[k] != "wall_seconds").collect();
     header.extend(shown.iter().map(|&k| paths[k].clone()));
     header.push("wall_seconds".into());
     let rows = runs
         .iter()
         .map(|r| {
             let mut row = vec![r.point.to_string()];
-            row.extend(
-                points[r.point]
-                    .assignments
-                    .iter()
-                    .map(|(_, v)| value_text(v)),
-            );
+            row.extend(points[r.point].assignments.iter().map(|(_, v)| value_text(v)));
             row.push(r.seed.to_string());
             row.extend(shown.iter().map(|&k| num(r.values[k])));
             row.push(r.wall_seconds.to_string());
@@ -90,12 +79,7 @@ pub(crate) fn write_points(
         .iter()
         .map(|r| {
             let mut row = vec![r.index.to_string()];
-            row.extend(
-                points[r.index]
-                    .assignments
-                    .iter()
-                    .map(|(_, v)| value_text(v)),
-            );
+            row.extend(points[r.index].assignments.iter().map(|(_, v)| value_text(v)));
             for s in &r.stats {
                 let has = s.ci.n > 0;
                 row.push(num(has.then_some(s.ci.mean)));

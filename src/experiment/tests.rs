@@ -34,12 +34,8 @@ impl Runner for Fake {
         if want_frames {
             self.wanted_frames.store(true, Ordering::SeqCst);
         }
-        let gpu = get(model, "workload.gpu")
-            .and_then(numeric_coord)
-            .unwrap_or(10.0);
-        let buffers = get(model, "display.buffers")
-            .and_then(|v| v.as_integer())
-            .unwrap_or(2) as f64;
+        let gpu = get(model, "workload.gpu").and_then(numeric_coord).unwrap_or(10.0);
+        let buffers = get(model, "display.buffers").and_then(|v| v.as_integer()).unwrap_or(2) as f64;
         let fidelity = get(model, "fidelity")
             .and_then(|v| v.as_str())
             .unwrap_or("triangle")
@@ -72,9 +68,7 @@ impl Runner for Fake {
         });
         let frames = want_frames.then(|| FrameTable {
             columns: vec!["Index".into(), "FrameTime".into()],
-            rows: (0..100)
-                .map(|i| vec![i as f64, gpu + (i % 10) as f64])
-                .collect(),
+            rows: (0..100).map(|i| vec![i as f64, gpu + (i % 10) as f64]).collect(),
         });
         Ok(RunOutput { summary, frames })
     }
@@ -128,9 +122,7 @@ fn parse_err(text: &str) -> String {
 }
 
 fn base_model() -> toml::Table {
-    "[display]\nbuffers = 2\n[workload]\ngpu = \"10ms\"\n"
-        .parse()
-        .unwrap()
+    "[display]\nbuffers = 2\n[workload]\ngpu = \"10ms\"\n".parse().unwrap()
 }
 
 fn read(dir: &Path, name: &str) -> String {
@@ -170,10 +162,7 @@ fn range_formatting() {
          [[sweep]]\nkey = \"c\"\nrange = { from = 0.1, to = 0.3, steps = 3, format = \"x{}us\" }\n\
          [[sweep]]\nkey = \"d\"\nrange = { from = 5, to = 9, steps = 1 }\n",
     );
-    assert_eq!(
-        exp.sweeps[0].values,
-        [0.0, 0.5, 1.0].map(toml::Value::Float)
-    );
+    assert_eq!(exp.sweeps[0].values, [0.0, 0.5, 1.0].map(toml::Value::Float));
     assert_eq!(exp.sweeps[1].values, [1, 2, 3, 4].map(toml::Value::Integer));
     let c: Vec<String> = exp.sweeps[2].values.iter().map(value_text).collect();
     assert_eq!(c, ["x0.1us", "x0.2us", "x0.3us"]);
@@ -186,41 +175,25 @@ fn range_formatting() {
 #[test]
 fn bad_experiment_files() {
     let e = parse_err("name = \"x\"\nreplicatons = 3\n");
-    assert!(
-        e.contains("experiments/bad.toml") && e.contains("replicatons"),
-        "{e}"
-    );
+    assert!(e.contains("experiments/bad.toml") && e.contains("replicatons"), "{e}");
 
-    let e = parse_err(
-        "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1]\nrange = { from = 1, to = 2, steps = 2 }\n",
-    );
+    let e = parse_err("name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1]\nrange = { from = 1, to = 2, steps = 2 }\n");
     assert!(e.contains("sweep[0]") && e.contains("not both"), "{e}");
 
     let e = parse_err("name = \"x\"\n[[sweep]]\nkey = \"a\"\n");
-    assert!(
-        e.contains("sweep[0]") && e.contains("needs `values` or `range`"),
-        "{e}"
-    );
+    assert!(e.contains("sweep[0]") && e.contains("needs `values` or `range`"), "{e}");
 
-    let e = parse_err(
-        "name = \"x\"\n[[sweep]]\nkey = \"a\"\nrange = { from = 1, to = 2, steps = 2, format = \"ms\" }\n",
-    );
+    let e =
+        parse_err("name = \"x\"\n[[sweep]]\nkey = \"a\"\nrange = { from = 1, to = 2, steps = 2, format = \"ms\" }\n");
     assert!(e.contains("sweep[0].range") && e.contains("{}"), "{e}");
 
-    let e = parse_err(
-        "name = \"x\"\n[[plot]]\nfile = \"p\"\nkind = \"line\"\nx = \"nope\"\ny = \"m\"\n",
-    );
-    assert!(
-        e.contains("plot[0] (p).x") && e.contains("not a sweep key"),
-        "{e}"
-    );
+    let e = parse_err("name = \"x\"\n[[plot]]\nfile = \"p\"\nkind = \"line\"\nx = \"nope\"\ny = \"m\"\n");
+    assert!(e.contains("plot[0] (p).x") && e.contains("not a sweep key"), "{e}");
 
     let e = parse_err("name = \"x\"\n[[plot]]\nfile = \"p\"\nkind = \"pie\"\n");
     assert!(e.contains("unknown kind `pie`"), "{e}");
 
-    let e = parse_err(
-        "name = \"x\"\n[[plot]]\nfile = \"../p\"\nkind = \"scatter\"\nx = \"a\"\ny = \"b\"\n",
-    );
+    let e = parse_err("name = \"x\"\n[[plot]]\nfile = \"../p\"\nkind = \"scatter\"\nx = \"a\"\ny = \"b\"\n");
     assert!(e.contains("plain file name"), "{e}");
 
     let e = parse_err(
@@ -233,38 +206,23 @@ fn bad_experiment_files() {
     );
 
     let e = parse_err("name = \"x\"\n[[check]]\npath = \"m\"\nexpect = 1.0\n");
-    assert!(
-        e.contains("exactly one of `tolerance` and `rel_tolerance`"),
-        "{e}"
-    );
+    assert!(e.contains("exactly one of `tolerance` and `rel_tolerance`"), "{e}");
 
-    let e = parse_err(
-        "name = \"x\"\n[[check]]\npath = \"m\"\nexpect = 1.0\nat_most_path = \"s\"\ntolerance = 0.1\n",
-    );
+    let e = parse_err("name = \"x\"\n[[check]]\npath = \"m\"\nexpect = 1.0\nat_most_path = \"s\"\ntolerance = 0.1\n");
     assert!(e.contains("not both"), "{e}");
     let e = parse_err("name = \"x\"\n[[check]]\npath = \"m\"\ntolerance = 0.1\n");
-    assert!(
-        e.contains("needs `expect` or `at_least_path`/`at_most_path`"),
-        "{e}"
-    );
-    let e = parse_err(
-        "name = \"x\"\n[[check]]\npath = \"m\"\nat_least_path = \" \"\ntolerance = 0.1\n",
-    );
+    assert!(e.contains("needs `expect` or `at_least_path`/`at_most_path`"), "{e}");
+    let e = parse_err("name = \"x\"\n[[check]]\npath = \"m\"\nat_least_path = \" \"\ntolerance = 0.1\n");
     assert!(e.contains("check[0] (m).at_least_path"), "{e}");
 
     let e = parse_err("name = \"x\"\nconfidence = 1.5\n");
     assert!(e.contains("`confidence`"), "{e}");
 
-    let e = parse_err(
-        "name = \"x\"\n[[derived]]\nname = \"d\"\nkind = \"interval_width\"\ncolumn = \"FrameTime\"\n",
-    );
+    let e = parse_err("name = \"x\"\n[[derived]]\nname = \"d\"\nkind = \"interval_width\"\ncolumn = \"FrameTime\"\n");
     assert!(e.contains("needs `level`"), "{e}");
 
     let e = parse_err("name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = \"oops\"\n");
-    assert!(
-        e.contains("experiments/bad.toml") && e.contains("values"),
-        "{e}"
-    );
+    assert!(e.contains("experiments/bad.toml") && e.contains("values"), "{e}");
 
     let missing = Path::new("/nonexistent/dir/exp.toml");
     let e = load_experiment(missing).unwrap_err();
@@ -280,10 +238,7 @@ fn load_from_file_resolves_model_relative_to_it() {
     let path = dir.path().join("exp.toml");
     std::fs::write(&path, "name = \"f\"\nmodel = \"models/m.toml\"\n").unwrap();
     let exp = load_experiment(&path).unwrap();
-    assert_eq!(
-        exp.model,
-        ModelSource::File(dir.path().join("models/m.toml"))
-    );
+    assert_eq!(exp.model, ModelSource::File(dir.path().join("models/m.toml")));
     let model = exp.resolve_model(&toml::Table::new()).unwrap();
     assert_eq!(model["display"]["buffers"].as_integer(), Some(3));
     let default = parse("name = \"d\"\n");
@@ -326,9 +281,7 @@ fn runs_and_writes_csvs_report_and_plots() {
          metrics.display_interval_ms.mean:n"
     ));
     // Point 0: values interval - 0.01, interval, interval + 0.01.
-    let ci = res.points[0]
-        .stat("metrics.display_interval_ms.mean")
-        .unwrap();
+    let ci = res.points[0].stat("metrics.display_interval_ms.mean").unwrap();
     assert!((ci.mean - interval).abs() < 1e-9);
     assert!((ci.half_width - 4.302_652_7 * 0.01 / 3f64.sqrt()).abs() < 1e-6);
     assert_eq!(ci.n, 3);
@@ -353,10 +306,7 @@ fn runs_and_writes_csvs_report_and_plots() {
         "summed simulation wall time: 48.000 s over 24 runs",
         "[interval.png](interval.png)",
     ] {
-        assert!(
-            report.contains(needle),
-            "report lacks {needle:?}:\n{report}"
-        );
+        assert!(report.contains(needle), "report lacks {needle:?}:\n{report}");
     }
     for f in ["interval.svg", "interval.png"] {
         assert!(std::fs::metadata(dir.path().join(f)).unwrap().len() > 0);
@@ -376,10 +326,7 @@ fn results_do_not_depend_on_scheduling() {
     let b = tempfile::tempdir().unwrap();
     run_experiment(&exp, &base_model(), &Fake::default(), a.path(), false).unwrap();
     // A second run on a one-thread pool must give byte-identical CSVs.
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     pool.install(|| run_experiment(&exp, &base_model(), &Fake::default(), b.path(), true))
         .unwrap();
     assert_eq!(read(a.path(), "points.csv"), read(b.path(), "points.csv"));
@@ -412,11 +359,7 @@ fn run_error_names_point_and_seed_and_keeps_finished_runs() {
         }
         other => panic!("unexpected error {other}"),
     }
-    assert!(
-        e.to_string()
-            .contains("point 1 (workload.gpu=13ms), seed 2"),
-        "{e}"
-    );
+    assert!(e.to_string().contains("point 1 (workload.gpu=13ms), seed 2"), "{e}");
     let runs = read(dir.path(), "runs.csv");
     assert_eq!(runs.lines().count(), 1 + 5, "{runs}");
     assert!(!runs.contains("13ms,2,"));
@@ -437,8 +380,7 @@ fn missing_metric_path_is_a_clear_error() {
 
 #[test]
 fn null_metric_gives_empty_cells_not_nan() {
-    let exp =
-        parse("name = \"n\"\nreplications = 2\n[[metric]]\npath = \"metrics.frame_time_ms.p99\"\n");
+    let exp = parse("name = \"n\"\nreplications = 2\n[[metric]]\npath = \"metrics.frame_time_ms.p99\"\n");
     let dir = tempfile::tempdir().unwrap();
     let res = run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap();
     assert_eq!(res.points[0].mean("metrics.frame_time_ms.p99"), None);
@@ -532,9 +474,7 @@ fn derived_values_and_frame_plots() {
         for ext in ["svg", "png"] {
             let path = dir.path().join(format!("{f}.{ext}"));
             assert!(
-                std::fs::metadata(&path)
-                    .map(|m| m.len() > 0)
-                    .unwrap_or(false),
+                std::fs::metadata(&path).map(|m| m.len() > 0).unwrap_or(false),
                 "{path:?}"
             );
         }
@@ -556,8 +496,7 @@ fn derived_values_and_frame_plots() {
 
 #[test]
 fn frame_column_missing_is_reported() {
-    let exp =
-        parse("name = \"h\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"Latency\"\n");
+    let exp = parse("name = \"h\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"Latency\"\n");
     let dir = tempfile::tempdir().unwrap();
     let e = run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap_err();
     assert!(
@@ -573,11 +512,7 @@ fn point_model_applies_set_then_sweep() {
         "name = \"p\"\n[set]\ndisplay.buffers = 4\n\"workload.kind\" = \"fixed\"\n\
          [[sweep]]\nkey = \"display.buffers\"\nvalues = [3]\n",
     );
-    assert_eq!(
-        exp.set.len(),
-        2,
-        "nested [set] tables flatten to dotted keys"
-    );
+    assert_eq!(exp.set.len(), 2, "nested [set] tables flatten to dotted keys");
     let pts = expand_points(&exp);
     let m = point_model(&exp, &base_model(), &pts[0]).unwrap();
     assert_eq!(m["display"]["buffers"].as_integer(), Some(3));
@@ -587,10 +522,7 @@ fn point_model_applies_set_then_sweep() {
     let exp = parse("name = \"p\"\n[set]\n\"workload.gpu.mean\" = 1\n");
     let dir = tempfile::tempdir().unwrap();
     let e = run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap_err();
-    assert!(
-        e.to_string().contains("cannot set `workload.gpu.mean`"),
-        "{e}"
-    );
+    assert!(e.to_string().contains("cannot set `workload.gpu.mean`"), "{e}");
 }
 
 #[test]
@@ -644,4 +576,35 @@ rel_tolerance = 0.01
         report.contains("at most `metrics.display_interval_ms.mean` = 16.6617"),
         "{report}"
     );
+}
+
+#[test]
+fn line_plot_where_selects_points() {
+    let text = format!(
+        "{BASIC}\n[[plot]]\nfile = \"two\"\nkind = \"line\"\nx = \"workload.gpu\"\n\
+         y = \"metrics.display_interval_ms.mean\"\nwhere = {{ \"display.buffers\" = 3 }}\n"
+    );
+    let exp = parse(&text);
+    let PlotKind::Line { filter, .. } = &exp.plots[1].kind else {
+        panic!("not a line plot")
+    };
+    assert_eq!(filter.len(), 1);
+    let dir = tempfile::tempdir().unwrap();
+    run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap();
+    let svg = read(dir.path(), "two.svg");
+    // One series (buffers = 3), named after the metric, not the filtered key.
+    assert!(!svg.contains("display.buffers=2"), "{svg}");
+    assert!(read(dir.path(), "interval.svg").contains("display.buffers=2"));
+    assert!(dir.path().join("two.png").exists());
+
+    let bad = format!(
+        "{BASIC}\n[[plot]]\nfile = \"bad\"\nkind = \"line\"\nx = \"workload.gpu\"\n\
+         y = \"metrics.display_interval_ms.mean\"\nwhere = {{ \"workload.gpu\" = \"10ms\" }}\n"
+    );
+    assert!(parse_err(&bad).contains("must not fix the x axis key"));
+    let bad = format!(
+        "{BASIC}\n[[plot]]\nfile = \"bad\"\nkind = \"line\"\nx = \"workload.gpu\"\n\
+         y = \"metrics.display_interval_ms.mean\"\nwhere = {{ \"display.buffers\" = 4 }}\n"
+    );
+    assert!(parse_err(&bad).contains("not one of the swept values"));
 }

@@ -9,9 +9,7 @@ use serde_json::{Value, json};
 
 use crate::engine::Time;
 use crate::systems::frame_pipeline::PipelineRun;
-use crate::systems::frame_pipeline::accounting::{
-    CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES, Track,
-};
+use crate::systems::frame_pipeline::accounting::{CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES, Track};
 
 fn us(t: Time) -> f64 {
     t.0 as f64 / 1e6
@@ -29,13 +27,10 @@ pub fn write_pipeline_trace(run: &PipelineRun, w: &mut dyn Write) -> std::io::Re
         (4, "GPU fragment"),
         (5, "Display"),
     ];
-    let mut events: Vec<Value> = vec![
-        json!({"ph": "M", "pid": 1, "name": "process_name", "args": {"name": "frame pipeline"}}),
-    ];
+    let mut events: Vec<Value> =
+        vec![json!({"ph": "M", "pid": 1, "name": "process_name", "args": {"name": "frame pipeline"}})];
     for (tid, name) in tracks {
-        events.push(
-            json!({"ph": "M", "pid": 1, "tid": tid, "name": "thread_name", "args": {"name": name}}),
-        );
+        events.push(json!({"ph": "M", "pid": 1, "tid": tid, "name": "thread_name", "args": {"name": name}}));
         events.push(json!({"ph": "M", "pid": 1, "tid": tid, "name": "thread_sort_index", "args": {"sort_index": tid}}));
     }
     for s in &log.spans {
@@ -57,19 +52,14 @@ pub fn write_pipeline_trace(run: &PipelineRun, w: &mut dyn Write) -> std::io::Re
         .filter_map(|r| r.displayed.map(|d| (r.index, d)))
         .collect();
     for (i, (frame, t)) in shown.iter().enumerate() {
-        let end = shown
-            .get(i + 1)
-            .map(|n| n.1)
-            .unwrap_or(Time(t.0 + run.refresh.0));
+        let end = shown.get(i + 1).map(|n| n.1).unwrap_or(Time(t.0 + run.refresh.0));
         events.push(json!({"ph": "X", "pid": 1, "tid": 5, "name": format!("frame {frame}"), "ts": us(*t), "dur": us(end) - us(*t)}));
     }
     for r in &run.records {
         events.push(json!({"ph": "i", "pid": 1, "tid": 1, "s": "t", "name": format!("frame {} input", r.index), "ts": us(r.input)}));
     }
     for (t, v) in &log.command_fifo {
-        events.push(
-            json!({"ph": "C", "pid": 1, "name": "command FIFO", "ts": us(*t), "args": {"used": v}}),
-        );
+        events.push(json!({"ph": "C", "pid": 1, "name": "command FIFO", "ts": us(*t), "args": {"used": v}}));
     }
     for (t, v) in &log.triangle_fifo {
         events.push(json!({"ph": "C", "pid": 1, "name": "triangle FIFO", "ts": us(*t), "args": {"triangles": v}}));

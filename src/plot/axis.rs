@@ -38,11 +38,7 @@ pub(crate) fn widen(lo: f64, hi: f64, pad: f64) -> (f64, f64) {
     if width > 0.0 && width.is_finite() {
         (lo - width * pad, hi + width * pad)
     } else {
-        let half = if lo == 0.0 {
-            1.0
-        } else {
-            (lo.abs() * 0.1).max(1e-9)
-        };
+        let half = if lo == 0.0 { 1.0 } else { (lo.abs() * 0.1).max(1e-9) };
         (lo - half, lo + half)
     }
 }

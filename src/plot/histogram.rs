@@ -66,10 +66,7 @@ fn bin(h: &Histogram) -> (Binned, usize) {
                 counts[i] += 1;
             }
             let n = v.len().max(1) as f64;
-            (
-                name,
-                counts.iter().map(|&c| c as f64 / (n * width)).collect(),
-            )
+            (name, counts.iter().map(|&c| c as f64 / (n * width)).collect())
         })
         .collect();
     (Binned { lo, width, groups }, dropped)
@@ -84,11 +81,7 @@ fn draw<DB: DrawingBackend>(
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let bins = h.bins.max(1);
     let hi = b.lo + b.width * bins as f64;
-    let ymax = b
-        .groups
-        .iter()
-        .flat_map(|g| g.1.iter().copied())
-        .fold(0.0f64, f64::max);
+    let ymax = b.groups.iter().flat_map(|g| g.1.iter().copied()).fold(0.0f64, f64::max);
     let ymax = if ymax > 0.0 && ymax.is_finite() {
         ymax * 1.08
     } else {
@@ -135,9 +128,8 @@ fn draw<DB: DrawingBackend>(
             .map_err(e)?;
         if !name.is_empty() {
             any_legend = true;
-            s.label(name.as_str()).legend(move |(x, y)| {
-                Rectangle::new([(x, y - 5), (x + 20, y + 5)], c.mix(0.6).filled())
-            });
+            s.label(name.as_str())
+                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], c.mix(0.6).filled()));
         }
     }
     if any_legend {
@@ -160,11 +152,7 @@ pub fn histogram(base: &Path, h: &Histogram) -> Result<(), PlotError> {
     if h.values.iter().all(|g| g.1.is_empty()) {
         notes.push("note: no data".into());
     }
-    render_both(
-        base,
-        |r| draw(r, h, &binned, &notes),
-        |r| draw(r, h, &binned, &notes),
-    )
+    render_both(base, |r| draw(r, h, &binned, &notes), |r| draw(r, h, &binned, &notes))
 }
 
 #[cfg(test)]
@@ -205,10 +193,7 @@ mod tests {
                 hist(
                     vec![
                         ("a".into(), (0..500).map(|i| (i % 37) as f64).collect()),
-                        (
-                            "b".into(),
-                            (0..300).map(|i| 10.0 + (i % 11) as f64).collect(),
-                        ),
+                        ("b".into(), (0..300).map(|i| 10.0 + (i % 11) as f64).collect()),
                     ],
                     30,
                 ),
@@ -218,10 +203,7 @@ mod tests {
             ("same", hist(vec![("a".into(), vec![3.0; 10])], 0)),
             (
                 "nan",
-                hist(
-                    vec![("a".into(), vec![f64::NAN, 1.0, f64::INFINITY, 2.0])],
-                    5,
-                ),
+                hist(vec![("a".into(), vec![f64::NAN, 1.0, f64::INFINITY, 2.0])], 5),
             ),
         ];
         for (name, h) in cases {

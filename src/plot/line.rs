@@ -56,9 +56,10 @@ fn prepare(plot: &LinePlot) -> (Vec<Prepared>, usize) {
         for (i, &(x, y)) in s.points.iter().enumerate() {
             match (to_axis(x, plot.log_x), to_axis(y, plot.log_y)) {
                 (Some(ax), Some(ay)) => {
-                    let ci = s.ci.as_ref().and_then(|c| c.get(i)).and_then(|&(lo, hi)| {
-                        Some((to_axis(lo, plot.log_y)?, to_axis(hi, plot.log_y)?))
-                    });
+                    let ci =
+                        s.ci.as_ref()
+                            .and_then(|c| c.get(i))
+                            .and_then(|&(lo, hi)| Some((to_axis(lo, plot.log_y)?, to_axis(hi, plot.log_y)?)));
                     rows.push((ax, ay, ci));
                 }
                 _ => dropped += 1,
@@ -119,18 +120,17 @@ fn draw<DB: DrawingBackend>(
             .map_err(e)?;
         if !s.name.is_empty() {
             any_legend = true;
-            line.label(s.name.as_str()).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
-            });
+            line.label(s.name.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
         }
         chart
             .draw_series(s.points.iter().map(|&p| Circle::new(p, 3, c.filled())))
             .map_err(e)?;
         chart
             .draw_series(
-                s.bars.iter().map(|&(x, lo, y, hi)| {
-                    ErrorBar::new_vertical(x, lo, y, hi, c.stroke_width(1), 8)
-                }),
+                s.bars
+                    .iter()
+                    .map(|&(x, lo, y, hi)| ErrorBar::new_vertical(x, lo, y, hi, c.stroke_width(1), 8)),
             )
             .map_err(e)?;
     }
@@ -150,9 +150,7 @@ fn draw<DB: DrawingBackend>(
 /// Write `plot` to `<base>.svg` and `<base>.png`.
 pub fn line_plot(base: &Path, plot: &LinePlot) -> Result<(), PlotError> {
     let (series, dropped) = prepare(plot);
-    let mut notes: Vec<String> = omitted_note(dropped, plot.log_x || plot.log_y)
-        .into_iter()
-        .collect();
+    let mut notes: Vec<String> = omitted_note(dropped, plot.log_x || plot.log_y).into_iter().collect();
     if series.iter().all(|s| s.points.is_empty()) {
         notes.push("note: no data".into());
     }

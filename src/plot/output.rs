@@ -43,9 +43,7 @@ pub(crate) fn render_both(
             .map_err(|e| e.to_string())
             .map_err(draw_err(&svg_path))?;
         svg(&root).map_err(draw_err(&svg_path))?;
-        root.present()
-            .map_err(|e| e.to_string())
-            .map_err(draw_err(&svg_path))?;
+        root.present().map_err(|e| e.to_string()).map_err(draw_err(&svg_path))?;
     }
     {
         let root = BitMapBackend::new(&png_path, (WIDTH, HEIGHT)).into_drawing_area();
@@ -53,27 +51,20 @@ pub(crate) fn render_both(
             .map_err(|e| e.to_string())
             .map_err(draw_err(&png_path))?;
         png(&root).map_err(draw_err(&png_path))?;
-        root.present()
-            .map_err(|e| e.to_string())
-            .map_err(draw_err(&png_path))?;
+        root.present().map_err(|e| e.to_string()).map_err(draw_err(&png_path))?;
     }
     Ok(())
 }
 
 /// Draw `notes` as small text lines in the bottom-left corner of `root`.
-pub(crate) fn draw_notes<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    notes: &[String],
-) -> Result<(), String> {
+pub(crate) fn draw_notes<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, notes: &[String]) -> Result<(), String> {
     let (_, h) = root.dim_in_pixel();
     for (i, note) in notes.iter().rev().enumerate() {
         let y = h as i32 - 18 - 16 * i as i32;
         root.draw(&Text::new(
             note.clone(),
             (8, y),
-            (super::font::FAMILY, 13)
-                .into_font()
-                .color(&RGBColor(150, 40, 40)),
+            (super::font::FAMILY, 13).into_font().color(&RGBColor(150, 40, 40)),
         ))
         .map_err(|e| e.to_string())?;
     }

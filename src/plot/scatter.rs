@@ -102,11 +102,7 @@ pub fn scatter(base: &Path, s: &Scatter) -> Result<(), PlotError> {
     if pts.is_empty() {
         notes.push("note: no data".into());
     }
-    render_both(
-        base,
-        |r| draw(r, s, &pts, &notes),
-        |r| draw(r, s, &pts, &notes),
-    )
+    render_both(base, |r| draw(r, s, &pts, &notes), |r| draw(r, s, &pts, &notes))
 }
 
 #[cfg(test)]
@@ -135,11 +131,7 @@ mod tests {
             (
                 "normal",
                 Scatter {
-                    points: vec![
-                        pt("triangle", 2.0, 0.0),
-                        pt("tile", 0.5, 0.02),
-                        pt("frame", 0.01, 0.3),
-                    ],
+                    points: vec![pt("triangle", 2.0, 0.0), pt("tile", 0.5, 0.02), pt("frame", 0.01, 0.3)],
                     ..base.clone()
                 },
             ),
@@ -148,11 +140,7 @@ mod tests {
                 Scatter {
                     log_x: true,
                     log_y: true,
-                    points: vec![
-                        pt("triangle", 2.0, 0.0),
-                        pt("tile", 0.5, 0.02),
-                        pt("frame", 0.01, 0.3),
-                    ],
+                    points: vec![pt("triangle", 2.0, 0.0), pt("tile", 0.5, 0.02), pt("frame", 0.01, 0.3)],
                     ..base.clone()
                 },
             ),

@@ -82,11 +82,7 @@ pub fn mesh_from_spec(spec: &str, base_dir: &Path) -> Result<Mesh, MeshError> {
     }
 }
 
-fn parse_num<T: std::str::FromStr>(
-    s: &str,
-    field: &'static str,
-    spec: &str,
-) -> Result<T, MeshError> {
+fn parse_num<T: std::str::FromStr>(s: &str, field: &'static str, spec: &str) -> Result<T, MeshError> {
     s.trim().parse().map_err(|_| MeshError::BadNumber {
         field,
         value: s.to_string(),
@@ -108,31 +104,25 @@ fn nonzero(x: u64, field: &'static str, spec: &str) -> Result<(), MeshError> {
 fn check_indices(count: Option<u64>, spec: &str) -> Result<(), MeshError> {
     match count {
         Some(n) if n <= MAX_INDICES => Ok(()),
-        _ => Err(MeshError::TooLarge {
-            spec: spec.to_string(),
-        }),
+        _ => Err(MeshError::TooLarge { spec: spec.to_string() }),
     }
 }
 
 /// Parses `WxH` and checks that a grid of that size fits the index limit
 /// (the limit also keeps every vertex id below [`RESTART`]).
 fn parse_size(s: &str, spec: &str) -> Result<(u32, u32), MeshError> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| MeshError::BadNumber {
-            field: "size (WxH)",
-            value: s.to_string(),
-            spec: spec.to_string(),
-        })?;
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| MeshError::BadNumber {
+        field: "size (WxH)",
+        value: s.to_string(),
+        spec: spec.to_string(),
+    })?;
     let w = parse_num::<u32>(w, "width", spec)?;
     let h = parse_num::<u32>(h, "height", spec)?;
     nonzero(u64::from(w), "width", spec)?;
     nonzero(u64::from(h), "height", spec)?;
     // A list needs 6 indices per quad; a strip fewer.
     check_indices(
-        u64::from(w)
-            .checked_mul(u64::from(h))
-            .and_then(|q| q.checked_mul(6)),
+        u64::from(w).checked_mul(u64::from(h)).and_then(|q| q.checked_mul(6)),
         spec,
     )?;
     Ok((w, h))
@@ -184,10 +174,7 @@ fn strip(w: u32, h: u32, name: &str) -> Mesh {
 /// Shuffles whole triangles of a list, deterministically from `seed`.
 fn shuffle_triangles(indices: &mut Vec<u32>, seed: u64) {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    let mut tris: Vec<[u32; 3]> = indices
-        .chunks_exact(3)
-        .map(|c| [c[0], c[1], c[2]])
-        .collect();
+    let mut tris: Vec<[u32; 3]> = indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     tris.shuffle(&mut rng);
     *indices = tris.into_iter().flatten().collect();
 }
@@ -268,9 +255,7 @@ fn load_obj(path: &Path, name: &str) -> Result<Mesh, MeshError> {
         single_index: true,
         ..Default::default()
     };
-    let loaded = tobj::load_obj_buf(&mut reader, &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    });
+    let loaded = tobj::load_obj_buf(&mut reader, &options, |_| Err(tobj::LoadError::OpenFileFailed));
     let (models, _materials) = loaded.map_err(|e| {
         use tobj::LoadError as L;
         // Errors found while parsing a line; the others come at the end of
@@ -353,12 +338,7 @@ fn load_idx(path: &Path, name: &str) -> Result<Mesh, MeshError> {
     finish_file(path, name, indices, vertex_count)
 }
 
-fn finish_file(
-    path: &Path,
-    name: &str,
-    indices: Vec<u32>,
-    vertex_count: u32,
-) -> Result<Mesh, MeshError> {
+fn finish_file(path: &Path, name: &str, indices: Vec<u32>, vertex_count: u32) -> Result<Mesh, MeshError> {
     if indices.len() < 3 {
         return Err(MeshError::Empty(path.display().to_string()));
     }

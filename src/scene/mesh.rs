@@ -166,9 +166,7 @@ impl Mesh {
 
     /// The runs of a strip that form triangles (length >= 3).
     fn strip_runs(&self) -> impl Iterator<Item = &[u32]> {
-        self.indices
-            .split(|&i| i == RESTART)
-            .filter(|r| r.len() >= 3)
+        self.indices.split(|&i| i == RESTART).filter(|r| r.len() >= 3)
     }
 
     /// Number of triangles (polygons in paper 000's Figure 1).
@@ -197,19 +195,34 @@ impl Mesh {
     /// The fetched indices in stream order (see [`index_count`](Self::index_count)).
     fn fetched(&self) -> Box<dyn Iterator<Item = u32> + '_> {
         match self.topology {
-            Topology::TriangleList => {
-                Box::new(self.indices[..3 * (self.indices.len() / 3)].iter().copied())
-            }
+            Topology::TriangleList => Box::new(self.indices[..3 * (self.indices.len() / 3)].iter().copied()),
             Topology::TriangleStrip => Box::new(self.strip_runs().flatten().copied()),
         }
     }
 
     /// Number of distinct vertices among the fetched indices.
     pub fn unique_vertices(&self) -> u64 {
-        let mut ids: Vec<u32> = self.fetched().collect();
-        ids.sort_unstable();
-        ids.dedup();
-        ids.len() as u64
+        // A bitmap over the vertex range: linear, no sort (indices were
+        // checked against vertex_count; larger ones fall back to a sort).
+        let n = self.vertex_count as usize;
+        let mut seen = vec![0u64; n.div_ceil(64)];
+        let mut count = 0u64;
+        let mut outside: Vec<u32> = Vec::new();
+        for i in self.fetched() {
+            let k = i as usize;
+            if k < n {
+                let (w, b) = (k / 64, 1u64 << (k % 64));
+                if seen[w] & b == 0 {
+                    seen[w] |= b;
+                    count += 1;
+                }
+            } else {
+                outside.push(i);
+            }
+        }
+        outside.sort_unstable();
+        outside.dedup();
+        count + outside.len() as u64
     }
 
     /// Runs the cache over the index stream; calls `charge(misses)` once per

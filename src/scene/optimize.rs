@@ -77,15 +77,9 @@ pub fn optimize_vertex_cache(indices: &[u32], vertex_count: u32) -> Vec<u32> {
     }
 
     let mut cache_pos: Vec<Option<usize>> = vec![None; vcount];
-    let mut score: Vec<f32> = (0..vcount)
-        .map(|v| vertex_score(None, remaining[v]))
-        .collect();
-    let tri_score = |score: &[f32], t: usize| -> f32 {
-        tris[3 * t..3 * t + 3]
-            .iter()
-            .map(|&v| score[v as usize])
-            .sum()
-    };
+    let mut score: Vec<f32> = (0..vcount).map(|v| vertex_score(None, remaining[v])).collect();
+    let tri_score =
+        |score: &[f32], t: usize| -> f32 { tris[3 * t..3 * t + 3].iter().map(|&v| score[v as usize]).sum() };
     let mut emitted = vec![false; tri_count];
     let mut best = (0..tri_count)
         .map(|t| (t, tri_score(&score, t)))

@@ -23,25 +23,19 @@ fn scaled(n: u64, scale: f64) -> u64 {
 /// The object groups of preset `name` at `scale` (fraction of the paper's
 /// object count), or `None` for an unknown name.
 pub fn preset_groups(name: &str, scale: f64) -> Option<Vec<ObjectGroup>> {
-    let group =
-        |name: &str, count: u64, tris: u64, acmr: f64, pixels: Dist<f64>, tex: u64, mat: u64| {
-            ObjectGroup {
-                name: name.to_string(),
-                count,
-                mesh: MeshRef::Stats {
-                    triangles: tris,
-                    acmr,
-                },
-                indexed: true,
-                triangle_pixels: pixels,
-                shaders: 1,
-                textures: tex,
-                materials: mat,
-                matrix_per_object: true,
-                geometry_upload: Bytes(0),
-                texture_upload: Bytes(0),
-            }
-        };
+    let group = |name: &str, count: u64, tris: u64, acmr: f64, pixels: Dist<f64>, tex: u64, mat: u64| ObjectGroup {
+        name: name.to_string(),
+        count,
+        mesh: MeshRef::Stats { triangles: tris, acmr },
+        indexed: true,
+        triangle_pixels: pixels,
+        shaders: 1,
+        textures: tex,
+        materials: mat,
+        matrix_per_object: true,
+        geometry_upload: Bytes(0),
+        texture_upload: Bytes(0),
+    };
     Some(match name {
         // 3,453,465 / 5609 = 616 triangles per building.
         "city" => vec![group(

@@ -43,11 +43,7 @@ pub fn t_critical(level: f64, df: f64) -> Option<f64> {
 pub fn mean_ci(values: &[f64], level: f64) -> MeanCi {
     let v: Vec<f64> = values.iter().copied().filter(|x| !x.is_nan()).collect();
     let n = v.len();
-    let mean = if n == 0 {
-        0.0
-    } else {
-        v.iter().sum::<f64>() / n as f64
-    };
+    let mean = if n == 0 { 0.0 } else { v.iter().sum::<f64>() / n as f64 };
     let point = MeanCi {
         mean,
         half_width: 0.0,

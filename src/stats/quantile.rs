@@ -79,11 +79,7 @@ pub fn quantile(sorted: &[f64], q: f64) -> f64 {
     let hi = (lo + 1).min(n - 1);
     let frac = h - lo as f64;
     let (a, b) = (sorted[lo], sorted[hi]);
-    if frac == 0.0 || a == b {
-        a
-    } else {
-        a + frac * (b - a)
-    }
+    if frac == 0.0 || a == b { a } else { a + frac * (b - a) }
 }
 
 #[cfg(test)]

@@ -42,15 +42,8 @@ pub fn patched_table(src: &ModelSource, sets: &[String]) -> Result<toml::Table, 
 }
 
 /// Builds and runs the system a model describes.
-pub fn run_model(
-    src: &ModelSource,
-    table: &toml::Table,
-    trace: bool,
-) -> Result<SystemRun, SimError> {
-    let system = table
-        .get("system")
-        .and_then(|v| v.as_str())
-        .unwrap_or("frame_pipeline");
+pub fn run_model(src: &ModelSource, table: &toml::Table, trace: bool) -> Result<SystemRun, SimError> {
+    let system = table.get("system").and_then(|v| v.as_str()).unwrap_or("frame_pipeline");
     match system {
         "frame_pipeline" => {
             let cfg: frame_pipeline::FramePipelineConfig = deserialize(table, src)?;
@@ -97,10 +90,7 @@ impl SystemRun {
     pub fn frame_table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
         match self {
             SystemRun::FramePipeline(r) => (
-                frame_pipeline::records::COLUMNS
-                    .iter()
-                    .map(|s| s.to_string())
-                    .collect(),
+                frame_pipeline::records::COLUMNS.iter().map(|s| s.to_string()).collect(),
                 frame_pipeline::records::frame_rows(&r.records)
                     .into_iter()
                     .map(|row| row.to_vec())
@@ -119,16 +109,14 @@ impl SystemRun {
                     for g in &mut s.groups {
                         if let crate::scene::config::MeshRef::Spec(spec) = &mut g.mesh {
                             let p = std::path::Path::new(spec.as_str());
-                            if (spec.ends_with(".obj") || spec.ends_with(".idx")) && p.is_relative()
-                            {
+                            if (spec.ends_with(".obj") || spec.ends_with(".idx")) && p.is_relative() {
                                 let abs = base_dir.join(p);
                                 *spec = abs.canonicalize().unwrap_or(abs).display().to_string();
                             }
                         }
                     }
                 }
-                let body = toml::to_string(&cfg)
-                    .unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
+                let body = toml::to_string(&cfg).unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
                 format!(
                     "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
                 )

@@ -29,8 +29,7 @@ pub fn metric(r: &PipelineRun, path: &str) -> f64 {
     for p in path.split('.') {
         v = &v[p];
     }
-    v.as_f64()
-        .unwrap_or_else(|| panic!("{path} is not a number: {v}"))
+    v.as_f64().unwrap_or_else(|| panic!("{path} is not a number: {v}"))
 }
 
 /// The fixed teaching model.
@@ -67,9 +66,7 @@ depth_order = "back_to_front"
 pub fn null_paths(v: &Value, path: &str, out: &mut Vec<String>) {
     match v {
         Value::Null => out.push(path.to_string()),
-        Value::Object(m) => m
-            .iter()
-            .for_each(|(k, x)| null_paths(x, &format!("{path}.{k}"), out)),
+        Value::Object(m) => m.iter().for_each(|(k, x)| null_paths(x, &format!("{path}.{k}"), out)),
         Value::Array(a) => a
             .iter()
             .enumerate()

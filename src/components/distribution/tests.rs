@@ -17,10 +17,7 @@ fn all_kinds() -> Vec<Dist<f64>> {
             median: 1.5,
             sigma: 0.5,
         },
-        Dist::Pareto {
-            scale: 1.0,
-            shape: 3.5,
-        },
+        Dist::Pareto { scale: 1.0, shape: 3.5 },
         Dist::Mixture {
             parts: vec![
                 MixturePart {
@@ -52,11 +49,7 @@ fn sample_means_converge() {
         let v = xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n as f64;
         assert!(close(m, d.mean(), 0.02), "{d:?}: mean {m} vs {}", d.mean());
         if d.variance() > 0.0 {
-            assert!(
-                close(v, d.variance(), 0.1),
-                "{d:?}: var {v} vs {}",
-                d.variance()
-            );
+            assert!(close(v, d.variance(), 0.1), "{d:?}: var {v} vs {}", d.variance());
         } else {
             assert_eq!(v, 0.0);
         }
@@ -87,17 +80,11 @@ fn expected_max_exact_for_const() {
 
 #[test]
 fn heavy_tails_are_infinite() {
-    let p = Dist::Pareto {
-        scale: 1.0,
-        shape: 1.0,
-    };
+    let p = Dist::Pareto { scale: 1.0, shape: 1.0 };
     assert_eq!(p.mean(), f64::INFINITY);
     assert_eq!(p.variance(), f64::INFINITY);
     assert_eq!(p.expected_max_with(2.0), f64::INFINITY);
-    let p2 = Dist::Pareto {
-        scale: 1.0,
-        shape: 1.5,
-    };
+    let p2 = Dist::Pareto { scale: 1.0, shape: 1.5 };
     assert!(p2.mean().is_finite());
     assert_eq!(p2.variance(), f64::INFINITY);
     let mut r = rng();
@@ -117,11 +104,7 @@ fn scaled_scales_moments() {
         let s = d.scaled(3.0);
         assert!(close(s.mean(), 3.0 * d.mean(), 1e-12));
         assert!(close(s.variance(), 9.0 * d.variance(), 1e-12));
-        assert!(close(
-            s.expected_max_with(6.0),
-            3.0 * d.expected_max_with(2.0),
-            1e-12
-        ));
+        assert!(close(s.expected_max_with(6.0), 3.0 * d.expected_max_with(2.0), 1e-12));
     }
 }
 
@@ -153,20 +136,8 @@ fn validation_names_the_parameter() {
             },
             "median",
         ),
-        (
-            Dist::Pareto {
-                scale: 1.0,
-                shape: 0.0,
-            },
-            "shape",
-        ),
-        (
-            Dist::Pareto {
-                scale: 0.0,
-                shape: 2.0,
-            },
-            "scale",
-        ),
+        (Dist::Pareto { scale: 1.0, shape: 0.0 }, "shape"),
+        (Dist::Pareto { scale: 0.0, shape: 2.0 }, "scale"),
         (Dist::Mixture { parts: vec![] }, "parts"),
         (
             Dist::Mixture {
@@ -208,9 +179,7 @@ struct Holder {
 }
 
 fn parse(src: &str) -> Result<Dist<f64>, String> {
-    toml::from_str::<Holder>(src)
-        .map(|h| h.d)
-        .map_err(|e| e.to_string())
+    toml::from_str::<Holder>(src).map(|h| h.d).map_err(|e| e.to_string())
 }
 
 #[test]
@@ -273,7 +242,6 @@ fn serde_errors_are_clear() {
     assert!(e.contains("missing field `kind`"), "{e}");
     let e = parse("d = true").unwrap_err();
     assert!(e.contains("a constant or a table"), "{e}");
-    let e = parse("d = { kind = \"mixture\", parts = [{ weight = 1, dist = 1, extra = 2 }] }")
-        .unwrap_err();
+    let e = parse("d = { kind = \"mixture\", parts = [{ weight = 1, dist = 1, extra = 2 }] }").unwrap_err();
     assert!(e.contains("extra"), "{e}");
 }

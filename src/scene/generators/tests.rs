@@ -9,9 +9,7 @@ fn build(spec: &str) -> Mesh {
 }
 
 fn err(spec: &str) -> String {
-    mesh_from_spec(spec, Path::new("."))
-        .expect_err(spec)
-        .to_string()
+    mesh_from_spec(spec, Path::new(".")).expect_err(spec).to_string()
 }
 
 fn sorted_tris(m: &Mesh) -> Vec<[u32; 3]> {
@@ -123,9 +121,7 @@ fn optimized_lowers_acmr() {
         ..sh
     };
     let reoptimized = reopt.cache_stats(&p).acmr();
-    eprintln!(
-        "ACMR fifo:32 shuffled {shuffled:.3} optimized {optimized:.3} re-optimized {reoptimized:.3}"
-    );
+    eprintln!("ACMR fifo:32 shuffled {shuffled:.3} optimized {optimized:.3} re-optimized {reoptimized:.3}");
     assert!(shuffled > 1.5, "{shuffled}");
     assert!(optimized < 0.8, "{optimized}");
     assert!(reoptimized < 0.8, "{reoptimized}");
@@ -152,10 +148,7 @@ fn spec_errors() {
         "random:1:2",
     ] {
         let e = err(s);
-        assert!(
-            e.contains("unknown mesh spec") && e.contains("grid:WxH"),
-            "{e}"
-        );
+        assert!(e.contains("unknown mesh spec") && e.contains("grid:WxH"), "{e}");
     }
     assert!(err("grid:ax4").contains("width"));
     assert!(err("grid:4xq").contains("height `q`"));
@@ -214,47 +207,27 @@ fn obj_errors() {
     assert!(matches!(e, MeshError::FileNotFound(_)));
     assert!(e.to_string().contains("missing.obj"), "{e}");
 
-    write(
-        dir.path(),
-        "bad.obj",
-        "v 0 0 0\nv 1 0 0\nv 0 zz 0\nf 1 2 3\n",
-    );
-    let e = mesh_from_spec("bad.obj", dir.path())
-        .unwrap_err()
-        .to_string();
+    write(dir.path(), "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 zz 0\nf 1 2 3\n");
+    let e = mesh_from_spec("bad.obj", dir.path()).unwrap_err().to_string();
     assert!(
         e.contains("bad.obj") && e.contains("line 3") && e.contains("position parse error"),
         "{e}"
     );
     write(dir.path(), "badf.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x");
-    let e = mesh_from_spec("badf.obj", dir.path())
-        .unwrap_err()
-        .to_string();
+    let e = mesh_from_spec("badf.obj", dir.path()).unwrap_err().to_string();
     assert!(e.contains("line 4") && e.contains("face"), "{e}");
-    write(
-        dir.path(),
-        "oob.obj",
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
-    );
-    let e = mesh_from_spec("oob.obj", dir.path())
-        .unwrap_err()
-        .to_string();
+    write(dir.path(), "oob.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+    let e = mesh_from_spec("oob.obj", dir.path()).unwrap_err().to_string();
     assert!(e.contains("oob.obj") && e.contains("out of bounds"), "{e}");
     write(dir.path(), "empty.obj", "v 0 0 0\n");
-    let e = mesh_from_spec("empty.obj", dir.path())
-        .unwrap_err()
-        .to_string();
+    let e = mesh_from_spec("empty.obj", dir.path()).unwrap_err().to_string();
     assert!(e.contains("no triangles"), "{e}");
 }
 
 #[test]
 fn idx_files() {
     let dir = tempfile::tempdir().unwrap();
-    write(
-        dir.path(),
-        "m.idx",
-        "# two triangles\n0 1 2\n2 1 3 # second\n\n",
-    );
+    write(dir.path(), "m.idx", "# two triangles\n0 1 2\n2 1 3 # second\n\n");
     let m = mesh_from_spec("m.idx", dir.path()).unwrap();
     assert_eq!(m.indices, [0, 1, 2, 2, 1, 3]);
     assert_eq!(m.vertex_count, 4);
@@ -271,17 +244,11 @@ fn idx_files() {
     write(dir.path(), "max.idx", "0 1 4294967295\n");
     assert!(mesh_from_spec("max.idx", dir.path()).is_err());
     write(dir.path(), "four.idx", "0 1 2 3\n");
-    let e = mesh_from_spec("four.idx", dir.path())
-        .unwrap_err()
-        .to_string();
+    let e = mesh_from_spec("four.idx", dir.path()).unwrap_err().to_string();
     assert!(e.contains("4 indices, not a multiple of 3"), "{e}");
     write(dir.path(), "none.idx", "# nothing\n");
-    let e = mesh_from_spec("none.idx", dir.path())
-        .unwrap_err()
-        .to_string();
+    let e = mesh_from_spec("none.idx", dir.path()).unwrap_err().to_string();
     assert!(e.contains("no triangles"), "{e}");
-    let e = mesh_from_spec("gone.idx", dir.path())
-        .unwrap_err()
-        .to_string();
+    let e = mesh_from_spec("gone.idx", dir.path()).unwrap_err().to_string();
     assert!(e.contains("gone.idx") && e.contains("not found"), "{e}");
 }

@@ -52,9 +52,7 @@ fn short_runs_are_not_fetched() {
     let m = Mesh {
         name: "short".into(),
         topology: Topology::TriangleStrip,
-        indices: vec![
-            RESTART, 0, 1, RESTART, 2, 3, 4, RESTART, RESTART, 5, RESTART,
-        ],
+        indices: vec![RESTART, 0, 1, RESTART, 2, 3, 4, RESTART, RESTART, 5, RESTART],
         vertex_count: 6,
     };
     m.validate().unwrap();

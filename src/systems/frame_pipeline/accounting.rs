@@ -4,7 +4,9 @@
 //! transitions become Perfetto spans when tracing.
 //!
 //! Bottleneck attribution (the unit limiting progress at each instant):
-//! GPU waiting for a swap image -> display (vsync); fragment busy with the
+//! GPU waiting for a swap image -> display (vsync); at `draw` fidelity, a
+//! running draw -> the stage with the larger total (F >= G: fragment);
+//! fragment busy with the
 //! geometry stage blocked or idle -> fragment; geometry busy with the
 //! fragment stage idle -> geometry; both busy -> the one the triangle FIFO
 //! leans towards (at least half full: fragment); front end preempted ->
@@ -39,14 +41,7 @@ pub const GEOM_STATES: [&str; 3] = ["busy", "blocked: triangle FIFO full", "idle
 /// Fragment-stage states.
 pub const FRAG_STATES: [&str; 2] = ["busy", "idle"];
 /// Bottleneck units.
-pub const BOTTLENECKS: [&str; 6] = [
-    "cpu",
-    "system",
-    "gpu_front_end",
-    "geometry",
-    "fragment",
-    "display",
-];
+pub const BOTTLENECKS: [&str; 6] = ["cpu", "system", "gpu_front_end", "geometry", "fragment", "display"];
 
 /// Trace tracks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -182,17 +177,15 @@ impl FramePipeline {
         let gpu_busy = front_state == 0 || geom_state == 0 || frag_state == 0;
         let bottleneck = if front_state == 2 {
             5
+        } else if let Some(fragment_limited) = self.draw_fragment_limited {
+            if fragment_limited { 4 } else { 3 }
         } else if frag_state == 0 && geom_state != 0 {
             4
         } else if geom_state == 0 && frag_state != 0 {
             3
         } else if geom_state == 0 && frag_state == 0 {
             let depth = self.tri_fifo.capacity().max(1);
-            if self.tri_fifo.len() as u64 * 2 >= depth {
-                4
-            } else {
-                3
-            }
+            if self.tri_fifo.len() as u64 * 2 >= depth { 4 } else { 3 }
         } else if front_state == 5 {
             1
         } else if front_state == 0 {
@@ -224,30 +217,9 @@ impl FramePipeline {
             attribute_cpu(st, spent, a.cpu_frame);
             a.cpu_frame = self.cpu_frame;
         }
-        set_traced(
-            &mut a.front,
-            now,
-            front_state,
-            Track::Front,
-            &mut a.trace,
-            1,
-        );
-        set_traced(
-            &mut a.geom,
-            now,
-            geom_state,
-            Track::Geometry,
-            &mut a.trace,
-            2,
-        );
-        set_traced(
-            &mut a.frag,
-            now,
-            frag_state,
-            Track::Fragment,
-            &mut a.trace,
-            1,
-        );
+        set_traced(&mut a.front, now, front_state, Track::Front, &mut a.trace, 1);
+        set_traced(&mut a.geom, now, geom_state, Track::Geometry, &mut a.trace, 2);
+        set_traced(&mut a.frag, now, frag_state, Track::Fragment, &mut a.trace, 1);
         a.bottleneck.set(now, bottleneck);
         // GPU busy per frame (the frame the front end is on).
         let gpu_state = if gpu_busy { 0 } else { 1 };

@@ -51,13 +51,7 @@ pub fn expected_max_normal(a: f64, m: f64, s: f64) -> f64 {
 
 /// The draw's times: `n` triangles, total geometry time `geometry`, triangle
 /// areas from `pixels`, `cost_per_pixel` picoseconds, FIFO depth `depth`.
-pub fn draw_times(
-    n: u64,
-    geometry: Duration,
-    pixels: &Dist<f64>,
-    cost_per_pixel: f64,
-    depth: u32,
-) -> DrawTimes {
+pub fn draw_times(n: u64, geometry: Duration, pixels: &Dist<f64>, cost_per_pixel: f64, depth: u32) -> DrawTimes {
     if n == 0 {
         return DrawTimes {
             geometry,
@@ -103,13 +97,7 @@ mod tests {
     #[test]
     fn balanced_constant_triangles_overlap() {
         // 1000 triangles, g = 10 ps, f = 10 ps each: deep FIFO -> max + fill.
-        let t = draw_times(
-            1000,
-            Duration(10_000),
-            &Dist::Const { value: 10.0 },
-            1.0,
-            1000,
-        );
+        let t = draw_times(1000, Duration(10_000), &Dist::Const { value: 10.0 }, 1.0, 1000);
         assert_eq!(t.total, Duration(10_010));
     }
 

@@ -138,9 +138,7 @@ impl Default for CpuConfig {
     fn default() -> Self {
         CpuConfig {
             input_sampling: Duration::ZERO,
-            non_render: Dist::Const {
-                value: Duration::ZERO,
-            },
+            non_render: Dist::Const { value: Duration::ZERO },
             per_object: Duration::ZERO,
             per_draw: Duration::ZERO,
             state_change: StateCosts::default(),
@@ -407,9 +405,7 @@ impl<'de> Deserialize<'de> for WorkloadConfig {
                 )));
             }
             None => {
-                return Err(D::Error::custom(
-                    "missing field `kind` (\"fixed\" or \"scene\")",
-                ));
+                return Err(D::Error::custom("missing field `kind` (\"fixed\" or \"scene\")"));
             }
         };
         fn inner<T: serde::de::DeserializeOwned, E: Error>(t: toml::Table) -> Result<T, E> {

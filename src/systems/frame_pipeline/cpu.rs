@@ -71,9 +71,7 @@ impl FramePipeline {
             Op::Clear => CpuPhase::Push(Command::Clear { frame }),
             Op::Fixed => {
                 let gpu = match &mut self.program {
-                    Program::Fixed { gpu, gpu_rng, .. } => {
-                        Duration::from_ps_f64(gpu.sample(gpu_rng))
-                    }
+                    Program::Fixed { gpu, gpu_rng, .. } => Duration::from_ps_f64(gpu.sample(gpu_rng)),
                     Program::Scene(_) => Duration::ZERO,
                 };
                 CpuPhase::Push(Command::Fixed { frame, gpu })
@@ -105,11 +103,7 @@ impl FramePipeline {
 
     /// Advances the CPU thread as far as it can go now. Returns whether
     /// anything changed.
-    pub(super) fn cpu_step(
-        &mut self,
-        now: Time,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<bool, PipelineError> {
+    pub(super) fn cpu_step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, PipelineError> {
         let mut progressed = false;
         loop {
             match self.cpu_phase {

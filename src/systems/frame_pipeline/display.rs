@@ -48,11 +48,7 @@ impl FramePipeline {
         }
         self.apply_flip(now, flip);
         if !self.done() {
-            s.after(
-                self.refresh,
-                Ev::Vblank,
-                "scheduling the next vertical blank",
-            )?;
+            s.after(self.refresh, Ev::Vblank, "scheduling the next vertical blank")?;
         }
         Ok(())
     }

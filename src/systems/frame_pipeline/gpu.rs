@@ -24,11 +24,7 @@ impl FramePipeline {
 
     /// Advances the front end as far as it can go now. Returns whether
     /// anything changed.
-    pub(super) fn front_step(
-        &mut self,
-        now: Time,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<bool, PipelineError> {
+    pub(super) fn front_step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, PipelineError> {
         let mut progressed = false;
         loop {
             match self.front_phase {
@@ -72,12 +68,7 @@ impl FramePipeline {
         }
     }
 
-    fn front_begin(
-        &mut self,
-        now: Time,
-        c: Command,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<FrontPhase, PipelineError> {
+    fn front_begin(&mut self, now: Time, c: Command, s: &mut Scheduler<Ev>) -> Result<FrontPhase, PipelineError> {
         let cmd_cost = self.cfg.gpu.command;
         match c {
             Command::Clear { .. } => {
@@ -102,12 +93,7 @@ impl FramePipeline {
         }
     }
 
-    fn front_start_clear(
-        &mut self,
-        now: Time,
-        c: Command,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<FrontPhase, PipelineError> {
+    fn front_start_clear(&mut self, now: Time, c: Command, s: &mut Scheduler<Ev>) -> Result<FrontPhase, PipelineError> {
         if let Command::Clear { frame } = c {
             self.gpu_frame = Some(frame);
             self.records[frame as usize].gpu_start = Some(now);
@@ -157,12 +143,7 @@ impl FramePipeline {
         })
     }
 
-    fn geom_start_draw(
-        &mut self,
-        now: Time,
-        draw: u32,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<(), PipelineError> {
+    fn geom_start_draw(&mut self, now: Time, draw: u32, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
         let Program::Scene(sc) = &self.program else {
             return Ok(());
         };
@@ -177,14 +158,30 @@ impl FramePipeline {
         match self.cfg.fidelity {
             Fidelity::Triangle => self.geom_next_triangle(now, s),
             Fidelity::Draw => {
-                let g = &sc.groups[d.group as usize];
-                let t = draw_times(
-                    triangles,
-                    mesh.geometry_time,
-                    &g.pixels,
-                    g.cost_per_pixel,
-                    self.cfg.gpu.fragment.fifo_depth,
-                );
+                let t = match d.closed {
+                    Some(t) => t,
+                    None => {
+                        let g = &sc.groups[d.group as usize];
+                        draw_times(
+                            triangles,
+                            mesh.geometry_time,
+                            &g.pixels,
+                            g.cost_per_pixel,
+                            self.cfg.gpu.fragment.fifo_depth,
+                        )
+                    }
+                };
+                self.draw_fragment_limited = Some(t.fragment >= t.geometry);
+                if self.acct.trace.is_none() {
+                    // Geometry runs [0, G] and fragments [T - F, T] of the
+                    // draw; T <= G + F, so the GPU is busy throughout. Without
+                    // a trace the split is credited at the end (one event).
+                    self.geom_busy = true;
+                    self.frag_busy = true;
+                    self.draw_split = Some((t.geometry, t.fragment, t.total));
+                    s.after(t.total, Ev::DrawDone, "draw")?;
+                    return Ok(());
+                }
                 if t.geometry.0 > 0 {
                     self.geom_busy = true;
                     s.after(t.geometry, Ev::DrawGeometry, "draw geometry")?;
@@ -202,18 +199,23 @@ impl FramePipeline {
     }
 
     /// `draw` fidelity: the draw's last fragment is done.
-    pub(super) fn draw_done(&mut self) {
+    pub(super) fn draw_done(&mut self, now: Time) {
+        if let Some((g, f, t)) = self.draw_split.take() {
+            // Both stage clocks have been "busy" since the draw began: keep G
+            // (resp. F) of it busy and move the rest to idle.
+            self.acct.geom.split(now);
+            self.acct.geom.transfer(0, 2, t.0 - g.0.min(t.0));
+            self.acct.frag.split(now);
+            self.acct.frag.transfer(0, 1, t.0 - f.0.min(t.0));
+        }
         self.geom_busy = false;
         self.frag_busy = false;
         self.geom_draw = None;
+        self.draw_fragment_limited = None;
     }
 
     /// Starts the next triangle of the current draw, or finishes the draw.
-    fn geom_next_triangle(
-        &mut self,
-        now: Time,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<(), PipelineError> {
+    fn geom_next_triangle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
         let Some(a) = self.geom_draw else {
             return Ok(());
         };
@@ -227,11 +229,7 @@ impl FramePipeline {
         let mesh = &sc.meshes[sc.draws[a.draw as usize].mesh as usize];
         let geo = &self.cfg.gpu.geometry;
         let tv = mesh.misses.of(a.next, a.triangles);
-        let fetch = if mesh.indices > 0 {
-            3 * geo.index_fetch.0
-        } else {
-            0
-        };
+        let fetch = if mesh.indices > 0 { 3 * geo.index_fetch.0 } else { 0 };
         let g = Duration(fetch + tv * geo.vertex_shader.0 + geo.triangle_setup.0);
         self.geom_busy = true;
         s.at(now.add(g, "geometry of a triangle")?, Ev::GeomTriangle);
@@ -239,11 +237,7 @@ impl FramePipeline {
     }
 
     /// `triangle` fidelity: a triangle left the geometry stage.
-    pub(super) fn geom_triangle_done(
-        &mut self,
-        now: Time,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<(), PipelineError> {
+    pub(super) fn geom_triangle_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
         self.geom_busy = false;
         let Some(a) = self.geom_draw.as_mut() else {
             return Ok(());
@@ -267,23 +261,14 @@ impl FramePipeline {
         self.geom_next_triangle(now, s)
     }
 
-    fn frag_start(
-        &mut self,
-        now: Time,
-        f: Duration,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<(), PipelineError> {
+    fn frag_start(&mut self, now: Time, f: Duration, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
         self.frag_busy = true;
         s.at(now.add(f, "fragments of a triangle")?, Ev::FragTriangle);
         Ok(())
     }
 
     /// `triangle` fidelity: the fragment stage finished a triangle.
-    pub(super) fn frag_triangle_done(
-        &mut self,
-        now: Time,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<(), PipelineError> {
+    pub(super) fn frag_triangle_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
         self.frag_busy = false;
         if let Some(f) = self.tri_fifo.pop() {
             self.frag_start(now, f, s)?;

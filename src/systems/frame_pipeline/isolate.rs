@@ -135,17 +135,10 @@ pub fn isolate(
             name: name.to_string(),
             frame_time_ms: ft,
             display_interval_ms: m["display_interval_ms"]["mean"].as_f64().unwrap_or(0.0),
-            change: if base_ft > 0.0 {
-                (ft - base_ft) / base_ft
-            } else {
-                0.0
-            },
+            change: if base_ft > 0.0 { (ft - base_ft) / base_ft } else { 0.0 },
         });
     }
-    let best = variants
-        .iter()
-        .skip(1)
-        .min_by(|a, b| a.change.total_cmp(&b.change));
+    let best = variants.iter().skip(1).min_by(|a, b| a.change.total_cmp(&b.change));
     let bottleneck = match best {
         Some(v) if v.change < -0.01 => v.name.clone(),
         _ => "none".to_string(),

@@ -14,8 +14,7 @@ use crate::components::noise::{Arrivals, NoiseSource, NoiseTarget};
 use crate::components::preemptible::{Preemptible, Wake};
 use crate::components::swap_chain::{PresentMode, SwapChain};
 use crate::engine::{
-    Control, Duration, EngineError, EventKind, Model, RngStreams, Scheduler, StreamRng, Time,
-    TimeError,
+    Control, Duration, EngineError, EventKind, Model, RngStreams, Scheduler, StreamRng, Time, TimeError,
 };
 
 use super::accounting::Accounting;
@@ -226,6 +225,13 @@ pub struct FramePipeline {
     pub(super) gpu_completed: u64,
     pub(super) geom_draw: Option<ActiveDraw>,
     pub(super) geom_busy: bool,
+    /// `draw` fidelity without a trace: the running draw's (geometry,
+    /// fragment, total) times, credited to the stage clocks when it ends
+    /// instead of with two extra events.
+    pub(super) draw_split: Option<(Duration, Duration, Duration)>,
+    /// `draw` fidelity: whether the running draw is fragment-limited (F >= G);
+    /// the bottleneck of the whole draw goes to that stage.
+    pub(super) draw_fragment_limited: Option<bool>,
     pub(super) geom_held: Option<Duration>,
     pub(super) tri_fifo: BoundedFifo<Duration>,
     pub(super) frag_busy: bool,
@@ -257,11 +263,7 @@ pub struct ActiveDraw {
 
 impl FramePipeline {
     /// Builds the system from a validated model and its compiled workload.
-    pub fn new(
-        cfg: FramePipelineConfig,
-        scene: Option<SceneProgram>,
-        trace: bool,
-    ) -> Result<Self, PipelineError> {
+    pub fn new(cfg: FramePipelineConfig, scene: Option<SceneProgram>, trace: bool) -> Result<Self, PipelineError> {
         let streams = RngStreams::new(cfg.run.seed);
         let program = match (&cfg.workload, scene) {
             (WorkloadConfig::Fixed(f), _) => Program::Fixed {
@@ -280,13 +282,7 @@ impl FramePipeline {
         };
         let mut noise = Vec::new();
         if cfg.noise.enabled {
-            for (i, p) in cfg
-                .noise
-                .periodic
-                .iter()
-                .enumerate()
-                .filter(|(_, p)| p.enabled)
-            {
+            for (i, p) in cfg.noise.periodic.iter().enumerate().filter(|(_, p)| p.enabled) {
                 let src = NoiseSource::new(
                     p.name.clone(),
                     p.target,
@@ -304,13 +300,7 @@ impl FramePipeline {
                 })?;
                 noise.push(src);
             }
-            for (i, r) in cfg
-                .noise
-                .random
-                .iter()
-                .enumerate()
-                .filter(|(_, r)| r.enabled)
-            {
+            for (i, r) in cfg.noise.random.iter().enumerate().filter(|(_, r)| r.enabled) {
                 let src = NoiseSource::new(
                     r.name.clone(),
                     r.target,
@@ -355,6 +345,8 @@ impl FramePipeline {
             gpu_completed: 0,
             geom_draw: None,
             geom_busy: false,
+            draw_split: None,
+            draw_fragment_limited: None,
             geom_held: None,
             frag_busy: false,
             vblanks: 0,
@@ -400,10 +392,7 @@ impl FramePipeline {
                 Command::Clear { .. } => b.clear.0,
                 Command::Swap { .. } => b.swap.0,
                 Command::Fixed { .. } => b.draw.0,
-                Command::Draw { draw, .. } => self
-                    .scene()
-                    .map(|s| s.draws[*draw as usize].bytes)
-                    .unwrap_or(b.draw.0),
+                Command::Draw { draw, .. } => self.scene().map(|s| s.draws[*draw as usize].bytes).unwrap_or(b.draw.0),
             },
         }
     }
@@ -490,12 +479,7 @@ impl FramePipeline {
         }
     }
 
-    fn noise_arrive(
-        &mut self,
-        now: Time,
-        source: u16,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<(), PipelineError> {
+    fn noise_arrive(&mut self, now: Time, source: u16, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
         let src = &mut self.noise[source as usize];
         let d = src.draw_duration();
         let target = src.target;
@@ -511,12 +495,7 @@ impl FramePipeline {
         Ok(())
     }
 
-    fn noise_end(
-        &mut self,
-        now: Time,
-        target: NoiseTarget,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<(), PipelineError> {
+    fn noise_end(&mut self, now: Time, target: NoiseTarget, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
         let unit = match target {
             NoiseTarget::Cpu => &mut self.cpu,
             NoiseTarget::Gpu => &mut self.front,
@@ -534,12 +513,7 @@ impl Model for FramePipeline {
     type Event = Ev;
     type Error = PipelineError;
 
-    fn handle(
-        &mut self,
-        now: Time,
-        ev: Ev,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<Control, PipelineError> {
+    fn handle(&mut self, now: Time, ev: Ev, s: &mut Scheduler<Ev>) -> Result<Control, PipelineError> {
         match ev {
             Ev::CpuDone { tag } => {
                 if self.cpu.complete(tag) {
@@ -555,17 +529,13 @@ impl Model for FramePipeline {
             Ev::FragTriangle => self.frag_triangle_done(now, s)?,
             Ev::DrawGeometry => self.geom_busy = false,
             Ev::DrawFragmentStart => self.frag_busy = true,
-            Ev::DrawDone => self.draw_done(),
+            Ev::DrawDone => self.draw_done(now),
             Ev::Vblank => self.vblank(now, s)?,
             Ev::NoiseArrive { source } => self.noise_arrive(now, source, s)?,
             Ev::NoiseEnd { target } => self.noise_end(now, target, s)?,
         }
         self.settle(now, s)?;
         self.account(now);
-        Ok(if self.done() {
-            Control::Stop
-        } else {
-            Control::Continue
-        })
+        Ok(if self.done() { Control::Stop } else { Control::Continue })
     }
 }

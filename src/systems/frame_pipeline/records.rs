@@ -112,9 +112,7 @@ pub fn frame_rows(records: &[FrameRecord]) -> Vec<[f64; 14]> {
             ms(end.since(r.start).0),
             ms(r.cpu_busy),
             ms(r.cpu_wait),
-            r.gpu_start
-                .map(|g| ms(g.since(r.start).0))
-                .unwrap_or(f64::NAN),
+            r.gpu_start.map(|g| ms(g.since(r.start).0)).unwrap_or(f64::NAN),
             gpu_time,
             ms(r.gpu_busy),
             if gpu_time.is_nan() {

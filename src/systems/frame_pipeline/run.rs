@@ -7,9 +7,7 @@ use serde_json::{Value, json};
 use crate::engine::{Duration, Limits, PS_PER_MS, RunStats, Scheduler, StopReason, run};
 use crate::stats::quantile::Summary;
 
-use super::accounting::{
-    BOTTLENECKS, CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES, TraceLog,
-};
+use super::accounting::{BOTTLENECKS, CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES, TraceLog};
 use super::config::{FramePipelineConfig, WorkloadConfig};
 use super::model::{FramePipeline, PipelineError};
 use super::records::{FrameRecord, frame_rows};
@@ -96,22 +94,15 @@ pub fn validate(cfg: &FramePipelineConfig) -> Result<(), PipelineError> {
         .validate()
         .map_err(|e| bad("cpu.non_render", e.to_string()))?;
     if let WorkloadConfig::Fixed(f) = &cfg.workload {
-        f.cpu
-            .validate()
-            .map_err(|e| bad("workload.cpu", e.to_string()))?;
-        f.gpu
-            .validate()
-            .map_err(|e| bad("workload.gpu", e.to_string()))?;
+        f.cpu.validate().map_err(|e| bad("workload.cpu", e.to_string()))?;
+        f.gpu.validate().map_err(|e| bad("workload.gpu", e.to_string()))?;
     }
     for (i, p) in cfg.noise.periodic.iter().enumerate() {
         p.duration
             .validate()
             .map_err(|e| bad(&format!("noise.periodic.{i}.duration"), e.to_string()))?;
         if p.period.0 == 0 {
-            return Err(bad(
-                &format!("noise.periodic.{i}.period"),
-                "must be greater than zero",
-            ));
+            return Err(bad(&format!("noise.periodic.{i}.period"), "must be greater than zero"));
         }
     }
     for (i, r) in cfg.noise.random.iter().enumerate() {
@@ -123,25 +114,19 @@ pub fn validate(cfg: &FramePipelineConfig) -> Result<(), PipelineError> {
 }
 
 /// Validates, builds and runs the model.
-pub fn run_pipeline(
-    cfg: FramePipelineConfig,
-    base_dir: &Path,
-    trace: bool,
-) -> Result<PipelineRun, PipelineError> {
+pub fn run_pipeline(cfg: FramePipelineConfig, base_dir: &Path, trace: bool) -> Result<PipelineRun, PipelineError> {
     validate(&cfg)?;
+    let build_start = std::time::Instant::now();
     let scene = match &cfg.workload {
-        WorkloadConfig::Scene(s) => {
-            Some(compile_scene(&cfg, s, base_dir).map_err(|e| match e {
-                super::workload::WorkloadError::Invalid { key, message } => {
-                    PipelineError::Invalid { key, message }
-                }
-            })?)
-        }
+        WorkloadConfig::Scene(s) => Some(compile_scene(&cfg, s, base_dir).map_err(|e| match e {
+            super::workload::WorkloadError::Invalid { key, message } => PipelineError::Invalid { key, message },
+        })?),
         WorkloadConfig::Fixed(_) => None,
     };
     let analytic = analytic_terms(&cfg, scene.as_ref());
     let scene_stats = scene.as_ref().map(|s| s.stats.clone());
     let mut model = FramePipeline::new(cfg, scene, trace)?;
+    let build_seconds = build_start.elapsed().as_secs_f64();
     let mut sched = Scheduler::new();
     model.start(&mut sched)?;
     let limits = Limits {
@@ -157,7 +142,10 @@ pub fn run_pipeline(
             state: model.describe(),
         });
     }
-    let summary = summarize(&model, &stats, analytic, scene_stats);
+    let mut summary = summarize(&model, &stats, analytic, scene_stats);
+    summary["build_seconds"] = json!(build_seconds);
+    summary["simulate_seconds"] = json!(stats.wall_seconds);
+    summary["wall_seconds"] = json!(build_seconds + stats.wall_seconds);
     let refresh = model.refresh;
     let end = stats.end_time;
     let a = &model.acct;

@@ -15,6 +15,7 @@ use crate::scene::config::{DepthOrder, MeshRef, SceneWorkload, StateOrder};
 use crate::scene::generators::mesh_from_spec;
 use crate::scene::presets::{PRESETS, preset_groups};
 
+use super::closed_form::{DrawTimes, draw_times};
 use super::config::{Fidelity, FramePipelineConfig};
 
 /// Errors while building the workload.
@@ -111,6 +112,8 @@ pub struct DrawItem {
     pub commands: u32,
     /// Bytes of the batch.
     pub bytes: u64,
+    /// The draw's closed-form times (computed at `draw` fidelity only).
+    pub closed: Option<DrawTimes>,
 }
 
 /// Scene statistics per frame, reported in the summary.
@@ -206,8 +209,7 @@ pub fn compile_scene(
 
     let pass = early_z_pass(scene.depth_order, scene.depth_complexity);
     let frag = &cfg.gpu.fragment;
-    let cost_per_pixel =
-        pass * frag.per_fragment.0 as f64 + (1.0 - pass) * frag.per_rejected_fragment.0 as f64;
+    let cost_per_pixel = pass * frag.per_fragment.0 as f64 + (1.0 - pass) * frag.per_rejected_fragment.0 as f64;
     let geo = &cfg.gpu.geometry;
     let need_per_triangle = cfg.fidelity == Fidelity::Triangle;
 
@@ -220,10 +222,7 @@ pub fn compile_scene(
 
     for (gi, g) in groups_cfg.iter().enumerate() {
         let key = if gi >= groups_cfg.len() - scene.groups.len() {
-            format!(
-                "workload.groups.{}",
-                gi - (groups_cfg.len() - scene.groups.len())
-            )
+            format!("workload.groups.{}", gi - (groups_cfg.len() - scene.groups.len()))
         } else {
             format!("workload.preset ({})", g.name)
         };
@@ -243,14 +242,7 @@ pub fn compile_scene(
         let mesh_id = match mesh_ids.get(&mesh_key) {
             Some(&id) => id,
             None => {
-                let info = build_mesh(
-                    &g.mesh,
-                    g.indexed,
-                    &geo.vertex_cache,
-                    need_per_triangle,
-                    base_dir,
-                    &key,
-                )?;
+                let info = build_mesh(&g.mesh, g.indexed, &geo.vertex_cache, need_per_triangle, base_dir, &key)?;
                 let geometry_time = add(
                     add(
                         mul(geo.index_fetch, info.indices, &key)?,
@@ -260,10 +252,7 @@ pub fn compile_scene(
                     mul(geo.triangle_setup, info.triangles, &key)?,
                     &key,
                 )?;
-                meshes.push(MeshInfo {
-                    geometry_time,
-                    ..info
-                });
+                meshes.push(MeshInfo { geometry_time, ..info });
                 let id = (meshes.len() - 1) as u32;
                 mesh_ids.insert(mesh_key, id);
                 id
@@ -303,6 +292,8 @@ pub fn compile_scene(
     };
     let mut draws = Vec::with_capacity(objects.len());
     let mut prev: Option<(u64, u64, u64)> = None;
+    // Closed forms per (mesh, group): computed once, only at `draw` fidelity.
+    let mut closed_cache: HashMap<(u32, u32), DrawTimes> = HashMap::new();
     for o in &objects {
         let (group, mesh, sh, tx, mt, matrix, geo_up, tex_up) = *o;
         let changed = [
@@ -347,15 +338,23 @@ pub fn compile_scene(
             b += bytes.upload.0;
             stats.upload_bytes += up;
         }
-        f = add(
-            f,
-            mul(gpu.command, commands as u64, "gpu.command")?,
-            "gpu.command",
-        )?;
+        f = add(f, mul(gpu.command, commands as u64, "gpu.command")?, "gpu.command")?;
         let m = &meshes[mesh as usize];
         stats.objects += 1;
         stats.triangles += m.triangles;
         stats.transformed_vertices += m.transformed;
+        let closed = (cfg.fidelity == Fidelity::Draw).then(|| {
+            *closed_cache.entry((mesh, group)).or_insert_with(|| {
+                let g = &groups[group as usize];
+                draw_times(
+                    m.triangles,
+                    m.geometry_time,
+                    &g.pixels,
+                    g.cost_per_pixel,
+                    cfg.gpu.fragment.fifo_depth,
+                )
+            })
+        });
         draws.push(DrawItem {
             group,
             mesh,
@@ -363,6 +362,7 @@ pub fn compile_scene(
             front: f,
             commands,
             bytes: b,
+            closed,
         });
     }
     Ok(SceneProgram {
@@ -399,18 +399,13 @@ fn build_mesh(
                 name: format!("{triangles} triangles, acmr {acmr}"),
                 triangles: *triangles,
                 transformed,
-                indices: if indexed {
-                    triangles.saturating_mul(3)
-                } else {
-                    0
-                },
+                indices: if indexed { triangles.saturating_mul(3) } else { 0 },
                 misses,
                 geometry_time: Duration::ZERO,
             })
         }
         MeshRef::Spec(spec) => {
-            let m = mesh_from_spec(spec, base_dir)
-                .map_err(|e| invalid(format!("{key}.mesh"), e.to_string()))?;
+            let m = mesh_from_spec(spec, base_dir).map_err(|e| invalid(format!("{key}.mesh"), e.to_string()))?;
             let triangles = m.triangles();
             if !indexed || *policy == CachePolicy::None {
                 return Ok(MeshInfo {
@@ -462,10 +457,7 @@ mod tests {
         assert_eq!(early_z_pass(DepthOrder::FrontToBack, 4.0), 0.25);
         assert_eq!(early_z_pass(DepthOrder::BackToFront, 4.0), 1.0);
         let r = early_z_pass(DepthOrder::Random, 4.0);
-        assert!(
-            (r - (1.0 + 0.5 + 1.0 / 3.0 + 0.25) / 4.0).abs() < 1e-9,
-            "{r}"
-        );
+        assert!((r - (1.0 + 0.5 + 1.0 / 3.0 + 0.25) / 4.0).abs() < 1e-9, "{r}");
         assert!((early_z_pass(DepthOrder::Random, 1.0) - 1.0).abs() < 1e-12);
     }
 
