@@ -10,11 +10,11 @@ use rendersim::systems::frame_pipeline::records::write_frames_csv;
 /// 20,000 triangles, 1 ns of geometry each; 1% of them cover 100 px (100 ns
 /// of fragments), the rest 0.001 px. G = 20 us, F = 20.02 us.
 fn bimodal(depth: u32) -> String {
-    scene_model(&format!(
-        r#"name = "mix"
-mesh = {{ triangles = 20000, acmr = 1.0 }}
-triangle_pixels = {{ kind = "mixture", parts = [ {{ weight = 0.99, dist = 0.001 }}, {{ weight = 0.01, dist = 100.0 }} ] }}"#
-    ))
+    scene_model(
+        &r#"name = "mix"
+mesh = { triangles = 20000, acmr = 1.0 }
+triangle_pixels = { kind = "mixture", parts = [ { weight = 0.99, dist = 0.001 }, { weight = 0.01, dist = 100.0 } ] }"#,
+    )
     .replace("fifo_depth = 16", &format!("fifo_depth = {depth}"))
 }
 
@@ -184,4 +184,31 @@ fn vertex_cache_changes_geometry_time_by_actually_transformed_vertices() {
     // 1 ns per transformed vertex, nothing else.
     assert!((geo(&shuffled) - tv(&shuffled) * 1e-6).abs() < 1e-9);
     assert!((geo(&optimized) - tv(&optimized) * 1e-6).abs() < 1e-9);
+}
+
+#[test]
+fn tracing_does_not_change_results_at_either_fidelity() {
+    use rendersim::config::ModelSource;
+    use rendersim::systems::{SystemRun, run_model};
+    for fid in ["triangle", "draw"] {
+        let src = ModelSource::from_text("d.toml", DEFAULT);
+        let mut t = src.table().unwrap();
+        for s in [
+            format!("fidelity=\"{fid}\""),
+            "run.frames=8".into(),
+            "run.warmup_frames=0".into(),
+        ] {
+            rendersim::config::apply_set(&mut t, &s).unwrap();
+        }
+        let get = |trace: bool| match run_model(&src, &t, trace).unwrap() {
+            SystemRun::FramePipeline(r) => *r,
+        };
+        let (a, b) = (get(false), get(true));
+        assert!(a.trace.is_none() && b.trace.is_some());
+        assert_eq!(csv(&a), csv(&b), "{fid}");
+        assert_eq!(a.clocks.geometry, b.clocks.geometry, "{fid}");
+        assert_eq!(a.clocks.fragment, b.clocks.fragment, "{fid}");
+        assert_eq!(a.clocks.bottleneck, b.clocks.bottleneck, "{fid}");
+        assert_eq!(a.summary["metrics"], b.summary["metrics"], "{fid}");
+    }
 }

@@ -228,15 +228,15 @@ pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) 
             .trim()
             .to_string();
         // A nested deserializer reports its own sub-path as "at `a.b`: ...".
-        if let Some(rest) = message.strip_prefix("at `") {
-            if let Some((sub, msg)) = rest.split_once("`: ") {
-                path = if path == "." || path.is_empty() {
-                    sub.to_string()
-                } else {
-                    format!("{path}.{sub}")
-                };
-                message = msg.to_string();
-            }
+        if let Some(rest) = message.strip_prefix("at `")
+            && let Some((sub, msg)) = rest.split_once("`: ")
+        {
+            path = if path == "." || path.is_empty() {
+                sub.to_string()
+            } else {
+                format!("{path}.{sub}")
+            };
+            message = msg.to_string();
         }
         // serde says: unknown field `refesh`, expected one of `refresh`, `vsync`
         let (key, suggestion) = match unknown_field(&message) {

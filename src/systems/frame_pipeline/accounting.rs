@@ -129,15 +129,17 @@ fn set_traced<const N: usize>(
     let old = clock.state();
     let since = clock.since();
     let spent = clock.set(now, state);
-    if let Some(t) = trace {
-        if old != state && old != idle && spent.0 > 0 {
-            t.spans.push(Span {
-                track,
-                state: old as u8,
-                start: since,
-                end: now,
-            });
-        }
+    if let Some(t) = trace
+        && old != state
+        && old != idle
+        && spent.0 > 0
+    {
+        t.spans.push(Span {
+            track,
+            state: old as u8,
+            start: since,
+            end: now,
+        });
     }
     (old, spent.0)
 }
@@ -231,10 +233,10 @@ impl FramePipeline {
         } else {
             spent
         };
-        if old == 0 {
-            if let Some(r) = a.gpu_frame.and_then(|f| self.records.get_mut(f as usize)) {
-                r.gpu_busy += spent;
-            }
+        if old == 0
+            && let Some(r) = a.gpu_frame.and_then(|f| self.records.get_mut(f as usize))
+        {
+            r.gpu_busy += spent;
         }
         if self.gpu_frame.is_some() {
             a.gpu_frame = self.gpu_frame;

@@ -25,13 +25,13 @@ impl FramePipeline {
             self.resolved += 1;
         }
         if let Some(f) = flip.shown {
-            if self.chain.mode() == PresentMode::Immediate {
-                if let Some(prev) = self.last_display {
-                    // Refresh boundaries crossed without a new frame.
-                    let p = self.refresh.0;
-                    let crossed = now.0 / p - prev.0 / p;
-                    self.repeated_refreshes += crossed.saturating_sub(1);
-                }
+            if self.chain.mode() == PresentMode::Immediate
+                && let Some(prev) = self.last_display
+            {
+                // Refresh boundaries crossed without a new frame.
+                let p = self.refresh.0;
+                let crossed = now.0 / p - prev.0 / p;
+                self.repeated_refreshes += crossed.saturating_sub(1);
             }
             self.records[f as usize].displayed = Some(now);
             self.last_display = Some(now);

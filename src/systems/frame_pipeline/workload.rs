@@ -152,6 +152,17 @@ pub struct SceneProgram {
     pub stats: SceneStats,
 }
 
+/// One object instance before ordering: its group, mesh, state ids
+/// (shader, texture, material), own matrix, and upload bytes per frame.
+#[derive(Debug, Clone, Copy)]
+struct Instance {
+    group: u32,
+    mesh: u32,
+    state: (u64, u64, u64),
+    matrix: bool,
+    upload: u64,
+}
+
 /// Probability that a fragment is shaded (passes early-z) given the depth
 /// complexity `d` and the draw order: front-to-back 1/d, back-to-front 1,
 /// random H(d)/d (the k-th of d surfaces drawn in random order is the nearest
@@ -216,8 +227,7 @@ pub fn compile_scene(
     let mut meshes: Vec<MeshInfo> = Vec::new();
     let mut mesh_ids: HashMap<(String, bool), u32> = HashMap::new();
     let mut groups = Vec::new();
-    // (group, mesh, shader, texture, material, matrix, uploads)
-    let mut objects: Vec<(u32, u32, u64, u64, u64, bool, u64, u64)> = Vec::new();
+    let mut objects: Vec<Instance> = Vec::new();
     let (mut shader_base, mut texture_base, mut material_base) = (0u64, 0u64, 0u64);
 
     for (gi, g) in groups_cfg.iter().enumerate() {
@@ -264,23 +274,24 @@ pub fn compile_scene(
             cost_per_pixel,
         });
         for i in 0..g.count {
-            objects.push((
-                gi as u32,
-                mesh_id,
-                shader_base + i % g.shaders,
-                texture_base + i % g.textures,
-                material_base + i % g.materials,
-                g.matrix_per_object,
-                g.geometry_upload.0,
-                g.texture_upload.0,
-            ));
+            objects.push(Instance {
+                group: gi as u32,
+                mesh: mesh_id,
+                state: (
+                    shader_base + i % g.shaders,
+                    texture_base + i % g.textures,
+                    material_base + i % g.materials,
+                ),
+                matrix: g.matrix_per_object,
+                upload: g.geometry_upload.0.saturating_add(g.texture_upload.0),
+            });
         }
         shader_base += g.shaders;
         texture_base += g.textures;
         material_base += g.materials;
     }
     if scene.state_order == StateOrder::Sorted {
-        objects.sort_by_key(|o| (o.2, o.3, o.4));
+        objects.sort_by_key(|o| o.state);
     }
 
     let cpu = &cfg.cpu;
@@ -295,7 +306,13 @@ pub fn compile_scene(
     // Closed forms per (mesh, group): computed once, only at `draw` fidelity.
     let mut closed_cache: HashMap<(u32, u32), DrawTimes> = HashMap::new();
     for o in &objects {
-        let (group, mesh, sh, tx, mt, matrix, geo_up, tex_up) = *o;
+        let Instance {
+            group,
+            mesh,
+            state: (sh, tx, mt),
+            matrix,
+            upload: up,
+        } = *o;
         let changed = [
             prev.is_none_or(|p| p.0 != sh),
             prev.is_none_or(|p| p.1 != tx),
@@ -331,7 +348,6 @@ pub fn compile_scene(
         stats.texture_changes += changed[1] as u64;
         stats.material_changes += changed[2] as u64;
         stats.matrix_changes += changed[3] as u64;
-        let up = geo_up.saturating_add(tex_up);
         if up > 0 {
             c = add(c, cfg.bus.bandwidth.transfer_time(up), "bus.bandwidth")?;
             commands += 1;
