@@ -212,3 +212,21 @@ fn tracing_does_not_change_results_at_either_fidelity() {
         assert_eq!(a.summary["metrics"], b.summary["metrics"], "{fid}");
     }
 }
+
+#[test]
+fn a_static_view_repeats_its_triangle_sizes_every_frame() {
+    let m = scene_model(
+        "name = \"g\"\nmesh = \"grid:20x20\"\ntriangle_pixels = { kind = \"lognormal\", median = 5.0, sigma = 1.0 }",
+    );
+    let gpu_ms = |view: &str| {
+        let r = run(&m, &["run.frames=6", &format!("workload.view=\"{view}\"")]);
+        r.records
+            .iter()
+            .map(|f| f.gpu_end.unwrap().0 - f.gpu_start.unwrap().0)
+            .collect::<Vec<u64>>()
+    };
+    let s = gpu_ms("static");
+    assert!(s.windows(2).all(|w| w[0] == w[1]), "{s:?}");
+    let v = gpu_ms("varying");
+    assert!(v.windows(2).any(|w| w[0] != w[1]), "{v:?}");
+}

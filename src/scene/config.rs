@@ -23,6 +23,20 @@ pub enum DepthOrder {
     Random,
 }
 
+/// Whether consecutive frames show the same view.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum View {
+    /// The same triangle sizes every frame.
+    Static,
+    /// New triangle sizes every frame.
+    Varying,
+}
+
+fn static_view() -> View {
+    View::Static
+}
+
 /// Order in which objects are submitted relative to their state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -37,6 +51,11 @@ pub enum StateOrder {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneWorkload {
+    /// `static`: every frame shows the same view (the same triangle sizes,
+    /// as when one viewpoint is rendered repeatedly); `varying`: sizes are
+    /// drawn afresh every frame (a moving camera).
+    #[serde(default = "static_view")]
+    pub view: View,
     /// Optional synthetic scene after paper 000 Table 5: city, terrain, forest.
     #[serde(default)]
     pub preset: Option<String>,

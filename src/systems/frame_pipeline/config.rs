@@ -84,6 +84,8 @@ pub struct RunConfig {
     pub seed: u64,
     /// Optional cap on handled events (a safety net for huge models).
     pub max_events: Option<u64>,
+    /// Optional end of simulated time: the run stops there even if frames remain.
+    pub until: Option<Duration>,
 }
 
 impl Default for RunConfig {
@@ -93,6 +95,7 @@ impl Default for RunConfig {
             warmup_frames: 0,
             seed: 1,
             max_events: None,
+            until: None,
         }
     }
 }

@@ -36,6 +36,11 @@ impl FramePipeline {
             self.records[f as usize].displayed = Some(now);
             self.last_display = Some(now);
             self.resolved += 1;
+            let warm = self.cfg.run.warmup_frames;
+            if warm > 0 && f >= warm && self.refresh_mark.is_none() {
+                // Refresh counts after warm-up start at the first later frame shown.
+                self.refresh_mark = Some((self.vblanks, self.repeated_refreshes, now));
+            }
         }
     }
 

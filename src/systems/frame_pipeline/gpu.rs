@@ -96,6 +96,10 @@ impl FramePipeline {
     fn front_start_clear(&mut self, now: Time, c: Command, s: &mut Scheduler<Ev>) -> Result<FrontPhase, PipelineError> {
         if let Command::Clear { frame } = c {
             self.gpu_frame = Some(frame);
+            if let Some(start) = &self.pixel_rng_start {
+                // A static view: this frame's triangles get the same sizes as every other's.
+                self.pixel_rng = start.clone();
+            }
             self.records[frame as usize].gpu_start = Some(now);
         }
         let work = self

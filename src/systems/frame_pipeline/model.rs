@@ -236,11 +236,16 @@ pub struct FramePipeline {
     pub(super) tri_fifo: BoundedFifo<Duration>,
     pub(super) frag_busy: bool,
     pub(super) pixel_rng: StreamRng,
+    /// The size stream's state at the start, restored every frame for a static view.
+    pub(super) pixel_rng_start: Option<StreamRng>,
     // display
     pub(super) chain: SwapChain,
     pub(super) refresh: Duration,
     pub(super) vblanks: u64,
     pub(super) repeated_refreshes: u64,
+    /// (vertical blanks, repeated refreshes, time) when the first frame after
+    /// warm-up was shown; refresh metrics count from there.
+    pub(super) refresh_mark: Option<(u64, u64, Time)>,
     pub(super) last_display: Option<Time>,
     pub(super) resolved: u64,
     // noise
@@ -330,6 +335,12 @@ impl FramePipeline {
             tri_fifo: BoundedFifo::new(cfg.gpu.fragment.fifo_depth as u64),
             non_render_rng: streams.stream("cpu.non_render"),
             pixel_rng: streams.stream("fragment.pixels"),
+            pixel_rng_start: match &cfg.workload {
+                WorkloadConfig::Scene(sc) if sc.view == crate::scene::config::View::Static => {
+                    Some(streams.stream("fragment.pixels"))
+                }
+                _ => None,
+            },
             program,
             frames_total,
             cpu: Preemptible::new(),
@@ -351,6 +362,7 @@ impl FramePipeline {
             frag_busy: false,
             vblanks: 0,
             repeated_refreshes: 0,
+            refresh_mark: None,
             last_display: None,
             resolved: 0,
             noise,
