@@ -25,13 +25,38 @@ pub enum CachePolicy {
     Fifo(u32),
     /// Least recently used, N entries; a hit moves the vertex to the front.
     Lru(u32),
+    /// meshoptimizer's `meshopt_analyzeVertexCache` model, exactly: a FIFO of
+    /// `cache` entries; the cache is flushed and a new warp begins when a
+    /// triangle's misses would overflow `warp` vertices, or after `primgroup`
+    /// triangles (0 = no limit). Triangle-level.
+    Meshopt {
+        /// FIFO entries (>= 3).
+        cache: u32,
+        /// Vertices per warp (0 = unlimited, else >= 3).
+        warp: u32,
+        /// Triangles per primitive group (0 = unlimited).
+        primgroup: u32,
+    },
+    /// Hardware-style batches (Kerbl et al., "Revisiting the Vertex Cache",
+    /// HPG 2018): the input assembler cuts the index stream into batches of
+    /// at most `vertices` distinct vertices and `triangles` triangles; a
+    /// vertex is shaded once per batch it appears in, never reused across
+    /// batches. Triangle-level.
+    Batch {
+        /// Distinct vertices per batch (>= 3).
+        vertices: u32,
+        /// Triangles per batch (>= 1).
+        triangles: u32,
+    },
 }
 
 /// A cache policy string that does not parse.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum CachePolicyError {
     /// The policy name is not known.
-    #[error("unknown vertex cache policy `{0}`; expected `none`, `fifo:N` or `lru:N`")]
+    #[error(
+        "unknown vertex cache policy `{0}`; expected `none`, `fifo:N`, `lru:N`, `meshopt:CACHE,WARP,PRIMGROUP` or `batch:VERTICES,TRIANGLES`"
+    )]
     UnknownPolicy(String),
     /// The policy needs a size (`fifo:N`).
     #[error("vertex cache policy `{0}` needs a size, e.g. `{0}:32`")]
@@ -43,6 +68,14 @@ pub enum CachePolicyError {
         spec: String,
         /// The size part.
         size: String,
+    },
+    /// Bad parameters of a `meshopt:` or `batch:` policy.
+    #[error("vertex cache policy `{spec}`: {reason}")]
+    BadParameters {
+        /// The policy as given.
+        spec: String,
+        /// What is wrong.
+        reason: String,
     },
     /// `none` takes no size.
     #[error("vertex cache policy `none` takes no size, got `{0}`")]
@@ -75,6 +108,53 @@ impl FromStr for CachePolicy {
             },
             "fifo" => Ok(CachePolicy::Fifo(parse_size()?)),
             "lru" => Ok(CachePolicy::Lru(parse_size()?)),
+            "meshopt" | "batch" => {
+                let z = size.ok_or_else(|| CachePolicyError::MissingSize(name.to_string()))?;
+                let nums: Vec<&str> = z.split(',').map(str::trim).collect();
+                let want = if name.eq_ignore_ascii_case("meshopt") { 3 } else { 2 };
+                let bad = |why: &str| CachePolicyError::BadParameters {
+                    spec: spec.to_string(),
+                    reason: why.to_string(),
+                };
+                if nums.len() != want {
+                    return Err(bad(if want == 3 {
+                        "expected meshopt:CACHE,WARP,PRIMGROUP, e.g. meshopt:32,32,32"
+                    } else {
+                        "expected batch:VERTICES,TRIANGLES, e.g. batch:32,32"
+                    }));
+                }
+                let mut v = Vec::with_capacity(3);
+                for n in &nums {
+                    v.push(
+                        n.parse::<u32>()
+                            .map_err(|_| bad(&format!("`{n}` is not an integer from 0 to 4294967295")))?,
+                    );
+                }
+                if want == 3 {
+                    if v[0] < 3 {
+                        return Err(bad("CACHE must be at least 3"));
+                    }
+                    if v[1] != 0 && v[1] < 3 {
+                        return Err(bad("WARP must be 0 (no limit) or at least 3"));
+                    }
+                    Ok(CachePolicy::Meshopt {
+                        cache: v[0],
+                        warp: v[1],
+                        primgroup: v[2],
+                    })
+                } else {
+                    if v[0] < 3 {
+                        return Err(bad("VERTICES must be at least 3 (one triangle)"));
+                    }
+                    if v[1] < 1 {
+                        return Err(bad("TRIANGLES must be at least 1"));
+                    }
+                    Ok(CachePolicy::Batch {
+                        vertices: v[0],
+                        triangles: v[1],
+                    })
+                }
+            }
             _ => Err(CachePolicyError::UnknownPolicy(spec.to_string())),
         }
     }
@@ -86,6 +166,8 @@ impl fmt::Display for CachePolicy {
             CachePolicy::None => write!(f, "none"),
             CachePolicy::Fifo(n) => write!(f, "fifo:{n}"),
             CachePolicy::Lru(n) => write!(f, "lru:{n}"),
+            CachePolicy::Meshopt { cache, warp, primgroup } => write!(f, "meshopt:{cache},{warp},{primgroup}"),
+            CachePolicy::Batch { vertices, triangles } => write!(f, "batch:{vertices},{triangles}"),
         }
     }
 }
@@ -107,6 +189,69 @@ impl<'de> Deserialize<'de> for CachePolicy {
 /// vertex ids from user files) go to a hash map so memory stays bounded.
 const DENSE_LIMIT: usize = 1 << 24;
 
+/// Fast path for whole triangle lists: meshoptimizer's analyzer loop (FIFO
+/// of `cache` entries, warps of `warp` vertices, groups of `primgroup`
+/// triangles; `fifo:N` is `(N, 0, 0)`), on a dense stamp array of
+/// `vertex_count` entries. Calls `charge(misses)` per triangle; returns
+/// (transformed, warps, unique vertices), or `None` as soon as an index is
+/// not below `vertex_count` (the caller then discards what was charged).
+pub fn analyze_triangle_list(
+    indices: &[u32],
+    vertex_count: usize,
+    cache: u32,
+    warp: u32,
+    primgroup: u32,
+    mut charge: impl FnMut(u8),
+) -> Option<(u64, u64, u64)> {
+    let mut stamps = vec![0u32; vertex_count];
+    let mut timestamp: u32 = cache.wrapping_add(1);
+    let (mut warp_offset, mut prim_offset, mut warps, mut transformed) = (0u32, 0u32, 0u64, 0u64);
+    for t in indices.chunks_exact(3) {
+        let (sa, sb, sc) = (
+            *stamps.get(t[0] as usize)?,
+            *stamps.get(t[1] as usize)?,
+            *stamps.get(t[2] as usize)?,
+        );
+        let m = u32::from(timestamp.wrapping_sub(sa) > cache)
+            + u32::from(timestamp.wrapping_sub(sb) > cache)
+            + u32::from(timestamp.wrapping_sub(sc) > cache);
+        if (primgroup != 0 && prim_offset == primgroup) || (warp != 0 && warp_offset + m > warp) {
+            warps += u64::from(warp_offset > 0);
+            warp_offset = 0;
+            prim_offset = 0;
+            timestamp = timestamp.wrapping_add(cache.wrapping_add(1));
+        }
+        let mut k = 0u8;
+        for &v in t {
+            // In bounds: checked above.
+            let s = &mut stamps[v as usize];
+            if timestamp.wrapping_sub(*s) > cache {
+                *s = timestamp;
+                timestamp = timestamp.wrapping_add(1);
+                k += 1;
+            }
+        }
+        warp_offset += u32::from(k);
+        prim_offset += 1;
+        transformed += u64::from(k);
+        charge(k);
+    }
+    warps += u64::from(warp_offset > 0);
+    // A stamp stays non-zero after its vertex's first insertion unless the
+    // 32-bit clock wrapped (more than about 4e9 / cache triangles).
+    let ticks = transformed + u64::from(cache) * (warps + 1);
+    let unique = if ticks < u64::from(u32::MAX) {
+        stamps.iter().filter(|&&s| s != 0).count() as u64
+    } else {
+        let mut seen = vec![false; vertex_count];
+        indices
+            .iter()
+            .filter(|&&i| !std::mem::replace(&mut seen[i as usize], true))
+            .count() as u64
+    };
+    Some((transformed, warps, unique))
+}
+
 /// A simulated post-transform vertex cache.
 #[derive(Clone, Debug)]
 pub struct VertexCache {
@@ -121,15 +266,67 @@ pub struct VertexCache {
     epoch: u64,
     /// LRU: the cached vertices, most recent first.
     lru: Vec<u32>,
+    /// Triangle-level policies: meshoptimizer's per-vertex 32-bit timestamps
+    /// (wrapping arithmetic, as in its C code), the clock, and the current
+    /// warp's vertices and triangles.
+    tri: TriangleState,
+}
+
+#[derive(Clone, Debug, Default)]
+struct TriangleState {
+    stamps: Vec<u32>,
+    sparse: HashMap<u32, u32>,
+    timestamp: u32,
+    warp_offset: u32,
+    prim_offset: u32,
+    warps: u64,
+}
+
+impl TriangleState {
+    #[inline]
+    fn stamp(&self, v: u32) -> u32 {
+        match self.stamps.get(v as usize) {
+            Some(s) => *s,
+            None => self.sparse.get(&v).copied().unwrap_or(0),
+        }
+    }
+
+    #[inline]
+    fn set_stamp(&mut self, v: u32, t: u32) {
+        let i = v as usize;
+        if i >= self.stamps.len() && i < DENSE_LIMIT {
+            let len = (i + 1).max(2 * self.stamps.len()).min(DENSE_LIMIT);
+            self.stamps.resize(len, 0);
+        }
+        match self.stamps.get_mut(i) {
+            Some(s) => *s = t,
+            None => {
+                self.sparse.insert(v, t);
+            }
+        }
+    }
 }
 
 impl VertexCache {
     /// An empty cache; `vertex_count_hint` presizes the FIFO stamp array.
     pub fn new(policy: &CachePolicy, vertex_count_hint: usize) -> Self {
         let (stamps, lru) = match policy {
-            CachePolicy::None => (Vec::new(), Vec::new()),
+            CachePolicy::None | CachePolicy::Meshopt { .. } | CachePolicy::Batch { .. } => (Vec::new(), Vec::new()),
             CachePolicy::Fifo(_) => (vec![0; vertex_count_hint.min(DENSE_LIMIT)], Vec::new()),
             CachePolicy::Lru(n) => (Vec::new(), Vec::with_capacity((*n as usize).min(1024))),
+        };
+        let tri = match policy {
+            CachePolicy::Meshopt { cache, .. } => TriangleState {
+                stamps: vec![0; vertex_count_hint.min(DENSE_LIMIT)],
+                timestamp: cache.wrapping_add(1),
+                ..TriangleState::default()
+            },
+            CachePolicy::Batch { vertices, .. } => TriangleState {
+                stamps: vec![0; vertex_count_hint.min(DENSE_LIMIT)],
+                timestamp: vertices.wrapping_add(1),
+                ..TriangleState::default()
+            },
+            _ => TriangleState::default(),
         };
         VertexCache {
             policy: policy.clone(),
@@ -138,6 +335,7 @@ impl VertexCache {
             now: 0,
             epoch: 0,
             lru,
+            tri,
         }
     }
 
@@ -155,13 +353,93 @@ impl VertexCache {
                 self.sparse.clear();
             }
             CachePolicy::Lru(_) => self.lru.clear(),
+            CachePolicy::Meshopt { .. } | CachePolicy::Batch { .. } => self.flush_warp(),
         }
+    }
+
+    /// True for policies that decide per triangle (warps, batches): use
+    /// [`VertexCache::access_triangle`] with them.
+    pub fn is_triangle_level(&self) -> bool {
+        matches!(self.policy, CachePolicy::Meshopt { .. } | CachePolicy::Batch { .. })
+    }
+
+    /// (cache entries, warp vertices, triangles per group) of a
+    /// triangle-level policy; `batch:V,T` is `meshopt:V,V,T` (a cache that
+    /// holds a whole batch never evicts inside it).
+    fn triangle_params(&self) -> (u32, u32, u32) {
+        match self.policy {
+            CachePolicy::Meshopt { cache, warp, primgroup } => (cache, warp, primgroup),
+            CachePolicy::Batch { vertices, triangles } => (vertices, vertices, triangles),
+            _ => (0, 0, 0),
+        }
+    }
+
+    fn flush_warp(&mut self) {
+        let (cache, _, _) = self.triangle_params();
+        let t = &mut self.tri;
+        t.warps += u64::from(t.warp_offset > 0);
+        t.warp_offset = 0;
+        t.prim_offset = 0;
+        t.timestamp = t.timestamp.wrapping_add(cache.wrapping_add(1));
+    }
+
+    /// Warps (batches) executed so far, counting the current one if it has
+    /// any vertex. Zero for per-index policies.
+    pub fn warps(&self) -> u64 {
+        self.tri.warps + u64::from(self.tri.warp_offset > 0)
+    }
+
+    /// Processes one triangle; returns how many of its vertices were
+    /// transformed (0 to 3). For `meshopt:` and `batch:` this is
+    /// meshoptimizer's `meshopt_analyzeVertexCache` step, including its
+    /// 32-bit wrapping timestamps; for the other policies it is three
+    /// [`VertexCache::access`] calls.
+    #[inline]
+    pub fn access_triangle(&mut self, tri: [u32; 3]) -> u8 {
+        if !self.is_triangle_level() {
+            return u8::from(self.access(tri[0])) + u8::from(self.access(tri[1])) + u8::from(self.access(tri[2]));
+        }
+        let (cache, warp, primgroup) = self.triangle_params();
+        let miss = |t: &TriangleState, v: u32| t.timestamp.wrapping_sub(t.stamp(v)) > cache;
+        let m = u32::from(miss(&self.tri, tri[0]))
+            + u32::from(miss(&self.tri, tri[1]))
+            + u32::from(miss(&self.tri, tri[2]));
+        if (primgroup != 0 && self.tri.prim_offset == primgroup) || (warp != 0 && self.tri.warp_offset + m > warp) {
+            self.flush_warp();
+        }
+        let mut transformed = 0u8;
+        for v in tri {
+            if miss(&self.tri, v) {
+                let t = self.tri.timestamp;
+                self.tri.set_stamp(v, t);
+                self.tri.timestamp = t.wrapping_add(1);
+                self.tri.warp_offset += 1;
+                transformed += 1;
+            }
+        }
+        self.tri.prim_offset += 1;
+        transformed
     }
 
     /// Looks up vertex `index`; returns `true` on a miss (the vertex is
     /// fetched and transformed, then cached).
+    ///
+    /// Triangle-level policies given single indices behave as a FIFO of
+    /// their cache size (no warp or batch limits).
     pub fn access(&mut self, index: u32) -> bool {
         match self.policy {
+            CachePolicy::Meshopt { .. } | CachePolicy::Batch { .. } => {
+                let (cache, _, _) = self.triangle_params();
+                let t = &mut self.tri;
+                if t.timestamp.wrapping_sub(t.stamp(index)) > cache {
+                    let now = t.timestamp;
+                    t.set_stamp(index, now);
+                    t.timestamp = now.wrapping_add(1);
+                    true
+                } else {
+                    false
+                }
+            }
             CachePolicy::None => true,
             CachePolicy::Fifo(n) => {
                 let i = index as usize;

@@ -6,7 +6,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::PlotError;
-use super::axis::{omitted_note, tick_label, widen};
+use super::axis::{coord, omitted_note, ticks, widen};
 use super::font::FAMILY;
 use super::output::{draw_notes, render_both};
 use super::palette::color;
@@ -88,22 +88,25 @@ fn draw<DB: DrawingBackend>(
         1.0
     };
     let pad = (hi - b.lo) * 0.02;
+    let xt = ticks(b.lo - pad, hi + pad, false, false);
+    let yt = ticks(0.0, ymax, false, false);
     let mut chart = ChartBuilder::on(root)
         .caption(&h.title, (FAMILY, 24))
         .margin(20)
         .x_label_area_size(55)
         .y_label_area_size(75)
-        .build_cartesian_2d((b.lo - pad)..(hi + pad), 0.0..ymax)
+        .build_cartesian_2d(coord(b.lo - pad, hi + pad, &xt), coord(0.0, ymax, &yt))
         .map_err(e)?;
-    let f = |v: &f64| tick_label(*v, false);
+    let fx = |v: &f64| xt.label_at(*v);
+    let fy = |v: &f64| yt.label_at(*v);
     chart
         .configure_mesh()
         .x_desc(h.x_label.as_str())
         .y_desc("density")
         .label_style((FAMILY, 14))
         .axis_desc_style((FAMILY, 16))
-        .x_label_formatter(&f)
-        .y_label_formatter(&f)
+        .x_label_formatter(&fx)
+        .y_label_formatter(&fy)
         .draw()
         .map_err(e)?;
     let mut any_legend = false;

@@ -6,7 +6,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::PlotError;
-use super::axis::{omitted_note, padded_range, tick_label, to_axis};
+use super::axis::{all_integers, coord, omitted_note, padded_range, ticks, to_axis};
 use super::font::FAMILY;
 use super::output::{draw_notes, render_both};
 use super::palette::color;
@@ -92,16 +92,19 @@ fn draw<DB: DrawingBackend>(
             .map(|p| p.1)
             .chain(s.bars.iter().flat_map(|b| [b.1, b.3]))
     }));
+    // Integer x data (frame counts, buffer counts, ...) gets whole-number ticks.
+    let x_integer = all_integers(plot.series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
+    let xt = ticks(xr.0, xr.1, plot.log_x, x_integer);
+    let yt = ticks(yr.0, yr.1, plot.log_y, false);
     let mut chart = ChartBuilder::on(root)
         .caption(&plot.title, (FAMILY, 24))
         .margin(20)
         .x_label_area_size(55)
         .y_label_area_size(75)
-        .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
+        .build_cartesian_2d(coord(xr.0, xr.1, &xt), coord(yr.0, yr.1, &yt))
         .map_err(e)?;
-    let (log_x, log_y) = (plot.log_x, plot.log_y);
-    let fx = move |v: &f64| tick_label(*v, log_x);
-    let fy = move |v: &f64| tick_label(*v, log_y);
+    let fx = |v: &f64| xt.label_at(*v);
+    let fy = |v: &f64| yt.label_at(*v);
     chart
         .configure_mesh()
         .x_desc(plot.x_label.as_str())

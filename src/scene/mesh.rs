@@ -229,8 +229,27 @@ impl Mesh {
     /// triangle in order. Returns (indices fetched, total misses).
     fn simulate(&self, policy: &CachePolicy, mut charge: impl FnMut(u8)) -> (u64, u64) {
         let mut cache = VertexCache::new(policy, self.vertex_count as usize);
-        let mut miss = |i: u32| u8::from(cache.access(i));
         let (mut indices, mut total) = (0u64, 0u64);
+        if cache.is_triangle_level() {
+            // Warps and batches are cut per triangle: feed whole triangles
+            // (a strip's triangles as the list it stands for).
+            let list;
+            let tris: &[u32] = match self.topology {
+                Topology::TriangleList => &self.indices,
+                Topology::TriangleStrip => {
+                    list = self.to_triangle_list();
+                    &list.indices
+                }
+            };
+            for t in tris.chunks_exact(3) {
+                let m = cache.access_triangle([t[0], t[1], t[2]]);
+                charge(m);
+                indices += 3;
+                total += u64::from(m);
+            }
+            return (indices, total);
+        }
+        let mut miss = |i: u32| u8::from(cache.access(i));
         match self.topology {
             Topology::TriangleList => {
                 for tri in self.indices.chunks_exact(3) {
@@ -260,6 +279,15 @@ impl Mesh {
     /// Simulates `policy` over the index stream in order (a restart does not
     /// flush the cache) and counts actually transformed vertices.
     pub fn cache_stats(&self, policy: &CachePolicy) -> CacheStats {
+        if let Some((transformed, _, unique)) = self.fast_list(policy, |_| {}) {
+            let triangles = self.indices.len() as u64 / 3;
+            return CacheStats {
+                indices: 3 * triangles,
+                triangles,
+                unique_vertices: unique,
+                transformed,
+            };
+        }
         let mut triangles = 0u64;
         let (indices, transformed) = self.simulate(policy, |_| triangles += 1);
         CacheStats {
@@ -276,8 +304,32 @@ impl Mesh {
     /// run's first two. The sum equals `cache_stats(policy).transformed`.
     pub fn misses_per_triangle(&self, policy: &CachePolicy) -> Vec<u8> {
         let mut out = Vec::with_capacity(self.triangles() as usize);
+        if self.fast_list(policy, |m| out.push(m)).is_some() {
+            return out;
+        }
+        out.clear();
         self.simulate(policy, |m| out.push(m));
         out
+    }
+
+    /// The dense fast path (`analyze_triangle_list`) for triangle lists
+    /// under FIFO, `meshopt:` and `batch:` policies, when every index is
+    /// below `vertex_count`; `None` otherwise.
+    fn fast_list(&self, policy: &CachePolicy, charge: impl FnMut(u8)) -> Option<(u64, u64, u64)> {
+        if self.topology != Topology::TriangleList || self.indices.len() % 3 != 0 {
+            return None;
+        }
+        let (c, w, p) = match *policy {
+            CachePolicy::Fifo(n) if n >= 3 => (n, 0, 0),
+            CachePolicy::Meshopt { cache, warp, primgroup } => (cache, warp, primgroup),
+            CachePolicy::Batch { vertices, triangles } => (vertices, vertices, triangles),
+            _ => return None,
+        };
+        let n = self.vertex_count as usize;
+        if n > 1 << 28 {
+            return None;
+        }
+        crate::components::vertex_cache::analyze_triangle_list(&self.indices, n, c, w, p, charge)
     }
 
     /// The same triangles as an indexed list. Strip winding alternates: the
