@@ -87,6 +87,38 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// Measure a mesh on a real adapter through wgpu (build with `--features wgpu`).
+    Measure {
+        /// Mesh spec (as for `vcache`).
+        mesh: String,
+        /// Extra vertex-shader ALU loop iterations.
+        #[arg(long, default_value_t = 0)]
+        vs_loops: u32,
+        /// Extra fragment-shader ALU loop iterations.
+        #[arg(long, default_value_t = 0)]
+        fs_loops: u32,
+        /// Depth test on.
+        #[arg(long)]
+        depth_test: bool,
+        /// Copies of the mesh at different depths.
+        #[arg(long, default_value_t = 1)]
+        layers: u32,
+        /// Depth order of the layers: front_to_back, back_to_front, random.
+        #[arg(long, default_value = "front_to_back")]
+        order: String,
+        /// Render target size, WxH.
+        #[arg(long, default_value = "512x512")]
+        size: String,
+        /// Unrecorded warm-up passes.
+        #[arg(long, default_value_t = 2)]
+        warmup: u32,
+        /// Recorded passes (the median is reported).
+        #[arg(long, default_value_t = 5)]
+        repeats: u32,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Speed benchmarks, printed as ratios against baselines measured in the same run.
     Bench {
         /// Which: kernel, pipeline, hour, all.
@@ -129,6 +161,9 @@ fn dispatch(cli: Cli) -> Result<()> {
             json,
         } => cmd_isolate(model, sets, factor, keep_vsync, json),
         Cmd::Vcache { mesh, policy, json } => cmd_vcache(&mesh, &policy, json),
+        Cmd::Measure { mesh, vs_loops, fs_loops, depth_test, layers, order, size, warmup, repeats, json } => {
+            cmd_measure(&mesh, vs_loops, fs_loops, depth_test, layers, &order, &size, warmup, repeats, json)
+        }
         Cmd::Bench { which, scale } => rendersim::bench::run_cli(&which, scale).map_err(anyhow::Error::msg),
     }
 }
@@ -356,4 +391,65 @@ fn cmd_vcache(mesh: &str, policy: &str, json: bool) -> Result<()> {
         );
     }
     Ok(())
+}
+
+#[cfg(feature = "wgpu")]
+#[allow(clippy::too_many_arguments)]
+fn cmd_measure(
+    mesh: &str,
+    vs_loops: u32,
+    fs_loops: u32,
+    depth_test: bool,
+    layers: u32,
+    order: &str,
+    size: &str,
+    warmup: u32,
+    repeats: u32,
+    json: bool,
+) -> Result<()> {
+    use rendersim::measure::{MeasureOptions, measure};
+    let (w, h) = size
+        .split_once('x')
+        .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
+        .ok_or_else(|| anyhow::anyhow!("--size {size:?}: expected WxH, e.g. 512x512"))?;
+    let order = order.parse().map_err(|e: String| anyhow::anyhow!("--order: {e}"))?;
+    let m = rendersim::scene::generators::mesh_from_spec(mesh, Path::new("."))?;
+    let opts = MeasureOptions { vs_loops, fs_loops, depth_test, layers, order, size: (w, h), warmup, repeats };
+    let r = measure(&m, mesh, &opts)?;
+    let mut v = serde_json::to_value(&r)?;
+    v["mesh"] = json!({"spec": mesh, "triangles": m.triangles(), "indices": m.index_count(), "unique_vertices": m.unique_vertices()});
+    if json {
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        println!(
+            "{mesh} on {} ({}, {}): VS invocations {}, clipper invocations {}, FS invocations {}, pass {:.3} ms (median of {}){}",
+            r.adapter.name,
+            r.adapter.driver,
+            r.adapter.device_type,
+            r.vs_invocations,
+            r.clipper_invocations,
+            r.fs_invocations,
+            r.pass_time_ns / 1e6,
+            r.pass_times_ns.len(),
+            if r.stable_counters { "" } else { "; counters varied between repeats" }
+        );
+    }
+    Ok(())
+}
+
+#[cfg(not(feature = "wgpu"))]
+#[allow(clippy::too_many_arguments)]
+fn cmd_measure(
+    _mesh: &str,
+    _vs_loops: u32,
+    _fs_loops: u32,
+    _depth_test: bool,
+    _layers: u32,
+    _order: &str,
+    _size: &str,
+    _warmup: u32,
+    _repeats: u32,
+    _json: bool,
+) -> Result<()> {
+    bail!("this rendersim was built without the `wgpu` feature; rebuild with `cargo build --release --features wgpu` (and, without a GPU, install Debian's mesa-vulkan-drivers for lavapipe)")
 }

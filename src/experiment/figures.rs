@@ -8,7 +8,8 @@ use super::run::PointResult;
 use super::spec::{Experiment, PlotKind, PlotSpec};
 use super::sweep::{Point, value_text};
 
-/// Draw one plot into `out_dir`.
+/// Draw one plot into `out_dir`; returns caption lines for the report (for
+/// histograms with a `range`: the values left outside it).
 pub(crate) fn draw(
     exp: &Experiment,
     spec: &PlotSpec,
@@ -17,7 +18,7 @@ pub(crate) fn draw(
     pooled: &[Vec<Vec<f64>>],
     columns: &[String],
     out_dir: &Path,
-) -> Result<(), PlotError> {
+) -> Result<Vec<String>, PlotError> {
     let base = out_dir.join(&spec.file);
     match &spec.kind {
         PlotKind::Line {
@@ -95,9 +96,15 @@ pub(crate) fn draw(
                     log_x: *log_x,
                     log_y: *log_y,
                 },
-            )
+            )?;
+            Ok(Vec::new())
         }
-        PlotKind::Histogram { column, bins, filter } => {
+        PlotKind::Histogram {
+            column,
+            bins,
+            range,
+            filter,
+        } => {
             let c = columns.iter().position(|k| k == column);
             let values = points
                 .iter()
@@ -107,15 +114,15 @@ pub(crate) fn draw(
                     (p.label(), v)
                 })
                 .collect();
-            histogram(
-                &base,
-                &Histogram {
-                    title: spec.title.clone(),
-                    x_label: spec.x_label.clone(),
-                    values,
-                    bins: *bins,
-                },
-            )
+            let h = Histogram {
+                title: spec.title.clone(),
+                x_label: spec.x_label.clone(),
+                values,
+                bins: *bins,
+                range: *range,
+            };
+            histogram(&base, &h)?;
+            Ok(h.outside_range_notes())
         }
         PlotKind::Scatter { x, y, log_x, log_y } => {
             let pts = results
@@ -138,7 +145,8 @@ pub(crate) fn draw(
                     log_x: *log_x,
                     log_y: *log_y,
                 },
-            )
+            )?;
+            Ok(Vec::new())
         }
     }
 }

@@ -37,7 +37,10 @@
 //! x = "workload.gpu"     # a sweep key; one series per value of the other keys
 //! y = ["metrics.display_interval_ms.mean"]   # metric paths or derived names
 //! # line: optional where = { key = value } draws only the matching points
-//! # histogram: column = "FrameTime", bins = 80, optional where = { key = value }
+//! # histogram: column = "FrameTime", bins = 80, optional where = { key = value },
+//! #   optional range = [lo, hi] (finite, lo < hi): the bins span [lo, hi] instead of
+//! #   the data; values outside are not drawn but counted, per group, in a note on the
+//! #   plot and a line under it in report.md; densities stay relative to all values
 //! # scatter: x and y are metric paths or derived names; log_x / log_y
 //! [[derived]]            # interval_width | quantile_width_from_min | relative_error | speedup
 //! name = "c99"

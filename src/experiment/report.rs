@@ -232,6 +232,9 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
                 p.title,
                 f = p.file
             );
+            for (_, caption) in r.plot_captions.iter().filter(|c| c.0 == p.file) {
+                let _ = writeln!(s, "Note: {caption}.\n");
+            }
         }
     }
     s

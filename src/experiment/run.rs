@@ -102,6 +102,9 @@ pub struct ExperimentResult {
     pub sim_wall_seconds: f64,
     /// Files written, relative to the output directory.
     pub files: Vec<PathBuf>,
+    /// Caption lines for the plots, as `(plot file, line)` in plot order
+    /// (e.g. histogram values outside the plot's `range`).
+    pub plot_captions: Vec<(String, String)>,
 }
 
 impl ExperimentResult {
@@ -292,13 +295,16 @@ pub fn run_experiment(
     }
     let checks_failed = checks.iter().filter(|c| !c.passed).count();
 
+    let mut plot_captions = Vec::new();
     for plot in &exp.plots {
-        figures::draw(exp, plot, &points, &point_results, &pooled, &columns, out_dir).map_err(|source| {
-            ExperimentError::Plot {
-                file: plot.file.clone(),
-                source,
-            }
-        })?;
+        let captions =
+            figures::draw(exp, plot, &points, &point_results, &pooled, &columns, out_dir).map_err(|source| {
+                ExperimentError::Plot {
+                    file: plot.file.clone(),
+                    source,
+                }
+            })?;
+        plot_captions.extend(captions.into_iter().map(|c| (plot.file.clone(), c)));
         files.push(PathBuf::from(format!("{}.svg", plot.file)));
         files.push(PathBuf::from(format!("{}.png", plot.file)));
     }
@@ -313,6 +319,7 @@ pub fn run_experiment(
         checks_failed,
         wall_seconds: 0.0,
         files,
+        plot_captions,
     };
     result.wall_seconds = started.elapsed().as_secs_f64();
     let report_path = out_dir.join("report.md");

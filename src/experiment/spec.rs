@@ -59,6 +59,9 @@ pub enum PlotKind {
         column: String,
         /// Number of bins.
         bins: usize,
+        /// Optional x range `(lo, hi)` of the bins (finite, `lo < hi`);
+        /// values outside are counted and noted, not drawn.
+        range: Option<(f64, f64)>,
         /// `where` filter: sweep key = value.
         filter: Vec<(String, toml::Value)>,
     },
@@ -401,6 +404,7 @@ struct RawPlot {
     y_label: Option<String>,
     column: Option<String>,
     bins: Option<i64>,
+    range: Option<Vec<f64>>,
     #[serde(default)]
     log_x: bool,
     #[serde(default)]
@@ -657,9 +661,31 @@ impl Validator<'_> {
                         Some(t) => filter(&format!("{key}.where"), t)?,
                         None => Vec::new(),
                     };
+                    let range = match &p.range {
+                        None => None,
+                        Some(r) => match r[..] {
+                            [lo, hi] if lo.is_finite() && hi.is_finite() && lo < hi => Some((lo, hi)),
+                            [lo, hi] if lo.is_finite() && hi.is_finite() => {
+                                return Err(self.err(
+                                    format!("{key}.range"),
+                                    format!("needs lo < hi, got [{lo}, {hi}]"),
+                                ));
+                            }
+                            [_, _] => {
+                                return Err(self.err(format!("{key}.range"), "bounds must be finite numbers"));
+                            }
+                            _ => {
+                                return Err(self.err(
+                                    format!("{key}.range"),
+                                    format!("must be [lo, hi] (two numbers), got {} value(s)", r.len()),
+                                ));
+                            }
+                        },
+                    };
                     PlotKind::Histogram {
                         column,
                         bins: bins as usize,
+                        range,
                         filter: f,
                     }
                 }
@@ -689,6 +715,9 @@ impl Validator<'_> {
                     ));
                 }
             };
+            if p.range.is_some() && !matches!(kind, PlotKind::Histogram { .. }) {
+                return Err(self.err(format!("{key}.range"), "only histogram plots take `range`"));
+            }
             if p.filter.is_some() && matches!(kind, PlotKind::Scatter { .. }) {
                 return Err(self.err(format!("{key}.where"), "only histogram and line plots take `where`"));
             }

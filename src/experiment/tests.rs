@@ -608,3 +608,57 @@ fn line_plot_where_selects_points() {
     );
     assert!(parse_err(&bad).contains("not one of the swept values"));
 }
+
+#[test]
+fn histogram_range_is_parsed_and_validated() {
+    let hist = |extra: &str| format!("name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"FrameTime\"\n{extra}");
+    // Integers are fine; no range means the bins span the data.
+    let exp = parse(&hist("range = [11, 14.5]\n"));
+    assert!(matches!(exp.plots[0].kind, PlotKind::Histogram { range: Some((11.0, 14.5)), .. }));
+    let exp = parse(&hist(""));
+    assert!(matches!(exp.plots[0].kind, PlotKind::Histogram { range: None, .. }));
+    for (bad, want) in [
+        ("range = [3, 3]\n", "needs lo < hi, got [3, 3]"),
+        ("range = [5.0, 1.0]\n", "needs lo < hi"),
+        ("range = [1.0]\n", "must be [lo, hi] (two numbers), got 1 value(s)"),
+        ("range = [1, 2, 3]\n", "got 3 value(s)"),
+        ("range = [nan, 2.0]\n", "bounds must be finite"),
+        ("range = [0.0, inf]\n", "bounds must be finite"),
+    ] {
+        let e = parse_err(&hist(bad));
+        assert!(
+            e.contains("experiments/bad.toml") && e.contains("plot[0] (h).range") && e.contains(want),
+            "{bad}: {e}"
+        );
+    }
+    let e = parse_err(&hist("range = [\"a\", \"b\"]\n"));
+    assert!(e.contains("experiments/bad.toml") && e.contains("range"), "{e}");
+    let e = parse_err(
+        "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[plot]]\nfile = \"p\"\nkind = \"line\"\nx = \"a\"\ny = \"m\"\nrange = [0, 1]\n",
+    );
+    assert!(e.contains("plot[0] (p).range") && e.contains("only histogram plots take `range`"), "{e}");
+}
+
+#[test]
+fn histogram_range_counts_values_outside_in_the_report() {
+    let text = FIDELITY.replace("bins = 20\n", "bins = 20\nrange = [12, 25]\n");
+    let exp = parse(&text);
+    let dir = tempfile::tempdir().unwrap();
+    let res = run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap();
+    // Frames are gpu + (i % 10) for 100 frames and 2 seeds: at 10ms, 10 and 11
+    // fall below 12 (40 values); at 20ms, 26..29 lie above 25 (80 values).
+    let captions: Vec<&str> = res.plot_captions.iter().map(|c| c.1.as_str()).collect();
+    assert_eq!(captions.len(), 2, "{captions:?}");
+    assert!(res.plot_captions.iter().all(|c| c.0 == "frames"));
+    assert!(
+        captions[0].starts_with("x range [12, 25]: 40 value(s) below and 0 above of 200 not shown (")
+            && captions[0].contains("10ms"),
+        "{captions:?}"
+    );
+    assert!(captions[1].contains("0 value(s) below and 80 above") && captions[1].contains("20ms"));
+    let report = read(dir.path(), "report.md");
+    assert!(report.contains(&format!("Note: {}.", captions[0])), "{report}");
+    // Without a range there are no captions.
+    let res = run_experiment(&parse(FIDELITY), &base_model(), &Fake::default(), dir.path(), false).unwrap();
+    assert!(res.plot_captions.is_empty());
+}

@@ -323,10 +323,13 @@ fn log_ticks(lo: f64, hi: f64, integer: bool) -> Ticks {
                 s => s * 2,
             };
         }
-    } else if one_two_five.len() >= 3 {
+    } else if one_two_five.len() >= 4 {
         Some((one_two_five, 0))
     } else if (3..=MAX_TICKS).contains(&one_to_nine.len()) {
+        // About a decade: 1..9 labels the range more evenly than 1-2-5.
         Some((one_to_nine, -1))
+    } else if one_two_five.len() == 3 {
+        Some((one_two_five, 0))
     } else {
         None
     };
@@ -465,6 +468,9 @@ mod tests {
 
     #[test]
     fn log_range_over_decades_gets_one_two_five() {
+        // Just under a decade: 1..9 rather than three 1-2-5 ticks.
+        let t = for_data(260.0, 1990.0, true, false);
+        assert_eq!(t.labels, ["300", "400", "500", "600", "700", "800", "900", "1000", "2000"]);
         let t = for_data(0.01, 0.2, true, false);
         assert_eq!(t.labels, ["0.01", "0.02", "0.05", "0.1", "0.2"]);
         let t = for_data(0.1, 130.0, true, false);

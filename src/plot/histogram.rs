@@ -6,14 +6,15 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::PlotError;
-use super::axis::{coord, omitted_note, ticks, widen};
+use super::axis::{coord, format_number, omitted_note, ticks, widen};
 use super::font::FAMILY;
 use super::output::{draw_notes, render_both};
 use super::palette::color;
 
 /// A histogram description: each group gets its own colour; all groups share
 /// the same bins; the y axis is probability density (each group integrates
-/// to 1).
+/// to 1, or with a [`range`](Histogram::range) to the fraction of its values
+/// inside the range).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Histogram {
     /// Title above the plot.
@@ -24,6 +25,62 @@ pub struct Histogram {
     pub values: Vec<(String, Vec<f64>)>,
     /// Number of bins (0 is treated as 1).
     pub bins: usize,
+    /// Optional x range `(lo, hi)` of the bins (ignored unless finite with
+    /// `lo < hi`); without it the bins span the data. Values outside are not
+    /// drawn but counted: a note on the plot gives the counts per group
+    /// (see [`Histogram::outside_range`]), and densities stay relative to
+    /// all of a group's finite values.
+    pub range: Option<(f64, f64)>,
+}
+
+impl Histogram {
+    /// The range actually used, if any (finite, `lo < hi`).
+    fn valid_range(&self) -> Option<(f64, f64)> {
+        self.range.filter(|&(lo, hi)| lo.is_finite() && hi.is_finite() && lo < hi)
+    }
+
+    /// Per group with finite values outside [`range`](Histogram::range):
+    /// `(group name, count below lo, count above hi)`. Empty without a range
+    /// or when every value is inside.
+    pub fn outside_range(&self) -> Vec<(String, usize, usize)> {
+        let Some((lo, hi)) = self.valid_range() else {
+            return Vec::new();
+        };
+        self.values
+            .iter()
+            .map(|(name, v)| {
+                let below = v.iter().filter(|x| x.is_finite() && **x < lo).count();
+                let above = v.iter().filter(|x| x.is_finite() && **x > hi).count();
+                (name.clone(), below, above)
+            })
+            .filter(|g| g.1 + g.2 > 0)
+            .collect()
+    }
+
+    /// One line per group with values outside the range, e.g.
+    /// `x range [11.9, 14.1]: 3 below, 5 above not shown (a=1)`.
+    pub fn outside_range_notes(&self) -> Vec<String> {
+        let Some((lo, hi)) = self.valid_range() else {
+            return Vec::new();
+        };
+        let groups = self.values.len();
+        self.outside_range()
+            .into_iter()
+            .map(|(name, below, above)| {
+                let total = self.values.iter().find(|g| g.0 == name).map_or(0, |g| g.1.iter().filter(|x| x.is_finite()).count());
+                let whose = if groups > 1 && !name.is_empty() {
+                    format!(" ({name})")
+                } else {
+                    String::new()
+                };
+                format!(
+                    "x range [{}, {}]: {below} value(s) below and {above} above of {total} not shown{whose}",
+                    format_number(lo),
+                    format_number(hi)
+                )
+            })
+            .collect()
+    }
 }
 
 /// Binned groups: shared edges and per-group densities.
@@ -45,23 +102,32 @@ fn bin(h: &Histogram) -> (Binned, usize) {
             (name.clone(), f)
         })
         .collect();
-    let all = finite.iter().flat_map(|g| g.1.iter().copied());
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for v in all {
-        lo = lo.min(v);
-        hi = hi.max(v);
-    }
-    if !lo.is_finite() {
-        (lo, hi) = (0.0, 1.0);
-    } else if hi <= lo {
-        (lo, hi) = widen(lo, hi, 0.0);
-    }
+    let (lo, hi) = match h.valid_range() {
+        Some(r) => r,
+        None => {
+            let all = finite.iter().flat_map(|g| g.1.iter().copied());
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for v in all {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+            if !lo.is_finite() {
+                (0.0, 1.0)
+            } else if hi <= lo {
+                widen(lo, hi, 0.0)
+            } else {
+                (lo, hi)
+            }
+        }
+    };
     let width = (hi - lo) / bins as f64;
     let groups = finite
         .into_iter()
         .map(|(name, v)| {
             let mut counts = vec![0u64; bins];
-            for x in &v {
+            // Values outside [lo, hi] (only with a range) are not binned but
+            // still count in `n`.
+            for x in v.iter().filter(|&&x| x >= lo && x <= hi) {
                 let i = (((x - lo) / width) as usize).min(bins - 1);
                 counts[i] += 1;
             }
@@ -152,6 +218,7 @@ fn draw<DB: DrawingBackend>(
 pub fn histogram(base: &Path, h: &Histogram) -> Result<(), PlotError> {
     let (binned, dropped) = bin(h);
     let mut notes: Vec<String> = omitted_note(dropped, false).into_iter().collect();
+    notes.extend(h.outside_range_notes().into_iter().map(|n| format!("note: {n}")));
     if h.values.iter().all(|g| g.1.is_empty()) {
         notes.push("note: no data".into());
     }
@@ -169,7 +236,49 @@ mod tests {
             x_label: "frame time (ms)".into(),
             values,
             bins,
+            range: None,
         }
+    }
+
+    #[test]
+    fn range_bins_only_inside_and_counts_the_rest() {
+        let h = Histogram {
+            range: Some((1.0, 3.0)),
+            ..hist(
+                vec![
+                    ("a".into(), vec![0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 3.5, f64::NAN]),
+                    ("b".into(), vec![2.0, 2.5]),
+                ],
+                2,
+            )
+        };
+        let (b, dropped) = bin(&h);
+        assert_eq!(dropped, 1);
+        assert_eq!((b.lo, b.width), (1.0, 1.0));
+        // a: [1,2) holds 1.0, 1.5; [2,3] holds 2.0, 3.0; of 7 finite values.
+        assert_eq!(b.groups[0].1, vec![2.0 / 7.0, 2.0 / 7.0]);
+        assert_eq!(b.groups[1].1, vec![0.0, 1.0]);
+        assert_eq!(h.outside_range(), vec![("a".to_string(), 2, 1)]);
+        let notes = h.outside_range_notes();
+        assert_eq!(
+            notes,
+            ["x range [1, 3]: 2 value(s) below and 1 above of 7 not shown (a)"]
+        );
+        // An invalid range is ignored: bins span the data again.
+        let h = Histogram {
+            range: Some((3.0, 1.0)),
+            ..h
+        };
+        assert_eq!(bin(&h).0.lo, 0.0);
+        assert!(h.outside_range().is_empty());
+        let dir = tempfile::tempdir().unwrap();
+        let base = dir.path().join("ranged");
+        histogram(&base, &Histogram {
+            range: Some((1.0, 3.0)),
+            ..h
+        })
+        .unwrap();
+        assert_plot_files(&base);
     }
 
     #[test]

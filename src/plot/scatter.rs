@@ -364,6 +364,80 @@ mod tests {
         }
     }
 
+    const AREA: Rect = Rect {
+        l: 0,
+        t: 0,
+        r: 800,
+        b: 500,
+    };
+
+    /// Placed labels overlap neither each other nor any marker, and stay inside.
+    fn assert_clear(centres: &[(i32, i32)], spots: &[Option<Rect>]) {
+        let placed: Vec<Rect> = spots.iter().flatten().copied().collect();
+        for (i, a) in placed.iter().enumerate() {
+            assert!(a.inside(&AREA), "{a:?}");
+            for b in &placed[i + 1..] {
+                assert!(!a.overlaps(b), "{a:?} overlaps {b:?}");
+            }
+            for &(x, y) in centres {
+                let m = Rect {
+                    l: x - MARKER,
+                    t: y - MARKER,
+                    r: x + MARKER + 1,
+                    b: y + MARKER + 1,
+                };
+                assert!(!a.overlaps(&m), "{a:?} covers the point at {x},{y}");
+            }
+        }
+    }
+
+    #[test]
+    fn labels_of_close_points_do_not_overlap() {
+        // Five points in a row, 60 px apart, with 220 px labels (the
+        // fidelity experiment's triangle points): the old fixed offset drew
+        // them all on top of each other.
+        let centres: Vec<(i32, i32)> = (0..5).map(|i| (300 + 60 * i, 450)).collect();
+        let sizes = vec![(220, 14); 5];
+        let spots = place_labels(&centres, &sizes, AREA, &[]);
+        assert_clear(&centres, &spots);
+        let placed = spots.iter().flatten().count();
+        assert!((2..5).contains(&placed), "{spots:?}");
+        // Deterministic.
+        assert_eq!(spots, place_labels(&centres, &sizes, AREA, &[]));
+        // Lone points keep the usual spot: above right, or above left in the
+        // right part of the plot.
+        let spots = place_labels(&[(100, 200), (700, 200)], &[(50, 14), (50, 14)], AREA, &[]);
+        assert_eq!(
+            spots[0],
+            Some(Rect {
+                l: 108,
+                t: 180,
+                r: 158,
+                b: 194
+            })
+        );
+        assert_eq!(spots[1].map(|r| r.r), Some(692));
+        // Empty labels take no space and are not reported as dropped.
+        let spots = place_labels(&[(100, 200)], &[(0, 0)], AREA, &[]);
+        assert_eq!(spots, vec![None]);
+        // Obstacles (already placed text) are avoided too.
+        let block = Rect {
+            l: 90,
+            t: 150,
+            r: 250,
+            b: 250,
+        };
+        let spots = place_labels(&[(100, 200)], &[(50, 14)], AREA, &[block]);
+        assert!(spots[0].is_some_and(|r| !r.overlaps(&block) && r.r <= 92), "{spots:?}");
+    }
+
+    #[test]
+    fn crowded_labels_many_points() {
+        let centres: Vec<(i32, i32)> = (0..40).map(|i| (20 + (i * 37) % 760, 20 + (i * 53) % 460)).collect();
+        let sizes: Vec<(i32, i32)> = (0..40).map(|i| (60 + (i * 13) % 150, 14)).collect();
+        assert_clear(&centres, &place_labels(&centres, &sizes, AREA, &[]));
+    }
+
     #[test]
     fn writes_files_for_normal_and_degenerate_data() {
         let dir = tempfile::tempdir().unwrap();
@@ -387,6 +461,22 @@ mod tests {
                     log_x: true,
                     log_y: true,
                     points: vec![pt("triangle", 2.0, 0.0), pt("tile", 0.5, 0.02), pt("frame", 0.01, 0.3)],
+                    ..base.clone()
+                },
+            ),
+            (
+                "crowded",
+                Scatter {
+                    log_x: true,
+                    points: (0..10)
+                        .map(|i| {
+                            pt(
+                                &format!("workload.scale={i}, fidelity=triangle"),
+                                0.05 * 1.5f64.powi(i),
+                                if i < 5 { 0.0 } else { 0.14 },
+                            )
+                        })
+                        .collect(),
                     ..base.clone()
                 },
             ),
