@@ -119,6 +119,20 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// Hypothesis study against real measurements (build with `--features wgpu`): h1 (vertex reuse).
+    Study {
+        /// Study name: h1.
+        name: String,
+        /// Recorded passes per measurement.
+        #[arg(long, default_value_t = 1)]
+        repeats: u32,
+        /// Also write the result as Markdown to FILE (e.g. docs/measurements/<adapter>.md).
+        #[arg(long, value_name = "FILE")]
+        markdown: Option<PathBuf>,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Speed benchmarks, printed as ratios against baselines measured in the same run.
     Bench {
         /// Which: kernel, pipeline, hour, all.
@@ -164,6 +178,7 @@ fn dispatch(cli: Cli) -> Result<()> {
         Cmd::Measure { mesh, vs_loops, fs_loops, depth_test, layers, order, size, warmup, repeats, json } => {
             cmd_measure(&mesh, vs_loops, fs_loops, depth_test, layers, &order, &size, warmup, repeats, json)
         }
+        Cmd::Study { name, repeats, markdown, json } => cmd_study(&name, repeats, markdown, json),
         Cmd::Bench { which, scale } => rendersim::bench::run_cli(&which, scale).map_err(anyhow::Error::msg),
     }
 }
@@ -452,4 +467,30 @@ fn cmd_measure(
     _json: bool,
 ) -> Result<()> {
     bail!("this rendersim was built without the `wgpu` feature; rebuild with `cargo build --release --features wgpu` (and, without a GPU, install Debian's mesa-vulkan-drivers for lavapipe)")
+}
+
+#[cfg(feature = "wgpu")]
+fn cmd_study(name: &str, repeats: u32, markdown: Option<PathBuf>, json: bool) -> Result<()> {
+    if name != "h1" {
+        bail!("unknown study {name:?} (available: h1; h2-h4 are not written yet)");
+    }
+    let r = rendersim::measure::h1::h1(repeats.max(1))?;
+    let md = r.markdown();
+    if let Some(path) = markdown {
+        write_atomic(&path, |w| w.write_all(md.as_bytes())).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if json {
+        println!("{}", serde_json::to_string_pretty(&r)?);
+    } else {
+        println!("{md}");
+    }
+    if !r.exact {
+        bail!("the fitted policy {} does not predict every validation mesh exactly", r.chosen);
+    }
+    Ok(())
+}
+
+#[cfg(not(feature = "wgpu"))]
+fn cmd_study(_name: &str, _repeats: u32, _markdown: Option<PathBuf>, _json: bool) -> Result<()> {
+    bail!("this rendersim was built without the `wgpu` feature; rebuild with `cargo build --release --features wgpu`")
 }

@@ -48,6 +48,19 @@ pub enum CachePolicy {
         /// Triangles per batch (>= 1).
         triangles: u32,
     },
+    /// A direct-mapped cache: vertex `i` lives in slot `i % slots` (a new
+    /// vertex evicts whatever was there); the cache is flushed every
+    /// `segment` triangles. Triangle-level.
+    Direct {
+        /// Slots (>= 1).
+        slots: u32,
+        /// Triangles per segment (>= 1).
+        segment: u32,
+    },
+    /// Mesa's lavapipe (llvmpipe's draw module, Mesa 22.3), as identified by
+    /// study H1 (docs/measurements): `direct:256,341` — 256 slots keyed by
+    /// index mod 256, flushed every 1023 indices.
+    Lavapipe,
 }
 
 /// A cache policy string that does not parse.
@@ -55,7 +68,7 @@ pub enum CachePolicy {
 pub enum CachePolicyError {
     /// The policy name is not known.
     #[error(
-        "unknown vertex cache policy `{0}`; expected `none`, `fifo:N`, `lru:N`, `meshopt:CACHE,WARP,PRIMGROUP` or `batch:VERTICES,TRIANGLES`"
+        "unknown vertex cache policy `{0}`; expected `none`, `fifo:N`, `lru:N`, `meshopt:CACHE,WARP,PRIMGROUP`, `batch:VERTICES,TRIANGLES`, `direct:SLOTS,SEGMENT_TRIANGLES` or `lavapipe`"
     )]
     UnknownPolicy(String),
     /// The policy needs a size (`fifo:N`).
@@ -102,6 +115,21 @@ impl FromStr for CachePolicy {
             }
         };
         match name.to_ascii_lowercase().as_str() {
+            "lavapipe" => match size {
+                None => Ok(CachePolicy::Lavapipe),
+                Some(_) => Err(CachePolicyError::UnexpectedSize(spec.to_string())),
+            },
+            "direct" => {
+                let z = size.ok_or_else(|| CachePolicyError::MissingSize(name.to_string()))?;
+                let bad = |why: &str| CachePolicyError::BadParameters { spec: spec.to_string(), reason: why.to_string() };
+                let (a, b) = z.split_once(',').ok_or_else(|| bad("expected direct:SLOTS,SEGMENT_TRIANGLES, e.g. direct:256,341"))?;
+                let slots = a.trim().parse::<u32>().map_err(|_| bad("SLOTS is not an integer"))?;
+                let segment = b.trim().parse::<u32>().map_err(|_| bad("SEGMENT_TRIANGLES is not an integer"))?;
+                if slots == 0 || segment == 0 {
+                    return Err(bad("SLOTS and SEGMENT_TRIANGLES must be at least 1"));
+                }
+                Ok(CachePolicy::Direct { slots, segment })
+            }
             "none" => match size {
                 None => Ok(CachePolicy::None),
                 Some(_) => Err(CachePolicyError::UnexpectedSize(spec.to_string())),
@@ -168,6 +196,8 @@ impl fmt::Display for CachePolicy {
             CachePolicy::Lru(n) => write!(f, "lru:{n}"),
             CachePolicy::Meshopt { cache, warp, primgroup } => write!(f, "meshopt:{cache},{warp},{primgroup}"),
             CachePolicy::Batch { vertices, triangles } => write!(f, "batch:{vertices},{triangles}"),
+            CachePolicy::Direct { slots, segment } => write!(f, "direct:{slots},{segment}"),
+            CachePolicy::Lavapipe => write!(f, "lavapipe"),
         }
     }
 }
@@ -311,7 +341,11 @@ impl VertexCache {
     /// An empty cache; `vertex_count_hint` presizes the FIFO stamp array.
     pub fn new(policy: &CachePolicy, vertex_count_hint: usize) -> Self {
         let (stamps, lru) = match policy {
-            CachePolicy::None | CachePolicy::Meshopt { .. } | CachePolicy::Batch { .. } => (Vec::new(), Vec::new()),
+            CachePolicy::None
+            | CachePolicy::Meshopt { .. }
+            | CachePolicy::Batch { .. }
+            | CachePolicy::Direct { .. }
+            | CachePolicy::Lavapipe => (Vec::new(), Vec::new()),
             CachePolicy::Fifo(_) => (vec![0; vertex_count_hint.min(DENSE_LIMIT)], Vec::new()),
             CachePolicy::Lru(n) => (Vec::new(), Vec::with_capacity((*n as usize).min(1024))),
         };
@@ -326,6 +360,8 @@ impl VertexCache {
                 timestamp: vertices.wrapping_add(1),
                 ..TriangleState::default()
             },
+            CachePolicy::Direct { slots, .. } => TriangleState { stamps: vec![u32::MAX; *slots as usize], ..TriangleState::default() },
+            CachePolicy::Lavapipe => TriangleState { stamps: vec![u32::MAX; 256], ..TriangleState::default() },
             _ => TriangleState::default(),
         };
         VertexCache {
@@ -354,13 +390,48 @@ impl VertexCache {
             }
             CachePolicy::Lru(_) => self.lru.clear(),
             CachePolicy::Meshopt { .. } | CachePolicy::Batch { .. } => self.flush_warp(),
+            CachePolicy::Direct { .. } | CachePolicy::Lavapipe => self.flush_direct(),
         }
     }
 
     /// True for policies that decide per triangle (warps, batches): use
     /// [`VertexCache::access_triangle`] with them.
     pub fn is_triangle_level(&self) -> bool {
-        matches!(self.policy, CachePolicy::Meshopt { .. } | CachePolicy::Batch { .. })
+        matches!(
+            self.policy,
+            CachePolicy::Meshopt { .. } | CachePolicy::Batch { .. } | CachePolicy::Direct { .. } | CachePolicy::Lavapipe
+        )
+    }
+
+    /// (slots, triangles per segment) of a direct-mapped policy.
+    fn direct_params(&self) -> Option<(u32, u32)> {
+        match self.policy {
+            CachePolicy::Direct { slots, segment } => Some((slots, segment)),
+            CachePolicy::Lavapipe => Some((256, 341)),
+            _ => None,
+        }
+    }
+
+    fn flush_direct(&mut self) {
+        self.tri.stamps.iter_mut().for_each(|s| *s = u32::MAX);
+        self.tri.warps += u64::from(self.tri.prim_offset > 0);
+        self.tri.prim_offset = 0;
+        self.tri.warp_offset = 0;
+    }
+
+    /// One vertex through a direct-mapped cache (slot array in `tri.stamps`;
+    /// `u32::MAX` = empty). True on a miss.
+    #[inline]
+    fn direct_access(&mut self, v: u32) -> bool {
+        let slots = self.tri.stamps.len() as u32;
+        let slot = &mut self.tri.stamps[(v % slots) as usize];
+        if *slot == v && v != u32::MAX {
+            false
+        } else {
+            *slot = v;
+            self.tri.warp_offset += 1;
+            true
+        }
     }
 
     /// (cache entries, warp vertices, triangles per group) of a
@@ -399,6 +470,13 @@ impl VertexCache {
         if !self.is_triangle_level() {
             return u8::from(self.access(tri[0])) + u8::from(self.access(tri[1])) + u8::from(self.access(tri[2]));
         }
+        if let Some((_, segment)) = self.direct_params() {
+            if self.tri.prim_offset == segment {
+                self.flush_direct();
+            }
+            self.tri.prim_offset += 1;
+            return u8::from(self.direct_access(tri[0])) + u8::from(self.direct_access(tri[1])) + u8::from(self.direct_access(tri[2]));
+        }
         let (cache, warp, primgroup) = self.triangle_params();
         let miss = |t: &TriangleState, v: u32| t.timestamp.wrapping_sub(t.stamp(v)) > cache;
         let m = u32::from(miss(&self.tri, tri[0]))
@@ -428,6 +506,7 @@ impl VertexCache {
     /// their cache size (no warp or batch limits).
     pub fn access(&mut self, index: u32) -> bool {
         match self.policy {
+            CachePolicy::Direct { .. } | CachePolicy::Lavapipe => self.direct_access(index),
             CachePolicy::Meshopt { .. } | CachePolicy::Batch { .. } => {
                 let (cache, _, _) = self.triangle_params();
                 let t = &mut self.tri;

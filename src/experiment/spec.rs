@@ -666,10 +666,9 @@ impl Validator<'_> {
                         Some(r) => match r[..] {
                             [lo, hi] if lo.is_finite() && hi.is_finite() && lo < hi => Some((lo, hi)),
                             [lo, hi] if lo.is_finite() && hi.is_finite() => {
-                                return Err(self.err(
-                                    format!("{key}.range"),
-                                    format!("needs lo < hi, got [{lo}, {hi}]"),
-                                ));
+                                return Err(
+                                    self.err(format!("{key}.range"), format!("needs lo < hi, got [{lo}, {hi}]"))
+                                );
                             }
                             [_, _] => {
                                 return Err(self.err(format!("{key}.range"), "bounds must be finite numbers"));

@@ -611,10 +611,18 @@ fn line_plot_where_selects_points() {
 
 #[test]
 fn histogram_range_is_parsed_and_validated() {
-    let hist = |extra: &str| format!("name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"FrameTime\"\n{extra}");
+    let hist = |extra: &str| {
+        format!("name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"FrameTime\"\n{extra}")
+    };
     // Integers are fine; no range means the bins span the data.
     let exp = parse(&hist("range = [11, 14.5]\n"));
-    assert!(matches!(exp.plots[0].kind, PlotKind::Histogram { range: Some((11.0, 14.5)), .. }));
+    assert!(matches!(
+        exp.plots[0].kind,
+        PlotKind::Histogram {
+            range: Some((11.0, 14.5)),
+            ..
+        }
+    ));
     let exp = parse(&hist(""));
     assert!(matches!(exp.plots[0].kind, PlotKind::Histogram { range: None, .. }));
     for (bad, want) in [
@@ -636,7 +644,10 @@ fn histogram_range_is_parsed_and_validated() {
     let e = parse_err(
         "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[plot]]\nfile = \"p\"\nkind = \"line\"\nx = \"a\"\ny = \"m\"\nrange = [0, 1]\n",
     );
-    assert!(e.contains("plot[0] (p).range") && e.contains("only histogram plots take `range`"), "{e}");
+    assert!(
+        e.contains("plot[0] (p).range") && e.contains("only histogram plots take `range`"),
+        "{e}"
+    );
 }
 
 #[test]

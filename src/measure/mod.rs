@@ -11,6 +11,7 @@
 
 mod device;
 mod geometry;
+pub mod h1;
 
 pub use device::{AdapterSummary, MeasureError, Measurement, MeasureOptions, measure};
 pub use geometry::{DepthOrder, mesh_positions};

@@ -470,7 +470,10 @@ mod tests {
     fn log_range_over_decades_gets_one_two_five() {
         // Just under a decade: 1..9 rather than three 1-2-5 ticks.
         let t = for_data(260.0, 1990.0, true, false);
-        assert_eq!(t.labels, ["300", "400", "500", "600", "700", "800", "900", "1000", "2000"]);
+        assert_eq!(
+            t.labels,
+            ["300", "400", "500", "600", "700", "800", "900", "1000", "2000"]
+        );
         let t = for_data(0.01, 0.2, true, false);
         assert_eq!(t.labels, ["0.01", "0.02", "0.05", "0.1", "0.2"]);
         let t = for_data(0.1, 130.0, true, false);

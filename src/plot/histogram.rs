@@ -36,7 +36,8 @@ pub struct Histogram {
 impl Histogram {
     /// The range actually used, if any (finite, `lo < hi`).
     fn valid_range(&self) -> Option<(f64, f64)> {
-        self.range.filter(|&(lo, hi)| lo.is_finite() && hi.is_finite() && lo < hi)
+        self.range
+            .filter(|&(lo, hi)| lo.is_finite() && hi.is_finite() && lo < hi)
     }
 
     /// Per group with finite values outside [`range`](Histogram::range):
@@ -67,7 +68,11 @@ impl Histogram {
         self.outside_range()
             .into_iter()
             .map(|(name, below, above)| {
-                let total = self.values.iter().find(|g| g.0 == name).map_or(0, |g| g.1.iter().filter(|x| x.is_finite()).count());
+                let total = self
+                    .values
+                    .iter()
+                    .find(|g| g.0 == name)
+                    .map_or(0, |g| g.1.iter().filter(|x| x.is_finite()).count());
                 let whose = if groups > 1 && !name.is_empty() {
                     format!(" ({name})")
                 } else {
@@ -273,10 +278,13 @@ mod tests {
         assert!(h.outside_range().is_empty());
         let dir = tempfile::tempdir().unwrap();
         let base = dir.path().join("ranged");
-        histogram(&base, &Histogram {
-            range: Some((1.0, 3.0)),
-            ..h
-        })
+        histogram(
+            &base,
+            &Histogram {
+                range: Some((1.0, 3.0)),
+                ..h
+            },
+        )
         .unwrap();
         assert_plot_files(&base);
     }

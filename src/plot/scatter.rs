@@ -422,7 +422,7 @@ mod tests {
         assert_eq!(spots, vec![None]);
         // Obstacles (already placed text) are avoided too.
         let block = Rect {
-            l: 90,
+            l: 97,
             t: 150,
             r: 250,
             b: 250,
