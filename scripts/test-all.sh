@@ -11,22 +11,42 @@ root=$(pwd)
 
 step() { printf '\n== %s\n' "$*"; }
 
+step "System packages: Mesa's lavapipe (Vulkan on the CPU) for the wgpu measurements"
+if ! ls /usr/share/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1; then
+  if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
+    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq mesa-vulkan-drivers libvulkan1 >/dev/null
+  else
+    echo "note: cannot install mesa-vulkan-drivers here (not root or no apt-get); measurement tests will report a missing adapter"
+  fi
+fi
+
 step "Python environment for notebooks"
 if [ ! -x .venv/bin/python ]; then
   python3 -m venv .venv
 fi
 .venv/bin/pip install --quiet --disable-pip-version-check -r notebooks/requirements.txt
 
-step "Build (release, once)"
-cargo build --release --locked --all-targets
+step "Build (release, once, with the wgpu measurement feature)"
+mkdir -p out/ci
+cargo build --release --locked --all-targets --features wgpu
 export RENDERSIM_BIN="$root/target/release/rendersim"
 
-step "Rust tests (unit, property, integration, doc)"
-cargo test --release --locked --no-fail-fast 2>&1 | tee target/test-output.txt
+step "Rust tests (unit, property, integration, doc; wgpu measurements on lavapipe)"
+cargo test --release --locked --no-fail-fast --features wgpu 2>&1 | tee target/test-output.txt
 grep -q "test result:" target/test-output.txt
 
+step "Study H1 on this machine's adapter (vertex reuse; must predict validation meshes exactly)"
+if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
+  if ! "$RENDERSIM_BIN" study h1 --markdown out/ci/h1.md > out/ci/h1.txt 2> out/ci/h1.err; then
+    cat out/ci/h1.txt out/ci/h1.err
+    exit 1
+  fi
+  head -n 6 out/ci/h1.txt
+else
+  echo "no Vulkan driver installed: study H1 skipped"
+fi
+
 step "Experiments"
-mkdir -p out/ci
 for f in experiments/*.toml; do
   name=$(basename "$f" .toml)
   echo "-- $name"

@@ -175,10 +175,26 @@ fn dispatch(cli: Cli) -> Result<()> {
             json,
         } => cmd_isolate(model, sets, factor, keep_vsync, json),
         Cmd::Vcache { mesh, policy, json } => cmd_vcache(&mesh, &policy, json),
-        Cmd::Measure { mesh, vs_loops, fs_loops, depth_test, layers, order, size, warmup, repeats, json } => {
-            cmd_measure(&mesh, vs_loops, fs_loops, depth_test, layers, &order, &size, warmup, repeats, json)
-        }
-        Cmd::Study { name, repeats, markdown, json } => cmd_study(&name, repeats, markdown, json),
+        Cmd::Measure {
+            mesh,
+            vs_loops,
+            fs_loops,
+            depth_test,
+            layers,
+            order,
+            size,
+            warmup,
+            repeats,
+            json,
+        } => cmd_measure(
+            &mesh, vs_loops, fs_loops, depth_test, layers, &order, &size, warmup, repeats, json,
+        ),
+        Cmd::Study {
+            name,
+            repeats,
+            markdown,
+            json,
+        } => cmd_study(&name, repeats, markdown, json),
         Cmd::Bench { which, scale } => rendersim::bench::run_cli(&which, scale).map_err(anyhow::Error::msg),
     }
 }
@@ -429,7 +445,16 @@ fn cmd_measure(
         .ok_or_else(|| anyhow::anyhow!("--size {size:?}: expected WxH, e.g. 512x512"))?;
     let order = order.parse().map_err(|e: String| anyhow::anyhow!("--order: {e}"))?;
     let m = rendersim::scene::generators::mesh_from_spec(mesh, Path::new("."))?;
-    let opts = MeasureOptions { vs_loops, fs_loops, depth_test, layers, order, size: (w, h), warmup, repeats };
+    let opts = MeasureOptions {
+        vs_loops,
+        fs_loops,
+        depth_test,
+        layers,
+        order,
+        size: (w, h),
+        warmup,
+        repeats,
+    };
     let r = measure(&m, mesh, &opts)?;
     let mut v = serde_json::to_value(&r)?;
     v["mesh"] = json!({"spec": mesh, "triangles": m.triangles(), "indices": m.index_count(), "unique_vertices": m.unique_vertices()});
@@ -446,7 +471,11 @@ fn cmd_measure(
             r.fs_invocations,
             r.pass_time_ns / 1e6,
             r.pass_times_ns.len(),
-            if r.stable_counters { "" } else { "; counters varied between repeats" }
+            if r.stable_counters {
+                ""
+            } else {
+                "; counters varied between repeats"
+            }
         );
     }
     Ok(())
@@ -466,7 +495,9 @@ fn cmd_measure(
     _repeats: u32,
     _json: bool,
 ) -> Result<()> {
-    bail!("this rendersim was built without the `wgpu` feature; rebuild with `cargo build --release --features wgpu` (and, without a GPU, install Debian's mesa-vulkan-drivers for lavapipe)")
+    bail!(
+        "this rendersim was built without the `wgpu` feature; rebuild with `cargo build --release --features wgpu` (and, without a GPU, install Debian's mesa-vulkan-drivers for lavapipe)"
+    )
 }
 
 #[cfg(feature = "wgpu")]
@@ -485,7 +516,10 @@ fn cmd_study(name: &str, repeats: u32, markdown: Option<PathBuf>, json: bool) ->
         println!("{md}");
     }
     if !r.exact {
-        bail!("the fitted policy {} does not predict every validation mesh exactly", r.chosen);
+        bail!(
+            "the fitted policy {} does not predict every validation mesh exactly",
+            r.chosen
+        );
     }
     Ok(())
 }

@@ -11,7 +11,7 @@ use rendersim::systems::frame_pipeline::records::write_frames_csv;
 /// of fragments), the rest 0.001 px. G = 20 us, F = 20.02 us.
 fn bimodal(depth: u32) -> String {
     scene_model(
-        &r#"name = "mix"
+        r#"name = "mix"
 mesh = { triangles = 20000, acmr = 1.0 }
 triangle_pixels = { kind = "mixture", parts = [ { weight = 0.99, dist = 0.001 }, { weight = 0.01, dist = 100.0 } ] }"#,
     )

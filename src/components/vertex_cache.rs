@@ -121,10 +121,18 @@ impl FromStr for CachePolicy {
             },
             "direct" => {
                 let z = size.ok_or_else(|| CachePolicyError::MissingSize(name.to_string()))?;
-                let bad = |why: &str| CachePolicyError::BadParameters { spec: spec.to_string(), reason: why.to_string() };
-                let (a, b) = z.split_once(',').ok_or_else(|| bad("expected direct:SLOTS,SEGMENT_TRIANGLES, e.g. direct:256,341"))?;
+                let bad = |why: &str| CachePolicyError::BadParameters {
+                    spec: spec.to_string(),
+                    reason: why.to_string(),
+                };
+                let (a, b) = z
+                    .split_once(',')
+                    .ok_or_else(|| bad("expected direct:SLOTS,SEGMENT_TRIANGLES, e.g. direct:256,341"))?;
                 let slots = a.trim().parse::<u32>().map_err(|_| bad("SLOTS is not an integer"))?;
-                let segment = b.trim().parse::<u32>().map_err(|_| bad("SEGMENT_TRIANGLES is not an integer"))?;
+                let segment = b
+                    .trim()
+                    .parse::<u32>()
+                    .map_err(|_| bad("SEGMENT_TRIANGLES is not an integer"))?;
                 if slots == 0 || segment == 0 {
                     return Err(bad("SLOTS and SEGMENT_TRIANGLES must be at least 1"));
                 }
@@ -360,8 +368,14 @@ impl VertexCache {
                 timestamp: vertices.wrapping_add(1),
                 ..TriangleState::default()
             },
-            CachePolicy::Direct { slots, .. } => TriangleState { stamps: vec![u32::MAX; *slots as usize], ..TriangleState::default() },
-            CachePolicy::Lavapipe => TriangleState { stamps: vec![u32::MAX; 256], ..TriangleState::default() },
+            CachePolicy::Direct { slots, .. } => TriangleState {
+                stamps: vec![u32::MAX; *slots as usize],
+                ..TriangleState::default()
+            },
+            CachePolicy::Lavapipe => TriangleState {
+                stamps: vec![u32::MAX; 256],
+                ..TriangleState::default()
+            },
             _ => TriangleState::default(),
         };
         VertexCache {
@@ -399,7 +413,10 @@ impl VertexCache {
     pub fn is_triangle_level(&self) -> bool {
         matches!(
             self.policy,
-            CachePolicy::Meshopt { .. } | CachePolicy::Batch { .. } | CachePolicy::Direct { .. } | CachePolicy::Lavapipe
+            CachePolicy::Meshopt { .. }
+                | CachePolicy::Batch { .. }
+                | CachePolicy::Direct { .. }
+                | CachePolicy::Lavapipe
         )
     }
 
@@ -475,7 +492,9 @@ impl VertexCache {
                 self.flush_direct();
             }
             self.tri.prim_offset += 1;
-            return u8::from(self.direct_access(tri[0])) + u8::from(self.direct_access(tri[1])) + u8::from(self.direct_access(tri[2]));
+            return u8::from(self.direct_access(tri[0]))
+                + u8::from(self.direct_access(tri[1]))
+                + u8::from(self.direct_access(tri[2]));
         }
         let (cache, warp, primgroup) = self.triangle_params();
         let miss = |t: &TriangleState, v: u32| t.timestamp.wrapping_sub(t.stamp(v)) > cache;

@@ -12,7 +12,9 @@ use super::geometry::{DepthOrder, mesh_positions};
 #[derive(Debug, thiserror::Error)]
 pub enum MeasureError {
     /// No Vulkan adapter (install Mesa's lavapipe: `mesa-vulkan-drivers`).
-    #[error("no Vulkan adapter found (on a machine without a GPU install Debian's mesa-vulkan-drivers for lavapipe): {0}")]
+    #[error(
+        "no Vulkan adapter found (on a machine without a GPU install Debian's mesa-vulkan-drivers for lavapipe): {0}"
+    )]
     NoAdapter(String),
     /// The adapter lacks a feature the measurement needs.
     #[error("adapter {adapter:?} lacks {feature}")]
@@ -119,7 +121,9 @@ fn stats_types() -> wgpu::PipelineStatisticsTypes {
 /// Draws `mesh` (`spec` names its generator, for positions) and measures it.
 pub fn measure(mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measurement, MeasureError> {
     if opts.layers == 0 || opts.repeats == 0 || opts.size.0 == 0 || opts.size.1 == 0 {
-        return Err(MeasureError::Option("layers, repeats and size must be at least 1".into()));
+        return Err(MeasureError::Option(
+            "layers, repeats and size must be at least 1".into(),
+        ));
     }
     if opts.size.0 > 8192 || opts.size.1 > 8192 {
         return Err(MeasureError::Option("render target larger than 8192x8192".into()));
@@ -153,7 +157,10 @@ pub fn measure(mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measure
     ];
     for (f, name) in needed {
         if !adapter.features().contains(f) {
-            return Err(MeasureError::MissingFeature { adapter: info.name.clone(), feature: name });
+            return Err(MeasureError::MissingFeature {
+                adapter: info.name.clone(),
+                feature: name,
+            });
         }
     }
     let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
@@ -219,8 +226,14 @@ pub fn measure(mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measure
         label: None,
         layout: &bgl,
         entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: ubuf.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: obuf.as_entire_binding() },
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: ubuf.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: obuf.as_entire_binding(),
+            },
         ],
     });
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -239,14 +252,25 @@ pub fn measure(mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measure
             buffers: &[Some(wgpu::VertexBufferLayout {
                 array_stride: 8,
                 step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x2, offset: 0, shader_location: 0 }],
+                attributes: &[wgpu::VertexAttribute {
+                    format: wgpu::VertexFormat::Float32x2,
+                    offset: 0,
+                    shader_location: 0,
+                }],
             })],
         },
-        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        primitive: wgpu::PrimitiveState {
+            cull_mode: None,
+            ..Default::default()
+        },
         depth_stencil: Some(wgpu::DepthStencilState {
             format: wgpu::TextureFormat::Depth32Float,
             depth_write_enabled: Some(opts.depth_test),
-            depth_compare: Some(if opts.depth_test { wgpu::CompareFunction::Less } else { wgpu::CompareFunction::Always }),
+            depth_compare: Some(if opts.depth_test {
+                wgpu::CompareFunction::Less
+            } else {
+                wgpu::CompareFunction::Always
+            }),
             stencil: Default::default(),
             bias: Default::default(),
         }),
@@ -255,12 +279,20 @@ pub fn measure(mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measure
             module: &shader,
             entry_point: Some("fs_main"),
             compilation_options: Default::default(),
-            targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+            targets: &[Some(wgpu::ColorTargetState {
+                format,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
         }),
         multiview_mask: None,
         cache: None,
     });
-    let extent = wgpu::Extent3d { width: opts.size.0, height: opts.size.1, depth_or_array_layers: 1 };
+    let extent = wgpu::Extent3d {
+        width: opts.size.0,
+        height: opts.size.1,
+        depth_or_array_layers: 1,
+    };
     let target = device.create_texture(&wgpu::TextureDescriptor {
         label: Some("target"),
         size: extent,
@@ -288,7 +320,11 @@ pub fn measure(mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measure
         ty: wgpu::QueryType::PipelineStatistics(stats_types()),
         count: 1,
     });
-    let time_q = device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("time"), ty: wgpu::QueryType::Timestamp, count: 2 });
+    let time_q = device.create_query_set(&wgpu::QuerySetDescriptor {
+        label: Some("time"),
+        ty: wgpu::QueryType::Timestamp,
+        count: 2,
+    });
     let resolve = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("resolve"),
         size: 256 * 2,
@@ -308,11 +344,17 @@ pub fn measure(mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measure
                     view: &tview,
                     depth_slice: None,
                     resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
                 })],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &dview,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
                     stencil_ops: None,
                 }),
                 timestamp_writes: Some(wgpu::RenderPassTimestampWrites {
@@ -346,12 +388,19 @@ pub fn measure(mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measure
         slice.map_async(wgpu::MapMode::Read, move |r| {
             let _ = tx.send(r);
         });
-        device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| MeasureError::Readback(e.to_string()))?;
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| MeasureError::Readback(e.to_string()))?;
         rx.recv()
             .map_err(|e| MeasureError::Readback(e.to_string()))?
             .map_err(|e| MeasureError::Readback(e.to_string()))?;
-        let data = slice.get_mapped_range().map_err(|e| MeasureError::Readback(e.to_string()))?;
-        let words: Vec<u64> = data.chunks_exact(8).map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8]))).collect();
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| MeasureError::Readback(e.to_string()))?;
+        let words: Vec<u64> = data
+            .chunks_exact(8)
+            .map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
+            .collect();
         drop(data);
         read.unmap();
         if round >= opts.warmup {
@@ -380,7 +429,9 @@ pub fn measure(mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measure
 }
 
 fn bytes_f32(v: &[[f32; 2]]) -> Vec<u8> {
-    v.iter().flat_map(|p| p[0].to_le_bytes().into_iter().chain(p[1].to_le_bytes())).collect()
+    v.iter()
+        .flat_map(|p| p[0].to_le_bytes().into_iter().chain(p[1].to_le_bytes()))
+        .collect()
 }
 
 fn bytes_u32(v: &[u32]) -> Vec<u8> {

@@ -24,7 +24,9 @@ impl std::str::FromStr for DepthOrder {
             "front_to_back" | "f2b" => Ok(DepthOrder::FrontToBack),
             "back_to_front" | "b2f" => Ok(DepthOrder::BackToFront),
             "random" => Ok(DepthOrder::Random),
-            _ => Err(format!("unknown depth order {s:?} (front_to_back, back_to_front, random)")),
+            _ => Err(format!(
+                "unknown depth order {s:?} (front_to_back, back_to_front, random)"
+            )),
         }
     }
 }

@@ -67,13 +67,24 @@ pub struct H1 {
 
 fn list(name: &str, indices: Vec<u32>) -> (String, Mesh) {
     let vc = indices.iter().copied().max().map_or(1, |m| m + 1);
-    (name.to_string(), Mesh { name: name.into(), topology: Topology::TriangleList, indices, vertex_count: vc })
+    (
+        name.to_string(),
+        Mesh {
+            name: name.into(),
+            topology: Topology::TriangleList,
+            indices,
+            vertex_count: vc,
+        },
+    )
 }
 
 fn probes() -> Vec<(String, Mesh)> {
     let mut v = Vec::new();
     for k in [1u32, 100, 341, 342, 683, 684, 1000] {
-        v.push(list(&format!("triangle 0 1 2 repeated {k} times"), [0, 1, 2].repeat(k as usize)));
+        v.push(list(
+            &format!("triangle 0 1 2 repeated {k} times"),
+            [0, 1, 2].repeat(k as usize),
+        ));
     }
     for n in [64u32, 128, 200, 256, 257, 300, 600] {
         let once: Vec<u32> = (0..n - 2).flat_map(|i| [i, i + 1, i + 2]).collect();
@@ -113,26 +124,38 @@ fn candidates() -> Vec<CachePolicy> {
     for (cache, warp, primgroup) in [(32, 32, 32), (16, 32, 32), (14, 64, 128), (128, 0, 0)] {
         v.push(CachePolicy::Meshopt { cache, warp, primgroup });
     }
-    v.push(CachePolicy::Batch { vertices: 32, triangles: 32 });
+    v.push(CachePolicy::Batch {
+        vertices: 32,
+        triangles: 32,
+    });
     v.push(CachePolicy::None);
     v
 }
 
 /// Runs the study on the default adapter.
 pub fn h1(repeats: u32) -> Result<H1, MeasureError> {
-    let opts = MeasureOptions { repeats, warmup: 1, size: (256, 256), ..MeasureOptions::default() };
+    let opts = MeasureOptions {
+        repeats,
+        warmup: 1,
+        size: (256, 256),
+        ..MeasureOptions::default()
+    };
     let t = Instant::now();
     let mut adapter = String::new();
-    let mut measure_all = |meshes: &[(String, Mesh)], spec_of: &dyn Fn(&str) -> String| -> Result<Vec<u64>, MeasureError> {
-        meshes
-            .iter()
-            .map(|(name, m)| {
-                let r = measure(m, &spec_of(name), &opts)?;
-                adapter = format!("{} ({}, {}, {})", r.adapter.name, r.adapter.driver, r.adapter.driver_info, r.adapter.device_type);
-                Ok(r.vs_invocations)
-            })
-            .collect()
-    };
+    let mut measure_all =
+        |meshes: &[(String, Mesh)], spec_of: &dyn Fn(&str) -> String| -> Result<Vec<u64>, MeasureError> {
+            meshes
+                .iter()
+                .map(|(name, m)| {
+                    let r = measure(m, &spec_of(name), &opts)?;
+                    adapter = format!(
+                        "{} ({}, {}, {})",
+                        r.adapter.name, r.adapter.driver, r.adapter.driver_info, r.adapter.device_type
+                    );
+                    Ok(r.vs_invocations)
+                })
+                .collect()
+        };
     let probe_meshes = probes();
     let probe_measured = measure_all(&probe_meshes, &|_| "probe".to_string())?;
     let val_meshes: Vec<(String, Mesh)> = VALIDATION
@@ -153,7 +176,11 @@ pub fn h1(repeats: u32) -> Result<H1, MeasureError> {
     for p in candidates() {
         let (pe, _) = err(&p, &probe_meshes, &probe_measured);
         let (ve, _) = err(&p, &val_meshes, &val_measured);
-        cands.push(Candidate { policy: p.to_string(), probe_error: pe, validation_error: ve });
+        cands.push(Candidate {
+            policy: p.to_string(),
+            probe_error: pe,
+            validation_error: ve,
+        });
         if best.as_ref().is_none_or(|b| pe < b.0) {
             best = Some((pe, p));
         }
@@ -177,7 +204,16 @@ pub fn h1(repeats: u32) -> Result<H1, MeasureError> {
     let validation = rows(&val_meshes, &val_measured);
     let simulate_seconds = t.elapsed().as_secs_f64();
     let exact = validation.iter().all(|r| r.measured == r.predicted);
-    Ok(H1 { adapter, chosen: chosen.to_string(), probes, validation, candidates: cands, exact, measure_seconds, simulate_seconds })
+    Ok(H1 {
+        adapter,
+        chosen: chosen.to_string(),
+        probes,
+        validation,
+        candidates: cands,
+        exact,
+        measure_seconds,
+        simulate_seconds,
+    })
 }
 
 impl H1 {
@@ -189,14 +225,23 @@ impl H1 {
              Measuring took {:.2} s; simulating {} candidate policies on all {} meshes took {:.4} s.\n\n",
             self.adapter,
             self.chosen,
-            if self.exact { "exactly" } else { "NOT exactly (see the table)" },
+            if self.exact {
+                "exactly"
+            } else {
+                "NOT exactly (see the table)"
+            },
             self.measure_seconds,
             self.candidates.len(),
             self.probes.len() + self.validation.len(),
             self.simulate_seconds
         );
-        for (title, rows) in [("Probes (fitting)", &self.probes), ("Validation (not used for fitting)", &self.validation)] {
-            s += &format!("### {title}\n\n| mesh | indices | unique vertices | measured VS invocations | predicted | error |\n|---|---|---|---|---|---|\n");
+        for (title, rows) in [
+            ("Probes (fitting)", &self.probes),
+            ("Validation (not used for fitting)", &self.validation),
+        ] {
+            s += &format!(
+                "### {title}\n\n| mesh | indices | unique vertices | measured VS invocations | predicted | error |\n|---|---|---|---|---|---|\n"
+            );
             for r in rows.iter() {
                 s += &format!(
                     "| {} | {} | {} | {} | {} | {} |\n",
@@ -213,8 +258,19 @@ impl H1 {
         let mut c = self.candidates.clone();
         c.sort_by_key(|x| (x.probe_error, x.validation_error));
         s += "### Candidates (10 best by probe error, then the usual suspects)\n\n| policy | probe error | validation error |\n|---|---|---|\n";
-        let usual = ["fifo:32", "lru:32", "meshopt:32,32,32", "meshopt:14,64,128", "batch:32,32", "none"];
-        for x in c.iter().take(10).chain(c.iter().filter(|x| usual.contains(&x.policy.as_str()))) {
+        let usual = [
+            "fifo:32",
+            "lru:32",
+            "meshopt:32,32,32",
+            "meshopt:14,64,128",
+            "batch:32,32",
+            "none",
+        ];
+        for x in c
+            .iter()
+            .take(10)
+            .chain(c.iter().filter(|x| usual.contains(&x.policy.as_str())))
+        {
             s += &format!("| `{}` | {} | {} |\n", x.policy, x.probe_error, x.validation_error);
         }
         s

@@ -13,5 +13,5 @@ mod device;
 mod geometry;
 pub mod h1;
 
-pub use device::{AdapterSummary, MeasureError, Measurement, MeasureOptions, measure};
+pub use device::{AdapterSummary, MeasureError, MeasureOptions, Measurement, measure};
 pub use geometry::{DepthOrder, mesh_positions};

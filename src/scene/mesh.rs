@@ -316,7 +316,7 @@ impl Mesh {
     /// under FIFO, `meshopt:` and `batch:` policies, when every index is
     /// below `vertex_count`; `None` otherwise.
     fn fast_list(&self, policy: &CachePolicy, charge: impl FnMut(u8)) -> Option<(u64, u64, u64)> {
-        if self.topology != Topology::TriangleList || self.indices.len() % 3 != 0 {
+        if self.topology != Topology::TriangleList || !self.indices.len().is_multiple_of(3) {
             return None;
         }
         let (c, w, p) = match *policy {
