@@ -5,6 +5,7 @@
 
 pub mod frame_pipeline;
 pub mod multi_rate;
+pub mod vr;
 
 use std::io::Write;
 
@@ -27,6 +28,9 @@ pub enum SimError {
     /// The multi-frame-rate system failed while running.
     #[error(transparent)]
     MultiRate(multi_rate::MultiRateError),
+    /// The VR pipeline failed while running.
+    #[error(transparent)]
+    Vr(vr::VrError),
 }
 
 /// The result of running one model.
@@ -36,6 +40,8 @@ pub enum SystemRun {
     FramePipeline(Box<frame_pipeline::PipelineRun>),
     /// A multi-frame-rate run.
     MultiRate(Box<multi_rate::MultiRateRun>),
+    /// A VR-pipeline run.
+    Vr(Box<vr::VrRun>),
 }
 
 /// Reads `--set` patches into the model's table.
@@ -71,10 +77,18 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: bool) -> Result<
                 Err(e) => Err(SimError::MultiRate(e)),
             }
         }
+        "vr" => {
+            let cfg: vr::VrConfig = deserialize(table, src)?;
+            match vr::run_vr(cfg) {
+                Ok(r) => Ok(SystemRun::Vr(Box::new(r))),
+                Err(vr::VrError::Invalid { key, message }) => Err(SimError::Config(invalid(src, &key, message, None))),
+                Err(e) => Err(SimError::Vr(e)),
+            }
+        }
         other => Err(SimError::Config(invalid(
             src,
             "system",
-            format!("unknown system {other:?} (known: frame_pipeline, multi_rate)"),
+            format!("unknown system {other:?} (known: frame_pipeline, multi_rate, vr)"),
             None,
         ))),
     }
@@ -86,6 +100,7 @@ impl SystemRun {
         match self {
             SystemRun::FramePipeline(r) => &r.summary,
             SystemRun::MultiRate(r) => &r.summary,
+            SystemRun::Vr(r) => &r.summary,
         }
     }
 
@@ -94,6 +109,7 @@ impl SystemRun {
         match self {
             SystemRun::FramePipeline(r) => &mut r.summary,
             SystemRun::MultiRate(r) => &mut r.summary,
+            SystemRun::Vr(r) => &mut r.summary,
         }
     }
 
@@ -102,6 +118,7 @@ impl SystemRun {
         match self {
             SystemRun::FramePipeline(r) => frame_pipeline::records::write_frames_csv(&r.records, w),
             SystemRun::MultiRate(r) => multi_rate::run::write_events_csv(&r.events, w),
+            SystemRun::Vr(r) => vr::run::write_motions_csv(&r.motions, w),
         }
     }
 
@@ -118,6 +135,10 @@ impl SystemRun {
             SystemRun::MultiRate(r) => (
                 multi_rate::latency::COLUMNS.iter().map(|s| s.to_string()).collect(),
                 multi_rate::latency::event_rows(&r.events),
+            ),
+            SystemRun::Vr(r) => (
+                vr::run::COLUMNS.iter().map(|s| s.to_string()).collect(),
+                vr::run::motion_rows(&r.motions),
             ),
         }
     }
@@ -144,6 +165,13 @@ impl SystemRun {
                     "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
                 )
             }
+            SystemRun::Vr(r) => {
+                let body =
+                    toml::to_string(&r.config).unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
+                format!(
+                    "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
+                )
+            }
             SystemRun::MultiRate(r) => {
                 let body =
                     toml::to_string(&r.config).unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
@@ -159,6 +187,7 @@ impl SystemRun {
         match self {
             SystemRun::FramePipeline(r) => crate::output::trace::write_pipeline_trace(r, w),
             SystemRun::MultiRate(r) => multi_rate::run::write_trace(r, w),
+            SystemRun::Vr(r) => vr::run::write_trace(r, w),
         }
     }
 }
