@@ -303,3 +303,23 @@ fn cli_writes_json_csv_and_trace() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn latency_experiments_pass_their_paper_checks() {
+    for exp in ["mfr-latency", "transfer-paths", "vr-warping"] {
+        let dir = std::env::temp_dir().join(format!("rendersim-exp-{exp}-{}", std::process::id()));
+        let o = Command::new(env!("CARGO_BIN_EXE_rendersim"))
+            .args(["experiment", &format!("experiments/{exp}.toml"), "--quiet", "--out"])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{exp}: {}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(dir.join("report.md").exists());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
