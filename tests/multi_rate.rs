@@ -323,3 +323,29 @@ fn latency_experiments_pass_their_paper_checks() {
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
+
+#[test]
+fn deferred_shading_moves_bytes_and_shading_to_the_fast_client() {
+    let plain = summary(CLUSTER, &["run.events=500"]);
+    let s = summary(CLUSTER, &["run.events=500", "deferred.enabled=true"]);
+    // 144 bits instead of 64 per pixel: 2.25 times the bytes on every buffer term.
+    assert_eq!(s["frame_bytes"].as_u64().unwrap(), 1280 * 1024 * 18);
+    close(
+        num(&s, "metrics.terms_ms.transfer"),
+        2.25 * num(&plain, "metrics.terms_ms.transfer"),
+        0.01,
+        "transfer",
+    );
+    // FC shades 4 lights x 1.31 Mpixel at 0.39 ns.
+    close(
+        num(&s, "deferred_shading_ms"),
+        4.0 * 1280.0 * 1024.0 * 0.39e-6,
+        1e-6,
+        "shading",
+    );
+    // 22.5 MiB over Gigabit Ethernet (250 ms) no longer keeps up with SC (211 ms).
+    assert_eq!(s["metrics"]["link_keeps_up"], Value::Bool(false));
+    let z = summary(MULTIGPU, &["run.events=500", "deferred.enabled=true"]);
+    assert_eq!(z["metrics"]["link_keeps_up"], Value::Bool(true));
+    assert!(try_run(CLUSTER, &["deferred.enabled=true", "deferred.normal_bits=50"]).is_err());
+}

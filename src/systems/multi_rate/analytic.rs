@@ -41,7 +41,7 @@ pub struct Terms {
     pub transfer: Duration,
     /// FC upload `T_draw`.
     pub fc_upload: Duration,
-    /// FC render `T_render`.
+    /// FC render `T_render` (plus deferred shading when enabled).
     pub fc_render: Duration,
     /// Conventional client frame.
     pub conventional_frame: Duration,
@@ -60,7 +60,7 @@ impl Terms {
             sc_readback: cfg.slow_client.readback.transfer_time(bytes),
             transfer: transfer_time(cfg, bytes),
             fc_upload: cfg.fast_client.upload.transfer_time(bytes),
-            fc_render: cfg.fast_client.render,
+            fc_render: Duration(cfg.fast_client.render.0.saturating_add(cfg.deferred_shading().0)),
             conventional_frame: cfg.conventional.frame.unwrap_or(cfg.slow_client.render),
             display: cfg.display.latency,
         }
@@ -204,6 +204,23 @@ mod tests {
             let t = Terms::of(&c).transfer.as_ms_f64();
             assert!((t - paper).abs() < tol, "{res:?}: {t} vs {paper}");
         }
+    }
+
+    #[test]
+    fn deferred_shading_buffers_and_cost() {
+        let c = cfg("system = \"multi_rate\"\n[deferred]\nenabled = true");
+        // 144 bits per pixel: 18 bytes, 2.25 times the 64-bit colour+depth.
+        assert_eq!(c.frame_bytes(), 1280 * 1024 * 18);
+        let wide = cfg("system = \"multi_rate\"\n[deferred]\nenabled = true\nnormal_bits = 96");
+        assert_eq!(wide.frame_bytes(), 1280 * 1024 * 24);
+        let idx = cfg("system = \"multi_rate\"\n[deferred]\nenabled = true\nmaterials = \"indices\"");
+        assert_eq!(idx.frame_bytes(), 1280 * 1024 * 12);
+        // Figure 8: four lights at 1600x1200 stereo in about 6 ms on FC.
+        let fig8 = cfg("system = \"multi_rate\"\nresolution = [1600, 1200]\nstereo = true\n[deferred]\nenabled = true");
+        let shading = fig8.deferred_shading().as_ms_f64();
+        assert!((shading - 6.0).abs() < 0.05, "{shading}");
+        let t = Terms::of(&fig8);
+        assert_eq!(t.fc_render.0, Duration::ms(23).0 + fig8.deferred_shading().0);
     }
 
     #[test]

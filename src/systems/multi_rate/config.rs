@@ -74,6 +74,9 @@ pub struct MultiRateConfig {
     /// The display's own latency, added after the last client frame ends.
     #[serde(default)]
     pub display: DisplayConfig,
+    /// Multi-GPU deferred shading (paper 003 §6): SC sends G-buffers, FC shades.
+    #[serde(default)]
+    pub deferred: DeferredConfig,
 }
 
 fn default_resolution() -> [u32; 2] {
@@ -300,14 +303,93 @@ pub struct DisplayConfig {
     pub latency: Duration,
 }
 
+/// How SC's G-buffer describes materials.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Materials {
+    /// 32-bit diffuse + 32-bit specular coefficients per pixel.
+    Coefficients,
+    /// A material index per pixel (`index_bits`), looked up on FC.
+    Indices,
+}
+
+/// Deferred shading split across the clients (paper 003 §6): SC renders
+/// depth, normals and materials; FC shades every pixel for every light.
+/// Bits per pixel: 32 depth + `normal_bits` + 64 (coefficients) or
+/// `index_bits` (indices): 144 by default, 192 with 96-bit normals. When
+/// enabled it replaces `bytes_per_pixel`.
+///
+/// Reading: the default cost per light per pixel, 0.39 ns, is Figure 8's
+/// 6 ms FC frame with four point lights at 1600x1200 in stereo, all
+/// counted as shading; SC's render time is left as given (the paper says
+/// shading leaves SC but gives no number).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DeferredConfig {
+    /// Use deferred shading.
+    pub enabled: bool,
+    /// Bits of the normal (48 = 3 x 16, or 96 = 3 x 32).
+    pub normal_bits: u32,
+    /// Coefficients or indices.
+    pub materials: Materials,
+    /// Bits of a material index (paper: not given; 16 assumed).
+    pub index_bits: u32,
+    /// Lights FC evaluates per pixel.
+    pub lights: u32,
+    /// FC's cost per light per pixel.
+    pub per_light_pixel: Duration,
+}
+
+impl Default for DeferredConfig {
+    fn default() -> Self {
+        DeferredConfig {
+            enabled: false,
+            normal_bits: 48,
+            materials: Materials::Coefficients,
+            index_bits: 16,
+            lights: 4,
+            per_light_pixel: Duration::ps(390),
+        }
+    }
+}
+
+impl DeferredConfig {
+    /// G-buffer bits per pixel.
+    pub fn bits_per_pixel(&self) -> u64 {
+        let materials = match self.materials {
+            Materials::Coefficients => 64,
+            Materials::Indices => self.index_bits as u64,
+        };
+        32 + self.normal_bits as u64 + materials
+    }
+}
+
 fn bw(s: &str) -> Bandwidth {
     Bandwidth::parse(s).expect("built-in bandwidth")
 }
 
 impl MultiRateConfig {
+    /// Pixels per frame (both eyes in stereo).
+    pub fn frame_pixels(&self) -> u64 {
+        let [w, h] = self.resolution;
+        w as u64 * h as u64 * if self.stereo { 2 } else { 1 }
+    }
+
     /// Bytes SC sends to FC per frame (doubled in stereo).
     pub fn frame_bytes(&self) -> u64 {
-        let [w, h] = self.resolution;
-        w as u64 * h as u64 * self.bytes_per_pixel as u64 * if self.stereo { 2 } else { 1 }
+        if self.deferred.enabled {
+            (self.frame_pixels() * self.deferred.bits_per_pixel()).div_ceil(8)
+        } else {
+            self.frame_pixels() * self.bytes_per_pixel as u64
+        }
+    }
+
+    /// FC's shading time per frame under deferred shading (zero otherwise).
+    pub fn deferred_shading(&self) -> Duration {
+        if !self.deferred.enabled {
+            return Duration::ZERO;
+        }
+        let n = self.frame_pixels().saturating_mul(self.deferred.lights as u64);
+        Duration(n.saturating_mul(self.deferred.per_light_pixel.0))
     }
 }

@@ -79,6 +79,27 @@ pub fn validate(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
     if cfg.run.events == 0 {
         return Err(bad("run.events", "must be at least 1 input event"));
     }
+    let d = &cfg.deferred;
+    if d.enabled {
+        if !matches!(d.normal_bits, 24 | 48 | 96) {
+            return Err(bad(
+                "deferred.normal_bits",
+                format!("must be 24, 48 or 96 (3 x 8, 16 or 32 bits), got {}", d.normal_bits),
+            ));
+        }
+        if !(1..=64).contains(&d.index_bits) {
+            return Err(bad(
+                "deferred.index_bits",
+                format!("must be between 1 and 64, got {}", d.index_bits),
+            ));
+        }
+        if cfg.bytes_per_pixel != 8 {
+            return Err(bad(
+                "bytes_per_pixel",
+                "deferred shading sets the bytes per pixel from its G-buffer; leave bytes_per_pixel at 8",
+            ));
+        }
+    }
     Ok(())
 }
 
@@ -196,6 +217,7 @@ fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &A
         "stopped_by": stats.stopped_by,
         "transfer_path": cfg.transfer.path.name(),
         "frame_bytes": cfg.frame_bytes(),
+        "deferred_shading_ms": cfg.deferred_shading().as_ms_f64(),
         "metrics": {
             "event_latency_ms": event_latency,
             "analytic_latency_ms": analytic_latency,
