@@ -349,3 +349,54 @@ fn deferred_shading_moves_bytes_and_shading_to_the_fast_client() {
     assert_eq!(z["metrics"]["link_keeps_up"], Value::Bool(true));
     assert!(try_run(CLUSTER, &["deferred.enabled=true", "deferred.normal_bits=50"]).is_err());
 }
+
+const MIGRATION: &str = include_str!("../models/mfr-migration.toml");
+
+#[test]
+fn bookkeeping_removes_the_release_artifact_and_over_prediction_the_selection_artifact() {
+    let s = summary(MIGRATION, &[]);
+    let m = &s["metrics"]["migration"];
+    let n = |p: &str, k: &str| m[p][k].as_u64().unwrap();
+    // Original system: dragging right after selecting shows the object
+    // twice until SC's image drops it; after release it is missing until
+    // SC's image holds it again.
+    assert!(
+        n("plain", "doubled_frames") > 0 && n("plain", "missing_frames") > 0,
+        "{m}"
+    );
+    // About one slow-path latency of FC frames (33 ms each) after release.
+    let frames = n("plain", "missing_frames") as f64 * 33.0;
+    let (lo, hi) = (
+        num(&s, "metrics.analytic_latency_ms.slow.phase_min") - 2.0 * 33.0,
+        num(&s, "metrics.analytic_latency_ms.slow.phase_max"),
+    );
+    assert!(
+        frames >= lo && frames <= hi,
+        "{frames} ms of missing frames vs [{lo}, {hi}]"
+    );
+    // Over-prediction (600 ms of hovering) and Table 3: no artifact.
+    assert_eq!(
+        (n("bookkeeping", "doubled_frames"), n("bookkeeping", "missing_frames")),
+        (0, 0),
+        "{m}"
+    );
+    // Selecting 50 ms after hovering leaves SC no time: the object shows twice
+    // (the paper's shadow-object case), but never goes missing.
+    let quick = summary(
+        MIGRATION,
+        &[
+            "migration.script=[{at=\"2s\",action=\"hover\"},{at=\"2.05s\",action=\"select\"},{at=\"2.06s\",action=\"drag\"},{at=\"4s\",action=\"release\"},{at=\"4.01s\",action=\"leave\"}]",
+        ],
+    );
+    let q = &quick["metrics"]["migration"]["bookkeeping"];
+    assert!(q["doubled_frames"].as_u64().unwrap() > 0, "{q}");
+    assert_eq!(q["missing_frames"].as_u64().unwrap(), 0, "{q}");
+    // Scripts out of order are refused with the key.
+    let e = try_run(
+        MIGRATION,
+        &["migration.script=[{at=\"3s\",action=\"hover\"},{at=\"2s\",action=\"select\"}]"],
+    )
+    .err()
+    .unwrap();
+    assert!(e.contains("migration.script.1.at"), "{e}");
+}

@@ -77,6 +77,17 @@ pub struct MultiRateConfig {
     /// Multi-GPU deferred shading (paper 003 §6): SC sends G-buffers, FC shades.
     #[serde(default)]
     pub deferred: DeferredConfig,
+    /// An interaction script for migration artifacts (paper 003 §4).
+    #[serde(default)]
+    pub migration: MigrationConfig,
+}
+
+/// The interaction script; empty = no migration analysis.
+#[derive(Debug, Clone, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct MigrationConfig {
+    /// Actions in time order, e.g. `{ at = "2s", action = "hover" }`.
+    pub script: Vec<super::migration::Step>,
 }
 
 fn default_resolution() -> [u32; 2] {

@@ -8,11 +8,13 @@
 //! - `analytic`: the paper's closed forms and the bounds over all phases;
 //! - `model`: the kernel model (clients, link, input events);
 //! - `latency`: per-event latencies and their stage breakdown;
+//! - `migration`: selection and release artifacts (paper 003 §4, Table 3);
 //! - `run`: validate, run, summarize, CSV, trace.
 
 pub mod analytic;
 pub mod config;
 pub mod latency;
+pub mod migration;
 pub mod model;
 pub mod run;
 

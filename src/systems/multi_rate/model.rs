@@ -170,6 +170,8 @@ pub struct MultiRate {
     pub fc_done: usize,
     /// Conventional frames that have ended.
     pub conv_done: usize,
+    /// The run goes on at least until FC has finished a frame after this.
+    pub min_end: Time,
 }
 
 impl MultiRate {
@@ -210,6 +212,7 @@ impl MultiRate {
             replaced: 0,
             fc_done: 0,
             conv_done: 0,
+            min_end: Time::ZERO,
         }
     }
 
@@ -269,6 +272,9 @@ impl MultiRate {
         };
         let j = Some(self.capturing_sample(*last));
         let fc = self.fc_done.checked_sub(1).map(|i| &self.fc[i]);
+        if fc.is_none_or(|f| f.end < self.min_end) {
+            return false;
+        }
         let fast = fc.is_some_and(|f| f.sample >= j);
         let slow = fc.and_then(|f| f.buffer).is_some_and(|b| self.sc[b].sample >= j);
         let conv = !self.conventional || self.conv_done.checked_sub(1).is_some_and(|i| self.conv[i].sample >= j);

@@ -79,6 +79,14 @@ pub fn validate(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
     if cfg.run.events == 0 {
         return Err(bad("run.events", "must be at least 1 input event"));
     }
+    for (i, w) in cfg.migration.script.windows(2).enumerate() {
+        if w[1].at < w[0].at {
+            return Err(bad(
+                &format!("migration.script.{}.at", i + 1),
+                "actions must be in time order",
+            ));
+        }
+    }
     let d = &cfg.deferred;
     if d.enabled {
         if !matches!(d.normal_bits, 24 | 48 | 96) {
@@ -116,6 +124,11 @@ pub fn run_multi_rate(cfg: MultiRateConfig) -> Result<MultiRateRun, MultiRateErr
         cfg.conventional.enabled,
         cfg.run.seed,
     );
+    if let Some(last) = cfg.migration.script.iter().map(|s| s.at).max() {
+        model.min_end = Time::ZERO
+            .add(last, "migration.script")?
+            .add(crate::engine::Duration::ms(1000), "migration.script")?;
+    }
     let mut sched = Scheduler::new();
     model.start(&mut sched)?;
     let limits = Limits {
@@ -204,7 +217,7 @@ fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &A
         );
     }
     let sent = m.sc.iter().filter(|f| f.arrived.is_some()).count();
-    json!({
+    let mut out = json!({
         "system": "multi_rate",
         "description": cfg.description,
         "seed": cfg.run.seed,
@@ -244,7 +257,11 @@ fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &A
             "buffers": {"sent": sent, "replaced_before_sending": m.replaced},
             "link_keeps_up": a.link_keeps_up,
         },
-    })
+    });
+    if !cfg.migration.script.is_empty() {
+        out["metrics"]["migration"] = super::migration::artifacts(m, &cfg.migration.script);
+    }
+    out
 }
 
 /// Writes the per-event table as CSV.
