@@ -306,7 +306,7 @@ fn cli_writes_json_csv_and_trace() {
 
 #[test]
 fn latency_experiments_pass_their_paper_checks() {
-    for exp in ["mfr-latency", "transfer-paths", "vr-warping"] {
+    for exp in ["mfr-latency", "transfer-paths", "vr-warping", "migration-artifacts"] {
         let dir = std::env::temp_dir().join(format!("rendersim-exp-{exp}-{}", std::process::id()));
         let o = Command::new(env!("CARGO_BIN_EXE_rendersim"))
             .args(["experiment", &format!("experiments/{exp}.toml"), "--quiet", "--out"])
