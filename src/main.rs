@@ -277,6 +277,12 @@ fn cmd_run(
 
 fn print_human(run: &SystemRun) {
     let s = run.summary();
+    if s["system"] == "multi_rate" {
+        return print_latency(s);
+    }
+    if s["system"] == "vr" {
+        return print_vr(s);
+    }
     let m = &s["metrics"];
     let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
     println!(
@@ -331,6 +337,71 @@ fn print_human(run: &SystemRun) {
         s["events"]["total"],
         f(&s["wall_seconds"]),
         f(&s["events_per_second"]) / 1e6,
+        f(&s["simulated_seconds"])
+    );
+}
+
+fn print_latency(s: &serde_json::Value) {
+    let m = &s["metrics"];
+    let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+    println!(
+        "{} (multi_rate, {} path), {} input events, seed {}",
+        s["model"].as_str().unwrap_or(""),
+        s["transfer_path"].as_str().unwrap_or(""),
+        s["input_events"],
+        s["seed"]
+    );
+    for path in ["fast", "slow", "conventional"] {
+        let v = &m["event_latency_ms"][path];
+        if v.is_null() {
+            continue;
+        }
+        let a = &m["analytic_latency_ms"][path];
+        println!(
+            "  {path:<13} latency min {:>7.1} mean {:>7.1} p99 {:>7.1} max {:>7.1} ms   paper best {:>6.1} worst {:>6.1}",
+            f(&v["min"]),
+            f(&v["mean"]),
+            f(&v["p99"]),
+            f(&v["max"]),
+            f(&a["best"]),
+            f(&a["worst"])
+        );
+    }
+    println!(
+        "  {} events in {:.3} s wall, {:.3} s simulated",
+        s["events"]["total"],
+        f(&s["wall_seconds"]),
+        f(&s["simulated_seconds"])
+    );
+}
+
+fn print_vr(s: &serde_json::Value) {
+    let m = &s["metrics"];
+    let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+    println!(
+        "{} (vr, {} scheme), {} motion events, seed {}",
+        s["model"].as_str().unwrap_or(""),
+        s["scheme"].as_str().unwrap_or(""),
+        s["input_events"],
+        s["seed"]
+    );
+    for kind in ["head", "object"] {
+        let v = &m["motion_to_photon_ms"][kind];
+        let a = &m["analytic_latency_ms"][kind];
+        println!(
+            "  {kind:<7} motion-to-photon min {:>6.1} mean {:>6.1} p99 {:>6.1} max {:>6.1} ms   closed form best {:>6.1} worst {:>6.1}",
+            f(&v["min"]),
+            f(&v["mean"]),
+            f(&v["p99"]),
+            f(&v["max"]),
+            f(&a["best"]),
+            f(&a["worst"])
+        );
+    }
+    println!(
+        "  {} events in {:.3} s wall, {:.3} s simulated",
+        s["events"]["total"],
+        f(&s["wall_seconds"]),
         f(&s["simulated_seconds"])
     );
 }

@@ -4,6 +4,8 @@
 //! experiment runner use.
 
 pub mod frame_pipeline;
+pub mod multi_rate;
+pub mod vr;
 
 use std::io::Write;
 
@@ -23,6 +25,12 @@ pub enum SimError {
     /// The frame pipeline failed while running.
     #[error(transparent)]
     Pipeline(frame_pipeline::PipelineError),
+    /// The multi-frame-rate system failed while running.
+    #[error(transparent)]
+    MultiRate(multi_rate::MultiRateError),
+    /// The VR pipeline failed while running.
+    #[error(transparent)]
+    Vr(vr::VrError),
 }
 
 /// The result of running one model.
@@ -30,6 +38,10 @@ pub enum SimError {
 pub enum SystemRun {
     /// A frame-pipeline run.
     FramePipeline(Box<frame_pipeline::PipelineRun>),
+    /// A multi-frame-rate run.
+    MultiRate(Box<multi_rate::MultiRateRun>),
+    /// A VR-pipeline run.
+    Vr(Box<vr::VrRun>),
 }
 
 /// Reads `--set` patches into the model's table.
@@ -55,10 +67,28 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: bool) -> Result<
                 Err(e) => Err(SimError::Pipeline(e)),
             }
         }
+        "multi_rate" => {
+            let cfg: multi_rate::MultiRateConfig = deserialize(table, src)?;
+            match multi_rate::run_multi_rate(cfg) {
+                Ok(r) => Ok(SystemRun::MultiRate(Box::new(r))),
+                Err(multi_rate::MultiRateError::Invalid { key, message }) => {
+                    Err(SimError::Config(invalid(src, &key, message, None)))
+                }
+                Err(e) => Err(SimError::MultiRate(e)),
+            }
+        }
+        "vr" => {
+            let cfg: vr::VrConfig = deserialize(table, src)?;
+            match vr::run_vr(cfg) {
+                Ok(r) => Ok(SystemRun::Vr(Box::new(r))),
+                Err(vr::VrError::Invalid { key, message }) => Err(SimError::Config(invalid(src, &key, message, None))),
+                Err(e) => Err(SimError::Vr(e)),
+            }
+        }
         other => Err(SimError::Config(invalid(
             src,
             "system",
-            format!("unknown system {other:?} (known: frame_pipeline)"),
+            format!("unknown system {other:?} (known: frame_pipeline, multi_rate, vr)"),
             None,
         ))),
     }
@@ -69,6 +99,8 @@ impl SystemRun {
     pub fn summary(&self) -> &Value {
         match self {
             SystemRun::FramePipeline(r) => &r.summary,
+            SystemRun::MultiRate(r) => &r.summary,
+            SystemRun::Vr(r) => &r.summary,
         }
     }
 
@@ -76,13 +108,17 @@ impl SystemRun {
     pub fn summary_mut(&mut self) -> &mut Value {
         match self {
             SystemRun::FramePipeline(r) => &mut r.summary,
+            SystemRun::MultiRate(r) => &mut r.summary,
+            SystemRun::Vr(r) => &mut r.summary,
         }
     }
 
-    /// Writes the per-frame table as CSV.
+    /// Writes the per-frame table as CSV (per input event for latency systems).
     pub fn write_frames_csv(&self, w: &mut dyn Write) -> std::io::Result<()> {
         match self {
             SystemRun::FramePipeline(r) => frame_pipeline::records::write_frames_csv(&r.records, w),
+            SystemRun::MultiRate(r) => multi_rate::run::write_events_csv(&r.events, w),
+            SystemRun::Vr(r) => vr::run::write_motions_csv(&r.motions, w),
         }
     }
 
@@ -95,6 +131,14 @@ impl SystemRun {
                     .into_iter()
                     .map(|row| row.to_vec())
                     .collect(),
+            ),
+            SystemRun::MultiRate(r) => (
+                multi_rate::latency::COLUMNS.iter().map(|s| s.to_string()).collect(),
+                multi_rate::latency::event_rows(&r.events),
+            ),
+            SystemRun::Vr(r) => (
+                vr::run::COLUMNS.iter().map(|s| s.to_string()).collect(),
+                vr::run::motion_rows(&r.motions),
             ),
         }
     }
@@ -121,6 +165,20 @@ impl SystemRun {
                     "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
                 )
             }
+            SystemRun::Vr(r) => {
+                let body =
+                    toml::to_string(&r.config).unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
+                format!(
+                    "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
+                )
+            }
+            SystemRun::MultiRate(r) => {
+                let body =
+                    toml::to_string(&r.config).unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
+                format!(
+                    "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
+                )
+            }
         }
     }
 
@@ -128,6 +186,8 @@ impl SystemRun {
     pub fn write_trace(&self, w: &mut dyn Write) -> std::io::Result<bool> {
         match self {
             SystemRun::FramePipeline(r) => crate::output::trace::write_pipeline_trace(r, w),
+            SystemRun::MultiRate(r) => multi_rate::run::write_trace(r, w),
+            SystemRun::Vr(r) => vr::run::write_trace(r, w),
         }
     }
 }

@@ -1,0 +1,323 @@
+//! Validating, running and summarizing a multi-frame-rate model.
+
+use std::io::Write;
+
+use serde_json::{Map, Value, json};
+
+use crate::engine::{Limits, RunStats, Scheduler, StopReason, Time, run};
+use crate::stats::quantile::Summary;
+
+use super::analytic::{Analytic, Bounds, Terms, analytic};
+use super::config::MultiRateConfig;
+use super::latency::{CONV_STAGES, EventRecord, FAST_STAGES, SLOW_STAGES, event_rows, follow_events, total_ms};
+use super::model::{MultiRate, MultiRateError};
+
+/// Everything a run produced.
+#[derive(Debug)]
+pub struct MultiRateRun {
+    /// The model as simulated.
+    pub config: MultiRateConfig,
+    /// Kernel statistics.
+    pub stats: RunStats,
+    /// The final model state (frames of every client).
+    pub model: MultiRate,
+    /// Every input event's fate.
+    pub events: Vec<EventRecord>,
+    /// Closed forms.
+    pub analytic: Analytic,
+    /// The JSON summary.
+    pub summary: Value,
+}
+
+fn bad(key: &str, message: impl Into<String>) -> MultiRateError {
+    MultiRateError::Invalid {
+        key: key.to_string(),
+        message: message.into(),
+    }
+}
+
+/// Checks values serde cannot.
+pub fn validate(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
+    if cfg.system != "multi_rate" {
+        return Err(bad("system", format!("expected \"multi_rate\", got {:?}", cfg.system)));
+    }
+    let [w, h] = cfg.resolution;
+    if w == 0 || h == 0 || w > 65536 || h > 65536 {
+        return Err(bad(
+            "resolution",
+            format!("must be [width, height] with each between 1 and 65536 pixels, got [{w}, {h}]"),
+        ));
+    }
+    if cfg.bytes_per_pixel == 0 || cfg.bytes_per_pixel > 64 {
+        return Err(bad(
+            "bytes_per_pixel",
+            format!("must be between 1 and 64, got {}", cfg.bytes_per_pixel),
+        ));
+    }
+    if cfg.tracker.period.0 == 0 {
+        return Err(bad("tracker.period", "must be greater than zero"));
+    }
+    if cfg.input.mean_interval.0 == 0 {
+        return Err(bad("input.mean_interval", "must be greater than zero"));
+    }
+    let t = Terms::of(cfg);
+    if t.sc_frame().0 == 0 {
+        return Err(bad(
+            "slow_client.render",
+            "SC's frame (render + read-back) must take some time",
+        ));
+    }
+    if t.fc_frame().0 == 0 {
+        return Err(bad(
+            "fast_client.render",
+            "FC's frame (upload + render) must take some time",
+        ));
+    }
+    if cfg.conventional.enabled && t.conventional_frame.0 == 0 {
+        return Err(bad("conventional.frame", "must be greater than zero"));
+    }
+    if cfg.run.events == 0 {
+        return Err(bad("run.events", "must be at least 1 input event"));
+    }
+    for (i, w) in cfg.migration.script.windows(2).enumerate() {
+        if w[1].at < w[0].at {
+            return Err(bad(
+                &format!("migration.script.{}.at", i + 1),
+                "actions must be in time order",
+            ));
+        }
+    }
+    let d = &cfg.deferred;
+    if d.enabled {
+        if !matches!(d.normal_bits, 24 | 48 | 96) {
+            return Err(bad(
+                "deferred.normal_bits",
+                format!("must be 24, 48 or 96 (3 x 8, 16 or 32 bits), got {}", d.normal_bits),
+            ));
+        }
+        if !(1..=64).contains(&d.index_bits) {
+            return Err(bad(
+                "deferred.index_bits",
+                format!("must be between 1 and 64, got {}", d.index_bits),
+            ));
+        }
+        if cfg.bytes_per_pixel != 8 {
+            return Err(bad(
+                "bytes_per_pixel",
+                "deferred shading sets the bytes per pixel from its G-buffer; leave bytes_per_pixel at 8",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Validates, runs and summarizes a model.
+pub fn run_multi_rate(cfg: MultiRateConfig) -> Result<MultiRateRun, MultiRateError> {
+    validate(&cfg)?;
+    let terms = Terms::of(&cfg);
+    let a = analytic(&terms);
+    let mut model = MultiRate::new(
+        terms,
+        cfg.run.events,
+        cfg.run.warmup,
+        cfg.input.mean_interval,
+        cfg.conventional.enabled,
+        cfg.run.seed,
+    );
+    if let Some(last) = cfg.migration.script.iter().map(|s| s.at).max() {
+        model.min_end = Time::ZERO
+            .add(last, "migration.script")?
+            .add(crate::engine::Duration::ms(1000), "migration.script")?;
+    }
+    let mut sched = Scheduler::new();
+    model.start(&mut sched)?;
+    let limits = Limits {
+        until: None,
+        max_events: cfg.run.max_events,
+    };
+    let stats = run(&mut model, &mut sched, limits)?;
+    if stats.stopped_by != StopReason::Model || !model.done() {
+        return Err(MultiRateError::Unfinished {
+            at: stats.end_time,
+            state: model.describe(),
+        });
+    }
+    let events = follow_events(&model);
+    let summary = summarize(&cfg, &model, &events, &a, &stats);
+    Ok(MultiRateRun {
+        config: cfg,
+        stats,
+        model,
+        events,
+        analytic: a,
+        summary,
+    })
+}
+
+fn dist(v: &[f64]) -> Value {
+    let s = Summary::of(v);
+    json!({"count": s.count, "min": s.min, "mean": s.mean, "p50": s.p50, "p99": s.p99, "max": s.max, "std": s.std})
+}
+
+fn breakdown<'a>(names: &[&str], rows: impl Iterator<Item = &'a Vec<u64>>) -> Value {
+    let mut sums = vec![0f64; names.len()];
+    let mut n = 0usize;
+    for r in rows {
+        for (s, v) in sums.iter_mut().zip(r) {
+            *s += *v as f64 / 1e9;
+        }
+        n += 1;
+    }
+    let n = n.max(1) as f64;
+    Value::Object(
+        names
+            .iter()
+            .zip(sums)
+            .map(|(k, s)| (k.to_string(), json!(s / n)))
+            .collect(),
+    )
+}
+
+fn bounds(b: &Bounds) -> Value {
+    json!({"best": b.best, "worst": b.worst, "phase_min": b.phase_min, "phase_max": b.phase_max, "phase_mean": b.phase_mean})
+}
+
+fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &Analytic, stats: &RunStats) -> Value {
+    let fast: Vec<f64> = events
+        .iter()
+        .filter_map(|e| e.fast.as_ref().map(|f| total_ms(&f.1)))
+        .collect();
+    let slow: Vec<f64> = events
+        .iter()
+        .filter_map(|e| e.slow.as_ref().map(|s| total_ms(&s.2)))
+        .collect();
+    let conv: Vec<f64> = events
+        .iter()
+        .filter_map(|e| e.conventional.as_ref().map(|c| total_ms(&c.1)))
+        .collect();
+    let t = &m.terms;
+    let by_kind: Map<String, Value> = stats
+        .kind_names
+        .iter()
+        .zip(&stats.by_kind)
+        .map(|(n, c)| (n.to_string(), json!(c)))
+        .collect();
+    let mut event_latency = json!({"fast": dist(&fast), "slow": dist(&slow)});
+    let mut analytic_latency = json!({"fast": bounds(&a.fast), "slow": bounds(&a.slow)});
+    let mut stages = json!({
+        "fast": breakdown(&FAST_STAGES, events.iter().filter_map(|e| e.fast.as_ref().map(|f| &f.1))),
+        "slow": breakdown(&SLOW_STAGES, events.iter().filter_map(|e| e.slow.as_ref().map(|s| &s.2))),
+    });
+    if cfg.conventional.enabled {
+        event_latency["conventional"] = dist(&conv);
+        analytic_latency["conventional"] = bounds(&a.conventional);
+        stages["conventional"] = breakdown(
+            &CONV_STAGES,
+            events.iter().filter_map(|e| e.conventional.as_ref().map(|c| &c.1)),
+        );
+    }
+    let sent = m.sc.iter().filter(|f| f.arrived.is_some()).count();
+    let mut out = json!({
+        "system": "multi_rate",
+        "description": cfg.description,
+        "seed": cfg.run.seed,
+        "input_events": events.len(),
+        "events": {"total": stats.events, "by_kind": by_kind},
+        "wall_seconds": stats.wall_seconds,
+        "simulate_seconds": stats.wall_seconds,
+        "events_per_second": if stats.wall_seconds > 0.0 { stats.events as f64 / stats.wall_seconds } else { 0.0 },
+        "simulated_seconds": stats.end_time.0 as f64 / 1e12,
+        "stopped_by": stats.stopped_by,
+        "transfer_path": cfg.transfer.path.name(),
+        "frame_bytes": cfg.frame_bytes(),
+        "deferred_shading_ms": cfg.deferred_shading().as_ms_f64(),
+        "metrics": {
+            "event_latency_ms": event_latency,
+            "analytic_latency_ms": analytic_latency,
+            "latency_breakdown_ms": stages,
+            "terms_ms": {
+                "tracker_period": t.tracker_period.as_ms_f64(),
+                "sensor_latency": t.sensor_latency.as_ms_f64(),
+                "sc_render": t.sc_render.as_ms_f64(),
+                "sc_readback": t.sc_readback.as_ms_f64(),
+                "sc_frame": t.sc_frame().as_ms_f64(),
+                "transfer": t.transfer.as_ms_f64(),
+                "fc_upload": t.fc_upload.as_ms_f64(),
+                "fc_render": t.fc_render.as_ms_f64(),
+                "fc_frame": t.fc_frame().as_ms_f64(),
+                "conventional_frame": t.conventional_frame.as_ms_f64(),
+                "display": t.display.as_ms_f64(),
+            },
+            "rates_hz": {
+                "slow_client": 1e3 / t.sc_frame().as_ms_f64(),
+                "fast_client": 1e3 / t.fc_frame().as_ms_f64(),
+                "transfer": if t.transfer.0 > 0 { 1e3 / t.transfer.as_ms_f64() } else { f64::INFINITY },
+            },
+            "frames": {"slow_client": m.sc.len(), "fast_client": m.fc_done, "conventional": m.conv_done},
+            "buffers": {"sent": sent, "replaced_before_sending": m.replaced},
+            "link_keeps_up": a.link_keeps_up,
+        },
+    });
+    if !cfg.migration.script.is_empty() {
+        out["metrics"]["migration"] = super::migration::artifacts(m, &cfg.migration.script);
+    }
+    out
+}
+
+/// Writes the per-event table as CSV.
+pub fn write_events_csv(events: &[EventRecord], w: &mut dyn Write) -> std::io::Result<()> {
+    writeln!(w, "{}", super::latency::COLUMNS.join(","))?;
+    for r in event_rows(events) {
+        let cells: Vec<String> = r
+            .iter()
+            .map(|v| if v.is_nan() { String::new() } else { format!("{v}") })
+            .collect();
+        writeln!(w, "{}", cells.join(","))?;
+    }
+    Ok(())
+}
+
+fn us(t: Time) -> f64 {
+    t.0 as f64 / 1e6
+}
+
+/// Writes a Chrome/Perfetto trace: one track per client and one for the
+/// link; input events as instants on the master's track.
+pub fn write_trace(r: &MultiRateRun, w: &mut dyn Write) -> std::io::Result<bool> {
+    let m = &r.model;
+    let tracks = [
+        (1, "master (input events)"),
+        (2, "slow client"),
+        (3, "transfer link"),
+        (4, "fast client"),
+        (5, "conventional client"),
+    ];
+    let mut ev: Vec<Value> =
+        vec![json!({"ph": "M", "pid": 1, "name": "process_name", "args": {"name": "multi-frame-rate"}})];
+    for (tid, name) in tracks {
+        ev.push(json!({"ph": "M", "pid": 1, "tid": tid, "name": "thread_name", "args": {"name": name}}));
+        ev.push(json!({"ph": "M", "pid": 1, "tid": tid, "name": "thread_sort_index", "args": {"sort_index": tid}}));
+    }
+    let span = |tid: u32, name: String, a: Time, b: Time| json!({"ph": "X", "pid": 1, "tid": tid, "name": name, "ts": us(a), "dur": us(b) - us(a)});
+    for (i, t) in m.inputs.iter().enumerate() {
+        ev.push(json!({"ph": "i", "pid": 1, "tid": 1, "s": "t", "name": format!("input {i}"), "ts": us(*t)}));
+    }
+    for (i, f) in m.sc.iter().enumerate() {
+        if f.readback_end > f.start {
+            ev.push(span(2, format!("SC {i} render"), f.start, f.render_end));
+            ev.push(span(2, format!("SC {i} read-back"), f.render_end, f.readback_end));
+        }
+        if let (Some(s), Some(e)) = (f.send_start, f.arrived) {
+            ev.push(span(3, format!("SC {i} transfer"), s, e));
+        }
+    }
+    for (i, f) in m.fc[..m.fc_done].iter().enumerate() {
+        ev.push(span(4, format!("FC {i} upload"), f.start, f.upload_end));
+        ev.push(span(4, format!("FC {i} render"), f.upload_end, f.end));
+    }
+    for (i, f) in m.conv[..m.conv_done].iter().enumerate() {
+        ev.push(span(5, format!("frame {i}"), f.start, f.end));
+    }
+    serde_json::to_writer(&mut *w, &json!({"traceEvents": ev, "displayTimeUnit": "ms"}))?;
+    Ok(true)
+}

@@ -1,0 +1,18 @@
+//! The VR pipeline of Zachmann's lecture (paper 001): tracker ->
+//! simulation -> renderer -> swap lock -> field-sequential stereo display
+//! at 120 Hz, as the naive single loop and as the decoupled scheme with a
+//! warping renderer (application frames at 20 Hz re-projected at 60 Hz with
+//! the newest camera pose and object transforms). Reports motion-to-photon
+//! latency of head and of object motion.
+//!
+//! - `config`: the model file; `analytic`: closed forms;
+//! - `model`: the kernel model; `run`: per-motion latencies, summary, trace.
+
+pub mod analytic;
+pub mod config;
+pub mod model;
+pub mod run;
+
+pub use config::VrConfig;
+pub use model::{Vr, VrError};
+pub use run::{VrRun, run_vr, validate};

@@ -1,0 +1,402 @@
+//! Multi-frame-rate latency (paper 003 §3.2): the paper's closed forms as
+//! oracles, the event simulation bracketed by the bounds over all phases,
+//! determinism, and clear errors for bad input.
+
+use std::process::Command;
+
+use rendersim::config::{ModelSource, apply_set};
+use rendersim::systems::{SystemRun, run_model};
+use serde_json::Value;
+
+const CLUSTER: &str = include_str!("../models/mfr-cluster.toml");
+const MULTIGPU: &str = include_str!("../models/mfr-multigpu.toml");
+
+fn try_run(text: &str, sets: &[&str]) -> Result<SystemRun, String> {
+    let src = ModelSource::from_text("test.toml", text);
+    let mut t = src.table().map_err(|e| e.to_string())?;
+    for s in sets {
+        apply_set(&mut t, s).map_err(|e| e.to_string())?;
+    }
+    run_model(&src, &t, false).map_err(|e| e.to_string())
+}
+
+fn summary(text: &str, sets: &[&str]) -> Value {
+    try_run(text, sets)
+        .unwrap_or_else(|e| panic!("run failed: {e}"))
+        .summary()
+        .clone()
+}
+
+fn num(v: &Value, path: &str) -> f64 {
+    let mut x = v;
+    for p in path.split('.') {
+        x = &x[p];
+    }
+    x.as_f64().unwrap_or_else(|| panic!("{path} is not a number: {x}"))
+}
+
+fn close(got: f64, want: f64, tol: f64, what: &str) {
+    assert!(
+        (got - want).abs() <= tol,
+        "{what}: got {got}, paper {want} (tolerance {tol})"
+    );
+}
+
+#[test]
+fn cluster_reproduces_the_papers_hand_analysis() {
+    let s = summary(CLUSTER, &["run.events=200"]);
+    let a = "metrics.analytic_latency_ms";
+    close(num(&s, &format!("{a}.conventional.best")), 206.0, 1e-9, "conventional");
+    close(num(&s, &format!("{a}.fast.best")), 73.0, 1e-9, "fast client");
+    // 40 + 166 + 20 + 111.1 (10 MiB at 90 MiB/s)
+    close(num(&s, &format!("{a}.slow.best")), 337.0, 0.2, "cluster slow client");
+    close(
+        num(&s, &format!("{a}.slow.worst")),
+        390.0,
+        0.2,
+        "cluster slow client, at most",
+    );
+    close(num(&s, "metrics.terms_ms.transfer"), 111.0, 0.2, "network transfer");
+    close(num(&s, "metrics.rates_hz.fast_client"), 30.0, 0.4, "FC rate");
+    close(
+        num(&s, "metrics.rates_hz.slow_client"),
+        5.4,
+        0.1,
+        "SC rate (paper: about 6 Hz)",
+    );
+}
+
+#[test]
+fn multi_gpu_reproduces_the_papers_hand_analysis() {
+    let s = summary(MULTIGPU, &["run.events=200"]);
+    let a = "metrics.analytic_latency_ms";
+    close(num(&s, &format!("{a}.fast.best")), 73.0, 1e-9, "fast client");
+    // The lock's 0.1 ms is the only transfer term.
+    close(
+        num(&s, &format!("{a}.slow.best")),
+        226.0,
+        0.1 + 1e-9,
+        "multi-GPU slow client",
+    );
+    close(
+        num(&s, &format!("{a}.slow.worst")),
+        279.0,
+        0.1 + 1e-9,
+        "multi-GPU slow client, at most",
+    );
+}
+
+#[test]
+fn table2_network_transfer_times_by_resolution() {
+    // Table 2: 6 / 10 / 15 MB in 66 / 111 / 166 ms. 1600x1200x8 B is
+    // 14.65 MiB, which the paper rounds up to 15 MB, so 162.8 ms here.
+    for (res, paper, tol) in [
+        ("[1024, 768]", 66.0, 1.0),
+        ("[1280, 1024]", 111.0, 0.2),
+        ("[1600, 1200]", 166.0, 4.0),
+    ] {
+        let s = summary(CLUSTER, &["run.events=20", &format!("resolution={res}")]);
+        close(num(&s, "metrics.terms_ms.transfer"), paper, tol, res);
+    }
+}
+
+/// The simulated distribution lies inside the bounds over all phases and
+/// its mean matches the closed-form mean over independent uniform phases.
+fn check_brackets(s: &Value, path: &str) {
+    let e = format!("metrics.event_latency_ms.{path}");
+    let a = format!("metrics.analytic_latency_ms.{path}");
+    let (min, mean, max) = (
+        num(s, &format!("{e}.min")),
+        num(s, &format!("{e}.mean")),
+        num(s, &format!("{e}.max")),
+    );
+    let (lo, hi, mu) = (
+        num(s, &format!("{a}.phase_min")),
+        num(s, &format!("{a}.phase_max")),
+        num(s, &format!("{a}.phase_mean")),
+    );
+    assert!(
+        min >= lo - 1e-6 && max <= hi + 1e-6,
+        "{path}: [{min}, {max}] outside [{lo}, {hi}]"
+    );
+    // With thousands of events the extremes come close to the bounds.
+    let width = hi - lo;
+    assert!(
+        min - lo < 0.05 * width && hi - max < 0.05 * width,
+        "{path}: [{min}, {max}] vs [{lo}, {hi}]"
+    );
+    assert!((mean - mu).abs() < 0.02 * mu, "{path}: mean {mean} vs closed form {mu}");
+}
+
+#[test]
+fn simulated_distributions_stay_within_the_phase_bounds() {
+    for model in [CLUSTER, MULTIGPU] {
+        let s = summary(model, &["run.events=4000"]);
+        for path in ["fast", "slow", "conventional"] {
+            check_brackets(&s, path);
+        }
+        // The paper's best case is reachable only on the fast and
+        // conventional paths; the slow path always adds FC's frame.
+        let e = "metrics.event_latency_ms";
+        let a = "metrics.analytic_latency_ms";
+        assert!(num(&s, &format!("{e}.fast.min")) >= num(&s, &format!("{a}.fast.best")));
+        assert!(num(&s, &format!("{e}.slow.min")) >= num(&s, &format!("{a}.slow.best")) + 33.0 - 1e-6);
+        // Waiting for SC's next frame start (up to 186 ms) takes the slow
+        // path beyond the paper's worst case, which assumes none.
+        assert!(num(&s, &format!("{e}.slow.max")) > num(&s, &format!("{a}.slow.worst")) + 100.0);
+        assert!(num(&s, &format!("{e}.slow.p99")) > num(&s, &format!("{a}.slow.worst")));
+    }
+}
+
+#[test]
+fn stage_breakdown_adds_up_to_the_mean_latency() {
+    let s = summary(CLUSTER, &["run.events=500", "display.latency=\"5ms\""]);
+    for path in ["fast", "slow", "conventional"] {
+        let b = &s["metrics"]["latency_breakdown_ms"][path];
+        let sum: f64 = b.as_object().unwrap().values().map(|v| v.as_f64().unwrap()).sum();
+        let mean = num(&s, &format!("metrics.event_latency_ms.{path}.mean"));
+        assert!((sum - mean).abs() < 1e-6, "{path}: stages {sum} vs mean {mean}");
+        close(num(b, "sensor_transport"), 40.0, 1e-9, "sensor transport");
+        close(num(b, "display"), 5.0, 1e-9, "display");
+    }
+    let slow = &s["metrics"]["latency_breakdown_ms"]["slow"];
+    close(num(slow, "render"), 166.0, 1e-9, "SC render");
+    close(num(slow, "readback"), 20.0, 1e-9, "SC read-back");
+    close(num(slow, "transfer"), 111.1, 0.1, "network transfer");
+    close(num(slow, "render_submission"), 10.0, 1e-9, "FC upload");
+}
+
+#[test]
+fn same_seed_same_numbers_other_seed_other_numbers() {
+    let strip = |mut v: Value| {
+        for k in ["wall_seconds", "simulate_seconds", "events_per_second"] {
+            v[k] = Value::Null;
+        }
+        v
+    };
+    let a = strip(summary(CLUSTER, &["run.events=300"]));
+    let b = strip(summary(CLUSTER, &["run.events=300"]));
+    let c = strip(summary(CLUSTER, &["run.events=300", "run.seed=2"]));
+    assert_eq!(a, b);
+    assert_ne!(a["metrics"]["event_latency_ms"], c["metrics"]["event_latency_ms"]);
+}
+
+#[test]
+fn a_link_slower_than_the_slow_client_replaces_buffers_and_still_finishes() {
+    // Stereo 1600x1200 over Gigabit Ethernet: 29.3 MiB in 325 ms per frame,
+    // longer than SC's frame, so read-back buffers wait and get replaced.
+    let s = summary(CLUSTER, &["run.events=300", "resolution=[1600, 1200]", "stereo=true"]);
+    assert_eq!(s["metrics"]["link_keeps_up"], Value::Bool(false));
+    assert!(s["metrics"]["buffers"]["replaced_before_sending"].as_u64().unwrap() > 0);
+    close(
+        num(&s, "metrics.terms_ms.transfer"),
+        2.0 * 162.76,
+        0.1,
+        "stereo transfer",
+    );
+    assert_eq!(num(&s, "metrics.event_latency_ms.slow.count"), 300.0);
+}
+
+#[test]
+fn faster_paths_shorten_only_the_slow_path() {
+    let net = summary(CLUSTER, &["run.events=2000"]);
+    let fast_net = summary(CLUSTER, &["run.events=2000", "network.bandwidth=\"180MiB/s\""]);
+    close(
+        num(&fast_net, "metrics.terms_ms.transfer"),
+        55.56,
+        0.01,
+        "doubled bandwidth",
+    );
+    for path in ["loopback", "shared_copy", "zero_copy"] {
+        let s = summary(CLUSTER, &["run.events=2000", &format!("transfer.path=\"{path}\"")]);
+        let (n, p) = (
+            num(&net, "metrics.event_latency_ms.slow.mean"),
+            num(&s, "metrics.event_latency_ms.slow.mean"),
+        );
+        let saved = num(&net, "metrics.terms_ms.transfer") - num(&s, "metrics.terms_ms.transfer");
+        assert!(
+            (n - p - saved).abs() < 0.03 * n,
+            "{path}: {n} -> {p}, transfer saved {saved}"
+        );
+        assert_eq!(
+            net["metrics"]["event_latency_ms"]["fast"], s["metrics"]["event_latency_ms"]["fast"],
+            "{path}: the fast path does not use the link"
+        );
+    }
+}
+
+#[test]
+fn bad_input_gives_clear_errors() {
+    for (sets, needle) in [
+        (vec!["resolution=[0, 1024]"], "resolution"),
+        (vec!["transfer.path=\"pigeon\""], "transfer.path"),
+        (vec!["network.bandwidth=\"90MB\""], "network.bandwidth"),
+        (vec!["tracker.period=\"0ms\""], "tracker.period"),
+        (vec!["fast_client.rendr=\"23ms\""], "rendr"),
+        (vec!["run.events=0"], "run.events"),
+    ] {
+        let e = try_run(CLUSTER, &sets)
+            .err()
+            .unwrap_or_else(|| panic!("{sets:?} should fail"));
+        assert!(e.contains(needle), "{sets:?}: {e}");
+    }
+}
+
+#[test]
+fn cli_writes_json_csv_and_trace() {
+    let dir = std::env::temp_dir().join(format!("rendersim-mfr-{}", std::process::id()));
+    let trace = dir.join("trace.json");
+    let o = Command::new(env!("CARGO_BIN_EXE_rendersim"))
+        .args([
+            "run",
+            "models/mfr-cluster.toml",
+            "--set",
+            "run.events=50",
+            "--json",
+            "--out",
+        ])
+        .arg(&dir)
+        .arg("--trace")
+        .arg(&trace)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    for path in ["fast", "slow"] {
+        for k in ["min", "mean", "p99", "max"] {
+            num(&v, &format!("metrics.event_latency_ms.{path}.{k}"));
+        }
+        for k in ["best", "worst"] {
+            num(&v, &format!("metrics.analytic_latency_ms.{path}.{k}"));
+        }
+    }
+    let csv = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 51);
+    assert!(csv.starts_with("event,input_ms,tracker_sample,fast_latency_ms"));
+    // The resolved model runs again to the same numbers.
+    let again = Command::new(env!("CARGO_BIN_EXE_rendersim"))
+        .args(["run", "--json"])
+        .arg(dir.join("model.toml"))
+        .output()
+        .unwrap();
+    assert!(again.status.success(), "{}", String::from_utf8_lossy(&again.stderr));
+    let w: Value = serde_json::from_slice(&again.stdout).unwrap();
+    assert_eq!(v["metrics"]["event_latency_ms"], w["metrics"]["event_latency_ms"]);
+    // One track per client; spans on a track never overlap.
+    let t: Value = serde_json::from_str(&std::fs::read_to_string(&trace).unwrap()).unwrap();
+    let mut by_tid: std::collections::BTreeMap<u64, Vec<(f64, f64)>> = Default::default();
+    for e in t["traceEvents"].as_array().unwrap() {
+        if e["ph"] == "X" {
+            let ts = e["ts"].as_f64().unwrap();
+            by_tid
+                .entry(e["tid"].as_u64().unwrap())
+                .or_default()
+                .push((ts, ts + e["dur"].as_f64().unwrap()));
+        }
+    }
+    assert_eq!(by_tid.keys().copied().collect::<Vec<_>>(), vec![2, 3, 4, 5]);
+    for (tid, mut spans) in by_tid {
+        spans.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for w in spans.windows(2) {
+            assert!(w[1].0 >= w[0].1 - 1e-6, "track {tid}: {w:?}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn latency_experiments_pass_their_paper_checks() {
+    for exp in ["mfr-latency", "transfer-paths", "vr-warping", "migration-artifacts"] {
+        let dir = std::env::temp_dir().join(format!("rendersim-exp-{exp}-{}", std::process::id()));
+        let o = Command::new(env!("CARGO_BIN_EXE_rendersim"))
+            .args(["experiment", &format!("experiments/{exp}.toml"), "--quiet", "--out"])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{exp}: {}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(dir.join("report.md").exists());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
+#[test]
+fn deferred_shading_moves_bytes_and_shading_to_the_fast_client() {
+    let plain = summary(CLUSTER, &["run.events=500"]);
+    let s = summary(CLUSTER, &["run.events=500", "deferred.enabled=true"]);
+    // 144 bits instead of 64 per pixel: 2.25 times the bytes on every buffer term.
+    assert_eq!(s["frame_bytes"].as_u64().unwrap(), 1280 * 1024 * 18);
+    close(
+        num(&s, "metrics.terms_ms.transfer"),
+        2.25 * num(&plain, "metrics.terms_ms.transfer"),
+        0.01,
+        "transfer",
+    );
+    // FC shades 4 lights x 1.31 Mpixel at 0.39 ns.
+    close(
+        num(&s, "deferred_shading_ms"),
+        4.0 * 1280.0 * 1024.0 * 0.39e-6,
+        1e-6,
+        "shading",
+    );
+    // 22.5 MiB over Gigabit Ethernet (250 ms) no longer keeps up with SC (211 ms).
+    assert_eq!(s["metrics"]["link_keeps_up"], Value::Bool(false));
+    let z = summary(MULTIGPU, &["run.events=500", "deferred.enabled=true"]);
+    assert_eq!(z["metrics"]["link_keeps_up"], Value::Bool(true));
+    assert!(try_run(CLUSTER, &["deferred.enabled=true", "deferred.normal_bits=50"]).is_err());
+}
+
+const MIGRATION: &str = include_str!("../models/mfr-migration.toml");
+
+#[test]
+fn bookkeeping_removes_the_release_artifact_and_over_prediction_the_selection_artifact() {
+    let s = summary(MIGRATION, &[]);
+    let m = &s["metrics"]["migration"];
+    let n = |p: &str, k: &str| m[p][k].as_u64().unwrap();
+    // Original system: dragging right after selecting shows the object
+    // twice until SC's image drops it; after release it is missing until
+    // SC's image holds it again.
+    assert!(
+        n("plain", "doubled_frames") > 0 && n("plain", "missing_frames") > 0,
+        "{m}"
+    );
+    // About one slow-path latency of FC frames (33 ms each) after release.
+    let frames = n("plain", "missing_frames") as f64 * 33.0;
+    let (lo, hi) = (
+        num(&s, "metrics.analytic_latency_ms.slow.phase_min") - 2.0 * 33.0,
+        num(&s, "metrics.analytic_latency_ms.slow.phase_max"),
+    );
+    assert!(
+        frames >= lo && frames <= hi,
+        "{frames} ms of missing frames vs [{lo}, {hi}]"
+    );
+    // Over-prediction (600 ms of hovering) and Table 3: no artifact.
+    assert_eq!(
+        (n("bookkeeping", "doubled_frames"), n("bookkeeping", "missing_frames")),
+        (0, 0),
+        "{m}"
+    );
+    // Selecting 50 ms after hovering leaves SC no time: the object shows twice
+    // (the paper's shadow-object case), but never goes missing.
+    let quick = summary(
+        MIGRATION,
+        &[
+            "migration.script=[{at=\"2s\",action=\"hover\"},{at=\"2.05s\",action=\"select\"},{at=\"2.06s\",action=\"drag\"},{at=\"4s\",action=\"release\"},{at=\"4.01s\",action=\"leave\"}]",
+        ],
+    );
+    let q = &quick["metrics"]["migration"]["bookkeeping"];
+    assert!(q["doubled_frames"].as_u64().unwrap() > 0, "{q}");
+    assert_eq!(q["missing_frames"].as_u64().unwrap(), 0, "{q}");
+    // Scripts out of order are refused with the key.
+    let e = try_run(
+        MIGRATION,
+        &["migration.script=[{at=\"3s\",action=\"hover\"},{at=\"2s\",action=\"select\"}]"],
+    )
+    .err()
+    .unwrap();
+    assert!(e.contains("migration.script.1.at"), "{e}");
+}
