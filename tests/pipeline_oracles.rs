@@ -202,6 +202,7 @@ fn tracing_does_not_change_results_at_either_fidelity() {
         }
         let get = |trace: bool| match run_model(&src, &t, trace).unwrap() {
             SystemRun::FramePipeline(r) => *r,
+            _ => panic!("not a frame-pipeline run"),
         };
         let (a, b) = (get(false), get(true));
         assert!(a.trace.is_none() && b.trace.is_some());

@@ -4,6 +4,7 @@
 //! experiment runner use.
 
 pub mod frame_pipeline;
+pub mod pixelflow;
 
 use std::io::Write;
 
@@ -23,6 +24,9 @@ pub enum SimError {
     /// The frame pipeline failed while running.
     #[error(transparent)]
     Pipeline(frame_pipeline::PipelineError),
+    /// The PixelFlow model failed while running.
+    #[error(transparent)]
+    PixelFlow(pixelflow::PixelFlowError),
 }
 
 /// The result of running one model.
@@ -30,6 +34,8 @@ pub enum SimError {
 pub enum SystemRun {
     /// A frame-pipeline run.
     FramePipeline(Box<frame_pipeline::PipelineRun>),
+    /// A PixelFlow run (one frame).
+    PixelFlow(Box<pixelflow::PixelFlowRun>),
 }
 
 /// Reads `--set` patches into the model's table.
@@ -55,10 +61,20 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: bool) -> Result<
                 Err(e) => Err(SimError::Pipeline(e)),
             }
         }
+        "pixelflow" => {
+            let cfg: pixelflow::PixelFlowConfig = deserialize(table, src)?;
+            match pixelflow::run_pixelflow(cfg, trace) {
+                Ok(r) => Ok(SystemRun::PixelFlow(Box::new(r))),
+                Err(pixelflow::PixelFlowError::Invalid { key, message }) => {
+                    Err(SimError::Config(invalid(src, &key, message, None)))
+                }
+                Err(e) => Err(SimError::PixelFlow(e)),
+            }
+        }
         other => Err(SimError::Config(invalid(
             src,
             "system",
-            format!("unknown system {other:?} (known: frame_pipeline)"),
+            format!("unknown system {other:?} (known: frame_pipeline, pixelflow)"),
             None,
         ))),
     }
@@ -69,6 +85,7 @@ impl SystemRun {
     pub fn summary(&self) -> &Value {
         match self {
             SystemRun::FramePipeline(r) => &r.summary,
+            SystemRun::PixelFlow(r) => &r.summary,
         }
     }
 
@@ -76,13 +93,16 @@ impl SystemRun {
     pub fn summary_mut(&mut self) -> &mut Value {
         match self {
             SystemRun::FramePipeline(r) => &mut r.summary,
+            SystemRun::PixelFlow(r) => &mut r.summary,
         }
     }
 
-    /// Writes the per-frame table as CSV.
+    /// Writes the per-frame table as CSV (PixelFlow: one row per screen
+    /// region of the simulated frame).
     pub fn write_frames_csv(&self, w: &mut dyn Write) -> std::io::Result<()> {
         match self {
             SystemRun::FramePipeline(r) => frame_pipeline::records::write_frames_csv(&r.records, w),
+            SystemRun::PixelFlow(r) => pixelflow::run::write_regions_csv(r, w),
         }
     }
 
@@ -95,6 +115,10 @@ impl SystemRun {
                     .into_iter()
                     .map(|row| row.to_vec())
                     .collect(),
+            ),
+            SystemRun::PixelFlow(r) => (
+                pixelflow::run::COLUMNS.iter().map(|s| s.to_string()).collect(),
+                pixelflow::run::region_rows(r),
             ),
         }
     }
@@ -121,6 +145,13 @@ impl SystemRun {
                     "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
                 )
             }
+            SystemRun::PixelFlow(r) => {
+                let body =
+                    toml::to_string(&r.config).unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
+                format!(
+                    "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
+                )
+            }
         }
     }
 
@@ -128,6 +159,7 @@ impl SystemRun {
     pub fn write_trace(&self, w: &mut dyn Write) -> std::io::Result<bool> {
         match self {
             SystemRun::FramePipeline(r) => crate::output::trace::write_pipeline_trace(r, w),
+            SystemRun::PixelFlow(r) => pixelflow::run::write_trace(r, w),
         }
     }
 }

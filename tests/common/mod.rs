@@ -15,6 +15,7 @@ pub fn try_run(text: &str, sets: &[&str]) -> Result<PipelineRun, String> {
     }
     match run_model(&src, &t, false).map_err(|e| e.to_string())? {
         SystemRun::FramePipeline(r) => Ok(*r),
+        other => Err(format!("not a frame-pipeline run: {}", other.summary()["system"])),
     }
 }
 
