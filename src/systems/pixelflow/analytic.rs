@@ -108,3 +108,26 @@ pub fn closed_form(cfg: &PixelFlowConfig) -> Analytic {
     a.latency_ms = a.front_end_ms + a.back_end_ms;
     a
 }
+
+/// The largest primitive count whose closed-form latency is at most
+/// `target_ms` (bisection; the closed forms are nondecreasing in n), or 0
+/// if even an empty frame takes longer. Capped at 10^10 primitives.
+pub fn primitives_at(cfg: &PixelFlowConfig, target_ms: f64) -> f64 {
+    let mut c = cfg.clone();
+    let mut lat = |n: u64| {
+        c.primitives = n;
+        closed_form(&c).latency_ms
+    };
+    if lat(0) > target_ms {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = (0u64, 10_000_000_000u64);
+    if lat(hi) <= target_ms {
+        return hi as f64;
+    }
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if lat(mid) <= target_ms { lo = mid } else { hi = mid }
+    }
+    lo as f64
+}

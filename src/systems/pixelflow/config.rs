@@ -84,9 +84,10 @@ pub struct PixelFlowConfig {
     pub samples: u32,
     /// Primitives per frame.
     pub primitives: u64,
-    /// Master seed (only `random` and `clustered` placement draw numbers).
-    #[serde(default = "default_seed")]
-    pub seed: u64,
+    /// Seed (`run.seed`, as in every system; only `random` and `clustered`
+    /// placement draw numbers).
+    #[serde(default)]
+    pub run: RunConfig,
     /// Where primitives fall.
     #[serde(default = "default_placement")]
     pub placement: Placement,
@@ -107,6 +108,20 @@ pub struct PixelFlowConfig {
     pub deferred: DeferredCosts,
     /// Costs of the non-texturing architecture (§6).
     pub nontex: NontexCosts,
+}
+
+/// Run settings.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RunConfig {
+    /// Master seed of the RNG streams.
+    pub seed: u64,
+}
+
+impl Default for RunConfig {
+    fn default() -> Self {
+        RunConfig { seed: 1 }
+    }
 }
 
 /// Cluster of primitives for `placement = "clustered"`.
@@ -178,9 +193,6 @@ pub struct NontexCosts {
 
 fn default_fidelity() -> Fidelity {
     Fidelity::Event
-}
-fn default_seed() -> u64 {
-    1
 }
 fn default_placement() -> Placement {
     Placement::Uniform

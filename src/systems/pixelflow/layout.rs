@@ -73,7 +73,7 @@ pub fn build(cfg: &PixelFlowConfig) -> Layout {
             }
         }
         Placement::Random | Placement::Clustered => {
-            let mut rng = RngStreams::new(cfg.seed).stream("pixelflow.placement");
+            let mut rng = RngStreams::new(cfg.run.seed).stream("pixelflow.placement");
             let fp = cfg.footprint();
             let (cols, _) = cfg.region_grid();
             let cluster = cfg.cluster.as_ref().filter(|_| cfg.placement == Placement::Clustered);

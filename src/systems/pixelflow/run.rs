@@ -248,7 +248,7 @@ fn summary(
         "samples": cfg.samples,
         "primitives": cfg.primitives,
         "placement": cfg.placement,
-        "seed": cfg.seed,
+        "seed": cfg.run.seed,
         "frames": 1,
         "warmup_frames": 0,
         "events": {"total": events, "by_kind": by_kind},
@@ -268,6 +268,8 @@ fn summary(
             "realised_overlap": realised,
             "region_entries": entries,
             "analytic": a,
+            "analytic_primitives_at_30ms": super::analytic::primitives_at(cfg, 30.0),
+            "analytic_primitives_at_40ms": super::analytic::primitives_at(cfg, 40.0),
         },
     })
 }

@@ -154,7 +154,7 @@ fn few_primitives_show_pipeline_fill_and_drain() {
 
 #[test]
 fn runs_are_deterministic_and_seeded() {
-    let sets = ["placement=\"random\"", "primitives=50000", "seed=7"];
+    let sets = ["placement=\"random\"", "primitives=50000", "run.seed=7"];
     let a = run_with(&sets).unwrap();
     let b = run_with(&sets).unwrap();
     assert_eq!(metric(&a, "latency_ms"), metric(&b, "latency_ms"));
@@ -162,7 +162,7 @@ fn runs_are_deterministic_and_seeded() {
         a.summary()["metrics"]["region_entries"],
         b.summary()["metrics"]["region_entries"]
     );
-    let c = run_with(&["placement=\"random\"", "primitives=50000", "seed=8"]).unwrap();
+    let c = run_with(&["placement=\"random\"", "primitives=50000", "run.seed=8"]).unwrap();
     assert_ne!(
         a.summary()["metrics"]["region_entries"],
         c.summary()["metrics"]["region_entries"]
