@@ -102,6 +102,8 @@ pub struct ExperimentResult {
     pub sim_wall_seconds: f64,
     /// Files written, relative to the output directory.
     pub files: Vec<PathBuf>,
+    /// Inverse what-ifs, in file order.
+    pub searches: Vec<super::inverse::SearchResult>,
 }
 
 impl ExperimentResult {
@@ -303,6 +305,31 @@ pub fn run_experiment(
         files.push(PathBuf::from(format!("{}.png", plot.file)));
     }
 
+    let mut search_base = base_model.clone();
+    for (k, v) in &exp.set {
+        set_dotted(&mut search_base, k, v.clone())?;
+    }
+    let search_seed = exp.seeds().first().copied().unwrap_or(1);
+    let searches: Vec<super::inverse::SearchResult> = exp
+        .searches
+        .par_iter()
+        .map(|sp| {
+            sp.run(runner, &search_base, search_seed)
+                .map_err(|message| ExperimentError::Search {
+                    name: sp.name.clone(),
+                    message,
+                })
+        })
+        .collect::<Result<_, _>>()?;
+    if !searches.is_empty() {
+        let path = out_dir.join("searches.csv");
+        std::fs::write(&path, super::inverse::csv(&searches)).map_err(|source| ExperimentError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        files.push(PathBuf::from("searches.csv"));
+    }
+
     let mut result = ExperimentResult {
         name: exp.name.clone(),
         paths,
@@ -313,10 +340,12 @@ pub fn run_experiment(
         checks_failed,
         wall_seconds: 0.0,
         files,
+        searches,
     };
     result.wall_seconds = started.elapsed().as_secs_f64();
     let report_path = out_dir.join("report.md");
-    std::fs::write(&report_path, report::render(exp, &result)).map_err(|source| ExperimentError::Io {
+    let report_text = report::render(exp, &result) + &super::inverse::report_section(&exp.searches, &result.searches);
+    std::fs::write(&report_path, report_text).map_err(|source| ExperimentError::Io {
         path: report_path,
         source,
     })?;
