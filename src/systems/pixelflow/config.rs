@@ -84,6 +84,11 @@ pub struct PixelFlowConfig {
     pub samples: u32,
     /// Primitives per frame.
     pub primitives: u64,
+    /// Frames in a row (standard and presort; nontex runs one). The first
+    /// starts on an idle machine; later frames start as soon as the
+    /// architecture allows (standard: two instruction buffers).
+    #[serde(default = "default_frames")]
+    pub frames: u32,
     /// Seed (`run.seed`, as in every system; only `random` and `clustered`
     /// placement draw numbers).
     #[serde(default)]
@@ -193,6 +198,9 @@ pub struct NontexCosts {
 
 fn default_fidelity() -> Fidelity {
     Fidelity::Event
+}
+fn default_frames() -> u32 {
+    1
 }
 fn default_placement() -> Placement {
     Placement::Uniform

@@ -188,6 +188,13 @@ pub struct PixelFlow {
     nodes: usize,
     regions: usize,
     shaders: usize,
+    frames: usize,
+    /// Regions over all frames (frame f's region j is `f * regions + j`).
+    total: usize,
+    geom_frame: Vec<u32>,
+    sorted: Vec<u32>,
+    /// Per frame: geometry start (earliest node), front end done (last node), done.
+    pub frame_times: Vec<(Option<Time>, Time, Option<Time>)>,
     // per node
     gen_ready: Vec<u32>,
     gen_busy: Vec<bool>,
@@ -241,18 +248,28 @@ impl PixelFlow {
         let nodes = layout.nodes;
         let regions = layout.regions;
         let shaders = cfg.shaders().max(1) as usize;
+        let frames = match cfg.architecture {
+            Architecture::Nontex => 1,
+            _ => cfg.frames.max(1) as usize,
+        };
+        let total = frames * regions;
         let b = cfg.nontex.batch_primitives.max(1);
         let batches = layout.prims.iter().map(|&p| p.div_ceil(b).max(1)).collect();
         PixelFlow {
             nodes,
             regions,
             shaders,
+            frames,
+            total,
+            geom_frame: vec![0; nodes],
+            sorted: vec![0; nodes],
+            frame_times: vec![(None, Time::ZERO, None); frames],
             gen_ready: vec![0; nodes],
             gen_busy: vec![false; nodes],
             gen_end: vec![Time::ZERO; nodes],
             rast_next: vec![0; nodes],
             rast_busy: vec![false; nodes],
-            region_rast: vec![0; regions],
+            region_rast: vec![0; total],
             comp_next: 0,
             net_busy: false,
             shader_reserved: vec![false; shaders],
@@ -272,7 +289,7 @@ impl PixelFlow {
             final_comp: false,
             front_end_done: Time::ZERO,
             finished: None,
-            records: vec![RegionRecord::default(); regions],
+            records: vec![RegionRecord::default(); total],
             busy: Busy {
                 geometry: vec![Duration::ZERO; nodes],
                 generate: vec![Duration::ZERO; nodes],
@@ -324,6 +341,10 @@ impl PixelFlow {
 
     /// Schedules the frame's first events.
     pub fn start(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), PixelFlowError> {
+        if self.cfg.architecture != Architecture::Nontex {
+            return self.settle(sched);
+        }
+        self.frame_times[0].0 = Some(Time::ZERO);
         for r in 0..self.nodes {
             let p = self.layout.prims[r];
             let (d, ev, name) = match self.cfg.architecture {
@@ -402,18 +423,57 @@ impl PixelFlow {
         }
     }
 
+    /// Whether node `r` may start the geometry (standard) or sorting pass
+    /// (presort) of its next frame.
+    fn geometry_may_start(&self, r: usize) -> bool {
+        let f = self.geom_frame[r] as usize;
+        if self.geom_busy[r] || self.gen_busy[r] || f >= self.frames {
+            return false;
+        }
+        match self.cfg.architecture {
+            // Two instruction buffers: frame f reuses frame f-2's buffer once
+            // this node has rasterized all of frame f-2.
+            Architecture::Standard => f < 2 || self.rast_next[r] as usize >= (f - 1) * self.regions,
+            // No frame pipelining: the next sorting pass follows the
+            // generation of this frame's instructions.
+            _ => self.gen_ready[r] as usize >= f * self.regions,
+        }
+    }
+
     fn settle_deferred(&mut self, sched: &mut Scheduler<Ev>) -> Result<bool, PixelFlowError> {
         let mut moved = false;
         let c = self.cfg.deferred.clone();
         let now = sched.now();
+        // A frame starts on every rasterizer at one instant (one head-pose
+        // sample): once every node may start it.
+        let all_may_start = (0..self.nodes).all(|r| self.geometry_may_start(r));
         for r in 0..self.nodes {
+            if all_may_start {
+                let f = self.geom_frame[r] as usize;
+                let p = self.layout.prims[r];
+                let (per, name) = match self.cfg.architecture {
+                    Architecture::Standard => (c.t_trans, "geometry + bucket sort"),
+                    _ => (c.t_first_pass, "sorting pass"),
+                };
+                let d = c
+                    .t_overhead
+                    .checked_add(mul(per, p, name)?)
+                    .unwrap_or(Duration(u64::MAX));
+                self.geom_busy[r] = true;
+                self.busy.geometry[r] = self.busy.geometry[r].checked_add(d).unwrap_or(Duration(u64::MAX));
+                let ft = &mut self.frame_times[f].0;
+                *ft = Some(ft.map_or(now, |t| t.min(now)));
+                self.work(sched, d, Ev::GeomDone(r as u32), 0, r as u32, name, f as u32)?;
+                moved = true;
+            }
             // Presort: generate the next region's instructions.
             if self.cfg.architecture == Architecture::Presort
                 && !self.geom_busy[r]
                 && !self.gen_busy[r]
-                && (self.gen_ready[r] as usize) < self.regions
+                && (self.gen_ready[r] as usize) < self.sorted[r] as usize * self.regions
             {
-                let j = self.gen_ready[r] as usize;
+                let g = self.gen_ready[r] as usize;
+                let j = g % self.regions;
                 let entries = self.layout.bin(r, j);
                 let total = self.layout.node_entries(r).max(1);
                 // The node's t_gen_each x primitives, spread over its regions
@@ -433,7 +493,7 @@ impl PixelFlow {
                     0,
                     r as u32,
                     "generate instructions",
-                    j as u32,
+                    g as u32,
                 )?;
                 moved = true;
             }
@@ -444,11 +504,15 @@ impl PixelFlow {
             // than one primitive after it.
             let streaming = self.gen_busy[r] && self.gen_ready[r] == j;
             if !self.rast_busy[r]
-                && (j as usize) < self.regions
+                && (j as usize) < self.total
                 && (self.gen_ready[r] > j || streaming)
                 && self.comp_next >= j
             {
-                let work = mul(c.t_rast_per_prim, self.layout.bin(r, j as usize), "rasterization")?;
+                let work = mul(
+                    c.t_rast_per_prim,
+                    self.layout.bin(r, j as usize % self.regions),
+                    "rasterization",
+                )?;
                 let mut d = work;
                 if streaming {
                     let tail = self.gen_end[r]
@@ -464,7 +528,7 @@ impl PixelFlow {
             }
         }
         let j = self.comp_next as usize;
-        if !self.net_busy && j < self.regions && self.region_rast[j] as usize == self.nodes {
+        if !self.net_busy && j < self.total && self.region_rast[j] as usize == self.nodes {
             let s = j % self.shaders;
             if !self.shader_reserved[s] {
                 self.shader_reserved[s] = true;
@@ -586,6 +650,7 @@ impl PixelFlow {
         let now = sched.now();
         if self.pass == 1 {
             self.front_end_done = now;
+            self.frame_times[0].1 = now;
         }
         for rec in &mut self.records {
             rec.rasterized = Some(now);
@@ -612,10 +677,17 @@ impl Model for PixelFlow {
         match ev {
             Ev::GeomDone(r) => {
                 let r = r as usize;
+                let f = self.geom_frame[r] as usize;
                 self.geom_busy[r] = false;
-                self.front_end_done = self.front_end_done.max(now);
+                self.geom_frame[r] += 1;
+                self.frame_times[f].1 = self.frame_times[f].1.max(now);
+                if f == 0 {
+                    self.front_end_done = self.front_end_done.max(now);
+                }
                 if self.cfg.architecture == Architecture::Standard {
-                    self.gen_ready[r] = self.regions as u32;
+                    self.gen_ready[r] = ((f + 1) * self.regions) as u32;
+                } else {
+                    self.sorted[r] += 1;
                 }
             }
             Ev::GenDone(r) => {
@@ -654,7 +726,13 @@ impl Model for PixelFlow {
                 self.load_busy = None;
                 self.records[j as usize].loaded = Some(now);
                 self.loaded += 1;
-                if self.loaded == self.regions {
+                if self.loaded.is_multiple_of(self.regions) {
+                    let f = self.loaded / self.regions - 1;
+                    if let Some(ft) = self.frame_times.get_mut(f) {
+                        ft.2 = Some(now);
+                    }
+                }
+                if self.loaded == self.total {
                     self.finished = Some(now);
                     return Ok(Control::Stop);
                 }

@@ -52,6 +52,18 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), PixelFlowError> {
     if cfg.system != "pixelflow" {
         return Err(bad("system", format!("expected \"pixelflow\", got {:?}", cfg.system)));
     }
+    if cfg.frames == 0 || cfg.frames > 10_000 {
+        return Err(bad(
+            "frames",
+            format!("must be between 1 and 10000, got {}", cfg.frames),
+        ));
+    }
+    if cfg.frames > 1 && cfg.architecture == super::Architecture::Nontex {
+        return Err(bad(
+            "frames",
+            "the non-texturing system is simulated one frame at a time (frames = 1)",
+        ));
+    }
     if cfg.samples == 0 {
         return Err(bad("samples", "must be at least 1 (1 = no antialiasing)"));
     }
@@ -139,6 +151,7 @@ pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, 
             None,
             wall,
             0.0,
+            &[(0.0, a.front_end_ms, a.latency_ms)],
         );
         return Ok(PixelFlowRun {
             config: cfg,
@@ -174,8 +187,17 @@ pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, 
         "color": ms(b.color),
         "load": ms(b.load),
     });
-    let latency = done.as_ms_f64();
-    let front = model.front_end_done.as_ms_f64();
+    let _ = done;
+    let frames: Vec<(f64, f64, f64)> = model
+        .frame_times
+        .iter()
+        .map(|(s, f, d)| {
+            let s = s.map_or(f64::NAN, |t| t.as_ms_f64());
+            (s, f.as_ms_f64(), d.map_or(f64::NAN, |t| t.as_ms_f64()))
+        })
+        .collect();
+    let latency = frames[0].2 - frames[0].0;
+    let front = frames[0].1 - frames[0].0;
     let summary = summary(
         &model.cfg,
         &analytic,
@@ -186,6 +208,7 @@ pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, 
         Some((&model.layout, &region_entries)),
         build_seconds + stats.wall_seconds,
         stats.wall_seconds,
+        &frames,
     );
     Ok(PixelFlowRun {
         analytic,
@@ -209,6 +232,7 @@ fn summary(
     layout: Option<(&Layout, &Vec<u64>)>,
     wall: f64,
     simulate: f64,
+    frames: &[(f64, f64, f64)],
 ) -> Value {
     let (events, by_kind) = match stats {
         Some(s) => (
@@ -237,6 +261,20 @@ fn summary(
     } else {
         0.0
     };
+    let lat: Vec<f64> = frames.iter().map(|f| f.2 - f.0).collect();
+    let intervals: Vec<f64> = frames.windows(2).map(|w| w[1].2 - w[0].2).collect();
+    let stat = |v: &[f64]| -> Value {
+        if v.is_empty() {
+            return Value::Null;
+        }
+        let mean = v.iter().sum::<f64>() / v.len() as f64;
+        let max = v.iter().copied().fold(f64::MIN, f64::max);
+        json!({"first": v[0], "last": v[v.len() - 1], "mean": mean, "max": max})
+    };
+    let frame_rows: Vec<Value> = frames
+        .iter()
+        .map(|f| json!({"start_ms": f.0, "front_end_done_ms": f.1, "done_ms": f.2, "latency_ms": f.2 - f.0}))
+        .collect();
     json!({
         "system": "pixelflow",
         "description": cfg.description,
@@ -249,7 +287,7 @@ fn summary(
         "primitives": cfg.primitives,
         "placement": cfg.placement,
         "seed": cfg.run.seed,
-        "frames": 1,
+        "frames": cfg.frames,
         "warmup_frames": 0,
         "events": {"total": events, "by_kind": by_kind},
         "wall_seconds": wall,
@@ -268,6 +306,9 @@ fn summary(
             "realised_overlap": realised,
             "region_entries": entries,
             "analytic": a,
+            "frame_latency_ms": stat(&lat),
+            "frame_interval_ms": stat(&intervals),
+            "per_frame": frame_rows,
             "analytic_primitives_at_30ms": super::analytic::primitives_at(cfg, 30.0),
             "analytic_primitives_at_40ms": super::analytic::primitives_at(cfg, 40.0),
         },
@@ -275,7 +316,8 @@ fn summary(
 }
 
 /// Columns of the per-region table.
-pub const COLUMNS: [&str; 8] = [
+pub const COLUMNS: [&str; 9] = [
+    "Frame",
     "Region",
     "Entries",
     "RasterizedMs",
@@ -292,8 +334,11 @@ pub fn region_rows(run: &PixelFlowRun) -> Vec<Vec<f64>> {
     run.records
         .iter()
         .enumerate()
-        .map(|(j, r)| {
+        .map(|(g, r)| {
+            let n = run.region_entries.len().max(1);
+            let j = g % n;
             vec![
+                (g / n) as f64,
                 j as f64,
                 run.region_entries.get(j).copied().unwrap_or(0) as f64,
                 t(r.rasterized),
