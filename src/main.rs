@@ -89,7 +89,7 @@ enum Cmd {
     },
     /// Speed benchmarks, printed as ratios against baselines measured in the same run.
     Bench {
-        /// Which: kernel, pipeline, hour, all.
+        /// Which: kernel, pipeline, hour, pixelflow, all.
         #[arg(default_value = "all")]
         which: String,
         /// Scale the work down (0.01 .. 1) for a quick check.
