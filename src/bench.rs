@@ -183,14 +183,56 @@ pub fn pipeline(w: u32) -> Result<PipelineBench, String> {
     })
 }
 
+/// Figures 3 and 4 of paper 002 at event fidelity, one thread: every
+/// architecture, 1 and 4 shaders, 1 and 8 samples, `counts` primitive
+/// counts from 0 to 1,000,000. Returns (runs, events, wall seconds).
+pub fn pixelflow_figures(counts: u32) -> Result<(u64, u64, f64), String> {
+    let src = ModelSource::from_text("models/pixelflow-20.toml", include_str!("../models/pixelflow-20.toml"));
+    let base = src.table().map_err(|e| e.to_string())?;
+    let (mut runs, mut events) = (0u64, 0u64);
+    let start = Instant::now();
+    for samples in [8, 1] {
+        for arch in ["standard", "presort", "nontex"] {
+            for shaders in [1, 4] {
+                for i in 0..counts.max(2) {
+                    let n = 1_000_000u64 * i as u64 / (counts.max(2) - 1) as u64;
+                    let mut t = base.clone();
+                    for s in [
+                        format!("samples={samples}"),
+                        format!("architecture=\"{arch}\""),
+                        format!("shading_nodes={shaders}"),
+                        format!("primitives={n}"),
+                    ] {
+                        apply_set(&mut t, &s).map_err(|e| e.to_string())?;
+                    }
+                    let r = run_model(&src, &t, false).map_err(|e| e.to_string())?;
+                    events += r.summary()["events"]["total"].as_u64().unwrap_or(0);
+                    runs += 1;
+                }
+            }
+        }
+    }
+    Ok((runs, events, start.elapsed().as_secs_f64()))
+}
+
 /// Prints the benchmarks for the CLI.
 pub fn run_cli(which: &str, scale: f64) -> Result<(), String> {
     if !(scale > 0.0 && scale <= 1.0) {
         return Err(format!("--scale must be in (0, 1], got {scale}"));
     }
     let all = which == "all";
-    if !matches!(which, "all" | "kernel" | "pipeline" | "hour") {
-        return Err(format!("unknown benchmark {which:?} (kernel, pipeline, hour, all)"));
+    if !matches!(which, "all" | "kernel" | "pipeline" | "hour" | "pixelflow") {
+        return Err(format!(
+            "unknown benchmark {which:?} (kernel, pipeline, hour, pixelflow, all)"
+        ));
+    }
+    if all || which == "pixelflow" {
+        let counts = ((51.0 * scale) as u32).max(2);
+        let (runs, events, wall) = pixelflow_figures(counts)?;
+        println!(
+            "pixelflow Figures 3 and 4 at event fidelity, one thread: {runs} runs ({counts} primitive counts x 3 architectures x 2 shader counts x 2 sample counts), {events} events, {wall:.3} s wall ({:.2} ms per run)",
+            1e3 * wall / runs as f64
+        );
     }
     if all || which == "kernel" {
         for pop in [1_000usize, 100_000] {

@@ -135,7 +135,7 @@ enum Cmd {
     },
     /// Speed benchmarks, printed as ratios against baselines measured in the same run.
     Bench {
-        /// Which: kernel, pipeline, hour, all.
+        /// Which: kernel, pipeline, hour, pixelflow, all.
         #[arg(default_value = "all")]
         which: String,
         /// Scale the work down (0.01 .. 1) for a quick check.
@@ -285,6 +285,37 @@ fn print_human(run: &SystemRun) {
     }
     let m = &s["metrics"];
     let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+    if s["system"] == "pixelflow" {
+        println!(
+            "{} ({}, {}), {} nodes ({} rasterizing, {} shading), {} samples, {} primitives",
+            s["model"].as_str().unwrap_or(""),
+            s["architecture"].as_str().unwrap_or(""),
+            s["fidelity"].as_str().unwrap_or(""),
+            s["nodes"],
+            s["rasterizers"],
+            s["shaders"],
+            s["samples"],
+            s["primitives"]
+        );
+        println!(
+            "  latency {:.3} ms (front end {:.3} + back end {:.3}); closed form {:.3} ms ({:+.2}%)",
+            f(&m["latency_ms"]),
+            f(&m["front_end_ms"]),
+            f(&m["back_end_ms"]),
+            f(&m["analytic_latency_ms"]),
+            100.0 * f(&m["relative_error"])
+        );
+        if let Some(st) = m["stages_ms"].as_object() {
+            let parts: Vec<String> = st.iter().map(|(k, v)| format!("{k} {:.3}", f(v))).collect();
+            println!("  busy per unit (ms): {}", parts.join(", "));
+        }
+        println!(
+            "  {} events in {:.4} s wall",
+            s["events"]["total"],
+            f(&s["wall_seconds"])
+        );
+        return;
+    }
     println!(
         "{} ({}), {} frames, seed {}",
         s["model"].as_str().unwrap_or(""),

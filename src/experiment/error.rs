@@ -33,6 +33,14 @@ pub enum ExperimentError {
         /// What is wrong with it.
         message: String,
     },
+    /// An inverse what-if (`[[search]]`) failed.
+    #[error("search {name:?} failed: {message}")]
+    Search {
+        /// The search's name.
+        name: String,
+        /// Why.
+        message: String,
+    },
     /// A dotted-key patch could not be applied to a model.
     #[error("cannot set `{key}`: {message}")]
     Patch {

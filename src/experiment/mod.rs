@@ -57,7 +57,19 @@
 //! at_least_path = "metrics.analytic.gpu_max_ms"   # either or both
 //! at_most_path = "metrics.analytic.gpu_sum_ms"
 //! rel_tolerance = 0.01   # relative to each bound (or tolerance = absolute)
+//! [[search]]             # inverse what-if: which value of one key reaches a target
+//! name = "first-pass"
+//! vary = "deferred.t_first_pass"
+//! from = 0.1             # bracket, bisection inside it
+//! to = 5.0
+//! format = "{}us"        # optional
+//! path = "metrics.analytic_primitives_at_30ms"
+//! target = 186572        # or target_from = { path = "...", set = { ... }, scale = 1.125 }
+//! set = { architecture = "presort" }   # overrides for this search only
 //! ```
+//!
+//! Searches are described in [`inverse`]; their results go to
+//! `searches.csv` and a section of `report.md`.
 //!
 //! Outputs in the output directory: `runs.csv` (one row per point and seed),
 //! `points.csv` (per point: `<path>:mean`, `:ci_low`, `:ci_high`, `:n` for
@@ -69,6 +81,7 @@ mod derived;
 mod dotted;
 mod error;
 mod figures;
+pub mod inverse;
 mod report;
 mod run;
 mod runner;

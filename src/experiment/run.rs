@@ -105,6 +105,8 @@ pub struct ExperimentResult {
     /// Caption lines for the plots, as `(plot file, line)` in plot order
     /// (e.g. histogram values outside the plot's `range`).
     pub plot_captions: Vec<(String, String)>,
+    /// Inverse what-ifs, in file order.
+    pub searches: Vec<super::inverse::SearchResult>,
 }
 
 impl ExperimentResult {
@@ -309,6 +311,31 @@ pub fn run_experiment(
         files.push(PathBuf::from(format!("{}.png", plot.file)));
     }
 
+    let mut search_base = base_model.clone();
+    for (k, v) in &exp.set {
+        set_dotted(&mut search_base, k, v.clone())?;
+    }
+    let search_seed = exp.seeds().first().copied().unwrap_or(1);
+    let searches: Vec<super::inverse::SearchResult> = exp
+        .searches
+        .par_iter()
+        .map(|sp| {
+            sp.run(runner, &search_base, search_seed)
+                .map_err(|message| ExperimentError::Search {
+                    name: sp.name.clone(),
+                    message,
+                })
+        })
+        .collect::<Result<_, _>>()?;
+    if !searches.is_empty() {
+        let path = out_dir.join("searches.csv");
+        std::fs::write(&path, super::inverse::csv(&searches)).map_err(|source| ExperimentError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        files.push(PathBuf::from("searches.csv"));
+    }
+
     let mut result = ExperimentResult {
         name: exp.name.clone(),
         paths,
@@ -320,10 +347,12 @@ pub fn run_experiment(
         wall_seconds: 0.0,
         files,
         plot_captions,
+        searches,
     };
     result.wall_seconds = started.elapsed().as_secs_f64();
     let report_path = out_dir.join("report.md");
-    std::fs::write(&report_path, report::render(exp, &result)).map_err(|source| ExperimentError::Io {
+    let report_text = report::render(exp, &result) + &super::inverse::report_section(&exp.searches, &result.searches);
+    std::fs::write(&report_path, report_text).map_err(|source| ExperimentError::Io {
         path: report_path,
         source,
     })?;

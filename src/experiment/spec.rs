@@ -207,6 +207,8 @@ pub struct Experiment {
     pub derived: Vec<Derived>,
     /// Reference checks.
     pub checks: Vec<Check>,
+    /// Inverse what-ifs (`[[search]]`).
+    pub searches: Vec<super::inverse::Search>,
 }
 
 impl Experiment {
@@ -336,6 +338,8 @@ struct RawExperiment {
     derived: Vec<RawDerived>,
     #[serde(default)]
     check: Vec<RawCheck>,
+    #[serde(default)]
+    search: Vec<super::inverse::RawSearch>,
 }
 
 fn default_model() -> String {
@@ -787,6 +791,20 @@ impl Validator<'_> {
             });
         }
 
+        let mut searches = Vec::new();
+        for (i, r) in raw.search.into_iter().enumerate() {
+            let flat = |t: &toml::Table| {
+                let mut v = Vec::new();
+                flatten("", t, &mut v);
+                v
+            };
+            let sp = super::inverse::validate(r, flat).map_err(|(k, m)| self.err(format!("search[{i}].{k}"), m))?;
+            if searches.iter().any(|o: &super::inverse::Search| o.name == sp.name) {
+                return Err(self.err(format!("search[{i}].name"), format!("`{}` is used twice", sp.name)));
+            }
+            searches.push(sp);
+        }
+
         Ok(Experiment {
             source: self.file.to_path_buf(),
             name: raw.name,
@@ -801,6 +819,7 @@ impl Validator<'_> {
             plots,
             derived,
             checks,
+            searches,
         })
     }
 }

@@ -5,6 +5,7 @@
 
 pub mod frame_pipeline;
 pub mod multi_rate;
+pub mod pixelflow;
 pub mod vr;
 
 use std::io::Write;
@@ -31,6 +32,9 @@ pub enum SimError {
     /// The VR pipeline failed while running.
     #[error(transparent)]
     Vr(vr::VrError),
+    /// The PixelFlow model failed while running.
+    #[error(transparent)]
+    PixelFlow(pixelflow::PixelFlowError),
 }
 
 /// The result of running one model.
@@ -42,6 +46,8 @@ pub enum SystemRun {
     MultiRate(Box<multi_rate::MultiRateRun>),
     /// A VR-pipeline run.
     Vr(Box<vr::VrRun>),
+    /// A PixelFlow run (one frame).
+    PixelFlow(Box<pixelflow::PixelFlowRun>),
 }
 
 /// Reads `--set` patches into the model's table.
@@ -85,10 +91,20 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: bool) -> Result<
                 Err(e) => Err(SimError::Vr(e)),
             }
         }
+        "pixelflow" => {
+            let cfg: pixelflow::PixelFlowConfig = deserialize(table, src)?;
+            match pixelflow::run_pixelflow(cfg, trace) {
+                Ok(r) => Ok(SystemRun::PixelFlow(Box::new(r))),
+                Err(pixelflow::PixelFlowError::Invalid { key, message }) => {
+                    Err(SimError::Config(invalid(src, &key, message, None)))
+                }
+                Err(e) => Err(SimError::PixelFlow(e)),
+            }
+        }
         other => Err(SimError::Config(invalid(
             src,
             "system",
-            format!("unknown system {other:?} (known: frame_pipeline, multi_rate, vr)"),
+            format!("unknown system {other:?} (known: frame_pipeline, multi_rate, vr, pixelflow)"),
             None,
         ))),
     }
@@ -101,6 +117,7 @@ impl SystemRun {
             SystemRun::FramePipeline(r) => &r.summary,
             SystemRun::MultiRate(r) => &r.summary,
             SystemRun::Vr(r) => &r.summary,
+            SystemRun::PixelFlow(r) => &r.summary,
         }
     }
 
@@ -110,15 +127,18 @@ impl SystemRun {
             SystemRun::FramePipeline(r) => &mut r.summary,
             SystemRun::MultiRate(r) => &mut r.summary,
             SystemRun::Vr(r) => &mut r.summary,
+            SystemRun::PixelFlow(r) => &mut r.summary,
         }
     }
 
-    /// Writes the per-frame table as CSV (per input event for latency systems).
+    /// Writes the per-frame table as CSV (per input event for latency
+    /// systems; PixelFlow: one row per screen region of the simulated frame).
     pub fn write_frames_csv(&self, w: &mut dyn Write) -> std::io::Result<()> {
         match self {
             SystemRun::FramePipeline(r) => frame_pipeline::records::write_frames_csv(&r.records, w),
             SystemRun::MultiRate(r) => multi_rate::run::write_events_csv(&r.events, w),
             SystemRun::Vr(r) => vr::run::write_motions_csv(&r.motions, w),
+            SystemRun::PixelFlow(r) => pixelflow::run::write_regions_csv(r, w),
         }
     }
 
@@ -139,6 +159,10 @@ impl SystemRun {
             SystemRun::Vr(r) => (
                 vr::run::COLUMNS.iter().map(|s| s.to_string()).collect(),
                 vr::run::motion_rows(&r.motions),
+            ),
+            SystemRun::PixelFlow(r) => (
+                pixelflow::run::COLUMNS.iter().map(|s| s.to_string()).collect(),
+                pixelflow::run::region_rows(r),
             ),
         }
     }
@@ -179,6 +203,13 @@ impl SystemRun {
                     "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
                 )
             }
+            SystemRun::PixelFlow(r) => {
+                let body =
+                    toml::to_string(&r.config).unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
+                format!(
+                    "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
+                )
+            }
         }
     }
 
@@ -188,6 +219,7 @@ impl SystemRun {
             SystemRun::FramePipeline(r) => crate::output::trace::write_pipeline_trace(r, w),
             SystemRun::MultiRate(r) => multi_rate::run::write_trace(r, w),
             SystemRun::Vr(r) => vr::run::write_trace(r, w),
+            SystemRun::PixelFlow(r) => pixelflow::run::write_trace(r, w),
         }
     }
 }

@@ -1,0 +1,415 @@
+//! Inverse what-ifs: which value of one model key makes a metric reach a
+//! target? A bracketed bisection over `[from, to]` (the metric must cross
+//! the target inside the bracket; a monotone metric is the intended case).
+//!
+//! ```toml
+//! [[search]]
+//! name = "presort-first-pass-for-claim-c"
+//! vary = "deferred.t_first_pass"       # the one key searched
+//! from = 0.1                           # bracket
+//! to = 5.0
+//! format = "{}us"                      # optional, like a sweep range's
+//! integer = false                      # true: write the value rounded, as an integer
+//! path = "metrics.analytic_primitives_at_30ms"
+//! target = 186572                      # or target_from = { path, set, scale }
+//! set = { architecture = "presort" }   # overrides for this search only
+//! tolerance = 0.001                    # relative to the target (default 0.001)
+//! max_iterations = 60                  # default 60
+//! ```
+//!
+//! `target_from = { path = "...", set = { ... }, scale = 1.0 }` runs the base
+//! model (experiment `[set]`, the search's `set`, then the reference's `set`;
+//! the varied key keeps its model value) once and takes `scale` times its
+//! metric `path` as the target: "presort should gain only 12.5%
+//! over standard" is `target_from = { path = "...", set = { architecture =
+//! "standard" }, scale = 1.125 }`.
+
+use serde::{Deserialize, Serialize};
+
+use super::dotted::{json_number, set_dotted};
+use super::runner::Runner;
+use super::sweep::format_range_number;
+
+/// One search, validated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Search {
+    /// Name shown in the report.
+    pub name: String,
+    /// Free text.
+    pub description: String,
+    /// Dotted model key that varies.
+    pub vary: String,
+    /// Lower end of the bracket.
+    pub from: f64,
+    /// Upper end of the bracket.
+    pub to: f64,
+    /// `{}` is replaced by the number (a string value); none: a float.
+    pub format: Option<String>,
+    /// Write the value as an integer (rounded), for counts.
+    pub integer: bool,
+    /// Metric path into the run summary.
+    pub path: String,
+    /// What the target is.
+    pub target: Target,
+    /// Overrides for this search, after the experiment's `[set]`.
+    pub set: Vec<(String, toml::Value)>,
+    /// Relative tolerance on the target.
+    pub tolerance: f64,
+    /// Bisection steps at most.
+    pub max_iterations: u32,
+}
+
+/// The value the metric should reach.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Target {
+    /// A number.
+    Value(f64),
+    /// `scale` times a metric of a reference run.
+    FromRun {
+        /// Metric path of the reference run.
+        path: String,
+        /// Overrides of the reference run.
+        set: Vec<(String, toml::Value)>,
+        /// Factor.
+        scale: f64,
+    },
+}
+
+/// What a search found.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SearchResult {
+    /// The search's name.
+    pub name: String,
+    /// The varied key.
+    pub vary: String,
+    /// The metric path.
+    pub path: String,
+    /// Target value of the metric.
+    pub target: f64,
+    /// Value at the bracket's ends (from, to).
+    pub at_ends: (f64, f64),
+    /// The value found (None when the bracket does not cross the target).
+    pub value: Option<f64>,
+    /// The metric at the value found.
+    pub metric: Option<f64>,
+    /// Runs made.
+    pub runs: u32,
+    /// Whether the tolerance was met.
+    pub converged: bool,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawSearch {
+    name: String,
+    #[serde(default)]
+    description: String,
+    vary: String,
+    from: f64,
+    to: f64,
+    format: Option<String>,
+    #[serde(default)]
+    integer: bool,
+    path: String,
+    target: Option<f64>,
+    target_from: Option<RawTargetFrom>,
+    #[serde(default)]
+    set: toml::Table,
+    tolerance: Option<f64>,
+    max_iterations: Option<u32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawTargetFrom {
+    path: String,
+    #[serde(default)]
+    set: toml::Table,
+    scale: Option<f64>,
+}
+
+/// Validates a raw search; the error is (key suffix, message).
+pub(crate) fn validate(
+    raw: RawSearch,
+    flatten: impl Fn(&toml::Table) -> Vec<(String, toml::Value)>,
+) -> Result<Search, (String, String)> {
+    let e = |k: &str, m: String| Err((k.to_string(), m));
+    if raw.name.trim().is_empty() {
+        return e("name", "must not be empty".into());
+    }
+    if raw.vary.split('.').any(|p| p.trim().is_empty()) {
+        return e("vary", format!("`{}` is not a dotted key", raw.vary));
+    }
+    if !(raw.from.is_finite() && raw.to.is_finite()) || raw.from >= raw.to {
+        return e(
+            "from",
+            format!("need finite from < to, got {} and {}", raw.from, raw.to),
+        );
+    }
+    if let Some(f) = &raw.format
+        && !f.contains("{}")
+    {
+        return e("format", format!("must contain `{{}}`, got \"{f}\""));
+    }
+    let tolerance = raw.tolerance.unwrap_or(1e-3);
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        return e("tolerance", format!("must be > 0, got {tolerance}"));
+    }
+    let target = match (raw.target, raw.target_from) {
+        (Some(v), None) if v.is_finite() => Target::Value(v),
+        (None, Some(t)) => {
+            let scale = t.scale.unwrap_or(1.0);
+            if !scale.is_finite() {
+                return e("target_from.scale", format!("must be finite, got {scale}"));
+            }
+            Target::FromRun {
+                path: t.path,
+                set: flatten(&t.set),
+                scale,
+            }
+        }
+        _ => {
+            return e(
+                "target",
+                "give exactly one of a finite `target` or `target_from`".into(),
+            );
+        }
+    };
+    Ok(Search {
+        name: raw.name,
+        description: raw.description,
+        vary: raw.vary,
+        from: raw.from,
+        to: raw.to,
+        format: raw.format,
+        integer: raw.integer,
+        path: raw.path,
+        target,
+        set: flatten(&raw.set),
+        tolerance,
+        max_iterations: raw.max_iterations.unwrap_or(60).clamp(1, 200),
+    })
+}
+
+impl Search {
+    fn value(&self, x: f64) -> toml::Value {
+        match &self.format {
+            Some(f) => toml::Value::String(f.replacen("{}", &format_range_number(x), 1)),
+            None if self.integer => toml::Value::Integer(x.round() as i64),
+            None => toml::Value::Float(x),
+        }
+    }
+
+    fn metric(
+        &self,
+        runner: &dyn Runner,
+        base: &toml::Table,
+        set: &[(String, toml::Value)],
+        path: &str,
+        seed: u64,
+    ) -> Result<f64, String> {
+        let mut model = base.clone();
+        for (k, v) in set {
+            set_dotted(&mut model, k, v.clone()).map_err(|e| e.to_string())?;
+        }
+        let out = runner.run(&model, seed, false)?;
+        json_number(&out.summary, path)?.ok_or_else(|| format!("`{path}` is not a number in the run summary"))
+    }
+
+    /// Runs the search from `base` (the experiment's model with its `[set]`).
+    pub fn run(&self, runner: &dyn Runner, base: &toml::Table, seed: u64) -> Result<SearchResult, String> {
+        let mut runs = 0;
+        let target = match &self.target {
+            Target::Value(v) => *v,
+            Target::FromRun { path, set, scale } => {
+                runs += 1;
+                let mut all = self.set.clone();
+                all.extend(set.iter().cloned());
+                scale * self.metric(runner, base, &all, path, seed)?
+            }
+        };
+        let mut at = |x: f64| -> Result<f64, String> {
+            runs += 1;
+            let mut set = self.set.clone();
+            set.push((self.vary.clone(), self.value(x)));
+            self.metric(runner, base, &set, &self.path, seed)
+        };
+        let (mut lo, mut hi) = (self.from, self.to);
+        let (flo, fhi) = (at(lo)?, at(hi)?);
+        let mut result = SearchResult {
+            name: self.name.clone(),
+            vary: self.vary.clone(),
+            path: self.path.clone(),
+            target,
+            at_ends: (flo, fhi),
+            value: None,
+            metric: None,
+            runs: 0,
+            converged: false,
+        };
+        let tol = self.tolerance * target.abs().max(f64::MIN_POSITIVE);
+        let (glo, ghi) = (flo - target, fhi - target);
+        if glo.abs() <= tol || ghi.abs() <= tol || glo.signum() != ghi.signum() {
+            let (mut best, mut best_m) = if glo.abs() <= ghi.abs() { (lo, flo) } else { (hi, fhi) };
+            let rising = ghi > glo;
+            for _ in 0..self.max_iterations {
+                if (best_m - target).abs() <= tol {
+                    result.converged = true;
+                    break;
+                }
+                let mid = 0.5 * (lo + hi);
+                let m = at(mid)?;
+                if (m - target).abs() < (best_m - target).abs() {
+                    (best, best_m) = (mid, m);
+                }
+                if (m < target) == rising {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            result.converged |= (best_m - target).abs() <= tol;
+            result.value = Some(best);
+            result.metric = Some(best_m);
+        }
+        result.runs = runs;
+        Ok(result)
+    }
+}
+
+/// The report section for the searches.
+pub fn report_section(searches: &[Search], results: &[SearchResult]) -> String {
+    if results.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from(
+        "\n## Inverse what-ifs\n\nEach search varies one key over a bracket (bisection) until the metric reaches \
+         the target.\n\n| search | key | metric | target | at bracket ends | value found | metric there | runs |\n\
+         |---|---|---|---|---|---|---|---|\n",
+    );
+    for (sp, r) in searches.iter().zip(results) {
+        let found = match (r.value, r.converged) {
+            (Some(v), true) => sp.value(v).to_string(),
+            (Some(v), false) => format!("{} (not converged)", sp.value(v)),
+            (None, _) => "none in the bracket".into(),
+        };
+        s.push_str(&format!(
+            "| {} | `{}` | `{}` | {:.6} | {} = {:.6}, {} = {:.6} | {} | {} | {} |\n",
+            r.name,
+            r.vary,
+            r.path,
+            r.target,
+            sp.value(sp.from),
+            r.at_ends.0,
+            sp.value(sp.to),
+            r.at_ends.1,
+            found,
+            r.metric.map_or("-".into(), |m| format!("{m:.6}")),
+            r.runs
+        ));
+    }
+    for sp in searches {
+        if !sp.description.is_empty() {
+            s.push_str(&format!("\n- **{}**: {}\n", sp.name, sp.description));
+        }
+    }
+    s
+}
+
+/// `searches.csv`.
+pub fn csv(results: &[SearchResult]) -> String {
+    let mut s = String::from("search,key,path,target,metric_at_from,metric_at_to,value,metric,converged,runs\n");
+    for r in results {
+        s.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{}\n",
+            r.name,
+            r.vary,
+            r.path,
+            r.target,
+            r.at_ends.0,
+            r.at_ends.1,
+            r.value.map_or(String::new(), |v| v.to_string()),
+            r.metric.map_or(String::new(), |v| v.to_string()),
+            r.converged,
+            r.runs
+        ));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::runner::RunOutput;
+
+    /// metric = 3 x + 1 (x read from `k`, a float or "<x>us").
+    struct Linear;
+    impl Runner for Linear {
+        fn run(&self, model: &toml::Table, _seed: u64, _f: bool) -> Result<RunOutput, String> {
+            let x = match model.get("k") {
+                Some(toml::Value::Float(f)) => *f,
+                Some(toml::Value::String(s)) => s.trim_end_matches("us").parse().map_err(|_| "bad".to_string())?,
+                Some(toml::Value::Integer(i)) => *i as f64,
+                _ => 0.0,
+            };
+            let scale = model.get("scale").and_then(|v| v.as_float()).unwrap_or(1.0);
+            Ok(RunOutput {
+                summary: serde_json::json!({"metrics": {"y": scale * (3.0 * x + 1.0)}}),
+                frames: None,
+            })
+        }
+    }
+
+    fn search(target: Target, format: Option<&str>) -> Search {
+        Search {
+            name: "s".into(),
+            description: String::new(),
+            vary: "k".into(),
+            from: 0.0,
+            to: 10.0,
+            format: format.map(String::from),
+            integer: false,
+            path: "metrics.y".into(),
+            target,
+            set: vec![],
+            tolerance: 1e-9,
+            max_iterations: 80,
+        }
+    }
+
+    #[test]
+    fn bisection_finds_the_value() {
+        let r = search(Target::Value(10.0), None)
+            .run(&Linear, &toml::Table::new(), 1)
+            .unwrap();
+        assert!(r.converged);
+        assert!((r.value.unwrap() - 3.0).abs() < 1e-6, "{r:?}");
+        let r = search(Target::Value(10.0), Some("{}us"))
+            .run(&Linear, &toml::Table::new(), 1)
+            .unwrap();
+        assert!((r.value.unwrap() - 3.0).abs() < 1e-6, "{r:?}");
+    }
+
+    #[test]
+    fn target_from_a_reference_run() {
+        let t = Target::FromRun {
+            path: "metrics.y".into(),
+            set: vec![("k".into(), toml::Value::Float(2.0))],
+            scale: 2.0,
+        };
+        // reference y(2) = 7, target 14 -> x = 13/3.
+        let r = search(t, None).run(&Linear, &toml::Table::new(), 1).unwrap();
+        assert!((r.target - 14.0).abs() < 1e-12);
+        assert!((r.value.unwrap() - 13.0 / 3.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_bracket_that_misses_reports_no_value() {
+        let r = search(Target::Value(100.0), None)
+            .run(&Linear, &toml::Table::new(), 1)
+            .unwrap();
+        assert_eq!(r.value, None);
+        assert!(!r.converged);
+        assert_eq!(r.at_ends, (1.0, 31.0));
+    }
+}

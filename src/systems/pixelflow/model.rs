@@ -1,0 +1,785 @@
+//! The event simulation of one PixelFlow frame (paper 002 §4-6), per node
+//! and screen region.
+//!
+//! Deferred-shading architectures (standard, presort), per rasterizing node:
+//! geometry (standard: the whole frame, bucket sorted; presort: the sorting
+//! pass, then instructions generated region by region), then for each region
+//! in order: rasterize -> depth-composite the appearance parameters over the
+//! network (one region at a time, all rasterizers' results) into the
+//! communication registers of shader `region mod shaders` -> shade -> send
+//! the color over the network's other direction -> load into frame-buffer
+//! memory. A node starts rasterizing region j once the composition of region
+//! j-1 has begun (its pixel memory holds one region, the communication
+//! registers the other); a composition waits for its shader's input buffer.
+//!
+//! Non-texturing architecture: per node, geometry and rasterization in
+//! batches of `batch_primitives` (fine-grained pipelining), into the
+//! completely instanced frame buffer; for every further sample, the stored
+//! instructions are rasterized again after the previous sample's whole-screen
+//! composition; the last composition runs region by region, pipelined with
+//! the loads into the frame buffer.
+//!
+//! The frame starts at time zero on an idle machine: the latency is the time
+//! the last region is in frame-buffer memory.
+
+use std::collections::VecDeque;
+
+use crate::engine::{Control, Duration, EngineError, EventKind, Model, Scheduler, Time, TimeError};
+
+use super::config::{Architecture, PixelFlowConfig};
+use super::layout::Layout;
+
+/// Errors of a PixelFlow run.
+#[derive(Debug, thiserror::Error)]
+pub enum PixelFlowError {
+    /// A value serde accepted but the model cannot use.
+    #[error("{key}: {message}")]
+    Invalid {
+        /// Dotted key.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Kernel error.
+    #[error(transparent)]
+    Engine(#[from] EngineError),
+    /// The simulation ended before the frame was complete (a model bug).
+    #[error("the frame stalled at {at} with {loaded} of {regions} regions loaded")]
+    Stalled {
+        /// Last event time.
+        at: Time,
+        /// Regions loaded.
+        loaded: usize,
+        /// Regions in all.
+        regions: usize,
+    },
+}
+
+impl From<TimeError> for PixelFlowError {
+    fn from(e: TimeError) -> Self {
+        PixelFlowError::Engine(EngineError::Time(e))
+    }
+}
+
+/// Events of the PixelFlow model.
+#[derive(Debug, Clone, Copy)]
+pub enum Ev {
+    /// A node's geometry pass (standard) or sorting pass (presort) is done.
+    GeomDone(u32),
+    /// Presort: a node generated the instructions of its next region.
+    GenDone(u32),
+    /// A node rasterized a region (deferred architectures).
+    RastDone(u32),
+    /// The network composited a region.
+    CompDone(u32),
+    /// A shader shaded a region.
+    ShadeDone(u32),
+    /// A region's color reached the frame-buffer node.
+    ColorDone(u32),
+    /// A region is in frame-buffer memory.
+    LoadDone(u32),
+    /// Nontex: a node's geometry finished a batch.
+    BatchGeomDone(u32),
+    /// Nontex: a node rasterized a batch (first sample) or a whole further
+    /// sample pass.
+    BatchRastDone(u32),
+    /// Nontex: the whole-screen composition of a non-final sample is done.
+    PassCompDone,
+}
+
+impl EventKind for Ev {
+    const NAMES: &'static [&'static str] = &[
+        "geometry_done",
+        "generate_done",
+        "rasterize_done",
+        "composite_done",
+        "shade_done",
+        "color_done",
+        "load_done",
+        "batch_geometry_done",
+        "batch_rasterize_done",
+        "pass_composite_done",
+    ];
+    fn kind(&self) -> usize {
+        match self {
+            Ev::GeomDone(_) => 0,
+            Ev::GenDone(_) => 1,
+            Ev::RastDone(_) => 2,
+            Ev::CompDone(_) => 3,
+            Ev::ShadeDone(_) => 4,
+            Ev::ColorDone(_) => 5,
+            Ev::LoadDone(_) => 6,
+            Ev::BatchGeomDone(_) => 7,
+            Ev::BatchRastDone(_) => 8,
+            Ev::PassCompDone => 9,
+        }
+    }
+}
+
+/// Trace processes, one per node role.
+pub const ROLES: [&str; 5] = [
+    "rasterizer geometry processors",
+    "rasterizer pixel arrays",
+    "shading nodes",
+    "composition network",
+    "frame-buffer node",
+];
+
+/// One span of the timeline.
+#[derive(Debug, Clone)]
+pub struct Span {
+    /// Role index into [`ROLES`].
+    pub role: u8,
+    /// Node (or network direction) within the role.
+    pub unit: u32,
+    /// What was done.
+    pub name: &'static str,
+    /// Region or batch.
+    pub arg: u32,
+    /// Start.
+    pub start: Time,
+    /// End.
+    pub end: Time,
+}
+
+/// Per-region timestamps.
+#[derive(Debug, Clone, Default)]
+pub struct RegionRecord {
+    /// Last rasterizer finished the region (final sample for nontex).
+    pub rasterized: Option<Time>,
+    /// Composition started.
+    pub comp_start: Option<Time>,
+    /// Composition done.
+    pub comp_done: Option<Time>,
+    /// Shading started.
+    pub shade_start: Option<Time>,
+    /// Shading done.
+    pub shade_done: Option<Time>,
+    /// In frame-buffer memory.
+    pub loaded: Option<Time>,
+}
+
+/// Per-unit busy totals (for per-stage times).
+#[derive(Debug, Clone, Default)]
+pub struct Busy {
+    /// Geometry processors per node (geometry, sorting pass, generation).
+    pub geometry: Vec<Duration>,
+    /// Presort generation per node.
+    pub generate: Vec<Duration>,
+    /// Pixel arrays per rasterizing node.
+    pub rasterize: Vec<Duration>,
+    /// Network, compositing direction.
+    pub composite: Duration,
+    /// Network, color direction.
+    pub color: Duration,
+    /// Shaders.
+    pub shade: Vec<Duration>,
+    /// Frame-buffer loads.
+    pub load: Duration,
+}
+
+/// The whole simulated machine for one frame.
+#[derive(Debug)]
+pub struct PixelFlow {
+    /// The configuration.
+    pub cfg: PixelFlowConfig,
+    /// The primitive layout.
+    pub layout: Layout,
+    nodes: usize,
+    regions: usize,
+    shaders: usize,
+    frames: usize,
+    /// Regions over all frames (frame f's region j is `f * regions + j`).
+    total: usize,
+    geom_frame: Vec<u32>,
+    sorted: Vec<u32>,
+    /// Per frame: geometry start (earliest node), front end done (last node), done.
+    pub frame_times: Vec<(Option<Time>, Time, Option<Time>)>,
+    // per node
+    gen_ready: Vec<u32>,
+    gen_busy: Vec<bool>,
+    gen_end: Vec<Time>,
+    rast_next: Vec<u32>,
+    rast_busy: Vec<bool>,
+    region_rast: Vec<u32>,
+    comp_next: u32,
+    net_busy: bool,
+    shader_reserved: Vec<bool>,
+    shader_ready: Vec<Option<u32>>,
+    shader_busy: Vec<Option<u32>>,
+    color_queue: VecDeque<u32>,
+    color_busy: Option<u32>,
+    load_queue: VecDeque<u32>,
+    load_busy: Option<u32>,
+    loaded: usize,
+    // nontex
+    batches: Vec<u64>,
+    geom_batches: Vec<u64>,
+    geom_busy: Vec<bool>,
+    rast_batches: Vec<u64>,
+    pass: u32,
+    pass_done_nodes: usize,
+    final_comp: bool,
+    /// Time the front end finished on every node.
+    pub front_end_done: Time,
+    /// Time the frame was in frame-buffer memory.
+    pub finished: Option<Time>,
+    /// Per-region timestamps.
+    pub records: Vec<RegionRecord>,
+    /// Busy totals.
+    pub busy: Busy,
+    /// Timeline, when recorded.
+    pub trace: Option<Vec<Span>>,
+}
+
+fn mul(d: Duration, k: u64, what: &str) -> Result<Duration, PixelFlowError> {
+    d.checked_mul(k).ok_or_else(|| {
+        PixelFlowError::from(TimeError::Overflow {
+            context: format!("computing {what} ({d} x {k})"),
+            at: Time::ZERO,
+            by: Duration(u64::MAX),
+        })
+    })
+}
+
+impl PixelFlow {
+    /// A machine about to start the frame.
+    pub fn new(cfg: PixelFlowConfig, layout: Layout, trace: bool) -> Self {
+        let nodes = layout.nodes;
+        let regions = layout.regions;
+        let shaders = cfg.shaders().max(1) as usize;
+        let frames = match cfg.architecture {
+            Architecture::Nontex => 1,
+            _ => cfg.frames.max(1) as usize,
+        };
+        let total = frames * regions;
+        let b = cfg.nontex.batch_primitives.max(1);
+        let batches = layout.prims.iter().map(|&p| p.div_ceil(b).max(1)).collect();
+        PixelFlow {
+            nodes,
+            regions,
+            shaders,
+            frames,
+            total,
+            geom_frame: vec![0; nodes],
+            sorted: vec![0; nodes],
+            frame_times: vec![(None, Time::ZERO, None); frames],
+            gen_ready: vec![0; nodes],
+            gen_busy: vec![false; nodes],
+            gen_end: vec![Time::ZERO; nodes],
+            rast_next: vec![0; nodes],
+            rast_busy: vec![false; nodes],
+            region_rast: vec![0; total],
+            comp_next: 0,
+            net_busy: false,
+            shader_reserved: vec![false; shaders],
+            shader_ready: vec![None; shaders],
+            shader_busy: vec![None; shaders],
+            color_queue: VecDeque::new(),
+            color_busy: None,
+            load_queue: VecDeque::new(),
+            load_busy: None,
+            loaded: 0,
+            batches,
+            geom_batches: vec![0; nodes],
+            geom_busy: vec![false; nodes],
+            rast_batches: vec![0; nodes],
+            pass: 1,
+            pass_done_nodes: 0,
+            final_comp: false,
+            front_end_done: Time::ZERO,
+            finished: None,
+            records: vec![RegionRecord::default(); total],
+            busy: Busy {
+                geometry: vec![Duration::ZERO; nodes],
+                generate: vec![Duration::ZERO; nodes],
+                rasterize: vec![Duration::ZERO; nodes],
+                shade: vec![Duration::ZERO; shaders],
+                ..Busy::default()
+            },
+            trace: trace.then(Vec::new),
+            layout,
+            cfg,
+        }
+    }
+
+    /// Regions in frame-buffer memory.
+    pub fn loaded(&self) -> usize {
+        self.loaded
+    }
+
+    fn span(&mut self, role: u8, unit: u32, name: &'static str, arg: u32, start: Time, end: Time) {
+        if let Some(t) = &mut self.trace {
+            t.push(Span {
+                role,
+                unit,
+                name,
+                arg,
+                start,
+                end,
+            });
+        }
+    }
+
+    /// Schedules `ev` after `d`, recording a span and adding `d` to a busy total.
+    #[allow(clippy::too_many_arguments)]
+    fn work(
+        &mut self,
+        sched: &mut Scheduler<Ev>,
+        d: Duration,
+        ev: Ev,
+        role: u8,
+        unit: u32,
+        name: &'static str,
+        arg: u32,
+    ) -> Result<Time, PixelFlowError> {
+        let now = sched.now();
+        let end = sched.after(d, ev, name)?;
+        self.span(role, unit, name, arg, now, end);
+        Ok(end)
+    }
+
+    /// Schedules the frame's first events.
+    pub fn start(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), PixelFlowError> {
+        if self.cfg.architecture != Architecture::Nontex {
+            return self.settle(sched);
+        }
+        self.frame_times[0].0 = Some(Time::ZERO);
+        for r in 0..self.nodes {
+            let p = self.layout.prims[r];
+            let (d, ev, name) = match self.cfg.architecture {
+                Architecture::Standard => {
+                    let c = &self.cfg.deferred;
+                    (
+                        c.t_overhead.checked_add(mul(c.t_trans, p, "geometry")?),
+                        Ev::GeomDone(r as u32),
+                        "geometry + bucket sort",
+                    )
+                }
+                Architecture::Presort => {
+                    let c = &self.cfg.deferred;
+                    (
+                        c.t_overhead.checked_add(mul(c.t_first_pass, p, "sorting pass")?),
+                        Ev::GeomDone(r as u32),
+                        "sorting pass",
+                    )
+                }
+                Architecture::Nontex => {
+                    let c = &self.cfg.nontex;
+                    let b = self.batch_prims(r, 0);
+                    (
+                        c.t_overhead.checked_add(mul(c.t_trans, b, "geometry")?),
+                        Ev::BatchGeomDone(r as u32),
+                        "geometry",
+                    )
+                }
+            };
+            let d = d.ok_or_else(|| {
+                PixelFlowError::from(TimeError::Overflow {
+                    context: "frame start-up".into(),
+                    at: Time::ZERO,
+                    by: Duration(u64::MAX),
+                })
+            })?;
+            self.busy.geometry[r] = d;
+            self.geom_busy[r] = true;
+            self.gen_end[r] = self.work(sched, d, ev, 0, r as u32, name, 0)?;
+        }
+        self.settle(sched)
+    }
+
+    // ----- nontex helpers -----
+
+    fn batch_prims(&self, node: usize, k: u64) -> u64 {
+        let b = self.cfg.nontex.batch_primitives.max(1);
+        let p = self.layout.prims[node];
+        p.saturating_sub(k * b).min(b)
+    }
+
+    /// Region entries of batch `k` of `node` (cumulative rounding of the
+    /// node's entries in proportion to its primitives).
+    fn batch_entries(&self, node: usize, k: u64) -> u64 {
+        let b = self.cfg.nontex.batch_primitives.max(1);
+        let p = self.layout.prims[node];
+        let e = self.layout.node_entries(node);
+        if p == 0 {
+            return 0;
+        }
+        let upto = |m: u64| -> u64 { ((e as u128 * (m * b).min(p) as u128) / p as u128) as u64 };
+        upto(k + 1) - upto(k)
+    }
+
+    fn settle(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), PixelFlowError> {
+        loop {
+            let mut moved = false;
+            match self.cfg.architecture {
+                Architecture::Nontex => moved |= self.settle_nontex(sched)?,
+                _ => moved |= self.settle_deferred(sched)?,
+            }
+            moved |= self.settle_tail(sched)?;
+            if !moved {
+                return Ok(());
+            }
+        }
+    }
+
+    /// Whether node `r` may start the geometry (standard) or sorting pass
+    /// (presort) of its next frame.
+    fn geometry_may_start(&self, r: usize) -> bool {
+        let f = self.geom_frame[r] as usize;
+        if self.geom_busy[r] || self.gen_busy[r] || f >= self.frames {
+            return false;
+        }
+        match self.cfg.architecture {
+            // Two instruction buffers: frame f reuses frame f-2's buffer once
+            // this node has rasterized all of frame f-2.
+            Architecture::Standard => f < 2 || self.rast_next[r] as usize >= (f - 1) * self.regions,
+            // No frame pipelining: the next sorting pass follows the
+            // generation of this frame's instructions.
+            _ => self.gen_ready[r] as usize >= f * self.regions,
+        }
+    }
+
+    fn settle_deferred(&mut self, sched: &mut Scheduler<Ev>) -> Result<bool, PixelFlowError> {
+        let mut moved = false;
+        let c = self.cfg.deferred.clone();
+        let now = sched.now();
+        // A frame starts on every rasterizer at one instant (one head-pose
+        // sample): once every node may start it.
+        let all_may_start = (0..self.nodes).all(|r| self.geometry_may_start(r));
+        for r in 0..self.nodes {
+            if all_may_start {
+                let f = self.geom_frame[r] as usize;
+                let p = self.layout.prims[r];
+                let (per, name) = match self.cfg.architecture {
+                    Architecture::Standard => (c.t_trans, "geometry + bucket sort"),
+                    _ => (c.t_first_pass, "sorting pass"),
+                };
+                let d = c
+                    .t_overhead
+                    .checked_add(mul(per, p, name)?)
+                    .unwrap_or(Duration(u64::MAX));
+                self.geom_busy[r] = true;
+                self.busy.geometry[r] = self.busy.geometry[r].checked_add(d).unwrap_or(Duration(u64::MAX));
+                let ft = &mut self.frame_times[f].0;
+                *ft = Some(ft.map_or(now, |t| t.min(now)));
+                self.work(sched, d, Ev::GeomDone(r as u32), 0, r as u32, name, f as u32)?;
+                moved = true;
+            }
+            // Presort: generate the next region's instructions.
+            if self.cfg.architecture == Architecture::Presort
+                && !self.geom_busy[r]
+                && !self.gen_busy[r]
+                && (self.gen_ready[r] as usize) < self.sorted[r] as usize * self.regions
+            {
+                let g = self.gen_ready[r] as usize;
+                let j = g % self.regions;
+                let entries = self.layout.bin(r, j);
+                let total = self.layout.node_entries(r).max(1);
+                // The node's t_gen_each x primitives, spread over its regions
+                // in proportion to their entries (cumulative rounding).
+                let p = self.layout.prims[r] as u128;
+                let before: u64 = (0..j).map(|k| self.layout.bin(r, k)).sum();
+                let ps = c.t_gen_each.0 as u128 * p;
+                let t0 = (ps * before as u128 / total as u128) as u64;
+                let t1 = (ps * (before + entries) as u128 / total as u128) as u64;
+                let d = Duration(t1 - t0);
+                self.gen_busy[r] = true;
+                self.busy.generate[r] = self.busy.generate[r].checked_add(d).unwrap_or(Duration(u64::MAX));
+                self.gen_end[r] = self.work(
+                    sched,
+                    d,
+                    Ev::GenDone(r as u32),
+                    0,
+                    r as u32,
+                    "generate instructions",
+                    g as u32,
+                )?;
+                moved = true;
+            }
+            let j = self.rast_next[r];
+            // Presort streams a region's instructions to the pixel array as
+            // they are generated (the DMA fetches them "as needed", §3): the
+            // rasterization may start with the generation and ends no earlier
+            // than one primitive after it.
+            let streaming = self.gen_busy[r] && self.gen_ready[r] == j;
+            if !self.rast_busy[r]
+                && (j as usize) < self.total
+                && (self.gen_ready[r] > j || streaming)
+                && self.comp_next >= j
+            {
+                let work = mul(
+                    c.t_rast_per_prim,
+                    self.layout.bin(r, j as usize % self.regions),
+                    "rasterization",
+                )?;
+                let mut d = work;
+                if streaming {
+                    let tail = self.gen_end[r]
+                        .since(now)
+                        .checked_add(c.t_rast_per_prim)
+                        .unwrap_or(Duration(u64::MAX));
+                    d = d.max(tail);
+                }
+                self.rast_busy[r] = true;
+                self.busy.rasterize[r] = self.busy.rasterize[r].checked_add(work).unwrap_or(Duration(u64::MAX));
+                self.work(sched, d, Ev::RastDone(r as u32), 1, r as u32, "rasterize", j)?;
+                moved = true;
+            }
+        }
+        let j = self.comp_next as usize;
+        if !self.net_busy && j < self.total && self.region_rast[j] as usize == self.nodes {
+            let s = j % self.shaders;
+            if !self.shader_reserved[s] {
+                self.shader_reserved[s] = true;
+                self.net_busy = true;
+                self.comp_next += 1;
+                let d = mul(c.t_comp_byte, c.appearance_bytes as u64, "composition")?;
+                self.busy.composite = self.busy.composite.checked_add(d).unwrap_or(Duration(u64::MAX));
+                self.records[j].comp_start = Some(now);
+                self.work(sched, d, Ev::CompDone(j as u32), 3, 0, "composite appearance", j as u32)?;
+                moved = true;
+            }
+        }
+        for s in 0..self.shaders {
+            if self.shader_busy[s].is_none()
+                && let Some(j) = self.shader_ready[s].take()
+            {
+                self.shader_reserved[s] = false;
+                self.shader_busy[s] = Some(j);
+                let d = c
+                    .t_shade_address
+                    .checked_add(c.t_shade_texture)
+                    .unwrap_or(Duration(u64::MAX));
+                self.busy.shade[s] = self.busy.shade[s].checked_add(d).unwrap_or(Duration(u64::MAX));
+                self.records[j as usize].shade_start = Some(now);
+                self.work(sched, d, Ev::ShadeDone(s as u32), 2, s as u32, "shade", j)?;
+                moved = true;
+            }
+        }
+        if self.color_busy.is_none()
+            && let Some(j) = self.color_queue.pop_front()
+        {
+            self.color_busy = Some(j);
+            let d = mul(c.t_comp_byte, c.color_bytes as u64, "color transfer")?;
+            self.busy.color = self.busy.color.checked_add(d).unwrap_or(Duration(u64::MAX));
+            self.work(sched, d, Ev::ColorDone(j), 3, 1, "send color", j)?;
+            moved = true;
+        }
+        Ok(moved)
+    }
+
+    fn settle_tail(&mut self, sched: &mut Scheduler<Ev>) -> Result<bool, PixelFlowError> {
+        if self.load_busy.is_none()
+            && let Some(j) = self.load_queue.pop_front()
+        {
+            self.load_busy = Some(j);
+            let d = match self.cfg.architecture {
+                Architecture::Nontex => self.cfg.nontex.t_load,
+                _ => self.cfg.deferred.t_load,
+            };
+            self.busy.load = self.busy.load.checked_add(d).unwrap_or(Duration(u64::MAX));
+            self.work(sched, d, Ev::LoadDone(j), 4, 0, "load frame buffer", j)?;
+            return Ok(true);
+        }
+        Ok(false)
+    }
+
+    fn settle_nontex(&mut self, sched: &mut Scheduler<Ev>) -> Result<bool, PixelFlowError> {
+        let mut moved = false;
+        let c = self.cfg.nontex.clone();
+        let now = sched.now();
+        if self.pass == 1 {
+            for r in 0..self.nodes {
+                if !self.geom_busy[r] && self.geom_batches[r] < self.batches[r] && self.geom_batches[r] > 0 {
+                    let k = self.geom_batches[r];
+                    let d = mul(c.t_trans, self.batch_prims(r, k), "geometry")?;
+                    self.geom_busy[r] = true;
+                    self.busy.geometry[r] = self.busy.geometry[r].checked_add(d).unwrap_or(Duration(u64::MAX));
+                    self.gen_end[r] =
+                        self.work(sched, d, Ev::BatchGeomDone(r as u32), 0, r as u32, "geometry", k as u32)?;
+                    moved = true;
+                }
+                // The pixel array takes instructions as the geometry
+                // processor writes them (§6: "completely pipelined"): a batch
+                // may start while it is generated and ends no earlier than one
+                // primitive after its geometry.
+                let streaming = self.geom_busy[r] && self.rast_batches[r] == self.geom_batches[r];
+                if !self.rast_busy[r] && (self.rast_batches[r] < self.geom_batches[r] || streaming) {
+                    let k = self.rast_batches[r];
+                    let work = mul(c.t_rast_per_prim, self.batch_entries(r, k), "rasterization")?;
+                    let mut d = work;
+                    if streaming {
+                        let tail = self.gen_end[r]
+                            .since(now)
+                            .checked_add(c.t_rast_per_prim)
+                            .unwrap_or(Duration(u64::MAX));
+                        d = d.max(tail);
+                    }
+                    self.rast_busy[r] = true;
+                    self.busy.rasterize[r] = self.busy.rasterize[r].checked_add(work).unwrap_or(Duration(u64::MAX));
+                    self.work(
+                        sched,
+                        d,
+                        Ev::BatchRastDone(r as u32),
+                        1,
+                        r as u32,
+                        "rasterize sample 1",
+                        k as u32,
+                    )?;
+                    moved = true;
+                }
+            }
+        }
+        // Final sample: composite region by region, pipelined with the loads.
+        if self.final_comp && !self.net_busy && (self.comp_next as usize) < self.regions {
+            let j = self.comp_next as usize;
+            self.comp_next += 1;
+            self.net_busy = true;
+            let d = mul(c.t_comp_byte, c.composite_bytes as u64, "composition")?;
+            self.busy.composite = self.busy.composite.checked_add(d).unwrap_or(Duration(u64::MAX));
+            self.records[j].comp_start = Some(now);
+            self.work(sched, d, Ev::CompDone(j as u32), 3, 0, "composite colors", j as u32)?;
+            moved = true;
+        }
+        Ok(moved)
+    }
+
+    /// Nontex: every node finished rasterizing the current sample.
+    fn nontex_pass_done(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), PixelFlowError> {
+        let now = sched.now();
+        if self.pass == 1 {
+            self.front_end_done = now;
+            self.frame_times[0].1 = now;
+        }
+        for rec in &mut self.records {
+            rec.rasterized = Some(now);
+        }
+        self.pass_done_nodes = 0;
+        if self.pass >= self.cfg.samples.max(1) {
+            self.final_comp = true;
+            return Ok(());
+        }
+        let c = &self.cfg.nontex;
+        let per_region = mul(c.t_comp_byte, c.composite_bytes as u64, "composition")?;
+        let d = mul(per_region, self.regions as u64, "composition")?;
+        self.busy.composite = self.busy.composite.checked_add(d).unwrap_or(Duration(u64::MAX));
+        self.work(sched, d, Ev::PassCompDone, 3, 0, "composite sample", self.pass)?;
+        Ok(())
+    }
+}
+
+impl Model for PixelFlow {
+    type Event = Ev;
+    type Error = PixelFlowError;
+
+    fn handle(&mut self, now: Time, ev: Ev, sched: &mut Scheduler<Ev>) -> Result<Control, PixelFlowError> {
+        match ev {
+            Ev::GeomDone(r) => {
+                let r = r as usize;
+                let f = self.geom_frame[r] as usize;
+                self.geom_busy[r] = false;
+                self.geom_frame[r] += 1;
+                self.frame_times[f].1 = self.frame_times[f].1.max(now);
+                if f == 0 {
+                    self.front_end_done = self.front_end_done.max(now);
+                }
+                if self.cfg.architecture == Architecture::Standard {
+                    self.gen_ready[r] = ((f + 1) * self.regions) as u32;
+                } else {
+                    self.sorted[r] += 1;
+                }
+            }
+            Ev::GenDone(r) => {
+                let r = r as usize;
+                self.gen_busy[r] = false;
+                self.gen_ready[r] += 1;
+            }
+            Ev::RastDone(r) => {
+                let r = r as usize;
+                let j = self.rast_next[r] as usize;
+                self.rast_busy[r] = false;
+                self.rast_next[r] += 1;
+                self.region_rast[j] += 1;
+                if self.region_rast[j] as usize == self.nodes {
+                    self.records[j].rasterized = Some(now);
+                }
+            }
+            Ev::CompDone(j) => {
+                self.net_busy = false;
+                self.records[j as usize].comp_done = Some(now);
+                match self.cfg.architecture {
+                    Architecture::Nontex => self.load_queue.push_back(j),
+                    _ => self.shader_ready[j as usize % self.shaders] = Some(j),
+                }
+            }
+            Ev::ShadeDone(s) => {
+                let j = self.shader_busy[s as usize].take().unwrap_or(0);
+                self.records[j as usize].shade_done = Some(now);
+                self.color_queue.push_back(j);
+            }
+            Ev::ColorDone(j) => {
+                self.color_busy = None;
+                self.load_queue.push_back(j);
+            }
+            Ev::LoadDone(j) => {
+                self.load_busy = None;
+                self.records[j as usize].loaded = Some(now);
+                self.loaded += 1;
+                if self.loaded.is_multiple_of(self.regions) {
+                    let f = self.loaded / self.regions - 1;
+                    if let Some(ft) = self.frame_times.get_mut(f) {
+                        ft.2 = Some(now);
+                    }
+                }
+                if self.loaded == self.total {
+                    self.finished = Some(now);
+                    return Ok(Control::Stop);
+                }
+            }
+            Ev::BatchGeomDone(r) => {
+                let r = r as usize;
+                self.geom_busy[r] = false;
+                self.geom_batches[r] += 1;
+            }
+            Ev::BatchRastDone(r) => {
+                let r = r as usize;
+                self.rast_busy[r] = false;
+                let done = if self.pass == 1 {
+                    self.rast_batches[r] += 1;
+                    self.rast_batches[r] == self.batches[r]
+                } else {
+                    true
+                };
+                if done {
+                    self.pass_done_nodes += 1;
+                    if self.pass_done_nodes == self.nodes {
+                        self.nontex_pass_done(sched)?;
+                    }
+                }
+            }
+            Ev::PassCompDone => {
+                // Next sample: rasterize the stored instructions again.
+                self.pass += 1;
+                let t = self.cfg.nontex.t_rast_per_prim;
+                for r in 0..self.nodes {
+                    let d = mul(t, self.layout.node_entries(r), "rasterization")?;
+                    self.rast_busy[r] = true;
+                    self.busy.rasterize[r] = self.busy.rasterize[r].checked_add(d).unwrap_or(Duration(u64::MAX));
+                    let pass = self.pass;
+                    self.work(
+                        sched,
+                        d,
+                        Ev::BatchRastDone(r as u32),
+                        1,
+                        r as u32,
+                        "rasterize sample",
+                        pass,
+                    )?;
+                }
+            }
+        }
+        self.settle(sched)?;
+        Ok(Control::Continue)
+    }
+}

@@ -1,0 +1,405 @@
+//! Validating, running and summarizing a PixelFlow model.
+
+use serde_json::{Value, json};
+
+use crate::engine::{Duration, Limits, RunStats, Scheduler, run};
+
+use super::analytic::{Analytic, closed_form};
+use super::config::{Fidelity, PixelFlowConfig, Placement, Size};
+use super::layout::{Layout, build};
+use super::model::{PixelFlow, PixelFlowError, RegionRecord, Span};
+
+/// Everything a run produced.
+#[derive(Debug)]
+pub struct PixelFlowRun {
+    /// The model as run.
+    pub config: PixelFlowConfig,
+    /// The closed form.
+    pub analytic: Analytic,
+    /// Kernel statistics (event fidelity).
+    pub stats: Option<RunStats>,
+    /// Per-region records (event fidelity).
+    pub records: Vec<RegionRecord>,
+    /// Region entries per region.
+    pub region_entries: Vec<u64>,
+    /// The JSON summary.
+    pub summary: Value,
+    /// Timeline, when asked for.
+    pub trace: Option<Vec<Span>>,
+}
+
+fn bad(key: &str, message: impl Into<String>) -> PixelFlowError {
+    PixelFlowError::Invalid {
+        key: key.to_string(),
+        message: message.into(),
+    }
+}
+
+fn check_size(key: &str, s: &Size) -> Result<(), PixelFlowError> {
+    for (k, v) in [("width", s.width), ("height", s.height)] {
+        if !v.is_finite() || v < 0.0 {
+            return Err(bad(
+                &format!("{key}.{k}"),
+                format!("must be a finite size >= 0 pixels, got {v}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Checks what serde cannot.
+pub fn validate(cfg: &PixelFlowConfig) -> Result<(), PixelFlowError> {
+    if cfg.system != "pixelflow" {
+        return Err(bad("system", format!("expected \"pixelflow\", got {:?}", cfg.system)));
+    }
+    if cfg.frames == 0 || cfg.frames > 10_000 {
+        return Err(bad(
+            "frames",
+            format!("must be between 1 and 10000, got {}", cfg.frames),
+        ));
+    }
+    if cfg.frames > 1 && cfg.architecture == super::Architecture::Nontex {
+        return Err(bad(
+            "frames",
+            "the non-texturing system is simulated one frame at a time (frames = 1)",
+        ));
+    }
+    if cfg.samples == 0 {
+        return Err(bad("samples", "must be at least 1 (1 = no antialiasing)"));
+    }
+    if cfg.rasterizers() == 0 {
+        return Err(bad(
+            "nodes",
+            format!(
+                "{} nodes leave no rasterizer (one frame-buffer node and {} shading nodes)",
+                cfg.nodes,
+                cfg.shaders()
+            ),
+        ));
+    }
+    if cfg.architecture != super::Architecture::Nontex && cfg.shading_nodes == 0 {
+        return Err(bad(
+            "shading_nodes",
+            "the texturing architectures need at least one shading node",
+        ));
+    }
+    check_size("display", &cfg.display)?;
+    check_size("primitive", &cfg.primitive)?;
+    check_size("aa_primitive", &cfg.aa_primitive)?;
+    check_size("region", &cfg.region)?;
+    if cfg.region.width < 1.0 || cfg.region.height < 1.0 || cfg.display.width < 1.0 || cfg.display.height < 1.0 {
+        return Err(bad("region", "display and region must be at least 1 x 1 pixel"));
+    }
+    if cfg.regions() > 1_000_000 {
+        return Err(bad(
+            "region",
+            format!("{} regions is more than 1,000,000", cfg.regions()),
+        ));
+    }
+    if cfg.nontex.batch_primitives == 0 {
+        return Err(bad("nontex.batch_primitives", "must be at least 1"));
+    }
+    if cfg.placement == Placement::Clustered {
+        let Some(c) = &cfg.cluster else {
+            return Err(bad("cluster", "placement = \"clustered\" needs a [cluster] table"));
+        };
+        if !(0.0..=1.0).contains(&c.fraction) {
+            return Err(bad(
+                "cluster.fraction",
+                format!("must be within 0..1, got {}", c.fraction),
+            ));
+        }
+        for (k, v) in [("x", c.x), ("y", c.y), ("width", c.width), ("height", c.height)] {
+            if !v.is_finite() || v < 0.0 {
+                return Err(bad(
+                    &format!("cluster.{k}"),
+                    format!("must be finite and >= 0, got {v}"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_ms_f64()
+}
+
+fn max_ms(v: &[Duration]) -> f64 {
+    v.iter().map(|d| ms(*d)).fold(0.0, f64::max)
+}
+
+/// Validates, builds and runs the model at its fidelity.
+pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, PixelFlowError> {
+    validate(&cfg)?;
+    let t0 = std::time::Instant::now();
+    let analytic = closed_form(&cfg);
+    if cfg.fidelity == Fidelity::Analytic {
+        let wall = t0.elapsed().as_secs_f64();
+        let a = &analytic;
+        let stages = json!({
+            "geometry": a.t_front_ms, "generate": a.t_gen_ms, "rasterize": a.t_rast_ms,
+            "composite": a.t_comp_ms, "shade": a.t_shade_ms, "load": a.t_load_ms,
+        });
+        let summary = summary(
+            &cfg,
+            &analytic,
+            None,
+            a.latency_ms,
+            a.front_end_ms,
+            stages,
+            None,
+            wall,
+            0.0,
+            &[(0.0, a.front_end_ms, a.latency_ms)],
+        );
+        return Ok(PixelFlowRun {
+            config: cfg,
+            analytic,
+            stats: None,
+            records: Vec::new(),
+            region_entries: Vec::new(),
+            summary,
+            trace: None,
+        });
+    }
+    let layout = build(&cfg);
+    let region_entries = layout.region_entries();
+    let build_seconds = t0.elapsed().as_secs_f64();
+    let mut model = PixelFlow::new(cfg, layout, trace);
+    let mut sched = Scheduler::new();
+    model.start(&mut sched)?;
+    let stats = run(&mut model, &mut sched, Limits::default())?;
+    let Some(done) = model.finished else {
+        return Err(PixelFlowError::Stalled {
+            at: stats.end_time,
+            loaded: model.loaded(),
+            regions: model.records.len(),
+        });
+    };
+    let b = &model.busy;
+    let stages = json!({
+        "geometry": max_ms(&b.geometry),
+        "generate": max_ms(&b.generate),
+        "rasterize": max_ms(&b.rasterize),
+        "composite": ms(b.composite),
+        "shade": max_ms(&b.shade),
+        "color": ms(b.color),
+        "load": ms(b.load),
+    });
+    let _ = done;
+    let frames: Vec<(f64, f64, f64)> = model
+        .frame_times
+        .iter()
+        .map(|(s, f, d)| {
+            let s = s.map_or(f64::NAN, |t| t.as_ms_f64());
+            (s, f.as_ms_f64(), d.map_or(f64::NAN, |t| t.as_ms_f64()))
+        })
+        .collect();
+    let latency = frames[0].2 - frames[0].0;
+    let front = frames[0].1 - frames[0].0;
+    let summary = summary(
+        &model.cfg,
+        &analytic,
+        Some(&stats),
+        latency,
+        front,
+        stages,
+        Some((&model.layout, &region_entries)),
+        build_seconds + stats.wall_seconds,
+        stats.wall_seconds,
+        &frames,
+    );
+    Ok(PixelFlowRun {
+        analytic,
+        stats: Some(stats),
+        records: std::mem::take(&mut model.records),
+        region_entries,
+        summary,
+        trace: model.trace.take(),
+        config: model.cfg,
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn summary(
+    cfg: &PixelFlowConfig,
+    a: &Analytic,
+    stats: Option<&RunStats>,
+    latency: f64,
+    front: f64,
+    stages: Value,
+    layout: Option<(&Layout, &Vec<u64>)>,
+    wall: f64,
+    simulate: f64,
+    frames: &[(f64, f64, f64)],
+) -> Value {
+    let (events, by_kind) = match stats {
+        Some(s) => (
+            s.events,
+            Value::Object(
+                s.kind_names
+                    .iter()
+                    .zip(&s.by_kind)
+                    .map(|(n, c)| (n.to_string(), json!(c)))
+                    .collect(),
+            ),
+        ),
+        None => (0, json!({})),
+    };
+    let (realised, entries) = match layout {
+        Some((l, e)) => {
+            let max = e.iter().copied().max().unwrap_or(0);
+            let min = e.iter().copied().min().unwrap_or(0);
+            let mean = e.iter().sum::<u64>() as f64 / e.len().max(1) as f64;
+            (l.realised_overlap(), json!({"min": min, "max": max, "mean": mean}))
+        }
+        None => (a.overlap, Value::Null),
+    };
+    let rel = if a.latency_ms > 0.0 {
+        (latency - a.latency_ms) / a.latency_ms
+    } else {
+        0.0
+    };
+    let lat: Vec<f64> = frames.iter().map(|f| f.2 - f.0).collect();
+    let intervals: Vec<f64> = frames.windows(2).map(|w| w[1].2 - w[0].2).collect();
+    let stat = |v: &[f64]| -> Value {
+        if v.is_empty() {
+            return Value::Null;
+        }
+        let mean = v.iter().sum::<f64>() / v.len() as f64;
+        let max = v.iter().copied().fold(f64::MIN, f64::max);
+        json!({"first": v[0], "last": v[v.len() - 1], "mean": mean, "max": max})
+    };
+    let frame_rows: Vec<Value> = frames
+        .iter()
+        .map(|f| json!({"start_ms": f.0, "front_end_done_ms": f.1, "done_ms": f.2, "latency_ms": f.2 - f.0}))
+        .collect();
+    json!({
+        "system": "pixelflow",
+        "description": cfg.description,
+        "fidelity": cfg.fidelity,
+        "architecture": cfg.architecture,
+        "nodes": cfg.nodes,
+        "rasterizers": cfg.rasterizers(),
+        "shaders": cfg.shaders(),
+        "samples": cfg.samples,
+        "primitives": cfg.primitives,
+        "placement": cfg.placement,
+        "seed": cfg.run.seed,
+        "frames": cfg.frames,
+        "warmup_frames": 0,
+        "events": {"total": events, "by_kind": by_kind},
+        "wall_seconds": wall,
+        "simulate_seconds": simulate,
+        "metrics": {
+            "latency_ms": latency,
+            "analytic_latency_ms": a.latency_ms,
+            "relative_error": rel,
+            "front_end_ms": front,
+            "back_end_ms": latency - front,
+            "analytic_front_end_ms": a.front_end_ms,
+            "analytic_back_end_ms": a.back_end_ms,
+            "stages_ms": stages,
+            "regions": a.regions,
+            "overlap": a.overlap,
+            "realised_overlap": realised,
+            "region_entries": entries,
+            "analytic": a,
+            "frame_latency_ms": stat(&lat),
+            "frame_interval_ms": stat(&intervals),
+            "per_frame": frame_rows,
+            "analytic_primitives_at_30ms": super::analytic::primitives_at(cfg, 30.0),
+            "analytic_primitives_at_40ms": super::analytic::primitives_at(cfg, 40.0),
+        },
+    })
+}
+
+/// Columns of the per-region table.
+pub const COLUMNS: [&str; 9] = [
+    "Frame",
+    "Region",
+    "Entries",
+    "RasterizedMs",
+    "CompositeStartMs",
+    "CompositeDoneMs",
+    "ShadeStartMs",
+    "ShadeDoneMs",
+    "LoadedMs",
+];
+
+/// The per-region table (NaN where a step does not apply).
+pub fn region_rows(run: &PixelFlowRun) -> Vec<Vec<f64>> {
+    let t = |x: Option<crate::engine::Time>| x.map_or(f64::NAN, |t| t.as_ms_f64());
+    run.records
+        .iter()
+        .enumerate()
+        .map(|(g, r)| {
+            let n = run.region_entries.len().max(1);
+            let j = g % n;
+            vec![
+                (g / n) as f64,
+                j as f64,
+                run.region_entries.get(j).copied().unwrap_or(0) as f64,
+                t(r.rasterized),
+                t(r.comp_start),
+                t(r.comp_done),
+                t(r.shade_start),
+                t(r.shade_done),
+                t(r.loaded),
+            ]
+        })
+        .collect()
+}
+
+/// Writes the per-region table as CSV.
+pub fn write_regions_csv(run: &PixelFlowRun, w: &mut dyn std::io::Write) -> std::io::Result<()> {
+    writeln!(w, "{}", COLUMNS.join(","))?;
+    for row in region_rows(run) {
+        let cells: Vec<String> = row
+            .iter()
+            .map(|v| if v.is_nan() { String::new() } else { format!("{v}") })
+            .collect();
+        writeln!(w, "{}", cells.join(","))?;
+    }
+    Ok(())
+}
+
+/// Writes a Chrome/Perfetto trace: one process per node role, one thread
+/// per node (or network direction); false if none was recorded.
+pub fn write_trace(run: &PixelFlowRun, w: &mut dyn std::io::Write) -> std::io::Result<bool> {
+    let Some(spans) = &run.trace else {
+        return Ok(false);
+    };
+    let us = |t: crate::engine::Time| t.0 as f64 / 1e6;
+    let mut ev = Vec::new();
+    for (i, role) in super::model::ROLES.iter().enumerate() {
+        let pid = i + 1;
+        ev.push(json!({"ph": "M", "pid": pid, "name": "process_name", "args": {"name": role}}));
+        ev.push(json!({"ph": "M", "pid": pid, "name": "process_sort_index", "args": {"sort_index": pid}}));
+    }
+    let mut named = std::collections::BTreeSet::new();
+    for s in spans {
+        let pid = s.role as usize + 1;
+        if named.insert((pid, s.unit)) {
+            let name = match s.role {
+                0 | 1 => format!("rasterizer {}", s.unit),
+                2 => format!("shader {}", s.unit),
+                3 => if s.unit == 0 {
+                    "composition"
+                } else {
+                    "color to frame buffer"
+                }
+                .to_string(),
+                _ => "frame-buffer memory".to_string(),
+            };
+            ev.push(json!({"ph": "M", "pid": pid, "tid": s.unit, "name": "thread_name", "args": {"name": name}}));
+        }
+        ev.push(json!({
+            "ph": "X", "pid": pid, "tid": s.unit, "name": s.name,
+            "ts": us(s.start), "dur": us(s.end) - us(s.start), "args": {"index": s.arg},
+        }));
+    }
+    serde_json::to_writer(&mut *w, &json!({"traceEvents": ev, "displayTimeUnit": "ms"}))?;
+    Ok(true)
+}
