@@ -16,7 +16,6 @@ pub mod components;
 pub mod config;
 pub mod engine;
 pub mod experiment;
-#[cfg(feature = "wgpu")]
 pub mod measure;
 pub mod output;
 pub mod plot;

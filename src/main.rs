@@ -80,7 +80,7 @@ enum Cmd {
     Vcache {
         /// Mesh: grid:WxH[:shuffled:SEED|:optimized], strip:WxH, random:T:V:SEED, FILE.obj, FILE.idx.
         mesh: String,
-        /// Cache policy: none, fifo:N, lru:N.
+        /// Cache policy: none, fifo:N, lru:N, meshopt:CACHE,WARP,PRIMGROUP, batch:V,T, direct:SLOTS,SEGMENT, lavapipe.
         #[arg(long)]
         policy: String,
         /// Print JSON.
@@ -115,18 +115,23 @@ enum Cmd {
         /// Recorded passes (the median is reported).
         #[arg(long, default_value_t = 5)]
         repeats: u32,
+        /// Collapse every vertex to one point: no fragments, the geometry stage alone.
+        #[arg(long)]
+        geometry_only: bool,
         /// Print JSON.
         #[arg(long)]
         json: bool,
     },
-    /// Hypothesis study against real measurements (build with `--features wgpu`): h1 (vertex reuse).
+    /// Hypothesis studies against real measurements (build with `--features wgpu`):
+    /// h1 vertex reuse, h2 sum vs max, h3 draw order, h4 cost per vertex, or all.
     Study {
-        /// Study name: h1.
+        /// Study name: h1, h2, h3, h4 or all.
         name: String,
-        /// Recorded passes per measurement.
-        #[arg(long, default_value_t = 1)]
+        /// Recorded passes per timed measurement, interleaved across a study's
+        /// passes (the median is used).
+        #[arg(long, default_value_t = 5)]
         repeats: u32,
-        /// Also write the result as Markdown to FILE (e.g. docs/measurements/<adapter>.md).
+        /// Also write the device's Markdown document to FILE (e.g. docs/measurements/<adapter>.md).
         #[arg(long, value_name = "FILE")]
         markdown: Option<PathBuf>,
         /// Print JSON.
@@ -185,9 +190,20 @@ fn dispatch(cli: Cli) -> Result<()> {
             size,
             warmup,
             repeats,
+            geometry_only,
             json,
         } => cmd_measure(
-            &mesh, vs_loops, fs_loops, depth_test, layers, &order, &size, warmup, repeats, json,
+            &mesh,
+            vs_loops,
+            fs_loops,
+            depth_test,
+            layers,
+            &order,
+            &size,
+            warmup,
+            repeats,
+            geometry_only,
+            json,
         ),
         Cmd::Study {
             name,
@@ -538,6 +554,7 @@ fn cmd_measure(
     size: &str,
     warmup: u32,
     repeats: u32,
+    geometry_only: bool,
     json: bool,
 ) -> Result<()> {
     use rendersim::measure::{MeasureOptions, measure};
@@ -556,6 +573,7 @@ fn cmd_measure(
         size: (w, h),
         warmup,
         repeats,
+        geometry_only,
     };
     let r = measure(&m, mesh, &opts)?;
     let mut v = serde_json::to_value(&r)?;
@@ -595,6 +613,7 @@ fn cmd_measure(
     _size: &str,
     _warmup: u32,
     _repeats: u32,
+    _geometry_only: bool,
     _json: bool,
 ) -> Result<()> {
     bail!(
@@ -604,24 +623,99 @@ fn cmd_measure(
 
 #[cfg(feature = "wgpu")]
 fn cmd_study(name: &str, repeats: u32, markdown: Option<PathBuf>, json: bool) -> Result<()> {
-    if name != "h1" {
-        bail!("unknown study {name:?} (available: h1; h2-h4 are not written yet)");
+    use rendersim::measure::report::{StudySection, device_document};
+    use rendersim::measure::{Gpu, h1, studies};
+    let names: Vec<&str> = match name {
+        "all" => vec!["h1", "h2", "h3", "h4"],
+        "h1" | "h2" | "h3" | "h4" => vec![name],
+        _ => bail!("unknown study {name:?} (available: h1, h2, h3, h4, all)"),
+    };
+    if repeats == 0 {
+        bail!("--repeats must be at least 1");
     }
-    let r = rendersim::measure::h1::h1(repeats.max(1))?;
-    let md = r.markdown();
+    let gpu = Gpu::open()?;
+    let mut sections = Vec::new();
+    let mut results = serde_json::Map::new();
+    let mut h1_exact = None;
+    for n in names {
+        let t = std::time::Instant::now();
+        let (verdict, md, value) = match n {
+            "h1" => {
+                // Counters do not vary between passes: one recorded pass each.
+                let r = h1::h1(&gpu, 1)?;
+                h1_exact = Some((r.exact, r.chosen.clone()));
+                let v = format!(
+                    "vertex reuse: `{}` predicts every validation mesh {}",
+                    r.chosen,
+                    if r.exact { "exactly" } else { "NOT exactly" }
+                );
+                (v, r.markdown(), serde_json::to_value(&r)?)
+            }
+            "h2" => {
+                let r = studies::run_h2(&gpu, Default::default(), repeats)?;
+                let best = &r.scores[0];
+                let v = format!(
+                    "sum vs max: **{}** fits best ({:.1}% mean error on the test cells)",
+                    best.hypothesis, best.mean_abs_error_pct
+                );
+                (v, r.markdown(), serde_json::to_value(&r)?)
+            }
+            "h3" => {
+                let r = studies::run_h3(&gpu, Default::default(), repeats)?;
+                let v = format!(
+                    "draw order: calibrated early-z costs predict the other orders within {:.1}% (mean)",
+                    r.prediction_error_pct()
+                );
+                (v, r.markdown(), serde_json::to_value(&r)?)
+            }
+            _ => {
+                let r = studies::run_h4(&gpu, Default::default(), repeats)?;
+                let v = match (&r.geometry_fit, &r.fit) {
+                    (Some(g), Some(f)) => format!(
+                        "cost per transformed vertex: {:.1} ns alone (R^2 {:.3}, leave-one-out error {:.1}%), \
+                         {:.1} ns in full passes (R^2 {:.3}, error {:.1}%)",
+                        g.slope * 1e6,
+                        g.r_squared,
+                        r.geometry_error_pct,
+                        f.slope * 1e6,
+                        f.r_squared,
+                        r.mean_abs_error_pct
+                    ),
+                    _ => "no line could be fitted".to_string(),
+                };
+                (v, r.markdown(), serde_json::to_value(&r)?)
+            }
+        };
+        if !json {
+            println!("{}: {verdict}", n.to_uppercase());
+        }
+        results.insert(n.to_string(), value);
+        sections.push(StudySection {
+            name: n.to_uppercase(),
+            verdict,
+            markdown: md,
+            seconds: t.elapsed().as_secs_f64(),
+        });
+    }
+    let command = format!("rendersim study {name} --repeats {repeats}");
+    let notes = if gpu.adapter.device_type == "Cpu" {
+        "The adapter is a software rasterizer on this machine's CPU: pass times include \
+         the CPU time it spends and vary with the machine's load."
+    } else {
+        ""
+    };
+    let doc = device_document(&gpu.describe(), &command, notes, &sections);
     if let Some(path) = markdown {
-        write_atomic(&path, |w| w.write_all(md.as_bytes())).with_context(|| format!("writing {}", path.display()))?;
+        write_atomic(&path, |w| w.write_all(doc.as_bytes())).with_context(|| format!("writing {}", path.display()))?;
     }
     if json {
-        println!("{}", serde_json::to_string_pretty(&r)?);
+        results.insert("adapter".into(), serde_json::to_value(&gpu.adapter)?);
+        println!("{}", serde_json::to_string_pretty(&results)?);
     } else {
-        println!("{md}");
+        println!("\n{doc}");
     }
-    if !r.exact {
-        bail!(
-            "the fitted policy {} does not predict every validation mesh exactly",
-            r.chosen
-        );
+    if let Some((false, chosen)) = h1_exact {
+        bail!("the fitted policy {chosen} does not predict every validation mesh exactly");
     }
     Ok(())
 }

@@ -54,6 +54,10 @@ pub struct MeasureOptions {
     pub warmup: u32,
     /// Recorded passes.
     pub repeats: u32,
+    /// Every vertex at one point: every triangle is degenerate and produces
+    /// no fragments, so the pass measures the geometry stage alone (index
+    /// fetch, vertex shading, setup of empty triangles).
+    pub geometry_only: bool,
 }
 
 impl Default for MeasureOptions {
@@ -67,6 +71,7 @@ impl Default for MeasureOptions {
             size: (512, 512),
             warmup: 2,
             repeats: 5,
+            geometry_only: false,
         }
     }
 }
@@ -118,314 +123,357 @@ fn stats_types() -> wgpu::PipelineStatisticsTypes {
         | wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS
 }
 
-/// Draws `mesh` (`spec` names its generator, for positions) and measures it.
-pub fn measure(mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measurement, MeasureError> {
-    if opts.layers == 0 || opts.repeats == 0 || opts.size.0 == 0 || opts.size.1 == 0 {
-        return Err(MeasureError::Option(
-            "layers, repeats and size must be at least 1".into(),
-        ));
-    }
-    if opts.size.0 > 8192 || opts.size.1 > 8192 {
-        return Err(MeasureError::Option("render target larger than 8192x8192".into()));
-    }
-    let start = Instant::now();
-    let list = mesh.to_triangle_list();
-    let positions = mesh_positions(mesh, spec);
+/// An opened adapter and device, reused across measurements (a study opens
+/// one and measures dozens of meshes on it).
+pub struct Gpu {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    /// The adapter that measures.
+    pub adapter: AdapterSummary,
+}
 
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
-        backends: wgpu::Backends::VULKAN,
-        ..wgpu::InstanceDescriptor::new_without_display_handle_from_env()
-    });
-    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-        power_preference: wgpu::PowerPreference::HighPerformance,
-        force_fallback_adapter: false,
-        compatible_surface: None,
-        apply_limit_buckets: false,
-    }))
-    .map_err(|e| MeasureError::NoAdapter(e.to_string()))?;
-    let info = adapter.get_info();
-    let summary = AdapterSummary {
-        name: info.name.clone(),
-        driver: info.driver.clone(),
-        driver_info: info.driver_info.clone(),
-        device_type: format!("{:?}", info.device_type),
-        backend: format!("{:?}", info.backend),
-    };
-    let needed = [
-        (wgpu::Features::PIPELINE_STATISTICS_QUERY, "PIPELINE_STATISTICS_QUERY"),
-        (wgpu::Features::TIMESTAMP_QUERY, "TIMESTAMP_QUERY"),
-    ];
-    for (f, name) in needed {
-        if !adapter.features().contains(f) {
-            return Err(MeasureError::MissingFeature {
-                adapter: info.name.clone(),
-                feature: name,
-            });
+impl Gpu {
+    /// Opens the first high-performance Vulkan adapter with pipeline-statistics
+    /// and timestamp queries.
+    pub fn open() -> Result<Gpu, MeasureError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
+            backends: wgpu::Backends::VULKAN,
+            ..wgpu::InstanceDescriptor::new_without_display_handle_from_env()
+        });
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            apply_limit_buckets: false,
+        }))
+        .map_err(|e| MeasureError::NoAdapter(e.to_string()))?;
+        let info = adapter.get_info();
+        let summary = AdapterSummary {
+            name: info.name.clone(),
+            driver: info.driver.clone(),
+            driver_info: info.driver_info.clone(),
+            device_type: format!("{:?}", info.device_type),
+            backend: format!("{:?}", info.backend),
+        };
+        let needed = [
+            (wgpu::Features::PIPELINE_STATISTICS_QUERY, "PIPELINE_STATISTICS_QUERY"),
+            (wgpu::Features::TIMESTAMP_QUERY, "TIMESTAMP_QUERY"),
+        ];
+        for (f, name) in needed {
+            if !adapter.features().contains(f) {
+                return Err(MeasureError::MissingFeature {
+                    adapter: info.name.clone(),
+                    feature: name,
+                });
+            }
         }
-    }
-    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-        label: Some("rendersim measure"),
-        required_features: wgpu::Features::PIPELINE_STATISTICS_QUERY | wgpu::Features::TIMESTAMP_QUERY,
-        required_limits: adapter.limits(),
-        ..Default::default()
-    }))
-    .map_err(|e| MeasureError::Device(e.to_string()))?;
-
-    let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("positions"),
-        contents: &bytes_f32(&positions),
-        usage: wgpu::BufferUsages::VERTEX,
-    });
-    let ibuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("indices"),
-        contents: &bytes_u32(&list.indices),
-        usage: wgpu::BufferUsages::INDEX,
-    });
-    let params = [opts.vs_loops, opts.fs_loops, opts.layers, 0u32];
-    let ubuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("params"),
-        contents: &bytes_u32(&params),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
-    let slots = opts.order.slots(opts.layers);
-    let obuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("order"),
-        contents: &bytes_u32(&slots),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("measure"),
-        source: wgpu::ShaderSource::Wgsl(include_str!("shader.wgsl").into()),
-    });
-    let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: None,
-        entries: &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility: wgpu::ShaderStages::VERTEX,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-        ],
-    });
-    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &bgl,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: ubuf.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: obuf.as_entire_binding(),
-            },
-        ],
-    });
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: None,
-        bind_group_layouts: &[Some(&bgl)],
-        ..Default::default()
-    });
-    let format = wgpu::TextureFormat::Rgba8Unorm;
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("measure"),
-        layout: Some(&layout),
-        vertex: wgpu::VertexState {
-            module: &shader,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: 8,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &[wgpu::VertexAttribute {
-                    format: wgpu::VertexFormat::Float32x2,
-                    offset: 0,
-                    shader_location: 0,
-                }],
-            })],
-        },
-        primitive: wgpu::PrimitiveState {
-            cull_mode: None,
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("rendersim measure"),
+            required_features: wgpu::Features::PIPELINE_STATISTICS_QUERY | wgpu::Features::TIMESTAMP_QUERY,
+            required_limits: adapter.limits(),
             ..Default::default()
-        },
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: wgpu::TextureFormat::Depth32Float,
-            depth_write_enabled: Some(opts.depth_test),
-            depth_compare: Some(if opts.depth_test {
-                wgpu::CompareFunction::Less
-            } else {
-                wgpu::CompareFunction::Always
-            }),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &shader,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
-            targets: &[Some(wgpu::ColorTargetState {
-                format,
-                blend: None,
-                write_mask: wgpu::ColorWrites::ALL,
-            })],
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
-    let extent = wgpu::Extent3d {
-        width: opts.size.0,
-        height: opts.size.1,
-        depth_or_array_layers: 1,
-    };
-    let target = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("target"),
-        size: extent,
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-        view_formats: &[],
-    });
-    let depth = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("depth"),
-        size: extent,
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Depth32Float,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-        view_formats: &[],
-    });
-    let tview = target.create_view(&Default::default());
-    let dview = depth.create_view(&Default::default());
-    let stats_q = device.create_query_set(&wgpu::QuerySetDescriptor {
-        label: Some("stats"),
-        ty: wgpu::QueryType::PipelineStatistics(stats_types()),
-        count: 1,
-    });
-    let time_q = device.create_query_set(&wgpu::QuerySetDescriptor {
-        label: Some("time"),
-        ty: wgpu::QueryType::Timestamp,
-        count: 2,
-    });
-    let resolve = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("resolve"),
-        size: 256 * 2,
-        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let period = queue.get_timestamp_period() as f64;
-    let mut times = Vec::new();
-    let mut counters: Vec<[u64; 4]> = Vec::new();
-    let index_count = list.indices.len() as u32;
-    for round in 0..opts.warmup + opts.repeats {
-        let mut enc = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("measured pass"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &tview,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &dview,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: Some(wgpu::RenderPassTimestampWrites {
-                    query_set: &time_q,
-                    beginning_of_pass_write_index: Some(0),
-                    end_of_pass_write_index: Some(1),
-                }),
-                occlusion_query_set: None,
-                ..Default::default()
-            });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.set_vertex_buffer(0, vbuf.slice(..));
-            pass.set_index_buffer(ibuf.slice(..), wgpu::IndexFormat::Uint32);
-            pass.begin_pipeline_statistics_query(&stats_q, 0);
-            pass.draw_indexed(0..index_count, 0, 0..opts.layers);
-            pass.end_pipeline_statistics_query();
+        }))
+        .map_err(|e| MeasureError::Device(e.to_string()))?;
+        Ok(Gpu {
+            device,
+            queue,
+            adapter: summary,
+        })
+    }
+
+    /// One line naming the adapter: name (driver, driver info, device type).
+    pub fn describe(&self) -> String {
+        let a = &self.adapter;
+        format!("{} ({}, {}, {})", a.name, a.driver, a.driver_info, a.device_type)
+    }
+}
+
+/// Opens the default adapter, draws `mesh` (`spec` names its generator, for
+/// positions) and measures it.
+pub fn measure(mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measurement, MeasureError> {
+    let start = Instant::now();
+    let gpu = Gpu::open()?;
+    let mut r = gpu.measure(mesh, spec, opts)?;
+    r.wall_seconds = start.elapsed().as_secs_f64();
+    Ok(r)
+}
+
+impl Gpu {
+    /// Draws `mesh` on this device and measures it.
+    pub fn measure(&self, mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measurement, MeasureError> {
+        if opts.layers == 0 || opts.repeats == 0 || opts.size.0 == 0 || opts.size.1 == 0 {
+            return Err(MeasureError::Option(
+                "layers, repeats and size must be at least 1".into(),
+            ));
         }
-        enc.resolve_query_set(&stats_q, 0..1, &resolve, 0);
-        enc.resolve_query_set(&time_q, 0..2, &resolve, 256);
-        let read = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("read"),
-            size: 512,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        if opts.size.0 > 8192 || opts.size.1 > 8192 {
+            return Err(MeasureError::Option("render target larger than 8192x8192".into()));
+        }
+        let start = Instant::now();
+        let list = mesh.to_triangle_list();
+        let positions = if opts.geometry_only {
+            vec![[0.5, 0.5]; mesh.vertex_count as usize]
+        } else {
+            mesh_positions(mesh, spec)
+        };
+        let (device, queue) = (&self.device, &self.queue);
+        let summary = self.adapter.clone();
+        let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("positions"),
+            contents: &bytes_f32(&positions),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let ibuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("indices"),
+            contents: &bytes_u32(&list.indices),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+        let params = [opts.vs_loops, opts.fs_loops, opts.layers, 0u32];
+        let ubuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("params"),
+            contents: &bytes_u32(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let slots = opts.order.slots(opts.layers);
+        let obuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("order"),
+            contents: &bytes_u32(&slots),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("measure"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("shader.wgsl").into()),
+        });
+        let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: None,
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::VERTEX,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &bgl,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: ubuf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: obuf.as_entire_binding(),
+                },
+            ],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: None,
+            bind_group_layouts: &[Some(&bgl)],
+            ..Default::default()
+        });
+        let format = wgpu::TextureFormat::Rgba8Unorm;
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("measure"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &shader,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: 8,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &[wgpu::VertexAttribute {
+                        format: wgpu::VertexFormat::Float32x2,
+                        offset: 0,
+                        shader_location: 0,
+                    }],
+                })],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: wgpu::TextureFormat::Depth32Float,
+                depth_write_enabled: Some(opts.depth_test),
+                depth_compare: Some(if opts.depth_test {
+                    wgpu::CompareFunction::Less
+                } else {
+                    wgpu::CompareFunction::Always
+                }),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &shader,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let extent = wgpu::Extent3d {
+            width: opts.size.0,
+            height: opts.size.1,
+            depth_or_array_layers: 1,
+        };
+        let target = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("target"),
+            size: extent,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let depth = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("depth"),
+            size: extent,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let tview = target.create_view(&Default::default());
+        let dview = depth.create_view(&Default::default());
+        let stats_q = device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("stats"),
+            ty: wgpu::QueryType::PipelineStatistics(stats_types()),
+            count: 1,
+        });
+        let time_q = device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("time"),
+            ty: wgpu::QueryType::Timestamp,
+            count: 2,
+        });
+        let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("resolve"),
+            size: 256 * 2,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, 512);
-        queue.submit([enc.finish()]);
-        let slice = read.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| MeasureError::Readback(e.to_string()))?;
-        rx.recv()
-            .map_err(|e| MeasureError::Readback(e.to_string()))?
-            .map_err(|e| MeasureError::Readback(e.to_string()))?;
-        let data = slice
-            .get_mapped_range()
-            .map_err(|e| MeasureError::Readback(e.to_string()))?;
-        let words: Vec<u64> = data
-            .chunks_exact(8)
-            .map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
-            .collect();
-        drop(data);
-        read.unmap();
-        if round >= opts.warmup {
-            counters.push([words[0], words[1], words[2], words[3]]);
-            let (t0, t1) = (words[32], words[33]);
-            times.push(t1.saturating_sub(t0) as f64 * period);
+        let period = queue.get_timestamp_period() as f64;
+        let mut times = Vec::new();
+        let mut counters: Vec<[u64; 4]> = Vec::new();
+        let index_count = list.indices.len() as u32;
+        for round in 0..opts.warmup + opts.repeats {
+            let mut enc = device.create_command_encoder(&Default::default());
+            {
+                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("measured pass"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &tview,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &dview,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: Some(wgpu::RenderPassTimestampWrites {
+                        query_set: &time_q,
+                        beginning_of_pass_write_index: Some(0),
+                        end_of_pass_write_index: Some(1),
+                    }),
+                    occlusion_query_set: None,
+                    ..Default::default()
+                });
+                pass.set_pipeline(&pipeline);
+                pass.set_bind_group(0, &bind, &[]);
+                pass.set_vertex_buffer(0, vbuf.slice(..));
+                pass.set_index_buffer(ibuf.slice(..), wgpu::IndexFormat::Uint32);
+                pass.begin_pipeline_statistics_query(&stats_q, 0);
+                pass.draw_indexed(0..index_count, 0, 0..opts.layers);
+                pass.end_pipeline_statistics_query();
+            }
+            enc.resolve_query_set(&stats_q, 0..1, &resolve, 0);
+            enc.resolve_query_set(&time_q, 0..2, &resolve, 256);
+            let read = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("read"),
+                size: 512,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, 512);
+            queue.submit([enc.finish()]);
+            let slice = read.slice(..);
+            let (tx, rx) = std::sync::mpsc::channel();
+            slice.map_async(wgpu::MapMode::Read, move |r| {
+                let _ = tx.send(r);
+            });
+            device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| MeasureError::Readback(e.to_string()))?;
+            rx.recv()
+                .map_err(|e| MeasureError::Readback(e.to_string()))?
+                .map_err(|e| MeasureError::Readback(e.to_string()))?;
+            let data = slice
+                .get_mapped_range()
+                .map_err(|e| MeasureError::Readback(e.to_string()))?;
+            let words: Vec<u64> = data
+                .chunks_exact(8)
+                .map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
+                .collect();
+            drop(data);
+            read.unmap();
+            if round >= opts.warmup {
+                counters.push([words[0], words[1], words[2], words[3]]);
+                let (t0, t1) = (words[32], words[33]);
+                times.push(t1.saturating_sub(t0) as f64 * period);
+            }
         }
+        let stable = counters.windows(2).all(|w| w[0] == w[1]);
+        let last = *counters.last().unwrap_or(&[0; 4]);
+        let mut sorted = times.clone();
+        sorted.sort_by(|a, b| a.total_cmp(b));
+        let median = sorted[sorted.len() / 2];
+        Ok(Measurement {
+            adapter: summary,
+            vs_invocations: last[0],
+            clipper_invocations: last[1],
+            clipper_primitives_out: last[2],
+            fs_invocations: last[3],
+            pass_time_ns: median,
+            pass_times_ns: times,
+            stable_counters: stable,
+            options: opts.clone(),
+            wall_seconds: start.elapsed().as_secs_f64(),
+        })
     }
-    let stable = counters.windows(2).all(|w| w[0] == w[1]);
-    let last = *counters.last().unwrap_or(&[0; 4]);
-    let mut sorted = times.clone();
-    sorted.sort_by(|a, b| a.total_cmp(b));
-    let median = sorted[sorted.len() / 2];
-    Ok(Measurement {
-        adapter: summary,
-        vs_invocations: last[0],
-        clipper_invocations: last[1],
-        clipper_primitives_out: last[2],
-        fs_invocations: last[3],
-        pass_time_ns: median,
-        pass_times_ns: times,
-        stable_counters: stable,
-        options: opts.clone(),
-        wall_seconds: start.elapsed().as_secs_f64(),
-    })
 }
 
 fn bytes_f32(v: &[[f32; 2]]) -> Vec<u8> {

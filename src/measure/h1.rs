@@ -16,7 +16,7 @@ use crate::components::vertex_cache::CachePolicy;
 use crate::scene::generators::mesh_from_spec;
 use crate::scene::mesh::{Mesh, Topology};
 
-use super::device::{MeasureError, MeasureOptions, measure};
+use super::device::{Gpu, MeasureError, MeasureOptions};
 
 /// One mesh: measured and predicted vertex-shader invocations.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -132,8 +132,8 @@ fn candidates() -> Vec<CachePolicy> {
     v
 }
 
-/// Runs the study on the default adapter.
-pub fn h1(repeats: u32) -> Result<H1, MeasureError> {
+/// Runs the study on `gpu`.
+pub fn h1(gpu: &Gpu, repeats: u32) -> Result<H1, MeasureError> {
     let opts = MeasureOptions {
         repeats,
         warmup: 1,
@@ -141,21 +141,13 @@ pub fn h1(repeats: u32) -> Result<H1, MeasureError> {
         ..MeasureOptions::default()
     };
     let t = Instant::now();
-    let mut adapter = String::new();
-    let mut measure_all =
-        |meshes: &[(String, Mesh)], spec_of: &dyn Fn(&str) -> String| -> Result<Vec<u64>, MeasureError> {
-            meshes
-                .iter()
-                .map(|(name, m)| {
-                    let r = measure(m, &spec_of(name), &opts)?;
-                    adapter = format!(
-                        "{} ({}, {}, {})",
-                        r.adapter.name, r.adapter.driver, r.adapter.driver_info, r.adapter.device_type
-                    );
-                    Ok(r.vs_invocations)
-                })
-                .collect()
-        };
+    let adapter = gpu.describe();
+    let measure_all = |meshes: &[(String, Mesh)], spec_of: &dyn Fn(&str) -> String| -> Result<Vec<u64>, MeasureError> {
+        meshes
+            .iter()
+            .map(|(name, m)| Ok(gpu.measure(m, &spec_of(name), &opts)?.vs_invocations))
+            .collect()
+    };
     let probe_meshes = probes();
     let probe_measured = measure_all(&probe_meshes, &|_| "probe".to_string())?;
     let val_meshes: Vec<(String, Mesh)> = VALIDATION

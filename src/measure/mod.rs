@@ -4,14 +4,37 @@
 //! shader invocations) and timestamp queries around the render pass; warm
 //! up, repeat, report the median. Knobs: extra vertex and fragment shader
 //! work (ALU loop counts), depth test, layers drawn in a depth order, render
-//! target size. Used by the hypothesis studies that check the simulator's
-//! vertex-reuse and cost models against a device (issue 3).
+//! target size, geometry only. Used by the hypothesis studies that check the
+//! simulator's vertex-reuse and cost models against a device (issue 3):
+//!
+//! - H1 (`h1.rs`): vertex reuse, paper 000 §2 and §4.5 (actually transformed
+//!   vertices);
+//! - H2 (`h2.rs`): sum vs max of the geometry and fragment terms, paper 000
+//!   §4.5.1 and Table 1;
+//! - H3 (`h3.rs`): draw order and early-z, paper 000 §4.5.2 and Table 3;
+//! - H4 (`h4.rs`): cost per transformed vertex over index orders.
+//!
+//! The analysis of each study (fits, predictions by the simulator, errors) is
+//! plain code compiled in every build and tested on synthetic measurements;
+//! only the parts that talk to a device need the `wgpu` feature.
 //!
 //! What lavapipe's counters mean is noted in `docs/measurements/README.md`.
 
+pub mod fit;
+pub mod h2;
+pub mod h3;
+pub mod h4;
+pub mod predict;
+pub mod report;
+
+#[cfg(feature = "wgpu")]
 mod device;
 mod geometry;
+#[cfg(feature = "wgpu")]
 pub mod h1;
+#[cfg(feature = "wgpu")]
+pub mod studies;
 
-pub use device::{AdapterSummary, MeasureError, MeasureOptions, Measurement, measure};
+#[cfg(feature = "wgpu")]
+pub use device::{AdapterSummary, Gpu, MeasureError, MeasureOptions, Measurement, measure};
 pub use geometry::{DepthOrder, mesh_positions};

@@ -4,7 +4,10 @@
 //! The grid family exercises the post-transform vertex cache of paper 000
 //! (sections 2 and 4.5): the same triangles drawn row by row, shuffled, or
 //! reordered by [`optimize_vertex_cache`] give very different numbers of
-//! actually transformed vertices.
+//! actually transformed vertices. `grid:WxH:local:WINDOW:SEED` shuffles the
+//! triangles only within consecutive windows of WINDOW triangles, so the
+//! locality of the order (and the reuse a cache finds) can be set between
+//! row order (window 1) and a full shuffle (a window as large as the mesh).
 //!
 //! Grid vertices are numbered row-major: vertex `(i, j)` (column `i` in
 //! `0..=W`, row `j` in `0..=H`) has id `j * (W + 1) + i`. Quad `(i, j)` with
@@ -57,6 +60,15 @@ pub fn mesh_from_spec(spec: &str, base_dir: &Path) -> Result<Mesh, MeshError> {
             let seed = parse_num::<u64>(seed, "seed", spec)?;
             let mut mesh = grid(w, h, spec);
             shuffle_triangles(&mut mesh.indices, seed);
+            Ok(mesh)
+        }
+        ["grid", size, "local", window, seed] => {
+            let (w, h) = parse_size(size, spec)?;
+            let window = parse_num::<usize>(window, "window", spec)?;
+            nonzero(window as u64, "window", spec)?;
+            let seed = parse_num::<u64>(seed, "seed", spec)?;
+            let mut mesh = grid(w, h, spec);
+            shuffle_within_windows(&mut mesh.indices, window, seed);
             Ok(mesh)
         }
         ["grid", size, "optimized"] => {
@@ -176,6 +188,17 @@ fn shuffle_triangles(indices: &mut Vec<u32>, seed: u64) {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let mut tris: Vec<[u32; 3]> = indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     tris.shuffle(&mut rng);
+    *indices = tris.into_iter().flatten().collect();
+}
+
+/// Shuffles the triangles of a list within consecutive windows of `window`
+/// triangles (the last window may be shorter).
+fn shuffle_within_windows(indices: &mut Vec<u32>, window: usize, seed: u64) {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let mut tris: Vec<[u32; 3]> = indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    for chunk in tris.chunks_mut(window) {
+        chunk.shuffle(&mut rng);
+    }
     *indices = tris.into_iter().flatten().collect();
 }
 

@@ -52,7 +52,7 @@ pub enum MeshError {
     /// The spec matches no generator.
     #[error(
         "unknown mesh spec `{0}`; expected one of: grid:WxH, grid:WxH:shuffled:SEED, \
-         grid:WxH:optimized, strip:WxH, random:T:V:SEED, or a path ending in .obj or .idx"
+         grid:WxH:optimized, grid:WxH:local:WINDOW:SEED, strip:WxH, random:T:V:SEED, or a path ending in .obj or .idx"
     )]
     UnknownGenerator(String),
     /// A number in a spec does not parse.

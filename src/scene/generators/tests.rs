@@ -252,3 +252,32 @@ fn idx_files() {
     let e = mesh_from_spec("gone.idx", dir.path()).unwrap_err().to_string();
     assert!(e.contains("gone.idx") && e.contains("not found"), "{e}");
 }
+
+#[test]
+fn local_shuffle_keeps_windows_and_interpolates_reuse() {
+    let g = build("grid:32x32");
+    let one = build("grid:32x32:local:1:3");
+    assert_eq!(one.indices, g.indices, "a window of one triangle keeps the order");
+    let w8 = build("grid:32x32:local:8:3");
+    assert_eq!(sorted_tris(&w8), sorted_tris(&g));
+    // Each window of 8 triangles holds the same triangles as in row order.
+    for (a, b) in w8.indices.chunks(24).zip(g.indices.chunks(24)) {
+        let mut x: Vec<[u32; 3]> = a.chunks(3).map(|t| [t[0], t[1], t[2]]).collect();
+        let mut y: Vec<[u32; 3]> = b.chunks(3).map(|t| [t[0], t[1], t[2]]).collect();
+        x.sort();
+        y.sort();
+        assert_eq!(x, y);
+    }
+    let p = CachePolicy::Fifo(16);
+    let acmr = |spec: &str| build(spec).cache_stats(&p).acmr();
+    let (a1, a64, a_all) = (
+        acmr("grid:32x32"),
+        acmr("grid:32x32:local:64:3"),
+        acmr("grid:32x32:local:4096:3"),
+    );
+    assert!(a1 < a64 && a64 < a_all, "{a1} {a64} {a_all}");
+    assert!(matches!(
+        mesh_from_spec("grid:8x8:local:0:1", std::path::Path::new(".")),
+        Err(MeshError::ZeroSize { .. })
+    ));
+}

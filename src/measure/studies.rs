@@ -1,0 +1,204 @@
+//! Running the hypothesis studies H2-H4 on a device: the passes each study
+//! needs, measured on one opened [`Gpu`], handed to the study's analysis.
+
+use std::path::Path;
+use std::time::Instant;
+
+use crate::scene::generators::mesh_from_spec;
+use crate::scene::mesh::Mesh;
+
+use super::device::{Gpu, MeasureError, MeasureOptions, Measurement};
+use super::fit::median;
+use super::geometry::DepthOrder;
+use super::h2::{self, H2, H2Measured, H2Setup};
+use super::h3::{self, H3, H3Measured, H3Pass, H3Setup};
+use super::h4::{self, H4, H4Row, H4Setup};
+use super::predict::PredictError;
+
+/// Errors of a study.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// A measurement failed.
+    #[error(transparent)]
+    Measure(#[from] MeasureError),
+    /// The simulator's prediction failed.
+    #[error(transparent)]
+    Predict(#[from] PredictError),
+    /// A study mesh could not be built.
+    #[error("study mesh: {0}")]
+    Mesh(String),
+}
+
+fn mesh(spec: &str) -> Result<Mesh, StudyError> {
+    mesh_from_spec(spec, Path::new(".")).map_err(|e| StudyError::Mesh(e.to_string()))
+}
+
+/// One pass to measure: mesh spec, mesh, options.
+type Condition<'a> = (&'a str, &'a Mesh, MeasureOptions);
+
+/// Measures every condition `rounds` times, interleaved (round 1 of every
+/// condition, then round 2, ...), so that a slow spell of the machine
+/// touches all conditions alike rather than one; the first round of each
+/// condition is preceded by one unrecorded warm-up pass. Returns one
+/// measurement per condition whose `pass_times_ns` holds every round and
+/// whose `pass_time_ns` is their median.
+fn interleaved(gpu: &Gpu, conds: &[Condition], rounds: u32) -> Result<Vec<Measurement>, StudyError> {
+    let mut out: Vec<Option<Measurement>> = vec![None; conds.len()];
+    for round in 0..rounds.max(1) {
+        for (slot, (spec, mesh, opts)) in out.iter_mut().zip(conds) {
+            let r = gpu.measure(
+                mesh,
+                spec,
+                &MeasureOptions {
+                    warmup: u32::from(round == 0),
+                    repeats: 1,
+                    ..opts.clone()
+                },
+            )?;
+            match slot {
+                None => *slot = Some(r),
+                Some(m) => {
+                    m.stable_counters &= r.vs_invocations == m.vs_invocations && r.fs_invocations == m.fs_invocations;
+                    m.pass_times_ns.extend(r.pass_times_ns);
+                    m.wall_seconds += r.wall_seconds;
+                }
+            }
+        }
+    }
+    Ok(out
+        .into_iter()
+        .flatten()
+        .map(|mut m| {
+            m.pass_time_ns = median(&m.pass_times_ns).unwrap_or(f64::NAN);
+            m
+        })
+        .collect())
+}
+
+/// Measures and analyses H2 (sum vs max).
+pub fn run_h2(gpu: &Gpu, setup: H2Setup, rounds: u32) -> Result<H2, StudyError> {
+    let t = Instant::now();
+    let grid = mesh(&setup.mesh)?;
+    let tiny = mesh("grid:1x1")?;
+    let base = MeasureOptions {
+        size: setup.size,
+        ..MeasureOptions::default()
+    };
+    let geometry_only = |vs_loops| MeasureOptions {
+        vs_loops,
+        geometry_only: true,
+        ..base.clone()
+    };
+    let full = |vs_loops, fs_loops| MeasureOptions {
+        vs_loops,
+        fs_loops,
+        ..base.clone()
+    };
+    let [vs, vc] = setup.vs_loops;
+    let [fs, fc] = setup.fs_loops;
+    let m = interleaved(
+        gpu,
+        &[
+            ("grid:1x1", &tiny, geometry_only(0)),
+            (&setup.mesh, &grid, geometry_only(vs)),
+            (&setup.mesh, &grid, geometry_only(vc)),
+            (&setup.mesh, &grid, full(vs, fs)),
+            (&setup.mesh, &grid, full(vs, fc)),
+            (&setup.mesh, &grid, full(vc, fs)),
+            (&setup.mesh, &grid, full(vc, fc)),
+        ],
+        rounds,
+    )?;
+    let measured = H2Measured {
+        overhead_ns: m[0].pass_time_ns,
+        geometry_ns: [m[1].pass_time_ns, m[2].pass_time_ns],
+        cells_ns: [
+            [m[3].pass_time_ns, m[4].pass_time_ns],
+            [m[5].pass_time_ns, m[6].pass_time_ns],
+        ],
+        vs_invocations: m[6].vs_invocations,
+        fs_invocations: m[6].fs_invocations,
+        fs_invocations_geometry_only: m[2].fs_invocations,
+        triangles: grid.triangles(),
+    };
+    Ok(h2::analyze(setup, measured, t.elapsed().as_secs_f64())?)
+}
+
+/// Measures and analyses H3 (draw order).
+pub fn run_h3(gpu: &Gpu, setup: H3Setup, rounds: u32) -> Result<H3, StudyError> {
+    let t = Instant::now();
+    let m = mesh(&setup.mesh)?;
+    let base = MeasureOptions {
+        size: setup.size,
+        fs_loops: setup.fs_loops,
+        ..MeasureOptions::default()
+    };
+    let layered = |depth_test, order| MeasureOptions {
+        layers: setup.layers,
+        depth_test,
+        order,
+        ..base.clone()
+    };
+    let r = interleaved(
+        gpu,
+        &[
+            (&setup.mesh, &m, base.clone()),
+            (&setup.mesh, &m, layered(false, DepthOrder::FrontToBack)),
+            (&setup.mesh, &m, layered(true, DepthOrder::FrontToBack)),
+            (&setup.mesh, &m, layered(true, DepthOrder::BackToFront)),
+            (&setup.mesh, &m, layered(true, DepthOrder::Random)),
+        ],
+        rounds,
+    )?;
+    let pass = |r: &Measurement| H3Pass {
+        time_ns: r.pass_time_ns,
+        fs_invocations: r.fs_invocations,
+    };
+    let measured = H3Measured {
+        one_layer: pass(&r[0]),
+        all_layers: pass(&r[1]),
+        ordered: [pass(&r[2]), pass(&r[3]), pass(&r[4])],
+        triangles: m.triangles(),
+    };
+    Ok(h3::analyze(setup, measured, t.elapsed().as_secs_f64())?)
+}
+
+/// Measures and analyses H4 (cost per transformed vertex).
+pub fn run_h4(gpu: &Gpu, setup: H4Setup, rounds: u32) -> Result<H4, StudyError> {
+    let policy: crate::components::vertex_cache::CachePolicy = setup
+        .cache
+        .parse()
+        .map_err(|e| StudyError::Mesh(format!("cache policy: {e}")))?;
+    let specs = setup.orders();
+    let meshes: Vec<Mesh> = specs.iter().map(|s| mesh(s)).collect::<Result<_, _>>()?;
+    let t = Instant::now();
+    let opts = |geometry_only| MeasureOptions {
+        size: setup.size,
+        vs_loops: setup.vs_loops,
+        geometry_only,
+        ..MeasureOptions::default()
+    };
+    let mut conds: Vec<Condition> = Vec::new();
+    for (spec, m) in specs.iter().zip(&meshes) {
+        conds.push((spec, m, opts(true)));
+        conds.push((spec, m, opts(false)));
+    }
+    let r = interleaved(gpu, &conds, rounds)?;
+    let measure_seconds = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let mut rows = Vec::new();
+    for (i, (spec, m)) in specs.iter().zip(&meshes).enumerate() {
+        let (geo, full) = (&r[2 * i], &r[2 * i + 1]);
+        rows.push(H4Row {
+            mesh: spec.clone(),
+            measured_vs: full.vs_invocations,
+            simulated_vs: m.cache_stats(&policy).transformed,
+            fs_invocations: full.fs_invocations,
+            geometry_ms: geo.pass_time_ns / 1e6,
+            measured_ms: full.pass_time_ns / 1e6,
+            predicted_geometry_ms: None,
+            predicted_ms: None,
+        });
+    }
+    Ok(h4::analyze(setup, rows, measure_seconds, t.elapsed().as_secs_f64()))
+}
