@@ -35,15 +35,15 @@ step "Rust tests (unit, property, integration, doc; wgpu measurements on lavapip
 cargo test --release --locked --no-fail-fast --features wgpu 2>&1 | tee target/test-output.txt
 grep -q "test result:" target/test-output.txt
 
-step "Study H1 on this machine's adapter (vertex reuse; must predict validation meshes exactly)"
+step "Studies H1-H4 on this machine's adapter (H1 must predict its validation meshes exactly)"
 if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
-  if ! "$RENDERSIM_BIN" study h1 --markdown out/ci/h1.md > out/ci/h1.txt 2> out/ci/h1.err; then
-    cat out/ci/h1.txt out/ci/h1.err
+  if ! "$RENDERSIM_BIN" study all --markdown out/ci/studies.md > out/ci/studies.txt 2> out/ci/studies.err; then
+    cat out/ci/studies.txt out/ci/studies.err
     exit 1
   fi
-  head -n 6 out/ci/h1.txt
+  head -n 4 out/ci/studies.txt
 else
-  echo "no Vulkan driver installed: study H1 skipped"
+  echo "no Vulkan driver installed: studies skipped"
 fi
 
 step "Experiments"

@@ -637,12 +637,24 @@ fn cmd_study(name: &str, repeats: u32, markdown: Option<PathBuf>, json: bool) ->
     let mut sections = Vec::new();
     let mut results = serde_json::Map::new();
     let mut h1_exact = None;
+    // H2-H4 price vertices with the reuse policy H1 identifies on this
+    // device: run H1 first (it only reads counters, one pass per mesh).
+    let mut fitted: Option<h1::H1> = None;
+    if names.iter().any(|n| *n != "h1") {
+        fitted = Some(h1::h1(&gpu, 1)?);
+    }
+    let cache = fitted
+        .as_ref()
+        .map_or_else(|| "lavapipe".to_string(), |r| r.chosen.clone());
     for n in names {
         let t = std::time::Instant::now();
         let (verdict, md, value) = match n {
             "h1" => {
                 // Counters do not vary between passes: one recorded pass each.
-                let r = h1::h1(&gpu, 1)?;
+                let r = match fitted.take() {
+                    Some(r) => r,
+                    None => h1::h1(&gpu, 1)?,
+                };
                 h1_exact = Some((r.exact, r.chosen.clone()));
                 let v = format!(
                     "vertex reuse: `{}` predicts every validation mesh {}",
@@ -652,7 +664,11 @@ fn cmd_study(name: &str, repeats: u32, markdown: Option<PathBuf>, json: bool) ->
                 (v, r.markdown(), serde_json::to_value(&r)?)
             }
             "h2" => {
-                let r = studies::run_h2(&gpu, Default::default(), repeats)?;
+                let setup = rendersim::measure::h2::H2Setup {
+                    cache: cache.clone(),
+                    ..Default::default()
+                };
+                let r = studies::run_h2(&gpu, setup, repeats)?;
                 let best = &r.scores[0];
                 let v = format!(
                     "sum vs max: **{}** fits best ({:.1}% mean error on the test cells)",
@@ -661,7 +677,11 @@ fn cmd_study(name: &str, repeats: u32, markdown: Option<PathBuf>, json: bool) ->
                 (v, r.markdown(), serde_json::to_value(&r)?)
             }
             "h3" => {
-                let r = studies::run_h3(&gpu, Default::default(), repeats)?;
+                let setup = rendersim::measure::h3::H3Setup {
+                    cache: cache.clone(),
+                    ..Default::default()
+                };
+                let r = studies::run_h3(&gpu, setup, repeats)?;
                 let v = format!(
                     "draw order: calibrated early-z costs predict the other orders within {:.1}% (mean)",
                     r.prediction_error_pct()
@@ -669,7 +689,11 @@ fn cmd_study(name: &str, repeats: u32, markdown: Option<PathBuf>, json: bool) ->
                 (v, r.markdown(), serde_json::to_value(&r)?)
             }
             _ => {
-                let r = studies::run_h4(&gpu, Default::default(), repeats)?;
+                let setup = rendersim::measure::h4::H4Setup {
+                    cache: cache.clone(),
+                    ..Default::default()
+                };
+                let r = studies::run_h4(&gpu, setup, repeats)?;
                 let v = match (&r.geometry_fit, &r.fit) {
                     (Some(g), Some(f)) => format!(
                         "cost per transformed vertex: {:.1} ns alone (R^2 {:.3}, leave-one-out error {:.1}%), \

@@ -127,6 +127,7 @@ fn studies_h2_to_h4_run_and_their_counters_match_the_simulator() {
             size: (96, 96),
             vs_loops: [0, 50],
             fs_loops: [0, 5],
+            auto_target_ms: None,
             ..H2Setup::default()
         },
         1,
@@ -150,6 +151,7 @@ fn studies_h2_to_h4_run_and_their_counters_match_the_simulator() {
             size: (64, 64),
             layers: 4,
             fs_loops: 2,
+            auto_target_ms: None,
             ..H3Setup::default()
         },
         1,
@@ -174,6 +176,7 @@ fn studies_h2_to_h4_run_and_their_counters_match_the_simulator() {
             grid: 24,
             size: (64, 64),
             vs_loops: 10,
+            auto_target_ms: None,
             ..H4Setup::default()
         },
         1,

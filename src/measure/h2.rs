@@ -39,6 +39,12 @@ pub struct H2Setup {
     pub cache: String,
     /// Triangle-FIFO depth of the simulator's prediction.
     pub fifo_depth: u32,
+    /// When set, the complex loop counts are found on the device before
+    /// measuring: the vertex shader's so that the geometry-only pass takes
+    /// at least this long (ms), then the fragment shader's so that F(complex)
+    /// reaches G(complex), where sum and max differ most. Any device then
+    /// gets a balanced, measurable 2x2.
+    pub auto_target_ms: Option<f64>,
 }
 
 impl Default for H2Setup {
@@ -50,6 +56,7 @@ impl Default for H2Setup {
             fs_loops: [0, 40],
             cache: "lavapipe".into(),
             fifo_depth: 16,
+            auto_target_ms: Some(15.0),
         }
     }
 }
@@ -231,7 +238,7 @@ impl H2 {
             "## H2: sum vs max of the geometry and fragment terms (paper 000 §4.5.1, Table 1)\n\n\
              Mesh `{}` on a {}x{} target ({} triangles, {} vertex-shader and {} fragment-shader invocations per pass); \
              vertex shader {} / {} loop iterations, fragment shader {} / {}. \
-             Terms from isolating passes: overhead {:.3} ms; geometry G = {:.3} / {:.3} ms (geometry-only passes, {} fragment invocations); \
+             {}Terms from isolating passes: overhead {:.3} ms; geometry G = {:.3} / {:.3} ms (geometry-only passes, {} fragment invocations); \
              fragments F = {:.3} / {:.3} ms (full minus geometry-only pass, simple vertex shader).\n\n",
             s.mesh,
             s.size.0,
@@ -243,6 +250,13 @@ impl H2 {
             s.vs_loops[1],
             s.fs_loops[0],
             s.fs_loops[1],
+            match s.auto_target_ms {
+                Some(t) => format!(
+                    "The complex loop counts were found on this device: the vertex shader's so that geometry alone takes at least {t} ms, \
+                     then the fragment shader's so that F(complex) reaches G(complex), where sum and max differ most. "
+                ),
+                None => String::new(),
+            },
             m.overhead_ns / 1e6,
             self.geometry_ms[0],
             self.geometry_ms[1],

@@ -36,6 +36,9 @@ pub struct H3Setup {
     pub fs_loops: u32,
     /// Vertex-cache policy the simulator uses.
     pub cache: String,
+    /// When set, the fragment loop count is found on the device before
+    /// measuring, so that shading one layer takes at least this long (ms).
+    pub auto_target_ms: Option<f64>,
 }
 
 impl Default for H3Setup {
@@ -46,6 +49,7 @@ impl Default for H3Setup {
             layers: 8,
             fs_loops: 40,
             cache: "lavapipe".into(),
+            auto_target_ms: Some(5.0),
         }
     }
 }
@@ -215,7 +219,7 @@ impl H3 {
         let [o, r, p] = self.costs_ms;
         let mut out = format!(
             "## H3: draw order and early-z (paper 000 §4.5.2, Table 3)\n\n\
-             `{}` as {} layers on a {}x{} target, fragment shader {} loop iterations, depth test on. \
+             `{}` as {} layers on a {}x{} target, fragment shader {} loop iterations{}, depth test on. \
              Calibration without the depth test: one layer {:.3} ms ({} fragment invocations), all layers {:.3} ms ({}). \
              Costs: overhead {o:.3} ms, rasterize and test {r:.3} ms per layer, shade {p:.3} ms per layer.\n\n\
              | order | layers shaded | fragment invocations | measured ms | predicted ms (err) | simulator ms (err; expects layers shaded) | |\n|---|---|---|---|---|---|---|\n",
@@ -224,6 +228,9 @@ impl H3 {
             s.size.0,
             s.size.1,
             s.fs_loops,
+            s.auto_target_ms.map_or(String::new(), |t| format!(
+                " (found on this device: shading one layer takes at least {t} ms)"
+            )),
             m.one_layer.time_ns / 1e6,
             m.one_layer.fs_invocations,
             m.all_layers.time_ns / 1e6,

@@ -26,6 +26,10 @@ pub struct H4Setup {
     pub vs_loops: u32,
     /// Vertex-cache policy the simulator uses.
     pub cache: String,
+    /// When set, the vertex loop count is found on the device before
+    /// measuring, so that the geometry-only pass of the cache-optimized order
+    /// takes at least this long (ms).
+    pub auto_target_ms: Option<f64>,
 }
 
 impl Default for H4Setup {
@@ -35,6 +39,7 @@ impl Default for H4Setup {
             size: (256, 256),
             vs_loops: 300,
             cache: "lavapipe".into(),
+            auto_target_ms: Some(10.0),
         }
     }
 }
@@ -157,7 +162,7 @@ impl H4 {
         };
         let mut out = format!(
             "## H4: cost per transformed vertex\n\n\
-             `grid:{w}x{w}` in {} index orders on a {}x{} target, vertex shader {} loop iterations. \
+             `grid:{w}x{w}` in {} index orders on a {}x{} target, vertex shader {} loop iterations{}. \
              Time against measured vertex-shader invocations: geometry only {}; full pass {}.\n\n\
              Predicted = the simulator's transformed vertices (policy `{}`) on a line fitted to the other orders (leave-one-out).\n\n\
              | order | measured VS | simulated VS | FS invocations | geometry-only ms | predicted (err) | full pass ms | predicted (err) |\n|---|---|---|---|---|---|---|---|\n",
@@ -165,6 +170,9 @@ impl H4 {
             s.size.0,
             s.size.1,
             s.vs_loops,
+            s.auto_target_ms.map_or(String::new(), |t| format!(
+                " (found on this device: the cache-optimized order's geometry takes at least {t} ms)"
+            )),
             line(&self.geometry_fit),
             line(&self.fit),
             s.cache,

@@ -75,8 +75,45 @@ fn interleaved(gpu: &Gpu, conds: &[Condition], rounds: u32) -> Result<Vec<Measur
         .collect())
 }
 
+/// The largest loop count any calibration tries.
+const MAX_LOOPS: u32 = 1 << 22;
+
+/// Finds a loop count whose `cost` (ns, roughly proportional to the loops)
+/// lies between `target_ns` and 1.5 times it: from `start`, rescale by
+/// target / cost (aiming 20% above the target), at most five tries, within
+/// 1..=[`MAX_LOOPS`]. Returns the last count tried.
+fn loops_for(
+    start: u32,
+    target_ns: f64,
+    mut cost: impl FnMut(u32) -> Result<f64, StudyError>,
+) -> Result<u32, StudyError> {
+    let mut loops = start.clamp(1, MAX_LOOPS);
+    for _ in 0..5 {
+        let c = cost(loops)?;
+        if c >= target_ns && c <= 1.5 * target_ns {
+            break;
+        }
+        let next = if c > 0.0 {
+            (f64::from(loops) * 1.2 * target_ns / c).ceil()
+        } else {
+            f64::from(loops) * 4.0
+        };
+        let next = next.clamp(1.0, f64::from(MAX_LOOPS)) as u32;
+        if next == loops {
+            break;
+        }
+        loops = next;
+    }
+    Ok(loops)
+}
+
+/// A short measurement (a warm-up, then the median of three passes), ns.
+fn quick(gpu: &Gpu, spec: &str, m: &Mesh, opts: MeasureOptions) -> Result<f64, StudyError> {
+    Ok(interleaved(gpu, &[(spec, m, opts)], 3)?[0].pass_time_ns)
+}
+
 /// Measures and analyses H2 (sum vs max).
-pub fn run_h2(gpu: &Gpu, setup: H2Setup, rounds: u32) -> Result<H2, StudyError> {
+pub fn run_h2(gpu: &Gpu, mut setup: H2Setup, rounds: u32) -> Result<H2, StudyError> {
     let t = Instant::now();
     let grid = mesh(&setup.mesh)?;
     let tiny = mesh("grid:1x1")?;
@@ -94,6 +131,22 @@ pub fn run_h2(gpu: &Gpu, setup: H2Setup, rounds: u32) -> Result<H2, StudyError> 
         fs_loops,
         ..base.clone()
     };
+    if let Some(target) = setup.auto_target_ms {
+        let spec = setup.mesh.clone();
+        let [vs, _] = setup.vs_loops;
+        let [fs, _] = setup.fs_loops;
+        let geo_simple = quick(gpu, &spec, &grid, geometry_only(vs))?;
+        let vc = loops_for(setup.vs_loops[1], target * 1e6, |l| {
+            Ok(quick(gpu, &spec, &grid, geometry_only(l))? - geo_simple)
+        })?;
+        let g_complex = quick(gpu, &spec, &grid, geometry_only(vc))? - geo_simple;
+        let frag_simple = quick(gpu, &spec, &grid, full(vs, fs))?;
+        let fc = loops_for(setup.fs_loops[1], g_complex, |l| {
+            Ok(quick(gpu, &spec, &grid, full(vs, l))? - frag_simple)
+        })?;
+        setup.vs_loops[1] = vc;
+        setup.fs_loops[1] = fc;
+    }
     let [vs, vc] = setup.vs_loops;
     let [fs, fc] = setup.fs_loops;
     let m = interleaved(
@@ -125,9 +178,20 @@ pub fn run_h2(gpu: &Gpu, setup: H2Setup, rounds: u32) -> Result<H2, StudyError> 
 }
 
 /// Measures and analyses H3 (draw order).
-pub fn run_h3(gpu: &Gpu, setup: H3Setup, rounds: u32) -> Result<H3, StudyError> {
+pub fn run_h3(gpu: &Gpu, mut setup: H3Setup, rounds: u32) -> Result<H3, StudyError> {
     let t = Instant::now();
     let m = mesh(&setup.mesh)?;
+    if let Some(target) = setup.auto_target_ms {
+        let one = |fs_loops| MeasureOptions {
+            size: setup.size,
+            fs_loops,
+            ..MeasureOptions::default()
+        };
+        let plain = quick(gpu, &setup.mesh, &m, one(0))?;
+        setup.fs_loops = loops_for(setup.fs_loops, target * 1e6, |l| {
+            Ok(quick(gpu, &setup.mesh, &m, one(l))? - plain)
+        })?;
+    }
     let base = MeasureOptions {
         size: setup.size,
         fs_loops: setup.fs_loops,
