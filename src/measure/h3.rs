@@ -164,6 +164,7 @@ pub fn analyze(setup: H3Setup, m: H3Measured, measure_seconds: f64) -> Result<H3
             fragments_per_triangle: frags_per_layer / tris,
             depth_order: (*key).into(),
             fifo_depth: 16,
+            binning: false,
         })?;
         let pass = crate::systems::frame_pipeline::workload::early_z_pass(scene_order(*order), l);
         rows.push(H3Row {

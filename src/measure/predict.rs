@@ -32,6 +32,8 @@ pub struct PassModel {
     pub depth_order: String,
     /// Triangles the FIFO between geometry and fragment stage holds.
     pub fifo_depth: u32,
+    /// Sort-middle binning (`gpu.fragment.binning = "draw"`) instead of the FIFO.
+    pub binning: bool,
 }
 
 impl PassModel {
@@ -52,6 +54,7 @@ vertex_shader = "{pv}"
 vertex_cache = "{cache}"
 [gpu.fragment]
 fifo_depth = {fifo}
+binning = "{binning}"
 per_fragment = "{pf}"
 per_rejected_fragment = "{pr}"
 [display]
@@ -74,6 +77,7 @@ triangle_pixels = {frag:?}
             pv = self.per_vertex,
             cache = self.cache,
             fifo = self.fifo_depth,
+            binning = if self.binning { "draw" } else { "off" },
             pf = self.per_fragment,
             pr = self.per_rejected_fragment,
             order = self.depth_order,
@@ -155,6 +159,7 @@ mod tests {
             fragments_per_triangle: 10.0,
             depth_order: "front_to_back".into(),
             fifo_depth: 1,
+            binning: false,
         }
     }
 
@@ -192,6 +197,13 @@ mod tests {
             "deep fifo {deep} should be near max {}",
             g.max(f)
         );
+        let binned = simulate_pass(&PassModel {
+            binning: true,
+            ..base.clone()
+        })
+        .unwrap()
+        .gpu_ms;
+        assert!((binned - (g + f)).abs() < 1e-9, "binned {binned} vs sum {}", g + f);
     }
 
     #[test]

@@ -50,8 +50,16 @@ pub fn expected_max_normal(a: f64, m: f64, s: f64) -> f64 {
 }
 
 /// The draw's times: `n` triangles, total geometry time `geometry`, triangle
-/// areas from `pixels`, `cost_per_pixel` picoseconds, FIFO depth `depth`.
-pub fn draw_times(n: u64, geometry: Duration, pixels: &Dist<f64>, cost_per_pixel: f64, depth: u32) -> DrawTimes {
+/// areas from `pixels`, `cost_per_pixel` picoseconds, FIFO depth `depth`, or
+/// `depth = None` for a sort-middle (binning) pipeline, where the stages run
+/// one after the other and the draw takes exactly G + F.
+pub fn draw_times(
+    n: u64,
+    geometry: Duration,
+    pixels: &Dist<f64>,
+    cost_per_pixel: f64,
+    depth: Option<u32>,
+) -> DrawTimes {
     if n == 0 {
         return DrawTimes {
             geometry,
@@ -64,6 +72,14 @@ pub fn draw_times(n: u64, geometry: Duration, pixels: &Dist<f64>, cost_per_pixel
     let f_mean = mean_px * cost_per_pixel;
     let f_total = n as f64 * f_mean;
     let g = g_total / n as f64;
+    let Some(depth) = depth else {
+        let fragment = Duration::from_ps_f64(f_total);
+        return DrawTimes {
+            geometry,
+            fragment,
+            total: Duration(geometry.0.saturating_add(fragment.0)),
+        };
+    };
     let w = (depth as u64 + 1).min(n) as f64;
     let windowed = if cost_per_pixel <= 0.0 {
         g_total
@@ -97,15 +113,21 @@ mod tests {
     #[test]
     fn balanced_constant_triangles_overlap() {
         // 1000 triangles, g = 10 ps, f = 10 ps each: deep FIFO -> max + fill.
-        let t = draw_times(1000, Duration(10_000), &Dist::Const { value: 10.0 }, 1.0, 1000);
+        let t = draw_times(1000, Duration(10_000), &Dist::Const { value: 10.0 }, 1.0, Some(1000));
         assert_eq!(t.total, Duration(10_010));
+        // Binned, the same draw takes the sum.
+        let b = draw_times(1000, Duration(10_000), &Dist::Const { value: 10.0 }, 1.0, None);
+        assert_eq!(
+            (b.geometry, b.fragment, b.total),
+            (Duration(10_000), Duration(10_000), Duration(20_000))
+        );
     }
 
     #[test]
     fn bimodal_triangles_with_one_slot_tend_to_sum() {
         // Half the triangles tiny, half huge: with w = 1, T = sum of max per triangle.
         let px = Dist::Uniform { min: 0.0, max: 0.0 };
-        let t = draw_times(10, Duration(100), &px, 1.0, 0);
+        let t = draw_times(10, Duration(100), &px, 1.0, Some(0));
         assert_eq!(t.total, Duration(100));
     }
 
@@ -116,7 +138,7 @@ mod tests {
             sigma: 1.5,
         };
         for depth in [0, 1, 4, 16, 256] {
-            let t = draw_times(5000, Duration(5000 * 30), &px, 3.0, depth);
+            let t = draw_times(5000, Duration(5000 * 30), &px, 3.0, Some(depth));
             let lo = t.geometry.max(t.fragment);
             let hi = Duration(t.geometry.0 + t.fragment.0);
             assert!(t.total >= lo && t.total <= hi, "{depth}: {t:?}");

@@ -262,22 +262,58 @@ impl Default for GeometryConfig {
     }
 }
 
+/// How triangles reach the fragment stage.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Binning {
+    /// Immediate mode: each triangle goes through the triangle FIFO as soon
+    /// as its geometry is done, so the two stages overlap (paper 000 §4.5.1).
+    #[default]
+    Off,
+    /// Sort-middle: all of a draw's triangles are transformed and binned
+    /// before its first fragment is shaded, and the next draw's geometry
+    /// waits until the bins are drained; the stages never overlap and a
+    /// draw costs G + F. `fifo_depth` is unused (the bins hold the draw).
+    /// Software rasterizers such as Mesa's llvmpipe work this way (study H2,
+    /// docs/measurements/).
+    Draw,
+}
+
 /// The fragment stage and the triangle FIFO in front of it (§4.5.1).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FragmentConfig {
     /// Triangles the FIFO between geometry and fragment holds (0 = direct hand-off).
     pub fifo_depth: u32,
+    /// `"off"` (immediate: triangles stream through the FIFO) or `"draw"`
+    /// (sort-middle: a draw's fragments start after all its geometry).
+    pub binning: Binning,
     /// Per shaded fragment.
     pub per_fragment: Duration,
     /// Per fragment rejected by the early depth test.
     pub per_rejected_fragment: Duration,
 }
 
+impl FragmentConfig {
+    /// The FIFO depth the closed form uses: `None` when binning.
+    pub fn depth(&self) -> Option<u32> {
+        match self.binning {
+            Binning::Off => Some(self.fifo_depth),
+            Binning::Draw => None,
+        }
+    }
+
+    /// Whether a draw's fragments wait for all of its geometry.
+    pub fn binned(&self) -> bool {
+        self.binning == Binning::Draw
+    }
+}
+
 impl Default for FragmentConfig {
     fn default() -> Self {
         FragmentConfig {
             fifo_depth: 16,
+            binning: Binning::Off,
             per_fragment: Duration::ZERO,
             per_rejected_fragment: Duration::ZERO,
         }

@@ -4,7 +4,9 @@
 //! fragment stage (paper 000 §4.5). At `triangle` fidelity every triangle is
 //! an event in both stages, so the bottleneck can move inside one draw
 //! (§4.5.1); at `draw` fidelity each draw is one closed form
-//! ([`super::closed_form`]).
+//! ([`super::closed_form`]). With `gpu.fragment.binning = "draw"` the FIFO
+//! becomes sort-middle bins: a draw's fragments start after its last
+//! triangle's geometry, and the next draw waits for the bins to drain.
 
 use crate::engine::{Duration, Scheduler, Time};
 
@@ -54,7 +56,9 @@ impl FramePipeline {
                     self.front_phase = self.front_job(now, c, work, s)?;
                 }
                 FrontPhase::Handoff(c) => {
-                    if self.geom_draw.is_some() {
+                    // Binning: the next draw's geometry waits for the bins to drain.
+                    let bins_busy = self.cfg.gpu.fragment.binned() && (self.frag_busy || !self.tri_fifo.is_empty());
+                    if self.geom_draw.is_some() || bins_busy {
                         return Ok(progressed);
                     }
                     if let Command::Draw { draw, .. } = c {
@@ -171,7 +175,7 @@ impl FramePipeline {
                             mesh.geometry_time,
                             &g.pixels,
                             g.cost_per_pixel,
-                            self.cfg.gpu.fragment.fifo_depth,
+                            self.cfg.gpu.fragment.depth(),
                         )
                     }
                 };
@@ -247,6 +251,7 @@ impl FramePipeline {
             return Ok(());
         };
         a.next += 1;
+        let last = a.next >= a.triangles;
         let draw = a.draw;
         let Program::Scene(sc) = &self.program else {
             return Ok(());
@@ -254,7 +259,16 @@ impl FramePipeline {
         let g = &sc.groups[sc.draws[draw as usize].group as usize];
         let px = g.pixels.sample(&mut self.pixel_rng);
         let f = Duration::from_ps_f64(px * g.cost_per_pixel);
-        if !self.frag_busy && self.tri_fifo.is_empty() {
+        if self.cfg.gpu.fragment.binned() {
+            // Sort-middle: bin the triangle; the draw's last triangle opens the bins.
+            self.tri_fifo.push(f, 1);
+            if last
+                && !self.frag_busy
+                && let Some(first) = self.tri_fifo.pop()
+            {
+                self.frag_start(now, first, s)?;
+            }
+        } else if !self.frag_busy && self.tri_fifo.is_empty() {
             self.frag_start(now, f, s)?;
         } else if self.tri_fifo.len() < self.tri_fifo.capacity() as usize {
             self.tri_fifo.push(f, 1);

@@ -332,7 +332,12 @@ impl FramePipeline {
         Ok(FramePipeline {
             refresh: cfg.display.refresh.period,
             chain: SwapChain::new(cfg.display.buffers, mode),
-            tri_fifo: BoundedFifo::new(cfg.gpu.fragment.fifo_depth as u64),
+            // Binning: the FIFO is the draw's bins and holds all of it.
+            tri_fifo: BoundedFifo::new(if cfg.gpu.fragment.binned() {
+                u64::MAX
+            } else {
+                cfg.gpu.fragment.fifo_depth as u64
+            }),
             non_render_rng: streams.stream("cpu.non_render"),
             pixel_rng: streams.stream("fragment.pixels"),
             pixel_rng_start: match &cfg.workload {

@@ -367,7 +367,7 @@ pub fn compile_scene(
                     m.geometry_time,
                     &g.pixels,
                     g.cost_per_pixel,
-                    cfg.gpu.fragment.fifo_depth,
+                    cfg.gpu.fragment.depth(),
                 )
             })
         });
