@@ -407,6 +407,16 @@ fn a_rate_cap_makes_the_client_wait_for_its_next_tick() {
 }
 
 #[test]
+fn network_bandwidth_units_pin_the_papers_mebibytes() {
+    // The paper's "90 MB/s" are 2^20-byte MB: 10 MiB in 111 ms is written "90MiB/s".
+    let mib = summary(CLUSTER, &["run.events=50", "network.bandwidth=\"90MiB/s\""]);
+    close(num(&mib, "metrics.terms_ms.transfer"), 111.111, 0.001, "90MiB/s");
+    // The unit parser is SI: "90MB/s" is 90e6 B/s, and 10 MiB takes 116.5 ms.
+    let si = summary(CLUSTER, &["run.events=50", "network.bandwidth=\"90MB/s\""]);
+    close(num(&si, "metrics.terms_ms.transfer"), 116.508, 0.001, "90MB/s");
+}
+
+#[test]
 fn deferred_shading_moves_bytes_and_shading_to_the_fast_client() {
     let plain = summary(CLUSTER, &["run.events=500"]);
     let s = summary(CLUSTER, &["run.events=500", "deferred.enabled=true"]);
