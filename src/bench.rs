@@ -183,10 +183,26 @@ pub fn pipeline(w: u32) -> Result<PipelineBench, String> {
     })
 }
 
+/// Issue 4's target for Figures 3 and 4 together (51 primitive counts x all
+/// configurations) at event fidelity: at most 10 s.
+pub const PIXELFLOW_TARGET_S: f64 = 10.0;
+
+/// The target for `counts` primitive counts: [`PIXELFLOW_TARGET_S`] scaled
+/// by `counts / 51` (so `--scale` keeps the comparison fair).
+pub fn pixelflow_target_s(counts: u32) -> f64 {
+    PIXELFLOW_TARGET_S * f64::from(counts) / 51.0
+}
+
 /// Figures 3 and 4 of paper 002 at event fidelity, one thread: every
 /// architecture, 1 and 4 shaders, 1 and 8 samples, `counts` primitive
 /// counts from 0 to 1,000,000. Returns (runs, events, wall seconds).
 pub fn pixelflow_figures(counts: u32) -> Result<(u64, u64, f64), String> {
+    pixelflow_figures_at(counts, "event")
+}
+
+/// [`pixelflow_figures`] at `fidelity` (`"event"` or `"analytic"`, the
+/// closed forms: the baseline the event simulation is compared with).
+pub fn pixelflow_figures_at(counts: u32, fidelity: &str) -> Result<(u64, u64, f64), String> {
     let src = ModelSource::from_text("models/pixelflow-20.toml", include_str!("../models/pixelflow-20.toml"));
     let base = src.table().map_err(|e| e.to_string())?;
     let (mut runs, mut events) = (0u64, 0u64);
@@ -202,6 +218,7 @@ pub fn pixelflow_figures(counts: u32) -> Result<(u64, u64, f64), String> {
                         format!("architecture=\"{arch}\""),
                         format!("shading_nodes={shaders}"),
                         format!("primitives={n}"),
+                        format!("fidelity=\"{fidelity}\""),
                     ] {
                         apply_set(&mut t, &s).map_err(|e| e.to_string())?;
                     }
@@ -229,9 +246,14 @@ pub fn run_cli(which: &str, scale: f64) -> Result<(), String> {
     if all || which == "pixelflow" {
         let counts = ((51.0 * scale) as u32).max(2);
         let (runs, events, wall) = pixelflow_figures(counts)?;
+        let (_, _, closed) = pixelflow_figures_at(counts, "analytic")?;
+        let target = pixelflow_target_s(counts);
         println!(
-            "pixelflow Figures 3 and 4 at event fidelity, one thread: {runs} runs ({counts} primitive counts x 3 architectures x 2 shader counts x 2 sample counts), {events} events, {wall:.3} s wall ({:.2} ms per run)",
-            1e3 * wall / runs as f64
+            "pixelflow Figures 3 and 4 at event fidelity, one thread: {runs} runs ({counts} primitive counts x 3 architectures x 2 shader counts x 2 sample counts), {events} events, {wall:.3} s wall ({:.2} ms per run); target <= {target:.3} s: ratio {:.4} of the target ({}); closed forms (analytic fidelity, same runs) {closed:.3} s, event / closed form {:.1}x",
+            1e3 * wall / runs as f64,
+            wall / target,
+            if wall <= target { "met" } else { "MISSED" },
+            wall / closed.max(1e-9)
         );
     }
     if all || which == "kernel" {
@@ -281,4 +303,25 @@ pub fn run_cli(which: &str, scale: f64) -> Result<(), String> {
     }
     let _ = Duration::ZERO;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pixelflow_target_scales_with_the_primitive_counts() {
+        assert_eq!(pixelflow_target_s(51), PIXELFLOW_TARGET_S);
+        assert!((pixelflow_target_s(25) - 10.0 * 25.0 / 51.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn pixelflow_figures_run_every_configuration_at_both_fidelities() {
+        // 2 counts x 3 architectures x 2 shader counts x 2 sample counts.
+        let (runs, events, _) = pixelflow_figures_at(2, "event").unwrap();
+        assert_eq!(runs, 24);
+        assert!(events > 0);
+        let (runs, events, _) = pixelflow_figures_at(2, "analytic").unwrap();
+        assert_eq!((runs, events), (24, 0));
+    }
 }

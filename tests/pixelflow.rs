@@ -120,4 +120,33 @@ fn claims_searches_find_the_published_discrepancies() {
     // (a) with the event simulation: over 600,000 primitives at 30 ms.
     let a = find("event-nontex-30ms");
     assert!(a.value.unwrap() > 600_000.0, "{a:?}");
+    // The verdicts under the published constants: (a) and (d) hold, (b) and (c) do not,
+    // each checked at 30 and 40 ms and with 1 and 4 shading nodes.
+    let claims = r.claims();
+    let verdict = |prefix: &str| {
+        let found: Vec<_> = claims.iter().filter(|c| c.0.starts_with(prefix)).collect();
+        assert!(!found.is_empty(), "no claim {prefix}: {claims:?}");
+        (
+            found.iter().map(|c| c.1).sum::<usize>(),
+            found.iter().map(|c| c.2).sum::<usize>(),
+        )
+    };
+    let (holds, n) = verdict("(a)");
+    assert_eq!(holds, n);
+    assert_eq!(verdict("(b)"), (0, 4));
+    assert_eq!(verdict("(c)"), (0, 4));
+    let (holds, n) = verdict("(d)");
+    assert_eq!((holds, n), (16, 16));
+    // Every (b) and (c) search finds a value inside its bracket.
+    for s in r
+        .searches
+        .iter()
+        .filter(|s| s.name.starts_with("b-") || s.name.starts_with("c-"))
+    {
+        assert!(s.converged, "{s:?}");
+    }
+    let b10 = find("b-first-pass-10pct-40ms-4sh");
+    let b15 = find("b-first-pass-15pct-40ms-4sh");
+    // A smaller gain needs a dearer first pass.
+    assert!(b10.value.unwrap() > b15.value.unwrap(), "{b10:?} {b15:?}");
 }

@@ -179,3 +179,56 @@ fn trace_has_a_track_per_stage_without_overlaps() {
         }
     }
 }
+
+#[test]
+fn stage_names_share_the_multi_frame_rate_vocabulary() {
+    use rendersim::systems::LATENCY_STAGES;
+    let known: Vec<&str> = LATENCY_STAGES.iter().map(|s| s.0).collect();
+    let keys = |s: &Value, kind: &str| -> Vec<String> {
+        s["metrics"]["latency_breakdown_ms"][kind]
+            .as_object()
+            .unwrap()
+            .keys()
+            .cloned()
+            .collect()
+    };
+    let n = summary(NAIVE, &["run.events=200"]);
+    let w = summary(WARP, &["run.events=200"]);
+    for (s, kind) in [(&n, "head"), (&n, "object"), (&w, "head"), (&w, "object")] {
+        for k in keys(s, kind) {
+            assert!(
+                known.contains(&k.as_str()),
+                "{kind}: stage {k} is not in the shared vocabulary"
+            );
+        }
+    }
+    let mut head = keys(&w, "head");
+    head.sort();
+    let mut want = vec![
+        "composite_render",
+        "display",
+        "input_sample",
+        "sensor_transport",
+        "simulation_wait",
+        "swap_lock",
+    ];
+    want.sort();
+    assert_eq!(head, want);
+    assert!(keys(&w, "object").contains(&"composite_wait".to_string()));
+    let m = summary_mfr();
+    for kind in ["fast", "slow", "conventional"] {
+        for k in keys(&m, kind) {
+            assert!(
+                known.contains(&k.as_str()),
+                "multi-rate {kind}: stage {k} is not in the shared vocabulary"
+            );
+        }
+    }
+}
+
+fn summary_mfr() -> Value {
+    let src = ModelSource::from_text("mfr-cluster.toml", include_str!("../models/mfr-cluster.toml"));
+    let mut t = src.table().unwrap();
+    apply_set(&mut t, "run.events=100").unwrap();
+    run_model(&src, &t, false).unwrap().summary().clone()
+}

@@ -27,12 +27,46 @@ pub struct CheckOutcome {
     /// Whether the measured value is within the tolerance of the expected
     /// value, or within the bounds widened by the tolerance.
     pub passed: bool,
+    /// Signed error: `measured - expect`; for bounds, the distance beyond
+    /// the violated bound (negative below the lower one, positive above the
+    /// upper one) and 0 inside them. `None` without a measurement.
+    pub error: Option<f64>,
+    /// The value `error` is relative to (`expect`, or the violated bound).
+    pub error_reference: Option<f64>,
+    /// The claim this check gives a verdict on (`claim = "..."` in the
+    /// experiment file): reported as holds / does not hold, never a failure.
+    pub claim: Option<String>,
 }
 
-/// A bound of a check against other values of the same point.
+impl CheckOutcome {
+    /// `error / |error_reference|` (`None` when either is missing or the
+    /// reference is zero).
+    pub fn relative_error(&self) -> Option<f64> {
+        let (e, r) = (self.error?, self.error_reference?);
+        (r != 0.0 && r.is_finite()).then(|| e / r.abs())
+    }
+
+    /// The error as report text: `+0.5 (+0.68%)`, `0 (inside the bounds)`, or `n/a`.
+    pub fn error_text(&self) -> String {
+        match (self.error, self.relative_error()) {
+            (None, _) => "n/a".into(),
+            (Some(e), _) if e == 0.0 && self.expect.is_none() => "0 (inside the bounds)".into(),
+            (Some(e), Some(r)) => format!(
+                "{}{} ({}{}%)",
+                if e >= 0.0 { "+" } else { "" },
+                super::report::fmt_precise(e),
+                if r >= 0.0 { "+" } else { "" },
+                super::report::fmt_num(r * 100.0)
+            ),
+            (Some(e), None) => format!("{}{}", if e >= 0.0 { "+" } else { "" }, super::report::fmt_precise(e)),
+        }
+    }
+}
+
+/// A bound of a check against other values of the same point, or a number.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Bound<'a> {
-    /// Its path or derived name.
+    /// Its path or derived name; empty for a fixed number.
     pub path: &'a str,
     /// Its value at the point (`None`: undefined, the check fails).
     pub value: Option<f64>,
@@ -68,11 +102,20 @@ pub fn evaluate_between(
         Some(b) => matches!((m, finite(b.value)), (Some(m), Some(h)) if m <= h + allowed_for(h)),
     };
     let show = |b: &Bound<'_>| {
-        format!(
-            "`{}` = {}",
-            b.path,
-            b.value.map(super::report::fmt_precise).unwrap_or_else(|| "n/a".into())
-        )
+        let v = b.value.map(super::report::fmt_precise).unwrap_or_else(|| "n/a".into());
+        if b.path.is_empty() {
+            v
+        } else {
+            format!("`{}` = {v}", b.path)
+        }
+    };
+    let (error, error_reference) = match m {
+        None => (None, None),
+        Some(m) => match (low.and_then(|b| finite(b.value)), high.and_then(|b| finite(b.value))) {
+            (Some(l), _) if m < l => (Some(m - l), Some(l)),
+            (_, Some(h)) if m > h => (Some(m - h), Some(h)),
+            (l, h) => (Some(0.0), l.or(h)),
+        },
     };
     let expected_text = match (&low, &high) {
         (Some(l), Some(h)) => format!("between {} and {}", show(l), show(h)),
@@ -95,6 +138,9 @@ pub fn evaluate_between(
         tolerance_text,
         expected_text,
         passed: m.is_some() && ok_low && ok_high,
+        error,
+        error_reference,
+        claim: None,
     }
 }
 
@@ -114,6 +160,9 @@ pub fn evaluate(path: &str, point: &str, measured: Option<f64>, expect: f64, tol
         tolerance_text,
         expected_text: super::report::fmt_precise(expect),
         passed,
+        error: measured.filter(|m| m.is_finite()).map(|m| m - expect),
+        error_reference: Some(expect),
+        claim: None,
     }
 }
 
@@ -160,5 +209,28 @@ mod tests {
         let o = evaluate_between("t", "p", Some(5.0), b("a", Some(4.0)), b("b", Some(6.5)), abs);
         assert_eq!(o.expected_text, "between `a` = 4 and `b` = 6.5");
         assert_eq!(o.expect, None);
+        assert_eq!(o.error, Some(0.0));
+        assert_eq!(o.error_text(), "0 (inside the bounds)");
+        // Below the lower bound: negative distance to it; a fixed-number bound shows as a number.
+        let o = evaluate_between("t", "p", Some(3.0), b("", Some(4.0)), None, abs);
+        assert_eq!(o.expected_text, "at least 4");
+        assert_eq!(o.error, Some(-1.0));
+        assert_eq!(o.relative_error(), Some(-0.25));
+        assert_eq!(o.error_text(), "-1 (-25.00%)");
+        let o = evaluate_between("t", "p", Some(8.0), b("a", Some(4.0)), b("", Some(6.0)), abs);
+        assert_eq!(o.error, Some(2.0));
+        assert_eq!(o.error_reference, Some(6.0));
+    }
+
+    #[test]
+    fn error_against_the_expected_value() {
+        let o = evaluate("m", "p", Some(73.5), 73.0, Tolerance::Absolute(1.0));
+        assert_eq!(o.error, Some(0.5));
+        assert!((o.relative_error().unwrap() - 0.5 / 73.0).abs() < 1e-12);
+        assert_eq!(o.error_text(), "+0.5 (+0.6849%)");
+        assert_eq!(
+            evaluate("m", "p", None, 1.0, Tolerance::Absolute(1.0)).error_text(),
+            "n/a"
+        );
     }
 }

@@ -1,6 +1,6 @@
 //! Derived values computed per point after all runs: frame-time spreads
 //! (`interval_width`, `quantile_width_from_min`) from pooled per-frame data,
-//! and fidelity comparisons (`relative_error`, `speedup`) between points.
+//! and comparisons between points (`relative_error`, `ratio`, `speedup`).
 //!
 //! Two spread definitions are provided because they answer different
 //! questions:
@@ -40,6 +40,12 @@ pub fn quantile_width_from_min(values: &[f64], level: f64) -> Option<f64> {
 /// either value is not finite.
 pub fn relative_error(value: f64, reference: f64) -> Option<f64> {
     let r = (value - reference).abs() / reference.abs();
+    (reference != 0.0 && r.is_finite()).then_some(r)
+}
+
+/// `value / reference`, `None` if the reference is zero or the ratio is not finite.
+pub fn ratio(value: f64, reference: f64) -> Option<f64> {
+    let r = value / reference;
     (reference != 0.0 && r.is_finite()).then_some(r)
 }
 
@@ -111,6 +117,10 @@ pub(crate) fn compute(exp: &Experiment, inp: &DerivedInputs<'_>) -> Vec<Vec<Opti
                         let r = reference_point(exp, p, reference)?;
                         relative_error(mean(p.index, path)?, mean(r, path)?)
                     }
+                    DerivedKind::Ratio { path, reference } => {
+                        let r = reference_point(exp, p, reference)?;
+                        ratio(mean(p.index, path)?, mean(r, path)?)
+                    }
                     DerivedKind::Speedup { reference } => {
                         let r = reference_point(exp, p, reference)?;
                         speedup(mean(p.index, "wall_seconds")?, mean(r, "wall_seconds")?)
@@ -150,6 +160,8 @@ mod tests {
         assert_eq!(relative_error(9.0, -10.0), Some(1.9));
         assert_eq!(relative_error(1.0, 0.0), None);
         assert_eq!(speedup(0.5, 2.0), Some(4.0));
+        assert_eq!(ratio(142.0, 100.0), Some(1.42));
+        assert_eq!(ratio(1.0, 0.0), None);
         assert_eq!(speedup(0.0, 2.0), None);
     }
 }

@@ -95,6 +95,16 @@ pub(crate) fn draw(
                     series,
                     log_x: *log_x,
                     log_y: *log_y,
+                    x_categories: if exp.sweeps[xi].categorical {
+                        exp.sweeps[xi]
+                            .coords
+                            .iter()
+                            .copied()
+                            .zip(exp.sweeps[xi].labels.iter().cloned())
+                            .collect()
+                    } else {
+                        Vec::new()
+                    },
                 },
             )?;
             Ok(Vec::new())

@@ -28,6 +28,9 @@
 //! [[sweep]]
 //! key = "display.buffers"
 //! values = [2, 3]
+//! labels = ["double", "triple"]   # optional: axis text per value (categorical x axis);
+//!                                 # values that are not numbers (arrays, tables) are
+//!                                 # categorical anyway, labelled with their text
 //! [[metric]]
 //! path = "metrics.display_interval_ms.mean"
 //! label = "display interval (ms)"
@@ -42,7 +45,7 @@
 //! #   the data; values outside are not drawn but counted, per group, in a note on the
 //! #   plot and a line under it in report.md; densities stay relative to all values
 //! # scatter: x and y are metric paths or derived names; log_x / log_y
-//! [[derived]]            # interval_width | quantile_width_from_min | relative_error | speedup
+//! [[derived]]            # interval_width | quantile_width_from_min | relative_error | ratio | speedup
 //! name = "c99"
 //! kind = "interval_width"
 //! column = "FrameTime"
@@ -57,6 +60,11 @@
 //! at_least_path = "metrics.analytic.gpu_max_ms"   # either or both
 //! at_most_path = "metrics.analytic.gpu_sum_ms"
 //! rel_tolerance = 0.01   # relative to each bound (or tolerance = absolute)
+//! [[check]]              # or fixed bounds: at_least = 600000, at_most = ...
+//! path = "metrics.analytic_primitives_at_30ms"
+//! at_least = 600000
+//! tolerance = 0
+//! claim = "(a) over 600,000 triangles at 30 ms"   # a verdict, not a test (below)
 //! [[search]]             # inverse what-if: which value of one key reaches a target
 //! name = "first-pass"
 //! vary = "deferred.t_first_pass"
@@ -70,6 +78,15 @@
 //!
 //! Searches are described in [`inverse`]; their results go to
 //! `searches.csv` and a section of `report.md`.
+//!
+//! A check with `claim = "text"` is a **verdict**: it is evaluated like any
+//! check, but `report.md` lists it under "Claims" as holds / does not hold
+//! (per claim: HOLDS, DOES NOT HOLD or HOLDS IN PART), with the measured
+//! value, the expected value or bounds and the error, and it never counts
+//! as a failed check. Checks without `claim` are tests: a failure fails the
+//! experiment (exit status 1 from the CLI). Every check's report row gives
+//! its error: measured minus expected (or the distance beyond a bound),
+//! absolute and relative.
 //!
 //! Outputs in the output directory: `runs.csv` (one row per point and seed),
 //! `points.csv` (per point: `<path>:mean`, `:ci_low`, `:ci_high`, `:n` for
@@ -94,14 +111,14 @@ mod tables;
 mod tests;
 
 pub use check::{Bound, CheckOutcome, evaluate_between};
-pub use derived::{interval_width, quantile_width_from_min, relative_error, speedup};
+pub use derived::{interval_width, quantile_width_from_min, ratio, relative_error, speedup};
 pub use dotted::{json_number, json_path, set_dotted};
 pub use error::ExperimentError;
 pub use run::{ExperimentResult, PathStat, PointResult, RunRecord, point_model, run_experiment};
 pub use runner::{FrameTable, RunOutput, Runner};
 pub use sim_runner::SimRunner;
 pub use spec::{
-    Check, Derived, DerivedKind, Expect, Experiment, Metric, ModelSource, PlotKind, PlotSpec, Tolerance,
+    BoundRef, Check, Derived, DerivedKind, Expect, Experiment, Metric, ModelSource, PlotKind, PlotSpec, Tolerance,
     load_experiment, parse_experiment,
 };
 pub use sweep::{Point, Sweep, expand_points, numeric_coord, value_text, values_match};

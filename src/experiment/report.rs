@@ -168,6 +168,9 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
                     "|mean `{path}` − reference| / |reference|, reference at {}",
                     filter_text(reference)
                 ),
+                DerivedKind::Ratio { path, reference } => {
+                    format!("mean `{path}` / reference, reference at {}", filter_text(reference))
+                }
                 DerivedKind::Speedup { reference } => format!(
                     "reference `wall_seconds` / this `wall_seconds`, reference at {}",
                     filter_text(reference)
@@ -186,22 +189,62 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
         s.push('\n');
     }
 
-    if !r.checks.is_empty() {
+    let claims = r.claims();
+    if !claims.is_empty() {
         let _ = writeln!(
             s,
-            "## Checks\n\n{} of {} passed.\n\n| value | point | measured | expected | tolerance | result |\n|---|---|---|---|---|---|",
-            r.checks.len() - r.checks_failed,
-            r.checks.len()
+            "## Claims\n\nVerdicts, not tests: each claim is checked like a reference check, and the \
+             outcome says whether it holds here. A claim that does not hold does not fail the experiment.\n"
         );
-        for c in &r.checks {
+        for (claim, holds, total) in &claims {
+            let verdict = match *holds {
+                h if h == *total => "**HOLDS**".to_string(),
+                0 => "**DOES NOT HOLD**".to_string(),
+                h => format!("**HOLDS IN PART** ({h} of {total})"),
+            };
+            let _ = writeln!(s, "- {verdict}: {claim}");
+        }
+        let _ = writeln!(
+            s,
+            "\n| claim | value | point | measured | expected | tolerance | error | verdict |\n|---|---|---|---|---|---|---|---|"
+        );
+        for c in r.checks.iter().filter(|c| c.claim.is_some()) {
             let _ = writeln!(
                 s,
-                "| `{}` | {} | {} | {} | {} | {} |",
+                "| {} | `{}` | {} | {} | {} | {} | {} | {} |",
+                cell(c.claim.as_deref().unwrap_or_default()),
                 c.path,
                 cell(&c.point),
                 c.measured.map(fmt_precise).unwrap_or_else(|| "n/a".into()),
                 cell(&c.expected_text),
                 c.tolerance_text,
+                cell(&c.error_text()),
+                if c.passed { "holds" } else { "does not hold" }
+            );
+        }
+        s.push('\n');
+    }
+
+    let tests: Vec<_> = r.checks.iter().filter(|c| c.claim.is_none()).collect();
+    if !tests.is_empty() {
+        let _ = writeln!(
+            s,
+            "## Checks\n\n{} of {} passed. `error` is measured minus expected (for bounds: the distance \
+             beyond the bound, 0 inside), relative to the expected value or bound.\n\n\
+             | value | point | measured | expected | tolerance | error | result |\n|---|---|---|---|---|---|---|",
+            tests.len() - r.checks_failed,
+            tests.len()
+        );
+        for c in tests {
+            let _ = writeln!(
+                s,
+                "| `{}` | {} | {} | {} | {} | {} | {} |",
+                c.path,
+                cell(&c.point),
+                c.measured.map(fmt_precise).unwrap_or_else(|| "n/a".into()),
+                cell(&c.expected_text),
+                c.tolerance_text,
+                cell(&c.error_text()),
                 if c.passed { "PASS" } else { "**FAIL**" }
             );
         }

@@ -14,7 +14,7 @@ use super::check::{Bound, CheckOutcome, evaluate, evaluate_between};
 use super::derived::{DerivedInputs, compute};
 use super::dotted::{json_number, set_dotted};
 use super::runner::Runner;
-use super::spec::{Expect, Experiment};
+use super::spec::{BoundRef, Expect, Experiment};
 use super::sweep::{Point, expand_points};
 use super::{ExperimentError, figures, report, tables};
 
@@ -94,7 +94,7 @@ pub struct ExperimentResult {
     pub runs: Vec<RunRecord>,
     /// Check outcomes, in file order (one per matching point).
     pub checks: Vec<CheckOutcome>,
-    /// How many checks failed.
+    /// How many checks failed (verdicts on claims never count).
     pub checks_failed: usize,
     /// Wall time of the whole experiment, in seconds.
     pub wall_seconds: f64,
@@ -125,12 +125,39 @@ impl ExperimentResult {
                 .collect();
             out.push_str(&format!("{}: {}\n", p.label, cells.join("; ")));
         }
-        if !self.checks.is_empty() {
+        let tests = self.checks.iter().filter(|c| c.claim.is_none()).count();
+        if tests > 0 {
             out.push_str(&format!(
                 "checks: {} passed, {} failed\n",
-                self.checks.len() - self.checks_failed,
+                tests - self.checks_failed,
                 self.checks_failed
             ));
+        }
+        for (claim, holds, total) in self.claims() {
+            let verdict = match holds {
+                h if h == total => "HOLDS".to_string(),
+                0 => "DOES NOT HOLD".to_string(),
+                h => format!("HOLDS IN PART ({h} of {total})"),
+            };
+            out.push_str(&format!("claim {verdict}: {claim}\n"));
+        }
+        out
+    }
+
+    /// Verdicts per claim, in file order: `(claim, outcomes that hold, outcomes)`.
+    pub fn claims(&self) -> Vec<(String, usize, usize)> {
+        let mut out: Vec<(String, usize, usize)> = Vec::new();
+        for c in &self.checks {
+            let Some(claim) = &c.claim else { continue };
+            let i = match out.iter().position(|o| &o.0 == claim) {
+                Some(i) => i,
+                None => {
+                    out.push((claim.clone(), 0, 0));
+                    out.len() - 1
+                }
+            };
+            out[i].1 += usize::from(c.passed);
+            out[i].2 += 1;
         }
         out
     }
@@ -282,20 +309,30 @@ pub fn run_experiment(
             checks.push(match &c.expect {
                 Expect::Value(v) => evaluate(&c.path, &pr.label, pr.value(&c.path), *v, c.tolerance),
                 Expect::Between { at_least, at_most } => {
-                    let low = at_least.as_deref().map(|path| Bound {
-                        path,
-                        value: pr.value(path),
-                    });
-                    let high = at_most.as_deref().map(|path| Bound {
-                        path,
-                        value: pr.value(path),
-                    });
+                    fn bound<'a>(b: &'a BoundRef, pr: &PointResult) -> Bound<'a> {
+                        match b {
+                            BoundRef::Path(path) => Bound {
+                                path: path.as_str(),
+                                value: pr.value(path),
+                            },
+                            BoundRef::Value(v) => Bound {
+                                path: "",
+                                value: Some(*v),
+                            },
+                        }
+                    }
+                    let low = at_least.as_ref().map(|b| bound(b, pr));
+                    let high = at_most.as_ref().map(|b| bound(b, pr));
                     evaluate_between(&c.path, &pr.label, pr.value(&c.path), low, high, c.tolerance)
                 }
             });
+            if let Some(last) = checks.last_mut() {
+                last.claim = c.claim.clone();
+            }
         }
     }
-    let checks_failed = checks.iter().filter(|c| !c.passed).count();
+    // Verdicts on claims are reported, never counted as failures.
+    let checks_failed = checks.iter().filter(|c| !c.passed && c.claim.is_none()).count();
 
     let mut plot_captions = Vec::new();
     for plot in &exp.plots {

@@ -121,6 +121,15 @@ pub enum DerivedKind {
         /// Sweep key = value identifying the reference point.
         reference: Vec<(String, toml::Value)>,
     },
+    /// `v / v_ref` for the replication mean `v` of `path`, the reference
+    /// point chosen as for `RelativeError` (e.g. presort's primitives at
+    /// 30 ms over standard's: 1.42 is a 42% gain).
+    Ratio {
+        /// Metric path.
+        path: String,
+        /// Sweep key = value identifying the reference point.
+        reference: Vec<(String, toml::Value)>,
+    },
     /// `wall_ref / wall` on the replication means of `wall_seconds`, with the
     /// reference point chosen as for `RelativeError`.
     Speedup {
@@ -147,20 +156,29 @@ pub enum Tolerance {
     Relative(f64),
 }
 
+/// One bound of a check: another value of the same point, or a number.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BoundRef {
+    /// A metric path or derived name (`at_least_path`, `at_most_path`).
+    Path(String),
+    /// A fixed number (`at_least`, `at_most`).
+    Value(f64),
+}
+
 /// What a check compares its value with.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Expect {
     /// A reference value: `|measured - value| <= tolerance`.
     Value(f64),
-    /// Bounds taken from other values of the same point (metric paths or
-    /// derived names): `measured >= at_least - tolerance` and
+    /// Bounds, each another value of the same point (metric path or
+    /// derived name) or a number: `measured >= at_least - tolerance` and
     /// `measured <= at_most + tolerance`, with a relative tolerance taken
     /// relative to each bound. At least one bound is given.
     Between {
-        /// Path or derived name of the lower bound.
-        at_least: Option<String>,
-        /// Path or derived name of the upper bound.
-        at_most: Option<String>,
+        /// The lower bound.
+        at_least: Option<BoundRef>,
+        /// The upper bound.
+        at_most: Option<BoundRef>,
     },
 }
 
@@ -175,6 +193,12 @@ pub struct Check {
     pub expect: Expect,
     /// Allowed deviation.
     pub tolerance: Tolerance,
+    /// `Some(text)`: a verdict, not a test. The check is evaluated the same
+    /// way, but its outcome is reported as "holds" / "does not hold" under
+    /// the claim `text` in the report's Claims section and never counts as
+    /// a failed check (an experiment can state that a published claim does
+    /// not hold without failing).
+    pub claim: Option<String>,
 }
 
 /// A validated experiment.
@@ -270,7 +294,7 @@ impl Experiment {
         }
         for d in &self.derived {
             match &d.kind {
-                DerivedKind::RelativeError { path, .. } => add(path),
+                DerivedKind::RelativeError { path, .. } | DerivedKind::Ratio { path, .. } => add(path),
                 DerivedKind::Speedup { .. } => add("wall_seconds"),
                 _ => {}
             }
@@ -278,7 +302,11 @@ impl Experiment {
         for c in &self.checks {
             add(&c.path);
             if let Expect::Between { at_least, at_most } = &c.expect {
-                at_least.iter().chain(at_most).for_each(|b| add(b));
+                for b in at_least.iter().chain(at_most) {
+                    if let BoundRef::Path(p) = b {
+                        add(p);
+                    }
+                }
             }
         }
         out
@@ -361,6 +389,7 @@ struct RawSweep {
     key: String,
     values: Option<Vec<toml::Value>>,
     range: Option<RawRange>,
+    labels: Option<Vec<String>>,
 }
 
 /// `range = { from, to, steps, format }` of a sweep.
@@ -437,8 +466,11 @@ struct RawCheck {
     expect: Option<f64>,
     at_least_path: Option<String>,
     at_most_path: Option<String>,
+    at_least: Option<f64>,
+    at_most: Option<f64>,
     tolerance: Option<f64>,
     rel_tolerance: Option<f64>,
+    claim: Option<String>,
 }
 
 /// Read and validate the experiment file at `path`.
@@ -515,6 +547,10 @@ impl Validator<'_> {
                     Sweep::from_values(s.key, values)
                 }
                 (None, Some(r)) => expand_range(s.key, &r).map_err(|m| self.err(format!("{key}.range"), m))?,
+            };
+            let sweep = match s.labels {
+                Some(l) => sweep.with_labels(l).map_err(|m| self.err(format!("{key}.labels"), m))?,
+                None => sweep,
             };
             sweeps.push(sweep);
         }
@@ -600,12 +636,19 @@ impl Validator<'_> {
                         .ok_or_else(|| self.err(&key, "kind `relative_error` needs `path`"))?,
                     reference: need_ref()?,
                 },
+                "ratio" => DerivedKind::Ratio {
+                    path: d
+                        .path
+                        .clone()
+                        .ok_or_else(|| self.err(&key, "kind `ratio` needs `path`"))?,
+                    reference: need_ref()?,
+                },
                 "speedup" => DerivedKind::Speedup { reference: need_ref()? },
                 other => {
                     return Err(self.err(
                         format!("{key}.kind"),
                         format!(
-                            "unknown kind `{other}` (expected interval_width, quantile_width_from_min, relative_error or speedup)"
+                            "unknown kind `{other}` (expected interval_width, quantile_width_from_min, relative_error, ratio or speedup)"
                         ),
                     ));
                 }
@@ -766,14 +809,47 @@ impl Validator<'_> {
                 Some(b) if b.trim().is_empty() => Err(self.err(format!("{key}.{name}"), "must not be empty")),
                 other => Ok(other),
             };
-            let at_least = bound(c.at_least_path, "at_least_path")?;
-            let at_most = bound(c.at_most_path, "at_most_path")?;
+            let number = |v: Option<f64>, name: &str| match v {
+                Some(v) if !v.is_finite() => Err(self.err(format!("{key}.{name}"), "must be finite")),
+                other => Ok(other.map(BoundRef::Value)),
+            };
+            let either = |p: Option<String>, v: Option<BoundRef>, name: &str| match (p, v) {
+                (Some(_), Some(_)) => Err(self.err(&key, format!("give either `{name}_path` or `{name}`, not both"))),
+                (Some(p), None) => Ok(Some(BoundRef::Path(p))),
+                (None, v) => Ok(v),
+            };
+            let at_least = either(
+                bound(c.at_least_path, "at_least_path")?,
+                number(c.at_least, "at_least")?,
+                "at_least",
+            )?;
+            let at_most = either(
+                bound(c.at_most_path, "at_most_path")?,
+                number(c.at_most, "at_most")?,
+                "at_most",
+            )?;
+            if let (Some(BoundRef::Value(lo)), Some(BoundRef::Value(hi))) = (&at_least, &at_most)
+                && lo > hi
+            {
+                return Err(self.err(&key, format!("`at_least` = {lo} is above `at_most` = {hi}")));
+            }
+            if let Some(text) = &c.claim
+                && text.trim().is_empty()
+            {
+                return Err(self.err(format!("{key}.claim"), "must not be empty"));
+            }
             let expect = match (c.expect, at_least.is_some() || at_most.is_some()) {
                 (Some(_), true) => {
-                    return Err(self.err(&key, "give either `expect` or `at_least_path`/`at_most_path`, not both"));
+                    return Err(self.err(
+                        &key,
+                        "give either `expect` or bounds (`at_least[_path]`/`at_most[_path]`), not both",
+                    ));
                 }
                 (None, false) => {
-                    return Err(self.err(&key, "needs `expect` or `at_least_path`/`at_most_path`"));
+                    return Err(self.err(
+                        &key,
+                        "needs `expect` or `at_least_path`/`at_most_path` (or `at_least`/`at_most`)",
+                    ));
                 }
                 (Some(v), false) => {
                     if !v.is_finite() {
@@ -788,6 +864,7 @@ impl Validator<'_> {
                 path: c.path,
                 expect,
                 tolerance,
+                claim: c.claim,
             });
         }
 

@@ -14,17 +14,56 @@ pub struct Sweep {
     /// the range number before formatting, the leading number of a string
     /// such as `"12ms"`, or else the value's index.
     pub coords: Vec<f64>,
+    /// Text per value for plot axes: the sweep's `labels` if given, else
+    /// [`value_text`].
+    pub labels: Vec<String>,
+    /// Whether plots label the x axis with `labels` at the values'
+    /// coordinates instead of numeric ticks: when `labels` were given, or
+    /// when some value is not a number (arrays, tables, strings without a
+    /// leading number), whose coordinate is only its index.
+    pub categorical: bool,
 }
 
 impl Sweep {
     /// A sweep over explicit `values`.
     pub fn from_values(key: String, values: Vec<toml::Value>) -> Sweep {
+        let categorical = values.iter().any(|v| numeric_coord(v).is_none());
         let coords = values
             .iter()
             .enumerate()
             .map(|(i, v)| numeric_coord(v).unwrap_or(i as f64))
             .collect();
-        Sweep { key, values, coords }
+        let labels = values.iter().map(value_text).collect();
+        Sweep {
+            key,
+            values,
+            coords,
+            labels,
+            categorical,
+        }
+    }
+
+    /// Replaces the axis labels (one per value) and makes the sweep
+    /// categorical on plot axes.
+    pub fn with_labels(mut self, labels: Vec<String>) -> Result<Sweep, String> {
+        if labels.len() != self.values.len() {
+            return Err(format!(
+                "needs one label per value: {} labels for {} values",
+                labels.len(),
+                self.values.len()
+            ));
+        }
+        if labels.iter().any(|l| l.trim().is_empty()) {
+            return Err("labels must not be empty".into());
+        }
+        for (i, l) in labels.iter().enumerate() {
+            if labels[..i].contains(l) {
+                return Err(format!("label `{l}` is used twice"));
+            }
+        }
+        self.labels = labels;
+        self.categorical = true;
+        Ok(self)
     }
 }
 
@@ -111,7 +150,7 @@ pub(crate) fn expand_range(key: String, r: &RawRange) -> Result<Sweep, String> {
         })
         .collect();
     let integral = from_int && to_int && numbers.iter().all(|x| (x - x.round()).abs() < 1e-9);
-    let values = numbers
+    let values: Vec<toml::Value> = numbers
         .iter()
         .map(|&x| match &r.format {
             Some(f) => toml::Value::String(f.replacen("{}", &format_range_number(x), 1)),
@@ -119,10 +158,13 @@ pub(crate) fn expand_range(key: String, r: &RawRange) -> Result<Sweep, String> {
             None => toml::Value::Float(x),
         })
         .collect();
+    let labels = values.iter().map(value_text).collect();
     Ok(Sweep {
         key,
         values,
         coords: numbers,
+        labels,
+        categorical: false,
     })
 }
 

@@ -6,7 +6,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::PlotError;
-use super::axis::{all_integers, coord, omitted_note, padded_range, ticks, to_axis};
+use super::axis::{Ticks, all_integers, coord, omitted_note, padded_range, ticks, to_axis};
 use super::font::FAMILY;
 use super::output::{draw_notes, render_both};
 use super::palette::color;
@@ -38,6 +38,29 @@ pub struct LinePlot {
     pub log_x: bool,
     /// Logarithmic y axis.
     pub log_y: bool,
+    /// Categorical x axis: `(x, label)` per category. When not empty the x
+    /// axis has one tick per category, labelled with its text, instead of
+    /// numeric ticks (e.g. resolutions `1024x768`, `1280x1024` drawn at
+    /// their indices 0 and 1). Ignored on a logarithmic x axis.
+    pub x_categories: Vec<(f64, String)>,
+}
+
+/// The ticks of a categorical x axis (positions ascending, labels distinct)
+/// and its range, half a category wider than the outer ones on each side.
+fn category_ticks(cats: &[(f64, String)]) -> (Ticks, (f64, f64)) {
+    let mut c: Vec<(f64, String)> = cats.iter().filter(|c| c.0.is_finite()).cloned().collect();
+    c.sort_by(|a, b| a.0.total_cmp(&b.0));
+    c.dedup_by(|a, b| a.0 == b.0 || a.1 == b.1);
+    let lo = c.first().map_or(0.0, |c| c.0);
+    let hi = c.last().map_or(1.0, |c| c.0);
+    let step = c.windows(2).map(|w| w[1].0 - w[0].0).fold(f64::INFINITY, f64::min);
+    let pad = if step.is_finite() { step / 2.0 } else { 0.5 };
+    let ticks = Ticks {
+        positions: c.iter().map(|c| c.0).collect(),
+        labels: c.into_iter().map(|c| c.1).collect(),
+        minor: Vec::new(),
+    };
+    (ticks, (lo - pad, hi + pad))
 }
 
 /// A series mapped to axis coordinates.
@@ -85,7 +108,8 @@ fn draw<DB: DrawingBackend>(
     notes: &[String],
 ) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
-    let xr = padded_range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
+    let categorical = !plot.x_categories.is_empty() && !plot.log_x;
+    let mut xr = padded_range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
     let yr = padded_range(series.iter().flat_map(|s| {
         s.points
             .iter()
@@ -94,7 +118,13 @@ fn draw<DB: DrawingBackend>(
     }));
     // Integer x data (frame counts, buffer counts, ...) gets whole-number ticks.
     let x_integer = all_integers(plot.series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
-    let xt = ticks(xr.0, xr.1, plot.log_x, x_integer);
+    let xt = if categorical {
+        let (t, r) = category_ticks(&plot.x_categories);
+        xr = r;
+        t
+    } else {
+        ticks(xr.0, xr.1, plot.log_x, x_integer)
+    };
     let yt = ticks(yr.0, yr.1, plot.log_y, false);
     let mut chart = ChartBuilder::on(root)
         .caption(&plot.title, (FAMILY, 24))
@@ -247,6 +277,34 @@ mod tests {
             line_plot(&base, &p).unwrap_or_else(|e| panic!("{name}: {e}"));
             assert_plot_files(&base);
         }
+    }
+
+    #[test]
+    fn categorical_x_axis_is_labelled_with_the_categories() {
+        let dir = tempfile::tempdir().unwrap();
+        let base = dir.path().join("cat");
+        let p = LinePlot {
+            x_categories: vec![
+                (0.0, "1024x768".into()),
+                (1.0, "1280x1024".into()),
+                (2.0, "1600x1200".into()),
+            ],
+            ..plot(vec![Series {
+                name: "network".into(),
+                points: vec![(0.0, 300.0), (1.0, 400.0), (2.0, 500.0)],
+                ci: None,
+            }])
+        };
+        line_plot(&base, &p).unwrap();
+        assert_plot_files(&base);
+        let svg = std::fs::read_to_string(base.with_extension("svg")).unwrap();
+        for l in ["1024x768", "1280x1024", "1600x1200"] {
+            assert!(svg.contains(l), "{l} missing");
+        }
+        let (t, r) = category_ticks(&p.x_categories);
+        assert_eq!(t.positions, vec![0.0, 1.0, 2.0]);
+        assert_eq!(r, (-0.5, 2.5));
+        assert_eq!(t.label_at(1.1), "1280x1024");
     }
 
     #[test]

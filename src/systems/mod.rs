@@ -17,6 +17,34 @@ use crate::config::{ConfigError, ModelSource, deserialize, invalid};
 /// The embedded default model (`models/default.toml`).
 pub const DEFAULT_MODEL: &str = include_str!("../../models/default.toml");
 
+/// The latency-stage vocabulary shared by the multi-frame-rate and VR
+/// breakdowns (`metrics.latency_breakdown_ms`), in chain order, each with
+/// the NVIDIA Reflex stage it corresponds to (docs/latency.md explains the
+/// mapping and which stages are zero in the papers' models).
+pub const LATENCY_STAGES: [(&str, &str); 12] = [
+    ("input_sample", "sensor/input (input to the sample that captures it)"),
+    (
+        "sensor_transport",
+        "sensor/input (tracker to application; Reflex has no separate stage)",
+    ),
+    (
+        "simulation_wait",
+        "simulation (wait for the simulation/frame start that reads the sample)",
+    ),
+    ("simulation", "simulation"),
+    ("render", "render (GPU render)"),
+    ("readback", "transfer (GPU to host)"),
+    ("transfer", "transfer (host to host)"),
+    (
+        "composite_wait",
+        "render submission (wait for the frame that takes another process's image)",
+    ),
+    ("render_submission", "render submission (upload and submit)"),
+    ("composite_render", "render (the frame that composites or re-projects)"),
+    ("swap_lock", "display (present: wait for the swap / vertical blank)"),
+    ("display", "display (scan-out to photons)"),
+];
+
 /// Errors of running any system.
 #[derive(Debug, thiserror::Error)]
 pub enum SimError {

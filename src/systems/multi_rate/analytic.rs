@@ -47,6 +47,10 @@ pub struct Terms {
     pub conventional_frame: Duration,
     /// Display latency.
     pub display: Duration,
+    /// SC's frame-rate cap (its period), if any.
+    pub sc_period: Option<Duration>,
+    /// FC's frame-rate cap (its period), if any.
+    pub fc_period: Option<Duration>,
 }
 
 impl Terms {
@@ -63,7 +67,21 @@ impl Terms {
             fc_render: Duration(cfg.fast_client.render.0.saturating_add(cfg.deferred_shading().0)),
             conventional_frame: cfg.conventional.frame.unwrap_or(cfg.slow_client.render),
             display: cfg.display.latency,
+            sc_period: cfg.slow_client.rate.as_ref().map(|r| r.period),
+            fc_period: cfg.fast_client.rate.as_ref().map(|r| r.period),
         }
+    }
+
+    /// SC's frame interval: its frame time, rounded up to whole periods of
+    /// its rate cap.
+    pub fn sc_interval(&self) -> Duration {
+        capped(self.sc_frame(), self.sc_period)
+    }
+
+    /// FC's frame interval: its frame time, rounded up to whole periods of
+    /// its rate cap (20 Hz caps a 33 ms frame to one every 50 ms).
+    pub fn fc_interval(&self) -> Duration {
+        capped(self.fc_frame(), self.fc_period)
     }
 
     /// SC frame time `R_sc + T_read`.
@@ -74,6 +92,14 @@ impl Terms {
     /// FC frame time `T_draw + T_render`.
     pub fn fc_frame(&self) -> Duration {
         Duration(self.fc_upload.0 + self.fc_render.0)
+    }
+}
+
+/// `frame` rounded up to a whole number of `period`s (unchanged without one).
+pub fn capped(frame: Duration, period: Option<Duration>) -> Duration {
+    match period {
+        Some(p) if p.0 > 0 => Duration(frame.0.div_ceil(p.0).max(1).saturating_mul(p.0)),
+        _ => frame,
     }
 }
 
@@ -127,6 +153,9 @@ pub fn analytic(t: &Terms) -> Analytic {
     let d = t.display.0;
     let fc = t.fc_frame().0;
     let sc = t.sc_frame().0;
+    // Frame intervals: the frame times unless a rate cap stretches them.
+    let fi = t.fc_interval().0;
+    let si = t.sc_interval().0;
     let x = t.transfer.0;
     let cv = t.conventional_frame.0;
     let half = |v: u64| v as f64 / 2.0;
@@ -136,17 +165,17 @@ pub fn analytic(t: &Terms) -> Analytic {
     Analytic {
         fast: Bounds {
             best: ms(fast_best + d),
-            worst: ms(fast_best + p + fc + d),
+            worst: ms(fast_best + p + fi + d),
             phase_min: ms(l + fc + d),
-            phase_max: ms(p + l + 2 * fc + d),
-            phase_mean: (half(p) + (l + fc + d) as f64 + half(fc)) / 1e9,
+            phase_max: ms(p + l + fi + fc + d),
+            phase_mean: (half(p) + (l + fc + d) as f64 + half(fi)) / 1e9,
         },
         slow: Bounds {
             best: ms(slow_best + d),
-            worst: ms(slow_best + p + fc + d),
+            worst: ms(slow_best + p + fi + d),
             phase_min: ms(slow_best + fc + d),
-            phase_max: ms(p + l + 2 * sc + x + 2 * fc + d),
-            phase_mean: (half(p) + (slow_best + fc + d) as f64 + half(sc) + half(fc)) / 1e9,
+            phase_max: ms(p + l + si + sc + x + fi + fc + d),
+            phase_mean: (half(p) + (slow_best + fc + d) as f64 + half(si) + half(fi)) / 1e9,
         },
         conventional: Bounds {
             best: ms(conv_best + d),
@@ -155,7 +184,7 @@ pub fn analytic(t: &Terms) -> Analytic {
             phase_max: ms(p + l + 2 * cv + d),
             phase_mean: (half(p) + (conv_best + d) as f64 + half(cv)) / 1e9,
         },
-        link_keeps_up: x <= sc,
+        link_keeps_up: x <= si,
     }
 }
 
@@ -221,6 +250,38 @@ mod tests {
         assert!((shading - 6.0).abs() < 0.05, "{shading}");
         let t = Terms::of(&fig8);
         assert_eq!(t.fc_render.0, Duration::ms(23).0 + fig8.deferred_shading().0);
+    }
+
+    #[test]
+    fn rate_caps_stretch_the_frame_interval() {
+        // Unset: the paper's numbers.
+        let free = analytic(&Terms::of(&cfg("system = \"multi_rate\"")));
+        // FC capped at 20 Hz: its 33 ms frame starts every 50 ms.
+        let c = cfg("system = \"multi_rate\"\n[fast_client]\nrate = \"20Hz\"");
+        let t = Terms::of(&c);
+        assert_eq!(t.fc_interval(), Duration::ms(50));
+        assert_eq!(t.fc_frame(), Duration::ms(33));
+        let a = analytic(&t);
+        assert!((a.fast.best - 73.0).abs() < 1e-9);
+        // Waiting for the next frame start: up to 50 ms instead of 33, 25 on average instead of 16.5.
+        assert!(
+            (a.fast.phase_max - (free.fast.phase_max + 17.0)).abs() < 1e-6,
+            "{:?}",
+            a.fast
+        );
+        assert!(
+            (a.fast.phase_mean - (free.fast.phase_mean + 8.5)).abs() < 1e-6,
+            "{:?}",
+            a.fast
+        );
+        assert!((a.fast.worst - (73.0 + 20.0 + 50.0)).abs() < 1e-9);
+        // Ticks quantize: at 60 Hz a 33 ms frame waits for the second tick (33.33 ms);
+        // a 200 ms SC cap gives 200 ms frames.
+        let fast_cap = Terms::of(&cfg("system = \"multi_rate\"\n[fast_client]\nrate = \"60Hz\""));
+        assert_eq!(fast_cap.fc_interval().0, 2 * fast_cap.fc_period.unwrap().0);
+        let sc = Terms::of(&cfg("system = \"multi_rate\"\n[slow_client]\nrate = \"200ms\""));
+        assert_eq!(sc.sc_interval(), Duration::ms(200));
+        assert_eq!(capped(Duration::ms(186), Some(Duration::ms(100))), Duration::ms(200));
     }
 
     #[test]

@@ -16,7 +16,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::config::Bandwidth;
+use crate::config::{Bandwidth, Rate};
 use crate::engine::Duration;
 
 /// The whole model.
@@ -168,6 +168,11 @@ pub struct SlowClientConfig {
     pub render: Duration,
     /// Read-back bandwidth (paper: 10 MiB in <= 20 ms).
     pub readback: Bandwidth,
+    /// Optional frame-rate cap (`"6Hz"` or a period like `"200ms"`): a frame
+    /// starts no earlier than the next tick of this rate (ticks from the
+    /// client's start phase), so frames come every
+    /// `ceil(frame / period) * period`. Unset: free-running (the paper).
+    pub rate: Option<Rate>,
 }
 
 impl Default for SlowClientConfig {
@@ -175,6 +180,7 @@ impl Default for SlowClientConfig {
         SlowClientConfig {
             render: Duration::ms(166),
             readback: bw("500MiB/s"),
+            rate: None,
         }
     }
 }
@@ -188,6 +194,9 @@ pub struct FastClientConfig {
     pub render: Duration,
     /// Upload bandwidth of SC's image (paper: 10 MiB in <= 10 ms).
     pub upload: Bandwidth,
+    /// Optional frame-rate cap, as for the slow client (e.g. `"60Hz"`:
+    /// a display-locked fast client). Unset: free-running (the paper).
+    pub rate: Option<Rate>,
 }
 
 impl Default for FastClientConfig {
@@ -195,6 +204,7 @@ impl Default for FastClientConfig {
         FastClientConfig {
             render: Duration::ms(23),
             upload: bw("1000MiB/s"),
+            rate: None,
         }
     }
 }

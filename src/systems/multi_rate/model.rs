@@ -190,8 +190,8 @@ impl MultiRate {
             Duration::from_ps_f64(frame.0 as f64 * r.random::<f64>())
         };
         let phases = [
-            phase("phase.slow_client", terms.sc_frame()),
-            phase("phase.fast_client", terms.fc_frame()),
+            phase("phase.slow_client", terms.sc_interval()),
+            phase("phase.fast_client", terms.fc_interval()),
             phase("phase.conventional", terms.conventional_frame),
         ];
         MultiRate {
@@ -239,6 +239,19 @@ impl MultiRate {
             sched.at(first, Ev::Input);
         }
         Ok(())
+    }
+
+    /// When a client whose last frame ended at `now` may start the next one:
+    /// at once without a rate cap, else at the next tick of its rate (ticks
+    /// at `phase + k * period`).
+    fn next_start(now: Time, phase: Duration, period: Option<Duration>) -> Time {
+        match period {
+            Some(p) if p.0 > 0 && now.0 > phase.0 => {
+                let k = (now.0 - phase.0).div_ceil(p.0);
+                Time(phase.0.saturating_add(k.saturating_mul(p.0)))
+            }
+            _ => now,
+        }
     }
 
     fn gap(&mut self) -> Duration {
@@ -345,7 +358,7 @@ impl Model for MultiRate {
                 } else {
                     self.send(now, idx, sched)?;
                 }
-                sched.at(now, Ev::ScFrameStart);
+                sched.at(Self::next_start(now, self.phases[0], t.sc_period), Ev::ScFrameStart);
             }
             Ev::TransferEnd => {
                 if let Some(idx) = self.in_flight.take() {
@@ -380,7 +393,7 @@ impl Model for MultiRate {
                 if self.done() {
                     return Ok(Control::Stop);
                 }
-                sched.at(now, Ev::FcFrameStart);
+                sched.at(Self::next_start(now, self.phases[1], t.fc_period), Ev::FcFrameStart);
             }
             Ev::ConvFrameStart => {
                 self.conv.push(ConvFrame {

@@ -73,6 +73,16 @@ pub fn validate(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
             "FC's frame (upload + render) must take some time",
         ));
     }
+    for (key, rate) in [
+        ("slow_client.rate", &cfg.slow_client.rate),
+        ("fast_client.rate", &cfg.fast_client.rate),
+    ] {
+        if let Some(r) = rate
+            && r.period.0 == 0
+        {
+            return Err(bad(key, format!("{:?} has a zero period", r.text)));
+        }
+    }
     if cfg.conventional.enabled && t.conventional_frame.0 == 0 {
         return Err(bad("conventional.frame", "must be greater than zero"));
     }
@@ -249,8 +259,8 @@ fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &A
                 "display": t.display.as_ms_f64(),
             },
             "rates_hz": {
-                "slow_client": 1e3 / t.sc_frame().as_ms_f64(),
-                "fast_client": 1e3 / t.fc_frame().as_ms_f64(),
+                "slow_client": 1e3 / t.sc_interval().as_ms_f64(),
+                "fast_client": 1e3 / t.fc_interval().as_ms_f64(),
                 "transfer": if t.transfer.0 > 0 { 1e3 / t.transfer.as_ms_f64() } else { f64::INFINITY },
             },
             "frames": {"slow_client": m.sc.len(), "fast_client": m.fc_done, "conventional": m.conv_done},

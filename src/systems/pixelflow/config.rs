@@ -99,6 +99,13 @@ pub struct PixelFlowConfig {
     /// Cluster rectangle (pixels, from the top-left corner) for `clustered`.
     #[serde(default)]
     pub cluster: Option<ClusterConfig>,
+    /// Load imbalance across the rasterizing nodes (what-if, event fidelity
+    /// only; the closed forms assume balance): `s` in `[0, 1)` gives node `r`
+    /// of `n` a share of the primitives proportional to
+    /// `1 + s (1 - 2r / (n - 1))`, so the first node gets `1 + s` times the
+    /// mean and the last `1 - s`; 0 (default) is the balanced round robin.
+    #[serde(default)]
+    pub node_skew: f64,
     /// Display size (640 x 512).
     pub display: Size,
     /// Screen region: the pixel-processor array (128 x 64).

@@ -54,9 +54,7 @@ pub fn build(cfg: &PixelFlowConfig) -> Layout {
     let nodes = cfg.rasterizers().max(1) as usize;
     let regions = cfg.regions() as usize;
     let n = cfg.primitives;
-    let prims: Vec<u64> = (0..nodes as u64)
-        .map(|r| n / nodes as u64 + u64::from(r < n % nodes as u64))
-        .collect();
+    let prims = node_counts(n, nodes, cfg.node_skew);
     let mut bins = vec![0u64; nodes * regions];
     match cfg.placement {
         Placement::Uniform => {
@@ -79,8 +77,17 @@ pub fn build(cfg: &PixelFlowConfig) -> Layout {
             let cluster = cfg.cluster.as_ref().filter(|_| cfg.placement == Placement::Clustered);
             let mut cov_x = Vec::with_capacity(8);
             let mut cov_y = Vec::with_capacity(8);
-            for i in 0..n {
-                let node = (i % nodes as u64) as usize;
+            // Round robin over the nodes that still have primitives to take:
+            // node i % nodes when the counts are balanced.
+            let mut left = prims.clone();
+            let mut next = 0usize;
+            for _ in 0..n {
+                while left[next] == 0 {
+                    next = (next + 1) % nodes;
+                }
+                left[next] -= 1;
+                let node = next;
+                next = (next + 1) % nodes;
                 let (x0, y0) = match cluster {
                     Some(c) if rng.random::<f64>() < c.fraction => (
                         c.x + rng.random::<f64>() * c.width,
@@ -109,6 +116,34 @@ pub fn build(cfg: &PixelFlowConfig) -> Layout {
     }
 }
 
+/// Primitives per rasterizing node: `n / nodes` each (the first `n % nodes`
+/// one more) for `skew = 0`; otherwise shares proportional to
+/// `1 + skew (1 - 2r / (nodes - 1))`, rounded so that they add up to `n`.
+pub fn node_counts(n: u64, nodes: usize, skew: f64) -> Vec<u64> {
+    if skew == 0.0 || nodes < 2 {
+        return (0..nodes as u64)
+            .map(|r| n / nodes as u64 + u64::from(r < n % nodes as u64))
+            .collect();
+    }
+    let weight = |r: usize| 1.0 + skew * (1.0 - 2.0 * r as f64 / (nodes - 1) as f64);
+    let total: f64 = (0..nodes).map(weight).sum();
+    let mut prefix = 0.0;
+    let mut prev = 0u64;
+    (0..nodes)
+        .map(|r| {
+            prefix += weight(r);
+            let cum = if r + 1 == nodes {
+                n
+            } else {
+                ((n as f64 * prefix / total).round() as u64).min(n)
+            };
+            let c = cum.saturating_sub(prev);
+            prev = prev.max(cum);
+            c
+        })
+        .collect()
+}
+
 /// Region indices along one axis covered by `[start, start + len)`, wrapping
 /// around the screen edge (distinct indices only).
 fn covered(start: f64, len: f64, screen: f64, region: f64, out: &mut Vec<usize>) {
@@ -123,6 +158,26 @@ fn covered(start: f64, len: f64, screen: f64, region: f64, out: &mut Vec<usize>)
         }
         let boundary = ((idx + 1) as f64 * region).min(screen);
         x += (boundary - px).max(1e-9);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::node_counts;
+
+    #[test]
+    fn node_counts_balanced_and_skewed() {
+        assert_eq!(node_counts(10, 3, 0.0), vec![4, 3, 3]);
+        // 15 nodes, skew 0.5: the first node gets 1.5 times the mean, the last 0.5 times.
+        let c = node_counts(1_500_000, 15, 0.5);
+        assert_eq!(c.iter().sum::<u64>(), 1_500_000);
+        assert_eq!(c[0], 150_000);
+        assert_eq!(c[7], 100_000);
+        assert_eq!(c[14], 50_000);
+        assert!(c.windows(2).all(|w| w[0] >= w[1]), "{c:?}");
+        // A few primitives still add up.
+        let c = node_counts(7, 15, 0.9);
+        assert_eq!(c.iter().sum::<u64>(), 7);
     }
 }
 

@@ -99,6 +99,12 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), PixelFlowError> {
     if cfg.nontex.batch_primitives == 0 {
         return Err(bad("nontex.batch_primitives", "must be at least 1"));
     }
+    if !(cfg.node_skew.is_finite() && (0.0..1.0).contains(&cfg.node_skew)) {
+        return Err(bad(
+            "node_skew",
+            format!("must be within [0, 1), got {}", cfg.node_skew),
+        ));
+    }
     if cfg.placement == Placement::Clustered {
         let Some(c) = &cfg.cluster else {
             return Err(bad("cluster", "placement = \"clustered\" needs a [cluster] table"));
@@ -286,6 +292,7 @@ fn summary(
         "samples": cfg.samples,
         "primitives": cfg.primitives,
         "placement": cfg.placement,
+        "node_skew": cfg.node_skew,
         "seed": cfg.run.seed,
         "frames": cfg.frames,
         "warmup_frames": 0,
@@ -296,6 +303,7 @@ fn summary(
             "latency_ms": latency,
             "analytic_latency_ms": a.latency_ms,
             "relative_error": rel,
+            "difference_pct": 100.0 * rel,
             "front_end_ms": front,
             "back_end_ms": latency - front,
             "analytic_front_end_ms": a.front_end_ms,

@@ -191,6 +191,35 @@ fn clustered_primitives_are_slower_than_the_closed_form() {
 }
 
 #[test]
+fn node_skew_costs_what_the_busiest_node_would_alone() {
+    // skew 0.5 over 15 (or 19) rasterizers: the first node takes 1.5 times the
+    // mean share, so with many primitives the frame costs what a balanced
+    // machine needs for 1.5 times the primitives. The closed form itself
+    // assumes balance and does not change.
+    for (arch, shaders) in [("standard", 4), ("presort", 4), ("nontex", 4), ("standard", 1)] {
+        let a = format!("architecture=\"{arch}\"");
+        let s = format!("shading_nodes={shaders}");
+        let skewed = run_with(&[&a, &s, "primitives=1140000", "node_skew=0.5"]).unwrap();
+        let heavier = run_with(&[&a, &s, "primitives=1710000", "fidelity=\"analytic\""]).unwrap();
+        let balanced = run_with(&[&a, &s, "primitives=1140000", "fidelity=\"analytic\""]).unwrap();
+        let lat = metric(&skewed, "latency_ms");
+        let want = metric(&heavier, "analytic_latency_ms");
+        assert!((lat - want).abs() <= 0.01 * want, "{arch}/{shaders}: {lat} vs {want}");
+        close(
+            metric(&skewed, "analytic_latency_ms"),
+            metric(&balanced, "analytic_latency_ms"),
+            1e-9,
+        );
+        assert!(lat > 1.3 * metric(&skewed, "analytic_latency_ms"), "{arch}: {lat}");
+    }
+    // Random placement with skew: every node's primitives are placed, the total is kept.
+    let r = run_with(&["placement=\"random\"", "primitives=20000", "node_skew=0.5"]).unwrap();
+    assert!(metric(&r, "latency_ms") > metric(&r, "analytic_latency_ms"));
+    let e = run_with(&["node_skew=1.0"]).unwrap_err().to_string();
+    assert!(e.contains("node_skew"), "{e}");
+}
+
+#[test]
 fn bad_input_gives_clear_errors() {
     let e = run_with(&["deferred.t_tran=\"1us\""]).unwrap_err().to_string();
     assert!(e.contains("t_tran"), "{e}");

@@ -23,23 +23,29 @@ pub const NAIVE_STAGES: [&str; 7] = [
     "swap_lock",
     "display",
 ];
-/// Stages of a head motion in the warp scheme.
+/// Stages of a head motion in the warp scheme: the warping renderer reads
+/// the newest pose at its frame start (`simulation_wait`, as a client's
+/// frame start in the multi-frame-rate chain) and re-projects the newest
+/// application frame (`composite_render`, as the fast client composites the
+/// slow client's image). Names from [`crate::systems::LATENCY_STAGES`].
 pub const WARP_HEAD_STAGES: [&str; 6] = [
     "input_sample",
     "sensor_transport",
-    "warp_wait",
-    "render",
+    "simulation_wait",
+    "composite_render",
     "swap_lock",
     "display",
 ];
-/// Stages of an object motion in the warp scheme.
+/// Stages of an object motion in the warp scheme: after the simulation step,
+/// the wait for the warping frame that takes its transforms is
+/// `composite_wait` (as the fast client's wait for the slow client's image).
 pub const WARP_OBJECT_STAGES: [&str; 8] = [
     "input_sample",
     "sensor_transport",
     "simulation_wait",
     "simulation",
-    "warp_wait",
-    "render",
+    "composite_wait",
+    "composite_render",
     "swap_lock",
     "display",
 ];
