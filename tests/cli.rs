@@ -259,3 +259,49 @@ fn vcache_reports_the_figure_keys() {
     let e = run_err(&["vcache", "grid:4x3", "--policy", "lfu:3"]);
     assert!(e.contains("lfu"), "{e}");
 }
+
+/// Paths of JSON nulls (NaN is written as null) in `v`.
+fn nulls(v: &serde_json::Value, path: &str, out: &mut Vec<String>) {
+    match v {
+        serde_json::Value::Null => out.push(path.to_string()),
+        serde_json::Value::Object(m) => m.iter().for_each(|(k, x)| nulls(x, &format!("{path}.{k}"), out)),
+        serde_json::Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .for_each(|(i, x)| nulls(x, &format!("{path}[{i}]"), out)),
+        _ => {}
+    }
+}
+
+#[test]
+fn run_until_stops_at_that_simulated_time() {
+    // The default model asks for 300 frames at 60 Hz (5 s); run.until cuts it at 100 ms.
+    let json = |extra: &[&str]| -> serde_json::Value {
+        let mut args = vec!["run", "--json", "--set", "run.until=\"100ms\""];
+        args.extend_from_slice(extra);
+        serde_json::from_str(&run_ok(&args)).unwrap()
+    };
+    let v = json(&["--set", "run.warmup_frames=0"]);
+    assert_eq!(v["stopped_by"], "time_limit", "{v}");
+    assert_eq!(v["simulated_seconds"].as_f64().unwrap(), 0.1, "{}", v["simulated_seconds"]);
+    // Double-buffered 60 Hz vsync: a frame is shown every 16.7 ms at best, so
+    // at most 6 frames complete by 100 ms; the frames still in flight are not reported.
+    let done = v["frames_simulated"].as_u64().unwrap();
+    assert!((3..=6).contains(&done), "{done} frames");
+    assert_eq!(v["metrics"]["frame_time_ms"]["count"].as_u64().unwrap(), done);
+    let displayed = v["metrics"]["displayed_frames"].as_u64().unwrap() + v["metrics"]["dropped_frames"].as_u64().unwrap();
+    assert_eq!(displayed, done);
+    let mut n = vec![];
+    nulls(&v, "", &mut n);
+    assert!(n.is_empty(), "NaN in the summary: {n:?}");
+    // Fewer frames completed than the warm-up leaves out: empty metrics, still no NaN.
+    let v = json(&[]);
+    assert_eq!(v["stopped_by"], "time_limit");
+    let mut n = vec![];
+    nulls(&v, "", &mut n);
+    assert!(n.is_empty(), "NaN in the summary: {n:?}");
+    // A limit beyond the run's end changes nothing.
+    let v = json(&["--set", "run.until=\"1000s\"", "--frames", "10"]);
+    assert_eq!(v["stopped_by"], "model");
+    assert_eq!(v["frames_simulated"], 10);
+}

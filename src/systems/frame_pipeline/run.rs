@@ -4,7 +4,7 @@ use std::path::Path;
 
 use serde_json::{Value, json};
 
-use crate::engine::{Duration, Limits, PS_PER_MS, RunStats, Scheduler, StopReason, run};
+use crate::engine::{Duration, Limits, PS_PER_MS, RunStats, Scheduler, StopReason, Time, run};
 use crate::stats::quantile::Summary;
 
 use super::accounting::{BOTTLENECKS, CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES, TraceLog};
@@ -130,7 +130,7 @@ pub fn run_pipeline(cfg: FramePipelineConfig, base_dir: &Path, trace: bool) -> R
     let mut sched = Scheduler::new();
     model.start(&mut sched)?;
     let limits = Limits {
-        until: None,
+        until: model.cfg.run.until.map(|d| Time(d.0)),
         max_events: model.cfg.run.max_events,
     };
     let stats = run(&mut model, &mut sched, limits)?;
@@ -141,6 +141,11 @@ pub fn run_pipeline(cfg: FramePipelineConfig, base_dir: &Path, trace: bool) -> R
             frames: model.frames_total,
             state: model.describe(),
         });
+    }
+    if !model.done() {
+        // Stopped by `run.until` or `run.max_events`: frames still in flight
+        // have no complete timeline, so only the completed ones are kept.
+        model.keep_completed_frames();
     }
     let mut summary = summarize(&model, &stats, analytic, scene_stats);
     summary["build_seconds"] = json!(build_seconds);
