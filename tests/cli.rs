@@ -91,6 +91,8 @@ fn out_dir_reruns_to_the_same_frames_and_trace_is_valid() {
         "5",
         "--set",
         "display.buffers=3",
+        "--set",
+        "fidelity=\"triangle\"",
         "--out",
         a.to_str().unwrap(),
         "--trace",
@@ -135,14 +137,37 @@ fn out_dir_reruns_to_the_same_frames_and_trace_is_valid() {
             .or_default()
             .push((ts, ts + e["dur"].as_f64().unwrap()));
     }
-    assert!(by_tid.len() >= 4, "tracks: {:?}", by_tid.keys());
+    // One named track per unit, each with spans (triangle fidelity: the
+    // geometry and fragment stages have per-triangle spans).
+    let track_names: std::collections::BTreeMap<i64, &str> = ev
+        .iter()
+        .filter(|e| e["ph"] == "M" && e["name"] == "thread_name")
+        .map(|e| (e["tid"].as_i64().unwrap(), e["args"]["name"].as_str().unwrap()))
+        .collect();
+    for unit in ["CPU thread", "GPU front end", "GPU geometry", "GPU fragment", "Display"] {
+        let tid = track_names
+            .iter()
+            .find(|(_, n)| **n == unit)
+            .map(|(t, _)| *t)
+            .unwrap_or_else(|| panic!("no track named {unit:?}: {track_names:?}"));
+        assert!(
+            by_tid.get(&tid).is_some_and(|s| !s.is_empty()),
+            "track {unit:?} has no spans"
+        );
+    }
     for (tid, mut spans) in by_tid {
         spans.sort_by(|x, y| x.0.total_cmp(&y.0));
         for w in spans.windows(2) {
             assert!(w[1].0 >= w[0].1 - 1e-6, "overlap on track {tid}: {w:?}");
         }
     }
-    assert!(ev.iter().any(|e| e["ph"] == "C" && e["name"] == "command FIFO"));
+    // Counter tracks for both FIFOs.
+    for counter in ["command FIFO", "triangle FIFO"] {
+        assert!(
+            ev.iter().any(|e| e["ph"] == "C" && e["name"] == counter),
+            "no {counter:?} counter"
+        );
+    }
 }
 
 #[test]
@@ -283,13 +308,19 @@ fn run_until_stops_at_that_simulated_time() {
     };
     let v = json(&["--set", "run.warmup_frames=0"]);
     assert_eq!(v["stopped_by"], "time_limit", "{v}");
-    assert_eq!(v["simulated_seconds"].as_f64().unwrap(), 0.1, "{}", v["simulated_seconds"]);
+    assert_eq!(
+        v["simulated_seconds"].as_f64().unwrap(),
+        0.1,
+        "{}",
+        v["simulated_seconds"]
+    );
     // Double-buffered 60 Hz vsync: a frame is shown every 16.7 ms at best, so
     // at most 6 frames complete by 100 ms; the frames still in flight are not reported.
     let done = v["frames_simulated"].as_u64().unwrap();
     assert!((3..=6).contains(&done), "{done} frames");
     assert_eq!(v["metrics"]["frame_time_ms"]["count"].as_u64().unwrap(), done);
-    let displayed = v["metrics"]["displayed_frames"].as_u64().unwrap() + v["metrics"]["dropped_frames"].as_u64().unwrap();
+    let displayed =
+        v["metrics"]["displayed_frames"].as_u64().unwrap() + v["metrics"]["dropped_frames"].as_u64().unwrap();
     assert_eq!(displayed, done);
     let mut n = vec![];
     nulls(&v, "", &mut n);
