@@ -24,11 +24,13 @@ fn fifo_depth_moves_frame_time_from_sum_to_max_monotonically() {
     // fragment busy times (the sampled sizes, not their expectation).
     let mut times = vec![];
     let mut bounds = (0.0, 0.0);
+    let mut realized = (0.0, 0.0);
     for depth in [0u32, 1, 2, 4, 16, 64, 256, 1024, 100_000] {
         let r = run(&bimodal(depth), &["run.frames=2"]);
         let g = r.clocks.geometry[0] as f64;
         let f = r.clocks.fragment[0] as f64;
         bounds = (g.max(f), g + f);
+        realized = (g, f);
         times.push(r.clocks.gpu[0] as f64);
     }
     let (max, sum) = bounds;
@@ -39,6 +41,36 @@ fn fifo_depth_moves_frame_time_from_sum_to_max_monotonically() {
     assert!(
         (times[0] - sum).abs() / sum < 0.03,
         "one-slot time {} vs sum {sum}",
+        times[0]
+    );
+    // Closed form for small depths D (the static view gives every depth the
+    // same sizes): 2 frames x 20,000 triangles, g = 1 ns each; a big triangle
+    // (100 ns of fragments) lets geometry run ahead by the D FIFO slots plus
+    // the triangle it holds, so (D + 1) g per big triangle overlaps, and every
+    // tiny triangle's 1 ps of fragments hides behind the next geometry step:
+    //   T(D) = G + F - (D + 1) g n_big - n_tiny f_tiny.
+    // It is exact while big triangles are more than D + 1 apart; the few
+    // closer pairs (about 2 p n_big = 8 at D = 1) overlap less, a few ns in
+    // all, so 0.1% of the sum (78 ns) bounds the gap. With D = 1 the time is
+    // about 1% below the sum (0.8 us of 78 us), twice the D = 0 overlap.
+    let (g_total, f_total) = realized;
+    let (n, g, f_big, f_tiny) = (40_000.0, 1_000.0, 100_000.0, 1.0);
+    let n_big = ((f_total - n * f_tiny) / (f_big - f_tiny)).round();
+    assert!(
+        (n_big * f_big + (n - n_big) * f_tiny - f_total).abs() < 0.5,
+        "{n_big} {f_total}"
+    );
+    for (depth, t) in [(0.0, times[0]), (1.0, times[1])] {
+        let closed = g_total + f_total - (depth + 1.0) * g * n_big - (n - n_big) * f_tiny;
+        assert!(
+            (t - closed).abs() < 1e-3 * sum,
+            "depth {depth}: time {t} ps vs closed form {closed} ps (sum {sum})"
+        );
+    }
+    assert!(
+        times[1] < times[0] && times[1] > 0.985 * sum,
+        "one-slot FIFO: {} not just below the sum {sum} (depth 0: {})",
+        times[1],
         times[0]
     );
     let last = *times.last().unwrap();
