@@ -59,7 +59,7 @@ enum Cmd {
         #[arg(long)]
         quiet: bool,
     },
-    /// Isolate the bottleneck (paper 004 §4.1): reduce CPU, geometry and raster load in turn.
+    /// Isolate the bottleneck (paper 004 §4.1): reduce CPU, GPU front-end, geometry and raster load in turn.
     Isolate {
         /// Model file (TOML); the default model when omitted.
         model: Option<PathBuf>,

@@ -272,6 +272,58 @@ fn isolate_finds_the_limiting_subsystem() {
     run_err(&["isolate", &m, "--factor", "1.5"]);
 }
 
+/// A scene model, vsync off, no noise, 10 frames at `draw` fidelity, with `extra` keys.
+fn isolate_scene(group: &str, extra: &str) -> String {
+    format!(
+        "fidelity = \"draw\"\n[run]\nframes = 10\n[display]\nvsync = false\n[noise]\nenabled = false\n{extra}\n\
+         [workload]\nkind = \"scene\"\n[[workload.groups]]\nname = \"g\"\n{group}\n"
+    )
+}
+
+#[test]
+fn isolate_reports_geometry_and_front_end_bound_models() {
+    let d = tempfile::tempdir().unwrap();
+    let iso = |name: &str, text: &str| -> serde_json::Value {
+        let m = write(d.path(), name, text);
+        serde_json::from_str(&run_ok(&["isolate", &m, "--json"])).unwrap()
+    };
+    let change = |v: &serde_json::Value, name: &str| {
+        v["variants"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|x| x["name"] == name)
+            .unwrap_or_else(|| panic!("no variant {name}: {v}"))["change"]
+            .as_f64()
+            .unwrap()
+    };
+    // Geometry-bound: 100,000 triangles x 100 ns of vertex shading = 10 ms; fragments 0.01 ms.
+    let v = iso(
+        "geometry.toml",
+        &isolate_scene(
+            "mesh = { triangles = 100000, acmr = 1.0 }\ntriangle_pixels = 0.1",
+            "[gpu.geometry]\nvertex_shader = \"100ns\"\n[gpu.fragment]\nper_fragment = \"1ns\"",
+        ),
+    );
+    assert_eq!(v["bottleneck"], "geometry", "{v}");
+    assert!((change(&v, "geometry") + 0.5).abs() < 0.01, "{v}");
+    // Front-end-bound: 100 draws, each batch 2 commands (matrix + draw) at
+    // 50 us of command processing, plus clear and swap: about 10 ms on the
+    // GPU front end, next to nothing on the CPU, geometry or fragments.
+    let v = iso(
+        "front.toml",
+        &isolate_scene(
+            "count = 100\nmesh = \"grid:1x1\"\ntriangle_pixels = 1.0",
+            "[gpu]\ncommand = \"50us\"\n[gpu.geometry]\nvertex_shader = \"1ns\"\n[gpu.fragment]\nper_fragment = \"1ns\"",
+        ),
+    );
+    assert_eq!(v["bottleneck"], "front_end", "{v}");
+    assert!((change(&v, "front_end") + 0.5).abs() < 0.01, "{v}");
+    for other in ["cpu", "geometry", "raster"] {
+        assert!(change(&v, other).abs() < 0.01, "{other}: {v}");
+    }
+}
+
 #[test]
 fn vcache_reports_the_figure_keys() {
     let out = run_ok(&["vcache", "grid:4x3", "--policy", "fifo:9", "--json"]);
