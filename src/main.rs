@@ -149,10 +149,28 @@ fn main() -> ExitCode {
     match dispatch(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_line(&e));
             ExitCode::from(2)
         }
     }
+}
+
+/// The error and its causes on one line, like `{:#}`, but a cause whose text
+/// the line already holds (a library error that prints its source, e.g. the
+/// OS error of a file that cannot be read) is not repeated.
+fn error_line(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
 }
 
 fn dispatch(cli: Cli) -> Result<()> {
@@ -206,10 +224,20 @@ fn load_source(model: Option<&Path>) -> Result<ModelSource> {
     })
 }
 
-fn model_table(src: &ModelSource, sets: &[String], seed: Option<u64>, frames: Option<u64>) -> Result<toml::Table> {
+/// Applies `key=value` to the table and records where the value came from
+/// (`origin`), so an error in it names the option rather than the file.
+fn set_noted(src: &mut ModelSource, t: &mut toml::Table, assignment: &str, origin: String) -> Result<()> {
+    apply_set(t, assignment)?;
+    if let Some((key, _)) = assignment.split_once('=') {
+        src.note_override(key.trim(), origin);
+    }
+    Ok(())
+}
+
+fn model_table(src: &mut ModelSource, sets: &[String], seed: Option<u64>, frames: Option<u64>) -> Result<toml::Table> {
     let mut t = src.table()?;
     for s in sets {
-        apply_set(&mut t, s)?;
+        set_noted(src, &mut t, s, format!("--set {s}"))?;
     }
     if let Some(seed) = seed {
         if seed > i64::MAX as u64 {
@@ -218,10 +246,10 @@ fn model_table(src: &ModelSource, sets: &[String], seed: Option<u64>, frames: Op
                 i64::MAX
             );
         }
-        apply_set(&mut t, &format!("run.seed={seed}"))?;
+        set_noted(src, &mut t, &format!("run.seed={seed}"), format!("--seed {seed}"))?;
     }
     if let Some(f) = frames {
-        apply_set(&mut t, &format!("run.frames={f}"))?;
+        set_noted(src, &mut t, &format!("run.frames={f}"), format!("--frames {f}"))?;
         let warm = t
             .get("run")
             .and_then(|r| r.get("warmup_frames"))
@@ -232,7 +260,12 @@ fn model_table(src: &ModelSource, sets: &[String], seed: Option<u64>, frames: Op
                 "note: run.warmup_frames = {warm} is not less than --frames {f}; using {} warm-up frames",
                 f / 10
             );
-            apply_set(&mut t, &format!("run.warmup_frames={}", f / 10))?;
+            set_noted(
+                src,
+                &mut t,
+                &format!("run.warmup_frames={}", f / 10),
+                format!("--frames {f}"),
+            )?;
         }
     }
     Ok(t)
@@ -248,8 +281,8 @@ fn cmd_run(
     out: Option<PathBuf>,
     trace: Option<PathBuf>,
 ) -> Result<()> {
-    let src = load_source(model.as_deref())?;
-    let table = model_table(&src, &sets, seed, frames)?;
+    let mut src = load_source(model.as_deref())?;
+    let table = model_table(&mut src, &sets, seed, frames)?;
     let mut run = run_model(&src, &table, trace.is_some())?;
     run.summary_mut()["model"] = json!(src.name);
     if let Some(dir) = &out {
@@ -473,8 +506,8 @@ fn cmd_experiment(file: &Path, out: Option<PathBuf>, quiet: bool) -> Result<()> 
 }
 
 fn cmd_isolate(model: Option<PathBuf>, sets: Vec<String>, factor: f64, keep_vsync: bool, json: bool) -> Result<()> {
-    let src = load_source(model.as_deref())?;
-    let table = model_table(&src, &sets, None, None)?;
+    let mut src = load_source(model.as_deref())?;
+    let table = model_table(&mut src, &sets, None, None)?;
     let cfg: rendersim::systems::frame_pipeline::FramePipelineConfig = rendersim::config::deserialize(&table, &src)?;
     let iso = rendersim::systems::frame_pipeline::isolate::isolate(&cfg, &src.base_dir, factor, keep_vsync)?;
     if json {

@@ -388,3 +388,64 @@ fn run_until_stops_at_that_simulated_time() {
     assert_eq!(v["stopped_by"], "model");
     assert_eq!(v["frames_simulated"], 10);
 }
+
+#[test]
+fn a_missing_model_file_reports_the_os_error_once() {
+    let d = tempfile::tempdir().unwrap();
+    let missing = d.path().join("none.toml");
+    let e = run_err(&["run", missing.to_str().unwrap()]);
+    assert!(e.contains("none.toml"), "{e}");
+    let os = std::fs::read_to_string(&missing).unwrap_err().to_string();
+    assert_eq!(e.matches(&os).count(), 1, "OS error not exactly once: {e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+    // The same for an experiment file.
+    let e = run_err(&["experiment", missing.to_str().unwrap()]);
+    assert_eq!(e.matches(&os).count(), 1, "OS error not exactly once: {e}");
+}
+
+#[test]
+fn a_bad_enum_value_names_its_key_and_the_valid_values() {
+    let e = run_err(&["run", "--set", "display.present_mode=mailbx"]);
+    assert!(e.contains("`display.present_mode`"), "{e}");
+    assert!(!e.contains("present_mode.mailbx"), "{e}");
+    for v in ["`fifo`", "`mailbox`", "`immediate`"] {
+        assert!(e.contains(v), "{v} not listed: {e}");
+    }
+    assert!(e.contains("did you mean `mailbox`"), "{e}");
+    // In a file: the key's line.
+    let d = tempfile::tempdir().unwrap();
+    let m = write(
+        d.path(),
+        "m.toml",
+        &format!("{SMALL}\n[command_fifo]\nunit = \"lines\"\n"),
+    );
+    let e = run_err(&["run", &m]);
+    let line = SMALL.lines().count() + 3;
+    assert!(e.contains(&format!("m.toml:{line}: key `command_fifo.unit`:")), "{e}");
+    assert!(e.contains("`entries`") && e.contains("`bytes`"), "{e}");
+}
+
+#[test]
+fn a_bad_set_value_is_reported_as_coming_from_the_option() {
+    // cpu.per_draw stands on a line of the embedded model, but the bad value came from --set.
+    let e = run_err(&["run", "--set", "cpu.per_draw=17"]);
+    assert!(e.contains("`--set cpu.per_draw=17`"), "{e}");
+    assert!(e.contains("key `cpu.per_draw`") && e.contains("needs a unit"), "{e}");
+    assert!(
+        !e.contains("<embedded default model>:"),
+        "reported at a line of the model: {e}"
+    );
+    // The same for a file, and for values the simulator rejects after parsing.
+    let d = tempfile::tempdir().unwrap();
+    let m = write(d.path(), "m.toml", &format!("{SMALL}\n[display]\nbuffers = 2\n"));
+    let e = run_err(&["run", &m, "--set", "display.buffers=1"]);
+    assert!(
+        e.contains("`--set display.buffers=1`") && e.contains("display.buffers"),
+        "{e}"
+    );
+    assert!(!e.contains("m.toml:"), "{e}");
+    // A bad value in the file itself still names its line.
+    let m = write(d.path(), "bad.toml", &format!("{SMALL}\n[display]\nbuffers = 1\n"));
+    let e = run_err(&["run", &m, "--set", "cpu.per_draw=\"1us\""]);
+    assert!(e.contains(&format!("bad.toml:{}", SMALL.lines().count() + 3)), "{e}");
+}
