@@ -349,11 +349,24 @@ fn print_human(run: &SystemRun) {
         );
         return;
     }
+    let frames = match s["stopped_by"].as_str() {
+        Some("time_limit") | Some("event_limit") => format!(
+            "{} of {} frames completed (stopped early: {} reached at {} s simulated)",
+            s["frames"],
+            s["frames_requested"],
+            if s["stopped_by"] == "time_limit" {
+                "run.until"
+            } else {
+                "run.max_events"
+            },
+            fixed(f(&s["simulated_seconds"]), 3)
+        ),
+        _ => format!("{} frames", s["frames"]),
+    };
     println!(
-        "{} ({}), {} frames, seed {}",
+        "{} ({}), {frames}, seed {}",
         s["model"].as_str().unwrap_or(""),
         s["fidelity"].as_str().unwrap_or(""),
-        s["frames"],
         s["seed"]
     );
     for (name, key) in [
@@ -364,17 +377,17 @@ fn print_human(run: &SystemRun) {
     ] {
         let v = &m[key];
         println!(
-            "  {name:<18} mean {:>8.3} ms   p50 {:>8.3}   p99 {:>8.3}   max {:>8.3}",
-            f(&v["mean"]),
-            f(&v["p50"]),
-            f(&v["p99"]),
-            f(&v["max"])
+            "  {name:<18} mean {:>8} ms   p50 {:>8}   p99 {:>8}   max {:>8}",
+            fixed(f(&v["mean"]), 3),
+            fixed(f(&v["p50"]), 3),
+            fixed(f(&v["p99"]), 3),
+            fixed(f(&v["max"]), 3)
         );
     }
     println!(
-        "  CPU busy {:.1}%   GPU busy {:.1}%   repeated refreshes {}   dropped frames {}",
-        100.0 * f(&m["cpu_busy_fraction"]),
-        100.0 * f(&m["gpu_busy_fraction"]),
+        "  CPU busy {}%   GPU busy {}%   repeated refreshes {}   dropped frames {}",
+        fixed(100.0 * f(&m["cpu_busy_fraction"]), 1),
+        fixed(100.0 * f(&m["gpu_busy_fraction"]), 1),
         m["repeated_refreshes"],
         m["dropped_frames"]
     );
@@ -384,25 +397,42 @@ fn print_human(run: &SystemRun) {
         let parts: Vec<String> = v
             .iter()
             .filter(|x| x.1 > 0.0005)
-            .map(|(k, x)| format!("{k} {:.1}%", 100.0 * x))
+            .map(|(k, x)| format!("{k} {}%", fixed(100.0 * x, 1)))
             .collect();
-        println!("  bottleneck: {}", parts.join(", "));
+        println!(
+            "  bottleneck: {}",
+            if parts.is_empty() {
+                "none (no simulated time)".to_string()
+            } else {
+                parts.join(", ")
+            }
+        );
     }
     let a = &m["analytic"];
     println!(
-        "  analytic per frame: CPU {:.3} ms, GPU front end {:.3} ms, geometry {:.3} ms, fragment {:.3} ms",
-        f(&a["cpu_ms"]),
-        f(&a["gpu_front_end_ms"]),
-        f(&a["geometry_ms"]),
-        f(&a["fragment_ms"])
+        "  analytic per frame: CPU {} ms, GPU front end {} ms, geometry {} ms, fragment {} ms",
+        fixed(f(&a["cpu_ms"]), 3),
+        fixed(f(&a["gpu_front_end_ms"]), 3),
+        fixed(f(&a["geometry_ms"]), 3),
+        fixed(f(&a["fragment_ms"]), 3)
     );
     println!(
-        "  {} events in {:.3} s wall ({:.2} M events/s), {:.3} s simulated",
+        "  {} events in {} s wall ({} M events/s), {} s simulated",
         s["events"]["total"],
-        f(&s["wall_seconds"]),
-        f(&s["events_per_second"]) / 1e6,
-        f(&s["simulated_seconds"])
+        fixed(f(&s["wall_seconds"]), 3),
+        fixed(f(&s["events_per_second"]) / 1e6, 2),
+        fixed(f(&s["simulated_seconds"]), 3)
     );
+}
+
+/// `x` with `decimals` decimals, never as a negative zero ("-0.000" for
+/// -0.0 or a tiny negative rounding error reads like a negative time).
+fn fixed(x: f64, decimals: usize) -> String {
+    let t = format!("{x:.decimals$}");
+    match t.strip_prefix('-') {
+        Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
+        _ => t,
+    }
 }
 
 fn print_latency(s: &serde_json::Value) {
@@ -519,11 +549,12 @@ fn cmd_isolate(model: Option<PathBuf>, sets: Vec<String>, factor: f64, keep_vsyn
         if keep_vsync { "on" } else { "off" }
     );
     for v in &iso.variants {
+        let change = fixed(100.0 * v.change, 1);
         println!(
-            "  {:<9} frame time {:>9.3} ms  ({:+.1}%)",
+            "  {:<9} frame time {:>9} ms  ({}{change}%)",
             v.name,
-            v.frame_time_ms,
-            100.0 * v.change
+            fixed(v.frame_time_ms, 3),
+            if change.starts_with('-') { "" } else { "+" }
         );
     }
     println!("  => bottleneck: {}   ({:.2} s wall)", iso.bottleneck, iso.wall_seconds);

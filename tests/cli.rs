@@ -449,3 +449,73 @@ fn a_bad_set_value_is_reported_as_coming_from_the_option() {
     let e = run_err(&["run", &m, "--set", "cpu.per_draw=\"1us\""]);
     assert!(e.contains(&format!("bad.toml:{}", SMALL.lines().count() + 3)), "{e}");
 }
+
+/// Whether `text` shows a negative zero such as "-0.000" or "-0.0".
+fn has_negative_zero(text: &str) -> bool {
+    text.match_indices("-0").any(|(i, _)| {
+        if text[..i].chars().next_back().is_some_and(|c| c.is_ascii_alphanumeric()) {
+            return false; // 10-0, 1e-05: not a signed number
+        }
+        let rest = &text[i + 1..];
+        let num: String = rest.chars().take_while(|c| c.is_ascii_digit() || *c == '.').collect();
+        !num.is_empty() && num.chars().all(|c| c == '0' || c == '.')
+    })
+}
+
+#[test]
+fn an_empty_scene_prints_no_negative_zeros() {
+    assert!(has_negative_zero("geometry -0.000 ms") && has_negative_zero("\"x\": -0.0,"));
+    assert!(!has_negative_zero("-0.25 ms, 10-0 and -1.000"));
+    let d = tempfile::tempdir().unwrap();
+    let m = write(
+        d.path(),
+        "empty.toml",
+        "[run]\nframes = 10\n[display]\nvsync = false\n[noise]\nenabled = false\n[workload]\nkind = \"scene\"\n\
+         [[workload.groups]]\nname = \"g\"\ncount = 0\nmesh = \"grid:1x1\"\ntriangle_pixels = 1.0\n",
+    );
+    let out = d.path().join("out");
+    let human = run_ok(&["run", &m, "--out", out.to_str().unwrap()]);
+    assert!(!has_negative_zero(&human), "{human}");
+    assert!(human.contains("geometry 0.000 ms"), "{human}");
+    let json = run_ok(&["run", &m, "--json"]);
+    assert!(!has_negative_zero(&json), "{json}");
+    for f in ["summary.json", "frames.csv"] {
+        let text = std::fs::read_to_string(out.join(f)).unwrap();
+        assert!(!has_negative_zero(&text), "{f}: {text}");
+    }
+    let iso = run_ok(&["isolate", &m]);
+    assert!(!has_negative_zero(&iso), "{iso}");
+}
+
+#[test]
+fn a_run_stopped_by_max_events_reports_the_frames_it_completed() {
+    let args = ["run", "--set", "run.max_events=1000000", "--set", "run.warmup_frames=0"];
+    let mut json_args = args.to_vec();
+    json_args.push("--json");
+    let v: serde_json::Value = serde_json::from_str(&run_ok(&json_args)).unwrap();
+    assert_eq!(v["stopped_by"], "event_limit", "{v}");
+    assert_eq!(v["events"]["total"], 1_000_000);
+    assert_eq!(v["frames_requested"], 300);
+    let done = v["frames"].as_u64().unwrap();
+    assert!(done > 0 && done < 300, "{done}");
+    assert_eq!(v["frames_simulated"], done);
+    let m = &v["metrics"];
+    assert_eq!(
+        m["displayed_frames"].as_u64().unwrap() + m["dropped_frames"].as_u64().unwrap(),
+        done
+    );
+    assert_eq!(m["frame_time_ms"]["count"], done);
+    let human = run_ok(&args);
+    assert!(
+        human.contains(&format!(
+            "{done} of 300 frames completed (stopped early: run.max_events reached"
+        )),
+        "{human}"
+    );
+    // A complete run says just how many frames it simulated.
+    let human = run_ok(&["run", "--frames", "5"]);
+    assert!(
+        human.contains(", 5 frames, seed 1") && !human.contains("stopped early"),
+        "{human}"
+    );
+}

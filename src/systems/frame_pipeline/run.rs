@@ -151,6 +151,7 @@ pub fn run_pipeline(cfg: FramePipelineConfig, base_dir: &Path, trace: bool) -> R
     summary["build_seconds"] = json!(build_seconds);
     summary["simulate_seconds"] = json!(stats.wall_seconds);
     summary["wall_seconds"] = json!(build_seconds + stats.wall_seconds);
+    positive_zeros(&mut summary);
     let refresh = model.refresh;
     let end = stats.end_time;
     let a = &model.acct;
@@ -175,6 +176,19 @@ pub fn run_pipeline(cfg: FramePipelineConfig, base_dir: &Path, trace: bool) -> R
         records: std::mem::take(&mut model.records),
         config: model.cfg,
     })
+}
+
+/// Replaces every -0.0 in `v` by 0.0 (an empty sum of floats is -0.0, and
+/// "-0" in an output reads like a negative time).
+fn positive_zeros(v: &mut Value) {
+    match v {
+        Value::Number(n) if n.as_f64() == Some(0.0) && n.as_f64().is_some_and(|x| x.is_sign_negative()) => {
+            *v = json!(0.0);
+        }
+        Value::Object(m) => m.values_mut().for_each(positive_zeros),
+        Value::Array(a) => a.iter_mut().for_each(positive_zeros),
+        _ => {}
+    }
 }
 
 fn ms(ps: u64) -> f64 {
@@ -284,8 +298,9 @@ fn summarize(
         "description": m.cfg.description,
         "fidelity": m.cfg.fidelity,
         "seed": m.cfg.run.seed,
-        "frames": m.cfg.run.frames,
+        "frames": m.records.len(),
         "frames_simulated": m.records.len(),
+        "frames_requested": m.cfg.run.frames,
         "warmup_frames": m.cfg.run.warmup_frames,
         "events": {"total": stats.events, "by_kind": by_kind},
         "wall_seconds": stats.wall_seconds,
