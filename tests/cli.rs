@@ -519,3 +519,35 @@ fn a_run_stopped_by_max_events_reports_the_frames_it_completed() {
         "{human}"
     );
 }
+
+#[test]
+fn system_noise_experiment_prints_the_paper_constant_at_the_end() {
+    let d = tempfile::tempdir().unwrap();
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/system-noise.toml");
+    let out = run_ok(&[
+        "experiment",
+        file.to_str().unwrap(),
+        "--out",
+        d.path().to_str().unwrap(),
+        "--quiet",
+    ]);
+    // The last lines: derived values per point, the check tally, the wall time.
+    let tail: Vec<&str> = out.lines().rev().take(6).collect();
+    let line = tail
+        .iter()
+        .find(|l| l.contains("noise.enabled=true") && l.contains("c99_from_min = "))
+        .unwrap_or_else(|| panic!("no c99 in the last lines:\n{out}"));
+    let c99: f64 = line
+        .split("c99_from_min = ")
+        .nth(1)
+        .and_then(|r| r.split(';').next())
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or_else(|| panic!("{line}"));
+    // The experiment's own check: the 99% width lies in 0.5 .. 1.5 ms (seed 1: 0.69 ms).
+    assert!((0.5..=1.5).contains(&c99), "{c99}");
+    assert!(
+        tail.iter()
+            .any(|l| l.contains("noise.enabled=false") && l.contains("c99_from_min = 0")),
+        "{out}"
+    );
+}
