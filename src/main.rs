@@ -59,7 +59,7 @@ enum Cmd {
         #[arg(long)]
         quiet: bool,
     },
-    /// Isolate the bottleneck (paper 004 §4.1): reduce CPU, geometry and raster load in turn.
+    /// Isolate the bottleneck (paper 004 §4.1): reduce CPU, GPU front-end, geometry and raster load in turn.
     Isolate {
         /// Model file (TOML); the default model when omitted.
         model: Option<PathBuf>,
@@ -154,10 +154,28 @@ fn main() -> ExitCode {
     match dispatch(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_line(&e));
             ExitCode::from(2)
         }
     }
+}
+
+/// The error and its causes on one line, like `{:#}`, but a cause whose text
+/// the line already holds (a library error that prints its source, e.g. the
+/// OS error of a file that cannot be read) is not repeated.
+fn error_line(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
 }
 
 fn dispatch(cli: Cli) -> Result<()> {
@@ -222,10 +240,20 @@ fn load_source(model: Option<&Path>) -> Result<ModelSource> {
     })
 }
 
-fn model_table(src: &ModelSource, sets: &[String], seed: Option<u64>, frames: Option<u64>) -> Result<toml::Table> {
+/// Applies `key=value` to the table and records where the value came from
+/// (`origin`), so an error in it names the option rather than the file.
+fn set_noted(src: &mut ModelSource, t: &mut toml::Table, assignment: &str, origin: String) -> Result<()> {
+    apply_set(t, assignment)?;
+    if let Some((key, _)) = assignment.split_once('=') {
+        src.note_override(key.trim(), origin);
+    }
+    Ok(())
+}
+
+fn model_table(src: &mut ModelSource, sets: &[String], seed: Option<u64>, frames: Option<u64>) -> Result<toml::Table> {
     let mut t = src.table()?;
     for s in sets {
-        apply_set(&mut t, s)?;
+        set_noted(src, &mut t, s, format!("--set {s}"))?;
     }
     if let Some(seed) = seed {
         if seed > i64::MAX as u64 {
@@ -234,10 +262,10 @@ fn model_table(src: &ModelSource, sets: &[String], seed: Option<u64>, frames: Op
                 i64::MAX
             );
         }
-        apply_set(&mut t, &format!("run.seed={seed}"))?;
+        set_noted(src, &mut t, &format!("run.seed={seed}"), format!("--seed {seed}"))?;
     }
     if let Some(f) = frames {
-        apply_set(&mut t, &format!("run.frames={f}"))?;
+        set_noted(src, &mut t, &format!("run.frames={f}"), format!("--frames {f}"))?;
         let warm = t
             .get("run")
             .and_then(|r| r.get("warmup_frames"))
@@ -248,7 +276,12 @@ fn model_table(src: &ModelSource, sets: &[String], seed: Option<u64>, frames: Op
                 "note: run.warmup_frames = {warm} is not less than --frames {f}; using {} warm-up frames",
                 f / 10
             );
-            apply_set(&mut t, &format!("run.warmup_frames={}", f / 10))?;
+            set_noted(
+                src,
+                &mut t,
+                &format!("run.warmup_frames={}", f / 10),
+                format!("--frames {f}"),
+            )?;
         }
     }
     Ok(t)
@@ -264,8 +297,8 @@ fn cmd_run(
     out: Option<PathBuf>,
     trace: Option<PathBuf>,
 ) -> Result<()> {
-    let src = load_source(model.as_deref())?;
-    let table = model_table(&src, &sets, seed, frames)?;
+    let mut src = load_source(model.as_deref())?;
+    let table = model_table(&mut src, &sets, seed, frames)?;
     let mut run = run_model(&src, &table, trace.is_some())?;
     run.summary_mut()["model"] = json!(src.name);
     if let Some(dir) = &out {
@@ -332,11 +365,24 @@ fn print_human(run: &SystemRun) {
         );
         return;
     }
+    let frames = match s["stopped_by"].as_str() {
+        Some("time_limit") | Some("event_limit") => format!(
+            "{} of {} frames completed (stopped early: {} reached at {} s simulated)",
+            s["frames"],
+            s["frames_requested"],
+            if s["stopped_by"] == "time_limit" {
+                "run.until"
+            } else {
+                "run.max_events"
+            },
+            fixed(f(&s["simulated_seconds"]), 3)
+        ),
+        _ => format!("{} frames", s["frames"]),
+    };
     println!(
-        "{} ({}), {} frames, seed {}",
+        "{} ({}), {frames}, seed {}",
         s["model"].as_str().unwrap_or(""),
         s["fidelity"].as_str().unwrap_or(""),
-        s["frames"],
         s["seed"]
     );
     for (name, key) in [
@@ -347,17 +393,17 @@ fn print_human(run: &SystemRun) {
     ] {
         let v = &m[key];
         println!(
-            "  {name:<18} mean {:>8.3} ms   p50 {:>8.3}   p99 {:>8.3}   max {:>8.3}",
-            f(&v["mean"]),
-            f(&v["p50"]),
-            f(&v["p99"]),
-            f(&v["max"])
+            "  {name:<18} mean {:>8} ms   p50 {:>8}   p99 {:>8}   max {:>8}",
+            fixed(f(&v["mean"]), 3),
+            fixed(f(&v["p50"]), 3),
+            fixed(f(&v["p99"]), 3),
+            fixed(f(&v["max"]), 3)
         );
     }
     println!(
-        "  CPU busy {:.1}%   GPU busy {:.1}%   repeated refreshes {}   dropped frames {}",
-        100.0 * f(&m["cpu_busy_fraction"]),
-        100.0 * f(&m["gpu_busy_fraction"]),
+        "  CPU busy {}%   GPU busy {}%   repeated refreshes {}   dropped frames {}",
+        fixed(100.0 * f(&m["cpu_busy_fraction"]), 1),
+        fixed(100.0 * f(&m["gpu_busy_fraction"]), 1),
         m["repeated_refreshes"],
         m["dropped_frames"]
     );
@@ -367,25 +413,42 @@ fn print_human(run: &SystemRun) {
         let parts: Vec<String> = v
             .iter()
             .filter(|x| x.1 > 0.0005)
-            .map(|(k, x)| format!("{k} {:.1}%", 100.0 * x))
+            .map(|(k, x)| format!("{k} {}%", fixed(100.0 * x, 1)))
             .collect();
-        println!("  bottleneck: {}", parts.join(", "));
+        println!(
+            "  bottleneck: {}",
+            if parts.is_empty() {
+                "none (no simulated time)".to_string()
+            } else {
+                parts.join(", ")
+            }
+        );
     }
     let a = &m["analytic"];
     println!(
-        "  analytic per frame: CPU {:.3} ms, GPU front end {:.3} ms, geometry {:.3} ms, fragment {:.3} ms",
-        f(&a["cpu_ms"]),
-        f(&a["gpu_front_end_ms"]),
-        f(&a["geometry_ms"]),
-        f(&a["fragment_ms"])
+        "  analytic per frame: CPU {} ms, GPU front end {} ms, geometry {} ms, fragment {} ms",
+        fixed(f(&a["cpu_ms"]), 3),
+        fixed(f(&a["gpu_front_end_ms"]), 3),
+        fixed(f(&a["geometry_ms"]), 3),
+        fixed(f(&a["fragment_ms"]), 3)
     );
     println!(
-        "  {} events in {:.3} s wall ({:.2} M events/s), {:.3} s simulated",
+        "  {} events in {} s wall ({} M events/s), {} s simulated",
         s["events"]["total"],
-        f(&s["wall_seconds"]),
-        f(&s["events_per_second"]) / 1e6,
-        f(&s["simulated_seconds"])
+        fixed(f(&s["wall_seconds"]), 3),
+        fixed(f(&s["events_per_second"]) / 1e6, 2),
+        fixed(f(&s["simulated_seconds"]), 3)
     );
+}
+
+/// `x` with `decimals` decimals, never as a negative zero ("-0.000" for
+/// -0.0 or a tiny negative rounding error reads like a negative time).
+fn fixed(x: f64, decimals: usize) -> String {
+    let t = format!("{x:.decimals$}");
+    match t.strip_prefix('-') {
+        Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
+        _ => t,
+    }
 }
 
 fn print_latency(s: &serde_json::Value) {
@@ -489,8 +552,8 @@ fn cmd_experiment(file: &Path, out: Option<PathBuf>, quiet: bool) -> Result<()> 
 }
 
 fn cmd_isolate(model: Option<PathBuf>, sets: Vec<String>, factor: f64, keep_vsync: bool, json: bool) -> Result<()> {
-    let src = load_source(model.as_deref())?;
-    let table = model_table(&src, &sets, None, None)?;
+    let mut src = load_source(model.as_deref())?;
+    let table = model_table(&mut src, &sets, None, None)?;
     let cfg: rendersim::systems::frame_pipeline::FramePipelineConfig = rendersim::config::deserialize(&table, &src)?;
     let iso = rendersim::systems::frame_pipeline::isolate::isolate(&cfg, &src.base_dir, factor, keep_vsync)?;
     if json {
@@ -502,11 +565,12 @@ fn cmd_isolate(model: Option<PathBuf>, sets: Vec<String>, factor: f64, keep_vsyn
         if keep_vsync { "on" } else { "off" }
     );
     for v in &iso.variants {
+        let change = fixed(100.0 * v.change, 1);
         println!(
-            "  {:<9} frame time {:>9.3} ms  ({:+.1}%)",
+            "  {:<9} frame time {:>9} ms  ({}{change}%)",
             v.name,
-            v.frame_time_ms,
-            100.0 * v.change
+            fixed(v.frame_time_ms, 3),
+            if change.starts_with('-') { "" } else { "+" }
         );
     }
     println!("  => bottleneck: {}   ({:.2} s wall)", iso.bottleneck, iso.wall_seconds);

@@ -91,6 +91,8 @@ fn out_dir_reruns_to_the_same_frames_and_trace_is_valid() {
         "5",
         "--set",
         "display.buffers=3",
+        "--set",
+        "fidelity=\"triangle\"",
         "--out",
         a.to_str().unwrap(),
         "--trace",
@@ -135,14 +137,37 @@ fn out_dir_reruns_to_the_same_frames_and_trace_is_valid() {
             .or_default()
             .push((ts, ts + e["dur"].as_f64().unwrap()));
     }
-    assert!(by_tid.len() >= 4, "tracks: {:?}", by_tid.keys());
+    // One named track per unit, each with spans (triangle fidelity: the
+    // geometry and fragment stages have per-triangle spans).
+    let track_names: std::collections::BTreeMap<i64, &str> = ev
+        .iter()
+        .filter(|e| e["ph"] == "M" && e["name"] == "thread_name")
+        .map(|e| (e["tid"].as_i64().unwrap(), e["args"]["name"].as_str().unwrap()))
+        .collect();
+    for unit in ["CPU thread", "GPU front end", "GPU geometry", "GPU fragment", "Display"] {
+        let tid = track_names
+            .iter()
+            .find(|(_, n)| **n == unit)
+            .map(|(t, _)| *t)
+            .unwrap_or_else(|| panic!("no track named {unit:?}: {track_names:?}"));
+        assert!(
+            by_tid.get(&tid).is_some_and(|s| !s.is_empty()),
+            "track {unit:?} has no spans"
+        );
+    }
     for (tid, mut spans) in by_tid {
         spans.sort_by(|x, y| x.0.total_cmp(&y.0));
         for w in spans.windows(2) {
             assert!(w[1].0 >= w[0].1 - 1e-6, "overlap on track {tid}: {w:?}");
         }
     }
-    assert!(ev.iter().any(|e| e["ph"] == "C" && e["name"] == "command FIFO"));
+    // Counter tracks for both FIFOs.
+    for counter in ["command FIFO", "triangle FIFO"] {
+        assert!(
+            ev.iter().any(|e| e["ph"] == "C" && e["name"] == counter),
+            "no {counter:?} counter"
+        );
+    }
 }
 
 #[test]
@@ -247,6 +272,58 @@ fn isolate_finds_the_limiting_subsystem() {
     run_err(&["isolate", &m, "--factor", "1.5"]);
 }
 
+/// A scene model, vsync off, no noise, 10 frames at `draw` fidelity, with `extra` keys.
+fn isolate_scene(group: &str, extra: &str) -> String {
+    format!(
+        "fidelity = \"draw\"\n[run]\nframes = 10\n[display]\nvsync = false\n[noise]\nenabled = false\n{extra}\n\
+         [workload]\nkind = \"scene\"\n[[workload.groups]]\nname = \"g\"\n{group}\n"
+    )
+}
+
+#[test]
+fn isolate_reports_geometry_and_front_end_bound_models() {
+    let d = tempfile::tempdir().unwrap();
+    let iso = |name: &str, text: &str| -> serde_json::Value {
+        let m = write(d.path(), name, text);
+        serde_json::from_str(&run_ok(&["isolate", &m, "--json"])).unwrap()
+    };
+    let change = |v: &serde_json::Value, name: &str| {
+        v["variants"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|x| x["name"] == name)
+            .unwrap_or_else(|| panic!("no variant {name}: {v}"))["change"]
+            .as_f64()
+            .unwrap()
+    };
+    // Geometry-bound: 100,000 triangles x 100 ns of vertex shading = 10 ms; fragments 0.01 ms.
+    let v = iso(
+        "geometry.toml",
+        &isolate_scene(
+            "mesh = { triangles = 100000, acmr = 1.0 }\ntriangle_pixels = 0.1",
+            "[gpu.geometry]\nvertex_shader = \"100ns\"\n[gpu.fragment]\nper_fragment = \"1ns\"",
+        ),
+    );
+    assert_eq!(v["bottleneck"], "geometry", "{v}");
+    assert!((change(&v, "geometry") + 0.5).abs() < 0.01, "{v}");
+    // Front-end-bound: 100 draws, each batch 2 commands (matrix + draw) at
+    // 50 us of command processing, plus clear and swap: about 10 ms on the
+    // GPU front end, next to nothing on the CPU, geometry or fragments.
+    let v = iso(
+        "front.toml",
+        &isolate_scene(
+            "count = 100\nmesh = \"grid:1x1\"\ntriangle_pixels = 1.0",
+            "[gpu]\ncommand = \"50us\"\n[gpu.geometry]\nvertex_shader = \"1ns\"\n[gpu.fragment]\nper_fragment = \"1ns\"",
+        ),
+    );
+    assert_eq!(v["bottleneck"], "front_end", "{v}");
+    assert!((change(&v, "front_end") + 0.5).abs() < 0.01, "{v}");
+    for other in ["cpu", "geometry", "raster"] {
+        assert!(change(&v, other).abs() < 0.01, "{other}: {v}");
+    }
+}
+
 #[test]
 fn vcache_reports_the_figure_keys() {
     let out = run_ok(&["vcache", "grid:4x3", "--policy", "fifo:9", "--json"]);
@@ -258,4 +335,219 @@ fn vcache_reports_the_figure_keys() {
     }
     let e = run_err(&["vcache", "grid:4x3", "--policy", "lfu:3"]);
     assert!(e.contains("lfu"), "{e}");
+}
+
+/// Paths of JSON nulls (NaN is written as null) in `v`.
+fn nulls(v: &serde_json::Value, path: &str, out: &mut Vec<String>) {
+    match v {
+        serde_json::Value::Null => out.push(path.to_string()),
+        serde_json::Value::Object(m) => m.iter().for_each(|(k, x)| nulls(x, &format!("{path}.{k}"), out)),
+        serde_json::Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .for_each(|(i, x)| nulls(x, &format!("{path}[{i}]"), out)),
+        _ => {}
+    }
+}
+
+#[test]
+fn run_until_stops_at_that_simulated_time() {
+    // The default model asks for 300 frames at 60 Hz (5 s); run.until cuts it at 100 ms.
+    let json = |extra: &[&str]| -> serde_json::Value {
+        let mut args = vec!["run", "--json", "--set", "run.until=\"100ms\""];
+        args.extend_from_slice(extra);
+        serde_json::from_str(&run_ok(&args)).unwrap()
+    };
+    let v = json(&["--set", "run.warmup_frames=0"]);
+    assert_eq!(v["stopped_by"], "time_limit", "{v}");
+    assert_eq!(
+        v["simulated_seconds"].as_f64().unwrap(),
+        0.1,
+        "{}",
+        v["simulated_seconds"]
+    );
+    // Double-buffered 60 Hz vsync: a frame is shown every 16.7 ms at best, so
+    // at most 6 frames complete by 100 ms; the frames still in flight are not reported.
+    let done = v["frames_simulated"].as_u64().unwrap();
+    assert!((3..=6).contains(&done), "{done} frames");
+    assert_eq!(v["metrics"]["frame_time_ms"]["count"].as_u64().unwrap(), done);
+    let displayed =
+        v["metrics"]["displayed_frames"].as_u64().unwrap() + v["metrics"]["dropped_frames"].as_u64().unwrap();
+    assert_eq!(displayed, done);
+    let mut n = vec![];
+    nulls(&v, "", &mut n);
+    assert!(n.is_empty(), "NaN in the summary: {n:?}");
+    // Fewer frames completed than the warm-up leaves out: empty metrics, still no NaN.
+    let v = json(&[]);
+    assert_eq!(v["stopped_by"], "time_limit");
+    let mut n = vec![];
+    nulls(&v, "", &mut n);
+    assert!(n.is_empty(), "NaN in the summary: {n:?}");
+    // A limit beyond the run's end changes nothing.
+    let v = json(&["--set", "run.until=\"1000s\"", "--frames", "10"]);
+    assert_eq!(v["stopped_by"], "model");
+    assert_eq!(v["frames_simulated"], 10);
+}
+
+#[test]
+fn a_missing_model_file_reports_the_os_error_once() {
+    let d = tempfile::tempdir().unwrap();
+    let missing = d.path().join("none.toml");
+    let e = run_err(&["run", missing.to_str().unwrap()]);
+    assert!(e.contains("none.toml"), "{e}");
+    let os = std::fs::read_to_string(&missing).unwrap_err().to_string();
+    assert_eq!(e.matches(&os).count(), 1, "OS error not exactly once: {e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+    // The same for an experiment file.
+    let e = run_err(&["experiment", missing.to_str().unwrap()]);
+    assert_eq!(e.matches(&os).count(), 1, "OS error not exactly once: {e}");
+}
+
+#[test]
+fn a_bad_enum_value_names_its_key_and_the_valid_values() {
+    let e = run_err(&["run", "--set", "display.present_mode=mailbx"]);
+    assert!(e.contains("`display.present_mode`"), "{e}");
+    assert!(!e.contains("present_mode.mailbx"), "{e}");
+    for v in ["`fifo`", "`mailbox`", "`immediate`"] {
+        assert!(e.contains(v), "{v} not listed: {e}");
+    }
+    assert!(e.contains("did you mean `mailbox`"), "{e}");
+    // In a file: the key's line.
+    let d = tempfile::tempdir().unwrap();
+    let m = write(
+        d.path(),
+        "m.toml",
+        &format!("{SMALL}\n[command_fifo]\nunit = \"lines\"\n"),
+    );
+    let e = run_err(&["run", &m]);
+    let line = SMALL.lines().count() + 3;
+    assert!(e.contains(&format!("m.toml:{line}: key `command_fifo.unit`:")), "{e}");
+    assert!(e.contains("`entries`") && e.contains("`bytes`"), "{e}");
+}
+
+#[test]
+fn a_bad_set_value_is_reported_as_coming_from_the_option() {
+    // cpu.per_draw stands on a line of the embedded model, but the bad value came from --set.
+    let e = run_err(&["run", "--set", "cpu.per_draw=17"]);
+    assert!(e.contains("`--set cpu.per_draw=17`"), "{e}");
+    assert!(e.contains("key `cpu.per_draw`") && e.contains("needs a unit"), "{e}");
+    assert!(
+        !e.contains("<embedded default model>:"),
+        "reported at a line of the model: {e}"
+    );
+    // The same for a file, and for values the simulator rejects after parsing.
+    let d = tempfile::tempdir().unwrap();
+    let m = write(d.path(), "m.toml", &format!("{SMALL}\n[display]\nbuffers = 2\n"));
+    let e = run_err(&["run", &m, "--set", "display.buffers=1"]);
+    assert!(
+        e.contains("`--set display.buffers=1`") && e.contains("display.buffers"),
+        "{e}"
+    );
+    assert!(!e.contains("m.toml:"), "{e}");
+    // A bad value in the file itself still names its line.
+    let m = write(d.path(), "bad.toml", &format!("{SMALL}\n[display]\nbuffers = 1\n"));
+    let e = run_err(&["run", &m, "--set", "cpu.per_draw=\"1us\""]);
+    assert!(e.contains(&format!("bad.toml:{}", SMALL.lines().count() + 3)), "{e}");
+}
+
+/// Whether `text` shows a negative zero such as "-0.000" or "-0.0".
+fn has_negative_zero(text: &str) -> bool {
+    text.match_indices("-0").any(|(i, _)| {
+        if text[..i].chars().next_back().is_some_and(|c| c.is_ascii_alphanumeric()) {
+            return false; // 10-0, 1e-05: not a signed number
+        }
+        let rest = &text[i + 1..];
+        let num: String = rest.chars().take_while(|c| c.is_ascii_digit() || *c == '.').collect();
+        !num.is_empty() && num.chars().all(|c| c == '0' || c == '.')
+    })
+}
+
+#[test]
+fn an_empty_scene_prints_no_negative_zeros() {
+    assert!(has_negative_zero("geometry -0.000 ms") && has_negative_zero("\"x\": -0.0,"));
+    assert!(!has_negative_zero("-0.25 ms, 10-0 and -1.000"));
+    let d = tempfile::tempdir().unwrap();
+    let m = write(
+        d.path(),
+        "empty.toml",
+        "[run]\nframes = 10\n[display]\nvsync = false\n[noise]\nenabled = false\n[workload]\nkind = \"scene\"\n\
+         [[workload.groups]]\nname = \"g\"\ncount = 0\nmesh = \"grid:1x1\"\ntriangle_pixels = 1.0\n",
+    );
+    let out = d.path().join("out");
+    let human = run_ok(&["run", &m, "--out", out.to_str().unwrap()]);
+    assert!(!has_negative_zero(&human), "{human}");
+    assert!(human.contains("geometry 0.000 ms"), "{human}");
+    let json = run_ok(&["run", &m, "--json"]);
+    assert!(!has_negative_zero(&json), "{json}");
+    for f in ["summary.json", "frames.csv"] {
+        let text = std::fs::read_to_string(out.join(f)).unwrap();
+        assert!(!has_negative_zero(&text), "{f}: {text}");
+    }
+    let iso = run_ok(&["isolate", &m]);
+    assert!(!has_negative_zero(&iso), "{iso}");
+}
+
+#[test]
+fn a_run_stopped_by_max_events_reports_the_frames_it_completed() {
+    let args = ["run", "--set", "run.max_events=1000000", "--set", "run.warmup_frames=0"];
+    let mut json_args = args.to_vec();
+    json_args.push("--json");
+    let v: serde_json::Value = serde_json::from_str(&run_ok(&json_args)).unwrap();
+    assert_eq!(v["stopped_by"], "event_limit", "{v}");
+    assert_eq!(v["events"]["total"], 1_000_000);
+    assert_eq!(v["frames_requested"], 300);
+    let done = v["frames"].as_u64().unwrap();
+    assert!(done > 0 && done < 300, "{done}");
+    assert_eq!(v["frames_simulated"], done);
+    let m = &v["metrics"];
+    assert_eq!(
+        m["displayed_frames"].as_u64().unwrap() + m["dropped_frames"].as_u64().unwrap(),
+        done
+    );
+    assert_eq!(m["frame_time_ms"]["count"], done);
+    let human = run_ok(&args);
+    assert!(
+        human.contains(&format!(
+            "{done} of 300 frames completed (stopped early: run.max_events reached"
+        )),
+        "{human}"
+    );
+    // A complete run says just how many frames it simulated.
+    let human = run_ok(&["run", "--frames", "5"]);
+    assert!(
+        human.contains(", 5 frames, seed 1") && !human.contains("stopped early"),
+        "{human}"
+    );
+}
+
+#[test]
+fn system_noise_experiment_prints_the_paper_constant_at_the_end() {
+    let d = tempfile::tempdir().unwrap();
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/system-noise.toml");
+    let out = run_ok(&[
+        "experiment",
+        file.to_str().unwrap(),
+        "--out",
+        d.path().to_str().unwrap(),
+        "--quiet",
+    ]);
+    // The last lines: derived values per point, the check tally, the wall time.
+    let tail: Vec<&str> = out.lines().rev().take(6).collect();
+    let line = tail
+        .iter()
+        .find(|l| l.contains("noise.enabled=true") && l.contains("c99_from_min = "))
+        .unwrap_or_else(|| panic!("no c99 in the last lines:\n{out}"));
+    let c99: f64 = line
+        .split("c99_from_min = ")
+        .nth(1)
+        .and_then(|r| r.split(';').next())
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or_else(|| panic!("{line}"));
+    // The experiment's own check: the 99% width lies in 0.5 .. 1.5 ms (seed 1: 0.69 ms).
+    assert!((0.5..=1.5).contains(&c99), "{c99}");
+    assert!(
+        tail.iter()
+            .any(|l| l.contains("noise.enabled=false") && l.contains("c99_from_min = 0")),
+        "{out}"
+    );
 }

@@ -24,11 +24,13 @@ fn fifo_depth_moves_frame_time_from_sum_to_max_monotonically() {
     // fragment busy times (the sampled sizes, not their expectation).
     let mut times = vec![];
     let mut bounds = (0.0, 0.0);
+    let mut realized = (0.0, 0.0);
     for depth in [0u32, 1, 2, 4, 16, 64, 256, 1024, 100_000] {
         let r = run(&bimodal(depth), &["run.frames=2"]);
         let g = r.clocks.geometry[0] as f64;
         let f = r.clocks.fragment[0] as f64;
         bounds = (g.max(f), g + f);
+        realized = (g, f);
         times.push(r.clocks.gpu[0] as f64);
     }
     let (max, sum) = bounds;
@@ -39,6 +41,36 @@ fn fifo_depth_moves_frame_time_from_sum_to_max_monotonically() {
     assert!(
         (times[0] - sum).abs() / sum < 0.03,
         "one-slot time {} vs sum {sum}",
+        times[0]
+    );
+    // Closed form for small depths D (the static view gives every depth the
+    // same sizes): 2 frames x 20,000 triangles, g = 1 ns each; a big triangle
+    // (100 ns of fragments) lets geometry run ahead by the D FIFO slots plus
+    // the triangle it holds, so (D + 1) g per big triangle overlaps, and every
+    // tiny triangle's 1 ps of fragments hides behind the next geometry step:
+    //   T(D) = G + F - (D + 1) g n_big - n_tiny f_tiny.
+    // It is exact while big triangles are more than D + 1 apart; the few
+    // closer pairs (about 2 p n_big = 8 at D = 1) overlap less, a few ns in
+    // all, so 0.1% of the sum (78 ns) bounds the gap. With D = 1 the time is
+    // about 1% below the sum (0.8 us of 78 us), twice the D = 0 overlap.
+    let (g_total, f_total) = realized;
+    let (n, g, f_big, f_tiny) = (40_000.0, 1_000.0, 100_000.0, 1.0);
+    let n_big = ((f_total - n * f_tiny) / (f_big - f_tiny)).round();
+    assert!(
+        (n_big * f_big + (n - n_big) * f_tiny - f_total).abs() < 0.5,
+        "{n_big} {f_total}"
+    );
+    for (depth, t) in [(0.0, times[0]), (1.0, times[1])] {
+        let closed = g_total + f_total - (depth + 1.0) * g * n_big - (n - n_big) * f_tiny;
+        assert!(
+            (t - closed).abs() < 1e-3 * sum,
+            "depth {depth}: time {t} ps vs closed form {closed} ps (sum {sum})"
+        );
+    }
+    assert!(
+        times[1] < times[0] && times[1] > 0.985 * sum,
+        "one-slot FIFO: {} not just below the sum {sum} (depth 0: {})",
+        times[1],
         times[0]
     );
     let last = *times.last().unwrap();
@@ -230,4 +262,125 @@ fn a_static_view_repeats_its_triangle_sizes_every_frame() {
     assert!(s.windows(2).all(|w| w[0] == w[1]), "{s:?}");
     let v = gpu_ms("varying");
     assert!(v.windows(2).any(|w| w[0] != w[1]), "{v:?}");
+}
+
+// ---- CPU cost model (paper 000 §4.3: per object, per draw, per state change
+// by kind, memory management over the bus), against closed forms in
+// picoseconds. Everything else costs nothing, so the CPU's work per frame is
+// exactly the sum of the configured terms.
+
+const US: u64 = 1_000_000;
+
+/// CPU work (ps) of each frame and over the run.
+fn cpu_work(r: &rendersim::systems::frame_pipeline::PipelineRun) -> (Vec<u64>, u64) {
+    (r.records.iter().map(|f| f.cpu_busy).collect(), r.clocks.cpu[0])
+}
+
+#[test]
+fn per_object_and_per_draw_costs_add_exactly_to_cpu_busy_time() {
+    let m = scene_model("name = \"g\"\ncount = 10\nmesh = \"grid:1x1\"\ntriangle_pixels = 0.0");
+    let sets = [
+        "cpu.input_sampling=\"7us\"",
+        "cpu.clear=\"3us\"",
+        "cpu.swap=\"11us\"",
+        "cpu.per_object=\"5us\"",
+        "cpu.per_draw=\"2us\"",
+    ];
+    let r = run(&m, &sets);
+    // 7 + 3 + 11 + 10 objects x (5 + 2) = 91 us per frame, exactly.
+    let per_frame = (7 + 3 + 11 + 10 * (5 + 2)) * US;
+    let (frames, total) = cpu_work(&r);
+    assert_eq!(frames, vec![per_frame; 3]);
+    assert_eq!(total, 3 * per_frame);
+    assert!((metric(&r, "metrics.analytic.cpu_ms") - 0.091).abs() < 1e-12);
+    // Each term counts: one more object adds exactly per_object + per_draw.
+    let r11 = run(&m.replace("count = 10", "count = 11"), &sets);
+    assert_eq!(cpu_work(&r11).0, vec![per_frame + 7 * US; 3]);
+    // per_draw alone: 10 x 2 us.
+    let only_draw = run(&m, &["cpu.per_draw=\"2us\""]);
+    assert_eq!(cpu_work(&only_draw).0, vec![20 * US; 3]);
+}
+
+#[test]
+fn state_changes_cost_per_kind_and_sorting_reduces_their_count() {
+    // 8 instances cycling over 2 shaders and 2 textures, 1 material, no
+    // per-object matrix. As listed the states go (0,0),(1,1),(0,0),(1,1)...:
+    // every object changes shader and texture (8 + 8), the material is set
+    // once. Sorted by (shader, texture, material): (0,0) x 4, (1,1) x 4, so
+    // 2 shader and 2 texture changes.
+    let m = scene_model(
+        "name = \"g\"\ncount = 8\nshaders = 2\ntextures = 2\nmatrix_per_object = false\nmesh = \"grid:1x1\"\ntriangle_pixels = 0.0",
+    );
+    let costs = [
+        "cpu.state_change.shader=\"40us\"",
+        "cpu.state_change.texture=\"15us\"",
+        "cpu.state_change.material=\"5us\"",
+        "cpu.state_change.matrix=\"1us\"",
+        "gpu.state_change.shader=\"20us\"",
+        "gpu.state_change.texture=\"5us\"",
+        "gpu.state_change.material=\"1us\"",
+        "gpu.state_change.matrix=\"0.2us\"",
+    ];
+    let run_order = |order: &str, extra: &[&str]| {
+        let mut s = costs.to_vec();
+        let o = format!("workload.state_order=\"{order}\"");
+        s.push(&o);
+        s.extend_from_slice(extra);
+        run(&m, &s)
+    };
+    let changes = |r: &rendersim::systems::frame_pipeline::PipelineRun| {
+        ["shader", "texture", "material", "matrix"]
+            .map(|k| r.summary["scene"][format!("{k}_changes")].as_u64().unwrap())
+    };
+    // Front-end busy time over the run (ps); gpu.command, clear and swap cost nothing here.
+    let front_busy = |r: &rendersim::systems::frame_pipeline::PipelineRun| r.clocks.front[0];
+
+    let listed = run_order("as_listed", &[]);
+    assert_eq!(changes(&listed), [8, 8, 1, 0]);
+    let cpu_listed = (8 * 40 + 8 * 15 + 5) * US;
+    assert_eq!(cpu_work(&listed).0, vec![cpu_listed; 3]);
+    assert_eq!(front_busy(&listed), 3 * (8 * 20 + 8 * 5 + 1) * US);
+
+    let sorted = run_order("sorted", &[]);
+    assert_eq!(changes(&sorted), [2, 2, 1, 0]);
+    let cpu_sorted = (2 * 40 + 2 * 15 + 5) * US;
+    assert_eq!(cpu_work(&sorted).0, vec![cpu_sorted; 3]);
+    assert_eq!(front_busy(&sorted), 3 * (2 * 20 + 2 * 5 + 1) * US);
+
+    // A matrix per object: one more change of that kind per object.
+    let mat = run_order("sorted", &["workload.groups.0.matrix_per_object=true"]);
+    assert_eq!(changes(&mat), [2, 2, 1, 8]);
+    assert_eq!(cpu_work(&mat).0, vec![cpu_sorted + 8 * US; 3]);
+    assert_eq!(front_busy(&mat), 3 * ((2 * 20 + 2 * 5 + 1) * US + 8 * 200_000));
+}
+
+#[test]
+fn upload_time_is_bytes_over_bus_bandwidth_exactly() {
+    let m = scene_model("name = \"g\"\nmesh = \"grid:1x1\"\ntriangle_pixels = 0.0");
+    let base = ["cpu.per_draw=\"10us\""];
+    let none = run(&m, &base);
+    assert_eq!(cpu_work(&none).0, vec![10 * US; 3]);
+    // 4 MB (3 MB of geometry + 1 MB of texture) at 4 GB/s: 1.000 ms per frame.
+    let with = |bw: &str| {
+        let mut s = base.to_vec();
+        let b = format!("bus.bandwidth=\"{bw}\"");
+        s.extend([
+            "workload.groups.0.geometry_upload=\"3MB\"",
+            "workload.groups.0.texture_upload=\"1MB\"",
+        ]);
+        s.push(&b);
+        run(&m, &s)
+    };
+    let up = with("4GB/s");
+    assert_eq!(up.summary["scene"]["upload_bytes"], 4_000_000);
+    assert_eq!(cpu_work(&up).0, vec![10 * US + 1_000 * US; 3]);
+    assert!((metric(&up, "metrics.analytic.cpu_ms") - metric(&none, "metrics.analytic.cpu_ms") - 1.0).abs() < 1e-12);
+    // Half the bandwidth, twice the time; binary units are exact too (4 MiB at 4 GiB/s = 0.9765625 ms).
+    assert_eq!(cpu_work(&with("2GB/s")).0, vec![10 * US + 2_000 * US; 3]);
+    let mib = {
+        let mut s = base.to_vec();
+        s.extend(["workload.groups.0.geometry_upload=\"4MiB\"", "bus.bandwidth=\"4GiB/s\""]);
+        run(&m, &s)
+    };
+    assert_eq!(cpu_work(&mib).0, vec![10 * US + 976_562_500; 3]);
 }

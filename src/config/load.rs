@@ -16,6 +16,10 @@ pub struct ModelSource {
     pub text: String,
     /// Directory relative paths inside the model resolve against.
     pub base_dir: PathBuf,
+    /// Keys given on the command line, in the order applied: (dotted key,
+    /// how it was given, e.g. `--set cpu.per_draw=17`). An error in such a
+    /// key names the option instead of a line of the file.
+    pub overrides: Vec<(String, String)>,
 }
 
 /// Errors of reading and validating model files.
@@ -48,7 +52,9 @@ pub enum ConfigError {
     /// A key is unknown or its value is invalid.
     #[error("{file}{}: key `{key}`: {message}{}", line.map(|l| format!(":{l}")).unwrap_or_default(), suggestion.as_ref().map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default())]
     Invalid {
-        /// File name.
+        /// File name; for a value given on the command line, that option
+        /// and the file (``value from `--set cpu.per_draw=17` (applied to
+        /// m.toml)``), without a line.
         file: String,
         /// Dotted key path.
         key: String,
@@ -72,6 +78,7 @@ impl ModelSource {
             name: path.display().to_string(),
             text,
             base_dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+            overrides: Vec::new(),
         })
     }
 
@@ -81,7 +88,23 @@ impl ModelSource {
             name: name.to_string(),
             text: text.to_string(),
             base_dir: PathBuf::from("."),
+            overrides: Vec::new(),
         }
+    }
+
+    /// Records that `key` was given on the command line as `origin`.
+    pub fn note_override(&mut self, key: &str, origin: String) {
+        self.overrides.push((key.to_string(), origin));
+    }
+
+    /// The command-line option that set `key` or a table above it (the last
+    /// one applied), if any.
+    pub fn override_of(&self, key: &str) -> Option<&str> {
+        self.overrides
+            .iter()
+            .rev()
+            .find(|(k, _)| key == k || key.strip_prefix(k.as_str()).is_some_and(|rest| rest.starts_with('.')))
+            .map(|(_, o)| o.as_str())
     }
 
     /// Parses the text into a TOML table.
@@ -238,6 +261,25 @@ pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) 
             };
             message = msg.to_string();
         }
+        // serde says: unknown variant `mailbx`, expected one of `fifo`, ...
+        // for a bad value: the key is the path itself, and the message
+        // lists the valid values.
+        if let Some(rest) = message.strip_prefix("unknown variant `")
+            && let Some((bad, expected)) = unknown_field(&message)
+        {
+            let key = if path == "." || path.is_empty() {
+                "(top level)".to_string()
+            } else {
+                path
+            };
+            let listed = rest
+                .split_once('`')
+                .map(|(_, r)| r.trim_start_matches(',').trim())
+                .unwrap_or("");
+            let message = format!("unknown value `{bad}`: {listed}");
+            let best = closest(&bad, &expected);
+            return invalid(src, &key, message, best);
+        }
         // serde says: unknown field `refesh`, expected one of `refresh`, `vsync`
         let (key, suggestion) = match unknown_field(&message) {
             Some((bad, expected)) => {
@@ -249,13 +291,7 @@ pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) 
                 } else {
                     format!("{path}.{bad}")
                 };
-                let best = expected
-                    .iter()
-                    .map(|c| (strsim::jaro_winkler(&bad, c), c))
-                    .filter(|(s, _)| *s > 0.7)
-                    .max_by(|a, b| a.0.total_cmp(&b.0))
-                    .map(|(_, c)| c.clone());
-                (key, best)
+                (key, closest(&bad, &expected))
             }
             None => (if path == "." { "(top level)".into() } else { path }, None),
         };
@@ -263,12 +299,27 @@ pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) 
     })
 }
 
-/// Builds an [`ConfigError::Invalid`] for `key`, finding its line.
+/// The candidate closest to a misspelt `bad`, if any is close.
+fn closest(bad: &str, candidates: &[String]) -> Option<String> {
+    candidates
+        .iter()
+        .map(|c| (strsim::jaro_winkler(bad, c), c))
+        .filter(|(s, _)| *s > 0.7)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, c)| c.clone())
+}
+
+/// Builds an [`ConfigError::Invalid`] for `key`, finding its line, or the
+/// command-line option that set it.
 pub fn invalid(src: &ModelSource, key: &str, message: String, suggestion: Option<String>) -> ConfigError {
+    let (file, line) = match src.override_of(key) {
+        Some(origin) => (format!("value from `{origin}` (applied to {})", src.name), None),
+        None => (src.name.clone(), src.line_of(key)),
+    };
     ConfigError::Invalid {
-        file: src.name.clone(),
+        file,
         key: key.to_string(),
-        line: src.line_of(key),
+        line,
         message,
         suggestion,
     }

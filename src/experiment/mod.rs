@@ -91,7 +91,10 @@
 //! Outputs in the output directory: `runs.csv` (one row per point and seed),
 //! `points.csv` (per point: `<path>:mean`, `:ci_low`, `:ci_high`, `:n` for
 //! every tracked path, then derived values), `<file>.svg`/`.png` per plot,
-//! and `report.md`.
+//! and `report.md`. On stdout `rendersim experiment` prints one line per
+//! point with the metrics, then the derived values per point (the numbers
+//! an experiment is usually run for, e.g. `c99_from_min` of `system-noise`),
+//! the check tally and the wall time.
 
 mod check;
 mod derived;

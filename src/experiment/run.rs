@@ -111,7 +111,9 @@ pub struct ExperimentResult {
 
 impl ExperimentResult {
     /// A short plain-text table: one line per point with each metric's mean
-    /// and half-width, then the check tally.
+    /// and half-width, then the derived values (`[[derived]]`: the numbers
+    /// an experiment is usually run for) one line per point where any is
+    /// defined, then the check tally.
     pub fn table(&self, exp: &Experiment) -> String {
         let mut out = String::new();
         for p in &self.points {
@@ -124,6 +126,22 @@ impl ExperimentResult {
                 })
                 .collect();
             out.push_str(&format!("{}: {}\n", p.label, cells.join("; ")));
+        }
+        let derived: Vec<String> = self
+            .points
+            .iter()
+            .filter_map(|p| {
+                let cells: Vec<String> = p
+                    .derived
+                    .iter()
+                    .filter_map(|(name, v)| v.map(|v| format!("{name} = {}", report::fmt_num(v))))
+                    .collect();
+                (!cells.is_empty()).then(|| format!("  {}: {}\n", p.label, cells.join("; ")))
+            })
+            .collect();
+        if !derived.is_empty() {
+            out.push_str("derived values:\n");
+            derived.iter().for_each(|l| out.push_str(l));
         }
         let tests = self.checks.iter().filter(|c| c.claim.is_none()).count();
         if tests > 0 {

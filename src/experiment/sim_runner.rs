@@ -29,6 +29,7 @@ impl Runner for SimRunner {
             name: self.name.clone(),
             text: String::new(),
             base_dir: self.base_dir.clone(),
+            overrides: Vec::new(),
         };
         let run = run_model(&src, &table, false).map_err(|e| e.to_string())?;
         let warmup = run

@@ -492,6 +492,18 @@ fn derived_values_and_frame_plots() {
         report.contains("## Derived values") && report.contains("`c_from_min`"),
         "{report}"
     );
+    // The printed table ends with the derived values, one line per point,
+    // just before the check tally.
+    let table = res.table(&exp);
+    let lines: Vec<&str> = table.lines().collect();
+    let at = lines.iter().position(|l| *l == "derived values:").expect(&table);
+    assert_eq!(lines.len(), at + 1 + 6 + 1, "{table}");
+    assert!(lines[at + 1].contains("c_from_min = 8.100"), "{table}");
+    assert!(
+        lines[at + 1].contains("draw_error = 0;") && lines[at + 1].contains("speedup = 1.000"),
+        "{table}"
+    );
+    assert!(lines.last().unwrap().starts_with("checks:"), "{table}");
 }
 
 #[test]

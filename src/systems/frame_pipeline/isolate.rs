@@ -1,8 +1,9 @@
 //! Bottleneck isolation as paper 004 §4.1 teaches: reduce one subsystem's
-//! load at a time (CPU work; geometry work per vertex and triangle; raster
-//! work per fragment) and see which reduction moves the frame time. Vsync
-//! is switched off by default, as §4.2 advises, so refresh quantization does
-//! not hide a change.
+//! load at a time (CPU work; the GPU front end's command processing: per
+//! command, per state change, clear and swap; geometry work per vertex and
+//! triangle; raster work per fragment) and see which reduction moves the
+//! frame time. Vsync is switched off by default, as §4.2 advises, so refresh
+//! quantization does not hide a change.
 
 use std::path::Path;
 
@@ -16,7 +17,8 @@ use super::run::run_pipeline;
 /// One variant's result.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Variant {
-    /// `baseline`, `cpu`, `geometry`, `raster`.
+    /// `baseline`, `cpu`, `front_end`, `geometry`, `raster` (scenes);
+    /// `baseline`, `cpu`, `front_end`, `gpu` (fixed workloads).
     pub name: String,
     /// Mean frame time (ms).
     pub frame_time_ms: f64,
@@ -33,7 +35,7 @@ pub struct Isolation {
     pub factor: f64,
     /// Whether vsync stayed on.
     pub vsync: bool,
-    /// Baseline and the three reductions.
+    /// Baseline and the reductions.
     pub variants: Vec<Variant>,
     /// The subsystem whose reduction moved the frame time most (`none` if
     /// no reduction moved it by more than 1%).
@@ -73,6 +75,21 @@ pub fn reduced(cfg: &FramePipelineConfig, which: &str, k: f64) -> FramePipelineC
                 f.cpu = scale_dist(&f.cpu, k);
             }
         }
+        "front_end" => {
+            // Everything the front end executes itself (the clear and swap
+            // run there in this model, see docs/models.md).
+            let g = &mut c.gpu;
+            g.command = scale(g.command, k);
+            g.clear = scale(g.clear, k);
+            g.swap = scale(g.swap, k);
+            let s = &mut g.state_change;
+            (s.shader, s.texture, s.material, s.matrix) = (
+                scale(s.shader, k),
+                scale(s.texture, k),
+                scale(s.material, k),
+                scale(s.matrix, k),
+            );
+        }
         "geometry" => {
             let g = &mut c.gpu.geometry;
             g.index_fetch = scale(g.index_fetch, k);
@@ -83,7 +100,6 @@ pub fn reduced(cfg: &FramePipelineConfig, which: &str, k: f64) -> FramePipelineC
             let f = &mut c.gpu.fragment;
             f.per_fragment = scale(f.per_fragment, k);
             f.per_rejected_fragment = scale(f.per_rejected_fragment, k);
-            c.gpu.clear = scale(c.gpu.clear, k);
         }
         "gpu" => {
             if let WorkloadConfig::Fixed(f) = &mut c.workload {
@@ -114,8 +130,8 @@ pub fn isolate(
         base.display.vsync = false;
     }
     let names: &[&str] = match base.workload {
-        WorkloadConfig::Fixed(_) => &["baseline", "cpu", "gpu"],
-        WorkloadConfig::Scene(_) => &["baseline", "cpu", "geometry", "raster"],
+        WorkloadConfig::Fixed(_) => &["baseline", "cpu", "front_end", "gpu"],
+        WorkloadConfig::Scene(_) => &["baseline", "cpu", "front_end", "geometry", "raster"],
     };
     let mut variants = Vec::new();
     let mut base_ft = 0.0;

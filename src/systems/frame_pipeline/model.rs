@@ -448,6 +448,17 @@ impl FramePipeline {
         self.resolved
     }
 
+    /// Drops the records of frames not yet displayed or dropped (after a run
+    /// stopped by a time or event limit): the leading completed frames stay.
+    pub fn keep_completed_frames(&mut self) {
+        let done = self
+            .records
+            .iter()
+            .take_while(|r| r.displayed.is_some() || r.dropped)
+            .count();
+        self.records.truncate(done);
+    }
+
     /// Whether all asked-for frames are done.
     pub fn done(&self) -> bool {
         self.resolved >= self.frames_total

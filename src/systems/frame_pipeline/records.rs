@@ -144,7 +144,12 @@ pub fn write_frames_csv<W: std::io::Write>(records: &[FrameRecord], w: W) -> std
                 } else if i == 0 || i >= 12 {
                     format!("{}", *v as u64)
                 } else {
-                    format!("{v:.9}")
+                    let t = format!("{v:.9}");
+                    // A tiny negative difference (MsGPUWait) must not print as "-0.000000000".
+                    match t.strip_prefix('-') {
+                        Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
+                        _ => t,
+                    }
                 }
             })
             .collect();

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use serde_json::{Value, json};
 
-use crate::engine::{Duration, Limits, PS_PER_MS, RunStats, Scheduler, StopReason, run};
+use crate::engine::{Duration, Limits, PS_PER_MS, RunStats, Scheduler, StopReason, Time, run};
 use crate::stats::quantile::Summary;
 
 use super::accounting::{BOTTLENECKS, CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES, TraceLog};
@@ -130,7 +130,7 @@ pub fn run_pipeline(cfg: FramePipelineConfig, base_dir: &Path, trace: bool) -> R
     let mut sched = Scheduler::new();
     model.start(&mut sched)?;
     let limits = Limits {
-        until: None,
+        until: model.cfg.run.until.map(|d| Time(d.0)),
         max_events: model.cfg.run.max_events,
     };
     let stats = run(&mut model, &mut sched, limits)?;
@@ -142,10 +142,16 @@ pub fn run_pipeline(cfg: FramePipelineConfig, base_dir: &Path, trace: bool) -> R
             state: model.describe(),
         });
     }
+    if !model.done() {
+        // Stopped by `run.until` or `run.max_events`: frames still in flight
+        // have no complete timeline, so only the completed ones are kept.
+        model.keep_completed_frames();
+    }
     let mut summary = summarize(&model, &stats, analytic, scene_stats);
     summary["build_seconds"] = json!(build_seconds);
     summary["simulate_seconds"] = json!(stats.wall_seconds);
     summary["wall_seconds"] = json!(build_seconds + stats.wall_seconds);
+    positive_zeros(&mut summary);
     let refresh = model.refresh;
     let end = stats.end_time;
     let a = &model.acct;
@@ -170,6 +176,19 @@ pub fn run_pipeline(cfg: FramePipelineConfig, base_dir: &Path, trace: bool) -> R
         records: std::mem::take(&mut model.records),
         config: model.cfg,
     })
+}
+
+/// Replaces every -0.0 in `v` by 0.0 (an empty sum of floats is -0.0, and
+/// "-0" in an output reads like a negative time).
+fn positive_zeros(v: &mut Value) {
+    match v {
+        Value::Number(n) if n.as_f64() == Some(0.0) && n.as_f64().is_some_and(|x| x.is_sign_negative()) => {
+            *v = json!(0.0);
+        }
+        Value::Object(m) => m.values_mut().for_each(positive_zeros),
+        Value::Array(a) => a.iter_mut().for_each(positive_zeros),
+        _ => {}
+    }
 }
 
 fn ms(ps: u64) -> f64 {
@@ -279,8 +298,9 @@ fn summarize(
         "description": m.cfg.description,
         "fidelity": m.cfg.fidelity,
         "seed": m.cfg.run.seed,
-        "frames": m.cfg.run.frames,
+        "frames": m.records.len(),
         "frames_simulated": m.records.len(),
+        "frames_requested": m.cfg.run.frames,
         "warmup_frames": m.cfg.run.warmup_frames,
         "events": {"total": stats.events, "by_kind": by_kind},
         "wall_seconds": stats.wall_seconds,
