@@ -687,127 +687,28 @@ fn cmd_measure(
 
 #[cfg(feature = "wgpu")]
 fn cmd_study(name: &str, repeats: u32, markdown: Option<PathBuf>, json: bool) -> Result<()> {
-    use rendersim::measure::report::{StudySection, device_document};
-    use rendersim::measure::{Gpu, h1, studies};
-    let names: Vec<&str> = match name {
-        "all" => vec!["h1", "h2", "h3", "h4"],
-        "h1" | "h2" | "h3" | "h4" => vec![name],
-        _ => bail!("unknown study {name:?} (available: h1, h2, h3, h4, all)"),
-    };
+    use rendersim::measure::{Gpu, studies};
+    let names = studies::study_names(name).map_err(anyhow::Error::msg)?;
     if repeats == 0 {
         bail!("--repeats must be at least 1");
     }
     let gpu = Gpu::open()?;
-    let mut sections = Vec::new();
-    let mut results = serde_json::Map::new();
-    let mut h1_exact = None;
-    // H2-H4 price vertices with the reuse policy H1 identifies on this
-    // device: run H1 first (it only reads counters, one pass per mesh).
-    let mut fitted: Option<(h1::H1, f64)> = None;
-    if names.iter().any(|n| *n != "h1") {
-        let t = std::time::Instant::now();
-        fitted = Some((h1::h1(&gpu, 1)?, t.elapsed().as_secs_f64()));
-    }
-    let cache = fitted
-        .as_ref()
-        .map_or_else(|| "lavapipe".to_string(), |(r, _)| r.chosen.clone());
-    for n in names {
-        let t = std::time::Instant::now();
-        let mut earlier = 0.0;
-        let (verdict, md, value) = match n {
-            "h1" => {
-                // Counters do not vary between passes: one recorded pass each.
-                let r = match fitted.take() {
-                    Some((r, secs)) => {
-                        earlier = secs;
-                        r
-                    }
-                    None => h1::h1(&gpu, 1)?,
-                };
-                h1_exact = Some((r.exact, r.chosen.clone()));
-                let v = format!(
-                    "vertex reuse: `{}` predicts every validation mesh {}",
-                    r.chosen,
-                    if r.exact { "exactly" } else { "NOT exactly" }
-                );
-                (v, r.markdown(), serde_json::to_value(&r)?)
-            }
-            "h2" => {
-                let setup = rendersim::measure::h2::H2Setup {
-                    cache: cache.clone(),
-                    ..Default::default()
-                };
-                let r = studies::run_h2(&gpu, setup, repeats)?;
-                let best = &r.scores[0];
-                let v = format!(
-                    "sum vs max: **{}** fits best ({:.1}% mean error on the test cells)",
-                    best.hypothesis, best.mean_abs_error_pct
-                );
-                (v, r.markdown(), serde_json::to_value(&r)?)
-            }
-            "h3" => {
-                let setup = rendersim::measure::h3::H3Setup {
-                    cache: cache.clone(),
-                    ..Default::default()
-                };
-                let r = studies::run_h3(&gpu, setup, repeats)?;
-                let v = format!(
-                    "draw order: calibrated early-z costs predict the other orders within {:.1}% (mean)",
-                    r.prediction_error_pct()
-                );
-                (v, r.markdown(), serde_json::to_value(&r)?)
-            }
-            _ => {
-                let setup = rendersim::measure::h4::H4Setup {
-                    cache: cache.clone(),
-                    ..Default::default()
-                };
-                let r = studies::run_h4(&gpu, setup, repeats)?;
-                let v = match (&r.geometry_fit, &r.fit) {
-                    (Some(g), Some(f)) => format!(
-                        "cost per transformed vertex: {:.1} ns alone (R^2 {:.3}, leave-one-out error {:.1}%), \
-                         {:.1} ns in full passes (R^2 {:.3}, error {:.1}%)",
-                        g.slope * 1e6,
-                        g.r_squared,
-                        r.geometry_error_pct,
-                        f.slope * 1e6,
-                        f.r_squared,
-                        r.mean_abs_error_pct
-                    ),
-                    _ => "no line could be fitted".to_string(),
-                };
-                (v, r.markdown(), serde_json::to_value(&r)?)
-            }
-        };
-        if !json {
-            println!("{}: {verdict}", n.to_uppercase());
-        }
-        results.insert(n.to_string(), value);
-        sections.push(StudySection {
-            name: n.to_uppercase(),
-            verdict,
-            markdown: md,
-            seconds: earlier + t.elapsed().as_secs_f64(),
-        });
-    }
     let command = format!("rendersim study {name} --repeats {repeats}");
-    let notes = if gpu.adapter.device_type == "Cpu" {
-        "The adapter is a software rasterizer on this machine's CPU: pass times include \
-         the CPU time it spends and vary with the machine's load."
-    } else {
-        ""
-    };
-    let doc = device_document(&gpu.describe(), &command, notes, &sections);
+    let r = studies::run_studies(&gpu, &names, repeats, &command, |s| {
+        if !json {
+            println!("{}: {}", s.name, s.verdict);
+        }
+    })?;
     if let Some(path) = markdown {
-        write_atomic(&path, |w| w.write_all(doc.as_bytes())).with_context(|| format!("writing {}", path.display()))?;
+        write_atomic(&path, |w| w.write_all(r.document.as_bytes()))
+            .with_context(|| format!("writing {}", path.display()))?;
     }
     if json {
-        results.insert("adapter".into(), serde_json::to_value(&gpu.adapter)?);
-        println!("{}", serde_json::to_string_pretty(&results)?);
+        println!("{}", serde_json::to_string_pretty(&r.json)?);
     } else {
-        println!("\n{doc}");
+        println!("\n{}", r.document);
     }
-    if let Some((false, chosen)) = h1_exact {
+    if let Some(chosen) = r.h1_inexact {
         bail!("the fitted policy {chosen} does not predict every validation mesh exactly");
     }
     Ok(())

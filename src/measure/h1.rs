@@ -209,6 +209,15 @@ pub fn h1(gpu: &Gpu, repeats: u32) -> Result<H1, MeasureError> {
 }
 
 impl H1 {
+    /// One line: the policy found and whether it predicts exactly.
+    pub fn verdict(&self) -> String {
+        format!(
+            "vertex reuse: `{}` predicts every validation mesh {}",
+            self.chosen,
+            if self.exact { "exactly" } else { "NOT exactly" }
+        )
+    }
+
     /// The result as a Markdown section.
     pub fn markdown(&self) -> String {
         let mut s = format!(

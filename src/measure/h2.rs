@@ -237,6 +237,17 @@ impl H2 {
         self.scores.first().map_or("none", |s| s.hypothesis.as_str())
     }
 
+    /// One line: the best hypothesis and its error.
+    pub fn verdict(&self) -> String {
+        match self.scores.first() {
+            Some(b) => format!(
+                "sum vs max: **{}** fits best ({:.1}% mean error on the test cells)",
+                b.hypothesis, b.mean_abs_error_pct
+            ),
+            None => "sum vs max: no hypothesis scored".into(),
+        }
+    }
+
     /// The result as a Markdown section.
     pub fn markdown(&self) -> String {
         let s = &self.setup;

@@ -213,6 +213,14 @@ impl H3 {
         e.iter().sum::<f64>() / e.len().max(1) as f64
     }
 
+    /// One line: how well the calibrated costs predict the other orders.
+    pub fn verdict(&self) -> String {
+        format!(
+            "draw order: calibrated early-z costs predict the other orders within {:.1}% (mean)",
+            self.prediction_error_pct()
+        )
+    }
+
     /// The result as a Markdown section.
     pub fn markdown(&self) -> String {
         let s = &self.setup;

@@ -148,6 +148,23 @@ pub fn analyze(setup: H4Setup, mut rows: Vec<H4Row>, measure_seconds: f64, simul
 }
 
 impl H4 {
+    /// One line: the cost per transformed vertex, alone and in full passes.
+    pub fn verdict(&self) -> String {
+        match (&self.geometry_fit, &self.fit) {
+            (Some(g), Some(f)) => format!(
+                "cost per transformed vertex: {:.1} ns alone (R^2 {:.3}, leave-one-out error {:.1}%), \
+                 {:.1} ns in full passes (R^2 {:.3}, error {:.1}%)",
+                g.slope * 1e6,
+                g.r_squared,
+                self.geometry_error_pct,
+                f.slope * 1e6,
+                f.r_squared,
+                self.mean_abs_error_pct
+            ),
+            _ => "cost per transformed vertex: no line could be fitted".into(),
+        }
+    }
+
     /// The result as a Markdown section.
     pub fn markdown(&self) -> String {
         let s = &self.setup;

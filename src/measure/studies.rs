@@ -1,5 +1,7 @@
-//! Running the hypothesis studies H2-H4 on a device: the passes each study
-//! needs, measured on one opened [`Gpu`], handed to the study's analysis.
+//! Running the hypothesis studies on a device: the passes each study needs,
+//! measured on one opened [`Gpu`], handed to the study's analysis; and
+//! [`run_studies`], which runs a list of them (H1 first: H2-H4 price vertices
+//! with the reuse policy it finds) and composes the per-device document.
 
 use std::path::Path;
 use std::time::Instant;
@@ -10,10 +12,12 @@ use crate::scene::mesh::Mesh;
 use super::device::{Gpu, MeasureError, MeasureOptions, Measurement};
 use super::fit::median;
 use super::geometry::DepthOrder;
+use super::h1;
 use super::h2::{self, H2, H2Measured, H2Setup};
 use super::h3::{self, H3, H3Measured, H3Pass, H3Setup};
 use super::h4::{self, H4, H4Row, H4Setup};
 use super::predict::PredictError;
+use super::report::{StudySection, device_document};
 
 /// Errors of a study.
 #[derive(Debug, thiserror::Error)]
@@ -265,4 +269,125 @@ pub fn run_h4(gpu: &Gpu, setup: H4Setup, rounds: u32) -> Result<H4, StudyError> 
         });
     }
     Ok(h4::analyze(setup, rows, measure_seconds, t.elapsed().as_secs_f64()))
+}
+
+/// The studies `name` stands for: `h1` .. `h4`, or `all`.
+pub fn study_names(name: &str) -> Result<Vec<&'static str>, String> {
+    match name {
+        "all" => Ok(vec!["h1", "h2", "h3", "h4"]),
+        "h1" => Ok(vec!["h1"]),
+        "h2" => Ok(vec!["h2"]),
+        "h3" => Ok(vec!["h3"]),
+        "h4" => Ok(vec!["h4"]),
+        _ => Err(format!("unknown study {name:?} (available: h1, h2, h3, h4, all)")),
+    }
+}
+
+/// What [`run_studies`] produced.
+#[derive(Debug)]
+pub struct StudiesRun {
+    /// Verdict, section and wall time per study, in order.
+    pub sections: Vec<StudySection>,
+    /// Every study's full result (and the adapter), for `--json`.
+    pub json: serde_json::Map<String, serde_json::Value>,
+    /// The per-device Markdown document.
+    pub document: String,
+    /// H1's chosen policy when it ran and did not predict every validation
+    /// mesh exactly (the one outcome that makes the command fail).
+    pub h1_inexact: Option<String>,
+}
+
+fn to_json<T: serde::Serialize>(v: &T) -> serde_json::Value {
+    serde_json::to_value(v).unwrap_or(serde_json::Value::Null)
+}
+
+/// Runs the named studies on `gpu` (`rounds` timed passes each, medians),
+/// calling `progress` after each; `command` is quoted in the document.
+pub fn run_studies(
+    gpu: &Gpu,
+    names: &[&str],
+    rounds: u32,
+    command: &str,
+    mut progress: impl FnMut(&StudySection),
+) -> Result<StudiesRun, StudyError> {
+    let mut sections = Vec::new();
+    let mut json = serde_json::Map::new();
+    let mut h1_inexact = None;
+    // H2-H4 price vertices with the reuse policy H1 identifies on this
+    // device: run H1 first (it only reads counters, one pass per mesh).
+    let mut fitted: Option<(h1::H1, f64)> = None;
+    if names.iter().any(|n| *n != "h1") {
+        let t = Instant::now();
+        fitted = Some((h1::h1(gpu, 1)?, t.elapsed().as_secs_f64()));
+    }
+    let cache = fitted
+        .as_ref()
+        .map_or_else(|| "lavapipe".to_string(), |(r, _)| r.chosen.clone());
+    for &n in names {
+        let t = Instant::now();
+        let mut earlier = 0.0;
+        let (verdict, markdown, value) = match n {
+            "h1" => {
+                let r = match fitted.take() {
+                    Some((r, secs)) => {
+                        earlier = secs;
+                        r
+                    }
+                    None => h1::h1(gpu, 1)?,
+                };
+                if !r.exact {
+                    h1_inexact = Some(r.chosen.clone());
+                }
+                (r.verdict(), r.markdown(), to_json(&r))
+            }
+            "h2" => {
+                let setup = H2Setup {
+                    cache: cache.clone(),
+                    ..H2Setup::default()
+                };
+                let r = run_h2(gpu, setup, rounds)?;
+                (r.verdict(), r.markdown(), to_json(&r))
+            }
+            "h3" => {
+                let setup = H3Setup {
+                    cache: cache.clone(),
+                    ..H3Setup::default()
+                };
+                let r = run_h3(gpu, setup, rounds)?;
+                (r.verdict(), r.markdown(), to_json(&r))
+            }
+            "h4" => {
+                let setup = H4Setup {
+                    cache: cache.clone(),
+                    ..H4Setup::default()
+                };
+                let r = run_h4(gpu, setup, rounds)?;
+                (r.verdict(), r.markdown(), to_json(&r))
+            }
+            other => return Err(StudyError::Mesh(format!("unknown study {other:?}"))),
+        };
+        json.insert(n.to_string(), value);
+        let section = StudySection {
+            name: n.to_uppercase(),
+            verdict,
+            markdown,
+            seconds: earlier + t.elapsed().as_secs_f64(),
+        };
+        progress(&section);
+        sections.push(section);
+    }
+    json.insert("adapter".into(), to_json(&gpu.adapter));
+    let notes = if gpu.adapter.device_type == "Cpu" {
+        "The adapter is a software rasterizer on this machine's CPU: pass times include \
+         the CPU time it spends and vary with the machine's load."
+    } else {
+        ""
+    };
+    let document = device_document(&gpu.describe(), command, notes, &sections);
+    Ok(StudiesRun {
+        sections,
+        json,
+        document,
+        h1_inexact,
+    })
 }
