@@ -1,0 +1,345 @@
+//! Experiment files: the TOML format, its validation, and the validated
+//! [`Experiment`] description.
+//!
+//! Parsing uses `deny_unknown_fields` everywhere, so a misspelt key is an
+//! error naming the key and line. Validation then checks cross-references
+//! (plot axes and `where` filters name sweep keys and sweep values, names are
+//! unique, exactly one of `values`/`range`, ...) and reports the offending
+//! entry as e.g. `sweep[1]` or `plot[0] (interval).x`.
+
+use std::collections::BTreeSet;
+use std::path::PathBuf;
+
+use super::ExperimentError;
+use super::sweep::Sweep;
+
+mod raw;
+mod validate;
+
+pub(crate) use raw::RawRange;
+pub use validate::{load_experiment, parse_experiment};
+
+/// Where the base model of an experiment comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ModelSource {
+    /// The embedded default model, supplied by the caller.
+    Default,
+    /// A model file (resolved relative to the experiment file).
+    File(PathBuf),
+}
+
+/// One reported metric: a dotted path into the run summary.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Metric {
+    /// Dotted path, e.g. `metrics.display_interval_ms.mean`.
+    pub path: String,
+    /// Human-readable label (defaults to the path).
+    pub label: String,
+}
+
+/// What a plot shows.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PlotKind {
+    /// `x` is a sweep key; one series per combination of the other sweep
+    /// keys' values (and per `y` entry); `y` are metric paths (mean with CI
+    /// bars) or derived value names (no bars).
+    Line {
+        /// The sweep key on the x axis.
+        x: String,
+        /// Metric paths or derived names.
+        y: Vec<String>,
+        /// Logarithmic x axis.
+        log_x: bool,
+        /// Logarithmic y axis.
+        log_y: bool,
+        /// `where` filter: only the points with these sweep values are
+        /// drawn (and the filtered keys are left out of the series names).
+        filter: Vec<(String, toml::Value)>,
+    },
+    /// Per-frame values of `column`, pooled over the replications of each
+    /// point, one group per point (optionally only the points matching `filter`).
+    Histogram {
+        /// Frame column, e.g. `FrameTime`.
+        column: String,
+        /// Number of bins.
+        bins: usize,
+        /// Optional x range `(lo, hi)` of the bins (finite, `lo < hi`);
+        /// values outside are counted and noted, not drawn.
+        range: Option<(f64, f64)>,
+        /// `where` filter: sweep key = value.
+        filter: Vec<(String, toml::Value)>,
+    },
+    /// One labelled point per experiment point; `x` and `y` are metric
+    /// paths (replication means) or derived names.
+    Scatter {
+        /// X metric path or derived name.
+        x: String,
+        /// Y metric path or derived name.
+        y: String,
+        /// Logarithmic x axis.
+        log_x: bool,
+        /// Logarithmic y axis.
+        log_y: bool,
+    },
+}
+
+/// A plot to write as `<file>.svg` and `<file>.png` in the output directory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlotSpec {
+    /// Base file name (no directory, no extension).
+    pub file: String,
+    /// Title.
+    pub title: String,
+    /// X axis description.
+    pub x_label: String,
+    /// Y axis description.
+    pub y_label: String,
+    /// The kind and its parameters.
+    pub kind: PlotKind,
+}
+
+/// How a derived value is computed for each point.
+#[derive(Debug, Clone, PartialEq)]
+pub enum DerivedKind {
+    /// Width of the central `level` interval of the pooled frame `column`:
+    /// `quantile(1 - (1 - level) / 2) - quantile((1 - level) / 2)`.
+    IntervalWidth {
+        /// Frame column.
+        column: String,
+        /// Coverage, in `(0, 1)`.
+        level: f64,
+    },
+    /// Spread above the minimum that covers `level` of the pooled frame
+    /// `column`: `quantile(level) - min` (the paper's constant `c`).
+    QuantileWidthFromMin {
+        /// Frame column.
+        column: String,
+        /// Coverage, in `(0, 1]`.
+        level: f64,
+    },
+    /// `|v - v_ref| / |v_ref|` for the replication mean `v` of `path`, where
+    /// `v_ref` is taken at the point that differs only in the `reference` keys.
+    RelativeError {
+        /// Metric path.
+        path: String,
+        /// Sweep key = value identifying the reference point.
+        reference: Vec<(String, toml::Value)>,
+    },
+    /// `v / v_ref` for the replication mean `v` of `path`, the reference
+    /// point chosen as for `RelativeError` (e.g. presort's primitives at
+    /// 30 ms over standard's: 1.42 is a 42% gain).
+    Ratio {
+        /// Metric path.
+        path: String,
+        /// Sweep key = value identifying the reference point.
+        reference: Vec<(String, toml::Value)>,
+    },
+    /// `wall_ref / wall` on the replication means of `wall_seconds`, with the
+    /// reference point chosen as for `RelativeError`.
+    Speedup {
+        /// Sweep key = value identifying the reference point.
+        reference: Vec<(String, toml::Value)>,
+    },
+}
+
+/// A value computed per point after all runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Derived {
+    /// Column name in `points.csv` and the report.
+    pub name: String,
+    /// What to compute.
+    pub kind: DerivedKind,
+}
+
+/// Allowed deviation of a checked value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tolerance {
+    /// `|measured - expect| <= tol`.
+    Absolute(f64),
+    /// `|measured - expect| <= tol * |expect|`.
+    Relative(f64),
+}
+
+/// One bound of a check: another value of the same point, or a number.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BoundRef {
+    /// A metric path or derived name (`at_least_path`, `at_most_path`).
+    Path(String),
+    /// A fixed number (`at_least`, `at_most`).
+    Value(f64),
+}
+
+/// What a check compares its value with.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Expect {
+    /// A reference value: `|measured - value| <= tolerance`.
+    Value(f64),
+    /// Bounds, each another value of the same point (metric path or
+    /// derived name) or a number: `measured >= at_least - tolerance` and
+    /// `measured <= at_most + tolerance`, with a relative tolerance taken
+    /// relative to each bound. At least one bound is given.
+    Between {
+        /// The lower bound.
+        at_least: Option<BoundRef>,
+        /// The upper bound.
+        at_most: Option<BoundRef>,
+    },
+}
+
+/// A reference value (or a pair of bounds) to compare against.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Check {
+    /// Metric path or derived name.
+    pub path: String,
+    /// Sweep key = value; every matching point is checked.
+    pub filter: Vec<(String, toml::Value)>,
+    /// Expected value or bounds.
+    pub expect: Expect,
+    /// Allowed deviation.
+    pub tolerance: Tolerance,
+    /// `Some(text)`: a verdict, not a test. The check is evaluated the same
+    /// way, but its outcome is reported as "holds" / "does not hold" under
+    /// the claim `text` in the report's Claims section and never counts as
+    /// a failed check (an experiment can state that a published claim does
+    /// not hold without failing).
+    pub claim: Option<String>,
+}
+
+/// A validated experiment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Experiment {
+    /// The file it was loaded from (used in messages and to resolve `model`).
+    pub source: PathBuf,
+    /// Short name.
+    pub name: String,
+    /// Paragraph shown in the report.
+    pub description: String,
+    /// Base model.
+    pub model: ModelSource,
+    /// Seeds per point.
+    pub replications: u32,
+    /// First seed; seeds are `base_seed .. base_seed + replications`.
+    pub base_seed: u64,
+    /// Confidence level of the intervals, in `(0, 1)`.
+    pub confidence: f64,
+    /// Fixed overrides (dotted key, value), applied before the sweeps.
+    /// Nested tables in `[set]` are flattened into dotted keys.
+    pub set: Vec<(String, toml::Value)>,
+    /// Sweeps, in file order; the first varies slowest.
+    pub sweeps: Vec<Sweep>,
+    /// Reported metrics.
+    pub metrics: Vec<Metric>,
+    /// Plots.
+    pub plots: Vec<PlotSpec>,
+    /// Derived values.
+    pub derived: Vec<Derived>,
+    /// Reference checks.
+    pub checks: Vec<Check>,
+    /// Inverse what-ifs (`[[search]]`).
+    pub searches: Vec<super::inverse::Search>,
+}
+
+impl Experiment {
+    /// The seeds every point runs with.
+    pub fn seeds(&self) -> Vec<u64> {
+        (0..u64::from(self.replications))
+            .map(|i| self.base_seed.wrapping_add(i))
+            .collect()
+    }
+
+    /// Whether some plot or derived value needs per-frame data.
+    pub fn needs_frames(&self) -> bool {
+        !self.frame_columns().is_empty()
+    }
+
+    /// Frame columns needed by plots and derived values (sorted, unique).
+    pub fn frame_columns(&self) -> Vec<String> {
+        let mut cols = BTreeSet::new();
+        for p in &self.plots {
+            if let PlotKind::Histogram { column, .. } = &p.kind {
+                cols.insert(column.clone());
+            }
+        }
+        for d in &self.derived {
+            match &d.kind {
+                DerivedKind::IntervalWidth { column, .. } | DerivedKind::QuantileWidthFromMin { column, .. } => {
+                    cols.insert(column.clone());
+                }
+                _ => {}
+            }
+        }
+        cols.into_iter().collect()
+    }
+
+    /// Every summary path the experiment reads, in a stable order: the
+    /// metrics first, then paths used only by plots, derived values and
+    /// checks. Derived names are not paths and are left out. `wall_seconds`
+    /// appears only if referenced explicitly.
+    pub fn tracked_paths(&self) -> Vec<String> {
+        let derived: BTreeSet<&str> = self.derived.iter().map(|d| d.name.as_str()).collect();
+        let mut out: Vec<String> = Vec::new();
+        let mut add = |p: &str| {
+            if !derived.contains(p) && !out.iter().any(|o| o == p) {
+                out.push(p.to_string());
+            }
+        };
+        for m in &self.metrics {
+            add(&m.path);
+        }
+        for p in &self.plots {
+            match &p.kind {
+                PlotKind::Line { y, .. } => y.iter().for_each(|y| add(y)),
+                PlotKind::Scatter { x, y, .. } => {
+                    add(x);
+                    add(y);
+                }
+                PlotKind::Histogram { .. } => {}
+            }
+        }
+        for d in &self.derived {
+            match &d.kind {
+                DerivedKind::RelativeError { path, .. } | DerivedKind::Ratio { path, .. } => add(path),
+                DerivedKind::Speedup { .. } => add("wall_seconds"),
+                _ => {}
+            }
+        }
+        for c in &self.checks {
+            add(&c.path);
+            if let Expect::Between { at_least, at_most } = &c.expect {
+                for b in at_least.iter().chain(at_most) {
+                    if let BoundRef::Path(p) = b {
+                        add(p);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The label of a metric path (its `[[metric]]` label, else the path).
+    pub fn label_of(&self, path: &str) -> String {
+        self.metrics
+            .iter()
+            .find(|m| m.path == path)
+            .map(|m| m.label.clone())
+            .unwrap_or_else(|| path.to_string())
+    }
+
+    /// The base model: a clone of `default_model` for `model = "default"`,
+    /// else the TOML file named by `model` (relative to the experiment file).
+    pub fn resolve_model(&self, default_model: &toml::Table) -> Result<toml::Table, ExperimentError> {
+        match &self.model {
+            ModelSource::Default => Ok(default_model.clone()),
+            ModelSource::File(path) => {
+                let text = std::fs::read_to_string(path).map_err(|source| ExperimentError::Io {
+                    path: path.clone(),
+                    source,
+                })?;
+                text.parse::<toml::Table>().map_err(|e| ExperimentError::Parse {
+                    file: path.clone(),
+                    message: e.to_string(),
+                })
+            }
+        }
+    }
+}
