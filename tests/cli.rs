@@ -551,3 +551,21 @@ fn system_noise_experiment_prints_the_paper_constant_at_the_end() {
         "{out}"
     );
 }
+
+#[cfg(unix)]
+#[test]
+fn a_closed_output_pipe_ends_quietly_without_a_panic() {
+    use std::process::Stdio;
+    let mut child = bin()
+        .args(["run", "models/fixed.toml", "--frames", "20", "--trace", "/dev/stdout"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The reader goes away at once, like `| head -c 0`.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_ne!(out.status.code(), Some(101), "{err}");
+}
