@@ -458,9 +458,7 @@ impl Gpu {
         }
         let stable = counters.windows(2).all(|w| w[0] == w[1]);
         let last = *counters.last().unwrap_or(&[0; 4]);
-        let mut sorted = times.clone();
-        sorted.sort_by(|a, b| a.total_cmp(b));
-        let median = sorted[sorted.len() / 2];
+        let median = super::fit::median(&times).unwrap_or(f64::NAN);
         Ok(Measurement {
             adapter: summary,
             vs_invocations: last[0],

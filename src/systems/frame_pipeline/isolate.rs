@@ -10,7 +10,7 @@ use std::path::Path;
 use crate::components::distribution::Dist;
 use crate::engine::Duration;
 
-use super::config::{FramePipelineConfig, WorkloadConfig};
+use super::config::{FramePipelineConfig, StateCosts, WorkloadConfig};
 use super::model::PipelineError;
 use super::run::run_pipeline;
 
@@ -48,6 +48,12 @@ fn scale(d: Duration, k: f64) -> Duration {
     Duration::from_ps_f64(d.0 as f64 * k)
 }
 
+fn scale_states(s: &mut StateCosts, k: f64) {
+    for d in [&mut s.shader, &mut s.texture, &mut s.material, &mut s.matrix] {
+        *d = scale(*d, k);
+    }
+}
+
 fn scale_dist(d: &Dist<Duration>, k: f64) -> Dist<Duration> {
     d.scaled_as(k)
 }
@@ -64,13 +70,7 @@ pub fn reduced(cfg: &FramePipelineConfig, which: &str, k: f64) -> FramePipelineC
             p.per_draw = scale(p.per_draw, k);
             p.clear = scale(p.clear, k);
             p.swap = scale(p.swap, k);
-            let s = &mut p.state_change;
-            (s.shader, s.texture, s.material, s.matrix) = (
-                scale(s.shader, k),
-                scale(s.texture, k),
-                scale(s.material, k),
-                scale(s.matrix, k),
-            );
+            scale_states(&mut p.state_change, k);
             if let WorkloadConfig::Fixed(f) = &mut c.workload {
                 f.cpu = scale_dist(&f.cpu, k);
             }
@@ -82,13 +82,7 @@ pub fn reduced(cfg: &FramePipelineConfig, which: &str, k: f64) -> FramePipelineC
             g.command = scale(g.command, k);
             g.clear = scale(g.clear, k);
             g.swap = scale(g.swap, k);
-            let s = &mut g.state_change;
-            (s.shader, s.texture, s.material, s.matrix) = (
-                scale(s.shader, k),
-                scale(s.texture, k),
-                scale(s.material, k),
-                scale(s.matrix, k),
-            );
+            scale_states(&mut g.state_change, k);
         }
         "geometry" => {
             let g = &mut c.gpu.geometry;
