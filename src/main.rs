@@ -9,7 +9,8 @@ use clap::{Parser, Subcommand};
 use serde_json::json;
 
 use rendersim::config::{ModelSource, apply_set};
-use rendersim::output::files::write_atomic;
+use rendersim::output::files::write_output;
+use rendersim::output::result_set::ResultSet;
 use rendersim::systems::{DEFAULT_MODEL, SystemRun, run_model};
 
 #[derive(Parser)]
@@ -157,6 +158,9 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+    // An interrupt removes the temporary files and staging folders of
+    // outputs being written; finished outputs are never touched.
+    rendersim::output::cleanup::remove_on_signals();
     let cli = Cli::parse();
     match dispatch(cli) {
         Ok(()) => ExitCode::SUCCESS,
@@ -306,30 +310,54 @@ fn cmd_run(
 ) -> Result<()> {
     let mut src = load_source(model.as_deref())?;
     let table = model_table(&mut src, &sets, seed, frames)?;
+    // Outputs are checked before simulating: a folder that cannot take the
+    // results, or a trace path that is a folder, is reported at once.
+    let set = match &out {
+        Some(dir) => Some(ResultSet::begin(dir, |name| RUN_FILES.contains(&name))?),
+        None => None,
+    };
+    if let Some(path) = &trace {
+        rendersim::output::files::destination(path)?;
+    }
     let mut run = run_model(&src, &table, trace.is_some())?;
     run.summary_mut()["model"] = json!(src.name);
-    if let Some(dir) = &out {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
+    if let Some(set) = &set {
+        let dir = set.dir();
         let summary = serde_json::to_string_pretty(run.summary())?;
-        write_atomic(&dir.join("summary.json"), |w| w.write_all(summary.as_bytes()))
-            .with_context(|| format!("writing {}", dir.join("summary.json").display()))?;
-        write_atomic(&dir.join("frames.csv"), |w| run.write_frames_csv(w))
-            .with_context(|| format!("writing {}", dir.join("frames.csv").display()))?;
-        let resolved = run.resolved_model(&src.base_dir);
-        write_atomic(&dir.join("model.toml"), |w| w.write_all(resolved.as_bytes()))
-            .with_context(|| format!("writing {}", dir.join("model.toml").display()))?;
+        std::fs::write(dir.join("summary.json"), summary).context("writing summary.json")?;
+        let mut frames = std::io::BufWriter::new(std::fs::File::create(dir.join("frames.csv"))?);
+        run.write_frames_csv(&mut frames).context("writing frames.csv")?;
+        std::io::Write::flush(&mut frames).context("writing frames.csv")?;
+        drop(frames);
+        std::fs::write(dir.join("model.toml"), run.resolved_model(&src.base_dir)).context("writing model.toml")?;
     }
+    // The trace first, then the folder is swapped in: a run whose trace
+    // could not be written leaves the earlier results as they were.
     if let Some(path) = &trace {
-        write_atomic(path, |w| run.write_trace(w).map(|_| ()))
+        write_output(path, |w| run.write_trace(w).map(|_| ()))
             .with_context(|| format!("writing trace {}", path.display()))?;
     }
+    if let Some(set) = set {
+        set.commit()?;
+    }
+    // With the trace on standard output, the report goes to standard error.
+    let trace_on_stdout = trace.as_deref().is_some_and(|p| p.as_os_str() == "-");
     if json {
-        println!("{}", serde_json::to_string_pretty(run.summary())?);
-    } else {
+        let text = serde_json::to_string_pretty(run.summary())?;
+        if trace_on_stdout {
+            eprintln!("{text}");
+        } else {
+            println!("{text}");
+        }
+    } else if !trace_on_stdout {
         print_human(&run);
     }
     Ok(())
 }
+
+/// The files `run --out` writes (a folder holding only these, written
+/// before result sets were marked, may be replaced).
+const RUN_FILES: [&str; 3] = ["summary.json", "frames.csv", "model.toml"];
 
 fn print_human(run: &SystemRun) {
     let s = run.summary();
@@ -536,9 +564,28 @@ fn cmd_experiment(file: &Path, out: Option<PathBuf>, quiet: bool) -> Result<()> 
         ),
     };
     let out = out.unwrap_or_else(|| PathBuf::from("out").join(&exp.name));
-    std::fs::create_dir_all(&out).with_context(|| format!("cannot create output directory {}", out.display()))?;
+    let set = ResultSet::begin(&out, experiment_file)?;
     let runner = SimRunner { name, base_dir };
-    let result = run_experiment(&exp, &base, &runner, &out, !quiet)?;
+    let result = match run_experiment(&exp, &base, &runner, set.dir(), !quiet) {
+        Ok(r) => r,
+        Err(e) => {
+            // Keep the runs that finished beside the earlier results, which
+            // stay as they were.
+            let failed = sibling(&out, "failed");
+            let finished =
+                std::fs::read_to_string(set.dir().join("runs.csv")).map_or(0, |t| t.lines().count().saturating_sub(1));
+            let kept = finished > 0 && set.commit_to(&failed).is_ok();
+            let mut msg = format!("{e}\nearlier results in {} are unchanged", out.display());
+            if kept {
+                msg.push_str(&format!(
+                    "; the {finished} run(s) that finished are in {}",
+                    failed.display()
+                ));
+            }
+            bail!(msg);
+        }
+    };
+    set.commit()?;
     println!("{}", result.table(&exp));
     println!(
         "experiment {:?}: {} points, {:.2} s wall ({:.2} s of simulation); results in {}",
@@ -556,6 +603,22 @@ fn cmd_experiment(file: &Path, out: Option<PathBuf>, quiet: bool) -> Result<()> 
         );
     }
     Ok(())
+}
+
+/// Whether an experiment's output folder from before result sets were
+/// marked holds this file (tables, report, plots).
+fn experiment_file(name: &str) -> bool {
+    [".csv", ".md", ".svg", ".png"].iter().any(|ext| name.ends_with(ext))
+}
+
+/// `DIR.suffix` beside `DIR`.
+fn sibling(dir: &Path, suffix: &str) -> PathBuf {
+    let dir = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
+    let name = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    dir.with_file_name(format!("{name}.{suffix}"))
 }
 
 fn cmd_isolate(model: Option<PathBuf>, sets: Vec<String>, factor: f64, keep_vsync: bool, json: bool) -> Result<()> {
@@ -707,8 +770,7 @@ fn cmd_study(name: &str, repeats: u32, markdown: Option<PathBuf>, json: bool) ->
         }
     })?;
     if let Some(path) = markdown {
-        write_atomic(&path, |w| w.write_all(r.document.as_bytes()))
-            .with_context(|| format!("writing {}", path.display()))?;
+        write_output(&path, |w| w.write_all(r.document.as_bytes()))?;
     }
     if json {
         println!("{}", serde_json::to_string_pretty(&r.json)?);

@@ -242,7 +242,13 @@ fn a_failed_run_keeps_earlier_results() {
         out.to_str().unwrap(),
     ]);
     assert_eq!(before, std::fs::read_to_string(out.join("summary.json")).unwrap());
-    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 3, "no stray files");
+    // summary.json, frames.csv, model.toml and the result-set marker.
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 4, "no stray files");
+    assert!(
+        std::fs::read_dir(d.path())
+            .unwrap()
+            .all(|e| !e.unwrap().file_name().to_string_lossy().starts_with(".out."))
+    );
 }
 
 #[test]
@@ -550,22 +556,4 @@ fn system_noise_experiment_prints_the_paper_constant_at_the_end() {
             .any(|l| l.contains("noise.enabled=false") && l.contains("c99_from_min = 0")),
         "{out}"
     );
-}
-
-#[cfg(unix)]
-#[test]
-fn a_closed_output_pipe_ends_quietly_without_a_panic() {
-    use std::process::Stdio;
-    let mut child = bin()
-        .args(["run", "models/fixed.toml", "--frames", "20", "--trace", "/dev/stdout"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    // The reader goes away at once, like `| head -c 0`.
-    drop(child.stdout.take());
-    let out = child.wait_with_output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!err.contains("panicked"), "{err}");
-    assert_ne!(out.status.code(), Some(101), "{err}");
 }

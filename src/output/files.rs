@@ -1,11 +1,116 @@
-//! Safe file writing: write next to the target under a temporary name, then
-//! rename over it, so readers never see half a file and a failure leaves the
-//! old file intact.
+//! Writing one output file without damaging what its path names.
+//!
+//! What is at the path decides how it is written:
+//!
+//! - `-`: standard output;
+//! - a FIFO, a character or block device, a socket, or a symbolic link to
+//!   one: opened and written in place (never replaced: replacing
+//!   `/dev/stdout` or a FIFO by a regular file would break every later
+//!   reader of it);
+//! - a regular file, a symbolic link to one (the link is followed and kept),
+//!   or nothing yet: written next to the final file under a temporary name
+//!   and renamed over it, so a reader never sees half a file and a failure or
+//!   an interrupt leaves the old file as it was.
+//!
+//! ```
+//! use std::io::Write;
+//! use rendersim::output::files::write_output;
+//!
+//! let dir = tempfile::tempdir().unwrap();
+//! let path = dir.path().join("hello.txt");
+//! write_output(&path, |w| w.write_all(b"hello\n")).unwrap();
+//! assert_eq!(std::fs::read_to_string(&path).unwrap(), "hello\n");
+//! ```
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// Writes `path` through `fill`, atomically (temp file + rename).
+use super::cleanup::Registered;
+use super::error::OutputError;
+
+/// How an output path is written.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Destination {
+    /// `-`: standard output.
+    Stdout,
+    /// Not a regular file (FIFO, device, socket): opened and written in place.
+    InPlace(PathBuf),
+    /// A regular file or nothing yet, with symbolic links resolved: written
+    /// to a temporary sibling and renamed over this path.
+    Replace(PathBuf),
+}
+
+/// Follows symbolic links from `path` to the path they finally name (which
+/// may not exist yet: a dangling link names the file it will create).
+pub fn resolve_links(path: &Path) -> Result<PathBuf, OutputError> {
+    let mut p = path.to_path_buf();
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&p) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let target = std::fs::read_link(&p).map_err(OutputError::io("reading the link", &p))?;
+                p = match p.parent() {
+                    Some(dir) if target.is_relative() => dir.join(target),
+                    _ => target,
+                };
+            }
+            _ => return Ok(p),
+        }
+    }
+    Err(OutputError::LinkLoop {
+        path: path.to_path_buf(),
+    })
+}
+
+/// Decides how `path` is written (see the module documentation).
+pub fn destination(path: &Path) -> Result<Destination, OutputError> {
+    if path.as_os_str() == "-" {
+        return Ok(Destination::Stdout);
+    }
+    let target = resolve_links(path)?;
+    match std::fs::metadata(&target) {
+        Ok(m) if m.is_dir() => Err(OutputError::IsAFolder {
+            path: path.to_path_buf(),
+        }),
+        Ok(m) if m.is_file() => Ok(Destination::Replace(target)),
+        Ok(_) => Ok(Destination::InPlace(target)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Destination::Replace(target)),
+        Err(e) => Err(OutputError::Io {
+            action: "looking at",
+            path: path.to_path_buf(),
+            source: e,
+        }),
+    }
+}
+
+/// Writes the output `path` through `fill` (see the module documentation for
+/// what happens to FIFOs, devices, links and `-`).
+pub fn write_output(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<(), OutputError> {
+    match destination(path)? {
+        Destination::Stdout => {
+            let stdout = std::io::stdout();
+            let mut w = std::io::BufWriter::new(stdout.lock());
+            fill(&mut w)
+                .and_then(|()| w.flush())
+                .map_err(OutputError::io("writing", "standard output"))
+        }
+        Destination::InPlace(p) => {
+            let f = std::fs::OpenOptions::new()
+                .write(true)
+                .open(&p)
+                .map_err(OutputError::io("opening", &p))?;
+            let mut w = std::io::BufWriter::new(f);
+            fill(&mut w)
+                .and_then(|()| w.flush())
+                .map_err(OutputError::io("writing", &p))
+        }
+        Destination::Replace(p) => write_atomic(&p, fill).map_err(OutputError::io("writing", &p)),
+    }
+}
+
+/// Writes the regular file `path` through `fill`, atomically: into a
+/// temporary sibling (removed on failure or interrupt), then renamed over
+/// `path`, keeping the old file's permissions. `path` must not be a
+/// symbolic link or special file; [`write_output`] sorts those out.
 pub fn write_atomic(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> std::io::Result<()> {
     let dir = path
         .parent()
@@ -16,17 +121,23 @@ pub fn write_atomic(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::R
         .map(|n| n.to_string_lossy().to_string())
         .unwrap_or_else(|| "out".into());
     let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let registered = Registered::new(&tmp);
     let result = (|| {
         let f = std::fs::File::create(&tmp)?;
         let mut w = std::io::BufWriter::new(f);
         fill(&mut w)?;
         w.flush()?;
-        drop(w);
-        std::fs::rename(&tmp, path)
+        let f = w.into_inner().map_err(|e| e.into_error())?;
+        if let Ok(old) = std::fs::metadata(path) {
+            f.set_permissions(old.permissions())?;
+        }
+        drop(f);
+        super::cleanup::while_locked(|| std::fs::rename(&tmp, path))
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
+    drop(registered);
     result
 }
 
@@ -46,5 +157,73 @@ mod tests {
         assert!(r.is_err());
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "old");
         assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 1);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_to_a_regular_file_stays_a_link_and_its_target_is_replaced() {
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("real.json");
+        std::fs::write(&target, "old").unwrap();
+        let link = d.path().join("link.json");
+        std::os::unix::fs::symlink("real.json", &link).unwrap();
+        write_output(&link, |w| w.write_all(b"new")).unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
+        // A dangling link creates the file it names.
+        std::fs::remove_file(&target).unwrap();
+        write_output(&link, |w| w.write_all(b"again")).unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "again");
+        assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 2);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn replacing_keeps_the_old_files_permissions() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join("a.csv");
+        std::fs::write(&p, "old").unwrap();
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_output(&p, |w| w.write_all(b"new")).unwrap();
+        assert_eq!(std::fs::metadata(&p).unwrap().permissions().mode() & 0o777, 0o640);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn special_files_are_written_in_place() {
+        let d = tempfile::tempdir().unwrap();
+        assert_eq!(destination(Path::new("-")).unwrap(), Destination::Stdout);
+        // A FIFO (made inside the temp folder) and a link to it.
+        let fifo = d.path().join("pipe");
+        let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        // SAFETY: a valid NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        assert_eq!(destination(&fifo).unwrap(), Destination::InPlace(fifo.clone()));
+        let link = d.path().join("to-pipe");
+        std::os::unix::fs::symlink(&fifo, &link).unwrap();
+        assert_eq!(destination(&link).unwrap(), Destination::InPlace(fifo.clone()));
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(&fifo).unwrap())
+        };
+        write_output(&link, |w| w.write_all(b"through the pipe")).unwrap();
+        assert_eq!(reader.join().unwrap(), b"through the pipe");
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        use std::os::unix::fs::FileTypeExt;
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+        assert!(matches!(destination(d.path()), Err(OutputError::IsAFolder { .. })));
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_loop_is_an_error() {
+        let d = tempfile::tempdir().unwrap();
+        let a = d.path().join("a");
+        let b = d.path().join("b");
+        std::os::unix::fs::symlink(&b, &a).unwrap();
+        std::os::unix::fs::symlink(&a, &b).unwrap();
+        assert!(matches!(destination(&a), Err(OutputError::LinkLoop { .. })));
     }
 }

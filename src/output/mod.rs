@@ -1,6 +1,18 @@
-//! Writing results: Chrome/Perfetto traces and files written safely (to a
-//! temporary name, then renamed, so a failed run never truncates earlier
-//! results).
+//! Writing results without losing or damaging anything.
+//!
+//! - [`files`]: one output file. Special files (FIFOs, devices, `-` for
+//!   standard output) are written in place; regular files are replaced
+//!   atomically (temporary sibling, then rename); symbolic links are kept.
+//! - [`result_set`]: a folder of results that belong together, staged beside
+//!   its target and swapped in whole, so a kill leaves the old set or the
+//!   new one, never a mix.
+//! - [`cleanup`]: temporary paths removed on SIGINT, SIGTERM and SIGHUP.
+//! - [`trace`]: Chrome/Perfetto trace JSON.
 
+pub mod cleanup;
+pub mod error;
 pub mod files;
+pub mod result_set;
 pub mod trace;
+
+pub use error::OutputError;

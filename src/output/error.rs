@@ -1,0 +1,59 @@
+//! Errors of writing outputs.
+
+use std::path::PathBuf;
+
+/// Why an output could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// The operating system refused a read, write, rename or removal.
+    #[error("{action} {path}: {source}")]
+    Io {
+        /// What was being done ("writing", "creating folder", ...).
+        action: &'static str,
+        /// The path it was done to.
+        path: PathBuf,
+        /// The operating system's error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file output names a folder.
+    #[error("{path} is a folder; give a file name (or `-` for standard output)")]
+    IsAFolder {
+        /// The path given.
+        path: PathBuf,
+    },
+    /// A result-set output names something that is not a folder.
+    #[error("{path} exists and is not a folder; give a folder for --out")]
+    NotAFolder {
+        /// The path given.
+        path: PathBuf,
+    },
+    /// A result-set output names a folder that holds files rendersim did not
+    /// write. A result set replaces its folder as a whole, so rendersim will
+    /// not take over a folder that holds anything else.
+    #[error(
+        "output folder {path} exists and holds files rendersim did not write ({examples}); \
+         rendersim replaces its output folder as a whole, so give a new or empty folder \
+         (or remove that one)"
+    )]
+    ForeignFolder {
+        /// The folder given.
+        path: PathBuf,
+        /// A few of the entries that are not rendersim's.
+        examples: String,
+    },
+    /// A symbolic link chain that does not end.
+    #[error("{path}: too many levels of symbolic links")]
+    LinkLoop {
+        /// The path given.
+        path: PathBuf,
+    },
+}
+
+impl OutputError {
+    /// An I/O error while doing `action` to `path`.
+    pub fn io(action: &'static str, path: impl Into<PathBuf>) -> impl FnOnce(std::io::Error) -> OutputError {
+        let path = path.into();
+        move |source| OutputError::Io { action, path, source }
+    }
+}

@@ -1,0 +1,396 @@
+//! A folder of results written as one unit.
+//!
+//! `rendersim run --out DIR` and `rendersim experiment --out DIR` write
+//! several files that belong together (a summary, a per-frame table, the
+//! resolved model; or runs, points, plots and a report). A [`ResultSet`] is
+//! written into a staging folder beside `DIR` and swapped in only when
+//! complete, so at any moment, even after a kill, `DIR` holds either the old
+//! set or the new one, never a mix:
+//!
+//! 1. [`ResultSet::begin`] checks `DIR` before any work is done (it must be a
+//!    folder rendersim wrote earlier, an empty folder, or absent) and creates
+//!    the staging folder `.DIR.partial-PID` beside it, which also proves the
+//!    place is writable before a long simulation starts;
+//! 2. the caller writes into [`ResultSet::dir`];
+//! 3. [`ResultSet::commit`] exchanges the two folders in one `renameat2`
+//!    call (Linux; elsewhere two renames) and removes the old set.
+//!
+//! Dropping an uncommitted set removes its staging folder; an interrupt
+//! (SIGINT, SIGTERM, SIGHUP) removes it too (see [`super::cleanup`]); a
+//! staging folder left by a killed process is removed by the next `begin`
+//! on the same `DIR`.
+//!
+//! Each set holds a marker file, [`MARKER`], which is how rendersim knows a
+//! folder is its own to replace. It never replaces a folder holding files
+//! it did not write.
+//!
+//! ```
+//! use std::io::Write;
+//! use rendersim::output::result_set::ResultSet;
+//!
+//! let parent = tempfile::tempdir().unwrap();
+//! let out = parent.path().join("results");
+//! let set = ResultSet::begin(&out, |_| false).unwrap();
+//! std::fs::write(set.dir().join("a.txt"), "first").unwrap();
+//! set.commit().unwrap();
+//! assert_eq!(std::fs::read_to_string(out.join("a.txt")).unwrap(), "first");
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use super::cleanup::{Registered, while_locked};
+use super::error::OutputError;
+use super::files::resolve_links;
+
+/// The marker file in every result set.
+pub const MARKER: &str = ".rendersim-set";
+
+/// A result set being written (see the module documentation).
+#[derive(Debug)]
+pub struct ResultSet {
+    target: PathBuf,
+    staging: PathBuf,
+    registered: Option<Registered>,
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_else(|| "out".into())
+}
+
+fn parent_of(p: &Path) -> PathBuf {
+    p.parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."))
+}
+
+/// Whether process `pid` still runs (unknown: assume it does).
+fn process_alive(pid: u32) -> bool {
+    #[cfg(unix)]
+    {
+        let Ok(pid) = libc::pid_t::try_from(pid) else {
+            return true;
+        };
+        // SAFETY: signal 0 only checks that the process exists.
+        let r = unsafe { libc::kill(pid, 0) };
+        r == 0 || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = pid;
+        true
+    }
+}
+
+/// Checks that `target` may be replaced by a result set: absent, empty,
+/// marked as rendersim's, or holding only regular files for which `legacy`
+/// says rendersim wrote them (sets written before the marker existed).
+fn check_replaceable(target: &Path, legacy: &dyn Fn(&str) -> bool) -> Result<(), OutputError> {
+    let meta = match std::fs::metadata(target) {
+        Ok(m) => m,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(OutputError::io("looking at", target)(e)),
+    };
+    if !meta.is_dir() {
+        return Err(OutputError::NotAFolder {
+            path: target.to_path_buf(),
+        });
+    }
+    if target.join(MARKER).is_file() {
+        return Ok(());
+    }
+    let mut foreign = Vec::new();
+    for entry in std::fs::read_dir(target).map_err(OutputError::io("reading folder", target))? {
+        let entry = entry.map_err(OutputError::io("reading folder", target))?;
+        let name = entry.file_name().to_string_lossy().to_string();
+        let is_file = entry.file_type().map(|t| t.is_file()).unwrap_or(false);
+        let temp = name.starts_with('.') && name.contains(".tmp-");
+        if !(is_file && (legacy(&name) || temp)) {
+            foreign.push(name);
+        }
+    }
+    if foreign.is_empty() {
+        return Ok(());
+    }
+    foreign.sort();
+    let more = foreign.len().saturating_sub(3);
+    let mut examples = foreign
+        .iter()
+        .take(3)
+        .map(|n| format!("{n:?}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if more > 0 {
+        examples.push_str(&format!(" and {more} more"));
+    }
+    Err(OutputError::ForeignFolder {
+        path: target.to_path_buf(),
+        examples,
+    })
+}
+
+/// `p` as an absolute path that ends in a name (so it has a parent to stage
+/// beside): `.` and `..` are resolved.
+fn absolute_folder(p: &Path) -> Result<PathBuf, OutputError> {
+    let abs = std::path::absolute(p).map_err(OutputError::io("looking at", p))?;
+    if abs.file_name().is_some() && !abs.ends_with("..") {
+        return Ok(abs);
+    }
+    abs.canonicalize().map_err(OutputError::io("looking at", p))
+}
+
+/// Removes staging and swapped-out folders of `name` left beside it by
+/// processes that no longer run.
+fn remove_stale(parent: &Path, name: &str) {
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let n = e.file_name().to_string_lossy().to_string();
+        let Some(rest) = n.strip_prefix(&format!(".{name}.")) else {
+            continue;
+        };
+        let pid = rest
+            .strip_prefix("partial-")
+            .or_else(|| rest.strip_prefix("old-"))
+            .and_then(|p| p.parse::<u32>().ok());
+        if let Some(pid) = pid
+            && pid != std::process::id()
+            && !process_alive(pid)
+            && e.path().is_dir()
+        {
+            let _ = std::fs::remove_dir_all(e.path());
+        }
+    }
+}
+
+/// Exchanges two existing folders in one step where the system can.
+fn exchange(a: &Path, b: &Path) -> std::io::Result<bool> {
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let ca = std::ffi::CString::new(a.as_os_str().as_bytes()).map_err(std::io::Error::other)?;
+        let cb = std::ffi::CString::new(b.as_os_str().as_bytes()).map_err(std::io::Error::other)?;
+        // SAFETY: two valid NUL-terminated paths, relative to the working folder.
+        let r = unsafe {
+            libc::renameat2(
+                libc::AT_FDCWD,
+                ca.as_ptr(),
+                libc::AT_FDCWD,
+                cb.as_ptr(),
+                libc::RENAME_EXCHANGE,
+            )
+        };
+        if r == 0 {
+            return Ok(true);
+        }
+        let e = std::io::Error::last_os_error();
+        match e.raw_os_error() {
+            // Not supported by this kernel or file system: fall back.
+            Some(libc::EINVAL) | Some(libc::ENOSYS) | Some(libc::ENOTSUP) => Ok(false),
+            _ => Err(e),
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        let _ = (a, b);
+        Ok(false)
+    }
+}
+
+impl ResultSet {
+    /// Starts a result set for `target` (see the module documentation).
+    /// `legacy` names the files an older rendersim wrote into such a folder
+    /// before sets were marked, so those folders can still be replaced.
+    pub fn begin(target: &Path, legacy: impl Fn(&str) -> bool) -> Result<Self, OutputError> {
+        let target = absolute_folder(&resolve_links(target)?)?;
+        check_replaceable(&target, &legacy)?;
+        let parent = parent_of(&target);
+        std::fs::create_dir_all(&parent).map_err(OutputError::io("creating folder", &parent))?;
+        let name = file_name(&target);
+        remove_stale(&parent, &name);
+        let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        if staging.exists() {
+            let _ = std::fs::remove_dir_all(&staging);
+        }
+        let registered = Registered::new(&staging);
+        std::fs::create_dir(&staging).map_err(OutputError::io("creating folder", &staging))?;
+        Ok(ResultSet {
+            target,
+            staging,
+            registered: Some(registered),
+        })
+    }
+
+    /// The folder to write the set's files into.
+    pub fn dir(&self) -> &Path {
+        &self.staging
+    }
+
+    /// The folder the set will replace.
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// Puts the finished set in place of the target folder; returns it.
+    pub fn commit(self) -> Result<PathBuf, OutputError> {
+        let target = self.target.clone();
+        self.commit_to(&target)
+    }
+
+    /// Puts the finished set in place of `other` instead (for example the
+    /// partial results of a failed experiment, kept beside the old set);
+    /// `other` must be replaceable as a result set too.
+    pub fn commit_to(mut self, other: &Path) -> Result<PathBuf, OutputError> {
+        let target = absolute_folder(&resolve_links(other)?)?;
+        if target != self.target {
+            check_replaceable(&target, &|_| false)?;
+        }
+        let marker = self.staging.join(MARKER);
+        std::fs::write(
+            &marker,
+            format!(
+                "This folder is a result set written by rendersim {}; rendersim replaces it as a whole when it writes here again.\n",
+                env!("CARGO_PKG_VERSION")
+            ),
+        )
+        .map_err(OutputError::io("writing", &marker))?;
+        let staging = self.staging.clone();
+        let swapped = while_locked(|| -> Result<Option<PathBuf>, OutputError> {
+            if !target.exists() {
+                std::fs::rename(&staging, &target).map_err(OutputError::io("moving the results to", &target))?;
+                return Ok(None);
+            }
+            if exchange(&staging, &target).map_err(OutputError::io("moving the results to", &target))? {
+                // The staging path now holds the old set.
+                return Ok(Some(staging.clone()));
+            }
+            let name = file_name(&target);
+            let old = parent_of(&target).join(format!(".{name}.old-{}", std::process::id()));
+            std::fs::rename(&target, &old).map_err(OutputError::io("moving the old results from", &target))?;
+            std::fs::rename(&staging, &target).map_err(OutputError::io("moving the results to", &target))?;
+            Ok(Some(old))
+        })?;
+        if let Some(old) = swapped {
+            let _ = std::fs::remove_dir_all(&old);
+        }
+        self.registered.take();
+        Ok(target)
+    }
+}
+
+impl Drop for ResultSet {
+    fn drop(&mut self) {
+        if self.registered.is_some() {
+            let _ = std::fs::remove_dir_all(&self.staging);
+            self.registered.take();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn files(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn a_new_set_replaces_the_old_one_whole() {
+        let d = tempfile::tempdir().unwrap();
+        let out = d.path().join("out");
+        let s = ResultSet::begin(&out, |_| false).unwrap();
+        std::fs::write(s.dir().join("a.csv"), "1").unwrap();
+        std::fs::write(s.dir().join("b.csv"), "1").unwrap();
+        s.commit().unwrap();
+        let s = ResultSet::begin(&out, |_| false).unwrap();
+        std::fs::write(s.dir().join("a.csv"), "2").unwrap();
+        s.commit().unwrap();
+        assert_eq!(files(&out), vec![MARKER.to_string(), "a.csv".into()]);
+        assert_eq!(std::fs::read_to_string(out.join("a.csv")).unwrap(), "2");
+        assert_eq!(files(d.path()), vec!["out".to_string()], "no staging left");
+    }
+
+    #[test]
+    fn an_abandoned_set_leaves_the_old_one_and_no_staging() {
+        let d = tempfile::tempdir().unwrap();
+        let out = d.path().join("out");
+        let s = ResultSet::begin(&out, |_| false).unwrap();
+        std::fs::write(s.dir().join("a.csv"), "1").unwrap();
+        s.commit().unwrap();
+        let s = ResultSet::begin(&out, |_| false).unwrap();
+        std::fs::write(s.dir().join("a.csv"), "2").unwrap();
+        drop(s);
+        assert_eq!(std::fs::read_to_string(out.join("a.csv")).unwrap(), "1");
+        assert_eq!(files(d.path()), vec!["out".to_string()]);
+    }
+
+    #[test]
+    fn a_folder_with_other_files_is_refused_before_any_work() {
+        let d = tempfile::tempdir().unwrap();
+        std::fs::write(d.path().join("thesis.tex"), "mine").unwrap();
+        let e = ResultSet::begin(d.path(), |_| false).unwrap_err();
+        assert!(matches!(e, OutputError::ForeignFolder { .. }), "{e}");
+        assert!(e.to_string().contains("thesis.tex"), "{e}");
+        assert_eq!(std::fs::read_to_string(d.path().join("thesis.tex")).unwrap(), "mine");
+        // A file where a folder is wanted.
+        let e = ResultSet::begin(&d.path().join("thesis.tex"), |_| false).unwrap_err();
+        assert!(matches!(e, OutputError::NotAFolder { .. }), "{e}");
+        // Files an older rendersim wrote are accepted.
+        let old = d.path().join("old");
+        std::fs::create_dir(&old).unwrap();
+        std::fs::write(old.join("summary.json"), "{}").unwrap();
+        let s = ResultSet::begin(&old, |n| n == "summary.json").unwrap();
+        s.commit().unwrap();
+        assert_eq!(files(&old), vec![MARKER.to_string()]);
+    }
+
+    #[test]
+    fn staging_left_by_a_dead_process_is_removed() {
+        let d = tempfile::tempdir().unwrap();
+        // PIDs are below 2^22 on Linux; this one does not run.
+        let stale = d.path().join(".out.partial-4194999");
+        std::fs::create_dir(&stale).unwrap();
+        std::fs::write(stale.join("a.csv"), "x").unwrap();
+        let s = ResultSet::begin(&d.path().join("out"), |_| false).unwrap();
+        assert!(!stale.exists());
+        s.commit().unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_to_a_folder_stays_a_link() {
+        let d = tempfile::tempdir().unwrap();
+        let real = d.path().join("real");
+        let link = d.path().join("link");
+        std::os::unix::fs::symlink("real", &link).unwrap();
+        let s = ResultSet::begin(&link, |_| false).unwrap();
+        std::fs::write(s.dir().join("a.csv"), "1").unwrap();
+        s.commit().unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read_to_string(real.join("a.csv")).unwrap(), "1");
+    }
+
+    #[test]
+    fn commit_to_another_folder_keeps_the_target() {
+        let d = tempfile::tempdir().unwrap();
+        let out = d.path().join("out");
+        let s = ResultSet::begin(&out, |_| false).unwrap();
+        std::fs::write(s.dir().join("a.csv"), "good").unwrap();
+        s.commit().unwrap();
+        let s = ResultSet::begin(&out, |_| false).unwrap();
+        std::fs::write(s.dir().join("a.csv"), "partial").unwrap();
+        let failed = d.path().join("out.failed");
+        s.commit_to(&failed).unwrap();
+        assert_eq!(std::fs::read_to_string(out.join("a.csv")).unwrap(), "good");
+        assert_eq!(std::fs::read_to_string(failed.join("a.csv")).unwrap(), "partial");
+    }
+}

@@ -1,0 +1,370 @@
+//! Outputs never damage what their paths name, and result sets are atomic
+//! as sets: FIFOs and links stay what they are, a folder holding other files
+//! is refused before any simulation, and a kill at any moment of a run or an
+//! experiment leaves the earlier results whole. Everything happens inside
+//! temp folders the tests create.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_rendersim"))
+}
+
+fn model(dir: &Path) -> String {
+    let p = dir.join("m.toml");
+    std::fs::write(
+        &p,
+        "[run]\nframes = 20\n[noise]\nenabled = false\n[workload]\nkind = \"fixed\"\ncpu = \"2ms\"\ngpu = \"9ms\"\n",
+    )
+    .unwrap();
+    p.display().to_string()
+}
+
+fn ok(cmd: &mut Command) -> String {
+    let o = cmd.output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    String::from_utf8(o.stdout).unwrap()
+}
+
+fn err(cmd: &mut Command) -> String {
+    let o = cmd.output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+/// Every file under `dir` with its bytes, sorted by name.
+fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (
+                e.file_name().to_string_lossy().to_string(),
+                std::fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+/// Names in `dir` that start with `.NAME.` (staging and swapped-out folders).
+fn leftovers(dir: &Path, name: &str) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter(|n| n.starts_with(&format!(".{name}.")))
+        .collect()
+}
+
+#[cfg(unix)]
+fn mkfifo(p: &Path) {
+    let c = std::ffi::CString::new(p.to_str().unwrap()).unwrap();
+    // SAFETY: a valid NUL-terminated path inside a temp folder.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+}
+
+#[cfg(unix)]
+fn is_fifo(p: &Path) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    std::fs::symlink_metadata(p).unwrap().file_type().is_fifo()
+}
+
+#[cfg(unix)]
+fn signal(child: &Child, sig: i32) {
+    // SAFETY: sending a signal to our own child process.
+    assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, sig) }, 0);
+}
+
+/// Polls until `cond` holds (the process under test gets there by itself;
+/// the bound only keeps a broken build from hanging the suite).
+fn wait_for(what: &str, mut cond: impl FnMut() -> bool) {
+    for _ in 0..6000 {
+        if cond() {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    panic!("never happened: {what}");
+}
+
+#[cfg(unix)]
+#[test]
+fn a_closed_output_pipe_ends_quietly_without_a_panic() {
+    let d = tempfile::tempdir().unwrap();
+    let mut child = bin()
+        .args(["run", &model(d.path()), "--trace", "-"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The reader goes away at once, like `| head -c 0`.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_ne!(out.status.code(), Some(101), "{err}");
+}
+
+#[test]
+fn a_trace_on_standard_output_is_the_whole_output() {
+    let d = tempfile::tempdir().unwrap();
+    let out = ok(bin().args(["run", &model(d.path()), "--trace", "-"]));
+    let v: serde_json::Value = serde_json::from_str(&out).expect("stdout is the trace alone");
+    assert!(v["traceEvents"].as_array().unwrap().len() > 20);
+}
+
+#[cfg(unix)]
+#[test]
+fn a_trace_into_a_fifo_arrives_whole_and_the_fifo_stays_a_fifo() {
+    let d = tempfile::tempdir().unwrap();
+    let fifo = d.path().join("trace.pipe");
+    mkfifo(&fifo);
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read(&fifo).unwrap())
+    };
+    ok(bin().args(["run", &model(d.path()), "--trace", fifo.to_str().unwrap()]));
+    let bytes = reader.join().unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&bytes).expect("the reader got the whole trace");
+    assert!(v["traceEvents"].as_array().unwrap().len() > 20);
+    assert!(is_fifo(&fifo), "the FIFO was replaced");
+}
+
+#[cfg(unix)]
+#[test]
+fn a_trace_through_a_link_replaces_the_target_and_keeps_the_link() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(d.path().join("real.json"), "old").unwrap();
+    let link = d.path().join("trace.json");
+    std::os::unix::fs::symlink("real.json", &link).unwrap();
+    ok(bin().args(["run", &model(d.path()), "--trace", link.to_str().unwrap()]));
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(d.path().join("real.json")).unwrap()).unwrap();
+    assert!(v["traceEvents"].is_array());
+    // A folder as the trace is refused before the run.
+    let e = err(bin().args(["run", &model(d.path()), "--trace", d.path().to_str().unwrap()]));
+    assert!(e.contains("is a folder"), "{e}");
+}
+
+#[test]
+fn out_refuses_a_folder_holding_other_files_before_simulating() {
+    let d = tempfile::tempdir().unwrap();
+    let mine = d.path().join("thesis");
+    std::fs::create_dir(&mine).unwrap();
+    std::fs::write(mine.join("chapter1.tex"), "years of work").unwrap();
+    let m = model(d.path());
+    let e = err(bin().args(["run", &m, "--frames", "100000000", "--out", mine.to_str().unwrap()]));
+    assert!(
+        e.contains("chapter1.tex") && e.contains("rendersim did not write"),
+        "{e}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(mine.join("chapter1.tex")).unwrap(),
+        "years of work"
+    );
+    // Under a file, a folder cannot be made: also before simulating.
+    let e = err(bin().args([
+        "run",
+        &m,
+        "--frames",
+        "100000000",
+        "--out",
+        mine.join("chapter1.tex/out").to_str().unwrap(),
+    ]));
+    assert!(e.contains("chapter1.tex"), "{e}");
+    // An experiment likewise.
+    let exp = d.path().join("e.toml");
+    std::fs::write(
+        &exp,
+        "name = \"e\"\nmodel = \"m.toml\"\n[[metric]]\npath = \"frames\"\n",
+    )
+    .unwrap();
+    let e = err(bin().args([
+        "experiment",
+        exp.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        mine.to_str().unwrap(),
+    ]));
+    assert!(e.contains("chapter1.tex"), "{e}");
+}
+
+#[test]
+fn a_rerun_replaces_the_whole_set_and_leaves_nothing_beside_it() {
+    let d = tempfile::tempdir().unwrap();
+    let m = model(d.path());
+    let out = d.path().join("out");
+    ok(bin().args(["run", &m, "--seed", "1", "--out", out.to_str().unwrap()]));
+    let first = snapshot(&out);
+    let names: Vec<&str> = first.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, [".rendersim-set", "frames.csv", "model.toml", "summary.json"]);
+    ok(bin().args(["run", &m, "--seed", "2", "--out", out.to_str().unwrap()]));
+    let second = snapshot(&out);
+    assert_ne!(first, second);
+    assert!(leftovers(d.path(), "out").is_empty());
+    // A folder written by an older rendersim (no marker, only its files) is accepted.
+    std::fs::remove_file(out.join(".rendersim-set")).unwrap();
+    ok(bin().args(["run", &m, "--out", out.to_str().unwrap()]));
+}
+
+/// `run --out DIR --trace FIFO` with no reader blocks after the set is
+/// staged and before it is swapped in: the write phase, held open.
+#[cfg(unix)]
+fn start_run_held_in_its_write_phase(d: &Path, out: &Path) -> (Child, PathBuf) {
+    let fifo = d.join("held.pipe");
+    if !fifo.exists() {
+        mkfifo(&fifo);
+    }
+    let child = bin()
+        .args([
+            "run",
+            &model(d),
+            "--seed",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+            "--trace",
+            fifo.to_str().unwrap(),
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let staging = out.with_file_name(format!(".out.partial-{}", child.id()));
+    let staged = staging.join("model.toml");
+    wait_for("the new set staged", || staged.exists());
+    (child, staging)
+}
+
+#[cfg(unix)]
+#[test]
+fn a_kill_in_the_write_phase_of_a_run_leaves_the_old_set() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("out");
+    ok(bin().args(["run", &model(d.path()), "--seed", "1", "--out", out.to_str().unwrap()]));
+    let old = snapshot(&out);
+
+    // SIGTERM (and SIGINT alike): the staging folder is removed.
+    let (mut child, staging) = start_run_held_in_its_write_phase(d.path(), &out);
+    signal(&child, libc::SIGTERM);
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(128 + libc::SIGTERM));
+    assert_eq!(snapshot(&out), old);
+    assert!(!staging.exists(), "staging removed on SIGTERM");
+    assert!(leftovers(d.path(), "out").is_empty());
+
+    // SIGKILL cannot be caught: the old set stays; the next run clears the staging left behind.
+    let (mut child, staging) = start_run_held_in_its_write_phase(d.path(), &out);
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert_eq!(snapshot(&out), old);
+    assert!(staging.exists());
+    ok(bin().args(["run", &model(d.path()), "--seed", "3", "--out", out.to_str().unwrap()]));
+    assert!(!staging.exists(), "stale staging removed");
+    assert_ne!(snapshot(&out), old);
+    assert!(leftovers(d.path(), "out").is_empty());
+}
+
+#[cfg(unix)]
+#[test]
+fn a_kill_during_an_experiment_leaves_the_old_set() {
+    let d = tempfile::tempdir().unwrap();
+    model(d.path());
+    let exp = d.path().join("e.toml");
+    let write_exp = |replications: u32| {
+        std::fs::write(
+            &exp,
+            format!(
+                "name = \"e\"\nmodel = \"m.toml\"\nreplications = {replications}\n[set]\n\"run.frames\" = 2000\n\
+                 [[metric]]\npath = \"metrics.frame_time_ms.mean\"\n"
+            ),
+        )
+        .unwrap()
+    };
+    let out = d.path().join("out");
+    write_exp(2);
+    ok(bin().args([
+        "experiment",
+        exp.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    let old = snapshot(&out);
+    assert!(old.iter().any(|(n, _)| n == "runs.csv"));
+
+    write_exp(400);
+    let mut child = bin()
+        .args([
+            "experiment",
+            exp.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let staging = d.path().join(format!(".out.partial-{}", child.id()));
+    wait_for("the staging folder", || staging.exists());
+    signal(&child, libc::SIGINT);
+    let status = child.wait().unwrap();
+    if status.code() == Some(128 + libc::SIGINT) {
+        assert_eq!(snapshot(&out), old, "the old set, whole");
+    } else {
+        // It finished before the signal landed: then the new set, whole.
+        assert!(status.success());
+        assert!(
+            snapshot(&out)
+                .iter()
+                .any(|(n, b)| n == "runs.csv" && b.len() > old.len())
+        );
+    }
+    assert!(leftovers(d.path(), "out").is_empty());
+}
+
+#[test]
+fn a_failed_experiment_keeps_the_old_set_and_puts_finished_runs_beside_it() {
+    let d = tempfile::tempdir().unwrap();
+    model(d.path());
+    let exp = d.path().join("e.toml");
+    let out = d.path().join("out");
+    std::fs::write(
+        &exp,
+        "name = \"e\"\nmodel = \"m.toml\"\n[[sweep]]\nkey = \"workload.gpu\"\nvalues = [\"5ms\", \"9ms\"]\n\
+         [[metric]]\npath = \"metrics.frame_time_ms.mean\"\n",
+    )
+    .unwrap();
+    ok(bin().args([
+        "experiment",
+        exp.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    let old = snapshot(&out);
+    // The second point now fails when it runs (a metric it does not have).
+    std::fs::write(
+        &exp,
+        "name = \"e\"\nmodel = \"m.toml\"\n[[sweep]]\nkey = \"workload.gpu\"\nvalues = [\"5ms\", \"9ms\"]\n\
+         [[metric]]\npath = \"metrics.no_such_metric\"\n",
+    )
+    .unwrap();
+    let e = err(bin().args([
+        "experiment",
+        exp.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    assert!(e.contains("unchanged"), "{e}");
+    assert_eq!(snapshot(&out), old);
+    assert!(leftovers(d.path(), "out").is_empty());
+}
