@@ -27,21 +27,28 @@ fi
 .venv/bin/pip install --quiet --disable-pip-version-check -r notebooks/requirements.txt
 
 step "Build (release, once, with the wgpu measurement feature)"
-mkdir -p out/ci
+# Everything the tests write goes into a temp folder made here, removed at
+# the end (set RENDERSIM_KEEP_CI_OUT=1 to keep it for a look).
+ci_out=$(mktemp -d "${TMPDIR:-/tmp}/rendersim-ci.XXXXXX")
+if [ -z "${RENDERSIM_KEEP_CI_OUT:-}" ]; then
+  trap 'rm -rf "$ci_out"' EXIT
+else
+  echo "outputs kept in $ci_out"
+fi
 cargo build --release --locked --all-targets --features wgpu
 export RENDERSIM_BIN="$root/target/release/rendersim"
 
 step "Rust tests (unit, property, integration, doc; wgpu measurements on lavapipe)"
-cargo test --release --locked --no-fail-fast --features wgpu 2>&1 | tee target/test-output.txt
-grep -q "test result:" target/test-output.txt
+cargo test --release --locked --no-fail-fast --features wgpu 2>&1 | tee "$ci_out/test-output.txt"
+grep -q "test result:" "$ci_out/test-output.txt"
 
 step "Studies H1-H4 on this machine's adapter (H1 must predict its validation meshes exactly)"
 if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
-  if ! "$RENDERSIM_BIN" study all --markdown out/ci/studies.md > out/ci/studies.txt 2> out/ci/studies.err; then
-    cat out/ci/studies.txt out/ci/studies.err
+  if ! "$RENDERSIM_BIN" study all --markdown "$ci_out/studies.md" > "$ci_out/studies.txt" 2> "$ci_out/studies.err"; then
+    cat "$ci_out/studies.txt" "$ci_out/studies.err"
     exit 1
   fi
-  head -n 4 out/ci/studies.txt
+  head -n 4 "$ci_out/studies.txt"
 else
   echo "no Vulkan driver installed: studies skipped"
 fi
@@ -50,7 +57,7 @@ step "Experiments"
 for f in experiments/*.toml; do
   name=$(basename "$f" .toml)
   echo "-- $name"
-  "$RENDERSIM_BIN" experiment "$f" --out "out/ci/$name" --quiet | tail -n 3
+  "$RENDERSIM_BIN" experiment "$f" --out "$ci_out/$name" --quiet | tail -n 3
 done
 
 step "Notebooks"
