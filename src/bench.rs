@@ -124,7 +124,7 @@ fn run_default_with(sets: &[&str]) -> Result<(serde_json::Value, f64), String> {
         apply_set(&mut t, s).map_err(|e| e.to_string())?;
     }
     let start = Instant::now();
-    let r = run_model(&src, &t, false).map_err(|e| e.to_string())?;
+    let r = run_model(&src, &t, None).map_err(|e| e.to_string())?;
     Ok((r.summary().clone(), start.elapsed().as_secs_f64()))
 }
 
@@ -222,7 +222,7 @@ pub fn pixelflow_figures_at(counts: u32, fidelity: &str) -> Result<(u64, u64, f6
                     ] {
                         apply_set(&mut t, &s).map_err(|e| e.to_string())?;
                     }
-                    let r = run_model(&src, &t, false).map_err(|e| e.to_string())?;
+                    let r = run_model(&src, &t, None).map_err(|e| e.to_string())?;
                     events += r.summary()["events"]["total"].as_u64().unwrap_or(0);
                     runs += 1;
                 }

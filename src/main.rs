@@ -9,8 +9,9 @@ use clap::{Parser, Subcommand};
 use serde_json::json;
 
 use rendersim::config::{ModelSource, apply_set};
-use rendersim::output::files::write_output;
+use rendersim::output::files::{open_output, write_output};
 use rendersim::output::result_set::ResultSet;
+use rendersim::output::trace::TraceWriter;
 use rendersim::systems::{DEFAULT_MODEL, SystemRun, run_model};
 
 #[derive(Parser)]
@@ -316,10 +317,25 @@ fn cmd_run(
         Some(dir) => Some(ResultSet::begin(dir, |name| RUN_FILES.contains(&name))?),
         None => None,
     };
-    if let Some(path) = &trace {
-        rendersim::output::files::destination(path)?;
-    }
-    let mut run = run_model(&src, &table, trace.is_some())?;
+    // The trace is written while the simulation runs (memory stays flat).
+    // A trace inside the --out folder belongs to the result set.
+    let trace = trace.map(|path| match &set {
+        Some(set)
+            if path.file_name().is_some()
+                && path.parent().and_then(|p| std::path::absolute(p).ok()).as_deref() == Some(set.target()) =>
+        {
+            set.dir().join(path.file_name().unwrap_or_default())
+        }
+        _ => path,
+    });
+    let (trace_file, writer) = match &trace {
+        Some(path) => {
+            let (file, w) = open_output(path)?;
+            (Some(file), Some(TraceWriter::new(w)))
+        }
+        None => (None, None),
+    };
+    let mut run = run_model(&src, &table, writer)?;
     run.summary_mut()["model"] = json!(src.name);
     if let Some(set) = &set {
         let dir = set.dir();
@@ -333,9 +349,11 @@ fn cmd_run(
     }
     // The trace first, then the folder is swapped in: a run whose trace
     // could not be written leaves the earlier results as they were.
-    if let Some(path) = &trace {
-        write_output(path, |w| run.write_trace(w).map(|_| ()))
+    if let (Some(file), Some(writer), Some(path)) = (trace_file, run.take_trace(), &trace) {
+        writer
+            .finish()
             .with_context(|| format!("writing trace {}", path.display()))?;
+        file.commit()?;
     }
     if let Some(set) = set {
         set.commit()?;

@@ -17,7 +17,7 @@ fn try_run(text: &str, sets: &[&str]) -> Result<SystemRun, String> {
     for s in sets {
         apply_set(&mut t, s).map_err(|e| e.to_string())?;
     }
-    run_model(&src, &t, false).map_err(|e| e.to_string())
+    run_model(&src, &t, None).map_err(|e| e.to_string())
 }
 
 fn summary(text: &str, sets: &[&str]) -> Value {
@@ -244,7 +244,8 @@ fn bad_input_gives_clear_errors() {
 
 #[test]
 fn cli_writes_json_csv_and_trace() {
-    let dir = std::env::temp_dir().join(format!("rendersim-mfr-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("out");
     let trace = dir.join("trace.json");
     let o = Command::new(env!("CARGO_BIN_EXE_rendersim"))
         .args([

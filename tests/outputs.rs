@@ -213,32 +213,24 @@ fn a_rerun_replaces_the_whole_set_and_leaves_nothing_beside_it() {
     ok(bin().args(["run", &m, "--out", out.to_str().unwrap()]));
 }
 
-/// `run --out DIR --trace FIFO` with no reader blocks after the set is
-/// staged and before it is swapped in: the write phase, held open.
+/// Starts `run --out DIR` held by `RENDERSIM_HOLD_BEFORE_SWAP` with its new
+/// set fully staged, just before the swap: the last moment of its write phase.
 #[cfg(unix)]
 fn start_run_held_in_its_write_phase(d: &Path, out: &Path) -> (Child, PathBuf) {
-    let fifo = d.join("held.pipe");
-    if !fifo.exists() {
-        mkfifo(&fifo);
-    }
+    let flag = d.join("held");
+    let _ = std::fs::remove_file(&flag);
     let child = bin()
-        .args([
-            "run",
-            &model(d),
-            "--seed",
-            "2",
-            "--out",
-            out.to_str().unwrap(),
-            "--trace",
-            fifo.to_str().unwrap(),
-        ])
+        .args(["run", &model(d), "--seed", "2", "--out", out.to_str().unwrap()])
+        .env("RENDERSIM_HOLD_BEFORE_SWAP", &flag)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
     let staging = out.with_file_name(format!(".out.partial-{}", child.id()));
-    let staged = staging.join("model.toml");
-    wait_for("the new set staged", || staged.exists());
+    wait_for("the new set staged", || flag.exists());
+    for f in ["summary.json", "frames.csv", "model.toml", ".rendersim-set"] {
+        assert!(staging.join(f).exists(), "{f} staged");
+    }
     (child, staging)
 }
 
@@ -268,6 +260,14 @@ fn a_kill_in_the_write_phase_of_a_run_leaves_the_old_set() {
     ok(bin().args(["run", &model(d.path()), "--seed", "3", "--out", out.to_str().unwrap()]));
     assert!(!staging.exists(), "stale staging removed");
     assert_ne!(snapshot(&out), old);
+    assert!(leftovers(d.path(), "out").is_empty());
+
+    // Released instead of killed, the held run swaps its set in.
+    let (mut child, _) = start_run_held_in_its_write_phase(d.path(), &out);
+    std::fs::remove_file(d.path().join("held")).unwrap();
+    assert!(child.wait().unwrap().success());
+    let seed2 = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    assert!(seed2.contains("\"seed\": 2"), "{seed2}");
     assert!(leftovers(d.path(), "out").is_empty());
 }
 

@@ -232,7 +232,13 @@ fn tracing_does_not_change_results_at_either_fidelity() {
         ] {
             rendersim::config::apply_set(&mut t, &s).unwrap();
         }
-        let get = |trace: bool| match run_model(&src, &t, trace).unwrap() {
+        let get = |trace: bool| match run_model(
+            &src,
+            &t,
+            trace.then(|| rendersim::output::trace::TraceWriter::new(Box::new(std::io::sink()))),
+        )
+        .unwrap()
+        {
             SystemRun::FramePipeline(r) => *r,
             _ => panic!("not a frame-pipeline run"),
         };

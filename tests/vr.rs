@@ -15,7 +15,7 @@ fn try_run(text: &str, sets: &[&str]) -> Result<SystemRun, String> {
     for s in sets {
         apply_set(&mut t, s).map_err(|e| e.to_string())?;
     }
-    run_model(&src, &t, false).map_err(|e| e.to_string())
+    run_model(&src, &t, None).map_err(|e| e.to_string())
 }
 
 fn summary(text: &str, sets: &[&str]) -> Value {
@@ -156,10 +156,14 @@ fn bad_input_gives_clear_errors() {
 #[test]
 fn trace_has_a_track_per_stage_without_overlaps() {
     for (text, tracks) in [(NAIVE, vec![2, 3, 5]), (WARP, vec![2, 3, 4, 5])] {
-        let run = try_run(text, &["run.events=100"]).unwrap();
-        let mut buf = Vec::new();
-        assert!(run.write_trace(&mut buf).unwrap());
-        let t: Value = serde_json::from_slice(&buf).unwrap();
+        let file = tempfile::NamedTempFile::new().unwrap();
+        let writer = rendersim::output::trace::TraceWriter::new(Box::new(file.reopen().unwrap()));
+        let src = ModelSource::from_text("test.toml", text);
+        let mut t = src.table().unwrap();
+        apply_set(&mut t, "run.events=100").unwrap();
+        let mut run = run_model(&src, &t, Some(writer)).unwrap();
+        assert!(run.take_trace().unwrap().finish().unwrap() > 0);
+        let t: Value = serde_json::from_slice(&std::fs::read(file.path()).unwrap()).unwrap();
         let mut by_tid: std::collections::BTreeMap<u64, Vec<(f64, f64)>> = Default::default();
         for e in t["traceEvents"].as_array().unwrap() {
             if e["ph"] == "X" {
@@ -230,5 +234,5 @@ fn summary_mfr() -> Value {
     let src = ModelSource::from_text("mfr-cluster.toml", include_str!("../models/mfr-cluster.toml"));
     let mut t = src.table().unwrap();
     apply_set(&mut t, "run.events=100").unwrap();
-    run_model(&src, &t, false).unwrap().summary().clone()
+    run_model(&src, &t, None).unwrap().summary().clone()
 }

@@ -31,7 +31,7 @@ impl Runner for SimRunner {
             base_dir: self.base_dir.clone(),
             overrides: Vec::new(),
         };
-        let run = run_model(&src, &table, false).map_err(|e| e.to_string())?;
+        let run = run_model(&src, &table, None).map_err(|e| e.to_string())?;
         let warmup = run
             .summary()
             .get("warmup_frames")

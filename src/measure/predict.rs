@@ -115,7 +115,7 @@ pub fn simulate_pass(m: &PassModel) -> Result<PassPrediction, PredictError> {
     let src = ModelSource::from_text("<measured pass>", &m.toml());
     let table = src.table().map_err(SimError::from)?;
     let t = std::time::Instant::now();
-    let run = run_model(&src, &table, false)?;
+    let run = run_model(&src, &table, None)?;
     let wall_seconds = t.elapsed().as_secs_f64();
     let SystemRun::FramePipeline(r) = run else {
         return Err(PredictError::Missing("a frame-pipeline run"));

@@ -8,7 +8,7 @@
 //!   `/dev/stdout` or a FIFO by a regular file would break every later
 //!   reader of it);
 //! - a regular file, a symbolic link to one (the link is followed and kept),
-//!   or nothing yet: written next to the final file under a temporary name
+//!   or nothing yet (missing folders above it are made): written next to the final file under a temporary name
 //!   and renamed over it, so a reader never sees half a file and a failure or
 //!   an interrupt leaves the old file as it was.
 //!
@@ -82,63 +82,109 @@ pub fn destination(path: &Path) -> Result<Destination, OutputError> {
     }
 }
 
-/// Writes the output `path` through `fill` (see the module documentation for
-/// what happens to FIFOs, devices, links and `-`).
-pub fn write_output(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<(), OutputError> {
+/// An output file open for writing while a run goes on (a trace streamed
+/// from the simulation). Write through the writer [`open_output`] returns,
+/// drop it, then [`OutputFile::commit`] puts the file in place. Dropping an
+/// uncommitted `OutputFile` removes its temporary file; the old file stays.
+#[derive(Debug)]
+pub struct OutputFile {
+    /// For a replaced file: (temporary, final) paths.
+    replace: Option<(PathBuf, PathBuf)>,
+    registered: Option<Registered>,
+}
+
+/// Opens the output `path` (see the module documentation for what happens
+/// to FIFOs, devices, links and `-`). Opening a FIFO waits for its reader.
+pub fn open_output(path: &Path) -> Result<(OutputFile, Box<dyn Write + Send>), OutputError> {
     match destination(path)? {
-        Destination::Stdout => {
-            let stdout = std::io::stdout();
-            let mut w = std::io::BufWriter::new(stdout.lock());
-            fill(&mut w)
-                .and_then(|()| w.flush())
-                .map_err(OutputError::io("writing", "standard output"))
-        }
+        Destination::Stdout => Ok((
+            OutputFile {
+                replace: None,
+                registered: None,
+            },
+            Box::new(std::io::BufWriter::new(std::io::stdout())),
+        )),
         Destination::InPlace(p) => {
             let f = std::fs::OpenOptions::new()
                 .write(true)
                 .open(&p)
                 .map_err(OutputError::io("opening", &p))?;
-            let mut w = std::io::BufWriter::new(f);
-            fill(&mut w)
-                .and_then(|()| w.flush())
-                .map_err(OutputError::io("writing", &p))
+            Ok((
+                OutputFile {
+                    replace: None,
+                    registered: None,
+                },
+                Box::new(std::io::BufWriter::new(f)),
+            ))
         }
-        Destination::Replace(p) => write_atomic(&p, fill).map_err(OutputError::io("writing", &p)),
+        Destination::Replace(p) => {
+            let dir = p
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            let name = p
+                .file_name()
+                .map(|n| n.to_string_lossy().to_string())
+                .unwrap_or_else(|| "out".into());
+            std::fs::create_dir_all(dir).map_err(OutputError::io("creating folder", dir))?;
+            let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+            let registered = Registered::new(&tmp);
+            let f = std::fs::File::create(&tmp).map_err(OutputError::io("creating", &tmp))?;
+            Ok((
+                OutputFile {
+                    replace: Some((tmp, p)),
+                    registered: Some(registered),
+                },
+                Box::new(std::io::BufWriter::new(f)),
+            ))
+        }
     }
 }
 
-/// Writes the regular file `path` through `fill`, atomically: into a
-/// temporary sibling (removed on failure or interrupt), then renamed over
-/// `path`, keeping the old file's permissions. `path` must not be a
-/// symbolic link or special file; [`write_output`] sorts those out.
-pub fn write_atomic(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> std::io::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_else(|| "out".into());
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let registered = Registered::new(&tmp);
-    let result = (|| {
-        let f = std::fs::File::create(&tmp)?;
-        let mut w = std::io::BufWriter::new(f);
-        fill(&mut w)?;
-        w.flush()?;
-        let f = w.into_inner().map_err(|e| e.into_error())?;
-        if let Ok(old) = std::fs::metadata(path) {
-            f.set_permissions(old.permissions())?;
+impl OutputFile {
+    /// Puts the written file in place (a rename over the old one, keeping
+    /// its permissions); nothing to do for files written in place. Flush and
+    /// drop the writer first.
+    pub fn commit(mut self) -> Result<(), OutputError> {
+        if let Some((tmp, path)) = self.replace.take() {
+            let r = (|| {
+                if let Ok(old) = std::fs::metadata(&path) {
+                    std::fs::set_permissions(&tmp, old.permissions())?;
+                }
+                super::cleanup::while_locked(|| std::fs::rename(&tmp, &path))
+            })();
+            if let Err(e) = r {
+                let _ = std::fs::remove_file(&tmp);
+                return Err(OutputError::io("writing", &path)(e));
+            }
         }
-        drop(f);
-        super::cleanup::while_locked(|| std::fs::rename(&tmp, path))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+        self.registered.take();
+        Ok(())
     }
-    drop(registered);
-    result
+}
+
+impl Drop for OutputFile {
+    fn drop(&mut self) {
+        if let Some((tmp, _)) = self.replace.take() {
+            let _ = std::fs::remove_file(tmp);
+        }
+    }
+}
+
+/// Writes the output `path` through `fill` (see the module documentation
+/// for what happens to FIFOs, devices, links and `-`).
+pub fn write_output(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<(), OutputError> {
+    let (file, mut w) = open_output(path)?;
+    let shown = if path.as_os_str() == "-" {
+        PathBuf::from("standard output")
+    } else {
+        path.to_path_buf()
+    };
+    fill(&mut w)
+        .and_then(|()| w.flush())
+        .map_err(OutputError::io("writing", shown))?;
+    drop(w);
+    file.commit()
 }
 
 #[cfg(test)]
@@ -149,8 +195,8 @@ mod tests {
     fn failure_keeps_old_file() {
         let d = tempfile::tempdir().unwrap();
         let p = d.path().join("a.txt");
-        write_atomic(&p, |w| w.write_all(b"old")).unwrap();
-        let r = write_atomic(&p, |w| {
+        write_output(&p, |w| w.write_all(b"old")).unwrap();
+        let r = write_output(&p, |w| {
             w.write_all(b"partial")?;
             Err(std::io::Error::other("boom"))
         });

@@ -20,6 +20,9 @@
 //! staging folder left by a killed process is removed by the next `begin`
 //! on the same `DIR`.
 //!
+//! A test can hold a process between staging and swap with the environment
+//! variable `RENDERSIM_HOLD_BEFORE_SWAP` (see [`ResultSet::commit_to`]).
+//!
 //! Each set holds a marker file, [`MARKER`], which is how rendersim knows a
 //! folder is its own to replace. It never replaces a folder holding files
 //! it did not write.
@@ -200,6 +203,26 @@ fn exchange(a: &Path, b: &Path) -> std::io::Result<bool> {
     }
 }
 
+/// Testing aid: with `RENDERSIM_HOLD_BEFORE_SWAP=FILE` in the environment,
+/// a commit creates FILE once its set is fully staged and waits (at most ten
+/// minutes) until FILE is removed, so a test can interrupt a process at the
+/// last moment before the swap.
+fn hold_for_tests() {
+    let Some(flag) = std::env::var_os("RENDERSIM_HOLD_BEFORE_SWAP") else {
+        return;
+    };
+    let flag = PathBuf::from(flag);
+    if std::fs::write(&flag, std::process::id().to_string()).is_err() {
+        return;
+    }
+    for _ in 0..60_000 {
+        if !flag.exists() {
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+}
+
 impl ResultSet {
     /// Starts a result set for `target` (see the module documentation).
     /// `legacy` names the files an older rendersim wrote into such a folder
@@ -242,7 +265,9 @@ impl ResultSet {
 
     /// Puts the finished set in place of `other` instead (for example the
     /// partial results of a failed experiment, kept beside the old set);
-    /// `other` must be replaceable as a result set too.
+    /// `other` must be replaceable as a result set too. (With
+    /// `RENDERSIM_HOLD_BEFORE_SWAP=FILE` set, it first creates FILE and
+    /// waits until FILE is removed: a testing aid.)
     pub fn commit_to(mut self, other: &Path) -> Result<PathBuf, OutputError> {
         let target = absolute_folder(&resolve_links(other)?)?;
         if target != self.target {
@@ -257,6 +282,7 @@ impl ResultSet {
             ),
         )
         .map_err(OutputError::io("writing", &marker))?;
+        hold_for_tests();
         let staging = self.staging.clone();
         let swapped = while_locked(|| -> Result<Option<PathBuf>, OutputError> {
             if !target.exists() {

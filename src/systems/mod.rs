@@ -13,6 +13,7 @@ use std::io::Write;
 use serde_json::Value;
 
 use crate::config::{ConfigError, ModelSource, deserialize, invalid};
+use crate::output::trace::TraceWriter;
 
 /// The embedded default model (`models/default.toml`).
 pub const DEFAULT_MODEL: &str = include_str!("../../models/default.toml");
@@ -87,8 +88,10 @@ pub fn patched_table(src: &ModelSource, sets: &[String]) -> Result<toml::Table, 
     Ok(t)
 }
 
-/// Builds and runs the system a model describes.
-pub fn run_model(src: &ModelSource, table: &toml::Table, trace: bool) -> Result<SystemRun, SimError> {
+/// Builds and runs the system a model describes. With a `trace` writer, the
+/// run's trace is written into it (the frame pipeline's while it runs) and
+/// handed back by [`SystemRun::take_trace`], to be closed by the caller.
+pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWriter>) -> Result<SystemRun, SimError> {
     let system = table.get("system").and_then(|v| v.as_str()).unwrap_or("frame_pipeline");
     match system {
         "frame_pipeline" => {
@@ -104,7 +107,13 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: bool) -> Result<
         "multi_rate" => {
             let cfg: multi_rate::MultiRateConfig = deserialize(table, src)?;
             match multi_rate::run_multi_rate(cfg) {
-                Ok(r) => Ok(SystemRun::MultiRate(Box::new(r))),
+                Ok(mut r) => {
+                    r.trace = trace.map(|mut t| {
+                        multi_rate::run::write_trace(&r, &mut t);
+                        t
+                    });
+                    Ok(SystemRun::MultiRate(Box::new(r)))
+                }
                 Err(multi_rate::MultiRateError::Invalid { key, message }) => {
                     Err(SimError::Config(invalid(src, &key, message, None)))
                 }
@@ -114,15 +123,27 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: bool) -> Result<
         "vr" => {
             let cfg: vr::VrConfig = deserialize(table, src)?;
             match vr::run_vr(cfg) {
-                Ok(r) => Ok(SystemRun::Vr(Box::new(r))),
+                Ok(mut r) => {
+                    r.trace = trace.map(|mut t| {
+                        vr::run::write_trace(&r, &mut t);
+                        t
+                    });
+                    Ok(SystemRun::Vr(Box::new(r)))
+                }
                 Err(vr::VrError::Invalid { key, message }) => Err(SimError::Config(invalid(src, &key, message, None))),
                 Err(e) => Err(SimError::Vr(e)),
             }
         }
         "pixelflow" => {
             let cfg: pixelflow::PixelFlowConfig = deserialize(table, src)?;
-            match pixelflow::run_pixelflow(cfg, trace) {
-                Ok(r) => Ok(SystemRun::PixelFlow(Box::new(r))),
+            match pixelflow::run_pixelflow(cfg, trace.is_some()) {
+                Ok(mut r) => {
+                    r.trace = trace.map(|mut t| {
+                        pixelflow::run::write_trace(&r, &mut t);
+                        t
+                    });
+                    Ok(SystemRun::PixelFlow(Box::new(r)))
+                }
                 Err(pixelflow::PixelFlowError::Invalid { key, message }) => {
                     Err(SimError::Config(invalid(src, &key, message, None)))
                 }
@@ -241,13 +262,14 @@ impl SystemRun {
         }
     }
 
-    /// Writes a Chrome/Perfetto trace, if the run recorded one.
-    pub fn write_trace(&self, w: &mut dyn Write) -> std::io::Result<bool> {
+    /// The run's trace writer, all events written, for the caller to close
+    /// ([`TraceWriter::finish`]); `None` when no trace was asked for.
+    pub fn take_trace(&mut self) -> Option<TraceWriter> {
         match self {
-            SystemRun::FramePipeline(r) => crate::output::trace::write_pipeline_trace(r, w),
-            SystemRun::MultiRate(r) => multi_rate::run::write_trace(r, w),
-            SystemRun::Vr(r) => vr::run::write_trace(r, w),
-            SystemRun::PixelFlow(r) => pixelflow::run::write_trace(r, w),
+            SystemRun::FramePipeline(r) => r.trace.take(),
+            SystemRun::MultiRate(r) => r.trace.take(),
+            SystemRun::Vr(r) => r.trace.take(),
+            SystemRun::PixelFlow(r) => r.trace.take(),
         }
     }
 }

@@ -13,7 +13,7 @@ pub fn try_run(text: &str, sets: &[&str]) -> Result<PipelineRun, String> {
     for s in sets {
         apply_set(&mut t, s).map_err(|e| e.to_string())?;
     }
-    match run_model(&src, &t, false).map_err(|e| e.to_string())? {
+    match run_model(&src, &t, None).map_err(|e| e.to_string())? {
         SystemRun::FramePipeline(r) => Ok(*r),
         other => Err(format!("not a frame-pipeline run: {}", other.summary()["system"])),
     }

@@ -15,9 +15,11 @@
 //! submitted and drawn -> display.
 
 use crate::components::state_clock::StateClock;
-use crate::engine::Time;
+use crate::engine::{Duration, Time};
+use crate::output::trace::TraceWriter;
 
 use super::model::{CpuPhase, FramePipeline, FrontPhase};
+use super::records::FrameRecord;
 
 /// CPU states.
 pub const CPU_STATES: [&str; 5] = [
@@ -43,7 +45,7 @@ pub const FRAG_STATES: [&str; 2] = ["busy", "idle"];
 /// Bottleneck units.
 pub const BOTTLENECKS: [&str; 6] = ["cpu", "system", "gpu_front_end", "geometry", "fragment", "display"];
 
-/// Trace tracks.
+/// Trace tracks (their track numbers in the trace are these plus one).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Track {
     /// CPU thread.
@@ -56,32 +58,98 @@ pub enum Track {
     Fragment = 3,
 }
 
-/// A span on a track.
-#[derive(Debug, Clone, Copy)]
-pub struct Span {
-    /// Track.
-    pub track: Track,
-    /// Index into the track's state names.
-    pub state: u8,
-    /// Start.
-    pub start: Time,
-    /// End.
-    pub end: Time,
+/// The frame pipeline's trace, written while it runs: one track per unit
+/// (CPU, GPU front end, geometry, fragment, display), a span per state a
+/// unit was in (the CPU's split per frame, so frame n+1's preparation is
+/// seen beside the GPU drawing frame n, as in paper 000 Figure 4), and
+/// counters for the command and triangle FIFOs.
+#[derive(Debug)]
+pub struct PipelineTrace {
+    writer: TraceWriter,
+    command_fifo: Option<u64>,
+    triangle_fifo: Option<u64>,
 }
 
-/// Recorded timeline for the trace output.
-#[derive(Debug, Default, Clone)]
-pub struct TraceLog {
-    /// Spans, per track in time order.
-    pub spans: Vec<Span>,
-    /// Command FIFO fill (time, used).
-    pub command_fifo: Vec<(Time, u64)>,
-    /// Triangle FIFO fill (time, entries).
-    pub triangle_fifo: Vec<(Time, u64)>,
+const PID: u32 = 1;
+const DISPLAY_TRACK: u32 = 5;
+
+impl PipelineTrace {
+    /// Names the process and the tracks on `writer`.
+    pub fn new(mut writer: TraceWriter) -> Self {
+        writer.process(PID, "frame pipeline");
+        for (tid, name) in [
+            (1, "CPU thread"),
+            (2, "GPU front end"),
+            (3, "GPU geometry"),
+            (4, "GPU fragment"),
+            (DISPLAY_TRACK, "Display"),
+        ] {
+            writer.track(PID, tid, name);
+        }
+        PipelineTrace {
+            writer,
+            command_fifo: None,
+            triangle_fifo: None,
+        }
+    }
+
+    /// A unit's state from `start` to `end` (`frame`: the CPU's frame).
+    fn state(&mut self, track: Track, state: usize, start: Time, end: Time, frame: Option<u64>) {
+        let names: &[&str] = match track {
+            Track::Cpu => &CPU_STATES,
+            Track::Front => &FRONT_STATES,
+            Track::Geometry => &GEOM_STATES,
+            Track::Fragment => &FRAG_STATES,
+        };
+        let tid = track as u32 + 1;
+        match frame {
+            Some(f) if state == 0 => {
+                let name = format!("frame {f}");
+                self.writer.span(PID, tid, &name, start, end, None);
+            }
+            Some(f) => self.writer.span(PID, tid, names[state], start, end, Some(("frame", f))),
+            None => self.writer.span(PID, tid, names[state], start, end, None),
+        }
+    }
+
+    fn fifo_levels(&mut self, now: Time, commands: u64, triangles: u64) {
+        if self.command_fifo != Some(commands) {
+            self.writer.counter(PID, "command FIFO", "used", now, commands);
+            self.command_fifo = Some(commands);
+        }
+        if self.triangle_fifo != Some(triangles) {
+            self.writer.counter(PID, "triangle FIFO", "triangles", now, triangles);
+            self.triangle_fifo = Some(triangles);
+        }
+    }
+
+    /// After the run: each frame's input as an instant on the CPU track, and
+    /// each displayed frame from its appearance to the next one (the last
+    /// for one refresh) on the display track. Returns the writer, to be
+    /// finished by whoever opened it.
+    pub fn end(mut self, records: &[FrameRecord], refresh: Duration) -> TraceWriter {
+        let shown: Vec<(u64, Time)> = records
+            .iter()
+            .filter_map(|r| r.displayed.map(|d| (r.index, d)))
+            .collect();
+        for (i, (frame, t)) in shown.iter().enumerate() {
+            let end = shown
+                .get(i + 1)
+                .map(|n| n.1)
+                .unwrap_or_else(|| Time(t.0.saturating_add(refresh.0)));
+            let name = format!("frame {frame}");
+            self.writer.span(PID, DISPLAY_TRACK, &name, *t, end, None);
+        }
+        for r in records {
+            let name = format!("frame {} input", r.index);
+            self.writer.instant(PID, 1, &name, r.input);
+        }
+        self.writer
+    }
 }
 
 /// Clocks and per-frame attribution.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Accounting {
     /// CPU clock.
     pub cpu: StateClock<5>,
@@ -97,13 +165,13 @@ pub struct Accounting {
     pub bottleneck: StateClock<6>,
     cpu_frame: u64,
     gpu_frame: Option<u64>,
-    /// Timeline, when tracing.
-    pub trace: Option<TraceLog>,
+    /// The trace, when one is written.
+    pub trace: Option<PipelineTrace>,
 }
 
 impl Accounting {
     /// Fresh clocks (everything idle at time zero).
-    pub fn new(trace: bool) -> Self {
+    pub fn new(trace: Option<TraceWriter>) -> Self {
         Accounting {
             cpu: StateClock::new(4),
             front: StateClock::new(1),
@@ -113,18 +181,21 @@ impl Accounting {
             bottleneck: StateClock::new(0),
             cpu_frame: 0,
             gpu_frame: None,
-            trace: trace.then(TraceLog::default),
+            trace: trace.map(PipelineTrace::new),
         }
     }
 }
 
+/// Moves `clock` to `state` at `now`; when the state changes, the closing
+/// interval (unless idle or empty) becomes a span on `track`.
 fn set_traced<const N: usize>(
     clock: &mut StateClock<N>,
     now: Time,
     state: usize,
     track: Track,
-    trace: &mut Option<TraceLog>,
+    trace: &mut Option<PipelineTrace>,
     idle: usize,
+    frame: Option<u64>,
 ) -> (usize, u64) {
     let old = clock.state();
     let since = clock.since();
@@ -134,12 +205,7 @@ fn set_traced<const N: usize>(
         && old != idle
         && spent.0 > 0
     {
-        t.spans.push(Span {
-            track,
-            state: old as u8,
-            start: since,
-            end: now,
-        });
+        t.state(track, old, since, now, frame);
     }
     (old, spent.0)
 }
@@ -202,7 +268,15 @@ impl FramePipeline {
 
         let a = &mut self.acct;
         // CPU: attribute the closing interval to the frame it belonged to.
-        let (old, spent) = set_traced(&mut a.cpu, now, cpu_state, Track::Cpu, &mut a.trace, 4);
+        let (old, spent) = set_traced(
+            &mut a.cpu,
+            now,
+            cpu_state,
+            Track::Cpu,
+            &mut a.trace,
+            4,
+            Some(a.cpu_frame),
+        );
         let mut attribute_cpu = |old: usize, spent: u64, frame: u64| {
             if let Some(r) = self.records.get_mut(frame as usize) {
                 match old {
@@ -215,13 +289,22 @@ impl FramePipeline {
         attribute_cpu(old, spent, a.cpu_frame);
         if self.cpu_frame != a.cpu_frame {
             let st = a.cpu.state();
+            let since = a.cpu.since();
             let spent = a.cpu.split(now).0;
             attribute_cpu(st, spent, a.cpu_frame);
+            // The CPU moved to the next frame in the same state: the trace
+            // closes the old frame's span here.
+            if let Some(t) = &mut a.trace
+                && st != 4
+                && spent > 0
+            {
+                t.state(Track::Cpu, st, since, now, Some(a.cpu_frame));
+            }
             a.cpu_frame = self.cpu_frame;
         }
-        set_traced(&mut a.front, now, front_state, Track::Front, &mut a.trace, 1);
-        set_traced(&mut a.geom, now, geom_state, Track::Geometry, &mut a.trace, 2);
-        set_traced(&mut a.frag, now, frag_state, Track::Fragment, &mut a.trace, 1);
+        set_traced(&mut a.front, now, front_state, Track::Front, &mut a.trace, 1, None);
+        set_traced(&mut a.geom, now, geom_state, Track::Geometry, &mut a.trace, 2, None);
+        set_traced(&mut a.frag, now, frag_state, Track::Fragment, &mut a.trace, 1, None);
         a.bottleneck.set(now, bottleneck);
         // GPU busy per frame (the frame the front end is on).
         let gpu_state = if gpu_busy { 0 } else { 1 };
@@ -242,14 +325,7 @@ impl FramePipeline {
             a.gpu_frame = self.gpu_frame;
         }
         if let Some(t) = &mut a.trace {
-            let used = self.fifo.used();
-            if t.command_fifo.last().map(|l| l.1) != Some(used) {
-                t.command_fifo.push((now, used));
-            }
-            let n = self.tri_fifo.len() as u64;
-            if t.triangle_fifo.last().map(|l| l.1) != Some(n) {
-                t.triangle_fifo.push((now, n));
-            }
+            t.fifo_levels(now, self.fifo.used(), self.tri_fifo.len() as u64);
         }
     }
 }

@@ -135,7 +135,7 @@ pub fn isolate(
         } else {
             reduced(&base, name, factor)
         };
-        let r = run_pipeline(c, base_dir, false)?;
+        let r = run_pipeline(c, base_dir, None)?;
         let m = &r.summary["metrics"];
         let ft = m["frame_time_ms"]["mean"].as_f64().unwrap_or(0.0);
         if *name == "baseline" {

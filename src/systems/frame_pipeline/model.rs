@@ -268,7 +268,11 @@ pub struct ActiveDraw {
 
 impl FramePipeline {
     /// Builds the system from a validated model and its compiled workload.
-    pub fn new(cfg: FramePipelineConfig, scene: Option<SceneProgram>, trace: bool) -> Result<Self, PipelineError> {
+    pub fn new(
+        cfg: FramePipelineConfig,
+        scene: Option<SceneProgram>,
+        trace: Option<crate::output::trace::TraceWriter>,
+    ) -> Result<Self, PipelineError> {
         let streams = RngStreams::new(cfg.run.seed);
         let program = match (&cfg.workload, scene) {
             (WorkloadConfig::Fixed(f), _) => Program::Fixed {

@@ -7,11 +7,12 @@ use serde_json::{Value, json};
 use crate::engine::{Duration, Limits, PS_PER_MS, RunStats, Scheduler, StopReason, Time, run};
 use crate::stats::quantile::Summary;
 
-use super::accounting::{BOTTLENECKS, CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES, TraceLog};
+use super::accounting::{BOTTLENECKS, CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES};
 use super::config::{FramePipelineConfig, WorkloadConfig};
 use super::model::{FramePipeline, PipelineError};
 use super::records::{FrameRecord, frame_rows};
 use super::workload::{SceneProgram, compile_scene};
+use crate::output::trace::TraceWriter;
 
 /// Everything a run produced.
 #[derive(Debug)]
@@ -24,8 +25,9 @@ pub struct PipelineRun {
     pub records: Vec<FrameRecord>,
     /// The JSON summary.
     pub summary: Value,
-    /// Timeline, when asked for.
-    pub trace: Option<TraceLog>,
+    /// The trace, when one was asked for: every event written, not yet
+    /// closed ([`TraceWriter::finish`]).
+    pub trace: Option<TraceWriter>,
     /// Refresh period (for trace output).
     pub refresh: Duration,
     /// Exact time per state of every unit, picoseconds (for conservation checks).
@@ -114,7 +116,11 @@ pub fn validate(cfg: &FramePipelineConfig) -> Result<(), PipelineError> {
 }
 
 /// Validates, builds and runs the model.
-pub fn run_pipeline(cfg: FramePipelineConfig, base_dir: &Path, trace: bool) -> Result<PipelineRun, PipelineError> {
+pub fn run_pipeline(
+    cfg: FramePipelineConfig,
+    base_dir: &Path,
+    trace: Option<TraceWriter>,
+) -> Result<PipelineRun, PipelineError> {
     validate(&cfg)?;
     let build_start = std::time::Instant::now();
     let scene = match &cfg.workload {
@@ -165,7 +171,8 @@ pub fn run_pipeline(cfg: FramePipelineConfig, base_dir: &Path, trace: bool) -> R
         elapsed: end.0,
     };
     let commands = model.command_counts();
-    let trace = model.acct.trace.take();
+    let records = std::mem::take(&mut model.records);
+    let trace = model.acct.trace.take().map(|t| t.end(&records, refresh));
     Ok(PipelineRun {
         stats,
         summary,
@@ -173,7 +180,7 @@ pub fn run_pipeline(cfg: FramePipelineConfig, base_dir: &Path, trace: bool) -> R
         refresh,
         clocks,
         commands,
-        records: std::mem::take(&mut model.records),
+        records,
         config: model.cfg,
     })
 }

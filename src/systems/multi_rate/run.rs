@@ -5,6 +5,7 @@ use std::io::Write;
 use serde_json::{Map, Value, json};
 
 use crate::engine::{Limits, RunStats, Scheduler, StopReason, Time, run};
+use crate::output::trace::TraceWriter;
 use crate::stats::quantile::Summary;
 
 use super::analytic::{Analytic, Bounds, Terms, analytic};
@@ -27,6 +28,8 @@ pub struct MultiRateRun {
     pub analytic: Analytic,
     /// The JSON summary.
     pub summary: Value,
+    /// The trace, when one was asked for: written, not yet closed.
+    pub trace: Option<TraceWriter>,
 }
 
 fn bad(key: &str, message: impl Into<String>) -> MultiRateError {
@@ -161,6 +164,7 @@ pub fn run_multi_rate(cfg: MultiRateConfig) -> Result<MultiRateRun, MultiRateErr
         events,
         analytic: a,
         summary,
+        trace: None,
     })
 }
 
@@ -287,47 +291,37 @@ pub fn write_events_csv(events: &[EventRecord], w: &mut dyn Write) -> std::io::R
     Ok(())
 }
 
-fn us(t: Time) -> f64 {
-    t.0 as f64 / 1e6
-}
-
 /// Writes a Chrome/Perfetto trace: one track per client and one for the
 /// link; input events as instants on the master's track.
-pub fn write_trace(r: &MultiRateRun, w: &mut dyn Write) -> std::io::Result<bool> {
+pub fn write_trace(r: &MultiRateRun, t: &mut TraceWriter) {
     let m = &r.model;
-    let tracks = [
+    t.process(1, "multi-frame-rate");
+    for (tid, name) in [
         (1, "master (input events)"),
         (2, "slow client"),
         (3, "transfer link"),
         (4, "fast client"),
         (5, "conventional client"),
-    ];
-    let mut ev: Vec<Value> =
-        vec![json!({"ph": "M", "pid": 1, "name": "process_name", "args": {"name": "multi-frame-rate"}})];
-    for (tid, name) in tracks {
-        ev.push(json!({"ph": "M", "pid": 1, "tid": tid, "name": "thread_name", "args": {"name": name}}));
-        ev.push(json!({"ph": "M", "pid": 1, "tid": tid, "name": "thread_sort_index", "args": {"sort_index": tid}}));
+    ] {
+        t.track(1, tid, name);
     }
-    let span = |tid: u32, name: String, a: Time, b: Time| json!({"ph": "X", "pid": 1, "tid": tid, "name": name, "ts": us(a), "dur": us(b) - us(a)});
-    for (i, t) in m.inputs.iter().enumerate() {
-        ev.push(json!({"ph": "i", "pid": 1, "tid": 1, "s": "t", "name": format!("input {i}"), "ts": us(*t)}));
+    for (i, at) in m.inputs.iter().enumerate() {
+        t.instant(1, 1, &format!("input {i}"), *at);
     }
     for (i, f) in m.sc.iter().enumerate() {
         if f.readback_end > f.start {
-            ev.push(span(2, format!("SC {i} render"), f.start, f.render_end));
-            ev.push(span(2, format!("SC {i} read-back"), f.render_end, f.readback_end));
+            t.span(1, 2, &format!("SC {i} render"), f.start, f.render_end, None);
+            t.span(1, 2, &format!("SC {i} read-back"), f.render_end, f.readback_end, None);
         }
         if let (Some(s), Some(e)) = (f.send_start, f.arrived) {
-            ev.push(span(3, format!("SC {i} transfer"), s, e));
+            t.span(1, 3, &format!("SC {i} transfer"), s, e, None);
         }
     }
     for (i, f) in m.fc[..m.fc_done].iter().enumerate() {
-        ev.push(span(4, format!("FC {i} upload"), f.start, f.upload_end));
-        ev.push(span(4, format!("FC {i} render"), f.upload_end, f.end));
+        t.span(1, 4, &format!("FC {i} upload"), f.start, f.upload_end, None);
+        t.span(1, 4, &format!("FC {i} render"), f.upload_end, f.end, None);
     }
     for (i, f) in m.conv[..m.conv_done].iter().enumerate() {
-        ev.push(span(5, format!("frame {i}"), f.start, f.end));
+        t.span(1, 5, &format!("frame {i}"), f.start, f.end, None);
     }
-    serde_json::to_writer(&mut *w, &json!({"traceEvents": ev, "displayTimeUnit": "ms"}))?;
-    Ok(true)
 }

@@ -3,6 +3,7 @@
 use serde_json::{Value, json};
 
 use crate::engine::{Duration, Limits, RunStats, Scheduler, run};
+use crate::output::trace::TraceWriter;
 
 use super::analytic::{Analytic, closed_form};
 use super::config::{Fidelity, PixelFlowConfig, Placement, Size};
@@ -25,7 +26,9 @@ pub struct PixelFlowRun {
     /// The JSON summary.
     pub summary: Value,
     /// Timeline, when asked for.
-    pub trace: Option<Vec<Span>>,
+    pub spans: Option<Vec<Span>>,
+    /// The trace, when one was asked for: written, not yet closed.
+    pub trace: Option<TraceWriter>,
 }
 
 fn bad(key: &str, message: impl Into<String>) -> PixelFlowError {
@@ -166,6 +169,7 @@ pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, 
             records: Vec::new(),
             region_entries: Vec::new(),
             summary,
+            spans: None,
             trace: None,
         });
     }
@@ -222,7 +226,8 @@ pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, 
         records: std::mem::take(&mut model.records),
         region_entries,
         summary,
-        trace: model.trace.take(),
+        spans: model.trace.take(),
+        trace: None,
         config: model.cfg,
     })
 }
@@ -375,21 +380,20 @@ pub fn write_regions_csv(run: &PixelFlowRun, w: &mut dyn std::io::Write) -> std:
 
 /// Writes a Chrome/Perfetto trace: one process per node role, one thread
 /// per node (or network direction); false if none was recorded.
-pub fn write_trace(run: &PixelFlowRun, w: &mut dyn std::io::Write) -> std::io::Result<bool> {
-    let Some(spans) = &run.trace else {
-        return Ok(false);
+pub fn write_trace(run: &PixelFlowRun, t: &mut TraceWriter) {
+    let Some(spans) = &run.spans else {
+        return;
     };
-    let us = |t: crate::engine::Time| t.0 as f64 / 1e6;
-    let mut ev = Vec::new();
     for (i, role) in super::model::ROLES.iter().enumerate() {
-        let pid = i + 1;
-        ev.push(json!({"ph": "M", "pid": pid, "name": "process_name", "args": {"name": role}}));
-        ev.push(json!({"ph": "M", "pid": pid, "name": "process_sort_index", "args": {"sort_index": pid}}));
+        let pid = i as u32 + 1;
+        t.process(pid, role);
+        t.process_order(pid, pid);
     }
     let mut named = std::collections::BTreeSet::new();
     for s in spans {
-        let pid = s.role as usize + 1;
-        if named.insert((pid, s.unit)) {
+        let pid = s.role as u32 + 1;
+        let tid = s.unit as u32;
+        if named.insert((pid, tid)) {
             let name = match s.role {
                 0 | 1 => format!("rasterizer {}", s.unit),
                 2 => format!("shader {}", s.unit),
@@ -401,13 +405,8 @@ pub fn write_trace(run: &PixelFlowRun, w: &mut dyn std::io::Write) -> std::io::R
                 .to_string(),
                 _ => "frame-buffer memory".to_string(),
             };
-            ev.push(json!({"ph": "M", "pid": pid, "tid": s.unit, "name": "thread_name", "args": {"name": name}}));
+            t.thread(pid, tid, &name);
         }
-        ev.push(json!({
-            "ph": "X", "pid": pid, "tid": s.unit, "name": s.name,
-            "ts": us(s.start), "dur": us(s.end) - us(s.start), "args": {"index": s.arg},
-        }));
+        t.span(pid, tid, s.name, s.start, s.end, Some(("index", s.arg as u64)));
     }
-    serde_json::to_writer(&mut *w, &json!({"traceEvents": ev, "displayTimeUnit": "ms"}))?;
-    Ok(true)
 }

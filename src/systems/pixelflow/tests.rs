@@ -12,7 +12,7 @@ fn run_with(sets: &[&str]) -> Result<SystemRun, crate::systems::SimError> {
     for s in sets {
         apply_set(&mut t, s).unwrap();
     }
-    run_model(&src, &t, false)
+    run_model(&src, &t, None)
 }
 
 fn metric(r: &SystemRun, key: &str) -> f64 {
@@ -247,12 +247,17 @@ fn every_region_is_loaded_once_and_in_order_of_its_steps() {
             assert!(w[0] <= w[1], "{row:?}");
         }
     }
-    let mut buf = Vec::new();
+    let file = tempfile::NamedTempFile::new().unwrap();
     let src = ModelSource::from_text("m", MODEL);
     let t = src.table().unwrap();
-    let traced = run_model(&src, &t, true).unwrap();
-    assert!(traced.write_trace(&mut buf).unwrap());
-    assert!(String::from_utf8(buf).unwrap().contains("composition network"));
+    let writer = crate::output::trace::TraceWriter::new(Box::new(file.reopen().unwrap()));
+    let mut traced = run_model(&src, &t, Some(writer)).unwrap();
+    assert!(traced.take_trace().unwrap().finish().unwrap() > 0);
+    assert!(
+        std::fs::read_to_string(file.path())
+            .unwrap()
+            .contains("composition network")
+    );
 }
 
 #[test]

@@ -7,6 +7,7 @@ use std::io::Write;
 use serde_json::{Value, json};
 
 use crate::engine::{Limits, RunStats, Scheduler, StopReason, Time, run};
+use crate::output::trace::TraceWriter;
 use crate::stats::quantile::Summary;
 
 use super::analytic::{Analytic, Bounds, analytic};
@@ -79,6 +80,8 @@ pub struct VrRun {
     pub analytic: Analytic,
     /// JSON summary.
     pub summary: Value,
+    /// The trace, when one was asked for: written, not yet closed.
+    pub trace: Option<TraceWriter>,
 }
 
 fn bad(key: &str, message: impl Into<String>) -> VrError {
@@ -212,6 +215,7 @@ pub fn run_vr(cfg: VrConfig) -> Result<VrRun, VrError> {
         motions,
         analytic: a,
         summary,
+        trace: None,
     })
 }
 
@@ -329,54 +333,48 @@ pub fn write_motions_csv(motions: &[MotionRecord], w: &mut dyn Write) -> std::io
     Ok(())
 }
 
-fn us(t: Time) -> f64 {
-    t.0 as f64 / 1e6
-}
-
 /// Writes a Perfetto trace: a track per stage (simulation, renderer, warping
 /// renderer, display) and motion instants.
-pub fn write_trace(r: &VrRun, w: &mut dyn Write) -> std::io::Result<bool> {
+pub fn write_trace(r: &VrRun, t: &mut TraceWriter) {
     let m = &r.model;
-    let tracks = [
+    t.process(1, "VR pipeline");
+    for (tid, name) in [
         (1, "tracker (motions)"),
         (2, "simulation"),
         (3, "renderer"),
         (4, "warping renderer"),
         (5, "display"),
-    ];
-    let mut ev: Vec<Value> =
-        vec![json!({"ph": "M", "pid": 1, "name": "process_name", "args": {"name": "VR pipeline"}})];
-    for (tid, name) in tracks {
-        ev.push(json!({"ph": "M", "pid": 1, "tid": tid, "name": "thread_name", "args": {"name": name}}));
-        ev.push(json!({"ph": "M", "pid": 1, "tid": tid, "name": "thread_sort_index", "args": {"sort_index": tid}}));
+    ] {
+        t.track(1, tid, name);
     }
-    let span = |tid: u32, name: String, a: Time, b: Time| json!({"ph": "X", "pid": 1, "tid": tid, "name": name, "ts": us(a), "dur": us(b) - us(a)});
-    for (i, t) in m.inputs.iter().enumerate() {
-        ev.push(json!({"ph": "i", "pid": 1, "tid": 1, "s": "t", "name": format!("motion {i}"), "ts": us(*t)}));
+    for (i, at) in m.inputs.iter().enumerate() {
+        t.instant(1, 1, &format!("motion {i}"), *at);
     }
     let field = m.cfg.display_latency();
     for (i, f) in m.frames.iter().take(m.swapped).enumerate() {
-        ev.push(span(2, format!("frame {i} simulation"), f.start, f.sim_end));
-        ev.push(span(3, format!("frame {i} render"), f.sim_end, f.render_end));
-        ev.push(span(3, format!("frame {i} swap lock"), f.render_end, f.swap));
+        t.span(1, 2, &format!("frame {i} simulation"), f.start, f.sim_end, None);
+        t.span(1, 3, &format!("frame {i} render"), f.sim_end, f.render_end, None);
+        t.span(1, 3, &format!("frame {i} swap lock"), f.render_end, f.swap, None);
     }
     for (i, s) in m.sims.iter().enumerate().filter(|(_, s)| s.end > s.start) {
-        ev.push(span(2, format!("step {i}"), s.start, s.end));
+        t.span(1, 2, &format!("step {i}"), s.start, s.end, None);
     }
     for (i, a) in m.apps.iter().enumerate().filter(|(_, a)| a.end > a.start) {
-        ev.push(span(3, format!("app frame {i}"), a.start, a.end));
+        t.span(1, 3, &format!("app frame {i}"), a.start, a.end, None);
     }
     for (i, f) in m.warps.iter().take(m.swapped).enumerate() {
-        ev.push(span(4, format!("warp {i}"), f.start, f.render_end));
+        t.span(1, 4, &format!("warp {i}"), f.start, f.render_end, None);
     }
     let swaps: Vec<Time> = match m.cfg.scheme {
         Scheme::Naive => m.frames.iter().take(m.swapped).map(|f| f.swap).collect(),
         Scheme::Warp => m.warps.iter().take(m.swapped).map(|f| f.swap).collect(),
     };
     for (i, s) in swaps.iter().enumerate() {
-        let end = swaps.get(i + 1).copied().unwrap_or(Time(s.0 + 2 * field.0));
-        ev.push(span(5, format!("image {i}"), *s, end));
+        // The last image stays for two fields (saturating: a trace end, not a result).
+        let end = swaps
+            .get(i + 1)
+            .copied()
+            .unwrap_or_else(|| Time(s.0.saturating_add(field.0.saturating_mul(2))));
+        t.span(1, 5, &format!("image {i}"), *s, end, None);
     }
-    serde_json::to_writer(&mut *w, &json!({"traceEvents": ev, "displayTimeUnit": "ms"}))?;
-    Ok(true)
 }
