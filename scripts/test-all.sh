@@ -39,8 +39,12 @@ cargo build --release --locked --all-targets --features wgpu
 export RENDERSIM_BIN="$root/target/release/rendersim"
 
 step "Rust tests (unit, property, integration, doc; wgpu measurements on lavapipe)"
-cargo test --release --locked --no-fail-fast --features wgpu 2>&1 | tee "$ci_out/test-output.txt"
+# (The fuzz test runs in its own step below, so that its counts are shown.)
+cargo test --release --locked --no-fail-fast --features wgpu -- --skip every_input_ends_in_a_result_or_a_clean_error 2>&1 | tee "$ci_out/test-output.txt"
 grep -q "test result:" "$ci_out/test-output.txt"
+
+step "Fuzz: 2,000 seeded cases of mutated models, --set values, meshes and experiments, plus the regression cases"
+cargo test --release --locked --features wgpu --test fuzz -- --nocapture
 
 step "Studies H1-H4 on this machine's adapter (H1 must predict its validation meshes exactly)"
 if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
