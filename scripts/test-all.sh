@@ -46,6 +46,13 @@ grep -q "test result:" "$ci_out/test-output.txt"
 step "Fuzz: 2,000 seeded cases of mutated models, --set values, meshes and experiments, plus the regression cases"
 cargo test --release --locked --features wgpu --test fuzz -- --nocapture
 
+step "Examples (each asserts what it shows)"
+for ex in examples/*.rs; do
+  name=$(basename "$ex" .rs)
+  echo "-- $name"
+  "target/release/examples/$name" | tail -n 2
+done
+
 step "Studies H1-H4 on this machine's adapter (H1 must predict its validation meshes exactly)"
 if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
   if ! "$RENDERSIM_BIN" study all --markdown "$ci_out/studies.md" > "$ci_out/studies.txt" 2> "$ci_out/studies.err"; then

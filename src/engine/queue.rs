@@ -3,6 +3,18 @@
 //! The sequence number is assigned at scheduling, so events due at the same
 //! instant run in the order they were scheduled. That makes every run
 //! deterministic whatever the heap's internal layout.
+//!
+//! ```
+//! use rendersim::engine::{EventQueue, Time};
+//!
+//! let mut q = EventQueue::new();
+//! q.push(Time(30), "late");
+//! q.push(Time(10), "first at 10");
+//! q.push(Time(10), "second at 10"); // same time: after the one scheduled before
+//! assert_eq!(q.peek_time(), Some(Time(10)));
+//! let order: Vec<&str> = std::iter::from_fn(|| q.pop().map(|s| s.event)).collect();
+//! assert_eq!(order, ["first at 10", "second at 10", "late"]);
+//! ```
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;

@@ -138,6 +138,23 @@ impl Duration {
     /// `ps`, exactly (decimal digits are not rounded through a float where the
     /// result is a whole number of picoseconds; finer digits are rounded to
     /// the nearest picosecond). A bare `0` is accepted.
+    ///
+    /// ```
+    /// use rendersim::engine::{Duration, Time};
+    ///
+    /// assert_eq!(Duration::parse("16.7ms").unwrap(), Duration(16_700_000_000));
+    /// assert_eq!(Duration::parse("1.85us").unwrap(), Duration(1_850_000));
+    /// assert_eq!(Duration::parse("0").unwrap(), Duration(0));
+    /// // Exact: a million microseconds is one second, to the picosecond.
+    /// assert_eq!(Duration::parse("1000000us").unwrap(), Duration::parse("1s").unwrap());
+    /// // Units are required; NaN, infinities and negatives are errors.
+    /// assert!(Duration::parse("16.7").is_err());
+    /// assert!(Duration::parse("NaNms").is_err());
+    /// assert!(Duration::parse("-1ms").is_err());
+    /// // Time arithmetic is checked: an overflow names what was scheduled.
+    /// let e = Time(u64::MAX - 1).add(Duration(2), "vertical blank").unwrap_err();
+    /// assert!(e.to_string().contains("vertical blank"));
+    /// ```
     pub fn parse(text: &str) -> Result<Duration, TimeError> {
         let err = |reason: &str| TimeError::Parse {
             text: text.to_string(),

@@ -19,7 +19,7 @@
 //! t.thread(1, 1, "CPU");
 //! t.span(1, 1, "work", Time(0), Time(2_000_000), None);
 //! t.counter(1, "queue", "used", Time(1_000_000), 3);
-//! assert_eq!(t.finish().unwrap(), 5); // 3 metadata events, a span and a counter
+//! assert_eq!(t.finish().unwrap(), 4); // two names, a span and a counter
 //! ```
 
 use std::io::Write;
