@@ -2,8 +2,10 @@
 //! its rate next to a baseline measured in the same run, as a ratio.
 //!
 //! - `kernel`: the classic hold model (a fixed population of pending events;
-//!   each handled event schedules one more at a random later time) through
-//!   the engine, against a bare `BinaryHeap` loop doing the same work.
+//!   each handled event schedules one more at a random later time) and a
+//!   stiff mix (nanosecond delays with one-second ones) through the engine,
+//!   on its radix heap and on its binary heap, against a bare `BinaryHeap`
+//!   loop doing the same work.
 //! - `pipeline`: one frame of about one million triangles at `triangle`
 //!   fidelity against the same frame at `draw` fidelity.
 //! - `hour`: one simulated hour of the default (noisy, 60 Hz) model at `draw`
@@ -17,7 +19,7 @@ use rand::Rng;
 
 use crate::config::{ModelSource, apply_set};
 use crate::engine::{
-    Control, Duration, EngineError, EventKind, Limits, Model, RngStreams, Scheduler, StreamRng, Time, run,
+    Control, Duration, EngineError, EventKind, Limits, Model, QueueKind, RngStreams, Scheduler, StreamRng, Time, run,
 };
 use crate::systems::{DEFAULT_MODEL, run_model};
 
@@ -33,47 +35,86 @@ impl EventKind for Hold {
     }
 }
 
+/// The delays of a kernel benchmark.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum KernelWork {
+    /// The classic hold model: delays uniform in 1 ps .. 2 us.
+    Hold,
+    /// A stiff mix: 99.9% of delays uniform in 1 .. 100 ns, 0.1% one second.
+    Stiff,
+}
+
+impl KernelWork {
+    /// The next delay, in picoseconds.
+    #[inline]
+    fn delay(self, rng: &mut StreamRng) -> u64 {
+        match self {
+            KernelWork::Hold => rng.random_range(1..2_000_000u64),
+            KernelWork::Stiff => {
+                if rng.random_range(0..1000u32) == 0 {
+                    1_000_000_000_000
+                } else {
+                    rng.random_range(1_000..=100_000u64)
+                }
+            }
+        }
+    }
+
+    /// Its name in the benchmark's lines.
+    pub fn name(self) -> &'static str {
+        match self {
+            KernelWork::Hold => "hold",
+            KernelWork::Stiff => "stiff",
+        }
+    }
+}
+
 struct HoldModel {
     rng: StreamRng,
+    work: KernelWork,
 }
 
 impl Model for HoldModel {
     type Event = Hold;
     type Error = EngineError;
     #[inline]
-    fn handle(&mut self, now: Time, ev: Hold, s: &mut Scheduler<Hold>) -> Result<Control, EngineError> {
-        let d = self.rng.random_range(1..2_000_000u64);
-        s.at(Time(now.0 + d), ev);
+    fn handle(&mut self, _now: Time, ev: Hold, s: &mut Scheduler<Hold>) -> Result<Control, EngineError> {
+        let d = self.work.delay(&mut self.rng);
+        s.after(Duration(d), ev, "benchmark event")?;
         Ok(Control::Continue)
     }
 }
 
-/// Result of the kernel benchmark.
+/// Result of one kernel benchmark case.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct KernelBench {
+    /// The delays.
+    pub work: KernelWork,
     /// Pending events.
     pub population: usize,
     /// Events handled.
     pub events: u64,
-    /// Engine events per second.
+    /// Engine events per second (its default queue, the radix heap).
     pub engine_events_per_s: f64,
-    /// Bare heap loop events per second.
+    /// Engine events per second on its binary-heap queue.
+    pub engine_binary_events_per_s: f64,
+    /// Bare `BinaryHeap` loop events per second (the baseline).
     pub bare_events_per_s: f64,
     /// engine / bare.
     pub ratio: f64,
 }
 
-/// Hold model with `population` pending events, `events` handled.
-pub fn kernel(population: usize, events: u64) -> KernelBench {
+fn engine_rate(work: KernelWork, population: usize, events: u64, kind: QueueKind) -> f64 {
     let streams = RngStreams::new(7);
-    // Engine.
-    let mut sched = Scheduler::new();
+    let mut sched = Scheduler::with_queue(kind);
     let mut init = streams.stream("init");
     for _ in 0..population {
         sched.at(Time(init.random_range(0..2_000_000u64)), Hold);
     }
     let mut m = HoldModel {
         rng: streams.stream("hold"),
+        work,
     };
     let t = Instant::now();
     let st = run(
@@ -84,10 +125,20 @@ pub fn kernel(population: usize, events: u64) -> KernelBench {
             max_events: Some(events),
         },
     )
-    .expect("hold model cannot overflow");
-    let engine_s = t.elapsed().as_secs_f64();
+    .expect("the benchmark model cannot overflow in a benchmark's span");
+    let secs = t.elapsed().as_secs_f64();
     assert_eq!(st.events, events);
+    events as f64 / secs
+}
+
+/// The kernel on `work` with `population` pending events, `events` handled,
+/// against a bare `BinaryHeap` loop doing the same work (same delays).
+pub fn kernel_case(work: KernelWork, population: usize, events: u64) -> KernelBench {
+    let population = population.max(1);
+    let engine = engine_rate(work, population, events, QueueKind::Radix);
+    let engine_binary = engine_rate(work, population, events, QueueKind::Binary);
     // Bare loop: the same work on a BinaryHeap of (time, seq).
+    let streams = RngStreams::new(7);
     let mut heap: BinaryHeap<Reverse<(u64, u64)>> = BinaryHeap::with_capacity(64);
     let mut init = streams.stream("init");
     let mut seq = 0u64;
@@ -101,21 +152,38 @@ pub fn kernel(population: usize, events: u64) -> KernelBench {
     for _ in 0..events {
         let Reverse((time, _)) = heap.pop().expect("population > 0");
         last = last.max(time);
-        let d = rng.random_range(1..2_000_000u64);
+        let d = work.delay(&mut rng);
         heap.push(Reverse((time + d, seq)));
         seq += 1;
     }
     let bare_s = t.elapsed().as_secs_f64();
     std::hint::black_box(last);
-    let e = events as f64;
+    let bare = events as f64 / bare_s;
     KernelBench {
+        work,
         population,
         events,
-        engine_events_per_s: e / engine_s,
-        bare_events_per_s: e / bare_s,
-        ratio: (e / engine_s) / (e / bare_s),
+        engine_events_per_s: engine,
+        engine_binary_events_per_s: engine_binary,
+        bare_events_per_s: bare,
+        ratio: engine / bare,
     }
 }
+
+/// The hold model with `population` pending events (see [`kernel_case`]).
+pub fn kernel(population: usize, events: u64) -> KernelBench {
+    kernel_case(KernelWork::Hold, population, events)
+}
+
+/// The kernel benchmark's cases: hold at 1,000, 100,000 and 1,000,000
+/// pending; stiff at 100,000 and 1,000,000 (issue 15's targets).
+pub const KERNEL_CASES: [(KernelWork, usize); 5] = [
+    (KernelWork::Hold, 1_000),
+    (KernelWork::Hold, 100_000),
+    (KernelWork::Hold, 1_000_000),
+    (KernelWork::Stiff, 100_000),
+    (KernelWork::Stiff, 1_000_000),
+];
 
 fn run_default_with(sets: &[&str]) -> Result<(serde_json::Value, f64), String> {
     let src = ModelSource::from_text("<embedded default model>", DEFAULT_MODEL);
@@ -257,12 +325,17 @@ pub fn run_cli(which: &str, scale: f64) -> Result<(), String> {
         );
     }
     if all || which == "kernel" {
-        for pop in [1_000usize, 100_000] {
-            let k = kernel(pop, (20_000_000.0 * scale) as u64);
+        for (work, pop) in KERNEL_CASES {
+            // At least 2 events per pending one, so the heap is in steady state.
+            let events = ((20_000_000.0 * scale) as u64).max(2 * pop as u64);
+            let k = kernel_case(work, pop, events);
             println!(
-                "kernel hold model, {} pending: engine {:.2} M events/s, bare BinaryHeap {:.2} M events/s, ratio {:.3}",
+                "kernel {}, {} pending: engine {:.2} M events/s ({:.1} ns/event; binary-heap queue {:.2} M events/s), bare BinaryHeap {:.2} M events/s, ratio {:.3}",
+                work.name(),
                 k.population,
                 k.engine_events_per_s / 1e6,
+                1e9 / k.engine_events_per_s,
+                k.engine_binary_events_per_s / 1e6,
                 k.bare_events_per_s / 1e6,
                 k.ratio
             );

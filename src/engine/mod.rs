@@ -3,11 +3,12 @@
 //! conditions, and named RNG streams. It knows nothing of GPUs.
 
 pub mod queue;
+pub mod radix_heap;
 pub mod rng;
 pub mod sim;
 pub mod time;
 
-pub use queue::EventQueue;
+pub use queue::{EventQueue, QueueKind};
 pub use rng::{RngStreams, StreamRng};
 pub use sim::{Control, EngineError, EventKind, Limits, Model, RunStats, Scheduler, StopReason, run};
 pub use time::{Duration, PS_PER_MS, PS_PER_NS, PS_PER_S, PS_PER_US, Time, TimeError};

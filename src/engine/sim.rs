@@ -8,7 +8,7 @@
 
 use std::time::Instant;
 
-use super::queue::EventQueue;
+use super::queue::{EventQueue, QueueKind};
 use super::time::{Duration, Time, TimeError};
 
 /// Implemented by each system's event enum so the loop can count per kind.
@@ -75,10 +75,16 @@ impl<E> Default for Scheduler<E> {
 }
 
 impl<E> Scheduler<E> {
-    /// An empty scheduler at time zero.
+    /// An empty scheduler at time zero (default queue: a radix heap).
     pub fn new() -> Self {
+        Self::with_queue(QueueKind::default())
+    }
+
+    /// An empty scheduler at time zero on a queue of the given kind (results
+    /// are the same; only the speed differs).
+    pub fn with_queue(kind: QueueKind) -> Self {
         Scheduler {
-            queue: EventQueue::with_capacity(64),
+            queue: EventQueue::of_kind(kind),
             now: Time::ZERO,
         }
     }
@@ -166,8 +172,8 @@ pub fn run<M: Model>(model: &mut M, sched: &mut Scheduler<M::Event>, limits: Lim
             break StopReason::Exhausted;
         };
         if next.time > until {
-            // Put it back so the caller could resume.
-            sched.queue.push(next.time, next.event);
+            // Put it back (in its place) so the caller could resume.
+            sched.queue.restore(next);
             sched.now = until;
             break StopReason::TimeLimit;
         }
