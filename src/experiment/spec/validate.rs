@@ -44,8 +44,18 @@ impl Validator<'_> {
         if raw.name.trim().is_empty() {
             return Err(self.err("name", "must not be empty"));
         }
-        if raw.replications < 1 || raw.replications > i64::from(u32::MAX) {
+        if raw.replications < 1 {
             return Err(self.err("replications", format!("must be at least 1, got {}", raw.replications)));
+        }
+        if raw.replications > crate::limits::MAX_REPLICATIONS {
+            return Err(self.err(
+                "replications",
+                format!(
+                    "{} is more than the limit of {} replications per point",
+                    raw.replications,
+                    crate::limits::MAX_REPLICATIONS
+                ),
+            ));
         }
         if !(raw.confidence > 0.0 && raw.confidence < 1.0) {
             return Err(self.err("confidence", format!("must be in (0, 1), got {}", raw.confidence)));
