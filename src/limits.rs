@@ -36,6 +36,10 @@ pub const MAX_DIRECT_CACHE_SLOTS: u32 = 1 << 20;
 /// Most replications per point of an experiment.
 pub const MAX_REPLICATIONS: i64 = 100_000;
 
+/// Most runs of an experiment: points (the product of the sweeps' sizes)
+/// times replications.
+pub const MAX_EXPERIMENT_RUNS: u64 = 1_000_000;
+
 /// Most PixelFlow nodes (`nodes`).
 pub const MAX_PIXELFLOW_NODES: u32 = 4096;
 

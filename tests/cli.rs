@@ -631,6 +631,18 @@ fn a_huge_replication_count_is_refused_with_its_limit() {
         "name = \"x\"\nmodel = \"default\"\nreplications = 100000000\n[[sweep]]\nkey = \"run.seed\"\nvalues = [1]\n",
     );
     limit_err(&["experiment", &f], &["replications", "100000000", "limit of 100000"]);
+    // Points x replications: three sweeps of 10^5 steps.
+    let mut text = String::from("name = \"x\"\nmodel = \"default\"\n");
+    for k in ["cpu.per_draw", "cpu.per_object", "cpu.clear"] {
+        text += &format!(
+            "[[sweep]]\nkey = \"{k}\"\nrange = {{ from = 1, to = 100000, steps = 100000, format = \"{{}}ns\" }}\n"
+        );
+    }
+    let f = write(d.path(), "s.toml", &text);
+    limit_err(
+        &["experiment", &f],
+        &["sweep", "100000 x 100000 x 100000", "limit of 1000000"],
+    );
 }
 
 #[test]
