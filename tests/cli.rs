@@ -716,6 +716,26 @@ fn a_run_over_max_memory_is_refused_before_it_starts() {
 }
 
 #[test]
+fn a_trace_over_max_memory_is_refused_before_the_run() {
+    // 18,432 triangles per frame at triangle fidelity, 10,000 frames: the
+    // timeline alone would take about 370 GiB.
+    let d = tempfile::tempdir().unwrap();
+    let t = d.path().join("t.json");
+    limit_err(
+        &[
+            "run",
+            &model("one-mesh.toml"),
+            "--set",
+            "run.frames=10000",
+            "--trace",
+            t.to_str().unwrap(),
+        ],
+        &["run.max_memory", "trace", "8 GiB"],
+    );
+    assert!(!t.exists());
+}
+
+#[test]
 fn latency_systems_over_a_long_simulated_span_are_refused() {
     for m in ["mfr-cluster.toml", "vr-naive.toml", "vr-warp.toml"] {
         limit_err(

@@ -174,6 +174,10 @@ fn check_scene_sizes(sc: &crate::scene::config::SceneWorkload) -> Result<(), Pip
 /// columns built from it.
 const BYTES_PER_FRAME: usize = std::mem::size_of::<FrameRecord>() + 14 * 8 + 8 * 8;
 
+/// Bytes of one trace entry: the recorded span and its JSON object while
+/// the trace is written.
+const TRACE_ENTRY_BYTES: usize = std::mem::size_of::<super::accounting::Span>() + 512;
+
 /// Estimates the memory a run needs from its inputs, before simulating:
 /// per-frame records, the scene's draws and generated index buffers, and,
 /// when `trace` is set and the scene is compiled, the timeline. Returns the
@@ -238,20 +242,16 @@ pub fn estimate_memory(cfg: &FramePipelineConfig, scene: Option<&SceneProgram>, 
         };
         let per_frame = commands.saturating_mul(4).saturating_add(triangles.saturating_mul(4));
         let mut b = 0u64;
-        add_bytes(
-            &mut b,
-            per_frame.saturating_mul(cfg.run.frames),
-            std::mem::size_of::<super::accounting::Span>(),
-        );
+        add_bytes(&mut b, per_frame.saturating_mul(cfg.run.frames), TRACE_ENTRY_BYTES);
         total = total.saturating_add(b);
-        parts.push(format!("trace about {per_frame} entries per frame = {}", show_bytes(b)));
+        parts.push(format!(
+            "trace: about {per_frame} entries per frame x {} frames x {TRACE_ENTRY_BYTES} bytes = {}",
+            cfg.run.frames,
+            show_bytes(b)
+        ));
     } else if trace {
         let mut b = 0u64;
-        add_bytes(
-            &mut b,
-            cfg.run.frames.saturating_mul(24),
-            std::mem::size_of::<super::accounting::Span>(),
-        );
+        add_bytes(&mut b, cfg.run.frames.saturating_mul(24), TRACE_ENTRY_BYTES);
         total = total.saturating_add(b);
         parts.push(format!("trace {}", show_bytes(b)));
     }
