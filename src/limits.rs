@@ -55,7 +55,7 @@ pub fn show_bytes(b: u64) -> String {
     for (name, size) in UNITS {
         if b >= size {
             let v = b as f64 / size as f64;
-            return if b % size == 0 {
+            return if b.is_multiple_of(size) {
                 format!("{} {name}", b / size)
             } else {
                 format!("{v:.1} {name}")
