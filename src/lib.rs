@@ -9,6 +9,7 @@
 //! - [`systems`]: simulated systems, each composed from components.
 //! - [`config`]: model files, units, `--set` patches, validation.
 //! - [`stats`], [`output`], [`plot`], [`experiment`]: results and studies.
+//! - [`limits`]: the stated limits on sizes read from input.
 #![warn(missing_docs)]
 
 pub mod bench;
@@ -16,6 +17,7 @@ pub mod components;
 pub mod config;
 pub mod engine;
 pub mod experiment;
+pub mod limits;
 pub mod measure;
 pub mod output;
 pub mod plot;

@@ -557,3 +557,210 @@ fn system_noise_experiment_prints_the_paper_constant_at_the_end() {
         "{out}"
     );
 }
+// Sizes read from input are checked against stated limits (src/limits.rs,
+// docs/models.md "Limits") before anything is allocated: a clear error that
+// names the key, the value and the limit, exit 2, never an allocation
+// failure or a panic.
+
+/// Runs, expects exit 2 and an error containing every one of `needles`,
+/// with no panic and no allocation failure.
+fn limit_err(args: &[&str], needles: &[&str]) {
+    let e = run_err(args);
+    assert!(!e.contains("memory allocation"), "{e}");
+    for n in needles {
+        assert!(e.contains(n), "{args:?}: expected {n:?} in: {e}");
+    }
+}
+
+fn model(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("models")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+#[test]
+fn a_huge_direct_vertex_cache_is_refused_with_its_limit() {
+    limit_err(
+        &["vcache", "grid:8x8", "--policy", "direct:4294967295,1"],
+        &["--policy", "4294967295", "limit of 1048576"],
+    );
+}
+
+#[test]
+fn huge_generated_meshes_are_refused_with_their_limit() {
+    limit_err(
+        &["vcache", "grid:40000x40000", "--policy", "fifo:32"],
+        &["grid:40000x40000", "9600000000 indices", "limit of 268435456"],
+    );
+    limit_err(
+        &["vcache", "random:700000000:1000:1", "--policy", "fifo:32"],
+        &["2100000000 indices", "limit of 268435456"],
+    );
+    limit_err(
+        &[
+            "run",
+            &model("one-mesh.toml"),
+            "--set",
+            "workload.groups.0.mesh=\"grid:100000x100000\"",
+        ],
+        &["workload.groups.0.mesh", "limit of 268435456"],
+    );
+}
+
+#[test]
+fn a_huge_replication_count_is_refused_with_its_limit() {
+    let d = tempfile::tempdir().unwrap();
+    let f = write(
+        d.path(),
+        "e.toml",
+        "name = \"x\"\nmodel = \"default\"\nreplications = 100000000\n[[sweep]]\nkey = \"run.seed\"\nvalues = [1]\n",
+    );
+    limit_err(&["experiment", &f], &["replications", "100000000", "limit of 100000"]);
+    // Points x replications: three sweeps of 10^5 steps.
+    let mut text = String::from("name = \"x\"\nmodel = \"default\"\n");
+    for k in ["cpu.per_draw", "cpu.per_object", "cpu.clear"] {
+        text += &format!(
+            "[[sweep]]\nkey = \"{k}\"\nrange = {{ from = 1, to = 100000, steps = 100000, format = \"{{}}ns\" }}\n"
+        );
+    }
+    let f = write(d.path(), "s.toml", &text);
+    limit_err(
+        &["experiment", &f],
+        &["sweep", "100000 x 100000 x 100000", "limit of 1000000"],
+    );
+}
+
+#[test]
+fn huge_pixelflow_sizes_are_refused_with_their_limit() {
+    let m = model("pixelflow-20.toml");
+    limit_err(
+        &["run", &m, "--set", "nodes=4294967295"],
+        &["key `nodes`", "4294967295", "limit of 4096"],
+    );
+    limit_err(
+        &["run", &m, "--set", "frames=10000", "--set", "region={width=1,height=1}"],
+        &["key `frames`", "3276800000 region records", "limit of 16777216"],
+    );
+}
+
+#[test]
+fn huge_scenes_are_refused_with_their_limit() {
+    limit_err(
+        &[
+            "run",
+            &model("one-mesh.toml"),
+            "--set",
+            "workload.groups.0.count=9223372036854775807",
+        ],
+        &["workload.groups.0.count", "9223372036854775807", "limit of 16777216"],
+    );
+    limit_err(
+        &["run", &model("city.toml"), "--set", "workload.scale=1e308"],
+        &["workload.scale", "1e308", "limit of 1000"],
+    );
+}
+
+#[test]
+fn a_run_over_max_memory_is_refused_before_it_starts() {
+    // 10^9 frames of records: about 268 GiB, over the 8 GiB default.
+    limit_err(
+        &["run", &model("fixed.toml"), "--set", "run.frames=1000000000"],
+        &[
+            "run.max_memory",
+            "1000000000 frames",
+            "GiB",
+            "8 GiB",
+            "--set run.max_memory=",
+        ],
+    );
+    // A lower limit of the user's own.
+    limit_err(
+        &[
+            "run",
+            &model("fixed.toml"),
+            "--set",
+            "run.frames=100000",
+            "--set",
+            "run.max_memory=\"1MiB\"",
+        ],
+        &["run.max_memory", "1 MiB"],
+    );
+    // Raised, the same run goes.
+    run_ok(&[
+        "run",
+        &model("fixed.toml"),
+        "--set",
+        "run.frames=100",
+        "--set",
+        "run.max_memory=\"16GiB\"",
+    ]);
+    limit_err(
+        &["run", &model("fixed.toml"), "--set", "run.max_memory=\"lots\""],
+        &["run.max_memory"],
+    );
+}
+
+#[test]
+fn a_trace_streams_to_its_file_and_takes_no_memory_budget() {
+    // One-mesh at triangle fidelity: 18,432 triangles a frame. Held in memory
+    // the timeline would need far more than 4 MiB; streamed, it needs none.
+    let d = tempfile::tempdir().unwrap();
+    let t = d.path().join("t.json");
+    run_ok(&[
+        "run",
+        &model("one-mesh.toml"),
+        "--frames",
+        "3",
+        "--set",
+        "run.max_memory=\"4MiB\"",
+        "--trace",
+        t.to_str().unwrap(),
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&t).unwrap()).unwrap();
+    assert!(v["traceEvents"].as_array().unwrap().len() > 50_000);
+}
+
+#[test]
+fn latency_systems_over_a_long_simulated_span_are_refused() {
+    for m in ["mfr-cluster.toml", "vr-naive.toml", "vr-warp.toml"] {
+        limit_err(
+            &["run", &model(m), "--set", "input.mean_interval=\"100000s\""],
+            &["run.max_memory", "input.mean_interval", "8 GiB"],
+        );
+    }
+}
+
+#[test]
+fn a_huge_input_event_count_is_refused_with_its_limit() {
+    for m in ["mfr-cluster.toml", "vr-naive.toml"] {
+        limit_err(
+            &["run", &model(m), "--set", "run.events=1000000000000"],
+            &["run.events", "1000000000000", "limit of 100000000"],
+        );
+    }
+}
+
+#[test]
+fn zero_time_frames_stop_at_max_events() {
+    let out = run_ok(&[
+        "run",
+        &model("fixed.toml"),
+        "--json",
+        "--set",
+        "workload.cpu=\"0ms\"",
+        "--set",
+        "workload.gpu=\"0ms\"",
+        "--set",
+        "display.vsync=false",
+        "--set",
+        "run.frames=10000000",
+        "--set",
+        "run.max_events=1000",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["stopped_by"], "event_limit");
+    assert_eq!(v["events"]["total"], 1000);
+    assert!(v["frames"].as_u64().unwrap() < 1100, "{}", v["frames"]);
+}

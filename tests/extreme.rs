@@ -91,3 +91,68 @@ fn a_run_past_the_picosecond_range_ends_with_a_clear_error() {
     .unwrap_err();
     assert!(e.contains("overflow") && e.contains("213 days"), "{e}");
 }
+
+#[test]
+fn frames_that_take_no_time_stop_at_run_max_events() {
+    // vsync off, nothing costs time: every frame happens at t = 0. Past the
+    // frames that could be in flight, each is one event of the run loop, so
+    // run.max_events holds (it used to run every frame at once, unbounded).
+    let free = [
+        "workload.cpu=\"0ms\"",
+        "workload.gpu=\"0ms\"",
+        "display.vsync=false",
+        "run.frames=10000000",
+        "run.warmup_frames=0",
+    ];
+    let r = run(FIXED, &[&free[..], &["run.max_events=500"]].concat());
+    assert_eq!(r.stats.stopped_by, rendersim::engine::StopReason::EventLimit);
+    assert_eq!(r.stats.events, 500);
+    assert!(r.records.len() < 600, "{}", r.records.len());
+    assert_eq!(r.summary["stopped_by"], "event_limit");
+    assert_eq!(r.clocks.elapsed, 0);
+    no_nulls(&r);
+    // Without a limit, a run of such frames ends by itself (a few events
+    // per frame past the first).
+    let all = run(
+        FIXED,
+        &[&free[..3], &["run.frames=2000", "run.warmup_frames=0"]].concat(),
+    );
+    assert_eq!(all.records.len(), 2000);
+    assert_eq!(all.stats.stopped_by, rendersim::engine::StopReason::Model);
+    assert!(all.stats.events >= 1990, "{}", all.stats.events);
+}
+
+#[test]
+fn frames_that_take_no_time_stop_at_run_until() {
+    // Rendering costs nothing; vsync paces the frames, so simulated time
+    // passes and run.until ends the run (10^7 frames requested).
+    let r = run(
+        FIXED,
+        &[
+            "workload.cpu=\"0ms\"",
+            "workload.gpu=\"0ms\"",
+            "run.frames=10000000",
+            "run.warmup_frames=0",
+            "run.until=\"1s\"",
+        ],
+    );
+    assert_eq!(r.stats.stopped_by, rendersim::engine::StopReason::TimeLimit);
+    assert_eq!(r.summary["stopped_by"], "time_limit");
+    assert!((55..=61).contains(&r.records.len()), "{}", r.records.len());
+    // Without vsync no time passes, so run.until cannot end the run; the
+    // frames' records are bounded by run.max_memory instead: 10^8 frames
+    // need about 27 GiB, more than the 8 GiB default, and are refused up front.
+    let e = common::try_run(
+        FIXED,
+        &[
+            "workload.cpu=\"0ms\"",
+            "workload.gpu=\"0ms\"",
+            "display.vsync=false",
+            "run.frames=100000000",
+            "run.warmup_frames=0",
+            "run.until=\"1s\"",
+        ],
+    )
+    .unwrap_err();
+    assert!(e.contains("run.max_memory"), "{e}");
+}

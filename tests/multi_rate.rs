@@ -493,3 +493,42 @@ fn bookkeeping_removes_the_release_artifact_and_over_prediction_the_selection_ar
     .unwrap();
     assert!(e.contains("migration.script.1.at"), "{e}");
 }
+
+#[test]
+fn records_past_run_max_memory_end_the_run_with_an_error_naming_the_key() {
+    use rendersim::engine::{Limits, Scheduler, run};
+    use rendersim::systems::multi_rate::analytic::Terms;
+    use rendersim::systems::multi_rate::{MultiRate, MultiRateConfig, MultiRateError};
+    let cfg: MultiRateConfig = toml::from_str(CLUSTER).unwrap();
+    let mut m = MultiRate::new(
+        Terms::of(&cfg),
+        cfg.run.events,
+        cfg.run.warmup,
+        cfg.input.mean_interval,
+        true,
+        1,
+    );
+    // The records grow with simulated time; 4 KiB is reached within seconds.
+    m.max_memory = 4096;
+    let mut s = Scheduler::new();
+    m.start(&mut s).unwrap();
+    let e = run(&mut m, &mut s, Limits::default()).unwrap_err();
+    match e {
+        MultiRateError::Invalid { key, message } => {
+            assert_eq!(key, "run.max_memory");
+            assert!(message.contains("4 KiB") && message.contains("FC"), "{message}");
+        }
+        other => panic!("{other}"),
+    }
+    assert!(m.record_bytes() <= 4096 + 64, "{}", m.record_bytes());
+}
+
+#[test]
+fn the_memory_estimate_grows_with_the_simulated_span_and_is_enforced() {
+    let (small, _) = rendersim::systems::multi_rate::run::estimate_memory(&toml::from_str(CLUSTER).unwrap());
+    assert!(small < 64 << 20, "{small}");
+    let e = try_run(CLUSTER, &["run.max_memory=\"64KiB\""]).unwrap_err();
+    assert!(e.contains("run.max_memory") && e.contains("64 KiB"), "{e}");
+    // The shipped model runs unchanged under the default.
+    assert!(try_run(CLUSTER, &["run.events=200"]).is_ok());
+}

@@ -236,3 +236,26 @@ fn summary_mfr() -> Value {
     apply_set(&mut t, "run.events=100").unwrap();
     run_model(&src, &t, None).unwrap().summary().clone()
 }
+
+#[test]
+fn records_past_run_max_memory_end_the_run_with_an_error_naming_the_key() {
+    use rendersim::engine::{Limits, Scheduler, run};
+    use rendersim::systems::vr::{Vr, VrConfig, VrError};
+    for text in [NAIVE, WARP] {
+        let cfg: VrConfig = toml::from_str(text).unwrap();
+        let mut m = Vr::new(cfg);
+        m.max_memory = 4096;
+        let mut s = Scheduler::new();
+        m.start(&mut s).unwrap();
+        match run(&mut m, &mut s, Limits::default()).unwrap_err() {
+            VrError::Invalid { key, message } => {
+                assert_eq!(key, "run.max_memory");
+                assert!(message.contains("4 KiB"), "{message}");
+            }
+            other => panic!("{other}"),
+        }
+        assert!(m.record_bytes() <= 4096 + 64, "{}", m.record_bytes());
+    }
+    let e = try_run(NAIVE, &["run.max_memory=\"64KiB\""]).unwrap_err();
+    assert!(e.contains("run.max_memory") && e.contains("64 KiB"), "{e}");
+}

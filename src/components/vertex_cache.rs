@@ -136,6 +136,12 @@ impl FromStr for CachePolicy {
                 if slots == 0 || segment == 0 {
                     return Err(bad("SLOTS and SEGMENT_TRIANGLES must be at least 1"));
                 }
+                if slots > crate::limits::MAX_DIRECT_CACHE_SLOTS {
+                    return Err(bad(&format!(
+                        "SLOTS {slots} is more than the limit of {} slots",
+                        crate::limits::MAX_DIRECT_CACHE_SLOTS
+                    )));
+                }
                 Ok(CachePolicy::Direct { slots, segment })
             }
             "none" => match size {

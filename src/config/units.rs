@@ -185,11 +185,13 @@ impl Bytes {
             "KiB" => 1 << 10,
             "MiB" => 1 << 20,
             "GiB" => 1 << 30,
+            "TB" => 1_000_000_000_000,
+            "TiB" => 1 << 40,
             _ => {
                 return Err(unit_err(
                     "size",
                     text,
-                    format!("unknown unit {unit:?} (use B, kB, MB, GB, KiB, MiB, GiB)"),
+                    format!("unknown unit {unit:?} (use B, kB, MB, GB, TB, KiB, MiB, GiB, TiB)"),
                 ));
             }
         };
@@ -293,5 +295,8 @@ mod tests {
         assert_eq!(Bytes::parse("64KiB").unwrap(), Bytes(65536));
         assert_eq!(Bytes::parse("12").unwrap(), Bytes(12));
         assert!(Bytes::parse("12 parsecs").is_err());
+        assert_eq!(Bytes::parse("8GiB").unwrap(), Bytes(8 << 30));
+        assert_eq!(Bytes::parse("2TiB").unwrap(), Bytes(2 << 40));
+        assert!(Bytes::parse("99999999TiB").is_err());
     }
 }

@@ -24,8 +24,8 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 use super::mesh::{Mesh, MeshError, RESTART, Topology};
 use super::optimize::optimize_vertex_cache;
 
-/// The most indices a generated mesh may have.
-pub const MAX_INDICES: u64 = 1 << 31;
+/// The most indices a generated mesh may have ([`crate::limits::MAX_MESH_INDICES`]).
+pub const MAX_INDICES: u64 = crate::limits::MAX_MESH_INDICES;
 
 /// Builds a mesh from a spec (see the module docs and [`MeshError::UnknownGenerator`]
 /// for the forms). File paths are relative to `base_dir` unless absolute.
@@ -94,6 +94,24 @@ pub fn mesh_from_spec(spec: &str, base_dir: &Path) -> Result<Mesh, MeshError> {
     }
 }
 
+/// Indices a generator spec (`grid:`, `strip:`, `random:`) will produce,
+/// read from the spec without building the mesh; `None` for a file or a
+/// spec that does not parse (building it reports the error). For memory
+/// estimates made before anything is allocated.
+pub fn spec_index_count(spec: &str) -> Option<u64> {
+    let parts: Vec<&str> = spec.trim().split(':').collect();
+    let wh = |size: &str| -> Option<(u64, u64)> {
+        let (w, h) = size.split_once(['x', 'X'])?;
+        Some((w.trim().parse().ok()?, h.trim().parse().ok()?))
+    };
+    match parts.as_slice() {
+        ["grid", size, ..] => wh(size).map(|(w, h)| w.saturating_mul(h).saturating_mul(6)),
+        ["strip", size] => wh(size).map(|(w, h)| (2 * (w.saturating_add(1)) + 1).saturating_mul(h)),
+        ["random", t, _, _] => t.trim().parse::<u64>().ok().map(|t| t.saturating_mul(3)),
+        _ => None,
+    }
+}
+
 fn parse_num<T: std::str::FromStr>(s: &str, field: &'static str, spec: &str) -> Result<T, MeshError> {
     s.trim().parse().map_err(|_| MeshError::BadNumber {
         field,
@@ -116,7 +134,10 @@ fn nonzero(x: u64, field: &'static str, spec: &str) -> Result<(), MeshError> {
 fn check_indices(count: Option<u64>, spec: &str) -> Result<(), MeshError> {
     match count {
         Some(n) if n <= MAX_INDICES => Ok(()),
-        _ => Err(MeshError::TooLarge { spec: spec.to_string() }),
+        _ => Err(MeshError::TooLarge {
+            spec: spec.to_string(),
+            indices: count.map_or_else(|| "more than 2^64".to_string(), |n| n.to_string()),
+        }),
     }
 }
 

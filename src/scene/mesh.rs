@@ -74,10 +74,15 @@ pub enum MeshError {
         spec: String,
     },
     /// The mesh would have too many indices.
-    #[error("mesh spec `{spec}` is too large: more than 2^31 indices")]
+    #[error(
+        "mesh spec `{spec}` is too large: {indices} indices, more than the limit of {}",
+        crate::limits::MAX_MESH_INDICES
+    )]
     TooLarge {
         /// The whole spec.
         spec: String,
+        /// The indices it would have (or "more than 2^64").
+        indices: String,
     },
     /// A mesh file does not exist.
     #[error("mesh file `{}` not found", .0.display())]

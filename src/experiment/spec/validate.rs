@@ -44,8 +44,18 @@ impl Validator<'_> {
         if raw.name.trim().is_empty() {
             return Err(self.err("name", "must not be empty"));
         }
-        if raw.replications < 1 || raw.replications > i64::from(u32::MAX) {
+        if raw.replications < 1 {
             return Err(self.err("replications", format!("must be at least 1, got {}", raw.replications)));
+        }
+        if raw.replications > crate::limits::MAX_REPLICATIONS {
+            return Err(self.err(
+                "replications",
+                format!(
+                    "{} is more than the limit of {} replications per point",
+                    raw.replications,
+                    crate::limits::MAX_REPLICATIONS
+                ),
+            ));
         }
         if !(raw.confidence > 0.0 && raw.confidence < 1.0) {
             return Err(self.err("confidence", format!("must be in (0, 1), got {}", raw.confidence)));
@@ -88,6 +98,30 @@ impl Validator<'_> {
                 None => sweep,
             };
             sweeps.push(sweep);
+        }
+        // Runs = points (the product of the sweeps' sizes) x replications,
+        // checked before the points are expanded.
+        let points = sweeps
+            .iter()
+            .try_fold(1u64, |n, s| n.checked_mul(s.values.len() as u64))
+            .unwrap_or(u64::MAX);
+        let runs = points.saturating_mul(raw.replications as u64);
+        if runs > crate::limits::MAX_EXPERIMENT_RUNS {
+            let sizes: Vec<String> = sweeps.iter().map(|s| s.values.len().to_string()).collect();
+            return Err(self.err(
+                "sweep",
+                format!(
+                    "{} points ({}) x {} replications = {runs} runs is more than the limit of {}",
+                    points,
+                    if sizes.is_empty() {
+                        "no sweep".to_string()
+                    } else {
+                        sizes.join(" x ")
+                    },
+                    raw.replications,
+                    crate::limits::MAX_EXPERIMENT_RUNS
+                ),
+            ));
         }
         let find_sweep = |k: &str| sweeps.iter().find(|s| s.key == k);
         let filter = |key: &str, t: &toml::Table| -> Result<Vec<(String, toml::Value)>, ExperimentError> {

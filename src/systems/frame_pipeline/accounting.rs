@@ -217,7 +217,7 @@ impl FramePipeline {
             1
         } else {
             match self.cpu_phase {
-                CpuPhase::Running | CpuPhase::Ready | CpuPhase::NextFrame => 0,
+                CpuPhase::Running | CpuPhase::Ready | CpuPhase::NextFrame | CpuPhase::ZeroTimeWait => 0,
                 CpuPhase::Push(_) | CpuPhase::Rendezvous => 2,
                 CpuPhase::WaitFrames => 3,
                 CpuPhase::Finished => 4,

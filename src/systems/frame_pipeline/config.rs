@@ -86,6 +86,10 @@ pub struct RunConfig {
     pub max_events: Option<u64>,
     /// Optional end of simulated time: the run stops there even if frames remain.
     pub until: Option<Duration>,
+    /// Most memory the run may need, estimated from the inputs before
+    /// simulating (default [`crate::limits::DEFAULT_MAX_MEMORY`], 8 GiB).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_memory: Option<Bytes>,
 }
 
 impl Default for RunConfig {
@@ -96,6 +100,7 @@ impl Default for RunConfig {
             seed: 1,
             max_events: None,
             until: None,
+            max_memory: None,
         }
     }
 }

@@ -120,6 +120,19 @@ impl FramePipeline {
                         self.cpu_phase = CpuPhase::WaitFrames;
                         return Ok(progressed || changed);
                     }
+                    // Frames that take no time would all run at this one
+                    // instant inside this call, unseen by the run loop and
+                    // its limits: past the most that could be in flight,
+                    // each goes through the loop as an event.
+                    let (at, n) = self.frames_at_instant;
+                    let n = if at == now { n } else { 0 };
+                    if n >= self.zero_time_after && !self.zero_time_go {
+                        s.at(now, Ev::ZeroTimeFrame);
+                        self.cpu_phase = CpuPhase::ZeroTimeWait;
+                        return Ok(true);
+                    }
+                    self.zero_time_go = false;
+                    self.frames_at_instant = (now, n + 1);
                     self.cpu_op = 0;
                     self.cpu_phase = CpuPhase::Ready;
                 }
@@ -152,7 +165,7 @@ impl FramePipeline {
                     }
                     self.cpu_phase = self.cpu_advance(now);
                 }
-                CpuPhase::Running | CpuPhase::Finished => return Ok(progressed),
+                CpuPhase::Running | CpuPhase::ZeroTimeWait | CpuPhase::Finished => return Ok(progressed),
             }
             progressed = true;
         }

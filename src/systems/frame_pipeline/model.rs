@@ -57,6 +57,11 @@ pub enum Ev {
         /// Which unit.
         target: NoiseTarget,
     },
+    /// The CPU thread starts a frame at the instant where more frames
+    /// started than could be in flight, so frames take no time: each such
+    /// frame goes through the run loop as an event, and `run.max_events`
+    /// holds for it (scheduled only for zero-time frames).
+    ZeroTimeFrame,
 }
 
 impl EventKind for Ev {
@@ -71,6 +76,7 @@ impl EventKind for Ev {
         "vblank",
         "noise_arrival",
         "noise_end",
+        "zero_time_frame",
     ];
     #[inline]
     fn kind(&self) -> usize {
@@ -85,6 +91,7 @@ impl EventKind for Ev {
             Ev::Vblank => 7,
             Ev::NoiseArrive { .. } => 8,
             Ev::NoiseEnd { .. } => 9,
+            Ev::ZeroTimeFrame => 10,
         }
     }
 }
@@ -185,6 +192,9 @@ pub enum CpuPhase {
     Push(Command),
     /// Pushed into a FIFO beyond its capacity (rendezvous): waits until taken.
     Rendezvous,
+    /// Waits for its [`Ev::ZeroTimeFrame`] event before starting a frame
+    /// that takes no time.
+    ZeroTimeWait,
     /// All frames submitted.
     Finished,
 }
@@ -215,6 +225,14 @@ pub struct FramePipeline {
     pub(super) cpu_frame: u64,
     pub(super) cpu_op: u32,
     pub(super) non_render_rng: StreamRng,
+    /// The instant the CPU thread last started a frame, and how many
+    /// frames it started then.
+    pub(super) frames_at_instant: (Time, u64),
+    /// Frames started at one instant beyond which a frame is known to take
+    /// no time (more than could be in flight); see [`Ev::ZeroTimeFrame`].
+    pub(super) zero_time_after: u64,
+    /// The pending [`Ev::ZeroTimeFrame`] was handled: start the frame.
+    pub(super) zero_time_go: bool,
     pub(super) fifo: BoundedFifo<Command>,
     pub(super) commands_issued: u64,
     pub(super) commands_executed: u64,
@@ -343,6 +361,9 @@ impl FramePipeline {
                 cfg.gpu.fragment.fifo_depth as u64
             }),
             non_render_rng: streams.stream("cpu.non_render"),
+            frames_at_instant: (Time::ZERO, 0),
+            zero_time_after: u64::from(cfg.cpu.max_frames_ahead) + u64::from(cfg.display.buffers) + 1,
+            zero_time_go: false,
             pixel_rng: streams.stream("fragment.pixels"),
             pixel_rng_start: match &cfg.workload {
                 WorkloadConfig::Scene(sc) if sc.view == crate::scene::config::View::Static => {
@@ -375,7 +396,7 @@ impl FramePipeline {
             last_display: None,
             resolved: 0,
             noise,
-            records: Vec::with_capacity(frames_total.min(1 << 24) as usize),
+            records: Vec::with_capacity(frames_total.min(1 << 16) as usize),
             acct: Accounting::new(trace),
             cfg,
         })
@@ -565,6 +586,10 @@ impl Model for FramePipeline {
             Ev::Vblank => self.vblank(now, s)?,
             Ev::NoiseArrive { source } => self.noise_arrive(now, source, s)?,
             Ev::NoiseEnd { target } => self.noise_end(now, target, s)?,
+            Ev::ZeroTimeFrame => {
+                self.zero_time_go = true;
+                self.cpu_phase = CpuPhase::NextFrame;
+            }
         }
         self.settle(now, s)?;
         self.account(now);

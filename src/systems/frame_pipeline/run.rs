@@ -112,6 +112,134 @@ pub fn validate(cfg: &FramePipelineConfig) -> Result<(), PipelineError> {
             .validate()
             .map_err(|e| bad(&format!("noise.random.{i}.duration"), e.to_string()))?;
     }
+    if let WorkloadConfig::Scene(sc) = &cfg.workload {
+        check_scene_sizes(sc)?;
+    }
+    Ok(())
+}
+
+/// Checks a scene's object counts and scale against [`crate::limits`]
+/// before anything is compiled or allocated.
+fn check_scene_sizes(sc: &crate::scene::config::SceneWorkload) -> Result<(), PipelineError> {
+    use crate::limits::{MAX_SCENE_OBJECTS, MAX_SCENE_SCALE};
+    if sc.scale.is_finite() && sc.scale > MAX_SCENE_SCALE {
+        return Err(bad(
+            "workload.scale",
+            format!(
+                "{:?} is more than the limit of {MAX_SCENE_SCALE:?} (times the paper's scene)",
+                sc.scale
+            ),
+        ));
+    }
+    let mut total = 0u64;
+    if let Some(p) = &sc.preset
+        && sc.scale.is_finite()
+        && sc.scale > 0.0
+        && let Some(groups) = crate::scene::presets::preset_groups(p, sc.scale)
+    {
+        total = groups.iter().fold(0u64, |t, g| t.saturating_add(g.count));
+    }
+    for (i, g) in sc.groups.iter().enumerate() {
+        if g.count > MAX_SCENE_OBJECTS {
+            return Err(bad(
+                &format!("workload.groups.{i}.count"),
+                format!(
+                    "{} objects is more than the limit of {MAX_SCENE_OBJECTS} per scene",
+                    g.count
+                ),
+            ));
+        }
+        total = total.saturating_add(g.count);
+        if total > MAX_SCENE_OBJECTS {
+            return Err(bad(
+                &format!("workload.groups.{i}.count"),
+                format!(
+                    "the scene has {total} objects up to this group, more than the limit of {MAX_SCENE_OBJECTS} per scene"
+                ),
+            ));
+        }
+    }
+    if total > MAX_SCENE_OBJECTS {
+        return Err(bad(
+            "workload.scale",
+            format!(
+                "preset {:?} at scale {} has {total} objects, more than the limit of {MAX_SCENE_OBJECTS} per scene",
+                sc.preset.as_deref().unwrap_or(""),
+                sc.scale
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Bytes a frame's results take: its record, its table row and the metric
+/// columns built from it.
+const BYTES_PER_FRAME: usize = std::mem::size_of::<FrameRecord>() + 14 * 8 + 8 * 8;
+
+/// Estimates the memory a run needs from its inputs, before simulating:
+/// per-frame records, the scene's draws and generated index buffers (a
+/// trace takes none: it streams to its file). Returns the bytes and a
+/// description of the terms.
+pub fn estimate_memory(cfg: &FramePipelineConfig) -> (u64, String) {
+    use crate::limits::{add_bytes, show_bytes};
+    let mut parts = Vec::new();
+    let mut total = 0u64;
+    let mut frames_bytes = 0u64;
+    add_bytes(&mut frames_bytes, cfg.run.frames, BYTES_PER_FRAME);
+    total = total.saturating_add(frames_bytes);
+    parts.push(format!(
+        "{} frames x {BYTES_PER_FRAME} bytes = {}",
+        cfg.run.frames,
+        show_bytes(frames_bytes)
+    ));
+    if let WorkloadConfig::Scene(sc) = &cfg.workload {
+        let mut objects: u64 = sc.groups.iter().fold(0, |t, g| t.saturating_add(g.count));
+        if let Some(p) = &sc.preset
+            && sc.scale.is_finite()
+            && sc.scale > 0.0
+            && let Some(groups) = crate::scene::presets::preset_groups(p, sc.scale)
+        {
+            objects = groups.iter().fold(objects, |t, g| t.saturating_add(g.count));
+        }
+        let per_object = std::mem::size_of::<super::workload::DrawItem>() + 48;
+        let mut b = 0u64;
+        add_bytes(&mut b, objects, per_object);
+        total = total.saturating_add(b);
+        parts.push(format!("{objects} objects x {per_object} bytes = {}", show_bytes(b)));
+        // A generated mesh: its 4-byte indices, a per-triangle count, and
+        // the reordering's temporaries (about 4 more words per index).
+        let mut mesh = 0u64;
+        for g in &sc.groups {
+            if let crate::scene::config::MeshRef::Spec(spec) = &g.mesh
+                && let Some(n) = crate::scene::generators::spec_index_count(spec)
+                && n <= crate::limits::MAX_MESH_INDICES
+            {
+                let per_index = if spec.contains("optimized") || spec.contains("shuffled") || spec.contains("local") {
+                    20
+                } else {
+                    6
+                };
+                add_bytes(&mut mesh, n, per_index);
+            }
+        }
+        if mesh > 0 {
+            total = total.saturating_add(mesh);
+            parts.push(format!("generated meshes {}", show_bytes(mesh)));
+        }
+    }
+    (total, parts.join(", "))
+}
+
+/// Fails with an error naming `run.max_memory` when the estimate exceeds it.
+fn check_memory(cfg: &FramePipelineConfig) -> Result<(), PipelineError> {
+    let limit = cfg.run.max_memory.map_or(crate::limits::DEFAULT_MAX_MEMORY, |b| b.0);
+    let (estimate, parts) = estimate_memory(cfg);
+    if estimate > limit {
+        return Err(bad(
+            "run.max_memory",
+            crate::limits::over_memory_message(estimate, &parts, limit),
+        ));
+    }
     Ok(())
 }
 
@@ -122,6 +250,7 @@ pub fn run_pipeline(
     trace: Option<TraceWriter>,
 ) -> Result<PipelineRun, PipelineError> {
     validate(&cfg)?;
+    check_memory(&cfg)?;
     let build_start = std::time::Instant::now();
     let scene = match &cfg.workload {
         WorkloadConfig::Scene(s) => Some(compile_scene(&cfg, s, base_dir).map_err(|e| match e {

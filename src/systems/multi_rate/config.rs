@@ -16,7 +16,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::config::{Bandwidth, Rate};
+use crate::config::{Bandwidth, Bytes, Rate};
 use crate::engine::Duration;
 
 /// The whole model.
@@ -109,6 +109,11 @@ pub struct RunConfig {
     pub warmup: Duration,
     /// Safety cap on handled events.
     pub max_events: Option<u64>,
+    /// Most memory the run's records may take: estimated from the inputs
+    /// before simulating and enforced while it runs (default
+    /// [`crate::limits::DEFAULT_MAX_MEMORY`], 8 GiB).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_memory: Option<Bytes>,
 }
 
 impl Default for RunConfig {
@@ -118,6 +123,7 @@ impl Default for RunConfig {
             events: 5000,
             warmup: Duration::ms(1000),
             max_events: None,
+            max_memory: None,
         }
     }
 }

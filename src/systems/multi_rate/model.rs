@@ -172,6 +172,9 @@ pub struct MultiRate {
     pub conv_done: usize,
     /// The run goes on at least until FC has finished a frame after this.
     pub min_end: Time,
+    /// Most bytes the frame and input records may take (`run.max_memory`);
+    /// the run fails with an error naming that key beyond it.
+    pub max_memory: u64,
 }
 
 impl MultiRate {
@@ -202,7 +205,7 @@ impl MultiRate {
             mean_interval: mean_interval.0 as f64,
             arrivals: rng.stream("input.arrivals"),
             phases,
-            inputs: Vec::with_capacity(events as usize),
+            inputs: Vec::with_capacity(events.min(1 << 16) as usize),
             sc: Vec::new(),
             fc: Vec::new(),
             conv: Vec::new(),
@@ -213,7 +216,39 @@ impl MultiRate {
             fc_done: 0,
             conv_done: 0,
             min_end: Time::ZERO,
+            max_memory: u64::MAX,
         }
+    }
+
+    /// Bytes the input and frame records take now.
+    pub fn record_bytes(&self) -> u64 {
+        use std::mem::size_of;
+        (self.inputs.len() * size_of::<Time>()
+            + self.sc.len() * size_of::<ScFrame>()
+            + self.fc.len() * size_of::<FcFrame>()
+            + self.conv.len() * size_of::<ConvFrame>()) as u64
+    }
+
+    /// Fails once the records outgrow `run.max_memory`.
+    fn check_growth(&self, now: Time) -> Result<(), MultiRateError> {
+        let used = self.record_bytes();
+        if used > self.max_memory {
+            return Err(MultiRateError::Invalid {
+                key: "run.max_memory".into(),
+                message: crate::limits::over_memory_message(
+                    used,
+                    &format!(
+                        "records of {} inputs, {} SC, {} FC and {} conventional frames after {now} of simulated time",
+                        self.inputs.len(),
+                        self.sc.len(),
+                        self.fc.len(),
+                        self.conv.len()
+                    ),
+                    self.max_memory,
+                ),
+            });
+        }
+        Ok(())
     }
 
     /// Schedules the first event of every process.
@@ -320,6 +355,9 @@ impl Model for MultiRate {
 
     fn handle(&mut self, now: Time, ev: Ev, sched: &mut Scheduler<Ev>) -> Result<Control, MultiRateError> {
         let t = self.terms;
+        if matches!(ev, Ev::Input | Ev::ScFrameStart | Ev::FcFrameStart | Ev::ConvFrameStart) {
+            self.check_growth(now)?;
+        }
         match ev {
             Ev::Input => {
                 self.inputs.push(now);

@@ -92,6 +92,16 @@ pub fn validate(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
     if cfg.run.events == 0 {
         return Err(bad("run.events", "must be at least 1 input event"));
     }
+    if cfg.run.events > crate::limits::MAX_INPUT_EVENTS {
+        return Err(bad(
+            "run.events",
+            format!(
+                "{} input events is more than the limit of {}",
+                cfg.run.events,
+                crate::limits::MAX_INPUT_EVENTS
+            ),
+        ));
+    }
     for (i, w) in cfg.migration.script.windows(2).enumerate() {
         if w[1].at < w[0].at {
             return Err(bad(
@@ -124,9 +134,56 @@ pub fn validate(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
     Ok(())
 }
 
+/// Bytes per input event after the run: its time, its record with the
+/// stages of three paths, and its table row.
+const BYTES_PER_EVENT: usize = std::mem::size_of::<Time>() + std::mem::size_of::<EventRecord>() + 3 * 12 * 8 + 8 * 8;
+
+/// Estimates the memory a run needs from its inputs before simulating: the
+/// expected simulated span (warm-up, `run.events` x `input.mean_interval`,
+/// the migration script) times each client's frame rate, plus the input
+/// events' records. Returns the bytes and a description.
+pub fn estimate_memory(cfg: &MultiRateConfig) -> (u64, String) {
+    use crate::limits::{add_bytes, show_bytes};
+    use std::mem::size_of;
+    let t = Terms::of(cfg);
+    let last = cfg.migration.script.iter().map(|s| s.at.0).max().unwrap_or(0) as f64;
+    let span = cfg.run.warmup.0 as f64 + cfg.run.events as f64 * cfg.input.mean_interval.0 as f64 + last + 1e12;
+    let frames = |interval: crate::engine::Duration| -> u64 {
+        (span / interval.0.max(1) as f64).min(u64::MAX as f64) as u64 + 1
+    };
+    let (sc, fc) = (frames(t.sc_interval()), frames(t.fc_interval()));
+    let conv = if cfg.conventional.enabled {
+        frames(t.conventional_frame)
+    } else {
+        0
+    };
+    let mut total = 0u64;
+    add_bytes(&mut total, sc, size_of::<super::model::ScFrame>());
+    add_bytes(&mut total, fc, size_of::<super::model::FcFrame>());
+    add_bytes(&mut total, conv, size_of::<super::model::ConvFrame>());
+    let mut events = 0u64;
+    add_bytes(&mut events, cfg.run.events, BYTES_PER_EVENT);
+    let total = total.saturating_add(events);
+    let parts = format!(
+        "{} input events = {}; over an expected {:.3e} s simulated (run.warmup + run.events x input.mean_interval): {sc} SC, {fc} FC and {conv} conventional frames",
+        cfg.run.events,
+        show_bytes(events),
+        span / 1e12
+    );
+    (total, parts)
+}
+
 /// Validates, runs and summarizes a model.
 pub fn run_multi_rate(cfg: MultiRateConfig) -> Result<MultiRateRun, MultiRateError> {
     validate(&cfg)?;
+    let max_memory = cfg.run.max_memory.map_or(crate::limits::DEFAULT_MAX_MEMORY, |b| b.0);
+    let (estimate, parts) = estimate_memory(&cfg);
+    if estimate > max_memory {
+        return Err(bad(
+            "run.max_memory",
+            crate::limits::over_memory_message(estimate, &parts, max_memory),
+        ));
+    }
     let terms = Terms::of(&cfg);
     let a = analytic(&terms);
     let mut model = MultiRate::new(
@@ -137,6 +194,7 @@ pub fn run_multi_rate(cfg: MultiRateConfig) -> Result<MultiRateRun, MultiRateErr
         cfg.conventional.enabled,
         cfg.run.seed,
     );
+    model.max_memory = max_memory;
     if let Some(last) = cfg.migration.script.iter().map(|s| s.at).max() {
         model.min_end = Time::ZERO
             .add(last, "migration.script")?

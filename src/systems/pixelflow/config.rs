@@ -248,7 +248,7 @@ impl PixelFlowConfig {
     /// Number of screen regions (40 for 640 x 512 and 128 x 64).
     pub fn regions(&self) -> u32 {
         let (c, r) = self.region_grid();
-        c * r
+        c.saturating_mul(r)
     }
 
     /// The primitive footprint binned with: `aa_primitive` for the

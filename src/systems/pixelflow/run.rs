@@ -55,6 +55,16 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), PixelFlowError> {
     if cfg.system != "pixelflow" {
         return Err(bad("system", format!("expected \"pixelflow\", got {:?}", cfg.system)));
     }
+    if cfg.nodes > crate::limits::MAX_PIXELFLOW_NODES {
+        return Err(bad(
+            "nodes",
+            format!(
+                "{} nodes is more than the limit of {}",
+                cfg.nodes,
+                crate::limits::MAX_PIXELFLOW_NODES
+            ),
+        ));
+    }
     if cfg.frames == 0 || cfg.frames > 10_000 {
         return Err(bad(
             "frames",
@@ -97,6 +107,29 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), PixelFlowError> {
         return Err(bad(
             "region",
             format!("{} regions is more than 1,000,000", cfg.regions()),
+        ));
+    }
+    let regions = cfg.regions() as u64;
+    let bins = u64::from(cfg.nodes).saturating_mul(regions);
+    if bins > crate::limits::MAX_PIXELFLOW_BINS {
+        return Err(bad(
+            "nodes",
+            format!(
+                "{} nodes x {regions} regions = {bins} bins is more than the limit of {}",
+                cfg.nodes,
+                crate::limits::MAX_PIXELFLOW_BINS
+            ),
+        ));
+    }
+    let records = u64::from(cfg.frames).saturating_mul(regions);
+    if records > crate::limits::MAX_PIXELFLOW_REGION_RECORDS {
+        return Err(bad(
+            "frames",
+            format!(
+                "{} frames x {regions} regions = {records} region records is more than the limit of {}",
+                cfg.frames,
+                crate::limits::MAX_PIXELFLOW_REGION_RECORDS
+            ),
         ));
     }
     if cfg.nontex.batch_primitives == 0 {

@@ -12,7 +12,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::config::Rate;
+use crate::config::{Bytes, Rate};
 use crate::engine::Duration;
 
 /// Naive single loop or decoupled warping.
@@ -71,6 +71,11 @@ pub struct RunConfig {
     pub warmup: Duration,
     /// Safety cap on handled events.
     pub max_events: Option<u64>,
+    /// Most memory the run's records may take: estimated from the inputs
+    /// before simulating and enforced while it runs (default
+    /// [`crate::limits::DEFAULT_MAX_MEMORY`], 8 GiB).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_memory: Option<Bytes>,
 }
 
 impl Default for RunConfig {
@@ -80,6 +85,7 @@ impl Default for RunConfig {
             events: 5000,
             warmup: Duration::ms(500),
             max_events: None,
+            max_memory: None,
         }
     }
 }

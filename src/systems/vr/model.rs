@@ -178,6 +178,9 @@ pub struct Vr {
     pub swapped: usize,
     sims_done: usize,
     apps_done: usize,
+    /// Most bytes the motion and frame records may take (`run.max_memory`);
+    /// the run fails with an error naming that key beyond it.
+    pub max_memory: u64,
 }
 
 impl Vr {
@@ -206,8 +209,42 @@ impl Vr {
             swapped: 0,
             sims_done: 0,
             apps_done: 0,
+            max_memory: u64::MAX,
             cfg,
         }
+    }
+
+    /// Bytes the motion and frame records take now.
+    pub fn record_bytes(&self) -> u64 {
+        use std::mem::size_of;
+        (self.inputs.len() * size_of::<Time>()
+            + self.frames.len() * size_of::<LoopFrame>()
+            + self.sims.len() * size_of::<SimStep>()
+            + self.apps.len() * size_of::<AppFrame>()
+            + self.warps.len() * size_of::<WarpFrame>()) as u64
+    }
+
+    /// Fails once the records outgrow `run.max_memory`.
+    fn check_growth(&self, now: Time) -> Result<(), VrError> {
+        let used = self.record_bytes();
+        if used > self.max_memory {
+            return Err(VrError::Invalid {
+                key: "run.max_memory".into(),
+                message: crate::limits::over_memory_message(
+                    used,
+                    &format!(
+                        "records of {} motions, {} loop frames, {} simulation steps, {} application and {} warped frames after {now} of simulated time",
+                        self.inputs.len(),
+                        self.frames.len(),
+                        self.sims.len(),
+                        self.apps.len(),
+                        self.warps.len()
+                    ),
+                    self.max_memory,
+                ),
+            });
+        }
+        Ok(())
     }
 
     /// Schedules the first events.
@@ -304,6 +341,12 @@ impl Model for Vr {
     fn handle(&mut self, now: Time, ev: Ev, sched: &mut Scheduler<Ev>) -> Result<Control, VrError> {
         let c = &self.cfg;
         let (step, render, warp, pair) = (c.simulation.step, c.renderer.render, c.warp.render, c.pair());
+        if matches!(
+            ev,
+            Ev::Input | Ev::LoopStart | Ev::SimStart | Ev::AppStart | Ev::WarpStart
+        ) {
+            self.check_growth(now)?;
+        }
         match ev {
             Ev::Input => {
                 self.inputs.push(now);

@@ -119,7 +119,58 @@ pub fn validate(cfg: &VrConfig) -> Result<(), VrError> {
     if cfg.run.events == 0 {
         return Err(bad("run.events", "must be at least 1 motion event"));
     }
+    if cfg.run.events > crate::limits::MAX_INPUT_EVENTS {
+        return Err(bad(
+            "run.events",
+            format!(
+                "{} motion events is more than the limit of {}",
+                cfg.run.events,
+                crate::limits::MAX_INPUT_EVENTS
+            ),
+        ));
+    }
     Ok(())
+}
+
+/// Bytes per motion event after the run: its time, its record with the
+/// stages of two paths, and its table row.
+const BYTES_PER_EVENT: usize = std::mem::size_of::<Time>() + std::mem::size_of::<MotionRecord>() + 2 * 12 * 8 + 4 * 8;
+
+/// Estimates the memory a run needs from its inputs before simulating: the
+/// expected simulated span (warm-up plus `run.events` x
+/// `input.mean_interval`) over each loop's period, plus the motions'
+/// records. Returns the bytes and a description.
+pub fn estimate_memory(cfg: &VrConfig) -> (u64, String) {
+    use crate::limits::{add_bytes, show_bytes};
+    use std::mem::size_of;
+    let span = cfg.run.warmup.0 as f64 + cfg.run.events as f64 * cfg.input.mean_interval.0 as f64;
+    let frames = |interval: u64| -> u64 { (span / interval.max(1) as f64).min(u64::MAX as f64) as u64 + 1 };
+    let (step, render) = (cfg.simulation.step.0, cfg.renderer.render.0);
+    let mut total = 0u64;
+    let desc = match cfg.scheme {
+        Scheme::Naive => {
+            let n = frames(step.saturating_add(render));
+            add_bytes(&mut total, n, size_of::<super::model::LoopFrame>());
+            format!("{n} loop frames")
+        }
+        Scheme::Warp => {
+            let (sims, apps, warps) = (frames(step), frames(render), frames(cfg.pair().0));
+            add_bytes(&mut total, sims, size_of::<super::model::SimStep>());
+            add_bytes(&mut total, apps, size_of::<super::model::AppFrame>());
+            add_bytes(&mut total, warps, size_of::<super::model::WarpFrame>());
+            format!("{sims} simulation steps, {apps} application and {warps} warped frames")
+        }
+    };
+    let mut events = 0u64;
+    add_bytes(&mut events, cfg.run.events, BYTES_PER_EVENT);
+    let total = total.saturating_add(events);
+    let parts = format!(
+        "{} motion events = {}; over an expected {:.3e} s simulated (run.warmup + run.events x input.mean_interval): {desc}",
+        cfg.run.events,
+        show_bytes(events),
+        span / 1e12
+    );
+    (total, parts)
 }
 
 fn gaps(points: &[Time], display: u64) -> Vec<u64> {
@@ -191,8 +242,17 @@ pub fn follow(m: &Vr) -> Vec<MotionRecord> {
 /// Validates, runs and summarizes.
 pub fn run_vr(cfg: VrConfig) -> Result<VrRun, VrError> {
     validate(&cfg)?;
+    let max_memory = cfg.run.max_memory.map_or(crate::limits::DEFAULT_MAX_MEMORY, |b| b.0);
+    let (estimate, parts) = estimate_memory(&cfg);
+    if estimate > max_memory {
+        return Err(bad(
+            "run.max_memory",
+            crate::limits::over_memory_message(estimate, &parts, max_memory),
+        ));
+    }
     let a = analytic(&cfg);
     let mut model = Vr::new(cfg.clone());
+    model.max_memory = max_memory;
     let mut sched = Scheduler::new();
     model.start(&mut sched)?;
     let limits = Limits {

@@ -1,0 +1,108 @@
+//! Stated limits on sizes read from input.
+//!
+//! Every count or size a user writes (a model key, a `--set`, an experiment
+//! file, a command-line option, a mesh spec) that decides how much memory is
+//! allocated is checked against one of these limits before anything is
+//! allocated, so bad input ends with an error naming the key, the value and
+//! the limit instead of `memory allocation of N bytes failed`.
+//! `docs/models.md` ("Limits") lists them for users.
+//!
+//! Beyond the per-key limits, systems with a `[run]` table estimate the
+//! memory a run needs from its inputs before simulating and compare it with
+//! `run.max_memory` (default [`DEFAULT_MAX_MEMORY`]).
+
+/// Default of `run.max_memory`: 8 GiB.
+pub const DEFAULT_MAX_MEMORY: u64 = 8 << 30;
+
+/// Most indices of a generated mesh (`grid:WxH`, `strip:WxH`,
+/// `random:T:V:SEED`): 2^28, a 1 GiB index buffer (a 6689 x 6689 grid).
+pub const MAX_MESH_INDICES: u64 = 1 << 28;
+
+/// Most objects in a frame-pipeline scene (the sum of every group's
+/// `count`, a preset's objects times `workload.scale` included): draws are
+/// indexed with 32 bits, and each costs about 100 bytes to compile.
+pub const MAX_SCENE_OBJECTS: u64 = 1 << 24;
+
+/// Largest `workload.scale` of a preset scene (a thousand times the paper's
+/// scene).
+pub const MAX_SCENE_SCALE: f64 = 1000.0;
+
+/// Most input events (`run.events`) a multi-frame-rate or VR model may follow.
+pub const MAX_INPUT_EVENTS: u64 = 100_000_000;
+
+/// Most slots of a `direct:SLOTS,SEGMENT` vertex cache (one 4-byte stamp per slot).
+pub const MAX_DIRECT_CACHE_SLOTS: u32 = 1 << 20;
+
+/// Most replications per point of an experiment.
+pub const MAX_REPLICATIONS: i64 = 100_000;
+
+/// Most runs of an experiment: points (the product of the sweeps' sizes)
+/// times replications.
+pub const MAX_EXPERIMENT_RUNS: u64 = 1_000_000;
+
+/// Most PixelFlow nodes (`nodes`).
+pub const MAX_PIXELFLOW_NODES: u32 = 4096;
+
+/// Most per-(node, region) bins of a PixelFlow layout (`nodes` x regions).
+pub const MAX_PIXELFLOW_BINS: u64 = 1 << 26;
+
+/// Most per-region records of a PixelFlow run (`frames` x regions).
+pub const MAX_PIXELFLOW_REGION_RECORDS: u64 = 1 << 24;
+
+/// Formats a byte count for messages: `8 GiB`, `1.5 MiB`, `512 bytes`.
+pub fn show_bytes(b: u64) -> String {
+    const UNITS: [(&str, u64); 4] = [("TiB", 1 << 40), ("GiB", 1 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)];
+    for (name, size) in UNITS {
+        if b >= size {
+            let v = b as f64 / size as f64;
+            return if b.is_multiple_of(size) {
+                format!("{} {name}", b / size)
+            } else {
+                format!("{v:.1} {name}")
+            };
+        }
+    }
+    format!("{b} bytes")
+}
+
+/// The message of a run whose estimated memory exceeds `run.max_memory`:
+/// names the estimate, what it is made of, the limit and how to raise it.
+pub fn over_memory_message(estimate: u64, parts: &str, limit: u64) -> String {
+    format!(
+        "the run would need about {} ({parts}), more than run.max_memory = {}; \
+         shorten the run, or raise the limit, e.g. `--set run.max_memory=\"{}\"` \
+         (default {})",
+        show_bytes(estimate),
+        show_bytes(limit),
+        suggest(estimate),
+        show_bytes(DEFAULT_MAX_MEMORY)
+    )
+}
+
+fn suggest(estimate: u64) -> String {
+    let gib = estimate.div_ceil(1 << 30).max(1);
+    let gib = gib.checked_next_power_of_two().unwrap_or(gib);
+    format!("{gib}GiB")
+}
+
+/// Adds `count` items of `size` bytes to `total`, saturating.
+pub fn add_bytes(total: &mut u64, count: u64, size: usize) {
+    *total = total.saturating_add(count.saturating_mul(size as u64));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn byte_counts_read_well() {
+        assert_eq!(show_bytes(DEFAULT_MAX_MEMORY), "8 GiB");
+        assert_eq!(show_bytes(1536 << 20), "1.5 GiB");
+        assert_eq!(show_bytes(100), "100 bytes");
+        let m = over_memory_message(9 << 30, "frames", DEFAULT_MAX_MEMORY);
+        assert!(
+            m.contains("9 GiB") && m.contains("run.max_memory = 8 GiB") && m.contains("16GiB"),
+            "{m}"
+        );
+    }
+}
