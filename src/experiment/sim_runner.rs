@@ -19,6 +19,13 @@ pub struct SimRunner {
     pub name: String,
     /// Directory of the model file.
     pub base_dir: PathBuf,
+    /// The model file's text, so that errors name the line of a key (empty:
+    /// no lines).
+    pub text: String,
+    /// Keys the experiment writes and where their values come from
+    /// ([`crate::experiment::Experiment::value_origins`]): an error in such a
+    /// value names the experiment file, not the model file.
+    pub origins: Vec<(String, String)>,
 }
 
 impl Runner for SimRunner {
@@ -27,9 +34,9 @@ impl Runner for SimRunner {
         crate::config::set_dotted(&mut table, "run.seed", toml::Value::Integer(seed as i64))?;
         let src = ModelSource {
             name: self.name.clone(),
-            text: String::new(),
+            text: self.text.clone(),
             base_dir: self.base_dir.clone(),
-            overrides: Vec::new(),
+            overrides: self.origins.clone(),
         };
         let run = run_model(&src, &table, false).map_err(|e| e.to_string())?;
         let warmup = run
@@ -101,6 +108,8 @@ mod tests {
         let runner = SimRunner {
             name: "test".into(),
             base_dir: PathBuf::from("."),
+            text: String::new(),
+            origins: Vec::new(),
         };
         let out = runner.run(&model, 1, true).unwrap();
         let frames = out.frames.unwrap();
