@@ -131,7 +131,7 @@ type Span = Option<std::ops::Range<usize>>;
 
 /// The entry of `parts` in a table: `a` then `b.c` for `a.b.c`, or a quoted
 /// key holding dots (`"b.c"`, as experiment `[set]` tables write keys).
-fn table_entry<'a, T>(parts: &[&'a str], get: impl Fn(&str) -> Option<T>) -> Option<(T, usize)> {
+fn table_entry<T>(parts: &[&str], get: impl Fn(&str) -> Option<T>) -> Option<(T, usize)> {
     (1..=parts.len()).find_map(|n| get(&parts[..n].join(".")).map(|e| (e, n)))
 }
 
