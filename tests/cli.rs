@@ -869,3 +869,30 @@ fn predictable_clock_overflow_is_reported_before_simulating() {
         "{e}"
     );
 }
+
+#[test]
+fn an_infinite_expected_cost_is_an_error_naming_the_distribution() {
+    // exp(sigma^2 / 2) overflows: the fragment term would be written as null.
+    let e = run_err(&[
+        "run",
+        "--frames",
+        "20",
+        "--set",
+        "run.until=\"1ms\"",
+        "--set",
+        "workload.groups.2.triangle_pixels.sigma=100",
+    ]);
+    assert!(
+        e.contains("`--set workload.groups.2.triangle_pixels.sigma=100`")
+            && e.contains("key `workload.groups.2.triangle_pixels`")
+            && e.contains("not a finite number"),
+        "{e}"
+    );
+    let e = run_err(&[
+        "run",
+        "models/fixed.toml",
+        "--set",
+        "workload.gpu={kind=\"pareto\", scale=\"1ms\", shape=0.5}",
+    ]);
+    assert!(e.contains("key `workload.gpu`") && e.contains("does not exist"), "{e}");
+}

@@ -98,13 +98,12 @@ impl ModelSource {
     }
 
     /// The command-line option that set `key` or a table above it (the last
-    /// one applied), if any.
+    /// one applied), else one that set a key inside `key` (a distribution's
+    /// `sigma` for an error about the distribution), if any.
     pub fn override_of(&self, key: &str) -> Option<&str> {
-        self.overrides
-            .iter()
-            .rev()
-            .find(|(k, _)| key == k || key.strip_prefix(k.as_str()).is_some_and(|rest| rest.starts_with('.')))
-            .map(|(_, o)| o.as_str())
+        let below = |a: &str, b: &str| a.strip_prefix(b).is_some_and(|rest| rest.starts_with('.'));
+        let last = |f: &dyn Fn(&str) -> bool| self.overrides.iter().rev().find(|(k, _)| f(k)).map(|(_, o)| o.as_str());
+        last(&|k| key == k || below(key, k)).or_else(|| last(&|k| below(k, key)))
     }
 
     /// Parses the text into a TOML table.
@@ -494,6 +493,20 @@ mod tests {
         assert_eq!(src.line_of("check.2"), Some(4));
         assert_eq!(dotted_path("a.b[0].c[12]"), "a.b.0.c.12");
         assert_eq!(dotted_path("[3].x"), "3.x");
+    }
+
+    #[test]
+    fn an_error_about_a_table_blames_an_option_that_set_a_key_inside_it() {
+        let mut src = ModelSource::from_text("m.toml", "[w]\nd = { kind = \"lognormal\", sigma = 1.0 }\n");
+        assert_eq!(src.override_of("w.d"), None);
+        src.note_override("w.d.sigma", "--set w.d.sigma=100".into());
+        assert_eq!(src.override_of("w.d"), Some("--set w.d.sigma=100"));
+        assert_eq!(src.override_of("w.d.sigma"), Some("--set w.d.sigma=100"));
+        assert_eq!(src.override_of("w.e"), None);
+        // A value set as a whole wins over one set inside it.
+        src.note_override("w", "--set w={}".into());
+        src.note_override("w.d.sigma", "--set w.d.sigma=3".into());
+        assert_eq!(src.override_of("w.d"), Some("--set w={}"));
     }
 
     #[test]

@@ -200,7 +200,8 @@ fn ms(ps: u64) -> f64 {
     ps as f64 / PS_PER_MS as f64
 }
 
-/// Refuses, before simulating, a run whose simulated time certainly passes
+/// Refuses, before simulating, expected per-frame terms that are not finite
+/// numbers (naming the distribution), and a run whose simulated time certainly passes
 /// the clock's range (`u64` picoseconds, about 213 days): `run.frames`
 /// frames take at least the largest expected per-frame term each (the
 /// units work in parallel, the slowest one bounds the frame rate; with a
@@ -210,14 +211,57 @@ fn ms(ps: u64) -> f64 {
 /// with `run.until` or `run.max_events` may stop earlier and are left to the
 /// clock's own checks.
 fn check_time_range(cfg: &FramePipelineConfig, analytic: &Value) -> Result<(), PipelineError> {
-    if cfg.run.until.is_some() || cfg.run.max_events.is_some() {
-        return Ok(());
-    }
-    let term = |k: &str| analytic[k].as_f64().unwrap_or(0.0) * PS_PER_MS as f64;
     let (cpu_key, gpu_key) = match &cfg.workload {
         WorkloadConfig::Fixed(_) => ("workload.cpu", "workload.gpu"),
         WorkloadConfig::Scene(_) => ("workload", "workload"),
     };
+    // An expected term that is not a finite number (a distribution whose
+    // mean overflows or does not exist) would be written as null.
+    for (k, what) in [
+        ("cpu_ms", "CPU time"),
+        ("gpu_front_end_ms", "GPU front-end time"),
+        ("geometry_ms", "geometry time"),
+        ("fragment_ms", "fragment time"),
+    ] {
+        if analytic[k].as_f64().is_some_and(f64::is_finite) {
+            continue;
+        }
+        let mut keys = vec![];
+        if !cfg.cpu.non_render.mean().is_finite() {
+            keys.push("cpu.non_render".to_string());
+        }
+        match &cfg.workload {
+            WorkloadConfig::Fixed(f) => {
+                if !f.cpu.mean().is_finite() {
+                    keys.push("workload.cpu".into());
+                }
+                if !f.gpu.mean().is_finite() {
+                    keys.push("workload.gpu".into());
+                }
+            }
+            WorkloadConfig::Scene(sc) => keys.extend(
+                sc.groups
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, g)| !g.triangle_pixels.mean().is_finite())
+                    .map(|(i, _)| format!("workload.groups.{i}.triangle_pixels")),
+            ),
+        }
+        if keys.is_empty() {
+            keys.push(if k == "cpu_ms" { cpu_key } else { gpu_key }.to_string());
+        }
+        return Err(bad(
+            &keys.join("|"),
+            format!(
+                "the expected {what} per frame is not a finite number: the mean of {} overflows or does not exist",
+                keys.join(", ")
+            ),
+        ));
+    }
+    if cfg.run.until.is_some() || cfg.run.max_events.is_some() {
+        return Ok(());
+    }
+    let term = |k: &str| analytic[k].as_f64().unwrap_or(0.0) * PS_PER_MS as f64;
     let mut terms = vec![
         ("CPU work", cpu_key, term("cpu_ms")),
         ("GPU front end work", gpu_key, term("gpu_front_end_ms")),
