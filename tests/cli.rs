@@ -896,3 +896,26 @@ fn an_infinite_expected_cost_is_an_error_naming_the_distribution() {
     ]);
     assert!(e.contains("key `workload.gpu`") && e.contains("does not exist"), "{e}");
 }
+
+#[test]
+fn a_search_value_is_blamed_on_the_search() {
+    let d = tempfile::tempdir().unwrap();
+    let model = std::fs::canonicalize("models/pixelflow-20.toml").unwrap();
+    let text = format!(
+        "name = \"s\"\nmodel = {:?}\n[set]\nfidelity = \"analytic\"\n[[metric]]\npath = \"metrics.latency_ms\"\n\
+         [[search]]\nname = \"bad\"\nvary = \"deferred.t_trans\"\nfrom = 0.1\nto = 5.0\nformat = \"{{}}us\"\n\
+         path = \"metrics.latency_ms\"\ntarget = 30.0\nset = {{ shading_nodes = 100 }}\n",
+        model.display().to_string()
+    );
+    let e = write(d.path(), "s.toml", &text);
+    let out = d.path().join("out");
+    let err = run_err(&["experiment", &e, "--quiet", "--out", out.to_str().unwrap()]);
+    assert!(
+        err.contains("search \"bad\" failed") && err.contains("[[search]] \"bad\", which sets shading_nodes"),
+        "{err}"
+    );
+    assert!(
+        err.contains("key `shading_nodes`") && !err.contains("pixelflow-20.toml:"),
+        "{err}"
+    );
+}

@@ -30,13 +30,23 @@ pub struct SimRunner {
 
 impl Runner for SimRunner {
     fn run(&self, model: &toml::Table, seed: u64, want_frames: bool) -> Result<RunOutput, String> {
+        self.run_noted(model, seed, want_frames, &[])
+    }
+
+    fn run_noted(
+        &self,
+        model: &toml::Table,
+        seed: u64,
+        want_frames: bool,
+        origins: &[(String, String)],
+    ) -> Result<RunOutput, String> {
         let mut table = model.clone();
         crate::config::set_dotted(&mut table, "run.seed", toml::Value::Integer(seed as i64))?;
         let src = ModelSource {
             name: self.name.clone(),
             text: self.text.clone(),
             base_dir: self.base_dir.clone(),
-            overrides: self.origins.clone(),
+            overrides: self.origins.iter().chain(origins).cloned().collect(),
         };
         let run = run_model(&src, &table, false).map_err(|e| e.to_string())?;
         let warmup = run
