@@ -167,9 +167,31 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {}", error_line(&e));
-            ExitCode::from(2)
+            ExitCode::from(if e.is::<ChecksFailed>() {
+                EXIT_CHECKS_FAILED
+            } else {
+                EXIT_ERROR
+            })
         }
     }
+}
+
+/// Exit status of an error: a file, key or value that is wrong, an option
+/// that does not parse, a run that cannot finish, output that cannot be
+/// written (clap's own usage errors exit 2 as well).
+const EXIT_ERROR: u8 = 2;
+
+/// Exit status of `rendersim experiment` when it ran to the end but a
+/// reference check (a `[[check]]` without `claim`) failed.
+const EXIT_CHECKS_FAILED: u8 = 1;
+
+/// An experiment ran, but some of its reference checks failed
+/// ([`EXIT_CHECKS_FAILED`]).
+#[derive(Debug, thiserror::Error)]
+#[error("{failed} reference check(s) failed; see {report}")]
+struct ChecksFailed {
+    failed: usize,
+    report: String,
 }
 
 /// The error and its causes on one line, like `{:#}`, but a cause whose text
@@ -495,8 +517,13 @@ fn print_human(run: &SystemRun) {
 }
 
 /// `x` with `decimals` decimals, never as a negative zero ("-0.000" for
-/// -0.0 or a tiny negative rounding error reads like a negative time).
+/// -0.0 or a tiny negative rounding error reads like a negative time);
+/// "n/a" for a missing number (a `null` statistic of an empty sample reads
+/// as NaN here).
 fn fixed(x: f64, decimals: usize) -> String {
+    if x.is_nan() {
+        return "n/a".to_string();
+    }
     let t = format!("{x:.decimals$}");
     match t.strip_prefix('-') {
         Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
@@ -521,13 +548,13 @@ fn print_latency(s: &serde_json::Value) {
         }
         let a = &m["analytic_latency_ms"][path];
         println!(
-            "  {path:<13} latency min {:>7.1} mean {:>7.1} p99 {:>7.1} max {:>7.1} ms   paper best {:>6.1} worst {:>6.1}",
-            f(&v["min"]),
-            f(&v["mean"]),
-            f(&v["p99"]),
-            f(&v["max"]),
-            f(&a["best"]),
-            f(&a["worst"])
+            "  {path:<13} latency min {:>7} mean {:>7} p99 {:>7} max {:>7} ms   paper best {:>6} worst {:>6}",
+            fixed(f(&v["min"]), 1),
+            fixed(f(&v["mean"]), 1),
+            fixed(f(&v["p99"]), 1),
+            fixed(f(&v["max"]), 1),
+            fixed(f(&a["best"]), 1),
+            fixed(f(&a["worst"]), 1)
         );
     }
     println!(
@@ -552,13 +579,13 @@ fn print_vr(s: &serde_json::Value) {
         let v = &m["motion_to_photon_ms"][kind];
         let a = &m["analytic_latency_ms"][kind];
         println!(
-            "  {kind:<7} motion-to-photon min {:>6.1} mean {:>6.1} p99 {:>6.1} max {:>6.1} ms   closed form best {:>6.1} worst {:>6.1}",
-            f(&v["min"]),
-            f(&v["mean"]),
-            f(&v["p99"]),
-            f(&v["max"]),
-            f(&a["best"]),
-            f(&a["worst"])
+            "  {kind:<7} motion-to-photon min {:>6} mean {:>6} p99 {:>6} max {:>6} ms   closed form best {:>6} worst {:>6}",
+            fixed(f(&v["min"]), 1),
+            fixed(f(&v["mean"]), 1),
+            fixed(f(&v["p99"]), 1),
+            fixed(f(&v["max"]), 1),
+            fixed(f(&a["best"]), 1),
+            fixed(f(&a["worst"]), 1)
         );
     }
     println!(
@@ -574,16 +601,26 @@ fn cmd_experiment(file: &Path, out: Option<PathBuf>, quiet: bool) -> Result<()> 
     let exp = load_experiment(file)?;
     let default = ModelSource::from_text("<embedded default model>", DEFAULT_MODEL).table()?;
     let base = exp.resolve_model(&default)?;
-    let (name, base_dir) = match &exp.model {
-        ExpModel::Default => ("<embedded default model>".to_string(), PathBuf::from(".")),
+    let (name, base_dir, text) = match &exp.model {
+        ExpModel::Default => (
+            "<embedded default model>".to_string(),
+            PathBuf::from("."),
+            DEFAULT_MODEL.to_string(),
+        ),
         ExpModel::File(p) => (
             p.display().to_string(),
             p.parent().map(Path::to_path_buf).unwrap_or_default(),
+            std::fs::read_to_string(p).unwrap_or_default(),
         ),
     };
     let out = out.unwrap_or_else(|| PathBuf::from("out").join(&exp.name));
     let set = ResultSet::begin(&out, experiment_file)?;
-    let runner = SimRunner { name, base_dir };
+    let runner = SimRunner {
+        name,
+        base_dir,
+        text,
+        origins: exp.value_origins(),
+    };
     let result = match run_experiment(&exp, &base, &runner, set.dir(), !quiet) {
         Ok(r) => r,
         Err(e) => {
@@ -614,11 +651,11 @@ fn cmd_experiment(file: &Path, out: Option<PathBuf>, quiet: bool) -> Result<()> 
         out.display()
     );
     if result.checks_failed > 0 {
-        bail!(
-            "{} reference check(s) failed; see {}",
-            result.checks_failed,
-            out.join("report.md").display()
-        );
+        return Err(ChecksFailed {
+            failed: result.checks_failed,
+            report: out.join("report.md").display().to_string(),
+        }
+        .into());
     }
     Ok(())
 }
@@ -642,6 +679,13 @@ fn sibling(dir: &Path, suffix: &str) -> PathBuf {
 fn cmd_isolate(model: Option<PathBuf>, sets: Vec<String>, factor: f64, keep_vsync: bool, json: bool) -> Result<()> {
     let mut src = load_source(model.as_deref())?;
     let table = model_table(&mut src, &sets, None, None)?;
+    let system = table.get("system").and_then(|v| v.as_str()).unwrap_or("frame_pipeline");
+    if system != "frame_pipeline" {
+        bail!(
+            "isolate applies to the frame pipeline; {} is a {system} model (`system = {system:?}`)",
+            src.name
+        );
+    }
     let cfg: rendersim::systems::frame_pipeline::FramePipelineConfig = rendersim::config::deserialize(&table, &src)?;
     let iso = rendersim::systems::frame_pipeline::isolate::isolate(&cfg, &src.base_dir, factor, keep_vsync)?;
     if json {

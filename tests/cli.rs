@@ -383,12 +383,23 @@ fn run_until_stops_at_that_simulated_time() {
     let mut n = vec![];
     nulls(&v, "", &mut n);
     assert!(n.is_empty(), "NaN in the summary: {n:?}");
-    // Fewer frames completed than the warm-up leaves out: empty metrics, still no NaN.
+    // Fewer frames completed than the warm-up leaves out: empty metrics, no
+    // NaN; the statistics of an empty distribution are null (not a measured
+    // 0) beside `count: 0`, and nothing else is null.
     let v = json(&[]);
     assert_eq!(v["stopped_by"], "time_limit");
     let mut n = vec![];
     nulls(&v, "", &mut n);
-    assert!(n.is_empty(), "NaN in the summary: {n:?}");
+    assert!(!n.is_empty());
+    for path in &n {
+        let (dist, stat) = path.rsplit_once('.').unwrap();
+        assert!(
+            ["mean", "p50", "p99", "min", "max", "std"].contains(&stat),
+            "null that is not a statistic: {path}"
+        );
+        let pointer = format!("{}/count", dist.replace('.', "/"));
+        assert_eq!(v.pointer(&pointer), Some(&serde_json::json!(0)), "{path}");
+    }
     // A limit beyond the run's end changes nothing.
     let v = json(&["--set", "run.until=\"1000s\"", "--frames", "10"]);
     assert_eq!(v["stopped_by"], "model");
@@ -763,4 +774,343 @@ fn zero_time_frames_stop_at_max_events() {
     assert_eq!(v["stopped_by"], "event_limit");
     assert_eq!(v["events"]["total"], 1000);
     assert!(v["frames"].as_u64().unwrap() < 1100, "{}", v["frames"]);
+}
+
+/// A scene model whose second `[[workload.groups]]` entry stands at a known line.
+const GROUPS: &str = r#"[run]
+frames = 10
+[noise]
+enabled = false
+[workload]
+kind = "scene"
+
+[[workload.groups]]
+name = "a"
+count = 2
+mesh = { triangles = 40, acmr = 0.9 }
+triangle_pixels = 4.0
+
+[[workload.groups]]
+name = "b"
+count = COUNT
+mesh = { triangles = 40, acmr = 0.9 }
+triangle_pixels = 4.0
+"#;
+
+#[test]
+fn keys_inside_arrays_of_tables_name_their_line() {
+    let d = tempfile::tempdir().unwrap();
+    let line = GROUPS.lines().position(|l| l == "count = COUNT").unwrap() + 1;
+    let m = write(d.path(), "g.toml", &GROUPS.replace("COUNT", "-3"));
+    let e = run_err(&["run", &m]);
+    assert!(
+        e.contains(&format!("g.toml:{line}: key `workload.groups.1.count`")),
+        "expected line {line}: {e}"
+    );
+    let m = write(
+        d.path(),
+        "h.toml",
+        &GROUPS.replace("count = COUNT", "count = 1\ntexturs = 3"),
+    );
+    let e = run_err(&["run", &m]);
+    assert!(
+        e.contains(&format!("h.toml:{}: key `workload.groups.1.texturs`", line + 1))
+            && e.contains("did you mean `textures`"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_set_on_an_array_element_is_blamed_on_the_option() {
+    let d = tempfile::tempdir().unwrap();
+    let m = write(d.path(), "g.toml", &GROUPS.replace("COUNT", "1"));
+    let e = run_err(&["run", &m, "--set", "workload.groups.1.count=-1"]);
+    assert!(
+        e.contains("`--set workload.groups.1.count=-1`") && e.contains("key `workload.groups.1.count`"),
+        "{e}"
+    );
+    assert!(!e.contains("g.toml:"), "blamed on a line of the model: {e}");
+    // The embedded default model too.
+    let e = run_err(&["run", "--set", "workload.groups.0.count=-1"]);
+    assert!(e.contains("`--set workload.groups.0.count=-1`"), "{e}");
+    assert!(!e.contains("<embedded default model>:"), "{e}");
+}
+
+const FIXED_EXPERIMENT: &str = r#"name = "e"
+model = "MODEL"
+
+[set]
+"run.frames" = 30
+"run.warmup_frames" = 3
+"workload.gpu" = "GPU"
+
+[[sweep]]
+key = "display.buffers"
+values = [2, BUFFERS]
+
+[[metric]]
+path = "metrics.frame_time_ms.mean"
+"#;
+
+fn experiment_file(dir: &Path, name: &str, gpu: &str, buffers: &str, extra: &str) -> String {
+    let model = write(dir, "m.toml", SMALL);
+    let text = FIXED_EXPERIMENT
+        .replace("MODEL", &model)
+        .replace("GPU", gpu)
+        .replace("BUFFERS", buffers);
+    write(dir, name, &format!("{text}{extra}"))
+}
+
+#[test]
+fn experiment_values_are_blamed_on_the_experiment_file() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("out");
+    let out = out.to_str().unwrap();
+    // A bad [set] value: the experiment file and the line of the key.
+    let e = experiment_file(d.path(), "e.toml", "-5ms", "3", "");
+    let err = run_err(&["experiment", &e, "--quiet", "--out", out]);
+    assert!(
+        err.contains("[set] workload.gpu in ") && err.contains("e.toml:7"),
+        "{err}"
+    );
+    assert!(!err.contains("m.toml:"), "blamed on the model file: {err}");
+    // A bad sweep value: the experiment file and the line of its [[sweep]].
+    let e = experiment_file(d.path(), "f.toml", "5ms", "30", "");
+    let err = run_err(&["experiment", &e, "--quiet", "--out", out]);
+    assert!(
+        err.contains("[[sweep]] of display.buffers in ") && err.contains("f.toml:10"),
+        "{err}"
+    );
+    assert!(
+        err.contains("key `display.buffers`") && !err.contains("m.toml:"),
+        "{err}"
+    );
+}
+
+#[test]
+fn experiment_check_entries_name_their_line() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("out");
+    let check = "\n[[check]]\npath = \"metrics.frame_time_ms.mean\"\nexpect = 9.0\ntolerance = 0.5\n\n[[check]]\npath = \"metrics.frame_time_ms.mean\"\nexpect = 9.0\n";
+    let e = experiment_file(d.path(), "e.toml", "9ms", "3", check);
+    let line = std::fs::read_to_string(&e)
+        .unwrap()
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| *l == "[[check]]")
+        .nth(1)
+        .unwrap()
+        .0
+        + 1;
+    let err = run_err(&["experiment", &e, "--quiet", "--out", out.to_str().unwrap()]);
+    assert!(
+        err.contains(&format!("e.toml:{line}: `check[1]")),
+        "expected line {line}: {err}"
+    );
+}
+
+#[test]
+fn failed_checks_exit_1_and_errors_exit_2() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("out");
+    let out = out.to_str().unwrap();
+    let check = "\n[[check]]\npath = \"metrics.frame_time_ms.mean\"\nat_most = 1.0\ntolerance = 0.0\n";
+    let e = experiment_file(d.path(), "e.toml", "9ms", "3", check);
+    let o = bin()
+        .args(["experiment", &e, "--quiet", "--out", out])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("reference check(s) failed") && !err.contains("panicked"),
+        "{err}"
+    );
+    assert!(Path::new(out).join("report.md").exists());
+    // A passing check exits 0, an invalid experiment exits 2.
+    let check = "\n[[check]]\npath = \"metrics.frame_time_ms.mean\"\nat_least = 1.0\ntolerance = 0.0\n";
+    let e = experiment_file(d.path(), "e.toml", "9ms", "3", check);
+    run_ok(&["experiment", &e, "--quiet", "--out", out]);
+    let e = experiment_file(d.path(), "e.toml", "9ms", "3", "\n[[check]]\npath = \"x\"\n");
+    run_err(&["experiment", &e, "--quiet", "--out", out]);
+}
+
+#[test]
+fn a_derived_value_blames_the_key_the_user_gave() {
+    let e = run_err(&["run", "models/mfr-cluster.toml", "--set", "slow_client.render=0ms"]);
+    assert!(
+        e.contains("`--set slow_client.render=0ms`") && e.contains("key `slow_client.render`"),
+        "{e}"
+    );
+    assert!(!e.contains("key `conventional.frame`"), "{e}");
+    // A constraint between two keys blames the one the user changed.
+    let e = run_err(&["run", "models/fixed.toml", "--set", "run.frames=5"]);
+    assert!(
+        e.contains("`--set run.frames=5`") && e.contains("key `run.frames`") && e.contains("run.warmup_frames (60)"),
+        "{e}"
+    );
+    let e = run_err(&["run", "models/fixed.toml", "--set", "run.warmup_frames=600"]);
+    assert!(e.contains("key `run.warmup_frames`"), "{e}");
+}
+
+#[test]
+fn policy_errors_name_the_policy_given() {
+    let e = run_err(&["vcache", "grid:4x4", "--policy", "lavapipe:3"]);
+    assert!(e.contains("`lavapipe` takes no size") && !e.contains("`none`"), "{e}");
+    let e = run_err(&["vcache", "grid:4x4", "--policy", "none:3"]);
+    assert!(e.contains("`none` takes no size"), "{e}");
+}
+
+#[test]
+fn isolate_refuses_other_systems_by_name() {
+    for (m, system) in [
+        ("models/mfr-cluster.toml", "multi_rate"),
+        ("models/pixelflow-20.toml", "pixelflow"),
+        ("models/vr-warp.toml", "vr"),
+    ] {
+        let e = run_err(&["isolate", m]);
+        assert!(
+            e.contains(&format!(
+                "isolate applies to the frame pipeline; {m} is a {system} model"
+            )),
+            "{e}"
+        );
+        assert!(!e.contains("unknown field"), "{e}");
+    }
+}
+
+#[test]
+fn non_finite_pixelflow_values_are_errors_naming_the_input() {
+    for (set, key) in [
+        ("region.width=1e+308", "region.width"),
+        ("display.height=1e308", "display.height"),
+        ("aa_primitive.width=1e300", "aa_primitive.width"),
+        ("deferred.t_rast_per_prim=1000000s", "deferred.t_rast_per_prim"),
+    ] {
+        let e = run_err(&["run", "models/pixelflow-20.toml", "--set", set, "--json"]);
+        assert!(
+            e.contains(&format!("`--set {set}`")) && e.contains(&format!("key `{key}`")),
+            "{set}: {e}"
+        );
+    }
+    // The closed forms alone never overflow a clock: a huge cost is fine there.
+    let out = run_ok(&[
+        "run",
+        "models/pixelflow-20.toml",
+        "--set",
+        "fidelity=\"analytic\"",
+        "--set",
+        "deferred.t_rast_per_prim=1000000s",
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(v["metrics"]["analytic_latency_ms"].as_f64().unwrap() > 1e12, "{v}");
+}
+
+#[test]
+fn empty_statistics_are_null_not_zero() {
+    let args = ["run", "models/fixed.toml", "--set", "run.max_events=5"];
+    let mut json_args = args.to_vec();
+    json_args.push("--json");
+    let v: serde_json::Value = serde_json::from_str(&run_ok(&json_args)).unwrap();
+    let s = &v["metrics"]["frame_time_ms"];
+    assert_eq!(s["count"], 0, "{s}");
+    for k in ["mean", "p50", "p99", "min", "max", "std"] {
+        assert!(s[k].is_null(), "{k}: {s}");
+    }
+    let human = run_ok(&args);
+    let line = human.lines().find(|l| l.contains("frame time")).unwrap();
+    assert!(line.contains("n/a") && !line.contains("0.000"), "{human}");
+}
+
+#[test]
+fn predictable_clock_overflow_is_reported_before_simulating() {
+    // 600 frames of 5,000,000 s each: reported up front, naming the keys.
+    let e = run_err(&[
+        "run",
+        "models/fixed.toml",
+        "--set",
+        "workload.gpu=\"5000000s\"",
+        "--set",
+        "display.vsync=true",
+    ]);
+    assert!(
+        e.contains("key `workload.gpu`") && e.contains("run.frames") && e.contains("213 days"),
+        "{e}"
+    );
+    let e = run_err(&["run", "models/fixed.toml", "--set", "display.refresh=\"2000000s\""]);
+    assert!(
+        e.contains("key `display.refresh`") && e.contains("would overflow"),
+        "{e}"
+    );
+    let e = run_err(&["run", "models/fixed.toml", "--frames", "100000000000"]);
+    assert!(
+        e.contains("`--frames 100000000000`") && e.contains("key `run.frames`"),
+        "{e}"
+    );
+    let e = run_err(&["run", "models/mfr-cluster.toml", "--set", "run.events=100000000000000"]);
+    assert!(
+        e.contains("key `run.events`") && e.contains("input.mean_interval"),
+        "{e}"
+    );
+    let e = run_err(&[
+        "run",
+        "models/vr-warp.toml",
+        "--set",
+        "input.mean_interval=\"1000000s\"",
+    ]);
+    assert!(
+        e.contains("key `input.mean_interval`") && e.contains("run.events"),
+        "{e}"
+    );
+}
+
+#[test]
+fn an_infinite_expected_cost_is_an_error_naming_the_distribution() {
+    // exp(sigma^2 / 2) overflows: the fragment term would be written as null.
+    let e = run_err(&[
+        "run",
+        "--frames",
+        "20",
+        "--set",
+        "run.until=\"1ms\"",
+        "--set",
+        "workload.groups.2.triangle_pixels.sigma=100",
+    ]);
+    assert!(
+        e.contains("`--set workload.groups.2.triangle_pixels.sigma=100`")
+            && e.contains("key `workload.groups.2.triangle_pixels`")
+            && e.contains("not a finite number"),
+        "{e}"
+    );
+    let e = run_err(&[
+        "run",
+        "models/fixed.toml",
+        "--set",
+        "workload.gpu={kind=\"pareto\", scale=\"1ms\", shape=0.5}",
+    ]);
+    assert!(e.contains("key `workload.gpu`") && e.contains("does not exist"), "{e}");
+}
+
+#[test]
+fn a_search_value_is_blamed_on_the_search() {
+    let d = tempfile::tempdir().unwrap();
+    let model = std::fs::canonicalize("models/pixelflow-20.toml").unwrap();
+    let text = format!(
+        "name = \"s\"\nmodel = {:?}\n[set]\nfidelity = \"analytic\"\n[[metric]]\npath = \"metrics.latency_ms\"\n\
+         [[search]]\nname = \"bad\"\nvary = \"deferred.t_trans\"\nfrom = 0.1\nto = 5.0\nformat = \"{{}}us\"\n\
+         path = \"metrics.latency_ms\"\ntarget = 30.0\nset = {{ shading_nodes = 100 }}\n",
+        model.display().to_string()
+    );
+    let e = write(d.path(), "s.toml", &text);
+    let out = d.path().join("out");
+    let err = run_err(&["experiment", &e, "--quiet", "--out", out.to_str().unwrap()]);
+    assert!(
+        err.contains("search \"bad\" failed") && err.contains("[[search]] \"bad\", which sets shading_nodes"),
+        "{err}"
+    );
+    assert!(
+        err.contains("key `shading_nodes`") && !err.contains("pixelflow-20.toml:"),
+        "{err}"
+    );
 }

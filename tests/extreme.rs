@@ -83,7 +83,9 @@ fn one_slot_and_zero_slot_fifos_and_zero_cost_stages() {
 
 #[test]
 fn a_run_past_the_picosecond_range_ends_with_a_clear_error() {
-    // 10^6 s per refresh: the 64-bit range (about 1.8e7 s) ends within 20 frames.
+    // 10^6 s per refresh: the 64-bit range (about 1.8e7 s) ends within 20
+    // frames; a vsynced FIFO shows each frame for a refresh at least, so this
+    // is reported before simulating.
     let e = try_run(
         FIXED,
         &["display.refresh=\"1000000s\"", "run.frames=40", "run.warmup_frames=0"],

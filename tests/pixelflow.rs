@@ -90,6 +90,8 @@ fn run_exp(name: &str) -> rendersim::experiment::ExperimentResult {
     let runner = SimRunner {
         name: name.into(),
         base_dir: file.parent().map(Path::to_path_buf).unwrap(),
+        text: String::new(),
+        origins: exp.value_origins(),
     };
     let r = run_experiment(&exp, &base, &runner, &out, false).unwrap();
     let _ = std::fs::remove_dir_all(&out);

@@ -90,9 +90,14 @@ pub enum CachePolicyError {
         /// What is wrong.
         reason: String,
     },
-    /// `none` takes no size.
-    #[error("vertex cache policy `none` takes no size, got `{0}`")]
-    UnexpectedSize(String),
+    /// A policy that takes no size (`none`, `lavapipe`) was given one.
+    #[error("vertex cache policy `{name}` takes no size, got `{spec}`")]
+    UnexpectedSize {
+        /// The policy name (`none`, `lavapipe`).
+        name: String,
+        /// The whole policy string.
+        spec: String,
+    },
 }
 
 impl FromStr for CachePolicy {
@@ -117,7 +122,10 @@ impl FromStr for CachePolicy {
         match name.to_ascii_lowercase().as_str() {
             "lavapipe" => match size {
                 None => Ok(CachePolicy::Lavapipe),
-                Some(_) => Err(CachePolicyError::UnexpectedSize(spec.to_string())),
+                Some(_) => Err(CachePolicyError::UnexpectedSize {
+                    name: name.to_string(),
+                    spec: spec.to_string(),
+                }),
             },
             "direct" => {
                 let z = size.ok_or_else(|| CachePolicyError::MissingSize(name.to_string()))?;
@@ -146,7 +154,10 @@ impl FromStr for CachePolicy {
             }
             "none" => match size {
                 None => Ok(CachePolicy::None),
-                Some(_) => Err(CachePolicyError::UnexpectedSize(spec.to_string())),
+                Some(_) => Err(CachePolicyError::UnexpectedSize {
+                    name: name.to_string(),
+                    spec: spec.to_string(),
+                }),
             },
             "fifo" => Ok(CachePolicy::Fifo(parse_size()?)),
             "lru" => Ok(CachePolicy::Lru(parse_size()?)),

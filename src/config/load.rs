@@ -98,13 +98,12 @@ impl ModelSource {
     }
 
     /// The command-line option that set `key` or a table above it (the last
-    /// one applied), if any.
+    /// one applied), else one that set a key inside `key` (a distribution's
+    /// `sigma` for an error about the distribution), if any.
     pub fn override_of(&self, key: &str) -> Option<&str> {
-        self.overrides
-            .iter()
-            .rev()
-            .find(|(k, _)| key == k || key.strip_prefix(k.as_str()).is_some_and(|rest| rest.starts_with('.')))
-            .map(|(_, o)| o.as_str())
+        let below = |a: &str, b: &str| a.strip_prefix(b).is_some_and(|rest| rest.starts_with('.'));
+        let last = |f: &dyn Fn(&str) -> bool| self.overrides.iter().rev().find(|(k, _)| f(k)).map(|(_, o)| o.as_str());
+        last(&|k| key == k || below(key, k)).or_else(|| last(&|k| below(k, key)))
     }
 
     /// Parses the text into a TOML table.
@@ -129,13 +128,21 @@ impl ModelSource {
 
 type Span = Option<std::ops::Range<usize>>;
 
+/// The entry of `parts` in a table: `a` then `b.c` for `a.b.c`, or a quoted
+/// key holding dots (`"b.c"`, as experiment `[set]` tables write keys).
+fn table_entry<T>(parts: &[&str], get: impl Fn(&str) -> Option<T>) -> Option<(T, usize)> {
+    (1..=parts.len()).find_map(|n| get(&parts[..n].join(".")).map(|e| (e, n)))
+}
+
 fn find_item(item: &toml_edit::Item, parts: &[&str], span: Span) -> Span {
-    let Some((first, rest)) = parts.split_first() else {
+    if parts.is_empty() {
         return span;
-    };
+    }
+    let first = parts[0];
+    let rest = &parts[1..];
     match item {
-        toml_edit::Item::Table(t) => match t.get_key_value(first) {
-            Some((k, v)) => find_item(v, rest, k.span().or(v.span()).or(span)),
+        toml_edit::Item::Table(t) => match table_entry(parts, |k| t.get_key_value(k)) {
+            Some(((k, v), n)) => find_item(v, &parts[n..], k.span().or(v.span()).or(span)),
             None => None,
         },
         toml_edit::Item::ArrayOfTables(a) => match first.parse::<usize>().ok().and_then(|i| a.get(i)) {
@@ -148,12 +155,14 @@ fn find_item(item: &toml_edit::Item, parts: &[&str], span: Span) -> Span {
 }
 
 fn find_value(v: &toml_edit::Value, parts: &[&str], span: Span) -> Span {
-    let Some((first, rest)) = parts.split_first() else {
+    if parts.is_empty() {
         return span;
-    };
+    }
+    let first = parts[0];
+    let rest = &parts[1..];
     match v {
-        toml_edit::Value::InlineTable(t) => match t.get_key_value(first) {
-            Some((k, v2)) => find_item(v2, rest, k.span().or(v2.span()).or(span)),
+        toml_edit::Value::InlineTable(t) => match table_entry(parts, |k| t.get_key_value(k)) {
+            Some(((k, v2), n)) => find_item(v2, &parts[n..], k.span().or(v2.span()).or(span)),
             None => None,
         },
         toml_edit::Value::Array(a) => match first.parse::<usize>().ok().and_then(|i| a.get(i)) {
@@ -240,7 +249,7 @@ pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Res
 pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) -> Result<T, ConfigError> {
     let de = table.clone();
     serde_path_to_error::deserialize::<_, T>(de).map_err(|e| {
-        let mut path = e.path().to_string();
+        let mut path = dotted_path(&e.path().to_string());
         let message = e.inner().to_string();
         // toml appends "in `key`" lines; the key path is reported separately.
         let mut message: String = message
@@ -254,8 +263,9 @@ pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) 
         if let Some(rest) = message.strip_prefix("at `")
             && let Some((sub, msg)) = rest.split_once("`: ")
         {
+            let sub = dotted_path(sub);
             path = if path == "." || path.is_empty() {
-                sub.to_string()
+                sub
             } else {
                 format!("{path}.{sub}")
             };
@@ -299,6 +309,21 @@ pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) 
     })
 }
 
+/// A serde path (`workload.groups[0].count`) in the dotted form of model
+/// keys and `--set` (`workload.groups.0.count`), so that its line in the file
+/// and the option that set it can be found.
+pub fn dotted_path(path: &str) -> String {
+    let mut out = String::with_capacity(path.len());
+    for c in path.chars() {
+        match c {
+            '[' => out.push('.'),
+            ']' => {}
+            c => out.push(c),
+        }
+    }
+    out.strip_prefix('.').map(str::to_string).unwrap_or(out)
+}
+
 /// The candidate closest to a misspelt `bad`, if any is close.
 fn closest(bad: &str, candidates: &[String]) -> Option<String> {
     candidates
@@ -311,7 +336,19 @@ fn closest(bad: &str, candidates: &[String]) -> Option<String> {
 
 /// Builds an [`ConfigError::Invalid`] for `key`, finding its line, or the
 /// command-line option that set it.
+///
+/// A value computed from several inputs may name them all, separated by
+/// `|` (`workload.gpu|run.frames`): the error blames the first of them that
+/// a command-line option (or an experiment) set, since that is the value
+/// the user just changed, else the first.
 pub fn invalid(src: &ModelSource, key: &str, message: String, suggestion: Option<String>) -> ConfigError {
+    let key = if key.contains('|') {
+        let mut candidates = key.split('|').map(str::trim).filter(|k| !k.is_empty());
+        let first = candidates.clone().next().unwrap_or(key);
+        candidates.find(|k| src.override_of(k).is_some()).unwrap_or(first)
+    } else {
+        key
+    };
     let (file, line) = match src.override_of(key) {
         Some(origin) => (format!("value from `{origin}` (applied to {})", src.name), None),
         None => (src.name.clone(), src.line_of(key)),
@@ -391,5 +428,97 @@ mod tests {
         assert!(apply_set(&mut t, "novalue").is_err());
         assert!(apply_set(&mut t, "g.3.n=1").is_err());
         assert!(apply_set(&mut t, "display.vsync.x=1").is_err());
+    }
+
+    #[derive(Deserialize, Debug)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Group {
+        name: String,
+        count: u64,
+    }
+    #[derive(Deserialize, Debug)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Workload {
+        groups: Vec<Group>,
+    }
+    #[derive(Deserialize, Debug)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct W {
+        workload: Workload,
+    }
+
+    const GROUPS: &str =
+        "[workload]\n\n[[workload.groups]]\nname = \"a\"\ncount = 1\n\n[[workload.groups]]\nname = \"b\"\ncount = -2\n";
+
+    #[test]
+    fn keys_in_arrays_of_tables_have_dotted_paths_and_lines() {
+        let src = ModelSource::from_text("m.toml", GROUPS);
+        let e = deserialize::<W>(&src.table().unwrap(), &src).unwrap_err().to_string();
+        assert!(e.starts_with("m.toml:9: key `workload.groups.1.count`"), "{e}");
+        let src = ModelSource::from_text("m.toml", &GROUPS.replace("count = -2", "cont = 2"));
+        let e = deserialize::<W>(&src.table().unwrap(), &src).unwrap_err().to_string();
+        assert!(e.starts_with("m.toml:9: key `workload.groups.1.cont`"), "{e}");
+        assert!(e.contains("did you mean `count`"), "{e}");
+    }
+
+    #[test]
+    fn a_set_array_element_is_blamed_on_the_option() {
+        let mut src = ModelSource::from_text("m.toml", &GROUPS.replace("count = -2", "count = 2"));
+        let mut t = src.table().unwrap();
+        apply_set(&mut t, "workload.groups.1.count=-1").unwrap();
+        src.note_override("workload.groups.1.count", "--set workload.groups.1.count=-1".into());
+        let e = deserialize::<W>(&t, &src).unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                "value from `--set workload.groups.1.count=-1` (applied to m.toml): key `workload.groups.1.count`"
+            ),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn lines_of_quoted_dotted_keys_and_inline_arrays() {
+        let src = ModelSource::from_text(
+            "e.toml",
+            "[set]\n\"run.frames\" = 3\nx.y = 1\n[[check]]\npath = \"p\"\n\n[[check]]\npath = \"q\"\n",
+        );
+        assert_eq!(src.line_of("set.run.frames"), Some(2));
+        assert_eq!(src.line_of("set.x.y"), Some(3));
+        assert_eq!(src.line_of("check.1.path"), Some(8));
+        assert_eq!(src.line_of("check.1"), Some(7));
+        // An entry past the end: the array's first line.
+        assert_eq!(src.line_of("check.2"), Some(4));
+        assert_eq!(dotted_path("a.b[0].c[12]"), "a.b.0.c.12");
+        assert_eq!(dotted_path("[3].x"), "3.x");
+    }
+
+    #[test]
+    fn an_error_about_a_table_blames_an_option_that_set_a_key_inside_it() {
+        let mut src = ModelSource::from_text("m.toml", "[w]\nd = { kind = \"lognormal\", sigma = 1.0 }\n");
+        assert_eq!(src.override_of("w.d"), None);
+        src.note_override("w.d.sigma", "--set w.d.sigma=100".into());
+        assert_eq!(src.override_of("w.d"), Some("--set w.d.sigma=100"));
+        assert_eq!(src.override_of("w.d.sigma"), Some("--set w.d.sigma=100"));
+        assert_eq!(src.override_of("w.e"), None);
+        // A value set as a whole wins over one set inside it.
+        src.note_override("w", "--set w={}".into());
+        src.note_override("w.d.sigma", "--set w.d.sigma=3".into());
+        assert_eq!(src.override_of("w.d"), Some("--set w={}"));
+    }
+
+    #[test]
+    fn a_value_of_several_keys_blames_the_one_the_user_set() {
+        let mut src = ModelSource::from_text("m.toml", "[workload]\ngpu = \"1ms\"\n[run]\nframes = 3\n");
+        let e = invalid(&src, "workload.gpu|run.frames", "too long".into(), None).to_string();
+        assert!(e.starts_with("m.toml:2: key `workload.gpu`"), "{e}");
+        src.note_override("run.frames", "--frames 9".into());
+        let e = invalid(&src, "workload.gpu|run.frames", "too long".into(), None).to_string();
+        assert!(
+            e.starts_with("value from `--frames 9`") && e.contains("key `run.frames`"),
+            "{e}"
+        );
     }
 }

@@ -24,10 +24,12 @@ pub enum ExperimentError {
         message: String,
     },
     /// An experiment file parsed but is not valid.
-    #[error("{}: `{key}`: {message}", file.display())]
+    #[error("{}{}: `{key}`: {message}", file.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
     Invalid {
         /// The experiment file.
         file: PathBuf,
+        /// 1-based line of the entry in the file, when found.
+        line: Option<usize>,
         /// Which entry is wrong, e.g. `sweep[1].range`.
         key: String,
         /// What is wrong with it.

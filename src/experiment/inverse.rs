@@ -212,7 +212,11 @@ impl Search {
         for (k, v) in set {
             set_dotted(&mut model, k, v.clone()).map_err(|e| e.to_string())?;
         }
-        let out = runner.run(&model, seed, false)?;
+        let origins: Vec<(String, String)> = set
+            .iter()
+            .map(|(k, _)| (k.clone(), format!("[[search]] {:?}, which sets {k}", self.name)))
+            .collect();
+        let out = runner.run_noted(&model, seed, false, &origins)?;
         json_number(&out.summary, path)?.ok_or_else(|| format!("`{path}` is not a number in the run summary"))
     }
 

@@ -84,7 +84,9 @@
 //! (per claim: HOLDS, DOES NOT HOLD or HOLDS IN PART), with the measured
 //! value, the expected value or bounds and the error, and it never counts
 //! as a failed check. Checks without `claim` are tests: a failure fails the
-//! experiment (exit status 1 from the CLI). Every check's report row gives
+//! experiment (exit status 1 from the CLI, after every output is written;
+//! an error, such as an invalid file or a failed run, exits 2). Every
+//! check's report row gives
 //! its error: measured minus expected (or the distance beyond a bound),
 //! absolute and relative.
 //!

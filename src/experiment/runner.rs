@@ -8,6 +8,21 @@ pub trait Runner: Sync {
     /// Run one model (a fully patched TOML table) with one seed. `want_frames`
     /// asks for per-frame columns too.
     fn run(&self, model: &toml::Table, seed: u64, want_frames: bool) -> Result<RunOutput, String>;
+
+    /// [`Runner::run`], with `origins` (dotted key, where its value comes
+    /// from) for keys set beyond the experiment's `[set]` and sweeps (an
+    /// inverse search's), so that an error in such a value names them.
+    /// Runners that do not report model errors ignore them.
+    fn run_noted(
+        &self,
+        model: &toml::Table,
+        seed: u64,
+        want_frames: bool,
+        origins: &[(String, String)],
+    ) -> Result<RunOutput, String> {
+        let _ = origins;
+        self.run(model, seed, want_frames)
+    }
 }
 
 /// What one run produced.

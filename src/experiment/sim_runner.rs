@@ -19,17 +19,34 @@ pub struct SimRunner {
     pub name: String,
     /// Directory of the model file.
     pub base_dir: PathBuf,
+    /// The model file's text, so that errors name the line of a key (empty:
+    /// no lines).
+    pub text: String,
+    /// Keys the experiment writes and where their values come from
+    /// ([`crate::experiment::Experiment::value_origins`]): an error in such a
+    /// value names the experiment file, not the model file.
+    pub origins: Vec<(String, String)>,
 }
 
 impl Runner for SimRunner {
     fn run(&self, model: &toml::Table, seed: u64, want_frames: bool) -> Result<RunOutput, String> {
+        self.run_noted(model, seed, want_frames, &[])
+    }
+
+    fn run_noted(
+        &self,
+        model: &toml::Table,
+        seed: u64,
+        want_frames: bool,
+        origins: &[(String, String)],
+    ) -> Result<RunOutput, String> {
         let mut table = model.clone();
         crate::config::set_dotted(&mut table, "run.seed", toml::Value::Integer(seed as i64))?;
         let src = ModelSource {
             name: self.name.clone(),
-            text: String::new(),
+            text: self.text.clone(),
             base_dir: self.base_dir.clone(),
-            overrides: Vec::new(),
+            overrides: self.origins.iter().chain(origins).cloned().collect(),
         };
         let run = run_model(&src, &table, None).map_err(|e| e.to_string())?;
         let warmup = run
@@ -101,6 +118,8 @@ mod tests {
         let runner = SimRunner {
             name: "test".into(),
             base_dir: PathBuf::from("."),
+            text: String::new(),
+            origins: Vec::new(),
         };
         let out = runner.run(&model, 1, true).unwrap();
         let frames = out.frames.unwrap();

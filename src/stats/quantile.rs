@@ -6,8 +6,9 @@
 use serde::Serialize;
 
 /// A compact summary of a sample. Never contains NaN: an empty sample gives
-/// `count = 0` and every other field `0.0`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+/// `count = 0` and every other field `0.0`, which is not a measurement:
+/// serialized (and through [`Summary::stat`]) those fields are `null`.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Summary {
     /// Number of values used (NaN inputs are dropped).
     pub count: u64,
@@ -25,7 +26,29 @@ pub struct Summary {
     pub std: f64,
 }
 
+impl Serialize for Summary {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut st = serializer.serialize_struct("Summary", 7)?;
+        st.serialize_field("count", &self.count)?;
+        st.serialize_field("mean", &self.stat(self.mean))?;
+        st.serialize_field("p50", &self.stat(self.p50))?;
+        st.serialize_field("p99", &self.stat(self.p99))?;
+        st.serialize_field("min", &self.stat(self.min))?;
+        st.serialize_field("max", &self.stat(self.max))?;
+        st.serialize_field("std", &self.stat(self.std))?;
+        st.end()
+    }
+}
+
 impl Summary {
+    /// `x`, one of this summary's fields, for output: `None` (JSON `null`,
+    /// "n/a" in reports) when the sample was empty, so that an empty
+    /// statistic never reads as a measured 0.
+    pub fn stat(&self, x: f64) -> Option<f64> {
+        (self.count > 0).then_some(x)
+    }
+
     /// Summarise `values`. NaN values are ignored; an empty (or all-NaN)
     /// sample gives the all-zero summary with `count = 0`.
     pub fn of(values: &[f64]) -> Summary {
@@ -142,5 +165,20 @@ mod tests {
         assert_eq!((s.min, s.p50, s.max), (1.0, 2.0, 3.0));
         let s = Summary::of(&[5.0]);
         assert_eq!((s.count, s.mean, s.std, s.p99), (1, 5.0, 0.0, 5.0));
+    }
+
+    #[test]
+    fn an_empty_summary_serializes_its_statistics_as_null() {
+        let v = serde_json::to_value(Summary::of(&[])).unwrap();
+        assert_eq!(v["count"], 0);
+        for k in ["mean", "p50", "p99", "min", "max", "std"] {
+            assert!(v[k].is_null(), "{k}: {v}");
+        }
+        let s = Summary::of(&[1.0, 3.0]);
+        let v = serde_json::to_value(s).unwrap();
+        assert_eq!(v["mean"], 2.0);
+        assert_eq!(v["min"], 1.0);
+        assert_eq!(s.stat(s.max), Some(3.0));
+        assert_eq!(Summary::of(&[f64::NAN]).stat(0.0), None);
     }
 }

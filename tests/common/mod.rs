@@ -64,9 +64,16 @@ depth_order = "back_to_front"
 }
 
 /// Walks a JSON value and returns the paths of nulls (NaN becomes null).
+/// The statistics of an empty distribution (`count: 0`) are null by design
+/// (no measurement, not a 0) and are not reported.
 pub fn null_paths(v: &Value, path: &str, out: &mut Vec<String>) {
+    const STATS: [&str; 6] = ["mean", "p50", "p99", "min", "max", "std"];
     match v {
         Value::Null => out.push(path.to_string()),
+        Value::Object(m) if m.get("count") == Some(&Value::from(0)) => m
+            .iter()
+            .filter(|(k, x)| !(x.is_null() && STATS.contains(&k.as_str())))
+            .for_each(|(k, x)| null_paths(x, &format!("{path}.{k}"), out)),
         Value::Object(m) => m.iter().for_each(|(k, x)| null_paths(x, &format!("{path}.{k}"), out)),
         Value::Array(a) => a
             .iter()

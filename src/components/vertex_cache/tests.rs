@@ -111,7 +111,14 @@ fn policy_string_errors() {
     assert!(e("fifo:x").contains("`x`"), "{}", e("fifo:x"));
     assert!(e("fifo:-3").contains("`-3`"));
     assert!(e("lfu:3").contains("unknown") && e("lfu:3").contains("lru:N"));
-    assert!(e("none:3").contains("no size"));
+    assert!(e("none:3").contains("`none` takes no size"), "{}", e("none:3"));
+    // The error names the policy given, not another one.
+    assert!(
+        e("lavapipe:3").contains("`lavapipe` takes no size"),
+        "{}",
+        e("lavapipe:3")
+    );
+    assert!(!e("lavapipe:3").contains("`none`"), "{}", e("lavapipe:3"));
     assert!(e("").contains("unknown"));
 }
 

@@ -325,6 +325,33 @@ impl Experiment {
             .unwrap_or_else(|| path.to_string())
     }
 
+    /// Where the model values the experiment writes come from, in the
+    /// order they are applied: (dotted model key, e.g. ``[set] workload.gpu
+    /// in e.toml:7`` or ``[[sweep]] of display.buffers in e.toml:12``), so
+    /// that an error in such a value names the experiment file instead of
+    /// the model file (see [`crate::config::ModelSource::overrides`]).
+    pub fn value_origins(&self) -> Vec<(String, String)> {
+        let text = std::fs::read_to_string(&self.source).unwrap_or_default();
+        let file = self.source.display().to_string();
+        let src = crate::config::ModelSource::from_text(&file, &text);
+        let at = |key: &str| match src.line_of(key) {
+            Some(line) => format!("{file}:{line}"),
+            None => file.clone(),
+        };
+        let mut origins = Vec::new();
+        for (k, _) in &self.set {
+            origins.push((k.clone(), format!("[set] {k} in {}", at(&format!("set.{k}")))));
+        }
+        for (i, s) in self.sweeps.iter().enumerate() {
+            let k = &s.key;
+            origins.push((
+                k.clone(),
+                format!("[[sweep]] of {k} in {}", at(&format!("sweep.{i}.key"))),
+            ));
+        }
+        origins
+    }
+
     /// The base model: a clone of `default_model` for `model = "default"`,
     /// else the TOML file named by `model` (relative to the experiment file).
     pub fn resolve_model(&self, default_model: &toml::Table) -> Result<toml::Table, ExperimentError> {

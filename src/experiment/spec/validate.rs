@@ -24,20 +24,44 @@ pub fn parse_experiment(text: &str, source: &Path) -> Result<Experiment, Experim
         file: source.to_path_buf(),
         message: e.to_string().trim_end().to_string(),
     })?;
-    Validator { file: source }.experiment(raw)
+    Validator { file: source, text }.experiment(raw)
 }
 
 pub(super) struct Validator<'a> {
     file: &'a Path,
+    text: &'a str,
 }
 
 impl Validator<'_> {
     fn err(&self, key: impl Into<String>, message: impl Into<String>) -> ExperimentError {
+        let key = key.into();
         ExperimentError::Invalid {
             file: self.file.to_path_buf(),
-            key: key.into(),
+            line: self.line_of(&key),
+            key,
             message: message.into(),
         }
+    }
+
+    /// The line of the entry an error `key` names (`check[2] (path).expect`
+    /// is `expect` of the third `[[check]]`), or of the nearest enclosing
+    /// entry that stands in the file.
+    fn line_of(&self, key: &str) -> Option<usize> {
+        let mut plain = String::with_capacity(key.len());
+        let mut depth = 0usize;
+        for c in key.chars() {
+            match c {
+                '(' => depth += 1,
+                ')' => depth = depth.saturating_sub(1),
+                c if depth == 0 => plain.push(c),
+                _ => {}
+            }
+        }
+        let plain = plain.replace(' ', "");
+        let dotted = crate::config::load::dotted_path(&plain);
+        let src = crate::config::ModelSource::from_text("", self.text);
+        let parts: Vec<&str> = dotted.split('.').collect();
+        (1..=parts.len()).rev().find_map(|n| src.line_of(&parts[..n].join(".")))
     }
 
     fn experiment(&self, raw: RawExperiment) -> Result<Experiment, ExperimentError> {

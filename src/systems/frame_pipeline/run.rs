@@ -4,6 +4,7 @@ use std::path::Path;
 
 use serde_json::{Value, json};
 
+use crate::components::swap_chain::PresentMode;
 use crate::engine::{Duration, Limits, PS_PER_MS, RunStats, Scheduler, StopReason, Time, run};
 use crate::stats::quantile::Summary;
 
@@ -87,8 +88,11 @@ pub fn validate(cfg: &FramePipelineConfig) -> Result<(), PipelineError> {
     }
     if cfg.run.frames > 0 && cfg.run.warmup_frames >= cfg.run.frames {
         return Err(bad(
-            "run.warmup_frames",
-            format!("must be less than run.frames ({})", cfg.run.frames),
+            "run.warmup_frames|run.frames",
+            format!(
+                "run.warmup_frames ({}) must be less than run.frames ({})",
+                cfg.run.warmup_frames, cfg.run.frames
+            ),
         ));
     }
     cfg.cpu
@@ -259,6 +263,7 @@ pub fn run_pipeline(
         WorkloadConfig::Fixed(_) => None,
     };
     let analytic = analytic_terms(&cfg, scene.as_ref());
+    check_time_range(&cfg, &analytic)?;
     let scene_stats = scene.as_ref().map(|s| s.stats.clone());
     let mut model = FramePipeline::new(cfg, scene, trace)?;
     let build_seconds = build_start.elapsed().as_secs_f64();
@@ -331,6 +336,99 @@ fn ms(ps: u64) -> f64 {
     ps as f64 / PS_PER_MS as f64
 }
 
+/// Refuses, before simulating, expected per-frame terms that are not finite
+/// numbers (naming the distribution), and a run whose simulated time certainly passes
+/// the clock's range (`u64` picoseconds, about 213 days): `run.frames`
+/// frames take at least the largest expected per-frame term each (the
+/// units work in parallel, the slowest one bounds the frame rate; with a
+/// vsynced FIFO swap chain a frame also takes at least a refresh). Such a
+/// run would otherwise simulate, possibly for a long time (every refresh
+/// of a vsynced display is an event), before failing at the overflow. Runs
+/// with `run.until` or `run.max_events` may stop earlier and are left to the
+/// clock's own checks.
+fn check_time_range(cfg: &FramePipelineConfig, analytic: &Value) -> Result<(), PipelineError> {
+    let (cpu_key, gpu_key) = match &cfg.workload {
+        WorkloadConfig::Fixed(_) => ("workload.cpu", "workload.gpu"),
+        WorkloadConfig::Scene(_) => ("workload", "workload"),
+    };
+    // An expected term that is not a finite number (a distribution whose
+    // mean overflows or does not exist) would be written as null.
+    for (k, what) in [
+        ("cpu_ms", "CPU time"),
+        ("gpu_front_end_ms", "GPU front-end time"),
+        ("geometry_ms", "geometry time"),
+        ("fragment_ms", "fragment time"),
+    ] {
+        if analytic[k].as_f64().is_some_and(f64::is_finite) {
+            continue;
+        }
+        let mut keys = vec![];
+        if !cfg.cpu.non_render.mean().is_finite() {
+            keys.push("cpu.non_render".to_string());
+        }
+        match &cfg.workload {
+            WorkloadConfig::Fixed(f) => {
+                if !f.cpu.mean().is_finite() {
+                    keys.push("workload.cpu".into());
+                }
+                if !f.gpu.mean().is_finite() {
+                    keys.push("workload.gpu".into());
+                }
+            }
+            WorkloadConfig::Scene(sc) => keys.extend(
+                sc.groups
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, g)| !g.triangle_pixels.mean().is_finite())
+                    .map(|(i, _)| format!("workload.groups.{i}.triangle_pixels")),
+            ),
+        }
+        if keys.is_empty() {
+            keys.push(if k == "cpu_ms" { cpu_key } else { gpu_key }.to_string());
+        }
+        return Err(bad(
+            &keys.join("|"),
+            format!(
+                "the expected {what} per frame is not a finite number: the mean of {} overflows or does not exist",
+                keys.join(", ")
+            ),
+        ));
+    }
+    if cfg.run.until.is_some() || cfg.run.max_events.is_some() {
+        return Ok(());
+    }
+    let term = |k: &str| analytic[k].as_f64().unwrap_or(0.0) * PS_PER_MS as f64;
+    let mut terms = vec![
+        ("CPU work", cpu_key, term("cpu_ms")),
+        ("GPU front end work", gpu_key, term("gpu_front_end_ms")),
+        ("geometry work", gpu_key, term("geometry_ms")),
+        ("fragment work", gpu_key, term("fragment_ms")),
+    ];
+    // A vsynced FIFO swap chain shows every frame for at least one refresh.
+    if cfg.display.vsync && cfg.display.present_mode == PresentMode::Fifo {
+        terms.push((
+            "display refresh",
+            "display.refresh",
+            cfg.display.refresh.period.0 as f64,
+        ));
+    }
+    let (what, source, per_frame) = terms.into_iter().max_by(|a, b| a.2.total_cmp(&b.2)).expect("terms");
+    let total = per_frame * cfg.run.frames as f64;
+    if total < u64::MAX as f64 {
+        return Ok(());
+    }
+    Err(bad(
+        &format!("{source}|run.frames"),
+        format!(
+            "run.frames = {} frames of at least {} s each ({what}, {source}) need about {:.3e} s of simulated time: \
+             the simulated clock would overflow (64-bit picoseconds, about 213 days); lower {source} or run.frames, or set run.until",
+            cfg.run.frames,
+            per_frame / PS_PER_MS as f64 / 1000.0,
+            total / PS_PER_MS as f64 / 1000.0,
+        ),
+    ))
+}
+
 /// Expected per-frame terms of paper 000 §4.1: ET_cpu, and ET_gpu split into
 /// front end, geometry and fragment. `gpu_max_ms` = max of the three (the
 /// front end overlaps the stages: it prepares the next draw while they work),
@@ -383,7 +481,8 @@ fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProgram>) -> Va
 fn summary_json(v: &[f64]) -> Value {
     let v: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
     let s = Summary::of(&v);
-    json!({"count": s.count, "mean": s.mean, "p50": s.p50, "p99": s.p99, "min": s.min, "max": s.max, "std": s.std})
+    let n = |x: f64| s.stat(x);
+    json!({"count": s.count, "mean": n(s.mean), "p50": n(s.p50), "p99": n(s.p99), "min": n(s.min), "max": n(s.max), "std": n(s.std)})
 }
 
 fn states_json(names: &[&str], totals: &[u64]) -> Value {

@@ -4,7 +4,7 @@ use std::io::Write;
 
 use serde_json::{Map, Value, json};
 
-use crate::engine::{Limits, RunStats, Scheduler, StopReason, Time, run};
+use crate::engine::{Duration, Limits, RunStats, Scheduler, StopReason, Time, run};
 use crate::output::trace::TraceWriter;
 use crate::stats::quantile::Summary;
 
@@ -87,7 +87,15 @@ pub fn validate(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
         }
     }
     if cfg.conventional.enabled && t.conventional_frame.0 == 0 {
-        return Err(bad("conventional.frame", "must be greater than zero"));
+        // Blame the key the value came from: without `conventional.frame`
+        // the conventional client renders for `slow_client.render`.
+        return Err(match cfg.conventional.frame {
+            Some(_) => bad("conventional.frame", "must be greater than zero"),
+            None => bad(
+                "slow_client.render",
+                "must be greater than zero: the conventional client (conventional.enabled) renders each frame for slow_client.render when conventional.frame is absent",
+            ),
+        });
     }
     if cfg.run.events == 0 {
         return Err(bad("run.events", "must be at least 1 input event"));
@@ -102,6 +110,7 @@ pub fn validate(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
             ),
         ));
     }
+    check_time_range(cfg.run.events, cfg.run.warmup, cfg.input.mean_interval)?;
     for (i, w) in cfg.migration.script.windows(2).enumerate() {
         if w[1].at < w[0].at {
             return Err(bad(
@@ -228,7 +237,8 @@ pub fn run_multi_rate(cfg: MultiRateConfig) -> Result<MultiRateRun, MultiRateErr
 
 fn dist(v: &[f64]) -> Value {
     let s = Summary::of(v);
-    json!({"count": s.count, "min": s.min, "mean": s.mean, "p50": s.p50, "p99": s.p99, "max": s.max, "std": s.std})
+    let n = |x: f64| s.stat(x);
+    json!({"count": s.count, "min": n(s.min), "mean": n(s.mean), "p50": n(s.p50), "p99": n(s.p99), "max": n(s.max), "std": n(s.std)})
 }
 
 fn breakdown<'a>(names: &[&str], rows: impl Iterator<Item = &'a Vec<u64>>) -> Value {
@@ -382,4 +392,23 @@ pub fn write_trace(r: &MultiRateRun, t: &mut TraceWriter) {
     for (i, f) in m.conv[..m.conv_done].iter().enumerate() {
         t.span(1, 5, &format!("frame {i}"), f.start, f.end, None);
     }
+}
+
+/// Refuses, before simulating, a run whose input events alone (`run.events`
+/// arrivals `input.mean_interval` apart on average, after `run.warmup`)
+/// reach past the clock's range (`u64` picoseconds, about 213 days).
+fn check_time_range(events: u64, warmup: Duration, mean_interval: Duration) -> Result<(), MultiRateError> {
+    let total = warmup.0 as f64 + events as f64 * mean_interval.0 as f64;
+    if total < u64::MAX as f64 {
+        return Ok(());
+    }
+    Err(bad(
+        "input.mean_interval|run.events|run.warmup",
+        format!(
+            "run.events = {events} inputs every {} s on average (after run.warmup) need about {:.3e} s of simulated time, \
+             more than the clock can count (about 213 days in picoseconds); lower input.mean_interval or run.events",
+            mean_interval.0 as f64 / 1e12,
+            total / 1e12
+        ),
+    ))
 }

@@ -2,7 +2,7 @@
 
 use serde_json::{Value, json};
 
-use crate::engine::{Duration, Limits, RunStats, Scheduler, run};
+use crate::engine::{Duration, Limits, PS_PER_MS, RunStats, Scheduler, run};
 use crate::output::trace::TraceWriter;
 
 use super::analytic::{Analytic, closed_form};
@@ -82,7 +82,7 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), PixelFlowError> {
     }
     if cfg.rasterizers() == 0 {
         return Err(bad(
-            "nodes",
+            "nodes|shading_nodes",
             format!(
                 "{} nodes leave no rasterizer (one frame-buffer node and {} shading nodes)",
                 cfg.nodes,
@@ -102,6 +102,40 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), PixelFlowError> {
     check_size("region", &cfg.region)?;
     if cfg.region.width < 1.0 || cfg.region.height < 1.0 || cfg.display.width < 1.0 || cfg.display.height < 1.0 {
         return Err(bad("region", "display and region must be at least 1 x 1 pixel"));
+    }
+    // Sizes whose products are not finite numbers (an area, the overlap
+    // factor) would turn the closed forms and the layout into NaN or
+    // infinity; name the size that does it.
+    let footprint_key = if cfg.samples > 1 && cfg.architecture != super::Architecture::Nontex {
+        "aa_primitive"
+    } else {
+        "primitive"
+    };
+    for (key, size) in [
+        ("display", &cfg.display),
+        ("region", &cfg.region),
+        (footprint_key, &cfg.footprint()),
+    ] {
+        if !size.area().is_finite() {
+            return Err(bad(
+                &format!("{key}.{}", if size.width >= size.height { "width" } else { "height" }),
+                format!(
+                    "{key} {:?} x {:?} pixels is too large: its area is not a finite number",
+                    size.width, size.height
+                ),
+            ));
+        }
+    }
+    let overlap = cfg.overlap();
+    if !overlap.is_finite() || !(overlap * cfg.primitives as f64).is_finite() {
+        let f = cfg.footprint();
+        return Err(bad(
+            footprint_key,
+            format!(
+                "the overlap factor (w+W)(h+H)/(W H) of a {:?} x {:?} primitive in {:?} x {:?} regions is not a finite number",
+                f.width, f.height, cfg.region.width, cfg.region.height
+            ),
+        ));
     }
     if cfg.regions() > 1_000_000 {
         return Err(bad(
@@ -163,6 +197,64 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), PixelFlowError> {
     Ok(())
 }
 
+/// The last guard: no closed-form term may be NaN or infinite (`max`
+/// would hide a NaN term behind a finite one), whatever [`validate`] let
+/// through, and at event fidelity none may pass the clock's range. The
+/// error names the inputs the term is made of.
+fn finite_closed_form(cfg: &PixelFlowConfig, a: &Analytic) -> Result<(), PixelFlowError> {
+    let frames = cfg.frames;
+    let costs = match cfg.architecture {
+        super::Architecture::Nontex => "nontex",
+        _ => "deferred",
+    };
+    let fp = if cfg.samples > 1 && cfg.architecture != super::Architecture::Nontex {
+        "aa_primitive"
+    } else {
+        "primitive"
+    };
+    // The inputs of each term, most likely culprit first; the error blames
+    // the first one set on the command line or by an experiment.
+    let sizes = "display.width|display.height|region.width|region.height";
+    let front = format!("primitives|nodes|{costs}.t_overhead|{costs}.t_trans|deferred.t_first_pass");
+    let rast = format!("primitives|{fp}.width|{fp}.height|region.width|region.height|nodes|{costs}.t_rast_per_prim");
+    let comp = format!("{sizes}|{costs}.t_comp_byte|deferred.appearance_bytes|nontex.composite_bytes");
+    let shade = format!("{sizes}|shading_nodes|deferred.t_shade_address|deferred.t_shade_texture");
+    let load = format!("{sizes}|{costs}.t_load");
+    let overlap = format!("{fp}.width|{fp}.height|region.width|region.height");
+    let all = format!("{rast}|{front}|{comp}|{shade}|{load}|samples");
+    for (term, v, keys) in [
+        ("overlap", a.overlap, overlap.as_str()),
+        ("t_front", a.t_front_ms, front.as_str()),
+        ("t_gen", a.t_gen_ms, "primitives|nodes|deferred.t_gen_each"),
+        ("t_rast", a.t_rast_ms, rast.as_str()),
+        ("t_comp", a.t_comp_ms, comp.as_str()),
+        ("t_shade", a.t_shade_ms, shade.as_str()),
+        ("t_load", a.t_load_ms, load.as_str()),
+        ("latency", a.latency_ms, all.as_str()),
+    ] {
+        let inputs = keys.replace('|', ", ");
+        if !v.is_finite() {
+            return Err(bad(
+                keys,
+                format!("the closed-form term {term} is not a finite number ({v}); it is computed from {inputs}"),
+            ));
+        }
+        // Predictable overflow of the simulated clock (u64 picoseconds):
+        // report it before simulating, not when the event is scheduled.
+        // (The analytic fidelity computes in floating point, no clock.)
+        let ps = v * PS_PER_MS as f64 * f64::from(frames);
+        if cfg.fidelity == Fidelity::Event && term != "overlap" && ps >= u64::MAX as f64 {
+            return Err(bad(
+                keys,
+                format!(
+                    "the closed-form term {term} is {v:.6e} ms per frame ({frames} frame(s)), more than the simulated clock can count (about 213 days in picoseconds); it is computed from {inputs}"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn ms(d: Duration) -> f64 {
     d.as_ms_f64()
 }
@@ -176,6 +268,7 @@ pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, 
     validate(&cfg)?;
     let t0 = std::time::Instant::now();
     let analytic = closed_form(&cfg);
+    finite_closed_form(&cfg, &analytic)?;
     if cfg.fidelity == Fidelity::Analytic {
         let wall = t0.elapsed().as_secs_f64();
         let a = &analytic;
@@ -241,6 +334,16 @@ pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, 
         .collect();
     let latency = frames[0].2 - frames[0].0;
     let front = frames[0].1 - frames[0].0;
+    for (what, v) in [("latency", latency), ("front end time", front)] {
+        if !v.is_finite() {
+            return Err(bad(
+                "primitives|display.width|display.height|region.width|region.height",
+                format!(
+                    "the simulated frame's {what} is not a finite number ({v}); check the sizes (display, region, primitive) and the costs"
+                ),
+            ));
+        }
+    }
     let summary = summary(
         &model.cfg,
         &analytic,

@@ -6,7 +6,7 @@ use std::io::Write;
 
 use serde_json::{Value, json};
 
-use crate::engine::{Limits, RunStats, Scheduler, StopReason, Time, run};
+use crate::engine::{Duration, Limits, RunStats, Scheduler, StopReason, Time, run};
 use crate::output::trace::TraceWriter;
 use crate::stats::quantile::Summary;
 
@@ -129,6 +129,7 @@ pub fn validate(cfg: &VrConfig) -> Result<(), VrError> {
             ),
         ));
     }
+    check_time_range(cfg.run.events, cfg.run.warmup, cfg.input.mean_interval)?;
     Ok(())
 }
 
@@ -285,7 +286,8 @@ fn total_ms(g: &[u64]) -> f64 {
 
 fn dist(v: &[f64]) -> Value {
     let s = Summary::of(v);
-    json!({"count": s.count, "min": s.min, "mean": s.mean, "p50": s.p50, "p99": s.p99, "max": s.max, "std": s.std})
+    let n = |x: f64| s.stat(x);
+    json!({"count": s.count, "min": n(s.min), "mean": n(s.mean), "p50": n(s.p50), "p99": n(s.p99), "max": n(s.max), "std": n(s.std)})
 }
 
 fn breakdown<'a>(names: &[&str], rows: impl Iterator<Item = &'a Vec<u64>>) -> Value {
@@ -437,4 +439,23 @@ pub fn write_trace(r: &VrRun, t: &mut TraceWriter) {
             .unwrap_or_else(|| Time(s.0.saturating_add(field.0.saturating_mul(2))));
         t.span(1, 5, &format!("image {i}"), *s, end, None);
     }
+}
+
+/// Refuses, before simulating, a run whose input events alone (`run.events`
+/// arrivals `input.mean_interval` apart on average, after `run.warmup`)
+/// reach past the clock's range (`u64` picoseconds, about 213 days).
+fn check_time_range(events: u64, warmup: Duration, mean_interval: Duration) -> Result<(), VrError> {
+    let total = warmup.0 as f64 + events as f64 * mean_interval.0 as f64;
+    if total < u64::MAX as f64 {
+        return Ok(());
+    }
+    Err(bad(
+        "input.mean_interval|run.events|run.warmup",
+        format!(
+            "run.events = {events} inputs every {} s on average (after run.warmup) need about {:.3e} s of simulated time, \
+             more than the clock can count (about 213 days in picoseconds); lower input.mean_interval or run.events",
+            mean_interval.0 as f64 / 1e12,
+            total / 1e12
+        ),
+    ))
 }
