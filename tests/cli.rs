@@ -737,7 +737,9 @@ fn a_trace_streams_to_its_file_and_takes_no_memory_budget() {
 fn latency_systems_over_a_long_simulated_span_are_refused() {
     for m in ["mfr-cluster.toml", "vr-naive.toml", "vr-warp.toml"] {
         limit_err(
-            &["run", &model(m), "--set", "input.mean_interval=\"100000s\""],
+            // 5000 inputs every 3000 s: 1.5e7 s, within the clock's range
+            // (100000 s would overflow it, an error of its own).
+            &["run", &model(m), "--set", "input.mean_interval=\"3000s\""],
             &["run.max_memory", "input.mean_interval", "8 GiB"],
         );
     }
@@ -1043,14 +1045,31 @@ fn predictable_clock_overflow_is_reported_before_simulating() {
         e.contains("key `display.refresh`") && e.contains("would overflow"),
         "{e}"
     );
-    let e = run_err(&["run", "models/fixed.toml", "--frames", "100000000000"]);
+    // (With room for that many frames' records: else run.max_memory says no first.)
+    let e = run_err(&[
+        "run",
+        "models/fixed.toml",
+        "--frames",
+        "100000000000",
+        "--set",
+        "run.max_memory=\"1000TiB\"",
+    ]);
     assert!(
         e.contains("`--frames 100000000000`") && e.contains("key `run.frames`"),
         "{e}"
     );
-    let e = run_err(&["run", "models/mfr-cluster.toml", "--set", "run.events=100000000000000"]);
+    // Within run.events' own limit (1e8), but 1e8 inputs a second apart
+    // outrun the clock.
+    let e = run_err(&[
+        "run",
+        "models/mfr-cluster.toml",
+        "--set",
+        "run.events=100000000",
+        "--set",
+        "input.mean_interval=\"1s\"",
+    ]);
     assert!(
-        e.contains("key `run.events`") && e.contains("input.mean_interval"),
+        e.contains("key `input.mean_interval`") && e.contains("run.events") && e.contains("213 days"),
         "{e}"
     );
     let e = run_err(&[
