@@ -27,6 +27,11 @@ pub const MAX_SCENE_OBJECTS: u64 = 1 << 24;
 /// scene).
 pub const MAX_SCENE_SCALE: f64 = 1000.0;
 
+/// Shortest display refresh period (`display.refresh`): 1 us, a 1 MHz
+/// display. Every refresh is an event, so a picosecond refresh would make a
+/// run of ordinary frames take billions of events.
+pub const MIN_REFRESH_PERIOD_PS: u64 = 1_000_000;
+
 /// Most input events (`run.events`) a multi-frame-rate or VR model may follow.
 pub const MAX_INPUT_EVENTS: u64 = 100_000_000;
 

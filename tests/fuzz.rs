@@ -36,6 +36,8 @@ const HANG_GUARD: Duration = Duration::from_secs(60);
 /// first (name, text), and the words one of which a clean error must contain.
 #[derive(Debug, Clone)]
 struct Case {
+    /// What was mutated (for a case whose input is a written file).
+    what: String,
     args: Vec<String>,
     files: Vec<(String, String)>,
     blame: Vec<String>,
@@ -59,19 +61,43 @@ impl Case {
 /// Base models, each with `--set`s that keep one run small, and the keys
 /// that those bound (a mutation of such a key drops its bound).
 fn bases() -> Vec<(&'static str, Vec<&'static str>)> {
+    // Systems with `run.max_memory` get 1 GiB (under the 3 GiB cap), so a
+    // long but valid run is refused by its own estimate, not by the cap; and
+    // `run.max_events`, so a valid but huge amount of work asked for (a
+    // million copies of a mesh) stops at a bound instead of running for hours.
+    const MEM: &str = "run.max_memory=\"1GiB\"";
+    const EVENTS: &str = "run.max_events=3000000";
     vec![
-        ("models/default.toml", vec!["run.frames=3", "run.warmup_frames=0"]),
-        ("models/fixed.toml", vec!["run.frames=20", "run.warmup_frames=2"]),
-        ("models/one-mesh.toml", vec!["run.frames=2", "run.warmup_frames=0"]),
+        (
+            "models/default.toml",
+            vec!["run.frames=3", "run.warmup_frames=0", MEM, EVENTS],
+        ),
+        (
+            "models/fixed.toml",
+            vec!["run.frames=20", "run.warmup_frames=2", MEM, EVENTS],
+        ),
+        (
+            "models/one-mesh.toml",
+            vec!["run.frames=2", "run.warmup_frames=0", MEM, EVENTS],
+        ),
         (
             "models/city.toml",
-            vec!["run.frames=2", "run.warmup_frames=0", "workload.scale=0.05"],
+            vec![
+                "run.frames=2",
+                "run.warmup_frames=0",
+                "workload.scale=0.05",
+                MEM,
+                EVENTS,
+            ],
         ),
-        ("models/single-view.toml", vec!["run.frames=30", "run.warmup_frames=2"]),
-        ("models/mfr-cluster.toml", vec!["run.events=40"]),
-        ("models/mfr-migration.toml", vec!["run.events=20"]),
-        ("models/vr-warp.toml", vec!["run.events=40"]),
-        ("models/vr-naive.toml", vec!["run.events=40"]),
+        (
+            "models/single-view.toml",
+            vec!["run.frames=30", "run.warmup_frames=2", MEM, EVENTS],
+        ),
+        ("models/mfr-cluster.toml", vec!["run.events=40", MEM, EVENTS]),
+        ("models/mfr-migration.toml", vec!["run.events=20", MEM, EVENTS]),
+        ("models/vr-warp.toml", vec!["run.events=40", MEM, EVENTS]),
+        ("models/vr-naive.toml", vec!["run.events=40", MEM, EVENTS]),
         ("models/pixelflow-20.toml", vec!["primitives=2000"]),
     ]
 }
@@ -179,6 +205,7 @@ fn model_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
     let mut args = vec!["run".to_string()];
     let mut files = Vec::new();
     let mut blame = vec![key.clone(), key.rsplit('.').next().unwrap().to_string()];
+    let mut what = String::new();
     match rng.random_range(0..4) {
         // The value in a model file (written as TOML).
         0 => {
@@ -195,6 +222,7 @@ fn model_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
             files.push((name.clone(), toml::to_string(&t).unwrap()));
             args.push(name.clone());
             blame.push(name);
+            what = format!("{file} with {key} = {value} in the file");
         }
         // A misspelt key in a model file.
         1 => {
@@ -212,6 +240,7 @@ fn model_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
             files.push((name.clone(), body));
             args.push(name.clone());
             blame.push(name);
+            what = format!("{file} with the misspelt key {typo}");
             blame.push(typo);
         }
         // The value from --set.
@@ -230,7 +259,12 @@ fn model_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
         }
     }
     args.push("--json".into());
-    Case { args, files, blame }
+    Case {
+        what,
+        args,
+        files,
+        blame,
+    }
 }
 
 fn mesh_case(rng: &mut Xoshiro256PlusPlus) -> Case {
@@ -290,6 +324,7 @@ fn mesh_case(rng: &mut Xoshiro256PlusPlus) -> Case {
     };
     let blame = vec![mesh.clone(), policy.clone(), "--policy".into(), "mesh".into()];
     Case {
+        what: String::new(),
         args: vec!["vcache".into(), mesh, "--policy".into(), policy, "--json".into()],
         files: vec![],
         blame,
@@ -364,6 +399,7 @@ fn experiment_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
         metric.to_string(),
     ];
     Case {
+        what: body.clone(),
         args: vec![
             "experiment".into(),
             name.clone(),
@@ -540,6 +576,7 @@ fn regressions() -> Vec<Case> {
                 })
                 .collect();
             Case {
+                what: String::new(),
                 args,
                 files: vec![],
                 blame,
@@ -588,7 +625,16 @@ fn every_input_ends_in_a_result_or_a_clean_error() {
             Ok(how) => *counts.lock().unwrap().entry(kind + how).or_default() += 1,
             Err(why) => {
                 *counts.lock().unwrap().entry(kind + "FAILED").or_default() += 1;
-                failures.lock().unwrap().push((case.command_line(), why));
+                let line = if case.what.is_empty() {
+                    case.command_line()
+                } else {
+                    format!(
+                        "{}\n        input: {}",
+                        case.command_line(),
+                        case.what.replace('\n', "\n               ")
+                    )
+                };
+                failures.lock().unwrap().push((line, why));
             }
         }
         let _ = std::fs::remove_dir_all(&d);

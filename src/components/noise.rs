@@ -65,6 +65,21 @@ pub enum NoiseError {
         /// Which parameter.
         what: &'static str,
     },
+    /// Tasks that take on average at least the time between them: the
+    /// unit would never catch up and their backlog would grow without bound.
+    #[error(
+        "system task {name:?}: its duration (mean {duration_ms} ms) is not less than the {what} ({gap_ms} ms): the unit would never catch up and the waiting tasks would grow without bound"
+    )]
+    Overloaded {
+        /// Source name.
+        name: String,
+        /// Which parameter spaces the tasks.
+        what: &'static str,
+        /// Mean duration, ms.
+        duration_ms: f64,
+        /// Mean time between arrivals, ms.
+        gap_ms: f64,
+    },
     /// The duration distribution is invalid.
     #[error("system task {name:?}: duration: {source}")]
     Duration {
@@ -97,6 +112,19 @@ impl NoiseSource {
             name: name.clone(),
             source,
         })?;
+        let (what, gap) = match &arrivals {
+            Arrivals::Periodic { period, .. } => ("period", period.0 as f64),
+            Arrivals::Poisson { mean_gap } => ("mean time between tasks (1/rate)", mean_gap.0 as f64),
+        };
+        let mean = duration.mean();
+        if !(mean < gap) {
+            return Err(NoiseError::Overloaded {
+                name,
+                what,
+                duration_ms: mean / 1e9,
+                gap_ms: gap / 1e9,
+            });
+        }
         Ok(NoiseSource {
             name,
             target,

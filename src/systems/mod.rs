@@ -53,17 +53,41 @@ pub enum SimError {
     #[error(transparent)]
     Config(#[from] ConfigError),
     /// The frame pipeline failed while running.
-    #[error(transparent)]
-    Pipeline(frame_pipeline::PipelineError),
+    #[error("{model}: {source}")]
+    Pipeline {
+        /// The model's name (its file, or the embedded default).
+        model: String,
+        /// What went wrong.
+        #[source]
+        source: frame_pipeline::PipelineError,
+    },
     /// The multi-frame-rate system failed while running.
-    #[error(transparent)]
-    MultiRate(multi_rate::MultiRateError),
+    #[error("{model}: {source}")]
+    MultiRate {
+        /// The model's name (its file, or the embedded default).
+        model: String,
+        /// What went wrong.
+        #[source]
+        source: multi_rate::MultiRateError,
+    },
     /// The VR pipeline failed while running.
-    #[error(transparent)]
-    Vr(vr::VrError),
+    #[error("{model}: {source}")]
+    Vr {
+        /// The model's name (its file, or the embedded default).
+        model: String,
+        /// What went wrong.
+        #[source]
+        source: vr::VrError,
+    },
     /// The PixelFlow model failed while running.
-    #[error(transparent)]
-    PixelFlow(pixelflow::PixelFlowError),
+    #[error("{model}: {source}")]
+    PixelFlow {
+        /// The model's name (its file, or the embedded default).
+        model: String,
+        /// What went wrong.
+        #[source]
+        source: pixelflow::PixelFlowError,
+    },
 }
 
 /// The result of running one model.
@@ -92,7 +116,21 @@ pub fn patched_table(src: &ModelSource, sets: &[String]) -> Result<toml::Table, 
 /// run's trace is written into it (the frame pipeline's while it runs) and
 /// handed back by [`SystemRun::take_trace`], to be closed by the caller.
 pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWriter>) -> Result<SystemRun, SimError> {
-    let system = table.get("system").and_then(|v| v.as_str()).unwrap_or("frame_pipeline");
+    let system = match table.get("system") {
+        None => "frame_pipeline",
+        Some(toml::Value::String(s)) => s.as_str(),
+        Some(other) => {
+            return Err(SimError::Config(invalid(
+                src,
+                "system",
+                format!(
+                    "expected a system name as a string (frame_pipeline, multi_rate, vr, pixelflow), found {}",
+                    other.type_str()
+                ),
+                None,
+            )));
+        }
+    };
     match system {
         "frame_pipeline" => {
             let cfg: frame_pipeline::FramePipelineConfig = deserialize(table, src)?;
@@ -101,7 +139,10 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWrit
                 Err(frame_pipeline::PipelineError::Invalid { key, message }) => {
                     Err(SimError::Config(invalid(src, &key, message, None)))
                 }
-                Err(e) => Err(SimError::Pipeline(e)),
+                Err(e) => Err(SimError::Pipeline {
+                    model: src.name.clone(),
+                    source: e,
+                }),
             }
         }
         "multi_rate" => {
@@ -117,7 +158,10 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWrit
                 Err(multi_rate::MultiRateError::Invalid { key, message }) => {
                     Err(SimError::Config(invalid(src, &key, message, None)))
                 }
-                Err(e) => Err(SimError::MultiRate(e)),
+                Err(e) => Err(SimError::MultiRate {
+                    model: src.name.clone(),
+                    source: e,
+                }),
             }
         }
         "vr" => {
@@ -131,7 +175,10 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWrit
                     Ok(SystemRun::Vr(Box::new(r)))
                 }
                 Err(vr::VrError::Invalid { key, message }) => Err(SimError::Config(invalid(src, &key, message, None))),
-                Err(e) => Err(SimError::Vr(e)),
+                Err(e) => Err(SimError::Vr {
+                    model: src.name.clone(),
+                    source: e,
+                }),
             }
         }
         "pixelflow" => {
@@ -147,7 +194,10 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWrit
                 Err(pixelflow::PixelFlowError::Invalid { key, message }) => {
                     Err(SimError::Config(invalid(src, &key, message, None)))
                 }
-                Err(e) => Err(SimError::PixelFlow(e)),
+                Err(e) => Err(SimError::PixelFlow {
+                    model: src.name.clone(),
+                    source: e,
+                }),
             }
         }
         other => Err(SimError::Config(invalid(

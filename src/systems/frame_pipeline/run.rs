@@ -71,6 +71,15 @@ pub fn validate(cfg: &FramePipelineConfig) -> Result<(), PipelineError> {
             format!("expected \"frame_pipeline\", got {:?}", cfg.system),
         ));
     }
+    if cfg.display.refresh.period.0 < crate::limits::MIN_REFRESH_PERIOD_PS {
+        return Err(bad(
+            "display.refresh",
+            format!(
+                "a refresh period of {} is shorter than the limit of 1us (1 MHz): every refresh is an event",
+                cfg.display.refresh.period
+            ),
+        ));
+    }
     if !(2..=16).contains(&cfg.display.buffers) {
         return Err(bad(
             "display.buffers",

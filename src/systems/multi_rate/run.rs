@@ -156,7 +156,13 @@ pub fn estimate_memory(cfg: &MultiRateConfig) -> (u64, String) {
     use std::mem::size_of;
     let t = Terms::of(cfg);
     let last = cfg.migration.script.iter().map(|s| s.at.0).max().unwrap_or(0) as f64;
-    let span = cfg.run.warmup.0 as f64 + cfg.run.events as f64 * cfg.input.mean_interval.0 as f64 + last + 1e12;
+    // After the last input the run goes on until every path has shown it:
+    // the tracker's delay, a few frames of each client and the display.
+    let tail = cfg.tracker.period.0 as f64
+        + cfg.tracker.latency.0 as f64
+        + 3.0 * (t.sc_interval().0 as f64 + t.fc_interval().0 as f64 + t.conventional_frame.0 as f64)
+        + cfg.display.latency.0 as f64;
+    let span = cfg.run.warmup.0 as f64 + cfg.run.events as f64 * cfg.input.mean_interval.0 as f64 + last + tail + 1e12;
     let frames = |interval: crate::engine::Duration| -> u64 {
         (span / interval.0.max(1) as f64).min(u64::MAX as f64) as u64 + 1
     };
@@ -174,7 +180,7 @@ pub fn estimate_memory(cfg: &MultiRateConfig) -> (u64, String) {
     add_bytes(&mut events, cfg.run.events, BYTES_PER_EVENT);
     let total = total.saturating_add(events);
     let parts = format!(
-        "{} input events = {}; over an expected {:.3e} s simulated (run.warmup + run.events x input.mean_interval): {sc} SC, {fc} FC and {conv} conventional frames",
+        "{} input events = {}; over an expected {:.3e} s simulated (run.warmup + run.events x input.mean_interval + tracker.latency and the clients' frames until the last is shown): {sc} SC, {fc} FC and {conv} conventional frames",
         cfg.run.events,
         show_bytes(events),
         span / 1e12

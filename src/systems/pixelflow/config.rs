@@ -226,7 +226,7 @@ impl PixelFlowConfig {
     pub fn rasterizers(&self) -> u32 {
         match self.architecture {
             Architecture::Nontex => self.nodes.saturating_sub(1),
-            _ => self.nodes.saturating_sub(1 + self.shading_nodes),
+            _ => self.nodes.saturating_sub(self.shading_nodes.saturating_add(1)),
         }
     }
 

@@ -80,6 +80,15 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), PixelFlowError> {
     if cfg.samples == 0 {
         return Err(bad("samples", "must be at least 1 (1 = no antialiasing)"));
     }
+    if cfg.architecture != super::Architecture::Nontex && cfg.shading_nodes >= cfg.nodes {
+        return Err(bad(
+            "shading_nodes|nodes",
+            format!(
+                "{} shading nodes leave no room among {} nodes (one is the frame buffer, at least one rasterizes)",
+                cfg.shading_nodes, cfg.nodes
+            ),
+        ));
+    }
     if cfg.rasterizers() == 0 {
         return Err(bad(
             "nodes|shading_nodes",
@@ -410,13 +419,15 @@ fn summary(
     };
     let lat: Vec<f64> = frames.iter().map(|f| f.2 - f.0).collect();
     let intervals: Vec<f64> = frames.windows(2).map(|w| w[1].2 - w[0].2).collect();
+    // Like every summary's statistics: `count`, and with no values (one
+    // frame has no interval) the other fields null.
     let stat = |v: &[f64]| -> Value {
         if v.is_empty() {
-            return Value::Null;
+            return json!({"count": 0, "first": null, "last": null, "mean": null, "max": null});
         }
         let mean = v.iter().sum::<f64>() / v.len() as f64;
         let max = v.iter().copied().fold(f64::MIN, f64::max);
-        json!({"first": v[0], "last": v[v.len() - 1], "mean": mean, "max": max})
+        json!({"count": v.len(), "first": v[0], "last": v[v.len() - 1], "mean": mean, "max": max})
     };
     let frame_rows: Vec<Value> = frames
         .iter()

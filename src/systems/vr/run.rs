@@ -144,7 +144,20 @@ const BYTES_PER_EVENT: usize = std::mem::size_of::<Time>() + std::mem::size_of::
 pub fn estimate_memory(cfg: &VrConfig) -> (u64, String) {
     use crate::limits::{add_bytes, show_bytes};
     use std::mem::size_of;
-    let span = cfg.run.warmup.0 as f64 + cfg.run.events as f64 * cfg.input.mean_interval.0 as f64;
+    // After the last motion the run goes on until it is shown: the tracker's
+    // delay, a few loop periods and the display.
+    let tail = [
+        cfg.tracker.period.0,
+        cfg.tracker.latency.0,
+        3 * cfg.simulation.step.0,
+        3 * cfg.renderer.render.0,
+        3 * cfg.pair().0,
+        2 * cfg.display_latency().0,
+    ]
+    .iter()
+    .map(|&x| x as f64)
+    .sum::<f64>();
+    let span = cfg.run.warmup.0 as f64 + cfg.run.events as f64 * cfg.input.mean_interval.0 as f64 + tail;
     let frames = |interval: u64| -> u64 { (span / interval.max(1) as f64).min(u64::MAX as f64) as u64 + 1 };
     let (step, render) = (cfg.simulation.step.0, cfg.renderer.render.0);
     let mut total = 0u64;
@@ -166,7 +179,7 @@ pub fn estimate_memory(cfg: &VrConfig) -> (u64, String) {
     add_bytes(&mut events, cfg.run.events, BYTES_PER_EVENT);
     let total = total.saturating_add(events);
     let parts = format!(
-        "{} motion events = {}; over an expected {:.3e} s simulated (run.warmup + run.events x input.mean_interval): {desc}",
+        "{} motion events = {}; over an expected {:.3e} s simulated (run.warmup + run.events x input.mean_interval + tracker.latency and the loops until the last is shown): {desc}",
         cfg.run.events,
         show_bytes(events),
         span / 1e12
