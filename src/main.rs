@@ -350,6 +350,8 @@ fn cmd_run(
         }
         _ => path,
     });
+    // With the trace on standard output, the report goes to standard error.
+    let trace_on_stdout = trace.as_deref().is_some_and(is_stdout);
     let (trace_file, writer) = match &trace {
         Some(path) => {
             let (file, w) = open_output(path)?;
@@ -380,8 +382,6 @@ fn cmd_run(
     if let Some(set) = set {
         set.commit()?;
     }
-    // With the trace on standard output, the report goes to standard error.
-    let trace_on_stdout = trace.as_deref().is_some_and(|p| p.as_os_str() == "-");
     if json {
         let text = serde_json::to_string_pretty(run.summary())?;
         if trace_on_stdout {
@@ -393,6 +393,22 @@ fn cmd_run(
         print_human(&run);
     }
     Ok(())
+}
+
+/// Whether `path` is this process's standard output: `-`, or the same file
+/// (`/dev/stdout`, `/proc/self/fd/1`, or the file stdout is redirected to).
+fn is_stdout(path: &Path) -> bool {
+    if path.as_os_str() == "-" {
+        return true;
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(a), Ok(b)) = (std::fs::metadata(path), std::fs::metadata("/proc/self/fd/1")) {
+            return a.dev() == b.dev() && a.ino() == b.ino();
+        }
+    }
+    false
 }
 
 /// The files `run --out` writes (a folder holding only these, written

@@ -368,3 +368,40 @@ fn a_failed_experiment_keeps_the_old_set_and_puts_finished_runs_beside_it() {
     assert_eq!(snapshot(&out), old);
     assert!(leftovers(d.path(), "out").is_empty());
 }
+
+/// A trace path that is a link to this process's standard output (what
+/// `/dev/stdout` is), made inside a temp folder: written in place, whether
+/// stdout is a pipe or a file the caller redirected it to; the link stays.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_trace_through_a_link_to_standard_output_is_written_in_place() {
+    let d = tempfile::tempdir().unwrap();
+    let link = d.path().join("stdout-link");
+    std::os::unix::fs::symlink("/proc/self/fd/1", &link).unwrap();
+    // Standard output a pipe.
+    let out = ok(bin().args(["run", &model(d.path()), "--trace", link.to_str().unwrap()]));
+    let v: serde_json::Value = serde_json::from_str(&out).expect("stdout is the trace alone");
+    assert!(v["traceEvents"].as_array().unwrap().len() > 20);
+    // Standard output redirected to a file.
+    let file = d.path().join("redirected.json");
+    let status = bin()
+        .args(["run", &model(d.path()), "--json", "--trace", link.to_str().unwrap()])
+        .stdout(std::fs::File::create(&file).unwrap())
+        .stderr(Stdio::piped())
+        .output()
+        .unwrap();
+    assert!(status.status.success());
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&file).unwrap()).expect("the file is the trace alone");
+    assert!(v["traceEvents"].as_array().unwrap().len() > 20);
+    // The JSON summary went to standard error instead.
+    let err = String::from_utf8_lossy(&status.stderr);
+    assert!(err.contains("\"metrics\""), "{err}");
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    let mut names: Vec<String> = std::fs::read_dir(d.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["m.toml", "redirected.json", "stdout-link"]);
+}

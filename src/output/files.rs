@@ -4,7 +4,8 @@
 //!
 //! - `-`: standard output;
 //! - a FIFO, a character or block device, a socket, or a symbolic link to
-//!   one: opened and written in place (never replaced: replacing
+//!   one, and anything under `/dev` or `/proc` (`/dev/stdout` redirected to
+//!   a file): opened and written in place (never replaced: replacing
 //!   `/dev/stdout` or a FIFO by a regular file would break every later
 //!   reader of it);
 //! - a regular file, a symbolic link to one (the link is followed and kept),
@@ -61,18 +62,42 @@ pub fn resolve_links(path: &Path) -> Result<PathBuf, OutputError> {
     })
 }
 
+/// Whether `p` lies under `/dev` or `/proc`, whose links (`/dev/stdout` ->
+/// `/proc/self/fd/1` -> `pipe:[...]` or the file a shell opened) name open
+/// files of a process rather than places to put a file.
+fn is_system_path(p: &Path) -> bool {
+    p.starts_with("/dev") || p.starts_with("/proc")
+}
+
 /// Decides how `path` is written (see the module documentation).
 pub fn destination(path: &Path) -> Result<Destination, OutputError> {
     if path.as_os_str() == "-" {
         return Ok(Destination::Stdout);
     }
-    let target = resolve_links(path)?;
-    match std::fs::metadata(&target) {
-        Ok(m) if m.is_dir() => Err(OutputError::IsAFolder {
-            path: path.to_path_buf(),
-        }),
-        Ok(m) if m.is_file() => Ok(Destination::Replace(target)),
-        Ok(_) => Ok(Destination::InPlace(target)),
+    // What the kernel finds at the path, following every link.
+    let found = std::fs::metadata(path);
+    if let Ok(m) = &found {
+        if m.is_dir() {
+            return Err(OutputError::IsAFolder {
+                path: path.to_path_buf(),
+            });
+        }
+        if !m.is_file() {
+            return Ok(Destination::InPlace(path.to_path_buf()));
+        }
+    }
+    let target = if is_system_path(path) {
+        path.to_path_buf()
+    } else {
+        resolve_links(path)?
+    };
+    if is_system_path(&target) {
+        // A file a process has open (a shell's `> file` seen through
+        // /dev/stdout): written in place, never replaced.
+        return Ok(Destination::InPlace(path.to_path_buf()));
+    }
+    match found {
+        Ok(_) => Ok(Destination::Replace(target)),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Destination::Replace(target)),
         Err(e) => Err(OutputError::Io {
             action: "looking at",
@@ -105,8 +130,12 @@ pub fn open_output(path: &Path) -> Result<(OutputFile, Box<dyn Write + Send>), O
             Box::new(std::io::BufWriter::new(std::io::stdout())),
         )),
         Destination::InPlace(p) => {
+            // A regular file reached through /dev or /proc is truncated like
+            // `tee` does; FIFOs and devices are not (they cannot be).
+            let regular = std::fs::metadata(&p).is_ok_and(|m| m.is_file());
             let f = std::fs::OpenOptions::new()
                 .write(true)
+                .truncate(regular)
                 .open(&p)
                 .map_err(OutputError::io("opening", &p))?;
             Ok((
@@ -249,7 +278,7 @@ mod tests {
         assert_eq!(destination(&fifo).unwrap(), Destination::InPlace(fifo.clone()));
         let link = d.path().join("to-pipe");
         std::os::unix::fs::symlink(&fifo, &link).unwrap();
-        assert_eq!(destination(&link).unwrap(), Destination::InPlace(fifo.clone()));
+        assert_eq!(destination(&link).unwrap(), Destination::InPlace(link.clone()));
         let reader = {
             let fifo = fifo.clone();
             std::thread::spawn(move || std::fs::read(&fifo).unwrap())
