@@ -111,3 +111,23 @@ mod tests {
         );
     }
 }
+
+/// The message refusing, before simulating, a latency-system run whose input
+/// events alone (`run.events` arrivals `input.mean_interval` apart on
+/// average, after `run.warmup`, all in picoseconds) reach past the clock's
+/// range (`u64` picoseconds, about 213 days); `None` when they fit. The key
+/// to blame is `input.mean_interval|run.events|run.warmup`.
+pub fn input_span_message(events: u64, warmup_ps: u64, mean_interval_ps: u64) -> Option<String> {
+    let total = warmup_ps as f64 + events as f64 * mean_interval_ps as f64;
+    (total >= u64::MAX as f64).then(|| {
+        format!(
+            "run.events = {events} inputs every {} s on average (after run.warmup) need about {:.3e} s of simulated time, \
+             more than the clock can count (about 213 days in picoseconds); lower input.mean_interval or run.events",
+            mean_interval_ps as f64 / 1e12,
+            total / 1e12
+        )
+    })
+}
+
+/// The keys [`input_span_message`] blames.
+pub const INPUT_SPAN_KEYS: &str = "input.mean_interval|run.events|run.warmup";

@@ -400,21 +400,11 @@ pub fn write_trace(r: &MultiRateRun, t: &mut TraceWriter) {
     }
 }
 
-/// Refuses, before simulating, a run whose input events alone (`run.events`
-/// arrivals `input.mean_interval` apart on average, after `run.warmup`)
-/// reach past the clock's range (`u64` picoseconds, about 213 days).
+/// Refuses, before simulating, a run whose input events alone reach past
+/// the clock's range ([`crate::limits::input_span_message`]).
 fn check_time_range(events: u64, warmup: Duration, mean_interval: Duration) -> Result<(), MultiRateError> {
-    let total = warmup.0 as f64 + events as f64 * mean_interval.0 as f64;
-    if total < u64::MAX as f64 {
-        return Ok(());
+    match crate::limits::input_span_message(events, warmup.0, mean_interval.0) {
+        Some(message) => Err(bad(crate::limits::INPUT_SPAN_KEYS, message)),
+        None => Ok(()),
     }
-    Err(bad(
-        "input.mean_interval|run.events|run.warmup",
-        format!(
-            "run.events = {events} inputs every {} s on average (after run.warmup) need about {:.3e} s of simulated time, \
-             more than the clock can count (about 213 days in picoseconds); lower input.mean_interval or run.events",
-            mean_interval.0 as f64 / 1e12,
-            total / 1e12
-        ),
-    ))
 }

@@ -84,7 +84,7 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), PixelFlowError> {
         return Err(bad(
             "shading_nodes|nodes",
             format!(
-                "{} shading nodes leave no room among {} nodes (one is the frame buffer, at least one rasterizes)",
+                "{} shading nodes among {} nodes leave no rasterizer (one node is the frame buffer, at least one must rasterize)",
                 cfg.shading_nodes, cfg.nodes
             ),
         ));
