@@ -6,7 +6,7 @@
 //! Compared: each model's `summary.json` (without its wall-time keys),
 //! `frames.csv` and `model.toml` (the repository's path written `$ROOT`);
 //! each experiment's `runs.csv` and `points.csv` without their wall-time
-//! columns (`wall_seconds*`, `speedup`). A file of at most 16 KiB is stored
+//! columns (`wall_seconds*`, `speedup`), and its `searches.csv` if any. A file of at most 16 KiB is stored
 //! whole (so a failure shows a diff); a larger one as its length and FNV-1a
 //! hash (`NAME.fnv`). `RENDERSIM_BLESS=1 cargo test --test golden` rewrites
 //! the stored outputs after an intended change: say why in the commit.
@@ -93,10 +93,14 @@ fn outputs(kind: &str, file: &Path, tmp: &Path) -> Vec<(String, Vec<u8>)> {
         ]
     } else {
         run(&["experiment", &rel, "--quiet"], &out);
-        vec![
+        let mut v = vec![
             ("runs.csv".into(), without_wall_columns(&out.join("runs.csv"))),
             ("points.csv".into(), without_wall_columns(&out.join("points.csv"))),
-        ]
+        ];
+        if out.join("searches.csv").exists() {
+            v.push(("searches.csv".into(), std::fs::read(out.join("searches.csv")).unwrap()));
+        }
+        v
     }
 }
 
