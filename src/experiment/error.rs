@@ -63,14 +63,6 @@ pub enum ExperimentError {
         /// The runner's message.
         message: String,
     },
-    /// A CSV output file could not be written.
-    #[error("writing {}: {message}", path.display())]
-    Csv {
-        /// The CSV file.
-        path: PathBuf,
-        /// The writer's message.
-        message: String,
-    },
     /// A plot could not be written.
     #[error("plot `{file}`: {source}")]
     Plot {

@@ -322,23 +322,36 @@ pub fn report_section(searches: &[Search], results: &[SearchResult]) -> String {
 
 /// `searches.csv`.
 pub fn csv(results: &[SearchResult]) -> String {
-    let mut s = String::from("search,key,path,target,metric_at_from,metric_at_to,value,metric,converged,runs\n");
-    for r in results {
-        s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{}\n",
-            r.name,
-            r.vary,
-            r.path,
-            r.target,
-            r.at_ends.0,
-            r.at_ends.1,
+    let header = [
+        "search",
+        "key",
+        "path",
+        "target",
+        "metric_at_from",
+        "metric_at_to",
+        "value",
+        "metric",
+        "converged",
+        "runs",
+    ];
+    let rows = results.iter().map(|r| {
+        vec![
+            r.name.clone(),
+            r.vary.clone(),
+            r.path.clone(),
+            r.target.to_string(),
+            r.at_ends.0.to_string(),
+            r.at_ends.1.to_string(),
             r.value.map_or(String::new(), |v| v.to_string()),
             r.metric.map_or(String::new(), |v| v.to_string()),
-            r.converged,
-            r.runs
-        ));
-    }
-    s
+            r.converged.to_string(),
+            r.runs.to_string(),
+        ]
+    });
+    let mut out = Vec::new();
+    // Writing into memory cannot fail.
+    let _ = crate::output::table::write_table(&mut out, &header, rows);
+    String::from_utf8(out).unwrap_or_default()
 }
 
 #[cfg(test)]

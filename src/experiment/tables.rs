@@ -12,19 +12,12 @@ fn num(v: Option<f64>) -> String {
 }
 
 fn write_rows(path: &Path, header: Vec<String>, rows: Vec<Vec<String>>) -> Result<(), ExperimentError> {
-    let err = |e: csv::Error| ExperimentError::Csv {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    };
-    let mut w = csv::Writer::from_path(path).map_err(err)?;
-    w.write_record(&header).map_err(err)?;
-    for r in rows {
-        w.write_record(&r).map_err(err)?;
-    }
-    w.flush().map_err(|source| ExperimentError::Io {
+    let io = |source| ExperimentError::Io {
         path: path.to_path_buf(),
         source,
-    })
+    };
+    let file = std::fs::File::create(path).map_err(io)?;
+    crate::output::table::write_table(std::io::BufWriter::new(file), &header, rows).map_err(io)
 }
 
 /// Write `runs.csv`: `point`, the sweep keys, `seed`, every tracked path

@@ -7,12 +7,14 @@
 //!   its target and swapped in whole, so a kill leaves the old set or the
 //!   new one, never a mix.
 //! - [`cleanup`]: temporary paths removed on SIGINT, SIGTERM and SIGHUP.
-//! - [`trace`]: Chrome/Perfetto trace JSON.
+//! - [`table`]: per-row tables as CSV through the `csv` crate.
+//! - [`trace`]: Chrome/Perfetto trace JSON, streamed.
 
 pub mod cleanup;
 pub mod error;
 pub mod files;
 pub mod result_set;
+pub mod table;
 pub mod trace;
 
 pub use error::OutputError;

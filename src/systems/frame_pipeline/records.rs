@@ -15,8 +15,6 @@
 //! - `MsBetweenDisplayChange`: this frame's appearance to the previous one's;
 //! - `Dropped`: 1 if the frame was never shown.
 
-use std::io::Write;
-
 use crate::engine::{PS_PER_MS, Time};
 
 /// One frame's timeline.
@@ -132,11 +130,8 @@ pub fn frame_rows(records: &[FrameRecord]) -> Vec<[f64; 14]> {
 
 /// Writes the frames table as CSV (exact decimal text; empty for missing).
 pub fn write_frames_csv<W: std::io::Write>(records: &[FrameRecord], w: W) -> std::io::Result<()> {
-    let mut w = std::io::BufWriter::new(w);
-    writeln!(w, "{}", COLUMNS.join(","))?;
-    for row in frame_rows(records) {
-        let cells: Vec<String> = row
-            .iter()
+    let rows = frame_rows(records).into_iter().map(|row| {
+        row.iter()
             .enumerate()
             .map(|(i, v)| {
                 if v.is_nan() {
@@ -152,8 +147,7 @@ pub fn write_frames_csv<W: std::io::Write>(records: &[FrameRecord], w: W) -> std
                     }
                 }
             })
-            .collect();
-        writeln!(w, "{}", cells.join(","))?;
-    }
-    w.flush()
+            .collect()
+    });
+    crate::output::table::write_table(std::io::BufWriter::new(w), &COLUMNS, rows)
 }

@@ -354,15 +354,11 @@ fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &A
 
 /// Writes the per-event table as CSV.
 pub fn write_events_csv(events: &[EventRecord], w: &mut dyn Write) -> std::io::Result<()> {
-    writeln!(w, "{}", super::latency::COLUMNS.join(","))?;
-    for r in event_rows(events) {
-        let cells: Vec<String> = r
-            .iter()
-            .map(|v| if v.is_nan() { String::new() } else { format!("{v}") })
-            .collect();
-        writeln!(w, "{}", cells.join(","))?;
-    }
-    Ok(())
+    use crate::output::table::{number, write_table};
+    let rows = event_rows(events)
+        .into_iter()
+        .map(|r| r.iter().map(|&v| number(v)).collect());
+    write_table(std::io::BufWriter::new(w), &super::latency::COLUMNS, rows)
 }
 
 /// Writes a Chrome/Perfetto trace: one track per client and one for the

@@ -514,15 +514,11 @@ pub fn region_rows(run: &PixelFlowRun) -> Vec<Vec<f64>> {
 
 /// Writes the per-region table as CSV.
 pub fn write_regions_csv(run: &PixelFlowRun, w: &mut dyn std::io::Write) -> std::io::Result<()> {
-    writeln!(w, "{}", COLUMNS.join(","))?;
-    for row in region_rows(run) {
-        let cells: Vec<String> = row
-            .iter()
-            .map(|v| if v.is_nan() { String::new() } else { format!("{v}") })
-            .collect();
-        writeln!(w, "{}", cells.join(","))?;
-    }
-    Ok(())
+    use crate::output::table::{number, write_table};
+    let rows = region_rows(run)
+        .into_iter()
+        .map(|r| r.iter().map(|&v| number(v)).collect());
+    write_table(std::io::BufWriter::new(w), &COLUMNS, rows)
 }
 
 /// Writes a Chrome/Perfetto trace: one process per node role, one thread

@@ -397,15 +397,11 @@ pub fn motion_rows(motions: &[MotionRecord]) -> Vec<Vec<f64>> {
 
 /// Writes the per-motion table as CSV.
 pub fn write_motions_csv(motions: &[MotionRecord], w: &mut dyn Write) -> std::io::Result<()> {
-    writeln!(w, "{}", COLUMNS.join(","))?;
-    for r in motion_rows(motions) {
-        let cells: Vec<String> = r
-            .iter()
-            .map(|v| if v.is_nan() { String::new() } else { format!("{v}") })
-            .collect();
-        writeln!(w, "{}", cells.join(","))?;
-    }
-    Ok(())
+    use crate::output::table::{number, write_table};
+    let rows = motion_rows(motions)
+        .into_iter()
+        .map(|r| r.iter().map(|&v| number(v)).collect());
+    write_table(std::io::BufWriter::new(w), &COLUMNS, rows)
 }
 
 /// Writes a Perfetto trace: a track per stage (simulation, renderer, warping
