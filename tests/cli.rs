@@ -1133,3 +1133,44 @@ fn a_search_value_is_blamed_on_the_search() {
         "{err}"
     );
 }
+
+#[test]
+fn every_system_near_the_end_of_the_clock_gives_a_clear_error_not_a_wrap() {
+    // 2^64 - 1 picoseconds: any sum or product with it overflows u64; each
+    // system must say so (or refuse the run's size), never wrap silently.
+    let max = "\"18446744073709551615ps\"";
+    for (model, key, extra) in [
+        ("one-mesh.toml", "gpu.geometry.vertex_shader", "run.warmup_frames=0"),
+        ("one-mesh.toml", "gpu.fragment.per_fragment", "run.warmup_frames=0"),
+        ("fixed.toml", "workload.gpu", "run.max_events=100"),
+        ("fixed.toml", "cpu.swap", "run.warmup_frames=0"),
+        ("mfr-cluster.toml", "tracker.latency", "run.events=20"),
+        ("mfr-cluster.toml", "slow_client.render", "run.events=20"),
+        ("vr-warp.toml", "tracker.latency", "run.events=20"),
+        ("vr-naive.toml", "renderer.render", "run.events=20"),
+        ("pixelflow-20.toml", "deferred.t_load", "primitives=1000"),
+    ] {
+        let e = run_err(&[
+            "run",
+            &model_path(model),
+            "--set",
+            &format!("{key}={max}"),
+            "--set",
+            extra,
+        ]);
+        assert!(
+            ["213 days", "overflow", "run.max_memory", "picosecond range"]
+                .iter()
+                .any(|w| e.contains(w)),
+            "{model} {key}: {e}"
+        );
+    }
+}
+
+fn model_path(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("models")
+        .join(name)
+        .display()
+        .to_string()
+}

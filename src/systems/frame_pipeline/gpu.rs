@@ -237,8 +237,20 @@ impl FramePipeline {
         let mesh = &sc.meshes[sc.draws[a.draw as usize].mesh as usize];
         let geo = &self.cfg.gpu.geometry;
         let tv = mesh.misses.of(a.next, a.triangles);
-        let fetch = if mesh.indices > 0 { 3 * geo.index_fetch.0 } else { 0 };
-        let g = Duration(fetch + tv * geo.vertex_shader.0 + geo.triangle_setup.0);
+        let fetch = if mesh.indices > 0 {
+            geo.index_fetch.checked_mul(3)
+        } else {
+            Some(Duration(0))
+        };
+        // Checked: a huge per-vertex cost times the vertices must not wrap.
+        let g = fetch
+            .and_then(|f| f.checked_add(geo.triangle_setup))
+            .and_then(|f| geo.vertex_shader.checked_mul(tv).and_then(|v| v.checked_add(f)))
+            .ok_or_else(|| crate::engine::TimeError::Overflow {
+                context: "computing the geometry time of a triangle (gpu.geometry costs)".into(),
+                at: now,
+                by: Duration(u64::MAX),
+            })?;
         self.geom_busy = true;
         s.at(now.add(g, "geometry of a triangle")?, Ev::GeomTriangle);
         Ok(())

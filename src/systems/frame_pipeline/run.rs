@@ -445,8 +445,9 @@ fn check_time_range(cfg: &FramePipelineConfig, analytic: &Value) -> Result<(), P
 /// their sum, the time with no overlap at all (§4.5.1's "sum" estimate).
 fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProgram>) -> Value {
     let c = &cfg.cpu;
-    let base_cpu = (c.input_sampling.0 + c.clear.0 + c.swap.0) as f64 + c.non_render.mean();
-    let base_front = (cfg.gpu.clear.0 + cfg.gpu.swap.0 + 2 * cfg.gpu.command.0) as f64;
+    // In f64: sums of huge costs must not wrap before the range check.
+    let base_cpu = c.input_sampling.0 as f64 + c.clear.0 as f64 + c.swap.0 as f64 + c.non_render.mean();
+    let base_front = cfg.gpu.clear.0 as f64 + cfg.gpu.swap.0 as f64 + 2.0 * cfg.gpu.command.0 as f64;
     let (cpu, front, geo, frag) = match (&cfg.workload, scene) {
         (WorkloadConfig::Fixed(f), _) => (
             base_cpu + f.cpu.mean(),

@@ -86,12 +86,12 @@ impl Terms {
 
     /// SC frame time `R_sc + T_read`.
     pub fn sc_frame(&self) -> Duration {
-        Duration(self.sc_render.0 + self.sc_readback.0)
+        Duration(self.sc_render.0.saturating_add(self.sc_readback.0))
     }
 
     /// FC frame time `T_draw + T_render`.
     pub fn fc_frame(&self) -> Duration {
-        Duration(self.fc_upload.0 + self.fc_render.0)
+        Duration(self.fc_upload.0.saturating_add(self.fc_render.0))
     }
 }
 

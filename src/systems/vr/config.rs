@@ -203,7 +203,11 @@ impl VrConfig {
     /// Time between swap opportunities (one stereo pair, or one field in mono).
     pub fn pair(&self) -> Duration {
         let f = self.display.field_rate.period;
-        if self.display.stereo { Duration(2 * f.0) } else { f }
+        if self.display.stereo {
+            Duration(f.0.saturating_mul(2))
+        } else {
+            f
+        }
     }
 
     /// Swap to visible.

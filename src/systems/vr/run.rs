@@ -147,15 +147,15 @@ pub fn estimate_memory(cfg: &VrConfig) -> (u64, String) {
     // After the last motion the run goes on until it is shown: the tracker's
     // delay, a few loop periods and the display.
     let tail = [
-        cfg.tracker.period.0,
-        cfg.tracker.latency.0,
-        3 * cfg.simulation.step.0,
-        3 * cfg.renderer.render.0,
-        3 * cfg.pair().0,
-        2 * cfg.display_latency().0,
+        (1.0, cfg.tracker.period.0),
+        (1.0, cfg.tracker.latency.0),
+        (3.0, cfg.simulation.step.0),
+        (3.0, cfg.renderer.render.0),
+        (3.0, cfg.pair().0),
+        (2.0, cfg.display_latency().0),
     ]
     .iter()
-    .map(|&x| x as f64)
+    .map(|&(k, x)| k * x as f64)
     .sum::<f64>();
     let span = cfg.run.warmup.0 as f64 + cfg.run.events as f64 * cfg.input.mean_interval.0 as f64 + tail;
     let frames = |interval: u64| -> u64 { (span / interval.max(1) as f64).min(u64::MAX as f64) as u64 + 1 };
@@ -202,7 +202,8 @@ pub fn follow(m: &Vr) -> Vec<MotionRecord> {
     for &t in &m.inputs {
         let j = m.capturing_sample(t);
         let sampled = m.sample_time(j);
-        let delivered = Time(sampled.0 + l);
+        // The simulation scheduled this delivery with checked time, so it fits.
+        let delivered = Time(sampled.0.saturating_add(l));
         let rec = match m.cfg.scheme {
             Scheme::Naive => {
                 let frames = &m.frames[..m.swapped];
