@@ -185,6 +185,54 @@ pub const KERNEL_CASES: [(KernelWork, usize); 5] = [
     (KernelWork::Stiff, 1_000_000),
 ];
 
+/// The kernel's scaling: hold and stiff at 1e3, 1e4, 1e5 and 1e6 pending
+/// (what `rendersim bench kernel --plot` draws).
+pub fn kernel_scaling(scale: f64) -> Vec<KernelBench> {
+    let mut out = Vec::new();
+    for work in [KernelWork::Hold, KernelWork::Stiff] {
+        for pop in [1_000usize, 10_000, 100_000, 1_000_000] {
+            let events = ((4_000_000.0 * scale) as u64).max(2 * pop as u64);
+            out.push(kernel_case(work, pop, events));
+        }
+    }
+    out
+}
+
+/// Draws ns per event against the number pending (log axes): the engine
+/// (radix heap), the engine on its binary heap and the bare `BinaryHeap`
+/// loop, for hold and stiff. `path` names the PNG; an SVG is written beside.
+pub fn plot_kernel(cases: &[KernelBench], path: &std::path::Path) -> Result<(), crate::plot::PlotError> {
+    use crate::plot::{LinePlot, Series, line_plot};
+    let mut series = Vec::new();
+    for work in [KernelWork::Hold, KernelWork::Stiff] {
+        let of = |rate: fn(&KernelBench) -> f64, name: &str| Series {
+            name: format!("{name}, {}", work.name()),
+            points: cases
+                .iter()
+                .filter(|c| c.work == work)
+                .map(|c| (c.population as f64, 1e9 / rate(c)))
+                .collect(),
+            ci: None,
+        };
+        series.push(of(|c| c.engine_events_per_s, "engine (radix heap)"));
+        series.push(of(|c| c.engine_binary_events_per_s, "engine (binary heap)"));
+        series.push(of(|c| c.bare_events_per_s, "bare BinaryHeap loop"));
+    }
+    let base = path.with_extension("");
+    line_plot(
+        &base,
+        &LinePlot {
+            title: "Event kernel: cost per event against events pending".into(),
+            x_label: "events pending (log)".into(),
+            y_label: "ns per event (log)".into(),
+            series,
+            log_x: true,
+            log_y: true,
+            x_categories: Vec::new(),
+        },
+    )
+}
+
 fn run_default_with(sets: &[&str]) -> Result<(serde_json::Value, f64), String> {
     let src = ModelSource::from_text("<embedded default model>", DEFAULT_MODEL);
     let mut t = src.table().map_err(|e| e.to_string())?;
@@ -381,6 +429,39 @@ pub fn run_cli(which: &str, scale: f64) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_kernel_plot_draws_every_case() {
+        let cases: Vec<KernelBench> = [KernelWork::Hold, KernelWork::Stiff]
+            .into_iter()
+            .flat_map(|work| {
+                [1_000usize, 1_000_000].into_iter().map(move |p| KernelBench {
+                    work,
+                    population: p,
+                    events: 2 * p as u64,
+                    engine_events_per_s: 2e7,
+                    engine_binary_events_per_s: 1e7 / (p as f64).log10(),
+                    bare_events_per_s: 1e7 / (p as f64).log10(),
+                    ratio: 2.0,
+                })
+            })
+            .collect();
+        let d = tempfile::tempdir().unwrap();
+        plot_kernel(&cases, &d.path().join("kernel.png")).unwrap();
+        for ext in ["png", "svg"] {
+            let bytes = std::fs::read(d.path().join(format!("kernel.{ext}"))).unwrap();
+            assert!(bytes.len() > 1000, "{ext}");
+        }
+    }
+
+    #[test]
+    fn a_kernel_case_handles_the_events_asked_for_and_measures_all_three() {
+        let k = kernel_case(KernelWork::Stiff, 100, 1_000);
+        assert_eq!((k.population, k.events), (100, 1_000));
+        for r in [k.engine_events_per_s, k.engine_binary_events_per_s, k.bare_events_per_s] {
+            assert!(r.is_finite() && r > 0.0);
+        }
+    }
 
     #[test]
     fn pixelflow_target_scales_with_the_primitive_counts() {

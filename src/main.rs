@@ -148,6 +148,11 @@ enum Cmd {
         /// Scale the work down (0.01 .. 1) for a quick check.
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
+        /// With `kernel`: also draw ns per event against the number pending
+        /// (1e3 .. 1e6, log axes) for the engine and the bare heap, hold and
+        /// stiff, into FILE (.png; an .svg beside it).
+        #[arg(long, value_name = "FILE")]
+        plot: Option<PathBuf>,
     },
 }
 
@@ -263,7 +268,18 @@ fn dispatch(cli: Cli) -> Result<()> {
             markdown,
             json,
         } => cmd_study(&name, repeats, markdown, json),
-        Cmd::Bench { which, scale } => rendersim::bench::run_cli(&which, scale).map_err(anyhow::Error::msg),
+        Cmd::Bench { which, scale, plot } => {
+            if plot.is_some() && which != "kernel" {
+                bail!("--plot draws the kernel benchmark: use `rendersim bench kernel --plot FILE.png`");
+            }
+            rendersim::bench::run_cli(&which, scale).map_err(anyhow::Error::msg)?;
+            if let Some(path) = plot {
+                let cases = rendersim::bench::kernel_scaling(scale);
+                rendersim::bench::plot_kernel(&cases, &path)?;
+                println!("kernel scaling plot: {}", path.display());
+            }
+            Ok(())
+        }
     }
 }
 
