@@ -125,6 +125,17 @@ impl<E> RadixHeap<E> {
             if self.levels == 0 {
                 return None;
             }
+            // The earliest bucket holds a single event (the common case when
+            // few are pending): it is the next one, no need to spread it.
+            let (l, v) = self.first_bucket()?;
+            let b = &mut self.buckets[l * DIGITS + v];
+            if b.len() == 1 {
+                let s = b.pop()?;
+                self.clear_bucket(l, v);
+                self.last = s.time.0;
+                self.len -= 1;
+                return Some(s);
+            }
             self.refill();
         }
         self.len -= 1;
@@ -143,6 +154,15 @@ impl<E> RadixHeap<E> {
         Some((l, w * 64 + words[w].trailing_zeros() as usize))
     }
 
+    /// Marks bucket (l, v) empty in the masks.
+    #[inline]
+    fn clear_bucket(&mut self, l: usize, v: usize) {
+        self.digits[l][v / 64] &= !(1 << (v % 64));
+        if self.digits[l].iter().all(|&w| w == 0) {
+            self.levels &= !(1 << l);
+        }
+    }
+
     /// Moves the earliest bucket to "now" (level 0: one time) or spreads it
     /// around its minimum, which becomes the new `last`.
     fn refill(&mut self) {
@@ -150,10 +170,7 @@ impl<E> RadixHeap<E> {
             return;
         };
         let mut moving = std::mem::take(&mut self.buckets[l * DIGITS + v]);
-        self.digits[l][v / 64] &= !(1 << (v % 64));
-        if self.digits[l].iter().all(|&w| w == 0) {
-            self.levels &= !(1 << l);
-        }
+        self.clear_bucket(l, v);
         if l == 0 {
             self.last = (self.last & !0xff) | v as u64;
             self.now.extend(moving.drain(..));
