@@ -44,7 +44,7 @@ cargo test --release --locked --no-fail-fast --features wgpu -- --skip every_inp
 grep -q "test result:" "$ci_out/test-output.txt"
 
 step "Fuzz: 2,000 seeded cases of mutated models, --set values, meshes and experiments, plus the regression cases"
-cargo test --release --locked --features wgpu --test fuzz -- --nocapture
+cargo test --release --locked --features wgpu --test it fuzz:: -- --nocapture
 
 step "Examples (each asserts what it shows)"
 for ex in examples/*.rs; do

@@ -8,7 +8,7 @@
 //! each experiment's `runs.csv` and `points.csv` without their wall-time
 //! columns (`wall_seconds*`, `speedup`), and its `searches.csv` if any. A file of at most 16 KiB is stored
 //! whole (so a failure shows a diff); a larger one as its length and FNV-1a
-//! hash (`NAME.fnv`). `RENDERSIM_BLESS=1 cargo test --test golden` rewrites
+//! hash (`NAME.fnv`). `RENDERSIM_BLESS=1 cargo test --release --test it golden::` rewrites
 //! the stored outputs after an intended change: say why in the commit.
 
 use std::path::{Path, PathBuf};

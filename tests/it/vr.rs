@@ -6,8 +6,8 @@ use rendersim::config::{ModelSource, apply_set};
 use rendersim::systems::{SystemRun, run_model};
 use serde_json::Value;
 
-const NAIVE: &str = include_str!("../models/vr-naive.toml");
-const WARP: &str = include_str!("../models/vr-warp.toml");
+const NAIVE: &str = include_str!("../../models/vr-naive.toml");
+const WARP: &str = include_str!("../../models/vr-warp.toml");
 
 fn try_run(text: &str, sets: &[&str]) -> Result<SystemRun, String> {
     let src = ModelSource::from_text("test.toml", text);
@@ -231,7 +231,7 @@ fn stage_names_share_the_multi_frame_rate_vocabulary() {
 }
 
 fn summary_mfr() -> Value {
-    let src = ModelSource::from_text("mfr-cluster.toml", include_str!("../models/mfr-cluster.toml"));
+    let src = ModelSource::from_text("mfr-cluster.toml", include_str!("../../models/mfr-cluster.toml"));
     let mut t = src.table().unwrap();
     apply_set(&mut t, "run.events=100").unwrap();
     run_model(&src, &t, None).unwrap().summary().clone()

@@ -8,8 +8,8 @@ use rendersim::config::{ModelSource, apply_set};
 use rendersim::systems::{SystemRun, run_model};
 use serde_json::Value;
 
-const CLUSTER: &str = include_str!("../models/mfr-cluster.toml");
-const MULTIGPU: &str = include_str!("../models/mfr-multigpu.toml");
+const CLUSTER: &str = include_str!("../../models/mfr-cluster.toml");
+const MULTIGPU: &str = include_str!("../../models/mfr-multigpu.toml");
 
 fn try_run(text: &str, sets: &[&str]) -> Result<SystemRun, String> {
     let src = ModelSource::from_text("test.toml", text);
@@ -443,7 +443,7 @@ fn deferred_shading_moves_bytes_and_shading_to_the_fast_client() {
     assert!(try_run(CLUSTER, &["deferred.enabled=true", "deferred.normal_bits=50"]).is_err());
 }
 
-const MIGRATION: &str = include_str!("../models/mfr-migration.toml");
+const MIGRATION: &str = include_str!("../../models/mfr-migration.toml");
 
 #[test]
 fn bookkeeping_removes_the_release_artifact_and_over_prediction_the_selection_artifact() {

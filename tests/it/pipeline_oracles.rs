@@ -3,7 +3,7 @@
 //! draw-fidelity closed form against the triangle simulation, early-z draw
 //! orders, and "build only what a scene uses".
 
-mod common;
+use crate::common;
 use common::{DEFAULT, FIXED, metric, run, scene_model};
 use rendersim::systems::frame_pipeline::records::write_frames_csv;
 

@@ -1,6 +1,6 @@
 //! Same seed, same bytes; another seed, other noise.
 
-mod common;
+use crate::common;
 use common::{DEFAULT, run};
 use rendersim::systems::frame_pipeline::records::write_frames_csv;
 

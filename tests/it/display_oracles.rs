@@ -1,7 +1,7 @@
 //! Display and latency oracles: vsync quantization with double and triple
 //! buffering (paper 004 §4.2), mailbox, immediate, and render-ahead latency.
 
-mod common;
+use crate::common;
 use common::{FIXED, metric, run};
 
 const REFRESH_MS: f64 = 1000.0 / 60.0;

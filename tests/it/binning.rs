@@ -3,7 +3,7 @@
 //! to drain, so the GPU time is exactly the sum of the stage terms (what study
 //! H2 measures on Mesa's llvmpipe), at both fidelities.
 
-mod common;
+use crate::common;
 use common::{metric, run, scene_model};
 
 fn model(count: u32, binning: &str, depth: u32) -> String {

@@ -2,7 +2,7 @@
 //! empty scene, a 10^8-triangle object, one- and zero-slot FIFOs, zero-cost
 //! stages, time overflow. Nothing panics; no NaN reaches the output.
 
-mod common;
+use crate::common;
 use common::{FIXED, null_paths, run, scene_model, try_run};
 
 fn no_nulls(r: &rendersim::systems::frame_pipeline::PipelineRun) {

@@ -4,7 +4,7 @@
 //! timeline is ordered, every frame ends displayed or dropped, and no output
 //! is NaN.
 
-mod common;
+use crate::common;
 use common::{null_paths, try_run};
 use proptest::prelude::*;
 

@@ -1,0 +1,23 @@
+//! rendersim's integration tests, in one binary (fewer binaries to link on
+//! a 2-core machine, as ripgrep and NeXosim do). Each module is one topic;
+//! `common` holds the helpers several share. Run one topic with
+//! `cargo test --test it <module>::`.
+
+mod architecture;
+mod binning;
+mod cli;
+mod common;
+mod conservation;
+mod determinism;
+mod display_oracles;
+mod extreme;
+mod fuzz;
+mod golden;
+mod lavapipe_policy;
+mod measure;
+mod meshopt_crosscheck;
+mod multi_rate;
+mod outputs;
+mod pipeline_oracles;
+mod pixelflow;
+mod vr;
