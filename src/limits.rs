@@ -131,3 +131,32 @@ pub fn input_span_message(events: u64, warmup_ps: u64, mean_interval_ps: u64) ->
 
 /// The keys [`input_span_message`] blames.
 pub const INPUT_SPAN_KEYS: &str = "input.mean_interval|run.events|run.warmup";
+
+/// Records expected over a simulated span of `span_ps` picoseconds for a loop
+/// with period `interval_ps` (at least one).
+pub fn records_over(span_ps: f64, interval_ps: u64) -> u64 {
+    (span_ps / interval_ps.max(1) as f64).min(u64::MAX as f64) as u64 + 1
+}
+
+/// The memory estimate of a latency system (multi_rate, vr): `frame_bytes`
+/// of frame records over `span_ps` of simulated time, plus `events` input
+/// records of `per_event` bytes. `noun` names the inputs ("input events"),
+/// `until_shown` what runs after the last one, `frames` the frame records.
+pub fn latency_estimate(
+    frame_bytes: u64,
+    events: u64,
+    per_event: usize,
+    noun: &str,
+    span_ps: f64,
+    until_shown: &str,
+    frames: &str,
+) -> (u64, String) {
+    let mut event_bytes = 0u64;
+    add_bytes(&mut event_bytes, events, per_event);
+    let parts = format!(
+        "{events} {noun} = {}; over an expected {:.3e} s simulated (run.warmup + run.events x input.mean_interval + tracker.latency and {until_shown} until the last is shown): {frames}",
+        show_bytes(event_bytes),
+        span_ps / 1e12
+    );
+    (frame_bytes.saturating_add(event_bytes), parts)
+}

@@ -187,7 +187,19 @@ fn scaled(v: &toml::Value, f: f64) -> Option<String> {
     }
 }
 
-fn model_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
+/// A base model drawn at random, its text and table, and one of its leaf
+/// keys with its value.
+#[allow(clippy::type_complexity)]
+fn pick_base(
+    rng: &mut Xoshiro256PlusPlus,
+) -> (
+    &'static str,
+    Vec<&'static str>,
+    String,
+    toml::Value,
+    String,
+    toml::Value,
+) {
     let all = bases();
     let (file, bounds) = all.choose(rng).unwrap().clone();
     let text = std::fs::read_to_string(Path::new(ROOT).join(file)).unwrap();
@@ -195,6 +207,11 @@ fn model_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
     let mut keys = Vec::new();
     leaves("", &table, &mut keys);
     let (key, old) = keys.choose(rng).unwrap().clone();
+    (file, bounds, text, table, key, old)
+}
+
+fn model_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
+    let (file, bounds, text, table, key, old) = pick_base(rng);
     let value = match rng.random_range(0..10) {
         0..=5 => NASTY.choose(rng).unwrap().to_string(),
         _ => {
@@ -332,13 +349,7 @@ fn mesh_case(rng: &mut Xoshiro256PlusPlus) -> Case {
 }
 
 fn experiment_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
-    let all = bases();
-    let (file, bounds) = all.choose(rng).unwrap().clone();
-    let text = std::fs::read_to_string(Path::new(ROOT).join(file)).unwrap();
-    let table: toml::Value = toml::from_str(&text).unwrap();
-    let mut keys = Vec::new();
-    leaves("", &table, &mut keys);
-    let (key, old) = keys.choose(rng).unwrap().clone();
+    let (file, bounds, _, _, key, old) = pick_base(rng);
     let pick = |rng: &mut Xoshiro256PlusPlus| -> String {
         if rng.random_bool(0.5) {
             NASTY.choose(rng).unwrap().to_string()

@@ -22,6 +22,19 @@ fn model(dir: &Path) -> String {
     p.display().to_string()
 }
 
+/// `rendersim experiment FILE --quiet --out DIR`.
+fn experiment(file: &Path, out: &Path) -> Command {
+    let mut c = bin();
+    c.args([
+        "experiment",
+        file.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    c
+}
+
 fn ok(cmd: &mut Command) -> String {
     let o = cmd.output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
@@ -185,13 +198,7 @@ fn out_refuses_a_folder_holding_other_files_before_simulating() {
         "name = \"e\"\nmodel = \"m.toml\"\n[[metric]]\npath = \"frames\"\n",
     )
     .unwrap();
-    let e = err(bin().args([
-        "experiment",
-        exp.to_str().unwrap(),
-        "--quiet",
-        "--out",
-        mine.to_str().unwrap(),
-    ]));
+    let e = err(&mut experiment(&exp, &mine));
     assert!(e.contains("chapter1.tex"), "{e}");
 }
 
@@ -289,25 +296,12 @@ fn a_kill_during_an_experiment_leaves_the_old_set() {
     };
     let out = d.path().join("out");
     write_exp(2);
-    ok(bin().args([
-        "experiment",
-        exp.to_str().unwrap(),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]));
+    ok(&mut experiment(&exp, &out));
     let old = snapshot(&out);
     assert!(old.iter().any(|(n, _)| n == "runs.csv"));
 
     write_exp(400);
-    let mut child = bin()
-        .args([
-            "experiment",
-            exp.to_str().unwrap(),
-            "--quiet",
-            "--out",
-            out.to_str().unwrap(),
-        ])
+    let mut child = experiment(&exp, &out)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
@@ -348,13 +342,7 @@ fn a_failed_experiment_keeps_the_old_set_and_puts_finished_runs_beside_it() {
          [[metric]]\npath = \"metrics.frame_time_ms.mean\"\n",
     )
     .unwrap();
-    ok(bin().args([
-        "experiment",
-        exp.to_str().unwrap(),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]));
+    ok(&mut experiment(&exp, &out));
     let old = snapshot(&out);
     // The second point now fails when it runs (a metric it does not have).
     std::fs::write(
@@ -363,13 +351,7 @@ fn a_failed_experiment_keeps_the_old_set_and_puts_finished_runs_beside_it() {
          [[metric]]\npath = \"metrics.no_such_metric\"\n",
     )
     .unwrap();
-    let e = err(bin().args([
-        "experiment",
-        exp.to_str().unwrap(),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]));
+    let e = err(&mut experiment(&exp, &out));
     assert!(e.contains("unchanged"), "{e}");
     assert_eq!(snapshot(&out), old);
     assert!(leftovers(d.path(), "out").is_empty());

@@ -152,7 +152,7 @@ const BYTES_PER_EVENT: usize = std::mem::size_of::<Time>() + std::mem::size_of::
 /// the migration script) times each client's frame rate, plus the input
 /// events' records. Returns the bytes and a description.
 pub fn estimate_memory(cfg: &MultiRateConfig) -> (u64, String) {
-    use crate::limits::{add_bytes, show_bytes};
+    use crate::limits::add_bytes;
     use std::mem::size_of;
     let t = Terms::of(cfg);
     let last = cfg.migration.script.iter().map(|s| s.at.0).max().unwrap_or(0) as f64;
@@ -163,9 +163,7 @@ pub fn estimate_memory(cfg: &MultiRateConfig) -> (u64, String) {
         + 3.0 * (t.sc_interval().0 as f64 + t.fc_interval().0 as f64 + t.conventional_frame.0 as f64)
         + cfg.display.latency.0 as f64;
     let span = cfg.run.warmup.0 as f64 + cfg.run.events as f64 * cfg.input.mean_interval.0 as f64 + last + tail + 1e12;
-    let frames = |interval: crate::engine::Duration| -> u64 {
-        (span / interval.0.max(1) as f64).min(u64::MAX as f64) as u64 + 1
-    };
+    let frames = |interval: crate::engine::Duration| crate::limits::records_over(span, interval.0);
     let (sc, fc) = (frames(t.sc_interval()), frames(t.fc_interval()));
     let conv = if cfg.conventional.enabled {
         frames(t.conventional_frame)
@@ -176,16 +174,15 @@ pub fn estimate_memory(cfg: &MultiRateConfig) -> (u64, String) {
     add_bytes(&mut total, sc, size_of::<super::model::ScFrame>());
     add_bytes(&mut total, fc, size_of::<super::model::FcFrame>());
     add_bytes(&mut total, conv, size_of::<super::model::ConvFrame>());
-    let mut events = 0u64;
-    add_bytes(&mut events, cfg.run.events, BYTES_PER_EVENT);
-    let total = total.saturating_add(events);
-    let parts = format!(
-        "{} input events = {}; over an expected {:.3e} s simulated (run.warmup + run.events x input.mean_interval + tracker.latency and the clients' frames until the last is shown): {sc} SC, {fc} FC and {conv} conventional frames",
+    crate::limits::latency_estimate(
+        total,
         cfg.run.events,
-        show_bytes(events),
-        span / 1e12
-    );
-    (total, parts)
+        BYTES_PER_EVENT,
+        "input events",
+        span,
+        "the clients' frames",
+        &format!("{sc} SC, {fc} FC and {conv} conventional frames"),
+    )
 }
 
 /// Validates, runs and summarizes a model.

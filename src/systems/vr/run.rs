@@ -142,7 +142,7 @@ const BYTES_PER_EVENT: usize = std::mem::size_of::<Time>() + std::mem::size_of::
 /// `input.mean_interval`) over each loop's period, plus the motions'
 /// records. Returns the bytes and a description.
 pub fn estimate_memory(cfg: &VrConfig) -> (u64, String) {
-    use crate::limits::{add_bytes, show_bytes};
+    use crate::limits::add_bytes;
     use std::mem::size_of;
     // After the last motion the run goes on until it is shown: the tracker's
     // delay, a few loop periods and the display.
@@ -158,7 +158,7 @@ pub fn estimate_memory(cfg: &VrConfig) -> (u64, String) {
     .map(|&(k, x)| k * x as f64)
     .sum::<f64>();
     let span = cfg.run.warmup.0 as f64 + cfg.run.events as f64 * cfg.input.mean_interval.0 as f64 + tail;
-    let frames = |interval: u64| -> u64 { (span / interval.max(1) as f64).min(u64::MAX as f64) as u64 + 1 };
+    let frames = |interval: u64| crate::limits::records_over(span, interval);
     let (step, render) = (cfg.simulation.step.0, cfg.renderer.render.0);
     let mut total = 0u64;
     let desc = match cfg.scheme {
@@ -175,16 +175,15 @@ pub fn estimate_memory(cfg: &VrConfig) -> (u64, String) {
             format!("{sims} simulation steps, {apps} application and {warps} warped frames")
         }
     };
-    let mut events = 0u64;
-    add_bytes(&mut events, cfg.run.events, BYTES_PER_EVENT);
-    let total = total.saturating_add(events);
-    let parts = format!(
-        "{} motion events = {}; over an expected {:.3e} s simulated (run.warmup + run.events x input.mean_interval + tracker.latency and the loops until the last is shown): {desc}",
+    crate::limits::latency_estimate(
+        total,
         cfg.run.events,
-        show_bytes(events),
-        span / 1e12
-    );
-    (total, parts)
+        BYTES_PER_EVENT,
+        "motion events",
+        span,
+        "the loops",
+        &desc,
+    )
 }
 
 fn gaps(points: &[Time], display: u64) -> Vec<u64> {
