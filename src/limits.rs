@@ -95,22 +95,6 @@ pub fn add_bytes(total: &mut u64, count: u64, size: usize) {
     *total = total.saturating_add(count.saturating_mul(size as u64));
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn byte_counts_read_well() {
-        assert_eq!(show_bytes(DEFAULT_MAX_MEMORY), "8 GiB");
-        assert_eq!(show_bytes(1536 << 20), "1.5 GiB");
-        assert_eq!(show_bytes(100), "100 bytes");
-        let m = over_memory_message(9 << 30, "frames", DEFAULT_MAX_MEMORY);
-        assert!(
-            m.contains("9 GiB") && m.contains("run.max_memory = 8 GiB") && m.contains("16GiB"),
-            "{m}"
-        );
-    }
-}
 
 /// The message refusing, before simulating, a latency-system run whose input
 /// events alone (`run.events` arrivals `input.mean_interval` apart on
@@ -132,31 +116,84 @@ pub fn input_span_message(events: u64, warmup_ps: u64, mean_interval_ps: u64) ->
 /// The keys [`input_span_message`] blames.
 pub const INPUT_SPAN_KEYS: &str = "input.mean_interval|run.events|run.warmup";
 
-/// Records expected over a simulated span of `span_ps` picoseconds for a loop
-/// with period `interval_ps` (at least one).
-pub fn records_over(span_ps: f64, interval_ps: u64) -> u64 {
-    (span_ps / interval_ps.max(1) as f64).min(u64::MAX as f64) as u64 + 1
+/// The memory estimate of a latency system (multi_rate, vr): `events` input
+/// records of `per_event` bytes (`noun` names them, "input events"). Their
+/// frames are not kept, so the simulated span does not count. Returns the
+/// bytes and a description.
+pub fn latency_estimate(events: u64, per_event: usize, noun: &str) -> (u64, String) {
+    let mut bytes = 0u64;
+    add_bytes(&mut bytes, events, per_event);
+    (
+        bytes,
+        format!(
+            "{events} {noun} = {} of records (run.events; frames are folded into the events they show as they end and not kept)",
+            show_bytes(bytes)
+        ),
+    )
 }
 
-/// The memory estimate of a latency system (multi_rate, vr): `frame_bytes`
-/// of frame records over `span_ps` of simulated time, plus `events` input
-/// records of `per_event` bytes. `noun` names the inputs ("input events"),
-/// `until_shown` what runs after the last one, `frames` the frame records.
-pub fn latency_estimate(
-    frame_bytes: u64,
-    events: u64,
-    per_event: usize,
-    noun: &str,
-    span_ps: f64,
-    until_shown: &str,
-    frames: &str,
-) -> (u64, String) {
-    let mut event_bytes = 0u64;
-    add_bytes(&mut event_bytes, events, per_event);
-    let parts = format!(
-        "{events} {noun} = {}; over an expected {:.3e} s simulated (run.warmup + run.events x input.mean_interval + tracker.latency and {until_shown} until the last is shown): {frames}",
-        show_bytes(event_bytes),
-        span_ps / 1e12
-    );
-    (frame_bytes.saturating_add(event_bytes), parts)
+/// Refuses, before simulating, a run whose expected simulated span reaches
+/// past the clock's range (`u64` picoseconds, about 213 days). `terms` are
+/// the span's parts, each with the key it comes from and its picoseconds
+/// (multiplicities applied): for a latency system the warm-up, the input
+/// events, and what follows the last input until every path has shown it (a
+/// tracker period and its latency, two frame intervals of each loop, the
+/// links and the display). Returns the key of the largest part and the
+/// message, or `None` when the span fits. Such a run would otherwise
+/// simulate up to the overflow before it failed, which can take minutes.
+pub fn span_check(terms: &[(&str, f64)]) -> Option<(String, String)> {
+    let total: f64 = terms.iter().map(|t| t.1).sum();
+    if total < u64::MAX as f64 {
+        return None;
+    }
+    // One part per key (a key may feed two loops).
+    let mut parts: Vec<(&str, f64)> = Vec::new();
+    for &(k, ps) in terms.iter().filter(|t| t.1 > 0.0) {
+        match parts.iter_mut().find(|p| p.0 == k) {
+            Some(p) => p.1 += ps,
+            None => parts.push((k, ps)),
+        }
+    }
+    parts.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let list = parts
+        .iter()
+        .take(3)
+        .map(|(k, ps)| format!("{k}: {:.3e} s", ps / 1e12))
+        .collect::<Vec<_>>()
+        .join(", ");
+    Some((
+        parts[0].0.to_string(),
+        format!(
+            "the run needs about {:.3e} s of simulated time until every input is shown (largest parts: {list}), \
+             more than the clock can count (about 213 days in picoseconds)",
+            total / 1e12
+        ),
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn byte_counts_read_well() {
+        assert_eq!(show_bytes(DEFAULT_MAX_MEMORY), "8 GiB");
+        assert_eq!(show_bytes(1536 << 20), "1.5 GiB");
+        assert_eq!(show_bytes(100), "100 bytes");
+        let m = over_memory_message(9 << 30, "frames", DEFAULT_MAX_MEMORY);
+        assert!(
+            m.contains("9 GiB") && m.contains("run.max_memory = 8 GiB") && m.contains("16GiB"),
+            "{m}"
+        );
+    }
+
+    #[test]
+    fn a_span_past_the_clock_blames_its_largest_part() {
+        let day = 86_400e12;
+        assert_eq!(span_check(&[("a", 100.0 * day), ("b", 100.0 * day)]), None);
+        let (key, m) = span_check(&[("a", 100.0 * day), ("b", 60.0 * day), ("b", 60.0 * day)]).unwrap();
+        // b feeds two loops: its parts add up before the largest is chosen.
+        assert_eq!(key, "b");
+        assert!(m.contains("b: 1.037e7 s") && m.contains("213 days"), "{m}");
+    }
 }

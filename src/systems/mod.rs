@@ -147,14 +147,8 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWrit
         }
         "multi_rate" => {
             let cfg: multi_rate::MultiRateConfig = deserialize(table, src)?;
-            match multi_rate::run_multi_rate(cfg) {
-                Ok(mut r) => {
-                    r.trace = trace.map(|mut t| {
-                        multi_rate::run::write_trace(&r, &mut t);
-                        t
-                    });
-                    Ok(SystemRun::MultiRate(Box::new(r)))
-                }
+            match multi_rate::run_multi_rate(cfg, trace) {
+                Ok(r) => Ok(SystemRun::MultiRate(Box::new(r))),
                 Err(multi_rate::MultiRateError::Invalid { key, message }) => {
                     Err(SimError::Config(invalid(src, &key, message, None)))
                 }
@@ -166,14 +160,8 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWrit
         }
         "vr" => {
             let cfg: vr::VrConfig = deserialize(table, src)?;
-            match vr::run_vr(cfg) {
-                Ok(mut r) => {
-                    r.trace = trace.map(|mut t| {
-                        vr::run::write_trace(&r, &mut t);
-                        t
-                    });
-                    Ok(SystemRun::Vr(Box::new(r)))
-                }
+            match vr::run_vr(cfg, trace) {
+                Ok(r) => Ok(SystemRun::Vr(Box::new(r))),
                 Err(vr::VrError::Invalid { key, message }) => Err(SimError::Config(invalid(src, &key, message, None))),
                 Err(e) => Err(SimError::Vr {
                     model: src.name.clone(),

@@ -9,7 +9,8 @@
 
 use crate::engine::Time;
 
-use super::model::MultiRate;
+use super::analytic::Terms;
+use super::model::{ConvFrame, FcFrame};
 
 /// Stages of the fast path (input visible in FC's own rendering).
 pub const FAST_STAGES: [&str; 6] = [
@@ -63,33 +64,95 @@ fn gaps(points: &[Time]) -> Vec<u64> {
     points.windows(2).map(|w| w[1].0.saturating_sub(w[0].0)).collect()
 }
 
-/// Follows every input event through the recorded frames.
-pub fn follow_events(m: &MultiRate) -> Vec<EventRecord> {
-    let t = &m.terms;
-    let disp = t.display.0;
-    let fcs = &m.fc[..m.fc_done];
-    let convs = &m.conv[..m.conv_done];
-    let (mut fi, mut si, mut ci) = (0usize, 0usize, 0usize);
-    let mut out = Vec::with_capacity(m.inputs.len());
-    for &te in &m.inputs {
-        let j = m.capturing_sample(te);
-        let sampled = m.sample_time(j);
-        // The simulation scheduled this delivery with checked time, so it fits.
-        let delivered = Time(sampled.0.saturating_add(t.sensor_latency.0));
-        while fi < fcs.len() && fcs[fi].sample < Some(j) {
-            fi += 1;
+/// Follows the input events through the frames as the frames end.
+///
+/// Every path shows the events in their order: an event captured by
+/// tracker sample `j` is shown by the first frame of the path that ends
+/// having read a sample at or after `j` (for the slow path: whose SC image
+/// read one). Samples only grow from frame to frame, so each path keeps a
+/// cursor into the records: a frame that ends shows the waiting events from
+/// the cursor on while their sample is within its own, and is not needed
+/// after that. The records are those of the whole run; no frame is kept.
+#[derive(Debug)]
+pub struct Follower {
+    terms: Terms,
+    /// Every input event's fate so far.
+    pub records: Vec<EventRecord>,
+    next_fast: usize,
+    next_slow: usize,
+    next_conv: usize,
+}
+
+impl Follower {
+    /// A follower for up to `events` input events.
+    pub fn new(terms: Terms, events: u64) -> Self {
+        Follower {
+            terms,
+            records: Vec::with_capacity(events.min(1 << 16) as usize),
+            next_fast: 0,
+            next_slow: 0,
+            next_conv: 0,
         }
-        let fast = fcs.get(fi).map(|f| {
+    }
+
+    /// The tracker sample that captures an input at `t` (the first at or after it).
+    pub fn capturing_sample(&self, t: Time) -> u64 {
+        t.0.div_ceil(self.terms.tracker_period.0.max(1))
+    }
+
+    /// Bytes the records take now (their stage lists included).
+    pub fn record_bytes(&self) -> u64 {
+        let stages: usize = self
+            .records
+            .iter()
+            .map(|r| {
+                r.fast.as_ref().map_or(0, |f| f.1.len())
+                    + r.slow.as_ref().map_or(0, |s| s.2.len())
+                    + r.conventional.as_ref().map_or(0, |c| c.1.len())
+            })
+            .sum();
+        (self.records.capacity() * std::mem::size_of::<EventRecord>() + stages * 8) as u64
+    }
+
+    /// An input event happens at `time`.
+    pub fn input(&mut self, time: Time) {
+        let sample = self.capturing_sample(time);
+        self.records.push(EventRecord {
+            time,
+            sample,
+            fast: None,
+            slow: None,
+            conventional: None,
+        });
+    }
+
+    /// The instants every path starts from: the event, its sample, and the
+    /// sample's delivery. (The simulation scheduled that delivery with
+    /// checked time, so it fits.)
+    fn opening(&self, r: &EventRecord) -> [Time; 3] {
+        let sampled = Time(r.sample.saturating_mul(self.terms.tracker_period.0));
+        [
+            r.time,
+            sampled,
+            Time(sampled.0.saturating_add(self.terms.sensor_latency.0)),
+        ]
+    }
+
+    /// FC frame number `index` ended: it shows the events its sample has
+    /// captured (fast path), and those its SC image's sample has (slow path).
+    pub fn fc_frame_end(&mut self, index: usize, f: &FcFrame) {
+        let disp = self.terms.display.0;
+        while self.next_fast < self.records.len() && f.sample >= Some(self.records[self.next_fast].sample) {
+            let [te, sampled, delivered] = self.opening(&self.records[self.next_fast]);
             let mut g = gaps(&[te, sampled, delivered, f.start, f.upload_end, f.end]);
             g.push(disp);
-            (fi, g)
-        });
-        while si < fcs.len() && fcs[si].buffer.and_then(|b| m.sc[b].sample) < Some(j) {
-            si += 1;
+            self.records[self.next_fast].fast = Some((index, g));
+            self.next_fast += 1;
         }
-        let slow = fcs.get(si).and_then(|f| {
-            let b = f.buffer?;
-            let s = &m.sc[b];
+        let Some((b, s)) = f.buffer else { return };
+        let Some(arrived) = s.arrived else { return };
+        while self.next_slow < self.records.len() && s.sample >= Some(self.records[self.next_slow].sample) {
+            let [te, sampled, delivered] = self.opening(&self.records[self.next_slow]);
             let mut g = gaps(&[
                 te,
                 sampled,
@@ -97,31 +160,35 @@ pub fn follow_events(m: &MultiRate) -> Vec<EventRecord> {
                 s.start,
                 s.render_end,
                 s.readback_end,
-                s.arrived?,
+                arrived,
                 f.start,
                 f.upload_end,
                 f.end,
             ]);
             g.push(disp);
-            Some((si, b, g))
-        });
-        while ci < convs.len() && convs[ci].sample < Some(j) {
-            ci += 1;
+            self.records[self.next_slow].slow = Some((index, b, g));
+            self.next_slow += 1;
         }
-        let conventional = convs.get(ci).map(|c| {
+    }
+
+    /// Conventional frame number `index` ended.
+    pub fn conv_frame_end(&mut self, index: usize, c: &ConvFrame) {
+        let disp = self.terms.display.0;
+        while self.next_conv < self.records.len() && c.sample >= Some(self.records[self.next_conv].sample) {
+            let [te, sampled, delivered] = self.opening(&self.records[self.next_conv]);
             let mut g = gaps(&[te, sampled, delivered, c.start, c.end]);
             g.push(disp);
-            (ci, g)
-        });
-        out.push(EventRecord {
-            time: te,
-            sample: j,
-            fast,
-            slow,
-            conventional,
-        });
+            self.records[self.next_conv].conventional = Some((index, g));
+            self.next_conv += 1;
+        }
     }
-    out
+
+    /// Whether every event so far is shown on every path (the conventional
+    /// one only when it runs).
+    pub fn all_shown(&self, conventional: bool) -> bool {
+        let n = self.records.len();
+        self.next_fast == n && self.next_slow == n && (!conventional || self.next_conv == n)
+    }
 }
 
 /// Total latency in milliseconds from stage gaps.

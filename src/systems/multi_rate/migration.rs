@@ -21,11 +21,10 @@
 //! object)", so the rule does not depend on the choice.
 
 use serde::{Deserialize, Serialize};
-use serde_json::{Value, json};
 
 use crate::engine::{Duration, Time};
 
-use super::model::MultiRate;
+use super::model::FcFrame;
 
 /// A user action.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -107,40 +106,81 @@ pub struct Counts {
     pub missing_frames: u64,
 }
 
-/// Counts artifacts over the FC frames that ended during the script (from
-/// its first action to one second after its last).
-pub fn artifacts(m: &MultiRate, script: &[Step]) -> Value {
-    let p = m.terms.tracker_period.0.max(1);
-    let state_time = |sample: Option<u64>| sample.map(|k| Time(k.saturating_mul(p)));
-    let first = script.iter().map(|s| s.at.0).min().unwrap_or(0);
-    let last = script
-        .iter()
-        .map(|s| s.at.0)
-        .max()
-        .unwrap_or(0)
-        .saturating_add(1_000_000_000_000);
-    let mut plain = Counts::default();
-    let mut book = Counts::default();
-    let mut frames = 0u64;
-    for f in m.fc[..m.fc_done].iter().filter(|f| f.end.0 >= first && f.end.0 <= last) {
-        let (Some(fc_t), Some(sc)) = (state_time(f.sample), f.buffer.map(|b| &m.sc[b])) else {
-            continue;
+/// Counts artifacts over the FC frames that end during the script (from its
+/// first action to one second after its last), frame by frame as they end.
+#[derive(Debug, Clone)]
+pub struct Artifacts {
+    script: Vec<Step>,
+    first: u64,
+    last: u64,
+    frames: u64,
+    plain: Counts,
+    book: Counts,
+}
+
+/// What [`Artifacts`] found, as the summary's `metrics.migration`.
+#[derive(Debug, Clone, Serialize)]
+pub struct ArtifactCounts {
+    /// FC frames that ended during the script and composited an SC image.
+    pub fc_frames: u64,
+    /// The original system.
+    pub plain: Counts,
+    /// The paper's bookkeeping scheme.
+    pub bookkeeping: Counts,
+}
+
+impl Artifacts {
+    /// Counting for `script`.
+    pub fn new(script: &[Step]) -> Self {
+        Artifacts {
+            first: script.iter().map(|s| s.at.0).min().unwrap_or(0),
+            last: script
+                .iter()
+                .map(|s| s.at.0)
+                .max()
+                .unwrap_or(0)
+                .saturating_add(1_000_000_000_000),
+            script: script.to_vec(),
+            frames: 0,
+            plain: Counts::default(),
+            book: Counts::default(),
+        }
+    }
+
+    /// An FC frame ended (`tracker_period` in picoseconds dates the samples).
+    pub fn fc_frame_end(&mut self, f: &FcFrame, tracker_period: u64) {
+        if f.end.0 < self.first || f.end.0 > self.last {
+            return;
+        }
+        let p = tracker_period.max(1);
+        let state_time = |sample: Option<u64>| sample.map(|k| Time(k.saturating_mul(p)));
+        let (Some(fc_t), Some((_, sc))) = (state_time(f.sample), f.buffer) else {
+            return;
         };
-        let Some(sc_t) = state_time(sc.sample) else { continue };
-        frames += 1;
+        let Some(sc_t) = state_time(sc.sample) else { return };
+        let script = &self.script;
+        self.frames += 1;
         let fc_state = state_at(script, fc_t);
         let sc_state = state_at(script, sc_t);
         let moved = moved_between(script, sc_t, fc_t);
         // plain: SC holds it unless SELECTED; FC draws it only when SELECTED.
         let held = sc_state != State::Selected;
         let draws = fc_state == State::Selected;
-        count(&mut plain, draws, held, moved);
+        count(&mut self.plain, draws, held, moved);
         // bookkeeping: SC drops it when OVER already; FC follows Table 3.
         let held = sc_state == State::Inactive;
         let draws = !(fc_state == State::Inactive && held);
-        count(&mut book, draws, held, moved);
+        count(&mut self.book, draws, held, moved);
     }
-    json!({"fc_frames": frames, "plain": plain, "bookkeeping": book})
+
+    /// The counts so far.
+    pub fn counts(&self) -> ArtifactCounts {
+        ArtifactCounts {
+            fc_frames: self.frames,
+            plain: self.plain,
+            bookkeeping: self.book,
+        }
+    }
 }
 
 fn count(c: &mut Counts, draws: bool, held: bool, moved: bool) {

@@ -22,7 +22,11 @@ use crate::engine::{
     Control, Duration, EngineError, EventKind, Model, RngStreams, Scheduler, StreamRng, Time, TimeError,
 };
 
+use crate::output::trace::TraceWriter;
+
 use super::analytic::Terms;
+use super::latency::Follower;
+use super::migration::Artifacts;
 
 /// Errors of a multi-frame-rate run.
 #[derive(Debug, thiserror::Error)]
@@ -112,8 +116,6 @@ pub struct ScFrame {
     pub send_start: Option<Time>,
     /// When it arrived at FC.
     pub arrived: Option<Time>,
-    /// Replaced in the mailbox by a newer buffer before it was sent.
-    pub replaced: bool,
 }
 
 /// One FC frame.
@@ -123,8 +125,9 @@ pub struct FcFrame {
     pub start: Time,
     /// Newest tracker sample delivered at `start`.
     pub sample: Option<u64>,
-    /// The SC frame whose image it uploaded.
-    pub buffer: Option<usize>,
+    /// The SC frame whose image it uploaded: its number and a copy of its
+    /// record (final: the image had arrived when FC took it).
+    pub buffer: Option<(usize, ScFrame)>,
     /// Upload end.
     pub upload_end: Time,
     /// Frame end (visible, before the display's own latency).
@@ -142,7 +145,12 @@ pub struct ConvFrame {
     pub end: Time,
 }
 
-/// All state of a run.
+/// All state of a run. Memory is bounded by the input events, not by the
+/// simulated span: a frame is folded into the events it shows when it ends
+/// ([`Follower`]) and its trace spans are written then, so only the frames
+/// in flight are held (SC's current frame, the buffers on the link and in
+/// the mailbox, the newest arrived image, FC's and the conventional
+/// client's current frames).
 #[derive(Debug)]
 pub struct MultiRate {
     /// Per-frame terms.
@@ -153,27 +161,34 @@ pub struct MultiRate {
     mean_interval: f64,
     arrivals: StreamRng,
     phases: [Duration; 3],
-    /// Input event times.
-    pub inputs: Vec<Time>,
-    /// SC frames.
-    pub sc: Vec<ScFrame>,
-    /// FC frames.
-    pub fc: Vec<FcFrame>,
-    /// Conventional frames.
-    pub conv: Vec<ConvFrame>,
-    in_flight: Option<usize>,
-    mailbox: Option<usize>,
-    latest_arrived: Option<usize>,
+    /// Every input event's fate, filled in as frames end.
+    pub follower: Follower,
+    sc_current: Option<(usize, ScFrame)>,
+    in_flight: Option<(usize, ScFrame)>,
+    mailbox: Option<(usize, ScFrame)>,
+    latest_arrived: Option<(usize, ScFrame)>,
+    fc_current: Option<FcFrame>,
+    fc_last: Option<FcFrame>,
+    conv_current: Option<ConvFrame>,
+    /// SC frames started.
+    pub sc_frames: usize,
+    /// SC buffers that reached FC.
+    pub sent: u64,
     /// Buffers replaced in the mailbox before being sent.
     pub replaced: u64,
-    /// FC frames that have ended (the last one may still be running).
+    /// FC frames that have ended.
     pub fc_done: usize,
     /// Conventional frames that have ended.
     pub conv_done: usize,
     /// The run goes on at least until FC has finished a frame after this.
     pub min_end: Time,
-    /// Most bytes the frame and input records may take (`run.max_memory`);
-    /// the run fails with an error naming that key beyond it.
+    /// Migration artifacts, counted as FC frames end (when the model has a
+    /// migration script).
+    pub migration: Option<Artifacts>,
+    /// The trace, written as the run goes.
+    pub trace: Option<TraceWriter>,
+    /// Most bytes the input records may take (`run.max_memory`); the run
+    /// fails with an error naming that key beyond it.
     pub max_memory: u64,
 }
 
@@ -205,44 +220,37 @@ impl MultiRate {
             mean_interval: mean_interval.0 as f64,
             arrivals: rng.stream("input.arrivals"),
             phases,
-            inputs: Vec::with_capacity(events.min(1 << 16) as usize),
-            sc: Vec::new(),
-            fc: Vec::new(),
-            conv: Vec::new(),
+            follower: Follower::new(terms, events),
+            sc_current: None,
             in_flight: None,
             mailbox: None,
             latest_arrived: None,
+            fc_current: None,
+            fc_last: None,
+            conv_current: None,
+            sc_frames: 0,
+            sent: 0,
             replaced: 0,
             fc_done: 0,
             conv_done: 0,
             min_end: Time::ZERO,
+            migration: None,
+            trace: None,
             max_memory: u64::MAX,
         }
     }
 
-    /// Bytes the input and frame records take now.
-    pub fn record_bytes(&self) -> u64 {
-        use std::mem::size_of;
-        (self.inputs.len() * size_of::<Time>()
-            + self.sc.len() * size_of::<ScFrame>()
-            + self.fc.len() * size_of::<FcFrame>()
-            + self.conv.len() * size_of::<ConvFrame>()) as u64
-    }
-
-    /// Fails once the records outgrow `run.max_memory`.
+    /// Fails once the input records outgrow `run.max_memory`.
     fn check_growth(&self, now: Time) -> Result<(), MultiRateError> {
-        let used = self.record_bytes();
+        let used = self.follower.record_bytes();
         if used > self.max_memory {
             return Err(MultiRateError::Invalid {
                 key: "run.max_memory".into(),
                 message: crate::limits::over_memory_message(
                     used,
                     &format!(
-                        "records of {} inputs, {} SC, {} FC and {} conventional frames after {now} of simulated time",
-                        self.inputs.len(),
-                        self.sc.len(),
-                        self.fc.len(),
-                        self.conv.len()
+                        "records of {} input events after {now} of simulated time",
+                        self.follower.records.len()
                     ),
                     self.max_memory,
                 ),
@@ -251,8 +259,21 @@ impl MultiRate {
         Ok(())
     }
 
-    /// Schedules the first event of every process.
+    /// Schedules the first event of every process and writes the trace's
+    /// tracks.
     pub fn start(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), MultiRateError> {
+        if let Some(t) = &mut self.trace {
+            t.process(1, "multi-frame-rate");
+            for (tid, name) in [
+                (1, "master (input events)"),
+                (2, "slow client"),
+                (3, "transfer link"),
+                (4, "fast client"),
+                (5, "conventional client"),
+            ] {
+                t.track(1, tid, name);
+            }
+        }
         sched.at(
             Time::ZERO.add(self.phases[0], "slow client start phase")?,
             Ev::ScFrameStart,
@@ -300,50 +321,40 @@ impl MultiRate {
         now.0.checked_sub(l).map(|x| x / p)
     }
 
-    /// The tracker sample that captures an input at `t` (the first at or after it).
-    pub fn capturing_sample(&self, t: Time) -> u64 {
-        t.0.div_ceil(self.terms.tracker_period.0.max(1))
-    }
-
-    /// Time tracker sample `k` is taken.
-    pub fn sample_time(&self, k: u64) -> Time {
-        Time(k.saturating_mul(self.terms.tracker_period.0))
-    }
-
     /// Whether every input is visible on every path.
     pub fn done(&self) -> bool {
         if self.events_left > 0 {
             return false;
         }
-        let Some(last) = self.inputs.last() else {
+        if self.follower.records.is_empty() {
             return true;
-        };
-        let j = Some(self.capturing_sample(*last));
-        let fc = self.fc_done.checked_sub(1).map(|i| &self.fc[i]);
-        if fc.is_none_or(|f| f.end < self.min_end) {
+        }
+        if self.fc_last.is_none_or(|f| f.end < self.min_end) {
             return false;
         }
-        let fast = fc.is_some_and(|f| f.sample >= j);
-        let slow = fc.and_then(|f| f.buffer).is_some_and(|b| self.sc[b].sample >= j);
-        let conv = !self.conventional || self.conv_done.checked_sub(1).is_some_and(|i| self.conv[i].sample >= j);
-        fast && slow && conv
+        self.follower.all_shown(self.conventional)
     }
 
     /// What is still missing (for errors).
     pub fn describe(&self) -> String {
         format!(
             "{} inputs issued, {} left; {} SC, {} FC, {} conventional frames",
-            self.inputs.len(),
+            self.follower.records.len(),
             self.events_left,
-            self.sc.len(),
-            self.fc.len(),
-            self.conv.len()
+            self.sc_frames,
+            self.fc_done + usize::from(self.fc_current.is_some()),
+            self.conv_done + usize::from(self.conv_current.is_some())
         )
     }
 
-    fn send(&mut self, now: Time, idx: usize, sched: &mut Scheduler<Ev>) -> Result<(), MultiRateError> {
-        self.in_flight = Some(idx);
-        self.sc[idx].send_start = Some(now);
+    fn send(
+        &mut self,
+        now: Time,
+        mut buffer: (usize, ScFrame),
+        sched: &mut Scheduler<Ev>,
+    ) -> Result<(), MultiRateError> {
+        buffer.1.send_start = Some(now);
+        self.in_flight = Some(buffer);
         sched.after(self.terms.transfer, Ev::TransferEnd, "SC -> FC transfer")?;
         Ok(())
     }
@@ -355,12 +366,13 @@ impl Model for MultiRate {
 
     fn handle(&mut self, now: Time, ev: Ev, sched: &mut Scheduler<Ev>) -> Result<Control, MultiRateError> {
         let t = self.terms;
-        if matches!(ev, Ev::Input | Ev::ScFrameStart | Ev::FcFrameStart | Ev::ConvFrameStart) {
-            self.check_growth(now)?;
-        }
         match ev {
             Ev::Input => {
-                self.inputs.push(now);
+                self.check_growth(now)?;
+                if let Some(tr) = &mut self.trace {
+                    tr.instant(1, 1, &format!("input {}", self.follower.records.len()), now);
+                }
+                self.follower.input(now);
                 self.events_left -= 1;
                 if self.events_left > 0 {
                     let g = self.gap();
@@ -368,47 +380,58 @@ impl Model for MultiRate {
                 }
             }
             Ev::ScFrameStart => {
-                self.sc.push(ScFrame {
-                    start: now,
-                    sample: self.delivered_sample(now),
-                    render_end: now,
-                    readback_end: now,
-                    send_start: None,
-                    arrived: None,
-                    replaced: false,
-                });
+                self.sc_current = Some((
+                    self.sc_frames,
+                    ScFrame {
+                        start: now,
+                        sample: self.delivered_sample(now),
+                        render_end: now,
+                        readback_end: now,
+                        send_start: None,
+                        arrived: None,
+                    },
+                ));
+                self.sc_frames += 1;
                 sched.after(t.sc_render, Ev::ScRenderEnd, "SC render")?;
             }
             Ev::ScRenderEnd => {
-                if let Some(f) = self.sc.last_mut() {
+                if let Some((_, f)) = &mut self.sc_current {
                     f.render_end = now;
                 }
                 sched.after(t.sc_readback, Ev::ScReadbackEnd, "SC read-back")?;
             }
             Ev::ScReadbackEnd => {
-                let idx = self.sc.len() - 1;
-                self.sc[idx].readback_end = now;
-                if self.in_flight.is_some() {
-                    if let Some(old) = self.mailbox.replace(idx) {
-                        self.sc[old].replaced = true;
-                        self.replaced += 1;
+                if let Some((i, mut f)) = self.sc_current.take() {
+                    f.readback_end = now;
+                    if let Some(tr) = &mut self.trace {
+                        tr.span(1, 2, &format!("SC {i} render"), f.start, f.render_end, None);
+                        tr.span(1, 2, &format!("SC {i} read-back"), f.render_end, f.readback_end, None);
                     }
-                } else {
-                    self.send(now, idx, sched)?;
+                    if self.in_flight.is_some() {
+                        if self.mailbox.replace((i, f)).is_some() {
+                            self.replaced += 1;
+                        }
+                    } else {
+                        self.send(now, (i, f), sched)?;
+                    }
                 }
                 sched.at(Self::next_start(now, self.phases[0], t.sc_period), Ev::ScFrameStart);
             }
             Ev::TransferEnd => {
-                if let Some(idx) = self.in_flight.take() {
-                    self.sc[idx].arrived = Some(now);
-                    self.latest_arrived = Some(idx);
+                if let Some((i, mut f)) = self.in_flight.take() {
+                    f.arrived = Some(now);
+                    if let (Some(tr), Some(s)) = (&mut self.trace, f.send_start) {
+                        tr.span(1, 3, &format!("SC {i} transfer"), s, now, None);
+                    }
+                    self.sent += 1;
+                    self.latest_arrived = Some((i, f));
                 }
                 if let Some(next) = self.mailbox.take() {
                     self.send(now, next, sched)?;
                 }
             }
             Ev::FcFrameStart => {
-                self.fc.push(FcFrame {
+                self.fc_current = Some(FcFrame {
                     start: now,
                     sample: self.delivered_sample(now),
                     buffer: self.latest_arrived,
@@ -418,23 +441,33 @@ impl Model for MultiRate {
                 sched.after(t.fc_upload, Ev::FcUploadEnd, "FC upload")?;
             }
             Ev::FcUploadEnd => {
-                if let Some(f) = self.fc.last_mut() {
+                if let Some(f) = &mut self.fc_current {
                     f.upload_end = now;
                 }
                 sched.after(t.fc_render, Ev::FcFrameEnd, "FC render")?;
             }
             Ev::FcFrameEnd => {
-                if let Some(f) = self.fc.last_mut() {
+                if let Some(mut f) = self.fc_current.take() {
                     f.end = now;
+                    let i = self.fc_done;
+                    if let Some(tr) = &mut self.trace {
+                        tr.span(1, 4, &format!("FC {i} upload"), f.start, f.upload_end, None);
+                        tr.span(1, 4, &format!("FC {i} render"), f.upload_end, f.end, None);
+                    }
+                    self.follower.fc_frame_end(i, &f);
+                    if let Some(m) = &mut self.migration {
+                        m.fc_frame_end(&f, t.tracker_period.0);
+                    }
+                    self.fc_last = Some(f);
+                    self.fc_done += 1;
                 }
-                self.fc_done = self.fc.len();
                 if self.done() {
                     return Ok(Control::Stop);
                 }
                 sched.at(Self::next_start(now, self.phases[1], t.fc_period), Ev::FcFrameStart);
             }
             Ev::ConvFrameStart => {
-                self.conv.push(ConvFrame {
+                self.conv_current = Some(ConvFrame {
                     start: now,
                     sample: self.delivered_sample(now),
                     end: now,
@@ -442,10 +475,15 @@ impl Model for MultiRate {
                 sched.after(t.conventional_frame, Ev::ConvFrameEnd, "conventional frame")?;
             }
             Ev::ConvFrameEnd => {
-                if let Some(f) = self.conv.last_mut() {
+                if let Some(mut f) = self.conv_current.take() {
                     f.end = now;
+                    let i = self.conv_done;
+                    if let Some(tr) = &mut self.trace {
+                        tr.span(1, 5, &format!("frame {i}"), f.start, f.end, None);
+                    }
+                    self.follower.conv_frame_end(i, &f);
+                    self.conv_done += 1;
                 }
-                self.conv_done = self.conv.len();
                 if self.done() {
                     return Ok(Control::Stop);
                 }

@@ -10,7 +10,7 @@ use crate::stats::quantile::Summary;
 
 use super::analytic::{Analytic, Bounds, Terms, analytic};
 use super::config::MultiRateConfig;
-use super::latency::{CONV_STAGES, EventRecord, FAST_STAGES, SLOW_STAGES, event_rows, follow_events, total_ms};
+use super::latency::{CONV_STAGES, EventRecord, FAST_STAGES, SLOW_STAGES, event_rows, total_ms};
 use super::model::{MultiRate, MultiRateError};
 
 /// Everything a run produced.
@@ -20,7 +20,8 @@ pub struct MultiRateRun {
     pub config: MultiRateConfig,
     /// Kernel statistics.
     pub stats: RunStats,
-    /// The final model state (frames of every client).
+    /// The final model state (counts of every client's frames; its
+    /// records are moved to `events`).
     pub model: MultiRate,
     /// Every input event's fate.
     pub events: Vec<EventRecord>,
@@ -111,6 +112,7 @@ pub fn validate(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
         ));
     }
     check_time_range(cfg.run.events, cfg.run.warmup, cfg.input.mean_interval)?;
+    check_span(cfg)?;
     for (i, w) in cfg.migration.script.windows(2).enumerate() {
         if w[1].at < w[0].at {
             return Err(bad(
@@ -143,50 +145,23 @@ pub fn validate(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
     Ok(())
 }
 
-/// Bytes per input event after the run: its time, its record with the
-/// stages of three paths, and its table row.
-const BYTES_PER_EVENT: usize = std::mem::size_of::<Time>() + std::mem::size_of::<EventRecord>() + 3 * 12 * 8 + 8 * 8;
+/// Bytes per input event: its record with the stages of three paths, and
+/// its table row.
+const BYTES_PER_EVENT: usize = std::mem::size_of::<EventRecord>() + 3 * 12 * 8 + 8 * 8;
 
 /// Estimates the memory a run needs from its inputs before simulating: the
-/// expected simulated span (warm-up, `run.events` x `input.mean_interval`,
-/// the migration script) times each client's frame rate, plus the input
-/// events' records. Returns the bytes and a description.
+/// input events' records. Frames are not kept (each is folded into the
+/// events it shows when it ends), so the simulated span costs time, not
+/// memory. Returns the bytes and a description.
 pub fn estimate_memory(cfg: &MultiRateConfig) -> (u64, String) {
-    use crate::limits::add_bytes;
-    use std::mem::size_of;
-    let t = Terms::of(cfg);
-    let last = cfg.migration.script.iter().map(|s| s.at.0).max().unwrap_or(0) as f64;
-    // After the last input the run goes on until every path has shown it:
-    // the tracker's delay, a few frames of each client and the display.
-    let tail = cfg.tracker.period.0 as f64
-        + cfg.tracker.latency.0 as f64
-        + 3.0 * (t.sc_interval().0 as f64 + t.fc_interval().0 as f64 + t.conventional_frame.0 as f64)
-        + cfg.display.latency.0 as f64;
-    let span = cfg.run.warmup.0 as f64 + cfg.run.events as f64 * cfg.input.mean_interval.0 as f64 + last + tail + 1e12;
-    let frames = |interval: crate::engine::Duration| crate::limits::records_over(span, interval.0);
-    let (sc, fc) = (frames(t.sc_interval()), frames(t.fc_interval()));
-    let conv = if cfg.conventional.enabled {
-        frames(t.conventional_frame)
-    } else {
-        0
-    };
-    let mut total = 0u64;
-    add_bytes(&mut total, sc, size_of::<super::model::ScFrame>());
-    add_bytes(&mut total, fc, size_of::<super::model::FcFrame>());
-    add_bytes(&mut total, conv, size_of::<super::model::ConvFrame>());
-    crate::limits::latency_estimate(
-        total,
-        cfg.run.events,
-        BYTES_PER_EVENT,
-        "input events",
-        span,
-        "the clients' frames",
-        &format!("{sc} SC, {fc} FC and {conv} conventional frames"),
-    )
+    crate::limits::latency_estimate(cfg.run.events, BYTES_PER_EVENT, "input events")
 }
 
-/// Validates, runs and summarizes a model.
-pub fn run_multi_rate(cfg: MultiRateConfig) -> Result<MultiRateRun, MultiRateError> {
+/// Validates, runs and summarizes a model. With a `trace` writer, the run's
+/// trace is written into it as the run goes (one track per client, one for
+/// the link, input events as instants on the master's track) and handed
+/// back in [`MultiRateRun::trace`], to be closed by the caller.
+pub fn run_multi_rate(cfg: MultiRateConfig, trace: Option<TraceWriter>) -> Result<MultiRateRun, MultiRateError> {
     validate(&cfg)?;
     let max_memory = cfg.run.max_memory.map_or(crate::limits::DEFAULT_MAX_MEMORY, |b| b.0);
     let (estimate, parts) = estimate_memory(&cfg);
@@ -207,6 +182,10 @@ pub fn run_multi_rate(cfg: MultiRateConfig) -> Result<MultiRateRun, MultiRateErr
         cfg.run.seed,
     );
     model.max_memory = max_memory;
+    model.trace = trace;
+    if !cfg.migration.script.is_empty() {
+        model.migration = Some(super::migration::Artifacts::new(&cfg.migration.script));
+    }
     if let Some(last) = cfg.migration.script.iter().map(|s| s.at).max() {
         model.min_end = Time::ZERO
             .add(last, "migration.script")?
@@ -225,8 +204,9 @@ pub fn run_multi_rate(cfg: MultiRateConfig) -> Result<MultiRateRun, MultiRateErr
             state: model.describe(),
         });
     }
-    let events = follow_events(&model);
+    let events = std::mem::take(&mut model.follower.records);
     let summary = summarize(&cfg, &model, &events, &a, &stats);
+    let trace = model.trace.take();
     Ok(MultiRateRun {
         config: cfg,
         stats,
@@ -234,7 +214,7 @@ pub fn run_multi_rate(cfg: MultiRateConfig) -> Result<MultiRateRun, MultiRateErr
         events,
         analytic: a,
         summary,
-        trace: None,
+        trace,
     })
 }
 
@@ -301,7 +281,6 @@ fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &A
             events.iter().filter_map(|e| e.conventional.as_ref().map(|c| &c.1)),
         );
     }
-    let sent = m.sc.iter().filter(|f| f.arrived.is_some()).count();
     let mut out = json!({
         "system": "multi_rate",
         "description": cfg.description,
@@ -338,13 +317,13 @@ fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &A
                 "fast_client": 1e3 / t.fc_interval().as_ms_f64(),
                 "transfer": if t.transfer.0 > 0 { 1e3 / t.transfer.as_ms_f64() } else { f64::INFINITY },
             },
-            "frames": {"slow_client": m.sc.len(), "fast_client": m.fc_done, "conventional": m.conv_done},
-            "buffers": {"sent": sent, "replaced_before_sending": m.replaced},
+            "frames": {"slow_client": m.sc_frames, "fast_client": m.fc_done, "conventional": m.conv_done},
+            "buffers": {"sent": m.sent, "replaced_before_sending": m.replaced},
             "link_keeps_up": a.link_keeps_up,
         },
     });
-    if !cfg.migration.script.is_empty() {
-        out["metrics"]["migration"] = super::migration::artifacts(m, &cfg.migration.script);
+    if let Some(migration) = &m.migration {
+        out["metrics"]["migration"] = json!(migration.counts());
     }
     out
 }
@@ -358,38 +337,62 @@ pub fn write_events_csv(events: &[EventRecord], w: &mut dyn Write) -> std::io::R
     write_table(std::io::BufWriter::new(w), &super::latency::COLUMNS, rows)
 }
 
-/// Writes a Chrome/Perfetto trace: one track per client and one for the
-/// link; input events as instants on the master's track.
-pub fn write_trace(r: &MultiRateRun, t: &mut TraceWriter) {
-    let m = &r.model;
-    t.process(1, "multi-frame-rate");
-    for (tid, name) in [
-        (1, "master (input events)"),
-        (2, "slow client"),
-        (3, "transfer link"),
-        (4, "fast client"),
-        (5, "conventional client"),
-    ] {
-        t.track(1, tid, name);
-    }
-    for (i, at) in m.inputs.iter().enumerate() {
-        t.instant(1, 1, &format!("input {i}"), *at);
-    }
-    for (i, f) in m.sc.iter().enumerate() {
-        if f.readback_end > f.start {
-            t.span(1, 2, &format!("SC {i} render"), f.start, f.render_end, None);
-            t.span(1, 2, &format!("SC {i} read-back"), f.render_end, f.readback_end, None);
+/// Refuses, before simulating, a run whose expected span (the input events
+/// and what follows the last one until every path shows it) reaches past
+/// the clock's range ([`crate::limits::span_check`]), blaming the largest
+/// part's key.
+fn check_span(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
+    let t = Terms::of(cfg);
+    let f = |d: Duration| d.0 as f64;
+    // Which key makes a client's interval: its rate cap or its frame.
+    let interval_key = |period: Option<Duration>, parts: [(&'static str, Duration); 2], rate_key: &'static str| {
+        if period.is_some_and(|p| p.0 > parts[0].1.0.saturating_add(parts[1].1.0)) {
+            rate_key
+        } else if parts[0].1 >= parts[1].1 {
+            parts[0].0
+        } else {
+            parts[1].0
         }
-        if let (Some(s), Some(e)) = (f.send_start, f.arrived) {
-            t.span(1, 3, &format!("SC {i} transfer"), s, e, None);
-        }
+    };
+    let sc_key = interval_key(
+        t.sc_period,
+        [
+            ("slow_client.render", t.sc_render),
+            ("slow_client.readback", t.sc_readback),
+        ],
+        "slow_client.rate",
+    );
+    let fc_key = interval_key(
+        t.fc_period,
+        [("fast_client.render", t.fc_render), ("fast_client.upload", t.fc_upload)],
+        "fast_client.rate",
+    );
+    let conv_key = if cfg.conventional.frame.is_some() {
+        "conventional.frame"
+    } else {
+        "slow_client.render"
+    };
+    let last_action = cfg.migration.script.iter().map(|s| s.at.0).max().unwrap_or(0);
+    let mut terms = vec![
+        ("run.warmup", f(cfg.run.warmup)),
+        (
+            "input.mean_interval",
+            cfg.run.events as f64 * f(cfg.input.mean_interval),
+        ),
+        ("migration.script", last_action as f64),
+        ("tracker.period", f(t.tracker_period)),
+        ("tracker.latency", f(t.sensor_latency)),
+        (sc_key, 2.0 * f(t.sc_interval())),
+        (fc_key, 2.0 * f(t.fc_interval())),
+        ("transfer.path", f(t.transfer)),
+        ("display.latency", f(t.display)),
+    ];
+    if cfg.conventional.enabled {
+        terms.push((conv_key, 2.0 * f(t.conventional_frame)));
     }
-    for (i, f) in m.fc[..m.fc_done].iter().enumerate() {
-        t.span(1, 4, &format!("FC {i} upload"), f.start, f.upload_end, None);
-        t.span(1, 4, &format!("FC {i} render"), f.upload_end, f.end, None);
-    }
-    for (i, f) in m.conv[..m.conv_done].iter().enumerate() {
-        t.span(1, 5, &format!("frame {i}"), f.start, f.end, None);
+    match crate::limits::span_check(&terms) {
+        Some((key, message)) => Err(bad(&key, message)),
+        None => Ok(()),
     }
 }
 

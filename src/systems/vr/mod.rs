@@ -6,10 +6,12 @@
 //! latency of head and of object motion.
 //!
 //! - `config`: the model file; `analytic`: closed forms;
-//! - `model`: the kernel model; `run`: per-motion latencies, summary, trace.
+//! - `model`: the kernel model; `latency`: per-motion latencies and their
+//!   stages, followed as frames swap; `run`: validate, run, summary, CSV.
 
 pub mod analytic;
 pub mod config;
+pub mod latency;
 pub mod model;
 pub mod run;
 

@@ -20,7 +20,10 @@ use crate::engine::{
     Control, Duration, EngineError, EventKind, Model, RngStreams, Scheduler, StreamRng, Time, TimeError,
 };
 
+use crate::output::trace::TraceWriter;
+
 use super::config::{Scheme, VrConfig};
+use super::latency::Follower;
 
 /// Errors of a VR run.
 #[derive(Debug, thiserror::Error)]
@@ -145,17 +148,22 @@ pub struct WarpFrame {
     pub start: Time,
     /// Camera pose: newest tracker sample at start.
     pub camera: Option<u64>,
-    /// Object transforms: newest published simulation step.
-    pub sim: Option<usize>,
-    /// Application frame re-projected.
-    pub app: Option<usize>,
+    /// Object transforms: the newest published simulation step, its number
+    /// and a copy of its record (final: it was published).
+    pub sim: Option<(usize, SimStep)>,
+    /// The newest finished application frame, re-projected: its number and
+    /// a copy of its record.
+    pub app: Option<(usize, AppFrame)>,
     /// Warp end.
     pub render_end: Time,
     /// Swap.
     pub swap: Time,
 }
 
-/// All state of a run.
+/// All state of a run. Memory is bounded by the motions, not by the
+/// simulated span: a frame is folded into the motions it shows when it
+/// swaps ([`Follower`]) and its trace spans are written as it goes, so only
+/// the frames in flight are held.
 #[derive(Debug)]
 pub struct Vr {
     /// The model.
@@ -164,22 +172,29 @@ pub struct Vr {
     mean_interval: f64,
     arrivals: StreamRng,
     phases: [Duration; 3],
-    /// Motion times.
-    pub inputs: Vec<Time>,
-    /// Naive loop frames.
-    pub frames: Vec<LoopFrame>,
-    /// Simulation steps.
-    pub sims: Vec<SimStep>,
-    /// Application frames.
-    pub apps: Vec<AppFrame>,
-    /// Warped frames.
-    pub warps: Vec<WarpFrame>,
+    /// Every motion's fate, filled in as frames swap.
+    pub follower: Follower,
+    frame: Option<LoopFrame>,
+    sim: Option<SimStep>,
+    sim_done: Option<(usize, SimStep)>,
+    app: Option<AppFrame>,
+    app_done: Option<(usize, AppFrame)>,
+    warp: Option<WarpFrame>,
+    last_swap: Option<(usize, Time)>,
+    /// Naive loop frames started.
+    pub frames: usize,
+    /// Simulation steps started.
+    pub sims: usize,
+    /// Application frames started.
+    pub apps: usize,
+    /// Warped frames started.
+    pub warps: usize,
     /// Frames (naive or warped) that have swapped.
     pub swapped: usize,
-    sims_done: usize,
-    apps_done: usize,
-    /// Most bytes the motion and frame records may take (`run.max_memory`);
-    /// the run fails with an error naming that key beyond it.
+    /// The trace, written as the run goes.
+    pub trace: Option<TraceWriter>,
+    /// Most bytes the motion records may take (`run.max_memory`); the run
+    /// fails with an error naming that key beyond it.
     pub max_memory: u64,
 }
 
@@ -201,44 +216,36 @@ impl Vr {
             mean_interval: cfg.input.mean_interval.0 as f64,
             arrivals: rng.stream("input.arrivals"),
             phases,
-            inputs: Vec::new(),
-            frames: Vec::new(),
-            sims: Vec::new(),
-            apps: Vec::new(),
-            warps: Vec::new(),
+            follower: Follower::new(&cfg),
+            frame: None,
+            sim: None,
+            sim_done: None,
+            app: None,
+            app_done: None,
+            warp: None,
+            last_swap: None,
+            frames: 0,
+            sims: 0,
+            apps: 0,
+            warps: 0,
             swapped: 0,
-            sims_done: 0,
-            apps_done: 0,
+            trace: None,
             max_memory: u64::MAX,
             cfg,
         }
     }
 
-    /// Bytes the motion and frame records take now.
-    pub fn record_bytes(&self) -> u64 {
-        use std::mem::size_of;
-        (self.inputs.len() * size_of::<Time>()
-            + self.frames.len() * size_of::<LoopFrame>()
-            + self.sims.len() * size_of::<SimStep>()
-            + self.apps.len() * size_of::<AppFrame>()
-            + self.warps.len() * size_of::<WarpFrame>()) as u64
-    }
-
-    /// Fails once the records outgrow `run.max_memory`.
+    /// Fails once the motion records outgrow `run.max_memory`.
     fn check_growth(&self, now: Time) -> Result<(), VrError> {
-        let used = self.record_bytes();
+        let used = self.follower.record_bytes();
         if used > self.max_memory {
             return Err(VrError::Invalid {
                 key: "run.max_memory".into(),
                 message: crate::limits::over_memory_message(
                     used,
                     &format!(
-                        "records of {} motions, {} loop frames, {} simulation steps, {} application and {} warped frames after {now} of simulated time",
-                        self.inputs.len(),
-                        self.frames.len(),
-                        self.sims.len(),
-                        self.apps.len(),
-                        self.warps.len()
+                        "records of {} motions after {now} of simulated time",
+                        self.follower.records.len()
                     ),
                     self.max_memory,
                 ),
@@ -247,8 +254,20 @@ impl Vr {
         Ok(())
     }
 
-    /// Schedules the first events.
+    /// Schedules the first events and writes the trace's tracks.
     pub fn start(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), VrError> {
+        if let Some(t) = &mut self.trace {
+            t.process(1, "VR pipeline");
+            for (tid, name) in [
+                (1, "tracker (motions)"),
+                (2, "simulation"),
+                (3, "renderer"),
+                (4, "warping renderer"),
+                (5, "display"),
+            ] {
+                t.track(1, tid, name);
+            }
+        }
         match self.cfg.scheme {
             Scheme::Naive => sched.at(Time::ZERO.add(self.phases[0], "loop phase")?, Ev::LoopStart),
             Scheme::Warp => {
@@ -267,6 +286,25 @@ impl Vr {
         Ok(())
     }
 
+    /// Writes the last image's span (it stays for two fields) and hands the
+    /// trace back.
+    pub fn finish_trace(&mut self) -> Option<TraceWriter> {
+        let mut t = self.trace.take()?;
+        if let Some((i, s)) = self.last_swap {
+            // Saturating: a trace's end, not a result.
+            let field = self.cfg.display_latency().0;
+            t.span(
+                1,
+                5,
+                &format!("image {i}"),
+                s,
+                Time(s.0.saturating_add(field.saturating_mul(2))),
+                None,
+            );
+        }
+        Some(t)
+    }
+
     fn gap(&mut self) -> Duration {
         Duration::from_ps_f64(-self.mean_interval * (1.0 - self.arrivals.random::<f64>()).ln())
     }
@@ -278,16 +316,6 @@ impl Vr {
             .map(|x| x / self.cfg.tracker.period.0.max(1))
     }
 
-    /// The sample that captures a motion at `t`.
-    pub fn capturing_sample(&self, t: Time) -> u64 {
-        t.0.div_ceil(self.cfg.tracker.period.0.max(1))
-    }
-
-    /// When sample `k` is taken.
-    pub fn sample_time(&self, k: u64) -> Time {
-        Time(k.saturating_mul(self.cfg.tracker.period.0))
-    }
-
     /// The first swap opportunity at or after `t`.
     pub fn next_boundary(&self, t: Time) -> Time {
         let p = self.cfg.pair().0.max(1);
@@ -296,40 +324,30 @@ impl Vr {
 
     /// Whether every motion is visible as head and as object motion.
     pub fn done(&self) -> bool {
-        if self.events_left > 0 {
-            return false;
-        }
-        let Some(last) = self.inputs.last() else {
-            return true;
-        };
-        let j = Some(self.capturing_sample(*last));
-        let Some(i) = self.swapped.checked_sub(1) else {
-            return false;
-        };
-        match self.cfg.scheme {
-            Scheme::Naive => self.frames[i].sample >= j,
-            Scheme::Warp => {
-                let w = &self.warps[i];
-                w.camera >= j && w.sim.and_then(|s| self.sims[s].sample) >= j
-            }
-        }
+        self.events_left == 0 && self.follower.all_shown()
     }
 
     /// What exists so far (for errors).
     pub fn describe(&self) -> String {
         format!(
             "{} motions issued, {} left; {} loop frames, {} simulation steps, {} application frames, {} warped frames",
-            self.inputs.len(),
+            self.follower.records.len(),
             self.events_left,
-            self.frames.len(),
-            self.sims.len(),
-            self.apps.len(),
-            self.warps.len()
+            self.frames,
+            self.sims,
+            self.apps,
+            self.warps
         )
     }
 
-    fn swapped_now(&mut self, count: usize) -> Control {
-        self.swapped = count;
+    /// A frame swapped at `now`: the display shows a new image.
+    fn swapped_now(&mut self, now: Time) -> Control {
+        let i = self.swapped;
+        if let (Some(t), Some((k, prev))) = (&mut self.trace, self.last_swap) {
+            t.span(1, 5, &format!("image {k}"), prev, now, None);
+        }
+        self.last_swap = Some((i, now));
+        self.swapped = i + 1;
         if self.done() { Control::Stop } else { Control::Continue }
     }
 }
@@ -341,15 +359,13 @@ impl Model for Vr {
     fn handle(&mut self, now: Time, ev: Ev, sched: &mut Scheduler<Ev>) -> Result<Control, VrError> {
         let c = &self.cfg;
         let (step, render, warp, pair) = (c.simulation.step, c.renderer.render, c.warp.render, c.pair());
-        if matches!(
-            ev,
-            Ev::Input | Ev::LoopStart | Ev::SimStart | Ev::AppStart | Ev::WarpStart
-        ) {
-            self.check_growth(now)?;
-        }
         match ev {
             Ev::Input => {
-                self.inputs.push(now);
+                self.check_growth(now)?;
+                if let Some(t) = &mut self.trace {
+                    t.instant(1, 1, &format!("motion {}", self.follower.records.len()), now);
+                }
+                self.follower.input(now);
                 self.events_left -= 1;
                 if self.events_left > 0 {
                     let g = self.gap();
@@ -357,90 +373,113 @@ impl Model for Vr {
                 }
             }
             Ev::LoopStart => {
-                self.frames.push(LoopFrame {
+                self.frame = Some(LoopFrame {
                     start: now,
                     sample: self.delivered_sample(now),
                     sim_end: now,
                     render_end: now,
                     swap: now,
                 });
+                self.frames += 1;
                 sched.after(step, Ev::LoopSimEnd, "simulation step")?;
             }
             Ev::LoopSimEnd => {
-                if let Some(f) = self.frames.last_mut() {
+                if let Some(f) = &mut self.frame {
                     f.sim_end = now;
                 }
                 sched.after(render, Ev::LoopRenderEnd, "render")?;
             }
             Ev::LoopRenderEnd => {
-                if let Some(f) = self.frames.last_mut() {
+                if let Some(f) = &mut self.frame {
                     f.render_end = now;
                 }
                 // The swap lock: wait for the next stereo-pair boundary.
                 sched.at(self.next_boundary(now), Ev::LoopSwap);
             }
             Ev::LoopSwap => {
-                if let Some(f) = self.frames.last_mut() {
+                if let Some(mut f) = self.frame.take() {
                     f.swap = now;
+                    let i = self.swapped;
+                    if let Some(t) = &mut self.trace {
+                        t.span(1, 2, &format!("frame {i} simulation"), f.start, f.sim_end, None);
+                        t.span(1, 3, &format!("frame {i} render"), f.sim_end, f.render_end, None);
+                        t.span(1, 3, &format!("frame {i} swap lock"), f.render_end, f.swap, None);
+                    }
+                    self.follower.loop_swap(&f);
                 }
-                let n = self.frames.len();
-                if self.swapped_now(n) == Control::Stop {
+                if self.swapped_now(now) == Control::Stop {
                     return Ok(Control::Stop);
                 }
                 sched.at(now, Ev::LoopStart);
             }
             Ev::SimStart => {
-                self.sims.push(SimStep {
+                self.sim = Some(SimStep {
                     start: now,
                     sample: self.delivered_sample(now),
                     end: now,
                 });
+                self.sims += 1;
                 sched.after(step, Ev::SimEnd, "simulation step")?;
             }
             Ev::SimEnd => {
-                if let Some(s) = self.sims.last_mut() {
+                if let Some(mut s) = self.sim.take() {
                     s.end = now;
+                    let i = self.sims - 1;
+                    if let Some(t) = &mut self.trace {
+                        t.span(1, 2, &format!("step {i}"), s.start, s.end, None);
+                    }
+                    self.sim_done = Some((i, s));
                 }
-                self.sims_done = self.sims.len();
                 sched.at(now, Ev::SimStart);
             }
             Ev::AppStart => {
-                self.apps.push(AppFrame {
+                self.app = Some(AppFrame {
                     start: now,
-                    sim: self.sims_done.checked_sub(1),
+                    sim: self.sim_done.map(|(i, _)| i),
                     end: now,
                 });
+                self.apps += 1;
                 sched.after(render, Ev::AppEnd, "application frame")?;
             }
             Ev::AppEnd => {
-                if let Some(a) = self.apps.last_mut() {
+                if let Some(mut a) = self.app.take() {
                     a.end = now;
+                    let i = self.apps - 1;
+                    if let Some(t) = &mut self.trace {
+                        t.span(1, 3, &format!("app frame {i}"), a.start, a.end, None);
+                    }
+                    self.app_done = Some((i, a));
                 }
-                self.apps_done = self.apps.len();
                 sched.at(now, Ev::AppStart);
             }
             Ev::WarpStart => {
-                self.warps.push(WarpFrame {
+                self.warp = Some(WarpFrame {
                     start: now,
                     camera: self.delivered_sample(now),
-                    sim: self.sims_done.checked_sub(1),
-                    app: self.apps_done.checked_sub(1),
+                    sim: self.sim_done,
+                    app: self.app_done,
                     render_end: now,
                     swap: now,
                 });
+                self.warps += 1;
                 sched.after(warp, Ev::WarpEnd, "warp")?;
                 sched.after(pair, Ev::WarpSwap, "warp swap")?;
             }
             Ev::WarpEnd => {
                 // The warp fits in one pair, so it ends before the next warp starts.
-                if let Some(w) = self.warps.last_mut() {
+                if let Some(w) = &mut self.warp {
                     w.render_end = now;
                 }
             }
             Ev::WarpSwap => {
-                let i = self.swapped;
-                self.warps[i].swap = now;
-                if self.swapped_now(i + 1) == Control::Stop {
+                if let Some(mut w) = self.warp.take() {
+                    w.swap = now;
+                    if let Some(t) = &mut self.trace {
+                        t.span(1, 4, &format!("warp {}", self.swapped), w.start, w.render_end, None);
+                    }
+                    self.follower.warp_swap(&w);
+                }
+                if self.swapped_now(now) == Control::Stop {
                     return Ok(Control::Stop);
                 }
                 // The next warp frame starts at this boundary.
