@@ -95,7 +95,6 @@ pub fn add_bytes(total: &mut u64, count: u64, size: usize) {
     *total = total.saturating_add(count.saturating_mul(size as u64));
 }
 
-
 /// The message refusing, before simulating, a latency-system run whose input
 /// events alone (`run.events` arrivals `input.mean_interval` apart on
 /// average, after `run.warmup`, all in picoseconds) reach past the clock's

@@ -3,6 +3,7 @@
 //! `frame_pipeline`); [`run_model`] is the one entry point the CLI and the
 //! experiment runner use.
 
+pub mod error;
 pub mod frame_pipeline;
 pub mod multi_rate;
 pub mod pixelflow;
@@ -14,6 +15,8 @@ use serde_json::Value;
 
 use crate::config::{ConfigError, ModelSource, deserialize, invalid};
 use crate::output::trace::TraceWriter;
+
+pub use error::SystemError;
 
 /// The embedded default model (`models/default.toml`).
 pub const DEFAULT_MODEL: &str = include_str!("../../models/default.toml");
@@ -52,42 +55,30 @@ pub enum SimError {
     /// The model file is wrong.
     #[error(transparent)]
     Config(#[from] ConfigError),
-    /// The frame pipeline failed while running.
+    /// The system failed while running.
     #[error("{model}: {source}")]
-    Pipeline {
+    Run {
         /// The model's name (its file, or the embedded default).
         model: String,
         /// What went wrong.
         #[source]
-        source: frame_pipeline::PipelineError,
+        source: SystemError,
     },
-    /// The multi-frame-rate system failed while running.
-    #[error("{model}: {source}")]
-    MultiRate {
-        /// The model's name (its file, or the embedded default).
-        model: String,
-        /// What went wrong.
-        #[source]
-        source: multi_rate::MultiRateError,
-    },
-    /// The VR pipeline failed while running.
-    #[error("{model}: {source}")]
-    Vr {
-        /// The model's name (its file, or the embedded default).
-        model: String,
-        /// What went wrong.
-        #[source]
-        source: vr::VrError,
-    },
-    /// The PixelFlow model failed while running.
-    #[error("{model}: {source}")]
-    PixelFlow {
-        /// The model's name (its file, or the embedded default).
-        model: String,
-        /// What went wrong.
-        #[source]
-        source: pixelflow::PixelFlowError,
-    },
+}
+
+impl SimError {
+    /// A system's error as the model's: a value the system cannot use is
+    /// blamed on the model file (with its line and the `--set` that gave
+    /// it), anything else names the model.
+    fn of(src: &ModelSource, e: SystemError) -> SimError {
+        match e {
+            SystemError::Invalid { key, message } => SimError::Config(invalid(src, &key, message, None)),
+            e => SimError::Run {
+                model: src.name.clone(),
+                source: e,
+            },
+        }
+    }
 }
 
 /// The result of running one model.
@@ -134,59 +125,34 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWrit
     match system {
         "frame_pipeline" => {
             let cfg: frame_pipeline::FramePipelineConfig = deserialize(table, src)?;
-            match frame_pipeline::run_pipeline(cfg, &src.base_dir, trace) {
-                Ok(r) => Ok(SystemRun::FramePipeline(Box::new(r))),
-                Err(frame_pipeline::PipelineError::Invalid { key, message }) => {
-                    Err(SimError::Config(invalid(src, &key, message, None)))
-                }
-                Err(e) => Err(SimError::Pipeline {
-                    model: src.name.clone(),
-                    source: e,
-                }),
-            }
+            frame_pipeline::run_pipeline(cfg, &src.base_dir, trace)
+                .map(|r| SystemRun::FramePipeline(Box::new(r)))
+                .map_err(|e| SimError::of(src, e))
         }
         "multi_rate" => {
             let cfg: multi_rate::MultiRateConfig = deserialize(table, src)?;
-            match multi_rate::run_multi_rate(cfg, trace) {
-                Ok(r) => Ok(SystemRun::MultiRate(Box::new(r))),
-                Err(multi_rate::MultiRateError::Invalid { key, message }) => {
-                    Err(SimError::Config(invalid(src, &key, message, None)))
-                }
-                Err(e) => Err(SimError::MultiRate {
-                    model: src.name.clone(),
-                    source: e,
-                }),
-            }
+            multi_rate::run_multi_rate(cfg, trace)
+                .map(|r| SystemRun::MultiRate(Box::new(r)))
+                .map_err(|e| SimError::of(src, e))
         }
         "vr" => {
             let cfg: vr::VrConfig = deserialize(table, src)?;
-            match vr::run_vr(cfg, trace) {
-                Ok(r) => Ok(SystemRun::Vr(Box::new(r))),
-                Err(vr::VrError::Invalid { key, message }) => Err(SimError::Config(invalid(src, &key, message, None))),
-                Err(e) => Err(SimError::Vr {
-                    model: src.name.clone(),
-                    source: e,
-                }),
-            }
+            vr::run_vr(cfg, trace)
+                .map(|r| SystemRun::Vr(Box::new(r)))
+                .map_err(|e| SimError::of(src, e))
         }
         "pixelflow" => {
             let cfg: pixelflow::PixelFlowConfig = deserialize(table, src)?;
-            match pixelflow::run_pixelflow(cfg, trace.is_some()) {
-                Ok(mut r) => {
+            let traced = trace.is_some();
+            pixelflow::run_pixelflow(cfg, traced)
+                .map(|mut r| {
                     r.trace = trace.map(|mut t| {
                         pixelflow::run::write_trace(&r, &mut t);
                         t
                     });
-                    Ok(SystemRun::PixelFlow(Box::new(r)))
-                }
-                Err(pixelflow::PixelFlowError::Invalid { key, message }) => {
-                    Err(SimError::Config(invalid(src, &key, message, None)))
-                }
-                Err(e) => Err(SimError::PixelFlow {
-                    model: src.name.clone(),
-                    source: e,
-                }),
-            }
+                    SystemRun::PixelFlow(Box::new(r))
+                })
+                .map_err(|e| SimError::of(src, e))
         }
         other => Err(SimError::Config(invalid(
             src,

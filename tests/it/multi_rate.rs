@@ -497,8 +497,9 @@ fn bookkeeping_removes_the_release_artifact_and_over_prediction_the_selection_ar
 #[test]
 fn records_past_run_max_memory_end_the_run_with_an_error_naming_the_key() {
     use rendersim::engine::{Limits, Scheduler, run};
+    use rendersim::systems::SystemError;
     use rendersim::systems::multi_rate::analytic::Terms;
-    use rendersim::systems::multi_rate::{MultiRate, MultiRateConfig, MultiRateError};
+    use rendersim::systems::multi_rate::{MultiRate, MultiRateConfig};
     let cfg: MultiRateConfig = toml::from_str(CLUSTER).unwrap();
     let mut m = MultiRate::new(
         Terms::of(&cfg),
@@ -516,7 +517,7 @@ fn records_past_run_max_memory_end_the_run_with_an_error_naming_the_key() {
     m.start(&mut s).unwrap();
     let e = run(&mut m, &mut s, Limits::default()).unwrap_err();
     match e {
-        MultiRateError::Invalid { key, message } => {
+        SystemError::Invalid { key, message } => {
             assert_eq!(key, "run.max_memory");
             assert!(
                 message.contains("4 KiB") && message.contains("input events"),

@@ -240,7 +240,8 @@ fn summary_mfr() -> Value {
 #[test]
 fn records_past_run_max_memory_end_the_run_with_an_error_naming_the_key() {
     use rendersim::engine::{Limits, Scheduler, run};
-    use rendersim::systems::vr::{Vr, VrConfig, VrError};
+    use rendersim::systems::SystemError;
+    use rendersim::systems::vr::{Vr, VrConfig};
     for text in [NAIVE, WARP] {
         let cfg: VrConfig = toml::from_str(text).unwrap();
         let mut m = Vr::new(cfg);
@@ -248,7 +249,7 @@ fn records_past_run_max_memory_end_the_run_with_an_error_naming_the_key() {
         let mut s = Scheduler::new();
         m.start(&mut s).unwrap();
         match run(&mut m, &mut s, Limits::default()).unwrap_err() {
-            VrError::Invalid { key, message } => {
+            SystemError::Invalid { key, message } => {
                 assert_eq!(key, "run.max_memory");
                 assert!(message.contains("4 KiB") && message.contains("motions"), "{message}");
             }

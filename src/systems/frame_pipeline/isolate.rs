@@ -11,8 +11,8 @@ use crate::components::distribution::Dist;
 use crate::engine::Duration;
 
 use super::config::{FramePipelineConfig, StateCosts, WorkloadConfig};
-use super::model::PipelineError;
 use super::run::run_pipeline;
+use crate::systems::error::SystemError;
 
 /// One variant's result.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -111,9 +111,9 @@ pub fn isolate(
     base_dir: &Path,
     factor: f64,
     keep_vsync: bool,
-) -> Result<Isolation, PipelineError> {
+) -> Result<Isolation, SystemError> {
     if !(factor.is_finite() && factor > 0.0 && factor < 1.0) {
-        return Err(PipelineError::Invalid {
+        return Err(SystemError::Invalid {
             key: "--factor".into(),
             message: format!("must be between 0 and 1 (exclusive), got {factor}"),
         });

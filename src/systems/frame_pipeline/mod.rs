@@ -24,5 +24,5 @@ pub mod run;
 pub mod workload;
 
 pub use config::{Fidelity, FramePipelineConfig};
-pub use model::{FramePipeline, PipelineError};
+pub use model::FramePipeline;
 pub use run::{PipelineRun, run_pipeline, validate};

@@ -13,9 +13,11 @@ use crate::components::fifo::{BoundedFifo, FifoUnit};
 use crate::components::noise::{Arrivals, NoiseSource, NoiseTarget};
 use crate::components::preemptible::{Preemptible, Wake};
 use crate::components::swap_chain::{PresentMode, SwapChain};
-use crate::engine::{
-    Control, Duration, EngineError, EventKind, Model, RngStreams, Scheduler, StreamRng, Time, TimeError,
-};
+use crate::engine::{Control, Duration, EventKind, Model, RngStreams, Scheduler, StreamRng, Time};
+use crate::systems::error::SystemError;
+/// The frame pipeline's former name for [`SystemError`], still used by
+/// `cpu.rs` and `gpu.rs`.
+pub(super) use crate::systems::error::SystemError as PipelineError;
 
 use super::accounting::Accounting;
 use super::config::{Fidelity, FramePipelineConfig, WorkloadConfig};
@@ -93,40 +95,6 @@ impl EventKind for Ev {
             Ev::NoiseEnd { .. } => 9,
             Ev::ZeroTimeFrame => 10,
         }
-    }
-}
-
-/// Errors of building or running the frame pipeline.
-#[derive(Debug, thiserror::Error)]
-pub enum PipelineError {
-    /// Kernel error (time overflow).
-    #[error(transparent)]
-    Engine(#[from] EngineError),
-    /// A model value the simulator cannot use.
-    #[error("{key}: {message}")]
-    Invalid {
-        /// Dotted key.
-        key: String,
-        /// What is wrong.
-        message: String,
-    },
-    /// The pipeline stopped making progress (a model bug, reported rather than hung).
-    #[error("the simulation stalled at {at} with {resolved} of {frames} frames done: {state}")]
-    Stalled {
-        /// When.
-        at: Time,
-        /// Frames done.
-        resolved: u64,
-        /// Frames asked for.
-        frames: u64,
-        /// A description of the units' states.
-        state: String,
-    },
-}
-
-impl From<TimeError> for PipelineError {
-    fn from(e: TimeError) -> Self {
-        PipelineError::Engine(EngineError::Time(e))
     }
 }
 
@@ -290,7 +258,7 @@ impl FramePipeline {
         cfg: FramePipelineConfig,
         scene: Option<SceneProgram>,
         trace: Option<crate::output::trace::TraceWriter>,
-    ) -> Result<Self, PipelineError> {
+    ) -> Result<Self, SystemError> {
         let streams = RngStreams::new(cfg.run.seed);
         let program = match (&cfg.workload, scene) {
             (WorkloadConfig::Fixed(f), _) => Program::Fixed {
@@ -301,7 +269,7 @@ impl FramePipeline {
             },
             (WorkloadConfig::Scene(_), Some(s)) => Program::Scene(s),
             (WorkloadConfig::Scene(_), None) => {
-                return Err(PipelineError::Invalid {
+                return Err(SystemError::Invalid {
                     key: "workload".into(),
                     message: "scene not compiled".into(),
                 });
@@ -321,7 +289,7 @@ impl FramePipeline {
                     p.duration.clone(),
                     streams.stream(&format!("noise.{}", p.name)),
                 )
-                .map_err(|e| PipelineError::Invalid {
+                .map_err(|e| SystemError::Invalid {
                     key: format!("noise.periodic.{i}"),
                     message: e.to_string(),
                 })?;
@@ -337,7 +305,7 @@ impl FramePipeline {
                     r.duration.clone(),
                     streams.stream(&format!("noise.{}", r.name)),
                 )
-                .map_err(|e| PipelineError::Invalid {
+                .map_err(|e| SystemError::Invalid {
                     key: format!("noise.random.{i}"),
                     message: e.to_string(),
                 })?;
@@ -403,7 +371,7 @@ impl FramePipeline {
     }
 
     /// Schedules the first events. Call once before running.
-    pub fn start(&mut self, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    pub fn start(&mut self, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         if self.frames_total == 0 {
             return Ok(());
         }
@@ -509,7 +477,7 @@ impl FramePipeline {
     }
 
     /// Lets the CPU thread and the front end make every step they can now.
-    fn settle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    fn settle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         loop {
             let a = self.cpu_step(now, s)?;
             let b = self.front_step(now, s)?;
@@ -532,7 +500,7 @@ impl FramePipeline {
         }
     }
 
-    fn noise_arrive(&mut self, now: Time, source: u16, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    fn noise_arrive(&mut self, now: Time, source: u16, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         let src = &mut self.noise[source as usize];
         let d = src.draw_duration();
         let target = src.target;
@@ -548,7 +516,7 @@ impl FramePipeline {
         Ok(())
     }
 
-    fn noise_end(&mut self, now: Time, target: NoiseTarget, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    fn noise_end(&mut self, now: Time, target: NoiseTarget, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         let unit = match target {
             NoiseTarget::Cpu => &mut self.cpu,
             NoiseTarget::Gpu => &mut self.front,
@@ -564,9 +532,9 @@ impl FramePipeline {
 
 impl Model for FramePipeline {
     type Event = Ev;
-    type Error = PipelineError;
+    type Error = SystemError;
 
-    fn handle(&mut self, now: Time, ev: Ev, s: &mut Scheduler<Ev>) -> Result<Control, PipelineError> {
+    fn handle(&mut self, now: Time, ev: Ev, s: &mut Scheduler<Ev>) -> Result<Control, SystemError> {
         match ev {
             Ev::CpuDone { tag } => {
                 if self.cpu.complete(tag) {

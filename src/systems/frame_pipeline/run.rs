@@ -10,10 +10,11 @@ use crate::stats::quantile::Summary;
 
 use super::accounting::{BOTTLENECKS, CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES};
 use super::config::{FramePipelineConfig, WorkloadConfig};
-use super::model::{FramePipeline, PipelineError};
+use super::model::FramePipeline;
 use super::records::{FrameRecord, frame_rows};
 use super::workload::{SceneProgram, compile_scene};
 use crate::output::trace::TraceWriter;
+use crate::systems::error::SystemError;
 
 /// Everything a run produced.
 #[derive(Debug)]
@@ -56,15 +57,15 @@ pub struct ClockTotals {
     pub elapsed: u64,
 }
 
-fn bad(key: &str, message: impl Into<String>) -> PipelineError {
-    PipelineError::Invalid {
+fn bad(key: &str, message: impl Into<String>) -> SystemError {
+    SystemError::Invalid {
         key: key.to_string(),
         message: message.into(),
     }
 }
 
 /// Checks values serde cannot (ranges, distributions).
-pub fn validate(cfg: &FramePipelineConfig) -> Result<(), PipelineError> {
+pub fn validate(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
     if cfg.system != "frame_pipeline" {
         return Err(bad(
             "system",
@@ -133,7 +134,7 @@ pub fn validate(cfg: &FramePipelineConfig) -> Result<(), PipelineError> {
 
 /// Checks a scene's object counts and scale against [`crate::limits`]
 /// before anything is compiled or allocated.
-fn check_scene_sizes(sc: &crate::scene::config::SceneWorkload) -> Result<(), PipelineError> {
+fn check_scene_sizes(sc: &crate::scene::config::SceneWorkload) -> Result<(), SystemError> {
     use crate::limits::{MAX_SCENE_OBJECTS, MAX_SCENE_SCALE};
     if sc.scale.is_finite() && sc.scale > MAX_SCENE_SCALE {
         return Err(bad(
@@ -244,7 +245,7 @@ pub fn estimate_memory(cfg: &FramePipelineConfig) -> (u64, String) {
 }
 
 /// Fails with an error naming `run.max_memory` when the estimate exceeds it.
-fn check_memory(cfg: &FramePipelineConfig) -> Result<(), PipelineError> {
+fn check_memory(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
     let limit = cfg.run.max_memory.map_or(crate::limits::DEFAULT_MAX_MEMORY, |b| b.0);
     let (estimate, parts) = estimate_memory(cfg);
     if estimate > limit {
@@ -261,13 +262,13 @@ pub fn run_pipeline(
     cfg: FramePipelineConfig,
     base_dir: &Path,
     trace: Option<TraceWriter>,
-) -> Result<PipelineRun, PipelineError> {
+) -> Result<PipelineRun, SystemError> {
     validate(&cfg)?;
     check_memory(&cfg)?;
     let build_start = std::time::Instant::now();
     let scene = match &cfg.workload {
         WorkloadConfig::Scene(s) => Some(compile_scene(&cfg, s, base_dir).map_err(|e| match e {
-            super::workload::WorkloadError::Invalid { key, message } => PipelineError::Invalid { key, message },
+            super::workload::WorkloadError::Invalid { key, message } => SystemError::Invalid { key, message },
         })?),
         WorkloadConfig::Fixed(_) => None,
     };
@@ -284,11 +285,15 @@ pub fn run_pipeline(
     };
     let stats = run(&mut model, &mut sched, limits)?;
     if stats.stopped_by == StopReason::Exhausted && !model.done() {
-        return Err(PipelineError::Stalled {
+        return Err(SystemError::Unfinished {
             at: stats.end_time,
-            resolved: model.resolved(),
-            frames: model.frames_total,
-            state: model.describe(),
+            missing: "every frame was done".into(),
+            state: format!(
+                "{} of {} frames done: {}",
+                model.resolved(),
+                model.frames_total,
+                model.describe()
+            ),
         });
     }
     if !model.done() {
@@ -355,7 +360,7 @@ fn ms(ps: u64) -> f64 {
 /// of a vsynced display is an event), before failing at the overflow. Runs
 /// with `run.until` or `run.max_events` may stop earlier and are left to the
 /// clock's own checks.
-fn check_time_range(cfg: &FramePipelineConfig, analytic: &Value) -> Result<(), PipelineError> {
+fn check_time_range(cfg: &FramePipelineConfig, analytic: &Value) -> Result<(), SystemError> {
     let (cpu_key, gpu_key) = match &cfg.workload {
         WorkloadConfig::Fixed(_) => ("workload.cpu", "workload.gpu"),
         WorkloadConfig::Scene(_) => ("workload", "workload"),

@@ -19,5 +19,5 @@ pub mod model;
 pub mod run;
 
 pub use config::MultiRateConfig;
-pub use model::{MultiRate, MultiRateError};
+pub use model::MultiRate;
 pub use run::{MultiRateRun, run_multi_rate, validate};

@@ -18,45 +18,14 @@
 
 use rand::Rng;
 
-use crate::engine::{
-    Control, Duration, EngineError, EventKind, Model, RngStreams, Scheduler, StreamRng, Time, TimeError,
-};
+use crate::engine::{Control, Duration, EventKind, Model, RngStreams, Scheduler, StreamRng, Time};
+use crate::systems::error::SystemError;
 
 use crate::output::trace::TraceWriter;
 
 use super::analytic::Terms;
 use super::latency::Follower;
 use super::migration::Artifacts;
-
-/// Errors of a multi-frame-rate run.
-#[derive(Debug, thiserror::Error)]
-pub enum MultiRateError {
-    /// Kernel error (time overflow, event budget).
-    #[error(transparent)]
-    Engine(#[from] EngineError),
-    /// A model value the simulator cannot use.
-    #[error("{key}: {message}")]
-    Invalid {
-        /// Dotted key.
-        key: String,
-        /// What is wrong.
-        message: String,
-    },
-    /// The run ended before every input event was seen on every path.
-    #[error("the run stopped at {at} before every input event was visible ({state})")]
-    Unfinished {
-        /// When.
-        at: Time,
-        /// What was still missing.
-        state: String,
-    },
-}
-
-impl From<TimeError> for MultiRateError {
-    fn from(e: TimeError) -> Self {
-        MultiRateError::Engine(EngineError::Time(e))
-    }
-}
 
 /// The events.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -241,10 +210,10 @@ impl MultiRate {
     }
 
     /// Fails once the input records outgrow `run.max_memory`.
-    fn check_growth(&self, now: Time) -> Result<(), MultiRateError> {
+    fn check_growth(&self, now: Time) -> Result<(), SystemError> {
         let used = self.follower.record_bytes();
         if used > self.max_memory {
-            return Err(MultiRateError::Invalid {
+            return Err(SystemError::Invalid {
                 key: "run.max_memory".into(),
                 message: crate::limits::over_memory_message(
                     used,
@@ -261,7 +230,7 @@ impl MultiRate {
 
     /// Schedules the first event of every process and writes the trace's
     /// tracks.
-    pub fn start(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), MultiRateError> {
+    pub fn start(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         if let Some(t) = &mut self.trace {
             t.process(1, "multi-frame-rate");
             for (tid, name) in [
@@ -347,12 +316,7 @@ impl MultiRate {
         )
     }
 
-    fn send(
-        &mut self,
-        now: Time,
-        mut buffer: (usize, ScFrame),
-        sched: &mut Scheduler<Ev>,
-    ) -> Result<(), MultiRateError> {
+    fn send(&mut self, now: Time, mut buffer: (usize, ScFrame), sched: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         buffer.1.send_start = Some(now);
         self.in_flight = Some(buffer);
         sched.after(self.terms.transfer, Ev::TransferEnd, "SC -> FC transfer")?;
@@ -362,9 +326,9 @@ impl MultiRate {
 
 impl Model for MultiRate {
     type Event = Ev;
-    type Error = MultiRateError;
+    type Error = SystemError;
 
-    fn handle(&mut self, now: Time, ev: Ev, sched: &mut Scheduler<Ev>) -> Result<Control, MultiRateError> {
+    fn handle(&mut self, now: Time, ev: Ev, sched: &mut Scheduler<Ev>) -> Result<Control, SystemError> {
         let t = self.terms;
         match ev {
             Ev::Input => {

@@ -11,7 +11,8 @@ use crate::stats::quantile::Summary;
 use super::analytic::{Analytic, Bounds, Terms, analytic};
 use super::config::MultiRateConfig;
 use super::latency::{CONV_STAGES, EventRecord, FAST_STAGES, SLOW_STAGES, event_rows, total_ms};
-use super::model::{MultiRate, MultiRateError};
+use super::model::MultiRate;
+use crate::systems::error::SystemError;
 
 /// Everything a run produced.
 #[derive(Debug)]
@@ -33,15 +34,15 @@ pub struct MultiRateRun {
     pub trace: Option<TraceWriter>,
 }
 
-fn bad(key: &str, message: impl Into<String>) -> MultiRateError {
-    MultiRateError::Invalid {
+fn bad(key: &str, message: impl Into<String>) -> SystemError {
+    SystemError::Invalid {
         key: key.to_string(),
         message: message.into(),
     }
 }
 
 /// Checks values serde cannot.
-pub fn validate(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
+pub fn validate(cfg: &MultiRateConfig) -> Result<(), SystemError> {
     if cfg.system != "multi_rate" {
         return Err(bad("system", format!("expected \"multi_rate\", got {:?}", cfg.system)));
     }
@@ -161,7 +162,7 @@ pub fn estimate_memory(cfg: &MultiRateConfig) -> (u64, String) {
 /// trace is written into it as the run goes (one track per client, one for
 /// the link, input events as instants on the master's track) and handed
 /// back in [`MultiRateRun::trace`], to be closed by the caller.
-pub fn run_multi_rate(cfg: MultiRateConfig, trace: Option<TraceWriter>) -> Result<MultiRateRun, MultiRateError> {
+pub fn run_multi_rate(cfg: MultiRateConfig, trace: Option<TraceWriter>) -> Result<MultiRateRun, SystemError> {
     validate(&cfg)?;
     let max_memory = cfg.run.max_memory.map_or(crate::limits::DEFAULT_MAX_MEMORY, |b| b.0);
     let (estimate, parts) = estimate_memory(&cfg);
@@ -199,8 +200,9 @@ pub fn run_multi_rate(cfg: MultiRateConfig, trace: Option<TraceWriter>) -> Resul
     };
     let stats = run(&mut model, &mut sched, limits)?;
     if stats.stopped_by != StopReason::Model || !model.done() {
-        return Err(MultiRateError::Unfinished {
+        return Err(SystemError::Unfinished {
             at: stats.end_time,
+            missing: "every input event was visible".into(),
             state: model.describe(),
         });
     }
@@ -341,7 +343,7 @@ pub fn write_events_csv(events: &[EventRecord], w: &mut dyn Write) -> std::io::R
 /// and what follows the last one until every path shows it) reaches past
 /// the clock's range ([`crate::limits::span_check`]), blaming the largest
 /// part's key.
-fn check_span(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
+fn check_span(cfg: &MultiRateConfig) -> Result<(), SystemError> {
     let t = Terms::of(cfg);
     let f = |d: Duration| d.0 as f64;
     // Which key makes a client's interval: its rate cap or its frame.
@@ -398,7 +400,7 @@ fn check_span(cfg: &MultiRateConfig) -> Result<(), MultiRateError> {
 
 /// Refuses, before simulating, a run whose input events alone reach past
 /// the clock's range ([`crate::limits::input_span_message`]).
-fn check_time_range(events: u64, warmup: Duration, mean_interval: Duration) -> Result<(), MultiRateError> {
+fn check_time_range(events: u64, warmup: Duration, mean_interval: Duration) -> Result<(), SystemError> {
     match crate::limits::input_span_message(events, warmup.0, mean_interval.0) {
         Some(message) => Err(bad(crate::limits::INPUT_SPAN_KEYS, message)),
         None => Ok(()),

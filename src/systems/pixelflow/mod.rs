@@ -19,5 +19,5 @@ pub mod run;
 mod tests;
 
 pub use config::{Architecture, Fidelity, PixelFlowConfig, Placement};
-pub use model::{PixelFlow, PixelFlowError};
+pub use model::PixelFlow;
 pub use run::{PixelFlowRun, run_pixelflow, validate};

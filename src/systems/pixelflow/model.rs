@@ -24,42 +24,11 @@
 
 use std::collections::VecDeque;
 
-use crate::engine::{Control, Duration, EngineError, EventKind, Model, Scheduler, Time, TimeError};
+use crate::engine::{Control, Duration, EventKind, Model, Scheduler, Time, TimeError};
+use crate::systems::error::SystemError;
 
 use super::config::{Architecture, PixelFlowConfig};
 use super::layout::Layout;
-
-/// Errors of a PixelFlow run.
-#[derive(Debug, thiserror::Error)]
-pub enum PixelFlowError {
-    /// A value serde accepted but the model cannot use.
-    #[error("{key}: {message}")]
-    Invalid {
-        /// Dotted key.
-        key: String,
-        /// What is wrong.
-        message: String,
-    },
-    /// Kernel error.
-    #[error(transparent)]
-    Engine(#[from] EngineError),
-    /// The simulation ended before the frame was complete (a model bug).
-    #[error("the frame stalled at {at} with {loaded} of {regions} regions loaded")]
-    Stalled {
-        /// Last event time.
-        at: Time,
-        /// Regions loaded.
-        loaded: usize,
-        /// Regions in all.
-        regions: usize,
-    },
-}
-
-impl From<TimeError> for PixelFlowError {
-    fn from(e: TimeError) -> Self {
-        PixelFlowError::Engine(EngineError::Time(e))
-    }
-}
 
 /// Events of the PixelFlow model.
 #[derive(Debug, Clone, Copy)]
@@ -232,9 +201,9 @@ pub struct PixelFlow {
     pub trace: Option<Vec<Span>>,
 }
 
-fn mul(d: Duration, k: u64, what: &str) -> Result<Duration, PixelFlowError> {
+fn mul(d: Duration, k: u64, what: &str) -> Result<Duration, SystemError> {
     d.checked_mul(k).ok_or_else(|| {
-        PixelFlowError::from(TimeError::Overflow {
+        SystemError::from(TimeError::Overflow {
             context: format!("computing {what} ({d} x {k})"),
             at: Time::ZERO,
             by: Duration(u64::MAX),
@@ -332,7 +301,7 @@ impl PixelFlow {
         unit: u32,
         name: &'static str,
         arg: u32,
-    ) -> Result<Time, PixelFlowError> {
+    ) -> Result<Time, SystemError> {
         let now = sched.now();
         let end = sched.after(d, ev, name)?;
         self.span(role, unit, name, arg, now, end);
@@ -340,7 +309,7 @@ impl PixelFlow {
     }
 
     /// Schedules the frame's first events.
-    pub fn start(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), PixelFlowError> {
+    pub fn start(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         if self.cfg.architecture != Architecture::Nontex {
             return self.settle(sched);
         }
@@ -375,7 +344,7 @@ impl PixelFlow {
                 }
             };
             let d = d.ok_or_else(|| {
-                PixelFlowError::from(TimeError::Overflow {
+                SystemError::from(TimeError::Overflow {
                     context: "frame start-up".into(),
                     at: Time::ZERO,
                     by: Duration(u64::MAX),
@@ -409,7 +378,7 @@ impl PixelFlow {
         upto(k + 1) - upto(k)
     }
 
-    fn settle(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), PixelFlowError> {
+    fn settle(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         loop {
             let mut moved = false;
             match self.cfg.architecture {
@@ -440,7 +409,7 @@ impl PixelFlow {
         }
     }
 
-    fn settle_deferred(&mut self, sched: &mut Scheduler<Ev>) -> Result<bool, PixelFlowError> {
+    fn settle_deferred(&mut self, sched: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         let mut moved = false;
         let c = self.cfg.deferred.clone();
         let now = sched.now();
@@ -569,7 +538,7 @@ impl PixelFlow {
         Ok(moved)
     }
 
-    fn settle_tail(&mut self, sched: &mut Scheduler<Ev>) -> Result<bool, PixelFlowError> {
+    fn settle_tail(&mut self, sched: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         if self.load_busy.is_none()
             && let Some(j) = self.load_queue.pop_front()
         {
@@ -585,7 +554,7 @@ impl PixelFlow {
         Ok(false)
     }
 
-    fn settle_nontex(&mut self, sched: &mut Scheduler<Ev>) -> Result<bool, PixelFlowError> {
+    fn settle_nontex(&mut self, sched: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         let mut moved = false;
         let c = self.cfg.nontex.clone();
         let now = sched.now();
@@ -646,7 +615,7 @@ impl PixelFlow {
     }
 
     /// Nontex: every node finished rasterizing the current sample.
-    fn nontex_pass_done(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), PixelFlowError> {
+    fn nontex_pass_done(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         let now = sched.now();
         if self.pass == 1 {
             self.front_end_done = now;
@@ -671,9 +640,9 @@ impl PixelFlow {
 
 impl Model for PixelFlow {
     type Event = Ev;
-    type Error = PixelFlowError;
+    type Error = SystemError;
 
-    fn handle(&mut self, now: Time, ev: Ev, sched: &mut Scheduler<Ev>) -> Result<Control, PixelFlowError> {
+    fn handle(&mut self, now: Time, ev: Ev, sched: &mut Scheduler<Ev>) -> Result<Control, SystemError> {
         match ev {
             Ev::GeomDone(r) => {
                 let r = r as usize;

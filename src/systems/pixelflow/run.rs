@@ -8,7 +8,8 @@ use crate::output::trace::TraceWriter;
 use super::analytic::{Analytic, closed_form};
 use super::config::{Fidelity, PixelFlowConfig, Placement, Size};
 use super::layout::{Layout, build};
-use super::model::{PixelFlow, PixelFlowError, RegionRecord, Span};
+use super::model::{PixelFlow, RegionRecord, Span};
+use crate::systems::error::SystemError;
 
 /// Everything a run produced.
 #[derive(Debug)]
@@ -31,14 +32,14 @@ pub struct PixelFlowRun {
     pub trace: Option<TraceWriter>,
 }
 
-fn bad(key: &str, message: impl Into<String>) -> PixelFlowError {
-    PixelFlowError::Invalid {
+fn bad(key: &str, message: impl Into<String>) -> SystemError {
+    SystemError::Invalid {
         key: key.to_string(),
         message: message.into(),
     }
 }
 
-fn check_size(key: &str, s: &Size) -> Result<(), PixelFlowError> {
+fn check_size(key: &str, s: &Size) -> Result<(), SystemError> {
     for (k, v) in [("width", s.width), ("height", s.height)] {
         if !v.is_finite() || v < 0.0 {
             return Err(bad(
@@ -51,7 +52,7 @@ fn check_size(key: &str, s: &Size) -> Result<(), PixelFlowError> {
 }
 
 /// Checks what serde cannot.
-pub fn validate(cfg: &PixelFlowConfig) -> Result<(), PixelFlowError> {
+pub fn validate(cfg: &PixelFlowConfig) -> Result<(), SystemError> {
     if cfg.system != "pixelflow" {
         return Err(bad("system", format!("expected \"pixelflow\", got {:?}", cfg.system)));
     }
@@ -210,7 +211,7 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), PixelFlowError> {
 /// would hide a NaN term behind a finite one), whatever [`validate`] let
 /// through, and at event fidelity none may pass the clock's range. The
 /// error names the inputs the term is made of.
-fn finite_closed_form(cfg: &PixelFlowConfig, a: &Analytic) -> Result<(), PixelFlowError> {
+fn finite_closed_form(cfg: &PixelFlowConfig, a: &Analytic) -> Result<(), SystemError> {
     let frames = cfg.frames;
     let costs = match cfg.architecture {
         super::Architecture::Nontex => "nontex",
@@ -273,7 +274,7 @@ fn max_ms(v: &[Duration]) -> f64 {
 }
 
 /// Validates, builds and runs the model at its fidelity.
-pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, PixelFlowError> {
+pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, SystemError> {
     validate(&cfg)?;
     let t0 = std::time::Instant::now();
     let analytic = closed_form(&cfg);
@@ -316,10 +317,10 @@ pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, 
     model.start(&mut sched)?;
     let stats = run(&mut model, &mut sched, Limits::default())?;
     let Some(done) = model.finished else {
-        return Err(PixelFlowError::Stalled {
+        return Err(SystemError::Unfinished {
             at: stats.end_time,
-            loaded: model.loaded(),
-            regions: model.records.len(),
+            missing: "the frame was complete".into(),
+            state: format!("{} of {} regions loaded", model.loaded(), model.records.len()),
         });
     };
     let b = &model.busy;

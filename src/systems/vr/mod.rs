@@ -16,5 +16,5 @@ pub mod model;
 pub mod run;
 
 pub use config::VrConfig;
-pub use model::{Vr, VrError};
+pub use model::Vr;
 pub use run::{VrRun, run_vr, validate};

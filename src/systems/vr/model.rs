@@ -16,44 +16,13 @@
 
 use rand::Rng;
 
-use crate::engine::{
-    Control, Duration, EngineError, EventKind, Model, RngStreams, Scheduler, StreamRng, Time, TimeError,
-};
+use crate::engine::{Control, Duration, EventKind, Model, RngStreams, Scheduler, StreamRng, Time};
+use crate::systems::error::SystemError;
 
 use crate::output::trace::TraceWriter;
 
 use super::config::{Scheme, VrConfig};
 use super::latency::Follower;
-
-/// Errors of a VR run.
-#[derive(Debug, thiserror::Error)]
-pub enum VrError {
-    /// Kernel error.
-    #[error(transparent)]
-    Engine(#[from] EngineError),
-    /// A model value the simulator cannot use.
-    #[error("{key}: {message}")]
-    Invalid {
-        /// Dotted key.
-        key: String,
-        /// What is wrong.
-        message: String,
-    },
-    /// The run ended before every motion was visible.
-    #[error("the run stopped at {at} before every motion event was visible ({state})")]
-    Unfinished {
-        /// When.
-        at: Time,
-        /// What was missing.
-        state: String,
-    },
-}
-
-impl From<TimeError> for VrError {
-    fn from(e: TimeError) -> Self {
-        VrError::Engine(EngineError::Time(e))
-    }
-}
 
 /// The events.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -236,10 +205,10 @@ impl Vr {
     }
 
     /// Fails once the motion records outgrow `run.max_memory`.
-    fn check_growth(&self, now: Time) -> Result<(), VrError> {
+    fn check_growth(&self, now: Time) -> Result<(), SystemError> {
         let used = self.follower.record_bytes();
         if used > self.max_memory {
-            return Err(VrError::Invalid {
+            return Err(SystemError::Invalid {
                 key: "run.max_memory".into(),
                 message: crate::limits::over_memory_message(
                     used,
@@ -255,7 +224,7 @@ impl Vr {
     }
 
     /// Schedules the first events and writes the trace's tracks.
-    pub fn start(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), VrError> {
+    pub fn start(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         if let Some(t) = &mut self.trace {
             t.process(1, "VR pipeline");
             for (tid, name) in [
@@ -354,9 +323,9 @@ impl Vr {
 
 impl Model for Vr {
     type Event = Ev;
-    type Error = VrError;
+    type Error = SystemError;
 
-    fn handle(&mut self, now: Time, ev: Ev, sched: &mut Scheduler<Ev>) -> Result<Control, VrError> {
+    fn handle(&mut self, now: Time, ev: Ev, sched: &mut Scheduler<Ev>) -> Result<Control, SystemError> {
         let c = &self.cfg;
         let (step, render, warp, pair) = (c.simulation.step, c.renderer.render, c.warp.render, c.pair());
         match ev {

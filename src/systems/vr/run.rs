@@ -13,7 +13,8 @@ use crate::stats::quantile::Summary;
 use super::analytic::{Analytic, Bounds, analytic};
 use super::config::{Scheme, VrConfig};
 use super::latency::{MotionRecord, NAIVE_STAGES, WARP_HEAD_STAGES, WARP_OBJECT_STAGES};
-use super::model::{Vr, VrError};
+use super::model::Vr;
+use crate::systems::error::SystemError;
 
 /// Everything a run produced.
 #[derive(Debug)]
@@ -34,15 +35,15 @@ pub struct VrRun {
     pub trace: Option<TraceWriter>,
 }
 
-fn bad(key: &str, message: impl Into<String>) -> VrError {
-    VrError::Invalid {
+fn bad(key: &str, message: impl Into<String>) -> SystemError {
+    SystemError::Invalid {
         key: key.to_string(),
         message: message.into(),
     }
 }
 
 /// Checks values serde cannot.
-pub fn validate(cfg: &VrConfig) -> Result<(), VrError> {
+pub fn validate(cfg: &VrConfig) -> Result<(), SystemError> {
     if cfg.system != "vr" {
         return Err(bad("system", format!("expected \"vr\", got {:?}", cfg.system)));
     }
@@ -100,7 +101,7 @@ pub fn estimate_memory(cfg: &VrConfig) -> (u64, String) {
 /// written into it as the run goes (a track per stage: simulation,
 /// renderer, warping renderer, display; motions as instants) and handed back
 /// in [`VrRun::trace`], to be closed by the caller.
-pub fn run_vr(cfg: VrConfig, trace: Option<TraceWriter>) -> Result<VrRun, VrError> {
+pub fn run_vr(cfg: VrConfig, trace: Option<TraceWriter>) -> Result<VrRun, SystemError> {
     validate(&cfg)?;
     let max_memory = cfg.run.max_memory.map_or(crate::limits::DEFAULT_MAX_MEMORY, |b| b.0);
     let (estimate, parts) = estimate_memory(&cfg);
@@ -122,8 +123,9 @@ pub fn run_vr(cfg: VrConfig, trace: Option<TraceWriter>) -> Result<VrRun, VrErro
     };
     let stats = run(&mut model, &mut sched, limits)?;
     if stats.stopped_by != StopReason::Model || !model.done() {
-        return Err(VrError::Unfinished {
+        return Err(SystemError::Unfinished {
             at: stats.end_time,
+            missing: "every motion event was visible".into(),
             state: model.describe(),
         });
     }
@@ -255,7 +257,7 @@ pub fn write_motions_csv(motions: &[MotionRecord], w: &mut dyn Write) -> std::io
 /// Refuses, before simulating, a run whose expected span (the motions and
 /// what follows the last one until it is shown) reaches past the clock's
 /// range ([`crate::limits::span_check`]), blaming the largest part's key.
-fn check_span(cfg: &VrConfig) -> Result<(), VrError> {
+fn check_span(cfg: &VrConfig) -> Result<(), SystemError> {
     let f = |d: Duration| d.0 as f64;
     let terms = [
         ("run.warmup", f(cfg.run.warmup)),
@@ -278,7 +280,7 @@ fn check_span(cfg: &VrConfig) -> Result<(), VrError> {
 
 /// Refuses, before simulating, a run whose input events alone reach past
 /// the clock's range ([`crate::limits::input_span_message`]).
-fn check_time_range(events: u64, warmup: Duration, mean_interval: Duration) -> Result<(), VrError> {
+fn check_time_range(events: u64, warmup: Duration, mean_interval: Duration) -> Result<(), SystemError> {
     match crate::limits::input_span_message(events, warmup.0, mean_interval.0) {
         Some(message) => Err(bad(crate::limits::INPUT_SPAN_KEYS, message)),
         None => Ok(()),
