@@ -23,6 +23,15 @@
 //!
 //! An event scheduled before the last popped time (a model bug the run loop
 //! reports) is kept aside and popped first, so the loop sees it at once.
+//!
+//! While few events are pending (a rendering pipeline keeps about five: the
+//! next vertical blank, the noise sources, the CPU's and the GPU's next
+//! completion) they are kept in one small array sorted latest first, so a
+//! push is a short scan and a pop takes the last element: no buckets, no
+//! spreading. Past [`SMALL_MAX`] pending the heap files them into its
+//! buckets (in `(time, seq)` order, which keeps every bucket in sequence
+//! order) and goes back to the array once at most [`SMALL_BACK`] are left.
+//! The pop order is the same `(time, seq)` order in both forms.
 
 use std::collections::VecDeque;
 
@@ -30,6 +39,10 @@ use super::queue::Scheduled;
 
 const LEVELS: usize = 8;
 const DIGITS: usize = 256;
+/// Pending events the small sorted array holds before the heap uses its buckets.
+pub const SMALL_MAX: usize = 32;
+/// Pending events at or below which the heap returns to the small array.
+pub const SMALL_BACK: usize = 8;
 
 /// The radix heap (see the module documentation).
 #[derive(Debug)]
@@ -47,6 +60,11 @@ pub struct RadixHeap<E> {
     /// Events scheduled before `last` (model bugs), popped first.
     stale: Vec<Scheduled<E>>,
     len: usize,
+    /// True while the events are in `small` (and nothing is in the buckets,
+    /// `now` or `stale`).
+    is_small: bool,
+    /// Small form: pending events sorted by `(time, seq)`, latest first.
+    small: Vec<Scheduled<E>>,
 }
 
 impl<E> Default for RadixHeap<E> {
@@ -77,7 +95,55 @@ impl<E> RadixHeap<E> {
             digits: [[0; 4]; LEVELS],
             stale: Vec::new(),
             len: 0,
+            is_small: true,
+            small: Vec::with_capacity(SMALL_MAX),
         }
+    }
+
+    /// Small form: inserts `s` after (in pop order) every event due at or
+    /// before its time (it has the largest sequence number so far).
+    #[inline]
+    fn small_insert(&mut self, s: Scheduled<E>) {
+        // Appended, then moved down past the earlier ones (usually few: a
+        // new event tends to be among the next due); no memmove call.
+        let v = &mut self.small;
+        v.push(s);
+        let mut i = v.len() - 1;
+        while i > 0 && v[i - 1].time <= v[i].time {
+            v.swap(i - 1, i);
+            i -= 1;
+        }
+    }
+
+    /// Leaves the small form: files its events into the buckets in
+    /// `(time, seq)` order.
+    #[cold]
+    fn spill_to_buckets(&mut self) {
+        self.is_small = false;
+        let mut small = std::mem::take(&mut self.small);
+        while let Some(s) = small.pop() {
+            if s.time.0 < self.last {
+                self.stale.push(s);
+            } else {
+                self.file(s);
+            }
+        }
+        self.small = small;
+    }
+
+    /// Back to the small form (few events left): pops them in order.
+    #[cold]
+    fn gather_to_small(&mut self) {
+        let mut out = std::mem::take(&mut self.small);
+        debug_assert!(out.is_empty());
+        let n = self.len;
+        while let Some(s) = self.pop_buckets() {
+            out.push(s);
+        }
+        out.reverse();
+        self.len = n;
+        self.small = out;
+        self.is_small = true;
     }
 
     #[inline]
@@ -97,6 +163,13 @@ impl<E> RadixHeap<E> {
     #[inline]
     pub fn push(&mut self, s: Scheduled<E>) {
         self.len += 1;
+        if self.is_small {
+            if self.small.len() < SMALL_MAX {
+                self.small_insert(s);
+                return;
+            }
+            self.spill_to_buckets();
+        }
         if s.time.0 < self.last {
             self.stale.push(s);
         } else {
@@ -107,6 +180,12 @@ impl<E> RadixHeap<E> {
     /// Puts back the event just popped (it goes before every other event
     /// due at the same time, as it was).
     pub fn restore(&mut self, s: Scheduled<E>) {
+        if self.is_small {
+            // It was the earliest: it goes back to the end.
+            self.len += 1;
+            self.small.push(s);
+            return;
+        }
         if s.time.0 == self.last {
             self.len += 1;
             self.now.push_front(s);
@@ -118,6 +197,23 @@ impl<E> RadixHeap<E> {
     /// Removes the earliest event (ties: the first scheduled).
     #[inline]
     pub fn pop(&mut self) -> Option<Scheduled<E>> {
+        if self.is_small {
+            let s = self.small.pop()?;
+            self.len -= 1;
+            // A stale event (a model bug) does not move time back.
+            self.last = self.last.max(s.time.0);
+            return Some(s);
+        }
+        let s = self.pop_buckets();
+        if self.len <= SMALL_BACK {
+            self.gather_to_small();
+        }
+        s
+    }
+
+    /// Removes the earliest event from the bucket form.
+    #[inline]
+    fn pop_buckets(&mut self) -> Option<Scheduled<E>> {
         if !self.stale.is_empty() {
             return self.pop_stale();
         }
@@ -196,6 +292,9 @@ impl<E> RadixHeap<E> {
 
     /// The earliest due time, without removing anything.
     pub fn peek_time(&self) -> Option<super::time::Time> {
+        if self.is_small {
+            return self.small.last().map(|s| s.time);
+        }
         if let Some(s) = self.stale.iter().min_by_key(|s| (s.time, s.seq)) {
             return Some(s.time);
         }
