@@ -95,23 +95,6 @@ pub fn add_bytes(total: &mut u64, count: u64, size: usize) {
     *total = total.saturating_add(count.saturating_mul(size as u64));
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn byte_counts_read_well() {
-        assert_eq!(show_bytes(DEFAULT_MAX_MEMORY), "8 GiB");
-        assert_eq!(show_bytes(1536 << 20), "1.5 GiB");
-        assert_eq!(show_bytes(100), "100 bytes");
-        let m = over_memory_message(9 << 30, "frames", DEFAULT_MAX_MEMORY);
-        assert!(
-            m.contains("9 GiB") && m.contains("run.max_memory = 8 GiB") && m.contains("16GiB"),
-            "{m}"
-        );
-    }
-}
-
 /// The message refusing, before simulating, a latency-system run whose input
 /// events alone (`run.events` arrivals `input.mean_interval` apart on
 /// average, after `run.warmup`, all in picoseconds) reach past the clock's
@@ -159,4 +142,21 @@ pub fn latency_estimate(
         span_ps / 1e12
     );
     (frame_bytes.saturating_add(event_bytes), parts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn byte_counts_read_well() {
+        assert_eq!(show_bytes(DEFAULT_MAX_MEMORY), "8 GiB");
+        assert_eq!(show_bytes(1536 << 20), "1.5 GiB");
+        assert_eq!(show_bytes(100), "100 bytes");
+        let m = over_memory_message(9 << 30, "frames", DEFAULT_MAX_MEMORY);
+        assert!(
+            m.contains("9 GiB") && m.contains("run.max_memory = 8 GiB") && m.contains("16GiB"),
+            "{m}"
+        );
+    }
 }

@@ -67,6 +67,7 @@ pub enum QueueKind {
 }
 
 #[derive(Debug)]
+#[allow(clippy::large_enum_variant)] // one per scheduler, never moved in a hot loop
 enum Store<E> {
     Radix(RadixHeap<E>),
     Binary(BinaryHeap<Scheduled<E>>),
