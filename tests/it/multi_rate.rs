@@ -4,7 +4,7 @@
 
 use std::process::Command;
 
-use rendersim::config::{ModelSource, apply_set};
+use rendersim::config::{ModelSource, Overrides, prepare};
 use rendersim::systems::{SystemRun, run_model};
 use serde_json::Value;
 
@@ -12,12 +12,9 @@ const CLUSTER: &str = include_str!("../../models/mfr-cluster.toml");
 const MULTIGPU: &str = include_str!("../../models/mfr-multigpu.toml");
 
 fn try_run(text: &str, sets: &[&str]) -> Result<SystemRun, String> {
-    let src = ModelSource::from_text("test.toml", text);
-    let mut t = src.table().map_err(|e| e.to_string())?;
-    for s in sets {
-        apply_set(&mut t, s).map_err(|e| e.to_string())?;
-    }
-    run_model(&src, &t, None).map_err(|e| e.to_string())
+    let m =
+        prepare(ModelSource::from_text("test.toml", text), &Overrides::with_sets(sets)).map_err(|e| e.to_string())?;
+    run_model(&m.source, &m.table, None).map_err(|e| e.to_string())
 }
 
 fn summary(text: &str, sets: &[&str]) -> Value {

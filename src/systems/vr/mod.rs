@@ -11,6 +11,7 @@
 pub mod analytic;
 pub mod config;
 pub mod model;
+pub mod report;
 pub mod run;
 
 pub use config::VrConfig;
