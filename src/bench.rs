@@ -1,5 +1,5 @@
-//! Speed benchmarks behind `rendersim bench` (and `cargo bench`): each prints
-//! its rate next to a baseline measured in the same run, as a ratio.
+//! Speed benchmarks behind `rendersim bench` (and `cargo bench`): each
+//! measures its rate next to a baseline measured in the same run.
 //!
 //! - `kernel`: the classic hold model (a fixed population of pending events;
 //!   each handled event schedules one more at a random later time) and a
@@ -10,6 +10,10 @@
 //!   fidelity against the same frame at `draw` fidelity.
 //! - `hour`: one simulated hour of the default (noisy, 60 Hz) model at `draw`
 //!   fidelity.
+//! - `pixelflow`: Figures 3 and 4 of paper 002 at event fidelity against
+//!   the closed forms and a target.
+//!
+//! The functions return the measurements; `rendersim bench` prints them.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -17,11 +21,11 @@ use std::time::Instant;
 
 use rand::Rng;
 
-use crate::config::{ModelSource, apply_set};
+use crate::config::{ConfigError, ModelSource, Overrides, load_model};
 use crate::engine::{
     Control, Duration, EngineError, EventKind, Limits, Model, QueueKind, RngStreams, Scheduler, StreamRng, Time, run,
 };
-use crate::systems::{DEFAULT_MODEL, run_model};
+use crate::systems::{SimError, run_model};
 
 /// Hold-model event.
 #[derive(Debug, Clone, Copy)]
@@ -233,20 +237,59 @@ pub fn plot_kernel(cases: &[KernelBench], path: &std::path::Path) -> Result<(), 
     )
 }
 
-fn run_default_with(sets: &[&str]) -> Result<(serde_json::Value, f64), String> {
-    let src = ModelSource::from_text("<embedded default model>", DEFAULT_MODEL);
-    let mut t = src.table().map_err(|e| e.to_string())?;
-    for s in sets {
-        apply_set(&mut t, s).map_err(|e| e.to_string())?;
+/// Why a benchmark could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// `--scale` is outside (0, 1].
+    #[error("--scale must be in (0, 1], got {0}")]
+    Scale(f64),
+    /// A benchmark's model is wrong.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// A benchmark's run failed.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+}
+
+/// One of the benchmarks of `rendersim bench`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Bench {
+    /// The event kernel against a bare heap ([`kernel_case`]).
+    Kernel,
+    /// One frame at both fidelities ([`pipeline_bench`]).
+    Pipeline,
+    /// One simulated hour of the default model ([`hour_bench`]).
+    Hour,
+    /// PixelFlow's Figures 3 and 4 ([`pixelflow_bench`]).
+    Pixelflow,
+}
+
+impl Bench {
+    /// Every benchmark, in the order `rendersim bench all` runs them.
+    pub const ALL: [Bench; 4] = [Bench::Pixelflow, Bench::Kernel, Bench::Pipeline, Bench::Hour];
+}
+
+/// Checks that `scale` (the fraction of the full work) is in (0, 1].
+pub fn check_scale(scale: f64) -> Result<(), BenchError> {
+    if scale > 0.0 && scale <= 1.0 {
+        Ok(())
+    } else {
+        Err(BenchError::Scale(scale))
     }
+}
+
+fn run_default_with(sets: &[&str]) -> Result<(serde_json::Value, f64), BenchError> {
+    let m = load_model(None, &Overrides::with_sets(sets))?;
     let start = Instant::now();
-    let r = run_model(&src, &t, None).map_err(|e| e.to_string())?;
+    let r = run_model(&m.source, &m.table, None)?;
     Ok((r.summary().clone(), start.elapsed().as_secs_f64()))
 }
 
 /// One frame at both fidelities.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct PipelineBench {
+    /// The grid's side: the frame is `grid:WxW`.
+    pub width: u32,
     /// Triangles in the frame.
     pub triangles: u64,
     /// Wall seconds, build (mesh, cache simulation) and simulation, `triangle`.
@@ -268,7 +311,7 @@ pub struct PipelineBench {
 }
 
 /// One frame of `grid:WxW` (2 W^2 triangles) at both fidelities.
-pub fn pipeline(w: u32) -> Result<PipelineBench, String> {
+pub fn pipeline(w: u32) -> Result<PipelineBench, BenchError> {
     let mesh = format!(
         "workload.groups=[{{name=\"big\", mesh=\"grid:{w}x{w}\", triangle_pixels={{kind=\"lognormal\", median=4.0, sigma=1.0}}}}]"
     );
@@ -287,6 +330,7 @@ pub fn pipeline(w: u32) -> Result<PipelineBench, String> {
     let ft = |s: &serde_json::Value| s["metrics"]["gpu_time_ms"]["mean"].as_f64().unwrap_or(f64::NAN);
     let sim = |s: &serde_json::Value| s["simulate_seconds"].as_f64().unwrap_or(f64::NAN);
     Ok(PipelineBench {
+        width: w,
         triangles: 2 * w as u64 * w as u64,
         triangle_total_s: w_tri,
         draw_total_s: w_draw,
@@ -312,15 +356,15 @@ pub fn pixelflow_target_s(counts: u32) -> f64 {
 /// Figures 3 and 4 of paper 002 at event fidelity, one thread: every
 /// architecture, 1 and 4 shaders, 1 and 8 samples, `counts` primitive
 /// counts from 0 to 1,000,000. Returns (runs, events, wall seconds).
-pub fn pixelflow_figures(counts: u32) -> Result<(u64, u64, f64), String> {
+pub fn pixelflow_figures(counts: u32) -> Result<(u64, u64, f64), BenchError> {
     pixelflow_figures_at(counts, "event")
 }
 
 /// [`pixelflow_figures`] at `fidelity` (`"event"` or `"analytic"`, the
 /// closed forms: the baseline the event simulation is compared with).
-pub fn pixelflow_figures_at(counts: u32, fidelity: &str) -> Result<(u64, u64, f64), String> {
+pub fn pixelflow_figures_at(counts: u32, fidelity: &str) -> Result<(u64, u64, f64), BenchError> {
     let src = ModelSource::from_text("models/pixelflow-20.toml", include_str!("../models/pixelflow-20.toml"));
-    let base = src.table().map_err(|e| e.to_string())?;
+    let base = src.table()?;
     let (mut runs, mut events) = (0u64, 0u64);
     let start = Instant::now();
     for samples in [8, 1] {
@@ -328,17 +372,16 @@ pub fn pixelflow_figures_at(counts: u32, fidelity: &str) -> Result<(u64, u64, f6
             for shaders in [1, 4] {
                 for i in 0..counts.max(2) {
                     let n = 1_000_000u64 * i as u64 / (counts.max(2) - 1) as u64;
-                    let mut t = base.clone();
-                    for s in [
+                    let (mut run_src, mut t) = (src.clone(), base.clone());
+                    Overrides::with_sets(&[
                         format!("samples={samples}"),
                         format!("architecture=\"{arch}\""),
                         format!("shading_nodes={shaders}"),
                         format!("primitives={n}"),
                         format!("fidelity=\"{fidelity}\""),
-                    ] {
-                        apply_set(&mut t, &s).map_err(|e| e.to_string())?;
-                    }
-                    let r = run_model(&src, &t, None).map_err(|e| e.to_string())?;
+                    ])
+                    .apply(&mut run_src, &mut t)?;
+                    let r = run_model(&run_src, &t, None)?;
                     events += r.summary()["events"]["total"].as_u64().unwrap_or(0);
                     runs += 1;
                 }
@@ -348,82 +391,78 @@ pub fn pixelflow_figures_at(counts: u32, fidelity: &str) -> Result<(u64, u64, f6
     Ok((runs, events, start.elapsed().as_secs_f64()))
 }
 
-/// Prints the benchmarks for the CLI.
-pub fn run_cli(which: &str, scale: f64) -> Result<(), String> {
-    if !(scale > 0.0 && scale <= 1.0) {
-        return Err(format!("--scale must be in (0, 1], got {scale}"));
-    }
-    let all = which == "all";
-    if !matches!(which, "all" | "kernel" | "pipeline" | "hour" | "pixelflow") {
-        return Err(format!(
-            "unknown benchmark {which:?} (kernel, pipeline, hour, pixelflow, all)"
-        ));
-    }
-    if all || which == "pixelflow" {
-        let counts = ((51.0 * scale) as u32).max(2);
-        let (runs, events, wall) = pixelflow_figures(counts)?;
-        let (_, _, closed) = pixelflow_figures_at(counts, "analytic")?;
-        let target = pixelflow_target_s(counts);
-        println!(
-            "pixelflow Figures 3 and 4 at event fidelity, one thread: {runs} runs ({counts} primitive counts x 3 architectures x 2 shader counts x 2 sample counts), {events} events, {wall:.3} s wall ({:.2} ms per run); target <= {target:.3} s: ratio {:.4} of the target ({}); closed forms (analytic fidelity, same runs) {closed:.3} s, event / closed form {:.1}x",
-            1e3 * wall / runs as f64,
-            wall / target,
-            if wall <= target { "met" } else { "MISSED" },
-            wall / closed.max(1e-9)
-        );
-    }
-    if all || which == "kernel" {
-        for (work, pop) in KERNEL_CASES {
-            // At least 2 events per pending one, so the heap is in steady state.
-            let events = ((20_000_000.0 * scale) as u64).max(2 * pop as u64);
-            let k = kernel_case(work, pop, events);
-            println!(
-                "kernel {}, {} pending: engine {:.2} M events/s ({:.1} ns/event; binary-heap queue {:.2} M events/s), bare BinaryHeap {:.2} M events/s, ratio {:.3}",
-                work.name(),
-                k.population,
-                k.engine_events_per_s / 1e6,
-                1e9 / k.engine_events_per_s,
-                k.engine_binary_events_per_s / 1e6,
-                k.bare_events_per_s / 1e6,
-                k.ratio
-            );
-        }
-    }
-    if all || which == "pipeline" {
-        let w = ((707.0 * scale.sqrt()) as u32).max(2);
-        let p = pipeline(w)?;
-        println!(
-            "pipeline, one frame of grid:{w}x{w} ({} triangles): triangle fidelity {:.3} s in total ({:.3} s event loop, {} events), draw fidelity {:.3} s in total ({:.6} s event loop, {} events); speed-up {:.1}x in total, {:.0}x in the event loop (the shared mesh build and cache simulation take {:.3} s); GPU time {:.3} ms vs {:.3} ms ({:+.3}%)",
-            p.triangles,
-            p.triangle_total_s,
-            p.triangle_simulate_s,
-            p.triangle_events,
-            p.draw_total_s,
-            p.draw_simulate_s,
-            p.draw_events,
-            p.triangle_total_s / p.draw_total_s,
-            p.triangle_simulate_s / p.draw_simulate_s,
-            p.draw_total_s - p.draw_simulate_s,
-            p.triangle_gpu_ms,
-            p.draw_gpu_ms,
-            100.0 * (p.draw_gpu_ms - p.triangle_gpu_ms) / p.triangle_gpu_ms
-        );
-    }
-    if all || which == "hour" {
-        let frames = (216_000.0 * scale) as u64;
-        let f = format!("run.frames={frames}");
-        let (s, wall) = run_default_with(&["fidelity=\"draw\"", f.as_str()])?;
-        println!(
-            "one {:.0}-second run of the default model at draw fidelity ({} frames, noise on): {:.3} s wall, {} events ({:.2} M events/s)",
-            s["simulated_seconds"].as_f64().unwrap_or(0.0),
-            frames,
-            wall,
-            s["events"]["total"],
-            s["events_per_second"].as_f64().unwrap_or(0.0) / 1e6
-        );
-    }
-    let _ = Duration::ZERO;
-    Ok(())
+/// Events handled by the kernel case with `population` pending at `scale`:
+/// at least 2 per pending one, so the heap is in steady state.
+pub fn kernel_events(population: usize, scale: f64) -> u64 {
+    ((20_000_000.0 * scale) as u64).max(2 * population as u64)
+}
+
+/// The PixelFlow benchmark: [`pixelflow_figures`] at event fidelity against
+/// the same runs at analytic fidelity and against the target.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct PixelflowBench {
+    /// Primitive counts per configuration.
+    pub counts: u32,
+    /// Runs at event fidelity.
+    pub runs: u64,
+    /// Events in all.
+    pub events: u64,
+    /// Wall seconds at event fidelity.
+    pub wall_s: f64,
+    /// Wall seconds of the same runs at analytic fidelity (closed forms).
+    pub closed_s: f64,
+    /// The target for `counts` ([`pixelflow_target_s`]).
+    pub target_s: f64,
+}
+
+/// The PixelFlow benchmark at `scale` (51 primitive counts at 1).
+pub fn pixelflow_bench(scale: f64) -> Result<PixelflowBench, BenchError> {
+    let counts = ((51.0 * scale) as u32).max(2);
+    let (runs, events, wall_s) = pixelflow_figures(counts)?;
+    let (_, _, closed_s) = pixelflow_figures_at(counts, "analytic")?;
+    Ok(PixelflowBench {
+        counts,
+        runs,
+        events,
+        wall_s,
+        closed_s,
+        target_s: pixelflow_target_s(counts),
+    })
+}
+
+/// The pipeline benchmark at `scale`: one frame of `grid:WxW` with W = 707
+/// at 1 (about a million triangles), fewer for smaller scales.
+pub fn pipeline_bench(scale: f64) -> Result<PipelineBench, BenchError> {
+    pipeline(((707.0 * scale.sqrt()) as u32).max(2))
+}
+
+/// One long run of the default model at draw fidelity.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct HourBench {
+    /// Frames simulated.
+    pub frames: u64,
+    /// Simulated seconds.
+    pub simulated_seconds: f64,
+    /// Wall seconds, loading included.
+    pub wall_s: f64,
+    /// Events handled.
+    pub events: u64,
+    /// The run's own events per second (its event loop).
+    pub events_per_second: f64,
+}
+
+/// The hour benchmark at `scale`: 216,000 frames (an hour at 60 Hz) at 1.
+pub fn hour_bench(scale: f64) -> Result<HourBench, BenchError> {
+    let frames = (216_000.0 * scale) as u64;
+    let f = format!("run.frames={frames}");
+    let (s, wall_s) = run_default_with(&["fidelity=\"draw\"", f.as_str()])?;
+    Ok(HourBench {
+        frames,
+        simulated_seconds: s["simulated_seconds"].as_f64().unwrap_or(0.0),
+        wall_s,
+        events: s["events"]["total"].as_u64().unwrap_or(0),
+        events_per_second: s["events_per_second"].as_f64().unwrap_or(0.0),
+    })
 }
 
 #[cfg(test)]

@@ -117,7 +117,8 @@ impl NoiseSource {
             Arrivals::Poisson { mean_gap } => ("mean time between tasks (1/rate)", mean_gap.0 as f64),
         };
         let mean = duration.mean();
-        if !(mean < gap) {
+        // Written so that a NaN mean is refused too.
+        if mean.partial_cmp(&gap) != Some(std::cmp::Ordering::Less) {
             return Err(NoiseError::Overloaded {
                 name,
                 what,

@@ -10,7 +10,7 @@ use serde::de::DeserializeOwned;
 /// Where a model came from and its text.
 #[derive(Debug, Clone)]
 pub struct ModelSource {
-    /// A file path, or `<embedded default>`.
+    /// A file path, or `<embedded default model>`.
     pub name: String,
     /// The TOML text.
     pub text: String,
@@ -40,6 +40,14 @@ pub enum ConfigError {
         file: String,
         /// The parser's message (it names line and column).
         message: String,
+    },
+    /// A command-line option's value cannot go into a model.
+    #[error("{option}: {reason}")]
+    Override {
+        /// The option as given, e.g. `--seed 18446744073709551615`.
+        option: String,
+        /// Why.
+        reason: String,
     },
     /// A `--set key=value` could not be applied.
     #[error("--set {assignment:?}: {reason}")]
@@ -177,73 +185,6 @@ fn line_at(text: &str, offset: usize) -> usize {
     text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
 }
 
-/// Applies `key.path=value` to `table`. The value is read as TOML (numbers,
-/// booleans, strings in quotes, arrays, inline tables); anything that is not
-/// valid TOML is taken as a plain string, so `--set workload.gpu=17ms` works.
-pub fn apply_set(table: &mut toml::Table, assignment: &str) -> Result<(), ConfigError> {
-    let err = |reason: &str| ConfigError::Set {
-        assignment: assignment.to_string(),
-        reason: reason.to_string(),
-    };
-    let (key, raw) = assignment.split_once('=').ok_or_else(|| err("expected key=value"))?;
-    let key = key.trim();
-    if key.is_empty() || key.split('.').any(|p| p.trim().is_empty()) {
-        return Err(err("empty key"));
-    }
-    let raw = raw.trim();
-    let value = match format!("v = {raw}").parse::<toml::Table>() {
-        Ok(mut t) => t.remove("v").unwrap_or(toml::Value::String(raw.to_string())),
-        Err(_) => toml::Value::String(raw.to_string()),
-    };
-    set_dotted(table, key, value).map_err(|r| err(&r))
-}
-
-/// Sets `value` at dotted `key` in `table`, creating intermediate tables.
-/// A numeric part indexes into an array (`workload.groups.0.count`).
-pub fn set_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
-    let parts: Vec<&str> = key.split('.').map(str::trim).collect();
-    let mut cur: &mut toml::Table = table;
-    for (i, part) in parts.iter().enumerate() {
-        let last = i + 1 == parts.len();
-        if last {
-            cur.insert(part.to_string(), value);
-            return Ok(());
-        }
-        let next_is_index = parts[i + 1].parse::<usize>().is_ok();
-        let entry = cur.entry(part.to_string()).or_insert_with(|| {
-            if next_is_index {
-                toml::Value::Array(vec![])
-            } else {
-                toml::Value::Table(toml::Table::new())
-            }
-        });
-        match entry {
-            toml::Value::Table(t) => cur = t,
-            toml::Value::Array(a) if next_is_index => {
-                let idx: usize = parts[i + 1].parse().unwrap_or(0);
-                let path = parts[..=i + 1].join(".");
-                let n = a.len();
-                let elem = a
-                    .get_mut(idx)
-                    .ok_or_else(|| format!("`{path}`: index {idx} is out of range (array has {n} entries)"))?;
-                if i + 2 == parts.len() {
-                    *elem = value;
-                    return Ok(());
-                }
-                match elem {
-                    toml::Value::Table(t) => {
-                        // Skip the index part on the next iteration.
-                        return set_dotted(t, &parts[i + 2..].join("."), value);
-                    }
-                    _ => return Err(format!("`{path}` is not a table")),
-                }
-            }
-            _ => return Err(format!("`{}` is not a table", parts[..=i].join("."))),
-        }
-    }
-    Ok(())
-}
-
 /// Deserializes `table` into `T`, turning serde's errors into
 /// [`ConfigError::Invalid`] with key path, line and suggestion.
 pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) -> Result<T, ConfigError> {
@@ -374,6 +315,7 @@ fn unknown_field(msg: &str) -> Option<(String, Vec<String>)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::config::apply_set;
     use serde::Deserialize;
 
     #[derive(Deserialize, Debug)]
@@ -412,22 +354,6 @@ mod tests {
         let src = ModelSource::from_text("m.toml", "[display\nrefresh = 1");
         let e = src.table().unwrap_err().to_string();
         assert!(e.contains("m.toml") && e.contains("line 1"), "{e}");
-    }
-
-    #[test]
-    fn set_patches_nested_keys() {
-        let mut t: toml::Table = "[display]\nvsync = true\n[[g]]\nn = 1\n".parse().unwrap();
-        apply_set(&mut t, "display.vsync=false").unwrap();
-        apply_set(&mut t, "display.refresh=60Hz").unwrap();
-        apply_set(&mut t, "a.b.c=3").unwrap();
-        apply_set(&mut t, "g.0.n=5").unwrap();
-        assert_eq!(t["display"]["vsync"], toml::Value::Boolean(false));
-        assert_eq!(t["display"]["refresh"], toml::Value::String("60Hz".into()));
-        assert_eq!(t["a"]["b"]["c"], toml::Value::Integer(3));
-        assert_eq!(t["g"][0]["n"], toml::Value::Integer(5));
-        assert!(apply_set(&mut t, "novalue").is_err());
-        assert!(apply_set(&mut t, "g.3.n=1").is_err());
-        assert!(apply_set(&mut t, "display.vsync.x=1").is_err());
     }
 
     #[derive(Deserialize, Debug)]

@@ -1,7 +1,12 @@
-//! Model files: units, loading, `--set` patches and validation.
+//! Model files: units, loading, `--set` patches and the other overrides,
+//! validation.
 
 pub mod load;
+pub mod overrides;
+pub mod patch;
 pub mod units;
 
-pub use load::{ConfigError, ModelSource, apply_set, deserialize, invalid, set_dotted};
+pub use load::{ConfigError, ModelSource, deserialize, invalid};
+pub use overrides::{DEFAULT_MODEL, DEFAULT_MODEL_NAME, Overrides, PreparedModel, load_model, prepare};
+pub use patch::{PatchError, apply_set, set_dotted};
 pub use units::{Bandwidth, Bytes, Rate, UnitError};

@@ -193,7 +193,7 @@ impl Duration {
 
 /// Parses a non-negative decimal number and multiplies it by `scale`, in
 /// integer arithmetic, rounding to the nearest whole unit.
-pub fn parse_scaled_decimal(num: &str, scale: u64) -> Result<u64, String> {
+pub(crate) fn parse_scaled_decimal(num: &str, scale: u64) -> Result<u64, String> {
     let num = num.trim().replace('_', "");
     if num.is_empty() {
         return Err("missing number".into());

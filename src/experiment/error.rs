@@ -36,21 +36,16 @@ pub enum ExperimentError {
         message: String,
     },
     /// An inverse what-if (`[[search]]`) failed.
-    #[error("search {name:?} failed: {message}")]
+    #[error("search {name:?} failed: {source}")]
     Search {
         /// The search's name.
         name: String,
         /// Why.
-        message: String,
+        source: Box<super::inverse::SearchError>,
     },
     /// A dotted-key patch could not be applied to a model.
-    #[error("cannot set `{key}`: {message}")]
-    Patch {
-        /// The dotted key.
-        key: String,
-        /// Why it could not be set.
-        message: String,
-    },
+    #[error(transparent)]
+    Patch(#[from] crate::config::PatchError),
     /// The simulator failed for one run, or its output lacked something.
     #[error("run failed at point {point} ({label}), seed {seed}: {message}")]
     Run {

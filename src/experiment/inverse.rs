@@ -26,8 +26,26 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::dotted::{json_number, set_dotted};
-use super::runner::Runner;
+use super::dotted::{MetricPathError, json_number};
+use super::runner::{RunError, Runner};
+use crate::config::{PatchError, set_dotted};
+
+/// Why a search could not finish.
+#[derive(Debug, thiserror::Error)]
+pub enum SearchError {
+    /// A key of the search could not be set in the model.
+    #[error(transparent)]
+    Patch(#[from] PatchError),
+    /// A run failed.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// The metric path is not in the run summary.
+    #[error(transparent)]
+    Metric(#[from] MetricPathError),
+    /// The metric is `null` in the run summary.
+    #[error("`{0}` is not a number in the run summary")]
+    NotANumber(String),
+}
 use super::sweep::format_range_number;
 
 /// One search, validated.
@@ -207,21 +225,21 @@ impl Search {
         set: &[(String, toml::Value)],
         path: &str,
         seed: u64,
-    ) -> Result<f64, String> {
+    ) -> Result<f64, SearchError> {
         let mut model = base.clone();
         for (k, v) in set {
-            set_dotted(&mut model, k, v.clone()).map_err(|e| e.to_string())?;
+            set_dotted(&mut model, k, v.clone())?;
         }
         let origins: Vec<(String, String)> = set
             .iter()
             .map(|(k, _)| (k.clone(), format!("[[search]] {:?}, which sets {k}", self.name)))
             .collect();
         let out = runner.run_noted(&model, seed, false, &origins)?;
-        json_number(&out.summary, path)?.ok_or_else(|| format!("`{path}` is not a number in the run summary"))
+        json_number(&out.summary, path)?.ok_or_else(|| SearchError::NotANumber(path.to_string()))
     }
 
     /// Runs the search from `base` (the experiment's model with its `[set]`).
-    pub fn run(&self, runner: &dyn Runner, base: &toml::Table, seed: u64) -> Result<SearchResult, String> {
+    pub fn run(&self, runner: &dyn Runner, base: &toml::Table, seed: u64) -> Result<SearchResult, SearchError> {
         let mut runs = 0;
         let target = match &self.target {
             Target::Value(v) => *v,
@@ -232,7 +250,7 @@ impl Search {
                 scale * self.metric(runner, base, &all, path, seed)?
             }
         };
-        let mut at = |x: f64| -> Result<f64, String> {
+        let mut at = |x: f64| -> Result<f64, SearchError> {
             runs += 1;
             let mut set = self.set.clone();
             set.push((self.vary.clone(), self.value(x)));
@@ -362,10 +380,13 @@ mod tests {
     /// metric = 3 x + 1 (x read from `k`, a float or "<x>us").
     struct Linear;
     impl Runner for Linear {
-        fn run(&self, model: &toml::Table, _seed: u64, _f: bool) -> Result<RunOutput, String> {
+        fn run(&self, model: &toml::Table, _seed: u64, _f: bool) -> Result<RunOutput, RunError> {
             let x = match model.get("k") {
                 Some(toml::Value::Float(f)) => *f,
-                Some(toml::Value::String(s)) => s.trim_end_matches("us").parse().map_err(|_| "bad".to_string())?,
+                Some(toml::Value::String(s)) => s
+                    .trim_end_matches("us")
+                    .parse()
+                    .map_err(|_| RunError::Other("bad".into()))?,
                 Some(toml::Value::Integer(i)) => *i as f64,
                 _ => 0.0,
             };

@@ -117,13 +117,13 @@ mod tests;
 
 pub use check::{Bound, CheckOutcome, evaluate_between};
 pub use derived::{interval_width, quantile_width_from_min, ratio, relative_error, speedup};
-pub use dotted::{json_number, json_path, set_dotted};
+pub use dotted::{MetricPathError, json_number, json_path};
 pub use error::ExperimentError;
 pub use run::{ExperimentResult, PathStat, PointResult, RunRecord, point_model, run_experiment};
-pub use runner::{FrameTable, RunOutput, Runner};
+pub use runner::{FrameTable, RunError, RunOutput, Runner};
 pub use sim_runner::SimRunner;
 pub use spec::{
     BoundRef, Check, Derived, DerivedKind, Expect, Experiment, Metric, ModelSource, PlotKind, PlotSpec, Tolerance,
     load_experiment, parse_experiment,
 };
-pub use sweep::{Point, Sweep, expand_points, numeric_coord, value_text, values_match};
+pub use sweep::{LabelsError, Point, Sweep, expand_points, numeric_coord, value_text, values_match};

@@ -12,11 +12,12 @@ use crate::stats::ci::{MeanCi, mean_ci};
 
 use super::check::{Bound, CheckOutcome, evaluate, evaluate_between};
 use super::derived::{DerivedInputs, compute};
-use super::dotted::{json_number, set_dotted};
+use super::dotted::json_number;
 use super::runner::Runner;
 use super::spec::{BoundRef, Expect, Experiment};
 use super::sweep::{Point, expand_points};
 use super::{ExperimentError, figures, report, tables};
+use crate::config::set_dotted;
 
 /// The numbers read from one run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -376,9 +377,9 @@ pub fn run_experiment(
         .par_iter()
         .map(|sp| {
             sp.run(runner, &search_base, search_seed)
-                .map_err(|message| ExperimentError::Search {
+                .map_err(|source| ExperimentError::Search {
                     name: sp.name.clone(),
-                    message,
+                    source: Box::new(source),
                 })
         })
         .collect::<Result<_, _>>()?;
@@ -442,7 +443,7 @@ fn run_job(
         message,
     };
     let t0 = Instant::now();
-    let out = runner.run(model, seed, want_frames).map_err(fail)?;
+    let out = runner.run(model, seed, want_frames).map_err(|e| fail(e.to_string()))?;
     let measured = t0.elapsed().as_secs_f64();
     let wall_seconds = match json_number(&out.summary, "wall_seconds") {
         Ok(Some(w)) => w,
@@ -455,7 +456,7 @@ fn run_job(
             r => r,
         })
         .collect::<Result<Vec<_>, _>>()
-        .map_err(fail)?;
+        .map_err(|e| fail(e.to_string()))?;
     let mut frames = Vec::with_capacity(columns.len());
     if want_frames {
         let table = out

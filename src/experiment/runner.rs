@@ -1,5 +1,19 @@
 //! The interface through which experiments reach the simulator.
 
+/// Why a [`Runner`] could not run a model.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The simulator refused the model or failed while running it.
+    #[error(transparent)]
+    Sim(#[from] crate::systems::SimError),
+    /// The seed could not be written into the model.
+    #[error(transparent)]
+    Patch(#[from] crate::config::PatchError),
+    /// Another runner's failure, in its words (a fake simulator in tests).
+    #[error("{0}")]
+    Other(String),
+}
+
 /// Runs the simulator for one fully patched model and one seed.
 ///
 /// Implemented by the simulator crate layer; experiments call it from several
@@ -7,7 +21,7 @@
 pub trait Runner: Sync {
     /// Run one model (a fully patched TOML table) with one seed. `want_frames`
     /// asks for per-frame columns too.
-    fn run(&self, model: &toml::Table, seed: u64, want_frames: bool) -> Result<RunOutput, String>;
+    fn run(&self, model: &toml::Table, seed: u64, want_frames: bool) -> Result<RunOutput, RunError>;
 
     /// [`Runner::run`], with `origins` (dotted key, where its value comes
     /// from) for keys set beyond the experiment's `[set]` and sweeps (an
@@ -19,7 +33,7 @@ pub trait Runner: Sync {
         seed: u64,
         want_frames: bool,
         origins: &[(String, String)],
-    ) -> Result<RunOutput, String> {
+    ) -> Result<RunOutput, RunError> {
         let _ = origins;
         self.run(model, seed, want_frames)
     }

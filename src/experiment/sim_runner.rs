@@ -1,11 +1,12 @@
 //! The [`Runner`] that runs the simulator itself.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use crate::config::ModelSource;
+use crate::config::{DEFAULT_MODEL, DEFAULT_MODEL_NAME, ModelSource};
 use crate::systems::run_model;
 
-use super::runner::{FrameTable, RunOutput, Runner};
+use super::runner::{FrameTable, RunError, RunOutput, Runner};
+use super::spec::{Experiment, ModelSource as ExperimentModel};
 
 /// Runs models with the simulator; relative paths inside models resolve
 /// against `base_dir`.
@@ -28,8 +29,33 @@ pub struct SimRunner {
     pub origins: Vec<(String, String)>,
 }
 
+impl SimRunner {
+    /// The runner for `exp`'s base model: its file (relative paths inside
+    /// it resolve against the file's folder), or the embedded default.
+    pub fn for_experiment(exp: &Experiment) -> SimRunner {
+        let (name, base_dir, text) = match &exp.model {
+            ExperimentModel::Default => (
+                DEFAULT_MODEL_NAME.to_string(),
+                PathBuf::from("."),
+                DEFAULT_MODEL.to_string(),
+            ),
+            ExperimentModel::File(p) => (
+                p.display().to_string(),
+                p.parent().map(Path::to_path_buf).unwrap_or_default(),
+                std::fs::read_to_string(p).unwrap_or_default(),
+            ),
+        };
+        SimRunner {
+            name,
+            base_dir,
+            text,
+            origins: exp.value_origins(),
+        }
+    }
+}
+
 impl Runner for SimRunner {
-    fn run(&self, model: &toml::Table, seed: u64, want_frames: bool) -> Result<RunOutput, String> {
+    fn run(&self, model: &toml::Table, seed: u64, want_frames: bool) -> Result<RunOutput, RunError> {
         self.run_noted(model, seed, want_frames, &[])
     }
 
@@ -39,7 +65,7 @@ impl Runner for SimRunner {
         seed: u64,
         want_frames: bool,
         origins: &[(String, String)],
-    ) -> Result<RunOutput, String> {
+    ) -> Result<RunOutput, RunError> {
         let mut table = model.clone();
         crate::config::set_dotted(&mut table, "run.seed", toml::Value::Integer(seed as i64))?;
         let src = ModelSource {
@@ -48,7 +74,7 @@ impl Runner for SimRunner {
             base_dir: self.base_dir.clone(),
             overrides: self.origins.iter().chain(origins).cloned().collect(),
         };
-        let run = run_model(&src, &table, None).map_err(|e| e.to_string())?;
+        let run = run_model(&src, &table, None)?;
         let warmup = run
             .summary()
             .get("warmup_frames")

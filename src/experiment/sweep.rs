@@ -45,26 +45,44 @@ impl Sweep {
 
     /// Replaces the axis labels (one per value) and makes the sweep
     /// categorical on plot axes.
-    pub fn with_labels(mut self, labels: Vec<String>) -> Result<Sweep, String> {
+    pub fn with_labels(mut self, labels: Vec<String>) -> Result<Sweep, LabelsError> {
         if labels.len() != self.values.len() {
-            return Err(format!(
-                "needs one label per value: {} labels for {} values",
-                labels.len(),
-                self.values.len()
-            ));
+            return Err(LabelsError::Count {
+                labels: labels.len(),
+                values: self.values.len(),
+            });
         }
         if labels.iter().any(|l| l.trim().is_empty()) {
-            return Err("labels must not be empty".into());
+            return Err(LabelsError::Empty);
         }
         for (i, l) in labels.iter().enumerate() {
             if labels[..i].contains(l) {
-                return Err(format!("label `{l}` is used twice"));
+                return Err(LabelsError::Twice(l.clone()));
             }
         }
         self.labels = labels;
         self.categorical = true;
         Ok(self)
     }
+}
+
+/// Why a sweep's `labels` were refused ([`Sweep::with_labels`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum LabelsError {
+    /// Not one label per value.
+    #[error("needs one label per value: {labels} labels for {values} values")]
+    Count {
+        /// Labels given.
+        labels: usize,
+        /// Values of the sweep.
+        values: usize,
+    },
+    /// A label is empty.
+    #[error("labels must not be empty")]
+    Empty,
+    /// A label is given twice.
+    #[error("label `{0}` is used twice")]
+    Twice(String),
 }
 
 /// The number a sweep value stands for: integers and floats as such, and the

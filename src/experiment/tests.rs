@@ -29,7 +29,7 @@ fn get<'a>(t: &'a toml::Table, key: &str) -> Option<&'a toml::Value> {
 }
 
 impl Runner for Fake {
-    fn run(&self, model: &toml::Table, seed: u64, want_frames: bool) -> Result<RunOutput, String> {
+    fn run(&self, model: &toml::Table, seed: u64, want_frames: bool) -> Result<RunOutput, RunError> {
         self.calls.fetch_add(1, Ordering::SeqCst);
         if want_frames {
             self.wanted_frames.store(true, Ordering::SeqCst);
@@ -46,7 +46,7 @@ impl Runner for Fake {
             .to_string();
         self.seen.lock().unwrap().push((kind.clone(), seed));
         if self.fail && gpu == 13.0 && seed == 2 {
-            return Err("GPU fell over".into());
+            return Err(RunError::Other("GPU fell over".into()));
         }
         let refresh = 1000.0 / 60.0;
         let interval = (gpu / refresh).ceil() * refresh * if buffers >= 3.0 { 0.9 } else { 1.0 };

@@ -17,16 +17,19 @@ pub enum DepthOrder {
     Random,
 }
 
+/// A depth order's name that is not one.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown depth order {0:?} (front_to_back, back_to_front, random)")]
+pub struct UnknownDepthOrder(pub String);
+
 impl std::str::FromStr for DepthOrder {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownDepthOrder;
+    fn from_str(s: &str) -> Result<Self, UnknownDepthOrder> {
         match s {
             "front_to_back" | "f2b" => Ok(DepthOrder::FrontToBack),
             "back_to_front" | "b2f" => Ok(DepthOrder::BackToFront),
             "random" => Ok(DepthOrder::Random),
-            _ => Err(format!(
-                "unknown depth order {s:?} (front_to_back, back_to_front, random)"
-            )),
+            _ => Err(UnknownDepthOrder(s.to_string())),
         }
     }
 }

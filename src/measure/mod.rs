@@ -37,4 +37,4 @@ pub mod studies;
 
 #[cfg(feature = "wgpu")]
 pub use device::{AdapterSummary, Gpu, MeasureError, MeasureOptions, Measurement, measure};
-pub use geometry::{DepthOrder, mesh_positions};
+pub use geometry::{DepthOrder, UnknownDepthOrder, mesh_positions};

@@ -271,15 +271,20 @@ pub fn run_h4(gpu: &Gpu, setup: H4Setup, rounds: u32) -> Result<H4, StudyError> 
     Ok(h4::analyze(setup, rows, measure_seconds, t.elapsed().as_secs_f64()))
 }
 
+/// A study name that is not one.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown study {0:?} (available: h1, h2, h3, h4, all)")]
+pub struct UnknownStudy(pub String);
+
 /// The studies `name` stands for: `h1` .. `h4`, or `all`.
-pub fn study_names(name: &str) -> Result<Vec<&'static str>, String> {
+pub fn study_names(name: &str) -> Result<Vec<&'static str>, UnknownStudy> {
     match name {
         "all" => Ok(vec!["h1", "h2", "h3", "h4"]),
         "h1" => Ok(vec!["h1"]),
         "h2" => Ok(vec!["h2"]),
         "h3" => Ok(vec!["h3"]),
         "h4" => Ok(vec!["h4"]),
-        _ => Err(format!("unknown study {name:?} (available: h1, h2, h3, h4, all)")),
+        _ => Err(UnknownStudy(name.to_string())),
     }
 }
 

@@ -8,6 +8,7 @@
 //!   new one, never a mix.
 //! - [`cleanup`]: temporary paths removed on SIGINT, SIGTERM and SIGHUP.
 //! - [`table`]: per-row tables as CSV through the `csv` crate.
+//! - [`text`]: numbers in human-readable reports.
 //! - [`trace`]: Chrome/Perfetto trace JSON, streamed.
 
 pub mod cleanup;
@@ -15,6 +16,7 @@ pub mod error;
 pub mod files;
 pub mod result_set;
 pub mod table;
+pub mod text;
 pub mod trace;
 
 pub use error::OutputError;

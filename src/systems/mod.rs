@@ -16,10 +16,8 @@ use serde_json::Value;
 use crate::config::{ConfigError, ModelSource, deserialize, invalid};
 use crate::output::trace::TraceWriter;
 
+pub use crate::config::DEFAULT_MODEL;
 pub use error::SystemError;
-
-/// The embedded default model (`models/default.toml`).
-pub const DEFAULT_MODEL: &str = include_str!("../../models/default.toml");
 
 /// The latency-stage vocabulary shared by the multi-frame-rate and VR
 /// breakdowns (`metrics.latency_breakdown_ms`), in chain order, each with
@@ -92,15 +90,6 @@ pub enum SystemRun {
     Vr(Box<vr::VrRun>),
     /// A PixelFlow run (one frame).
     PixelFlow(Box<pixelflow::PixelFlowRun>),
-}
-
-/// Reads `--set` patches into the model's table.
-pub fn patched_table(src: &ModelSource, sets: &[String]) -> Result<toml::Table, ConfigError> {
-    let mut t = src.table()?;
-    for s in sets {
-        crate::config::apply_set(&mut t, s)?;
-    }
-    Ok(t)
 }
 
 /// Builds and runs the system a model describes. With a `trace` writer, the
@@ -181,6 +170,17 @@ impl SystemRun {
             SystemRun::MultiRate(r) => &mut r.summary,
             SystemRun::Vr(r) => &mut r.summary,
             SystemRun::PixelFlow(r) => &mut r.summary,
+        }
+    }
+
+    /// Writes the human-readable report of the run (what `rendersim run`
+    /// prints without `--json`), from its summary.
+    pub fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        match self {
+            SystemRun::FramePipeline(r) => frame_pipeline::report::write_report(&r.summary, w),
+            SystemRun::MultiRate(r) => multi_rate::report::write_report(&r.summary, w),
+            SystemRun::Vr(r) => vr::report::write_report(&r.summary, w),
+            SystemRun::PixelFlow(r) => pixelflow::report::write_report(&r.summary, w),
         }
     }
 

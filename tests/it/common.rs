@@ -1,19 +1,17 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use rendersim::config::{ModelSource, apply_set};
+use rendersim::config::{ModelSource, Overrides, prepare};
 use rendersim::systems::frame_pipeline::PipelineRun;
 use rendersim::systems::{SystemRun, run_model};
 use serde_json::Value;
 
-/// Runs a model given as TOML text with `--set`-style patches.
+/// Runs a model given as TOML text with `--set` patches (the command line's
+/// way, [`rendersim::config::prepare`]).
 pub fn try_run(text: &str, sets: &[&str]) -> Result<PipelineRun, String> {
-    let src = ModelSource::from_text("test.toml", text);
-    let mut t = src.table().map_err(|e| e.to_string())?;
-    for s in sets {
-        apply_set(&mut t, s).map_err(|e| e.to_string())?;
-    }
-    match run_model(&src, &t, None).map_err(|e| e.to_string())? {
+    let m =
+        prepare(ModelSource::from_text("test.toml", text), &Overrides::with_sets(sets)).map_err(|e| e.to_string())?;
+    match run_model(&m.source, &m.table, None).map_err(|e| e.to_string())? {
         SystemRun::FramePipeline(r) => Ok(*r),
         other => Err(format!("not a frame-pipeline run: {}", other.summary()["system"])),
     }

@@ -4,7 +4,7 @@
 
 use std::process::Command;
 
-use rendersim::config::{ModelSource, apply_set};
+use rendersim::config::{ModelSource, Overrides, prepare};
 use rendersim::systems::{SystemRun, run_model};
 use serde_json::Value;
 
@@ -12,12 +12,9 @@ const CLUSTER: &str = include_str!("../../models/mfr-cluster.toml");
 const MULTIGPU: &str = include_str!("../../models/mfr-multigpu.toml");
 
 fn try_run(text: &str, sets: &[&str]) -> Result<SystemRun, String> {
-    let src = ModelSource::from_text("test.toml", text);
-    let mut t = src.table().map_err(|e| e.to_string())?;
-    for s in sets {
-        apply_set(&mut t, s).map_err(|e| e.to_string())?;
-    }
-    run_model(&src, &t, None).map_err(|e| e.to_string())
+    let m =
+        prepare(ModelSource::from_text("test.toml", text), &Overrides::with_sets(sets)).map_err(|e| e.to_string())?;
+    run_model(&m.source, &m.table, None).map_err(|e| e.to_string())
 }
 
 fn summary(text: &str, sets: &[&str]) -> Value {
@@ -532,12 +529,8 @@ fn records_past_run_max_memory_end_the_run_with_an_error_naming_the_key() {
 fn memory_is_bounded_by_the_input_events_not_the_simulated_span() {
     use rendersim::systems::multi_rate::run::estimate_memory;
     let est = |sets: &[&str]| {
-        let src = ModelSource::from_text("m.toml", CLUSTER);
-        let mut t = src.table().unwrap();
-        for s in sets {
-            apply_set(&mut t, s).unwrap();
-        }
-        estimate_memory(&toml::Value::Table(t).try_into().unwrap()).0
+        let m = prepare(ModelSource::from_text("m.toml", CLUSTER), &Overrides::with_sets(sets)).unwrap();
+        estimate_memory(&toml::Value::Table(m.table).try_into().unwrap()).0
     };
     // The same events over a thousand times the span: the same estimate.
     assert_eq!(est(&[]), est(&["input.mean_interval=\"300s\""]));

@@ -2,7 +2,7 @@
 //! warping scheme, closed forms as oracles, simulated distributions inside
 //! the phase bounds, determinism, clear errors.
 
-use rendersim::config::{ModelSource, apply_set};
+use rendersim::config::{ModelSource, Overrides, apply_set, prepare};
 use rendersim::systems::{SystemRun, run_model};
 use serde_json::Value;
 
@@ -10,12 +10,9 @@ const NAIVE: &str = include_str!("../../models/vr-naive.toml");
 const WARP: &str = include_str!("../../models/vr-warp.toml");
 
 fn try_run(text: &str, sets: &[&str]) -> Result<SystemRun, String> {
-    let src = ModelSource::from_text("test.toml", text);
-    let mut t = src.table().map_err(|e| e.to_string())?;
-    for s in sets {
-        apply_set(&mut t, s).map_err(|e| e.to_string())?;
-    }
-    run_model(&src, &t, None).map_err(|e| e.to_string())
+    let m =
+        prepare(ModelSource::from_text("test.toml", text), &Overrides::with_sets(sets)).map_err(|e| e.to_string())?;
+    run_model(&m.source, &m.table, None).map_err(|e| e.to_string())
 }
 
 fn summary(text: &str, sets: &[&str]) -> Value {

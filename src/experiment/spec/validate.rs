@@ -118,7 +118,9 @@ impl Validator<'_> {
                 (None, Some(r)) => expand_range(s.key, &r).map_err(|m| self.err(format!("{key}.range"), m))?,
             };
             let sweep = match s.labels {
-                Some(l) => sweep.with_labels(l).map_err(|m| self.err(format!("{key}.labels"), m))?,
+                Some(l) => sweep
+                    .with_labels(l)
+                    .map_err(|m| self.err(format!("{key}.labels"), m.to_string()))?,
                 None => sweep,
             };
             sweeps.push(sweep);

@@ -9,6 +9,7 @@
 //! - `closed_form`: the `draw`-fidelity formula;
 //! - `accounting`: state clocks, bottleneck attribution, trace timeline;
 //! - `records`: per-frame records and the PresentMon-style table;
+//! - `report`: the human-readable report of a run;
 //! - `run`: validate, build, run, summarize.
 
 pub mod accounting;
@@ -20,6 +21,7 @@ mod gpu;
 pub mod isolate;
 pub mod model;
 pub mod records;
+pub mod report;
 pub mod run;
 pub mod workload;
 

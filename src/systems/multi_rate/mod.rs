@@ -16,6 +16,7 @@ pub mod config;
 pub mod latency;
 pub mod migration;
 pub mod model;
+pub mod report;
 pub mod run;
 
 pub use config::MultiRateConfig;

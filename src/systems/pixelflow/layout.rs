@@ -161,6 +161,11 @@ fn covered(start: f64, len: f64, screen: f64, region: f64, out: &mut Vec<usize>)
     }
 }
 
+/// The footprint's expected overlap factor, for documentation and tests.
+pub fn overlap_of(p: Size, region: Size) -> f64 {
+    (p.width + region.width) * (p.height + region.height) / region.area()
+}
+
 #[cfg(test)]
 mod tests {
     use super::node_counts;
@@ -179,9 +184,4 @@ mod tests {
         let c = node_counts(7, 15, 0.9);
         assert_eq!(c.iter().sum::<u64>(), 7);
     }
-}
-
-/// The footprint's expected overlap factor, for documentation and tests.
-pub fn overlap_of(p: Size, region: Size) -> f64 {
-    (p.width + region.width) * (p.height + region.height) / region.area()
 }

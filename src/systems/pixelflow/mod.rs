@@ -13,6 +13,7 @@ pub mod analytic;
 pub mod config;
 pub mod layout;
 pub mod model;
+pub mod report;
 pub mod run;
 
 #[cfg(test)]

@@ -536,7 +536,7 @@ pub fn write_trace(run: &PixelFlowRun, t: &mut TraceWriter) {
     let mut named = std::collections::BTreeSet::new();
     for s in spans {
         let pid = s.role as u32 + 1;
-        let tid = s.unit as u32;
+        let tid = s.unit;
         if named.insert((pid, tid)) {
             let name = match s.role {
                 0 | 1 => format!("rasterizer {}", s.unit),

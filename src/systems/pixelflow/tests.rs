@@ -1,18 +1,18 @@
 //! Closed forms against numbers worked by hand from paper 002, the event
 //! simulation against the closed forms, determinism and bad input.
 
-use crate::config::{ModelSource, apply_set};
+use crate::config::{ModelSource, Overrides, prepare};
 use crate::systems::{SystemRun, run_model};
 
 const MODEL: &str = include_str!("../../../models/pixelflow-20.toml");
 
 fn run_with(sets: &[&str]) -> Result<SystemRun, crate::systems::SimError> {
-    let src = ModelSource::from_text("pixelflow-20.toml", MODEL);
-    let mut t = src.table().unwrap();
-    for s in sets {
-        apply_set(&mut t, s).unwrap();
-    }
-    run_model(&src, &t, None)
+    let m = prepare(
+        ModelSource::from_text("pixelflow-20.toml", MODEL),
+        &Overrides::with_sets(sets),
+    )
+    .unwrap();
+    run_model(&m.source, &m.table, None)
 }
 
 fn metric(r: &SystemRun, key: &str) -> f64 {

@@ -13,6 +13,7 @@ pub mod analytic;
 pub mod config;
 pub mod latency;
 pub mod model;
+pub mod report;
 pub mod run;
 
 pub use config::VrConfig;

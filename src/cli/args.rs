@@ -1,0 +1,390 @@
+//! The command line's arguments in clap's terms: one struct per command,
+//! closed choices as [`ValueEnum`]s, `--size` and `--policy` read by value
+//! parsers, and conversions into the library's option structs. A value that
+//! does not parse is reported in the words the command line always used
+//! (`error: --size "12": expected WxH, e.g. 512x512`), exit status 2.
+
+use std::ffi::OsStr;
+use std::marker::PhantomData;
+use std::path::PathBuf;
+
+use clap::builder::{PossibleValue, TypedValueParser};
+use clap::error::ErrorKind;
+use clap::{Args, ValueEnum};
+
+use rendersim::bench::Bench;
+use rendersim::components::vertex_cache::CachePolicy;
+use rendersim::config::Overrides;
+use rendersim::measure::{DepthOrder, UnknownDepthOrder};
+
+/// `rendersim run`.
+#[derive(Args)]
+pub struct RunArgs {
+    /// Model file (TOML).
+    pub model: Option<PathBuf>,
+    /// Override a model key: --set display.buffers=3 (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+    /// Master seed (overrides run.seed).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Frames to simulate (overrides run.frames).
+    #[arg(long)]
+    pub frames: Option<u64>,
+    /// Print the JSON summary.
+    #[arg(long)]
+    pub json: bool,
+    /// Write summary.json, frames.csv and model.toml into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Write a Chrome/Perfetto trace to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub trace: Option<PathBuf>,
+}
+
+impl From<&RunArgs> for Overrides {
+    fn from(a: &RunArgs) -> Overrides {
+        Overrides {
+            sets: a.sets.clone(),
+            seed: a.seed,
+            frames: a.frames,
+        }
+    }
+}
+
+/// `rendersim experiment`.
+#[derive(Args)]
+pub struct ExperimentArgs {
+    /// Experiment file (TOML).
+    pub file: PathBuf,
+    /// Output directory (default out/<experiment name>).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Hide the progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// `rendersim isolate`.
+#[derive(Args)]
+pub struct IsolateArgs {
+    /// Model file (TOML); the default model when omitted.
+    pub model: Option<PathBuf>,
+    /// Override a model key (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+    /// Load factor for the reduced subsystem.
+    #[arg(long, default_value_t = 0.5)]
+    pub factor: f64,
+    /// Keep vsync on (by default it is switched off so quantization does not hide changes).
+    #[arg(long)]
+    pub keep_vsync: bool,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl From<&IsolateArgs> for Overrides {
+    fn from(a: &IsolateArgs) -> Overrides {
+        Overrides::with_sets(&a.sets)
+    }
+}
+
+/// `rendersim vcache`.
+#[derive(Args)]
+pub struct VcacheArgs {
+    /// Mesh: grid:WxH[:shuffled:SEED|:optimized], strip:WxH, random:T:V:SEED, FILE.obj, FILE.idx.
+    pub mesh: String,
+    /// Cache policy: none, fifo:N, lru:N, meshopt:CACHE,WARP,PRIMGROUP, batch:V,T, direct:SLOTS,SEGMENT, lavapipe.
+    #[arg(long, value_parser = Plain::new(parse_policy))]
+    pub policy: CachePolicy,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `rendersim measure`.
+#[derive(Args)]
+#[cfg_attr(not(feature = "wgpu"), allow(dead_code))] // read only with the `wgpu` feature
+pub struct MeasureArgs {
+    /// Mesh spec (as for `vcache`).
+    pub mesh: String,
+    /// Extra vertex-shader ALU loop iterations.
+    #[arg(long, default_value_t = 0)]
+    pub vs_loops: u32,
+    /// Extra fragment-shader ALU loop iterations.
+    #[arg(long, default_value_t = 0)]
+    pub fs_loops: u32,
+    /// Depth test on.
+    #[arg(long)]
+    pub depth_test: bool,
+    /// Copies of the mesh at different depths.
+    #[arg(long, default_value_t = 1)]
+    pub layers: u32,
+    /// Depth order of the layers: front_to_back, back_to_front, random.
+    #[arg(long, default_value = "front_to_back", value_parser = Choice::<Order>::new(unknown_order))]
+    pub order: Order,
+    /// Render target size, WxH.
+    #[arg(long, default_value = "512x512", value_parser = Plain::new(parse_size))]
+    pub size: Size,
+    /// Unrecorded warm-up passes.
+    #[arg(long, default_value_t = 2)]
+    pub warmup: u32,
+    /// Recorded passes (the median is reported).
+    #[arg(long, default_value_t = 5)]
+    pub repeats: u32,
+    /// Collapse every vertex to one point: no fragments, the geometry stage alone.
+    #[arg(long)]
+    pub geometry_only: bool,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[cfg(feature = "wgpu")]
+impl From<&MeasureArgs> for rendersim::measure::MeasureOptions {
+    fn from(a: &MeasureArgs) -> Self {
+        rendersim::measure::MeasureOptions {
+            vs_loops: a.vs_loops,
+            fs_loops: a.fs_loops,
+            depth_test: a.depth_test,
+            layers: a.layers,
+            order: a.order.into(),
+            size: (a.size.width, a.size.height),
+            warmup: a.warmup,
+            repeats: a.repeats,
+            geometry_only: a.geometry_only,
+        }
+    }
+}
+
+/// `rendersim study`.
+#[derive(Args)]
+#[cfg_attr(not(feature = "wgpu"), allow(dead_code))] // read only with the `wgpu` feature
+pub struct StudyArgs {
+    /// Study name: h1, h2, h3, h4 or all.
+    #[arg(value_parser = Choice::<Study>::new(unknown_study))]
+    pub name: Study,
+    /// Recorded passes per timed measurement, interleaved across a study's
+    /// passes (the median is used).
+    #[arg(long, default_value_t = 5)]
+    pub repeats: u32,
+    /// Also write the device's Markdown document to FILE (e.g. docs/measurements/<adapter>.md).
+    #[arg(long, value_name = "FILE")]
+    pub markdown: Option<PathBuf>,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `rendersim bench`.
+#[derive(Args)]
+pub struct BenchArgs {
+    /// Which: kernel, pipeline, hour, pixelflow, all.
+    #[arg(default_value = "all", value_parser = Choice::<BenchTarget>::new(unknown_bench))]
+    pub which: BenchTarget,
+    /// Scale the work down (0.01 .. 1) for a quick check.
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f64,
+    /// With `kernel`: also draw ns per event against the number pending
+    /// (1e3 .. 1e6, log axes) for the engine and the bare heap, hold and
+    /// stiff, into FILE (.png; an .svg beside it).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+}
+
+/// The depth order of `measure --order`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+#[value(rename_all = "snake_case")]
+pub enum Order {
+    /// Nearest layer first.
+    #[value(alias = "f2b")]
+    FrontToBack,
+    /// Farthest layer first.
+    #[value(alias = "b2f")]
+    BackToFront,
+    /// A fixed pseudo-random permutation.
+    Random,
+}
+
+impl From<Order> for DepthOrder {
+    fn from(o: Order) -> DepthOrder {
+        match o {
+            Order::FrontToBack => DepthOrder::FrontToBack,
+            Order::BackToFront => DepthOrder::BackToFront,
+            Order::Random => DepthOrder::Random,
+        }
+    }
+}
+
+fn unknown_order(s: &str) -> String {
+    format!("--order: {}", UnknownDepthOrder(s.to_string()))
+}
+
+/// The studies of `rendersim study`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Study {
+    /// H1, vertex reuse.
+    H1,
+    /// H2, sum vs max.
+    H2,
+    /// H3, draw order.
+    H3,
+    /// H4, cost per vertex.
+    H4,
+    /// All four.
+    All,
+}
+
+#[cfg_attr(not(feature = "wgpu"), allow(dead_code))]
+impl Study {
+    /// The name as given on the command line.
+    pub fn name(self) -> String {
+        self.to_possible_value()
+            .map(|v| v.get_name().to_string())
+            .unwrap_or_default()
+    }
+}
+
+fn unknown_study(s: &str) -> String {
+    format!("unknown study {s:?} (available: h1, h2, h3, h4, all)")
+}
+
+/// The benchmarks of `rendersim bench`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BenchTarget {
+    /// The event kernel.
+    Kernel,
+    /// One frame at both fidelities.
+    Pipeline,
+    /// One simulated hour.
+    Hour,
+    /// PixelFlow's Figures 3 and 4.
+    Pixelflow,
+    /// All of them.
+    All,
+}
+
+impl From<BenchTarget> for Vec<Bench> {
+    fn from(t: BenchTarget) -> Vec<Bench> {
+        match t {
+            BenchTarget::Kernel => vec![Bench::Kernel],
+            BenchTarget::Pipeline => vec![Bench::Pipeline],
+            BenchTarget::Hour => vec![Bench::Hour],
+            BenchTarget::Pixelflow => vec![Bench::Pixelflow],
+            BenchTarget::All => Bench::ALL.to_vec(),
+        }
+    }
+}
+
+fn unknown_bench(s: &str) -> String {
+    format!("unknown benchmark {s:?} (kernel, pipeline, hour, pixelflow, all)")
+}
+
+/// A render target size, `WxH`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Size {
+    /// Pixels across.
+    pub width: u32,
+    /// Pixels down.
+    pub height: u32,
+}
+
+fn parse_size(size: &str) -> anyhow::Result<Size> {
+    size.split_once('x')
+        .and_then(|(w, h)| {
+            Some(Size {
+                width: w.parse().ok()?,
+                height: h.parse().ok()?,
+            })
+        })
+        .ok_or_else(|| anyhow::anyhow!("--size {size:?}: expected WxH, e.g. 512x512"))
+}
+
+fn parse_policy(policy: &str) -> anyhow::Result<CachePolicy> {
+    policy.parse().map_err(|e| anyhow::anyhow!("--policy {policy:?}: {e}"))
+}
+
+/// A usage error with `message` as its whole text (`error: ` before it),
+/// exit status 2.
+fn invalid_value(cmd: &clap::Command, message: String) -> clap::Error {
+    clap::Error::raw(ErrorKind::InvalidValue, format!("{message}\n")).with_cmd(cmd)
+}
+
+/// A value parser for a closed choice `E`, whose refusal reads `unknown(value)`.
+#[derive(Clone)]
+pub struct Choice<E> {
+    unknown: fn(&str) -> String,
+    choice: PhantomData<fn() -> E>,
+}
+
+impl<E> Choice<E> {
+    fn new(unknown: fn(&str) -> String) -> Self {
+        Choice {
+            unknown,
+            choice: PhantomData,
+        }
+    }
+}
+
+impl<E: ValueEnum + Clone + Send + Sync + 'static> TypedValueParser for Choice<E> {
+    type Value = E;
+
+    fn parse_ref(&self, cmd: &clap::Command, _arg: Option<&clap::Arg>, value: &OsStr) -> Result<E, clap::Error> {
+        let text = value.to_string_lossy();
+        E::from_str(&text, false).map_err(|_| invalid_value(cmd, (self.unknown)(&text)))
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        Some(Box::new(
+            E::value_variants().iter().filter_map(|v| v.to_possible_value()),
+        ))
+    }
+}
+
+/// A value parser from a function whose error is the whole message.
+#[derive(Clone)]
+pub struct Plain<T> {
+    parse: fn(&str) -> anyhow::Result<T>,
+}
+
+impl<T> Plain<T> {
+    fn new(parse: fn(&str) -> anyhow::Result<T>) -> Self {
+        Plain { parse }
+    }
+}
+
+impl<T: Clone + Send + Sync + 'static> TypedValueParser for Plain<T> {
+    type Value = T;
+
+    fn parse_ref(&self, cmd: &clap::Command, _arg: Option<&clap::Arg>, value: &OsStr) -> Result<T, clap::Error> {
+        (self.parse)(&value.to_string_lossy()).map_err(|e| invalid_value(cmd, e.to_string()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_and_choices_parse_as_before() {
+        assert_eq!(
+            parse_size("640x480").unwrap(),
+            Size {
+                width: 640,
+                height: 480
+            }
+        );
+        assert_eq!(
+            parse_size("12").unwrap_err().to_string(),
+            "--size \"12\": expected WxH, e.g. 512x512"
+        );
+        assert_eq!(Order::from_str("f2b", false), Ok(Order::FrontToBack));
+        assert_eq!(Study::All.name(), "all");
+        assert_eq!(Vec::<Bench>::from(BenchTarget::All), Bench::ALL.to_vec());
+        assert_eq!(
+            unknown_order("x"),
+            "--order: unknown depth order \"x\" (front_to_back, back_to_front, random)"
+        );
+    }
+}

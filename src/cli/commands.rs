@@ -1,0 +1,332 @@
+//! What each command does: the library called with the parsed arguments,
+//! its results written to files or printed.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use serde_json::json;
+
+use rendersim::config::{ModelSource, load_model};
+use rendersim::output::files::open_output;
+use rendersim::output::result_set::ResultSet;
+use rendersim::output::text::fixed;
+use rendersim::output::trace::TraceWriter;
+use rendersim::systems::run_model;
+
+use super::args::{BenchArgs, ExperimentArgs, IsolateArgs, MeasureArgs, RunArgs, StudyArgs, VcacheArgs};
+use super::print;
+
+/// An experiment ran, but some of its reference checks failed (exit
+/// status 1).
+#[derive(Debug, thiserror::Error)]
+#[error("{failed} reference check(s) failed; see {report}")]
+pub struct ChecksFailed {
+    failed: usize,
+    report: String,
+}
+
+/// The files `run --out` writes (a folder holding only these, written
+/// before result sets were marked, may be replaced).
+const RUN_FILES: [&str; 3] = ["summary.json", "frames.csv", "model.toml"];
+
+/// `rendersim run`.
+pub fn run(args: RunArgs) -> Result<()> {
+    let model = load_model(args.model.as_deref(), &(&args).into())?;
+    for note in &model.notes {
+        eprintln!("note: {note}");
+    }
+    let src = &model.source;
+    // Outputs are checked before simulating: a folder that cannot take the
+    // results, or a trace path that is a folder, is reported at once.
+    let set = match &args.out {
+        Some(dir) => Some(ResultSet::begin(dir, |name| RUN_FILES.contains(&name))?),
+        None => None,
+    };
+    // The trace is written while the simulation runs (memory stays flat).
+    // A trace inside the --out folder belongs to the result set.
+    let trace = args.trace.map(|path| match &set {
+        Some(set)
+            if path.file_name().is_some()
+                && path.parent().and_then(|p| std::path::absolute(p).ok()).as_deref() == Some(set.target()) =>
+        {
+            set.dir().join(path.file_name().unwrap_or_default())
+        }
+        _ => path,
+    });
+    // With the trace on standard output, the report goes to standard error.
+    let trace_on_stdout = trace.as_deref().is_some_and(is_stdout);
+    let (trace_file, writer) = match &trace {
+        Some(path) => {
+            let (file, w) = open_output(path)?;
+            (Some(file), Some(TraceWriter::new(w)))
+        }
+        None => (None, None),
+    };
+    let mut run = run_model(src, &model.table, writer)?;
+    run.summary_mut()["model"] = json!(src.name);
+    if let Some(set) = &set {
+        let dir = set.dir();
+        let summary = serde_json::to_string_pretty(run.summary())?;
+        std::fs::write(dir.join("summary.json"), summary).context("writing summary.json")?;
+        let mut frames = std::io::BufWriter::new(std::fs::File::create(dir.join("frames.csv"))?);
+        run.write_frames_csv(&mut frames).context("writing frames.csv")?;
+        frames.flush().context("writing frames.csv")?;
+        drop(frames);
+        std::fs::write(dir.join("model.toml"), run.resolved_model(&src.base_dir)).context("writing model.toml")?;
+    }
+    // The trace first, then the folder is swapped in: a run whose trace
+    // could not be written leaves the earlier results as they were.
+    if let (Some(file), Some(writer), Some(path)) = (trace_file, run.take_trace(), &trace) {
+        writer
+            .finish()
+            .with_context(|| format!("writing trace {}", path.display()))?;
+        file.commit()?;
+    }
+    if let Some(set) = set {
+        set.commit()?;
+    }
+    if args.json {
+        let text = serde_json::to_string_pretty(run.summary())?;
+        if trace_on_stdout {
+            eprintln!("{text}");
+        } else {
+            println!("{text}");
+        }
+    } else if !trace_on_stdout {
+        run.write_report(&mut std::io::stdout().lock())?;
+    }
+    Ok(())
+}
+
+/// Whether `path` is this process's standard output: `-`, or the same file
+/// (`/dev/stdout`, `/proc/self/fd/1`, or the file stdout is redirected to).
+fn is_stdout(path: &Path) -> bool {
+    if path.as_os_str() == "-" {
+        return true;
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(a), Ok(b)) = (std::fs::metadata(path), std::fs::metadata("/proc/self/fd/1")) {
+            return a.dev() == b.dev() && a.ino() == b.ino();
+        }
+    }
+    false
+}
+
+/// `rendersim experiment`.
+pub fn experiment(args: ExperimentArgs) -> Result<()> {
+    use rendersim::experiment::{SimRunner, load_experiment, run_experiment};
+    let exp = load_experiment(&args.file)?;
+    let base = exp.resolve_model(&ModelSource::embedded_default().table()?)?;
+    let out = args.out.unwrap_or_else(|| PathBuf::from("out").join(&exp.name));
+    let set = ResultSet::begin(&out, experiment_file)?;
+    let runner = SimRunner::for_experiment(&exp);
+    let result = match run_experiment(&exp, &base, &runner, set.dir(), !args.quiet) {
+        Ok(r) => r,
+        Err(e) => {
+            // Keep the runs that finished beside the earlier results, which
+            // stay as they were.
+            let failed = sibling(&out, "failed");
+            let finished =
+                std::fs::read_to_string(set.dir().join("runs.csv")).map_or(0, |t| t.lines().count().saturating_sub(1));
+            let kept = finished > 0 && set.commit_to(&failed).is_ok();
+            let mut msg = format!("{e}\nearlier results in {} are unchanged", out.display());
+            if kept {
+                msg.push_str(&format!(
+                    "; the {finished} run(s) that finished are in {}",
+                    failed.display()
+                ));
+            }
+            bail!(msg);
+        }
+    };
+    set.commit()?;
+    println!("{}", result.table(&exp));
+    println!(
+        "experiment {:?}: {} points, {:.2} s wall ({:.2} s of simulation); results in {}",
+        exp.name,
+        result.points.len(),
+        result.wall_seconds,
+        result.sim_wall_seconds,
+        out.display()
+    );
+    if result.checks_failed > 0 {
+        return Err(ChecksFailed {
+            failed: result.checks_failed,
+            report: out.join("report.md").display().to_string(),
+        }
+        .into());
+    }
+    Ok(())
+}
+
+/// Whether an experiment's output folder from before result sets were
+/// marked holds this file (tables, report, plots).
+fn experiment_file(name: &str) -> bool {
+    [".csv", ".md", ".svg", ".png"].iter().any(|ext| name.ends_with(ext))
+}
+
+/// `DIR.suffix` beside `DIR`.
+fn sibling(dir: &Path, suffix: &str) -> PathBuf {
+    let dir = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
+    let name = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    dir.with_file_name(format!("{name}.{suffix}"))
+}
+
+/// `rendersim isolate`.
+pub fn isolate(args: IsolateArgs) -> Result<()> {
+    let model = load_model(args.model.as_deref(), &(&args).into())?;
+    let (src, table) = (&model.source, &model.table);
+    let system = table.get("system").and_then(|v| v.as_str()).unwrap_or("frame_pipeline");
+    if system != "frame_pipeline" {
+        bail!(
+            "isolate applies to the frame pipeline; {} is a {system} model (`system = {system:?}`)",
+            src.name
+        );
+    }
+    let cfg: rendersim::systems::frame_pipeline::FramePipelineConfig = rendersim::config::deserialize(table, src)?;
+    let (factor, keep_vsync) = (args.factor, args.keep_vsync);
+    let iso = rendersim::systems::frame_pipeline::isolate::isolate(&cfg, &src.base_dir, factor, keep_vsync)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&iso)?);
+        return Ok(());
+    }
+    println!(
+        "bottleneck isolation (load x{factor}, vsync {}):",
+        if keep_vsync { "on" } else { "off" }
+    );
+    for v in &iso.variants {
+        let change = fixed(100.0 * v.change, 1);
+        println!(
+            "  {:<9} frame time {:>9} ms  ({}{change}%)",
+            v.name,
+            fixed(v.frame_time_ms, 3),
+            if change.starts_with('-') { "" } else { "+" }
+        );
+    }
+    println!("  => bottleneck: {}   ({:.2} s wall)", iso.bottleneck, iso.wall_seconds);
+    Ok(())
+}
+
+/// `rendersim vcache`.
+pub fn vcache(args: VcacheArgs) -> Result<()> {
+    let (mesh, policy) = (&args.mesh, &args.policy);
+    let start = std::time::Instant::now();
+    let m = rendersim::scene::generators::mesh_from_spec(mesh, Path::new("."))?;
+    let s = m.cache_stats(policy);
+    let secs = start.elapsed().as_secs_f64();
+    let out = json!({
+        "mesh": mesh, "policy": policy.to_string(), "indices": s.indices, "triangles": s.triangles,
+        "unique_vertices": s.unique_vertices, "transformed": s.transformed, "acmr": s.acmr(), "atvr": s.atvr(),
+        "wall_seconds": secs,
+    });
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&out)?);
+    } else {
+        println!(
+            "{mesh} under {policy}: {} triangles, {} indices, {} unique vertices, {} transformed; ACMR {:.4}, ATVR {:.4}",
+            s.triangles,
+            s.indices,
+            s.unique_vertices,
+            s.transformed,
+            s.acmr(),
+            s.atvr()
+        );
+    }
+    Ok(())
+}
+
+/// `rendersim measure`.
+#[cfg(feature = "wgpu")]
+pub fn measure(args: MeasureArgs) -> Result<()> {
+    let mesh = &args.mesh;
+    let m = rendersim::scene::generators::mesh_from_spec(mesh, Path::new("."))?;
+    let r = rendersim::measure::measure(&m, mesh, &(&args).into())?;
+    let mut v = serde_json::to_value(&r)?;
+    v["mesh"] = json!({"spec": mesh, "triangles": m.triangles(), "indices": m.index_count(), "unique_vertices": m.unique_vertices()});
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        println!("{}", print::measurement(mesh, &r));
+    }
+    Ok(())
+}
+
+/// `rendersim measure` without the `wgpu` feature.
+#[cfg(not(feature = "wgpu"))]
+pub fn measure(_args: MeasureArgs) -> Result<()> {
+    bail!(
+        "this rendersim was built without the `wgpu` feature; rebuild with `cargo build --release --features wgpu` (and, without a GPU, install Debian's mesa-vulkan-drivers for lavapipe)"
+    )
+}
+
+/// `rendersim study`.
+#[cfg(feature = "wgpu")]
+pub fn study(args: StudyArgs) -> Result<()> {
+    use rendersim::measure::{Gpu, studies};
+    let (name, repeats, json) = (args.name.name(), args.repeats, args.json);
+    let names = studies::study_names(&name)?;
+    if repeats == 0 {
+        bail!("--repeats must be at least 1");
+    }
+    let gpu = Gpu::open()?;
+    let command = format!("rendersim study {name} --repeats {repeats}");
+    let r = studies::run_studies(&gpu, &names, repeats, &command, |s| {
+        if !json {
+            println!("{}: {}", s.name, s.verdict);
+        }
+    })?;
+    if let Some(path) = args.markdown {
+        rendersim::output::files::write_output(&path, |w| w.write_all(r.document.as_bytes()))?;
+    }
+    if json {
+        println!("{}", serde_json::to_string_pretty(&r.json)?);
+    } else {
+        println!("\n{}", r.document);
+    }
+    if let Some(chosen) = r.h1_inexact {
+        bail!("the fitted policy {chosen} does not predict every validation mesh exactly");
+    }
+    Ok(())
+}
+
+/// `rendersim study` without the `wgpu` feature.
+#[cfg(not(feature = "wgpu"))]
+pub fn study(_args: StudyArgs) -> Result<()> {
+    bail!("this rendersim was built without the `wgpu` feature; rebuild with `cargo build --release --features wgpu`")
+}
+
+/// `rendersim bench`: each benchmark's line as soon as it is measured.
+pub fn bench(args: BenchArgs) -> Result<()> {
+    use super::args::BenchTarget;
+    use rendersim::bench::{self, Bench, KERNEL_CASES};
+    if args.plot.is_some() && args.which != BenchTarget::Kernel {
+        bail!("--plot draws the kernel benchmark: use `rendersim bench kernel --plot FILE.png`");
+    }
+    let scale = args.scale;
+    bench::check_scale(scale)?;
+    for b in Vec::<Bench>::from(args.which) {
+        match b {
+            Bench::Pixelflow => println!("{}", print::pixelflow_bench(&bench::pixelflow_bench(scale)?)),
+            Bench::Kernel => {
+                for (work, pop) in KERNEL_CASES {
+                    let k = bench::kernel_case(work, pop, bench::kernel_events(pop, scale));
+                    println!("{}", print::kernel_bench(&k));
+                }
+            }
+            Bench::Pipeline => println!("{}", print::pipeline_bench(&bench::pipeline_bench(scale)?)),
+            Bench::Hour => println!("{}", print::hour_bench(&bench::hour_bench(scale)?)),
+        }
+    }
+    if let Some(path) = args.plot {
+        let cases = bench::kernel_scaling(scale);
+        bench::plot_kernel(&cases, &path)?;
+        println!("kernel scaling plot: {}", path.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,8 @@
+//! The `rendersim` command line behind `main.rs`: its arguments in clap's
+//! terms ([`args`]), what each command does ([`commands`]) and the lines it
+//! prints for benchmarks and measurements ([`print`]). All simulation logic
+//! lives in the library.
+
+pub mod args;
+pub mod commands;
+pub mod print;
