@@ -196,20 +196,3 @@ mod tests {
         assert!(m.contains("b: 1.037e7 s") && m.contains("213 days"), "{m}");
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn byte_counts_read_well() {
-        assert_eq!(show_bytes(DEFAULT_MAX_MEMORY), "8 GiB");
-        assert_eq!(show_bytes(1536 << 20), "1.5 GiB");
-        assert_eq!(show_bytes(100), "100 bytes");
-        let m = over_memory_message(9 << 30, "frames", DEFAULT_MAX_MEMORY);
-        assert!(
-            m.contains("9 GiB") && m.contains("run.max_memory = 8 GiB") && m.contains("16GiB"),
-            "{m}"
-        );
-    }
-}
