@@ -7,6 +7,7 @@ pub mod error;
 pub mod frame_pipeline;
 pub mod multi_rate;
 pub mod pixelflow;
+pub mod summary;
 pub mod vr;
 
 use std::io::Write;

@@ -2,15 +2,19 @@
 
 use std::io::Write;
 
-use serde_json::{Map, Value, json};
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+use serde_json::Value;
 
 use crate::engine::{Duration, Limits, RunStats, Scheduler, StopReason, Time, run};
 use crate::output::trace::TraceWriter;
-use crate::stats::quantile::Summary;
+use crate::systems::summary::{Dist, EventCounts, events_per_second, mean_stages, to_json};
 
 use super::analytic::{Analytic, Bounds, Terms, analytic};
 use super::config::MultiRateConfig;
 use super::latency::{CONV_STAGES, EventRecord, FAST_STAGES, SLOW_STAGES, event_rows, total_ms};
+use super::migration::ArtifactCounts;
 use super::model::MultiRate;
 use crate::systems::error::SystemError;
 
@@ -220,114 +224,217 @@ pub fn run_multi_rate(cfg: MultiRateConfig, trace: Option<TraceWriter>) -> Resul
     })
 }
 
-fn dist(v: &[f64]) -> Value {
-    let s = Summary::of(v);
-    let n = |x: f64| s.stat(x);
-    json!({"count": s.count, "min": n(s.min), "mean": n(s.mean), "p50": n(s.p50), "p99": n(s.p99), "max": n(s.max), "std": n(s.std)})
+/// One value per path: through FC, through SC's image, and through the
+/// conventional client (when it runs).
+#[derive(Debug, Clone, Serialize)]
+pub struct Paths<T> {
+    /// Input visible in FC's own rendering.
+    pub fast: T,
+    /// Input visible in SC's image, composited by FC.
+    pub slow: T,
+    /// Input visible through the conventional single client.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub conventional: Option<T>,
 }
 
-fn breakdown<'a>(names: &[&str], rows: impl Iterator<Item = &'a Vec<u64>>) -> Value {
-    let mut sums = vec![0f64; names.len()];
-    let mut n = 0usize;
-    for r in rows {
-        for (s, v) in sums.iter_mut().zip(r) {
-            *s += *v as f64 / 1e9;
-        }
-        n += 1;
-    }
-    let n = n.max(1) as f64;
-    Value::Object(
-        names
-            .iter()
-            .zip(sums)
-            .map(|(k, s)| (k.to_string(), json!(s / n)))
-            .collect(),
-    )
+/// The model's per-frame terms, milliseconds (paper 003 §3's symbols).
+#[derive(Debug, Clone, Serialize)]
+pub struct TermsMs {
+    /// Tracker sample period `P`.
+    pub tracker_period: f64,
+    /// Sample to clients `L`.
+    pub sensor_latency: f64,
+    /// SC's render `R_sc`.
+    pub sc_render: f64,
+    /// SC's read-back `T_read`.
+    pub sc_readback: f64,
+    /// SC's frame `R_sc + T_read`.
+    pub sc_frame: f64,
+    /// One image over the transfer path.
+    pub transfer: f64,
+    /// FC's upload of SC's image `T_draw`.
+    pub fc_upload: f64,
+    /// FC's render (plus deferred shading when on).
+    pub fc_render: f64,
+    /// FC's frame.
+    pub fc_frame: f64,
+    /// The conventional client's frame.
+    pub conventional_frame: f64,
+    /// The display's own latency.
+    pub display: f64,
 }
 
-fn bounds(b: &Bounds) -> Value {
-    json!({"best": b.best, "worst": b.worst, "phase_min": b.phase_min, "phase_max": b.phase_max, "phase_mean": b.phase_mean})
+/// Rates, hertz.
+#[derive(Debug, Clone, Serialize)]
+pub struct RatesHz {
+    /// SC's frames.
+    pub slow_client: f64,
+    /// FC's frames.
+    pub fast_client: f64,
+    /// Images the link can carry (null for a zero-time path).
+    pub transfer: f64,
+}
+
+/// Frames each client finished (SC: started).
+#[derive(Debug, Clone, Serialize)]
+pub struct FrameCounts {
+    /// SC frames started.
+    pub slow_client: usize,
+    /// FC frames finished.
+    pub fast_client: usize,
+    /// Conventional frames finished.
+    pub conventional: usize,
+}
+
+/// The fate of SC's read-back buffers.
+#[derive(Debug, Clone, Serialize)]
+pub struct BufferCounts {
+    /// Buffers that reached FC.
+    pub sent: u64,
+    /// Buffers replaced in the one-slot mailbox by a newer one before the
+    /// link was free (latest wins).
+    pub replaced_before_sending: u64,
+}
+
+/// `metrics` of a multi-frame-rate summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct MultiRateMetrics {
+    /// Simulated latency of every input event, per path.
+    pub event_latency_ms: Paths<Dist>,
+    /// The paper's closed forms and the bounds over all phases, per path.
+    pub analytic_latency_ms: Paths<Bounds>,
+    /// Mean milliseconds per latency stage, per path (stage names in
+    /// [`crate::systems::LATENCY_STAGES`]).
+    pub latency_breakdown_ms: Paths<BTreeMap<String, f64>>,
+    /// The per-frame terms.
+    pub terms_ms: TermsMs,
+    /// Frame and link rates.
+    pub rates_hz: RatesHz,
+    /// Frames per client.
+    pub frames: FrameCounts,
+    /// SC's buffers.
+    pub buffers: BufferCounts,
+    /// Whether the link carries SC's images as fast as SC makes them.
+    pub link_keeps_up: bool,
+    /// Migration artifacts (when the model has a migration script).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub migration: Option<ArtifactCounts>,
+}
+
+/// The summary of a multi-frame-rate run (`summary.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct MultiRateSummary {
+    /// `"multi_rate"`.
+    pub system: &'static str,
+    /// The model's description.
+    pub description: String,
+    /// Master seed.
+    pub seed: u64,
+    /// Input events followed.
+    pub input_events: usize,
+    /// Kernel events.
+    pub events: EventCounts,
+    /// Wall time of the run.
+    pub wall_seconds: f64,
+    /// Wall time of the simulation (the same: nothing is built first).
+    pub simulate_seconds: f64,
+    /// Kernel events per wall second.
+    pub events_per_second: f64,
+    /// Simulated time at the end.
+    pub simulated_seconds: f64,
+    /// Why the run stopped (`model`: every input shown on every path).
+    pub stopped_by: StopReason,
+    /// The transfer path from SC to FC.
+    pub transfer_path: &'static str,
+    /// Bytes of one image (or G-buffer) SC sends.
+    pub frame_bytes: u64,
+    /// FC's deferred-shading time per frame (0 when off).
+    pub deferred_shading_ms: f64,
+    /// The results.
+    pub metrics: MultiRateMetrics,
 }
 
 fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &Analytic, stats: &RunStats) -> Value {
-    let fast: Vec<f64> = events
-        .iter()
-        .filter_map(|e| e.fast.as_ref().map(|f| total_ms(&f.1)))
-        .collect();
-    let slow: Vec<f64> = events
-        .iter()
-        .filter_map(|e| e.slow.as_ref().map(|s| total_ms(&s.2)))
-        .collect();
-    let conv: Vec<f64> = events
-        .iter()
-        .filter_map(|e| e.conventional.as_ref().map(|c| total_ms(&c.1)))
-        .collect();
+    let latencies = |path: fn(&EventRecord) -> Option<&Vec<u64>>| -> Vec<f64> {
+        events.iter().filter_map(|e| path(e).map(|g| total_ms(g))).collect()
+    };
+    fn fast(e: &EventRecord) -> Option<&Vec<u64>> {
+        e.fast.as_ref().map(|f| &f.1)
+    }
+    fn slow(e: &EventRecord) -> Option<&Vec<u64>> {
+        e.slow.as_ref().map(|s| &s.2)
+    }
+    fn conv(e: &EventRecord) -> Option<&Vec<u64>> {
+        e.conventional.as_ref().map(|c| &c.1)
+    }
+    let conventional = cfg.conventional.enabled;
     let t = &m.terms;
-    let by_kind: Map<String, Value> = stats
-        .kind_names
-        .iter()
-        .zip(&stats.by_kind)
-        .map(|(n, c)| (n.to_string(), json!(c)))
-        .collect();
-    let mut event_latency = json!({"fast": dist(&fast), "slow": dist(&slow)});
-    let mut analytic_latency = json!({"fast": bounds(&a.fast), "slow": bounds(&a.slow)});
-    let mut stages = json!({
-        "fast": breakdown(&FAST_STAGES, events.iter().filter_map(|e| e.fast.as_ref().map(|f| &f.1))),
-        "slow": breakdown(&SLOW_STAGES, events.iter().filter_map(|e| e.slow.as_ref().map(|s| &s.2))),
-    });
-    if cfg.conventional.enabled {
-        event_latency["conventional"] = dist(&conv);
-        analytic_latency["conventional"] = bounds(&a.conventional);
-        stages["conventional"] = breakdown(
-            &CONV_STAGES,
-            events.iter().filter_map(|e| e.conventional.as_ref().map(|c| &c.1)),
-        );
-    }
-    let mut out = json!({
-        "system": "multi_rate",
-        "description": cfg.description,
-        "seed": cfg.run.seed,
-        "input_events": events.len(),
-        "events": {"total": stats.events, "by_kind": by_kind},
-        "wall_seconds": stats.wall_seconds,
-        "simulate_seconds": stats.wall_seconds,
-        "events_per_second": if stats.wall_seconds > 0.0 { stats.events as f64 / stats.wall_seconds } else { 0.0 },
-        "simulated_seconds": stats.end_time.0 as f64 / 1e12,
-        "stopped_by": stats.stopped_by,
-        "transfer_path": cfg.transfer.path.name(),
-        "frame_bytes": cfg.frame_bytes(),
-        "deferred_shading_ms": cfg.deferred_shading().as_ms_f64(),
-        "metrics": {
-            "event_latency_ms": event_latency,
-            "analytic_latency_ms": analytic_latency,
-            "latency_breakdown_ms": stages,
-            "terms_ms": {
-                "tracker_period": t.tracker_period.as_ms_f64(),
-                "sensor_latency": t.sensor_latency.as_ms_f64(),
-                "sc_render": t.sc_render.as_ms_f64(),
-                "sc_readback": t.sc_readback.as_ms_f64(),
-                "sc_frame": t.sc_frame().as_ms_f64(),
-                "transfer": t.transfer.as_ms_f64(),
-                "fc_upload": t.fc_upload.as_ms_f64(),
-                "fc_render": t.fc_render.as_ms_f64(),
-                "fc_frame": t.fc_frame().as_ms_f64(),
-                "conventional_frame": t.conventional_frame.as_ms_f64(),
-                "display": t.display.as_ms_f64(),
+    let summary = MultiRateSummary {
+        system: "multi_rate",
+        description: cfg.description.clone(),
+        seed: cfg.run.seed,
+        input_events: events.len(),
+        events: EventCounts::of(stats),
+        wall_seconds: stats.wall_seconds,
+        simulate_seconds: stats.wall_seconds,
+        events_per_second: events_per_second(stats),
+        simulated_seconds: stats.end_time.0 as f64 / 1e12,
+        stopped_by: stats.stopped_by,
+        transfer_path: cfg.transfer.path.name(),
+        frame_bytes: cfg.frame_bytes(),
+        deferred_shading_ms: cfg.deferred_shading().as_ms_f64(),
+        metrics: MultiRateMetrics {
+            event_latency_ms: Paths {
+                fast: Dist::of(&latencies(fast)),
+                slow: Dist::of(&latencies(slow)),
+                conventional: conventional.then(|| Dist::of(&latencies(conv))),
             },
-            "rates_hz": {
-                "slow_client": 1e3 / t.sc_interval().as_ms_f64(),
-                "fast_client": 1e3 / t.fc_interval().as_ms_f64(),
-                "transfer": if t.transfer.0 > 0 { 1e3 / t.transfer.as_ms_f64() } else { f64::INFINITY },
+            analytic_latency_ms: Paths {
+                fast: a.fast,
+                slow: a.slow,
+                conventional: conventional.then_some(a.conventional),
             },
-            "frames": {"slow_client": m.sc_frames, "fast_client": m.fc_done, "conventional": m.conv_done},
-            "buffers": {"sent": m.sent, "replaced_before_sending": m.replaced},
-            "link_keeps_up": a.link_keeps_up,
+            latency_breakdown_ms: Paths {
+                fast: mean_stages(&FAST_STAGES, events.iter().filter_map(fast)),
+                slow: mean_stages(&SLOW_STAGES, events.iter().filter_map(slow)),
+                conventional: conventional.then(|| mean_stages(&CONV_STAGES, events.iter().filter_map(conv))),
+            },
+            terms_ms: TermsMs {
+                tracker_period: t.tracker_period.as_ms_f64(),
+                sensor_latency: t.sensor_latency.as_ms_f64(),
+                sc_render: t.sc_render.as_ms_f64(),
+                sc_readback: t.sc_readback.as_ms_f64(),
+                sc_frame: t.sc_frame().as_ms_f64(),
+                transfer: t.transfer.as_ms_f64(),
+                fc_upload: t.fc_upload.as_ms_f64(),
+                fc_render: t.fc_render.as_ms_f64(),
+                fc_frame: t.fc_frame().as_ms_f64(),
+                conventional_frame: t.conventional_frame.as_ms_f64(),
+                display: t.display.as_ms_f64(),
+            },
+            rates_hz: RatesHz {
+                slow_client: 1e3 / t.sc_interval().as_ms_f64(),
+                fast_client: 1e3 / t.fc_interval().as_ms_f64(),
+                transfer: if t.transfer.0 > 0 {
+                    1e3 / t.transfer.as_ms_f64()
+                } else {
+                    f64::INFINITY
+                },
+            },
+            frames: FrameCounts {
+                slow_client: m.sc_frames,
+                fast_client: m.fc_done,
+                conventional: m.conv_done,
+            },
+            buffers: BufferCounts {
+                sent: m.sent,
+                replaced_before_sending: m.replaced,
+            },
+            link_keeps_up: a.link_keeps_up,
+            migration: m.migration.as_ref().map(|x| x.counts()),
         },
-    });
-    if let Some(migration) = &m.migration {
-        out["metrics"]["migration"] = json!(migration.counts());
-    }
-    out
+    };
+    to_json(&summary)
 }
 
 /// Writes the per-event table as CSV.

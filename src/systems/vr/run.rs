@@ -4,11 +4,14 @@
 
 use std::io::Write;
 
-use serde_json::{Value, json};
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+use serde_json::Value;
 
 use crate::engine::{Duration, Limits, RunStats, Scheduler, StopReason, run};
 use crate::output::trace::TraceWriter;
-use crate::stats::quantile::Summary;
+use crate::systems::summary::{Dist, EventCounts, mean_stages, to_json};
 
 use super::analytic::{Analytic, Bounds, analytic};
 use super::config::{Scheme, VrConfig};
@@ -147,33 +150,66 @@ fn total_ms(g: &[u64]) -> f64 {
     g.iter().sum::<u64>() as f64 / 1e9
 }
 
-fn dist(v: &[f64]) -> Value {
-    let s = Summary::of(v);
-    let n = |x: f64| s.stat(x);
-    json!({"count": s.count, "min": n(s.min), "mean": n(s.mean), "p50": n(s.p50), "p99": n(s.p99), "max": n(s.max), "std": n(s.std)})
+/// One value per motion kind.
+#[derive(Debug, Clone, Serialize)]
+pub struct Motions<T> {
+    /// Head motion (camera pose).
+    pub head: T,
+    /// Object motion (through the simulation).
+    pub object: T,
 }
 
-fn breakdown<'a>(names: &[&str], rows: impl Iterator<Item = &'a Vec<u64>>) -> Value {
-    let mut sums = vec![0f64; names.len()];
-    let mut n = 0usize;
-    for r in rows {
-        for (s, v) in sums.iter_mut().zip(r) {
-            *s += *v as f64 / 1e9;
-        }
-        n += 1;
-    }
-    let n = n.max(1) as f64;
-    Value::Object(
-        names
-            .iter()
-            .zip(sums)
-            .map(|(k, s)| (k.to_string(), json!(s / n)))
-            .collect(),
-    )
+/// `metrics` of a VR summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct VrMetrics {
+    /// Simulated motion-to-photon latency of every motion.
+    pub motion_to_photon_ms: Motions<Dist>,
+    /// The closed forms and the bounds over all phases.
+    pub analytic_latency_ms: Motions<Bounds>,
+    /// Mean milliseconds per latency stage (stage names in
+    /// [`crate::systems::LATENCY_STAGES`]).
+    pub latency_breakdown_ms: Motions<BTreeMap<String, f64>>,
+    /// One stereo pair of the display (the swap period).
+    pub display_frame_ms: f64,
+    /// Frames that swapped.
+    pub displayed_frames: usize,
+    /// Warp only: age of the re-projected application frame at the swap
+    /// that showed each head motion.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub app_frame_age_ms: Option<Dist>,
+    /// Warp only: application frames started.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub application_frames: Option<usize>,
+    /// Warp only: simulation steps started.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulation_steps: Option<usize>,
 }
 
-fn bounds(b: &Bounds) -> Value {
-    json!({"best": b.best, "worst": b.worst, "phase_min": b.phase_min, "phase_max": b.phase_max, "phase_mean": b.phase_mean})
+/// The summary of a VR run (`summary.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct VrSummary {
+    /// `"vr"`.
+    pub system: &'static str,
+    /// `naive` or `warp`.
+    pub scheme: Scheme,
+    /// The model's description.
+    pub description: String,
+    /// Master seed.
+    pub seed: u64,
+    /// Motions followed.
+    pub input_events: usize,
+    /// Kernel events.
+    pub events: EventCounts,
+    /// Wall time of the run.
+    pub wall_seconds: f64,
+    /// Wall time of the simulation (the same: nothing is built first).
+    pub simulate_seconds: f64,
+    /// Simulated time at the end.
+    pub simulated_seconds: f64,
+    /// Why the run stopped (`model`: every motion shown).
+    pub stopped_by: StopReason,
+    /// The results.
+    pub metrics: VrMetrics,
 }
 
 fn summarize(cfg: &VrConfig, m: &Vr, motions: &[MotionRecord], a: &Analytic, stats: &RunStats) -> Value {
@@ -186,44 +222,43 @@ fn summarize(cfg: &VrConfig, m: &Vr, motions: &[MotionRecord], a: &Analytic, sta
         Scheme::Naive => (&NAIVE_STAGES, &NAIVE_STAGES),
         Scheme::Warp => (&WARP_HEAD_STAGES, &WARP_OBJECT_STAGES),
     };
-    let by_kind: serde_json::Map<String, Value> = stats
-        .kind_names
+    let warp = cfg.scheme == Scheme::Warp;
+    let ages: Vec<f64> = motions
         .iter()
-        .zip(&stats.by_kind)
-        .map(|(n, c)| (n.to_string(), json!(c)))
+        .filter_map(|r| r.app_age.map(|v| v as f64 / 1e9))
         .collect();
-    let mut metrics = json!({
-        "motion_to_photon_ms": {"head": dist(&head), "object": dist(&object)},
-        "analytic_latency_ms": {"head": bounds(&a.head), "object": bounds(&a.object)},
-        "latency_breakdown_ms": {
-            "head": breakdown(hs, motions.iter().filter_map(|r| r.head.as_ref())),
-            "object": breakdown(os, motions.iter().filter_map(|r| r.object.as_ref())),
+    let summary = VrSummary {
+        system: "vr",
+        scheme: cfg.scheme,
+        description: cfg.description.clone(),
+        seed: cfg.run.seed,
+        input_events: motions.len(),
+        events: EventCounts::of(stats),
+        wall_seconds: stats.wall_seconds,
+        simulate_seconds: stats.wall_seconds,
+        simulated_seconds: stats.end_time.0 as f64 / 1e12,
+        stopped_by: stats.stopped_by,
+        metrics: VrMetrics {
+            motion_to_photon_ms: Motions {
+                head: Dist::of(&head),
+                object: Dist::of(&object),
+            },
+            analytic_latency_ms: Motions {
+                head: a.head,
+                object: a.object,
+            },
+            latency_breakdown_ms: Motions {
+                head: mean_stages(hs, motions.iter().filter_map(|r| r.head.as_ref())),
+                object: mean_stages(os, motions.iter().filter_map(|r| r.object.as_ref())),
+            },
+            display_frame_ms: a.frame_ms,
+            displayed_frames: m.swapped,
+            app_frame_age_ms: warp.then(|| Dist::of(&ages)),
+            application_frames: warp.then_some(m.apps),
+            simulation_steps: warp.then_some(m.sims),
         },
-        "display_frame_ms": a.frame_ms,
-        "displayed_frames": m.swapped,
-    });
-    if cfg.scheme == Scheme::Warp {
-        let ages: Vec<f64> = motions
-            .iter()
-            .filter_map(|r| r.app_age.map(|v| v as f64 / 1e9))
-            .collect();
-        metrics["app_frame_age_ms"] = dist(&ages);
-        metrics["application_frames"] = json!(m.apps);
-        metrics["simulation_steps"] = json!(m.sims);
-    }
-    json!({
-        "system": "vr",
-        "scheme": cfg.scheme,
-        "description": cfg.description,
-        "seed": cfg.run.seed,
-        "input_events": motions.len(),
-        "events": {"total": stats.events, "by_kind": by_kind},
-        "wall_seconds": stats.wall_seconds,
-        "simulate_seconds": stats.wall_seconds,
-        "simulated_seconds": stats.end_time.0 as f64 / 1e12,
-        "stopped_by": stats.stopped_by,
-        "metrics": metrics,
-    })
+    };
+    to_json(&summary)
 }
 
 /// Columns of the per-motion table.
