@@ -1,15 +1,17 @@
 //! Validating, running and summarizing a PixelFlow model.
 
-use serde_json::{Value, json};
+use serde::Serialize;
+use serde_json::Value;
 
 use crate::engine::{Duration, Limits, PS_PER_MS, RunStats, Scheduler, run};
 use crate::output::trace::TraceWriter;
 
 use super::analytic::{Analytic, closed_form};
-use super::config::{Fidelity, PixelFlowConfig, Placement, Size};
+use super::config::{Architecture, Fidelity, PixelFlowConfig, Placement, Size};
 use super::layout::{Layout, build};
 use super::model::{PixelFlow, RegionRecord, Span};
 use crate::systems::error::SystemError;
+use crate::systems::summary::{EventCounts, to_json};
 
 /// Everything a run produced.
 #[derive(Debug)]
@@ -282,10 +284,15 @@ pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, 
     if cfg.fidelity == Fidelity::Analytic {
         let wall = t0.elapsed().as_secs_f64();
         let a = &analytic;
-        let stages = json!({
-            "geometry": a.t_front_ms, "generate": a.t_gen_ms, "rasterize": a.t_rast_ms,
-            "composite": a.t_comp_ms, "shade": a.t_shade_ms, "load": a.t_load_ms,
-        });
+        let stages = StagesMs {
+            geometry: a.t_front_ms,
+            generate: a.t_gen_ms,
+            rasterize: a.t_rast_ms,
+            composite: a.t_comp_ms,
+            shade: a.t_shade_ms,
+            color: None,
+            load: a.t_load_ms,
+        };
         let summary = summary(
             &cfg,
             &analytic,
@@ -324,15 +331,15 @@ pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, 
         });
     };
     let b = &model.busy;
-    let stages = json!({
-        "geometry": max_ms(&b.geometry),
-        "generate": max_ms(&b.generate),
-        "rasterize": max_ms(&b.rasterize),
-        "composite": ms(b.composite),
-        "shade": max_ms(&b.shade),
-        "color": ms(b.color),
-        "load": ms(b.load),
-    });
+    let stages = StagesMs {
+        geometry: max_ms(&b.geometry),
+        generate: max_ms(&b.generate),
+        rasterize: max_ms(&b.rasterize),
+        composite: ms(b.composite),
+        shade: max_ms(&b.shade),
+        color: Some(ms(b.color)),
+        load: ms(b.load),
+    };
     let _ = done;
     let frames: Vec<(f64, f64, f64)> = model
         .frame_times
@@ -378,6 +385,168 @@ pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, 
     })
 }
 
+/// Busy time per pipeline stage, milliseconds (the busiest unit of a stage
+/// with several; the closed form's terms at `analytic` fidelity).
+#[derive(Debug, Clone, Serialize)]
+pub struct StagesMs {
+    /// Geometry (the front end).
+    pub geometry: f64,
+    /// Generating region entries.
+    pub generate: f64,
+    /// Rasterizing.
+    pub rasterize: f64,
+    /// Composition network.
+    pub composite: f64,
+    /// Shading.
+    pub shade: f64,
+    /// Color transfer to the frame buffer (event simulation only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub color: Option<f64>,
+    /// Loading the frame buffer.
+    pub load: f64,
+}
+
+/// Region entries per screen region (a primitive counts once per region it
+/// touches).
+#[derive(Debug, Clone, Serialize)]
+pub struct EntryCounts {
+    /// Fewest.
+    pub min: u64,
+    /// Most.
+    pub max: u64,
+    /// Mean.
+    pub mean: f64,
+}
+
+/// A few statistics over frames; `null` with `count: 0` when there are no
+/// values (one frame has no interval).
+#[derive(Debug, Clone, Serialize)]
+pub struct FrameStats {
+    /// Values.
+    pub count: usize,
+    /// The first frame's.
+    pub first: Option<f64>,
+    /// The last frame's.
+    pub last: Option<f64>,
+    /// Mean.
+    pub mean: Option<f64>,
+    /// Largest.
+    pub max: Option<f64>,
+}
+
+impl FrameStats {
+    fn of(v: &[f64]) -> Self {
+        let (first, last) = (v.first().copied(), v.last().copied());
+        let mean = (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
+        let max = (!v.is_empty()).then(|| v.iter().copied().fold(f64::MIN, f64::max));
+        FrameStats {
+            count: v.len(),
+            first,
+            last,
+            mean,
+            max,
+        }
+    }
+}
+
+/// One frame's instants, milliseconds.
+#[derive(Debug, Clone, Serialize)]
+pub struct FrameTimes {
+    /// The frame started (its first primitive entered geometry).
+    pub start_ms: f64,
+    /// The front end finished it.
+    pub front_end_done_ms: f64,
+    /// Its last region was loaded.
+    pub done_ms: f64,
+    /// `done_ms - start_ms`.
+    pub latency_ms: f64,
+}
+
+/// `metrics` of a PixelFlow summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct PixelFlowMetrics {
+    /// The first frame's latency (start to last region loaded).
+    pub latency_ms: f64,
+    /// The closed form's latency (paper 002 §4-6).
+    pub analytic_latency_ms: f64,
+    /// `(latency - analytic) / analytic` (0 when the closed form is 0).
+    pub relative_error: f64,
+    /// `relative_error` in percent.
+    pub difference_pct: f64,
+    /// The first frame's front end.
+    pub front_end_ms: f64,
+    /// The first frame's back end (`latency - front end`).
+    pub back_end_ms: f64,
+    /// The closed form's front end.
+    pub analytic_front_end_ms: f64,
+    /// The closed form's back end.
+    pub analytic_back_end_ms: f64,
+    /// Busy time per stage.
+    pub stages_ms: StagesMs,
+    /// Screen regions.
+    pub regions: u32,
+    /// The closed form's overlap factor.
+    pub overlap: f64,
+    /// The overlap of the simulated placement (the closed form's at
+    /// `analytic` fidelity).
+    pub realised_overlap: f64,
+    /// Region entries per region (null at `analytic` fidelity).
+    pub region_entries: Option<EntryCounts>,
+    /// Every term of the closed form.
+    pub analytic: Analytic,
+    /// Latency over the frames.
+    pub frame_latency_ms: FrameStats,
+    /// Intervals between frames' ends.
+    pub frame_interval_ms: FrameStats,
+    /// Every frame's instants.
+    pub per_frame: Vec<FrameTimes>,
+    /// Primitives the closed form fits in 30 ms.
+    pub analytic_primitives_at_30ms: f64,
+    /// Primitives the closed form fits in 40 ms.
+    pub analytic_primitives_at_40ms: f64,
+}
+
+/// The summary of a PixelFlow run (`summary.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct PixelFlowSummary {
+    /// `"pixelflow"`.
+    pub system: &'static str,
+    /// The model's description.
+    pub description: String,
+    /// `analytic` or `event`.
+    pub fidelity: Fidelity,
+    /// The architecture.
+    pub architecture: Architecture,
+    /// Nodes.
+    pub nodes: u32,
+    /// Nodes that rasterize.
+    pub rasterizers: u32,
+    /// Nodes that shade.
+    pub shaders: u32,
+    /// Samples per pixel.
+    pub samples: u32,
+    /// Primitives per frame.
+    pub primitives: u64,
+    /// How primitives are placed on the screen.
+    pub placement: Placement,
+    /// Load imbalance between nodes.
+    pub node_skew: f64,
+    /// Master seed.
+    pub seed: u64,
+    /// Frames simulated.
+    pub frames: u32,
+    /// Always 0 (every frame is reported).
+    pub warmup_frames: u32,
+    /// Kernel events (none at `analytic` fidelity).
+    pub events: EventCounts,
+    /// Wall time of the run.
+    pub wall_seconds: f64,
+    /// Wall time of the simulation alone.
+    pub simulate_seconds: f64,
+    /// The results.
+    pub metrics: PixelFlowMetrics,
+}
+
 #[allow(clippy::too_many_arguments)]
 fn summary(
     cfg: &PixelFlowConfig,
@@ -385,33 +554,29 @@ fn summary(
     stats: Option<&RunStats>,
     latency: f64,
     front: f64,
-    stages: Value,
+    stages: StagesMs,
     layout: Option<(&Layout, &Vec<u64>)>,
     wall: f64,
     simulate: f64,
     frames: &[(f64, f64, f64)],
 ) -> Value {
-    let (events, by_kind) = match stats {
-        Some(s) => (
-            s.events,
-            Value::Object(
-                s.kind_names
-                    .iter()
-                    .zip(&s.by_kind)
-                    .map(|(n, c)| (n.to_string(), json!(c)))
-                    .collect(),
-            ),
-        ),
-        None => (0, json!({})),
+    let events = match stats {
+        Some(s) => EventCounts::of(s),
+        None => EventCounts {
+            total: 0,
+            by_kind: Default::default(),
+        },
     };
     let (realised, entries) = match layout {
-        Some((l, e)) => {
-            let max = e.iter().copied().max().unwrap_or(0);
-            let min = e.iter().copied().min().unwrap_or(0);
-            let mean = e.iter().sum::<u64>() as f64 / e.len().max(1) as f64;
-            (l.realised_overlap(), json!({"min": min, "max": max, "mean": mean}))
-        }
-        None => (a.overlap, Value::Null),
+        Some((l, e)) => (
+            l.realised_overlap(),
+            Some(EntryCounts {
+                min: e.iter().copied().min().unwrap_or(0),
+                max: e.iter().copied().max().unwrap_or(0),
+                mean: e.iter().sum::<u64>() as f64 / e.len().max(1) as f64,
+            }),
+        ),
+        None => (a.overlap, None),
     };
     let rel = if a.latency_ms > 0.0 {
         (latency - a.latency_ms) / a.latency_ms
@@ -420,60 +585,55 @@ fn summary(
     };
     let lat: Vec<f64> = frames.iter().map(|f| f.2 - f.0).collect();
     let intervals: Vec<f64> = frames.windows(2).map(|w| w[1].2 - w[0].2).collect();
-    // Like every summary's statistics: `count`, and with no values (one
-    // frame has no interval) the other fields null.
-    let stat = |v: &[f64]| -> Value {
-        if v.is_empty() {
-            return json!({"count": 0, "first": null, "last": null, "mean": null, "max": null});
-        }
-        let mean = v.iter().sum::<f64>() / v.len() as f64;
-        let max = v.iter().copied().fold(f64::MIN, f64::max);
-        json!({"count": v.len(), "first": v[0], "last": v[v.len() - 1], "mean": mean, "max": max})
-    };
-    let frame_rows: Vec<Value> = frames
-        .iter()
-        .map(|f| json!({"start_ms": f.0, "front_end_done_ms": f.1, "done_ms": f.2, "latency_ms": f.2 - f.0}))
-        .collect();
-    json!({
-        "system": "pixelflow",
-        "description": cfg.description,
-        "fidelity": cfg.fidelity,
-        "architecture": cfg.architecture,
-        "nodes": cfg.nodes,
-        "rasterizers": cfg.rasterizers(),
-        "shaders": cfg.shaders(),
-        "samples": cfg.samples,
-        "primitives": cfg.primitives,
-        "placement": cfg.placement,
-        "node_skew": cfg.node_skew,
-        "seed": cfg.run.seed,
-        "frames": cfg.frames,
-        "warmup_frames": 0,
-        "events": {"total": events, "by_kind": by_kind},
-        "wall_seconds": wall,
-        "simulate_seconds": simulate,
-        "metrics": {
-            "latency_ms": latency,
-            "analytic_latency_ms": a.latency_ms,
-            "relative_error": rel,
-            "difference_pct": 100.0 * rel,
-            "front_end_ms": front,
-            "back_end_ms": latency - front,
-            "analytic_front_end_ms": a.front_end_ms,
-            "analytic_back_end_ms": a.back_end_ms,
-            "stages_ms": stages,
-            "regions": a.regions,
-            "overlap": a.overlap,
-            "realised_overlap": realised,
-            "region_entries": entries,
-            "analytic": a,
-            "frame_latency_ms": stat(&lat),
-            "frame_interval_ms": stat(&intervals),
-            "per_frame": frame_rows,
-            "analytic_primitives_at_30ms": super::analytic::primitives_at(cfg, 30.0),
-            "analytic_primitives_at_40ms": super::analytic::primitives_at(cfg, 40.0),
+    let summary = PixelFlowSummary {
+        system: "pixelflow",
+        description: cfg.description.clone(),
+        fidelity: cfg.fidelity,
+        architecture: cfg.architecture,
+        nodes: cfg.nodes,
+        rasterizers: cfg.rasterizers(),
+        shaders: cfg.shaders(),
+        samples: cfg.samples,
+        primitives: cfg.primitives,
+        placement: cfg.placement,
+        node_skew: cfg.node_skew,
+        seed: cfg.run.seed,
+        frames: cfg.frames,
+        warmup_frames: 0,
+        events,
+        wall_seconds: wall,
+        simulate_seconds: simulate,
+        metrics: PixelFlowMetrics {
+            latency_ms: latency,
+            analytic_latency_ms: a.latency_ms,
+            relative_error: rel,
+            difference_pct: 100.0 * rel,
+            front_end_ms: front,
+            back_end_ms: latency - front,
+            analytic_front_end_ms: a.front_end_ms,
+            analytic_back_end_ms: a.back_end_ms,
+            stages_ms: stages,
+            regions: a.regions,
+            overlap: a.overlap,
+            realised_overlap: realised,
+            region_entries: entries,
+            analytic: a.clone(),
+            frame_latency_ms: FrameStats::of(&lat),
+            frame_interval_ms: FrameStats::of(&intervals),
+            per_frame: frames
+                .iter()
+                .map(|f| FrameTimes {
+                    start_ms: f.0,
+                    front_end_done_ms: f.1,
+                    done_ms: f.2,
+                    latency_ms: f.2 - f.0,
+                })
+                .collect(),
+            analytic_primitives_at_30ms: super::analytic::primitives_at(cfg, 30.0),
+            analytic_primitives_at_40ms: super::analytic::primitives_at(cfg, 40.0),
         },
-    })
+    };
+    to_json(&summary)
 }
 
 /// Columns of the per-region table.
