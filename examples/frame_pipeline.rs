@@ -8,7 +8,8 @@
 //! Run it with `cargo run --release --example frame_pipeline`.
 
 use rendersim::config::{ModelSource, apply_set};
-use rendersim::systems::{SystemRun, run_model};
+use rendersim::systems::frame_pipeline::PipelineRun;
+use rendersim::systems::run_model;
 
 const MODEL: &str = r#"
 [run]
@@ -32,7 +33,7 @@ fn display_interval(gpu: &str) -> f64 {
     let mut table = src.table().expect("valid TOML");
     apply_set(&mut table, &format!("workload.gpu=\"{gpu}\"")).expect("a valid --set");
     let run = run_model(&src, &table, None).expect("the model runs");
-    let SystemRun::FramePipeline(r) = run else {
+    let Ok(r) = run.downcast::<PipelineRun>() else {
         unreachable!("a model without `system` is a frame pipeline")
     };
     // Conservation: every unit's states add up to the elapsed time exactly.

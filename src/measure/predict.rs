@@ -8,7 +8,7 @@
 
 use crate::config::ModelSource;
 use crate::engine::Duration;
-use crate::systems::{SimError, SystemRun, run_model};
+use crate::systems::{SimError, run_model};
 
 /// A pass to predict.
 #[derive(Debug, Clone, PartialEq)]
@@ -117,7 +117,7 @@ pub fn simulate_pass(m: &PassModel) -> Result<PassPrediction, PredictError> {
     let t = std::time::Instant::now();
     let run = run_model(&src, &table, None)?;
     let wall_seconds = t.elapsed().as_secs_f64();
-    let SystemRun::FramePipeline(r) = run else {
+    let Ok(r) = run.downcast::<crate::systems::frame_pipeline::PipelineRun>() else {
         return Err(PredictError::Missing("a frame-pipeline run"));
     };
     let gpu_ms = r.summary["metrics"]["gpu_time_ms"]["mean"]

@@ -14,7 +14,7 @@ use std::io::Write;
 
 use serde_json::Value;
 
-use crate::config::{ConfigError, ModelSource, deserialize, invalid};
+use crate::config::{ConfigError, ModelSource, invalid};
 use crate::output::trace::TraceWriter;
 
 pub use crate::config::DEFAULT_MODEL;
@@ -69,7 +69,7 @@ impl SimError {
     /// A system's error as the model's: a value the system cannot use is
     /// blamed on the model file (with its line and the `--set` that gave
     /// it), anything else names the model.
-    fn of(src: &ModelSource, e: SystemError) -> SimError {
+    pub fn of(src: &ModelSource, e: SystemError) -> SimError {
         match e {
             SystemError::Invalid { key, message } => SimError::Config(invalid(src, &key, message, None)),
             e => SimError::Run {
@@ -80,24 +80,84 @@ impl SimError {
     }
 }
 
-/// The result of running one model.
-#[derive(Debug)]
-pub enum SystemRun {
-    /// A frame-pipeline run.
-    FramePipeline(Box<frame_pipeline::PipelineRun>),
-    /// A multi-frame-rate run.
-    MultiRate(Box<multi_rate::MultiRateRun>),
-    /// A VR-pipeline run.
-    Vr(Box<vr::VrRun>),
-    /// A PixelFlow run (one frame).
-    PixelFlow(Box<pixelflow::PixelFlowRun>),
+/// One simulated system. Adding a system means implementing this for a unit
+/// struct in the system's `system.rs` (its run type implements [`Outcome`])
+/// and adding one line to [`SYSTEMS`].
+pub trait System: Sync {
+    /// The name a model file gives in `system = "..."`.
+    fn name(&self) -> &'static str;
+
+    /// Reads the model's typed config from its table (with `--set` patches
+    /// applied), validates it and runs it; with a `trace` writer, the run's
+    /// trace goes into it.
+    fn run(
+        &self,
+        src: &ModelSource,
+        table: &toml::Table,
+        trace: Option<TraceWriter>,
+    ) -> Result<Box<dyn Outcome>, SimError>;
 }
 
-/// Builds and runs the system a model describes. With a `trace` writer, the
-/// run's trace is written into it (the frame pipeline's while it runs) and
-/// handed back by [`SystemRun::take_trace`], to be closed by the caller.
+/// What a finished run of any system offers: its summary, its per-row
+/// table, its human report, its resolved model and its trace.
+pub trait Outcome: std::fmt::Debug + Send {
+    /// The summary as JSON (`summary.json`; experiments read it by dotted path).
+    fn summary(&self) -> &Value;
+
+    /// The summary, to add to (the CLI adds the model's name).
+    fn summary_mut(&mut self) -> &mut Value;
+
+    /// Writes the human-readable report (`rendersim run` without `--json`).
+    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()>;
+
+    /// The per-row table's columns and rows: per frame, per input event
+    /// (latency systems) or per screen region (PixelFlow).
+    fn table(&self) -> (Vec<String>, Vec<Vec<f64>>);
+
+    /// Writes the per-row table as CSV (`frames.csv`).
+    fn write_table(&self, w: &mut dyn Write) -> std::io::Result<()>;
+
+    /// The fully resolved model as TOML, runnable again (relative file paths
+    /// in it made absolute against `base_dir`).
+    fn resolved_model(&self, base_dir: &std::path::Path) -> String;
+
+    /// The trace writer, all events written, for the caller to close.
+    fn take_trace(&mut self) -> Option<TraceWriter>;
+
+    /// The run as `Any`, to see which system's run type it is.
+    fn as_any(&self) -> &dyn std::any::Any;
+
+    /// The run as `Any`, to get the system's own run type back.
+    fn into_any(self: Box<Self>) -> Box<dyn std::any::Any>;
+}
+
+/// Every system, by the name a model file gives.
+pub const SYSTEMS: &[&dyn System] = &[
+    &frame_pipeline::system::FramePipelineSystem,
+    &multi_rate::system::MultiRateSystem,
+    &vr::system::VrSystem,
+    &pixelflow::system::PixelFlowSystem,
+];
+
+/// A resolved model's TOML with the header every system writes.
+pub fn resolved_toml<T: serde::Serialize>(cfg: &T) -> String {
+    let body = toml::to_string(cfg).unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
+    format!("# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}")
+}
+
+/// The result of running one model, whatever its system.
+#[derive(Debug)]
+pub struct SystemRun(Box<dyn Outcome>);
+
+fn known_systems() -> String {
+    SYSTEMS.iter().map(|s| s.name()).collect::<Vec<_>>().join(", ")
+}
+
+/// Builds and runs the system a model describes (its `system` key, default
+/// `frame_pipeline`). With a `trace` writer, the run's trace is written into
+/// it and handed back by [`SystemRun::take_trace`], to be closed by the caller.
 pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWriter>) -> Result<SystemRun, SimError> {
-    let system = match table.get("system") {
+    let name = match table.get("system") {
         None => "frame_pipeline",
         Some(toml::Value::String(s)) => s.as_str(),
         Some(other) => {
@@ -105,49 +165,20 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWrit
                 src,
                 "system",
                 format!(
-                    "expected a system name as a string (frame_pipeline, multi_rate, vr, pixelflow), found {}",
+                    "expected a system name as a string ({}), found {}",
+                    known_systems(),
                     other.type_str()
                 ),
                 None,
             )));
         }
     };
-    match system {
-        "frame_pipeline" => {
-            let cfg: frame_pipeline::FramePipelineConfig = deserialize(table, src)?;
-            frame_pipeline::run_pipeline(cfg, &src.base_dir, trace)
-                .map(|r| SystemRun::FramePipeline(Box::new(r)))
-                .map_err(|e| SimError::of(src, e))
-        }
-        "multi_rate" => {
-            let cfg: multi_rate::MultiRateConfig = deserialize(table, src)?;
-            multi_rate::run_multi_rate(cfg, trace)
-                .map(|r| SystemRun::MultiRate(Box::new(r)))
-                .map_err(|e| SimError::of(src, e))
-        }
-        "vr" => {
-            let cfg: vr::VrConfig = deserialize(table, src)?;
-            vr::run_vr(cfg, trace)
-                .map(|r| SystemRun::Vr(Box::new(r)))
-                .map_err(|e| SimError::of(src, e))
-        }
-        "pixelflow" => {
-            let cfg: pixelflow::PixelFlowConfig = deserialize(table, src)?;
-            let traced = trace.is_some();
-            pixelflow::run_pixelflow(cfg, traced)
-                .map(|mut r| {
-                    r.trace = trace.map(|mut t| {
-                        pixelflow::run::write_trace(&r, &mut t);
-                        t
-                    });
-                    SystemRun::PixelFlow(Box::new(r))
-                })
-                .map_err(|e| SimError::of(src, e))
-        }
-        other => Err(SimError::Config(invalid(
+    match SYSTEMS.iter().find(|s| s.name() == name) {
+        Some(system) => system.run(src, table, trace).map(SystemRun),
+        None => Err(SimError::Config(invalid(
             src,
             "system",
-            format!("unknown system {other:?} (known: frame_pipeline, multi_rate, vr, pixelflow)"),
+            format!("unknown system {name:?} (known: {})", known_systems()),
             None,
         ))),
     }
@@ -156,125 +187,52 @@ pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWrit
 impl SystemRun {
     /// The JSON summary.
     pub fn summary(&self) -> &Value {
-        match self {
-            SystemRun::FramePipeline(r) => &r.summary,
-            SystemRun::MultiRate(r) => &r.summary,
-            SystemRun::Vr(r) => &r.summary,
-            SystemRun::PixelFlow(r) => &r.summary,
-        }
+        self.0.summary()
     }
 
     /// Mutable summary (the CLI adds the model's name).
     pub fn summary_mut(&mut self) -> &mut Value {
-        match self {
-            SystemRun::FramePipeline(r) => &mut r.summary,
-            SystemRun::MultiRate(r) => &mut r.summary,
-            SystemRun::Vr(r) => &mut r.summary,
-            SystemRun::PixelFlow(r) => &mut r.summary,
-        }
+        self.0.summary_mut()
     }
 
     /// Writes the human-readable report of the run (what `rendersim run`
-    /// prints without `--json`), from its summary.
+    /// prints without `--json`).
     pub fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        match self {
-            SystemRun::FramePipeline(r) => frame_pipeline::report::write_report(&r.summary, w),
-            SystemRun::MultiRate(r) => multi_rate::report::write_report(&r.summary, w),
-            SystemRun::Vr(r) => vr::report::write_report(&r.summary, w),
-            SystemRun::PixelFlow(r) => pixelflow::report::write_report(&r.summary, w),
-        }
+        self.0.write_report(w)
     }
 
-    /// Writes the per-frame table as CSV (per input event for latency
-    /// systems; PixelFlow: one row per screen region of the simulated frame).
+    /// Writes the per-row table as CSV (per frame; per input event for
+    /// latency systems; PixelFlow: one row per screen region).
     pub fn write_frames_csv(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        match self {
-            SystemRun::FramePipeline(r) => frame_pipeline::records::write_frames_csv(&r.records, w),
-            SystemRun::MultiRate(r) => multi_rate::run::write_events_csv(&r.events, w),
-            SystemRun::Vr(r) => vr::run::write_motions_csv(&r.motions, w),
-            SystemRun::PixelFlow(r) => pixelflow::run::write_regions_csv(r, w),
-        }
+        self.0.write_table(w)
     }
 
-    /// The per-frame table (columns and rows), for experiments.
+    /// The per-row table (columns and rows), for experiments.
     pub fn frame_table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
-        match self {
-            SystemRun::FramePipeline(r) => (
-                frame_pipeline::records::COLUMNS.iter().map(|s| s.to_string()).collect(),
-                frame_pipeline::records::frame_rows(&r.records)
-                    .into_iter()
-                    .map(|row| row.to_vec())
-                    .collect(),
-            ),
-            SystemRun::MultiRate(r) => (
-                multi_rate::latency::COLUMNS.iter().map(|s| s.to_string()).collect(),
-                multi_rate::latency::event_rows(&r.events),
-            ),
-            SystemRun::Vr(r) => (
-                vr::run::COLUMNS.iter().map(|s| s.to_string()).collect(),
-                vr::run::motion_rows(&r.motions),
-            ),
-            SystemRun::PixelFlow(r) => (
-                pixelflow::run::COLUMNS.iter().map(|s| s.to_string()).collect(),
-                pixelflow::run::region_rows(r),
-            ),
-        }
+        self.0.table()
     }
 
     /// The fully resolved model as TOML (runnable again); relative mesh
     /// file paths are made absolute against `base_dir`.
     pub fn resolved_model(&self, base_dir: &std::path::Path) -> String {
-        match self {
-            SystemRun::FramePipeline(r) => {
-                let mut cfg = r.config.clone();
-                if let frame_pipeline::config::WorkloadConfig::Scene(s) = &mut cfg.workload {
-                    for g in &mut s.groups {
-                        if let crate::scene::config::MeshRef::Spec(spec) = &mut g.mesh {
-                            let p = std::path::Path::new(spec.as_str());
-                            if (spec.ends_with(".obj") || spec.ends_with(".idx")) && p.is_relative() {
-                                let abs = base_dir.join(p);
-                                *spec = abs.canonicalize().unwrap_or(abs).display().to_string();
-                            }
-                        }
-                    }
-                }
-                let body = toml::to_string(&cfg).unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
-                format!(
-                    "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
-                )
-            }
-            SystemRun::Vr(r) => {
-                let body =
-                    toml::to_string(&r.config).unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
-                format!(
-                    "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
-                )
-            }
-            SystemRun::MultiRate(r) => {
-                let body =
-                    toml::to_string(&r.config).unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
-                format!(
-                    "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
-                )
-            }
-            SystemRun::PixelFlow(r) => {
-                let body =
-                    toml::to_string(&r.config).unwrap_or_else(|e| format!("# could not serialize the model: {e}\n"));
-                format!(
-                    "# Fully resolved model written by rendersim; run it again with `rendersim run model.toml`.\n{body}"
-                )
-            }
-        }
+        self.0.resolved_model(base_dir)
     }
 
     /// The run's trace writer, all events written, for the caller to close
     /// ([`TraceWriter::finish`]); `None` when no trace was asked for.
     pub fn take_trace(&mut self) -> Option<TraceWriter> {
-        match self {
-            SystemRun::FramePipeline(r) => r.trace.take(),
-            SystemRun::MultiRate(r) => r.trace.take(),
-            SystemRun::Vr(r) => r.trace.take(),
-            SystemRun::PixelFlow(r) => r.trace.take(),
+        self.0.take_trace()
+    }
+
+    /// The system's own run type (`PipelineRun`, `MultiRateRun`, `VrRun`,
+    /// `PixelFlowRun`), or the run back when it is of another system.
+    pub fn downcast<T: Outcome + 'static>(self) -> Result<T, SystemRun> {
+        if !self.0.as_any().is::<T>() {
+            return Err(self);
+        }
+        match self.0.into_any().downcast::<T>() {
+            Ok(r) => Ok(*r),
+            Err(_) => unreachable!("checked by `is` above"),
         }
     }
 }

@@ -3,7 +3,7 @@
 
 use rendersim::config::{ModelSource, Overrides, prepare};
 use rendersim::systems::frame_pipeline::PipelineRun;
-use rendersim::systems::{SystemRun, run_model};
+use rendersim::systems::run_model;
 use serde_json::Value;
 
 /// Runs a model given as TOML text with `--set` patches (the command line's
@@ -11,10 +11,10 @@ use serde_json::Value;
 pub fn try_run(text: &str, sets: &[&str]) -> Result<PipelineRun, String> {
     let m =
         prepare(ModelSource::from_text("test.toml", text), &Overrides::with_sets(sets)).map_err(|e| e.to_string())?;
-    match run_model(&m.source, &m.table, None).map_err(|e| e.to_string())? {
-        SystemRun::FramePipeline(r) => Ok(*r),
-        other => Err(format!("not a frame-pipeline run: {}", other.summary()["system"])),
-    }
+    run_model(&m.source, &m.table, None)
+        .map_err(|e| e.to_string())?
+        .downcast::<PipelineRun>()
+        .map_err(|other| format!("not a frame-pipeline run: {}", other.summary()["system"]))
 }
 
 /// Runs and panics with the error on failure.

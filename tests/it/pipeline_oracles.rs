@@ -221,7 +221,7 @@ fn vertex_cache_changes_geometry_time_by_actually_transformed_vertices() {
 #[test]
 fn tracing_does_not_change_results_at_either_fidelity() {
     use rendersim::config::ModelSource;
-    use rendersim::systems::{SystemRun, run_model};
+    use rendersim::systems::run_model;
     for fid in ["triangle", "draw"] {
         let src = ModelSource::from_text("d.toml", DEFAULT);
         let mut t = src.table().unwrap();
@@ -232,15 +232,15 @@ fn tracing_does_not_change_results_at_either_fidelity() {
         ] {
             rendersim::config::apply_set(&mut t, &s).unwrap();
         }
-        let get = |trace: bool| match run_model(
-            &src,
-            &t,
-            trace.then(|| rendersim::output::trace::TraceWriter::new(Box::new(std::io::sink()))),
-        )
-        .unwrap()
-        {
-            SystemRun::FramePipeline(r) => *r,
-            _ => panic!("not a frame-pipeline run"),
+        let get = |trace: bool| {
+            run_model(
+                &src,
+                &t,
+                trace.then(|| rendersim::output::trace::TraceWriter::new(Box::new(std::io::sink()))),
+            )
+            .unwrap()
+            .downcast::<rendersim::systems::frame_pipeline::PipelineRun>()
+            .expect("a frame-pipeline run")
         };
         let (a, b) = (get(false), get(true));
         assert!(a.trace.is_none() && b.trace.is_some());

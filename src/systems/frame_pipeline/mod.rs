@@ -23,6 +23,7 @@ pub mod model;
 pub mod records;
 pub mod report;
 pub mod run;
+pub mod system;
 pub mod workload;
 
 pub use config::{Fidelity, FramePipelineConfig};

@@ -18,6 +18,7 @@ pub mod migration;
 pub mod model;
 pub mod report;
 pub mod run;
+pub mod system;
 
 pub use config::MultiRateConfig;
 pub use model::MultiRate;

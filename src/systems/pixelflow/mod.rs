@@ -15,6 +15,7 @@ pub mod layout;
 pub mod model;
 pub mod report;
 pub mod run;
+pub mod system;
 
 #[cfg(test)]
 mod tests;

@@ -15,6 +15,7 @@ pub mod latency;
 pub mod model;
 pub mod report;
 pub mod run;
+pub mod system;
 
 pub use config::VrConfig;
 pub use model::Vr;

@@ -1,0 +1,90 @@
+//! The frame pipeline in the system registry ([`crate::systems::SYSTEMS`]).
+
+use std::any::Any;
+use std::io::Write;
+use std::path::Path;
+
+use serde_json::Value;
+
+use crate::config::{ModelSource, deserialize};
+use crate::output::trace::TraceWriter;
+use crate::systems::{Outcome, SimError, System, resolved_toml};
+
+use super::config::{FramePipelineConfig, WorkloadConfig};
+use super::records::{COLUMNS, frame_rows, write_frames_csv};
+use super::run::{PipelineRun, run_pipeline};
+
+/// `system = "frame_pipeline"` (the default).
+pub struct FramePipelineSystem;
+
+impl System for FramePipelineSystem {
+    fn name(&self) -> &'static str {
+        "frame_pipeline"
+    }
+
+    fn run(
+        &self,
+        src: &ModelSource,
+        table: &toml::Table,
+        trace: Option<TraceWriter>,
+    ) -> Result<Box<dyn Outcome>, SimError> {
+        let cfg: FramePipelineConfig = deserialize(table, src)?;
+        let run = run_pipeline(cfg, &src.base_dir, trace).map_err(|e| SimError::of(src, e))?;
+        Ok(Box::new(run))
+    }
+}
+
+impl Outcome for PipelineRun {
+    fn summary(&self) -> &Value {
+        &self.summary
+    }
+
+    fn summary_mut(&mut self) -> &mut Value {
+        &mut self.summary
+    }
+
+    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        super::report::write_report(&self.summary, w)
+    }
+
+    fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
+        (
+            COLUMNS.iter().map(|s| s.to_string()).collect(),
+            frame_rows(&self.records).into_iter().map(|row| row.to_vec()).collect(),
+        )
+    }
+
+    fn write_table(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        write_frames_csv(&self.records, w)
+    }
+
+    /// Mesh files named relative to the model are made absolute, so the
+    /// resolved model runs from anywhere.
+    fn resolved_model(&self, base_dir: &Path) -> String {
+        let mut cfg = self.config.clone();
+        if let WorkloadConfig::Scene(s) = &mut cfg.workload {
+            for g in &mut s.groups {
+                if let crate::scene::config::MeshRef::Spec(spec) = &mut g.mesh {
+                    let p = Path::new(spec.as_str());
+                    if (spec.ends_with(".obj") || spec.ends_with(".idx")) && p.is_relative() {
+                        let abs = base_dir.join(p);
+                        *spec = abs.canonicalize().unwrap_or(abs).display().to_string();
+                    }
+                }
+            }
+        }
+        resolved_toml(&cfg)
+    }
+
+    fn take_trace(&mut self) -> Option<TraceWriter> {
+        self.trace.take()
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn into_any(self: Box<Self>) -> Box<dyn Any> {
+        self
+    }
+}

@@ -1,0 +1,77 @@
+//! The multi-frame-rate system in the system registry
+//! ([`crate::systems::SYSTEMS`]).
+
+use std::any::Any;
+use std::io::Write;
+use std::path::Path;
+
+use serde_json::Value;
+
+use crate::config::{ModelSource, deserialize};
+use crate::output::trace::TraceWriter;
+use crate::systems::{Outcome, SimError, System, resolved_toml};
+
+use super::config::MultiRateConfig;
+use super::latency::{COLUMNS, event_rows};
+use super::run::{MultiRateRun, run_multi_rate, write_events_csv};
+
+/// `system = "multi_rate"`.
+pub struct MultiRateSystem;
+
+impl System for MultiRateSystem {
+    fn name(&self) -> &'static str {
+        "multi_rate"
+    }
+
+    fn run(
+        &self,
+        src: &ModelSource,
+        table: &toml::Table,
+        trace: Option<TraceWriter>,
+    ) -> Result<Box<dyn Outcome>, SimError> {
+        let cfg: MultiRateConfig = deserialize(table, src)?;
+        let run = run_multi_rate(cfg, trace).map_err(|e| SimError::of(src, e))?;
+        Ok(Box::new(run))
+    }
+}
+
+impl Outcome for MultiRateRun {
+    fn summary(&self) -> &Value {
+        &self.summary
+    }
+
+    fn summary_mut(&mut self) -> &mut Value {
+        &mut self.summary
+    }
+
+    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        super::report::write_report(&self.summary, w)
+    }
+
+    fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
+        (
+            COLUMNS.iter().map(|s| s.to_string()).collect(),
+            event_rows(&self.events),
+        )
+    }
+
+    fn write_table(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        write_events_csv(&self.events, w)
+    }
+
+    fn resolved_model(&self, _base_dir: &Path) -> String {
+        resolved_toml(&self.config)
+    }
+
+    fn take_trace(&mut self) -> Option<TraceWriter> {
+        self.trace.take()
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn into_any(self: Box<Self>) -> Box<dyn Any> {
+        self
+    }
+}

@@ -1,0 +1,78 @@
+//! PixelFlow in the system registry ([`crate::systems::SYSTEMS`]).
+
+use std::any::Any;
+use std::io::Write;
+use std::path::Path;
+
+use serde_json::Value;
+
+use crate::config::{ModelSource, deserialize};
+use crate::output::trace::TraceWriter;
+use crate::systems::{Outcome, SimError, System, resolved_toml};
+
+use super::config::PixelFlowConfig;
+use super::run::{COLUMNS, PixelFlowRun, region_rows, run_pixelflow, write_regions_csv, write_trace};
+
+/// `system = "pixelflow"`.
+pub struct PixelFlowSystem;
+
+impl System for PixelFlowSystem {
+    fn name(&self) -> &'static str {
+        "pixelflow"
+    }
+
+    /// One frame's spans are kept while it runs and written to the trace at
+    /// the end (the frame pipeline and the latency systems stream theirs).
+    fn run(
+        &self,
+        src: &ModelSource,
+        table: &toml::Table,
+        trace: Option<TraceWriter>,
+    ) -> Result<Box<dyn Outcome>, SimError> {
+        let cfg: PixelFlowConfig = deserialize(table, src)?;
+        let mut run = run_pixelflow(cfg, trace.is_some()).map_err(|e| SimError::of(src, e))?;
+        run.trace = trace.map(|mut t| {
+            write_trace(&run, &mut t);
+            t
+        });
+        Ok(Box::new(run))
+    }
+}
+
+impl Outcome for PixelFlowRun {
+    fn summary(&self) -> &Value {
+        &self.summary
+    }
+
+    fn summary_mut(&mut self) -> &mut Value {
+        &mut self.summary
+    }
+
+    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        super::report::write_report(&self.summary, w)
+    }
+
+    fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
+        (COLUMNS.iter().map(|s| s.to_string()).collect(), region_rows(self))
+    }
+
+    fn write_table(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        write_regions_csv(self, w)
+    }
+
+    fn resolved_model(&self, _base_dir: &Path) -> String {
+        resolved_toml(&self.config)
+    }
+
+    fn take_trace(&mut self) -> Option<TraceWriter> {
+        self.trace.take()
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn into_any(self: Box<Self>) -> Box<dyn Any> {
+        self
+    }
+}
