@@ -8,6 +8,7 @@ pub mod frame_pipeline;
 pub mod multi_rate;
 pub mod pixelflow;
 pub mod summary;
+pub mod tracked_input;
 pub mod vr;
 
 use std::io::Write;

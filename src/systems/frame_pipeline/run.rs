@@ -16,7 +16,7 @@ use super::model::FramePipeline;
 use super::records::{FrameRecord, frame_rows};
 use super::workload::{SceneProgram, compile_scene};
 use crate::output::trace::TraceWriter;
-use crate::systems::error::SystemError;
+use crate::systems::error::{SystemError, invalid as bad};
 use crate::systems::summary::{Dist, EventCounts, events_per_second, to_json};
 
 /// Everything a run produced.
@@ -58,13 +58,6 @@ pub struct ClockTotals {
     pub bottleneck: [u64; 6],
     /// Elapsed simulated time.
     pub elapsed: u64,
-}
-
-fn bad(key: &str, message: impl Into<String>) -> SystemError {
-    SystemError::Invalid {
-        key: key.to_string(),
-        message: message.into(),
-    }
 }
 
 /// Checks values serde cannot (ranges, distributions).

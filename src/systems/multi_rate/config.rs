@@ -16,8 +16,26 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::config::{Bandwidth, Bytes, Rate};
+use crate::config::{Bandwidth, Rate};
 use crate::engine::Duration;
+use crate::systems::tracked_input;
+
+/// `[run]`: 5000 input events after a 1000 ms warm-up.
+pub type RunConfig = tracked_input::RunConfig<MultiRateDefaults>;
+/// `[input]`: a Poisson process, 97 ms apart on average.
+pub use tracked_input::InputConfig;
+/// `[tracker]`: a sample every 20 ms, delivered 40 ms later.
+pub type TrackerConfig = tracked_input::TrackerConfig<MultiRateDefaults>;
+
+/// This system's defaults for the shared tables.
+#[derive(Debug, Clone)]
+pub struct MultiRateDefaults;
+
+impl tracked_input::Defaults for MultiRateDefaults {
+    const WARMUP_MS: u64 = 1000;
+    const TRACKER_PERIOD_MS: u64 = 20;
+    const TRACKER_LATENCY_MS: u64 = 40;
+}
 
 /// The whole model.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -95,75 +113,6 @@ fn default_resolution() -> [u32; 2] {
 }
 fn default_bpp() -> u32 {
     8
-}
-
-/// Run length and seed.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct RunConfig {
-    /// Master seed of all RNG streams.
-    pub seed: u64,
-    /// Input events to follow through the pipeline.
-    pub events: u64,
-    /// Simulated time before the first input event (all clients running).
-    pub warmup: Duration,
-    /// Safety cap on handled events.
-    pub max_events: Option<u64>,
-    /// Most memory the run's records may take: estimated from the inputs
-    /// before simulating and enforced while it runs (default
-    /// [`crate::limits::DEFAULT_MAX_MEMORY`], 8 GiB).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub max_memory: Option<Bytes>,
-}
-
-impl Default for RunConfig {
-    fn default() -> Self {
-        RunConfig {
-            seed: 1,
-            events: 5000,
-            warmup: Duration::ms(1000),
-            max_events: None,
-            max_memory: None,
-        }
-    }
-}
-
-/// Input events: a Poisson process (exponential gaps drawn from the
-/// `input.arrivals` stream), so each event falls at a random phase of every
-/// periodic process.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct InputConfig {
-    /// Mean time between input events.
-    pub mean_interval: Duration,
-}
-
-impl Default for InputConfig {
-    fn default() -> Self {
-        InputConfig {
-            mean_interval: Duration::ms(97),
-        }
-    }
-}
-
-/// The master's tracker: samples every `period`; a sample reaches the
-/// clients `latency` later (paper: 50 Hz, 40 ms).
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct TrackerConfig {
-    /// Time between tracker samples.
-    pub period: Duration,
-    /// Sensor-to-client latency of a sample.
-    pub latency: Duration,
-}
-
-impl Default for TrackerConfig {
-    fn default() -> Self {
-        TrackerConfig {
-            period: Duration::ms(20),
-            latency: Duration::ms(40),
-        }
-    }
 }
 
 /// The slow client: render the whole scene, then read colour and depth back.

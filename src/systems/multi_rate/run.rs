@@ -16,7 +16,7 @@ use super::config::MultiRateConfig;
 use super::latency::{CONV_STAGES, EventRecord, FAST_STAGES, SLOW_STAGES, event_rows, total_ms};
 use super::migration::ArtifactCounts;
 use super::model::MultiRate;
-use crate::systems::error::SystemError;
+use crate::systems::error::{SystemError, invalid as bad};
 
 /// Everything a run produced.
 #[derive(Debug)]
@@ -36,13 +36,6 @@ pub struct MultiRateRun {
     pub summary: Value,
     /// The trace, when one was asked for: written, not yet closed.
     pub trace: Option<TraceWriter>,
-}
-
-fn bad(key: &str, message: impl Into<String>) -> SystemError {
-    SystemError::Invalid {
-        key: key.to_string(),
-        message: message.into(),
-    }
 }
 
 /// Checks values serde cannot.

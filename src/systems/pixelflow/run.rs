@@ -10,7 +10,7 @@ use super::analytic::{Analytic, closed_form};
 use super::config::{Architecture, Fidelity, PixelFlowConfig, Placement, Size};
 use super::layout::{Layout, build};
 use super::model::{PixelFlow, RegionRecord, Span};
-use crate::systems::error::SystemError;
+use crate::systems::error::{SystemError, invalid as bad};
 use crate::systems::summary::{EventCounts, to_json};
 
 /// Everything a run produced.
@@ -32,13 +32,6 @@ pub struct PixelFlowRun {
     pub spans: Option<Vec<Span>>,
     /// The trace, when one was asked for: written, not yet closed.
     pub trace: Option<TraceWriter>,
-}
-
-fn bad(key: &str, message: impl Into<String>) -> SystemError {
-    SystemError::Invalid {
-        key: key.to_string(),
-        message: message.into(),
-    }
 }
 
 fn check_size(key: &str, s: &Size) -> Result<(), SystemError> {

@@ -12,8 +12,26 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::config::{Bytes, Rate};
+use crate::config::Rate;
 use crate::engine::Duration;
+use crate::systems::tracked_input;
+
+/// `[run]`: 5000 input events after a 500 ms warm-up.
+pub type RunConfig = tracked_input::RunConfig<VrDefaults>;
+/// `[input]`: a Poisson process, 97 ms apart on average.
+pub use tracked_input::InputConfig;
+/// `[tracker]`: a sample every 5 ms, delivered 10 ms later.
+pub type TrackerConfig = tracked_input::TrackerConfig<VrDefaults>;
+
+/// This system's defaults for the shared tables.
+#[derive(Debug, Clone)]
+pub struct VrDefaults;
+
+impl tracked_input::Defaults for VrDefaults {
+    const WARMUP_MS: u64 = 500;
+    const TRACKER_PERIOD_MS: u64 = 5;
+    const TRACKER_LATENCY_MS: u64 = 10;
+}
 
 /// Naive single loop or decoupled warping.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -57,74 +75,6 @@ pub struct VrConfig {
     /// The display.
     #[serde(default)]
     pub display: DisplayConfig,
-}
-
-/// Run length and seed.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct RunConfig {
-    /// Master seed of all RNG streams.
-    pub seed: u64,
-    /// Motion events to follow.
-    pub events: u64,
-    /// Simulated time before the first event.
-    pub warmup: Duration,
-    /// Safety cap on handled events.
-    pub max_events: Option<u64>,
-    /// Most memory the run's records may take: estimated from the inputs
-    /// before simulating and enforced while it runs (default
-    /// [`crate::limits::DEFAULT_MAX_MEMORY`], 8 GiB).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub max_memory: Option<Bytes>,
-}
-
-impl Default for RunConfig {
-    fn default() -> Self {
-        RunConfig {
-            seed: 1,
-            events: 5000,
-            warmup: Duration::ms(500),
-            max_events: None,
-            max_memory: None,
-        }
-    }
-}
-
-/// Motion events: Poisson arrivals from the `input.arrivals` stream. Each
-/// is followed twice: as a head motion (camera pose) and as an object
-/// motion (an object moved by a tracked device, through the simulation).
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct InputConfig {
-    /// Mean time between events.
-    pub mean_interval: Duration,
-}
-
-impl Default for InputConfig {
-    fn default() -> Self {
-        InputConfig {
-            mean_interval: Duration::ms(97),
-        }
-    }
-}
-
-/// The tracker: samples every `period`, available `latency` later.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct TrackerConfig {
-    /// Sample period (not in the slides: an assumption).
-    pub period: Duration,
-    /// Sample to application (slides: 10 ms).
-    pub latency: Duration,
-}
-
-impl Default for TrackerConfig {
-    fn default() -> Self {
-        TrackerConfig {
-            period: Duration::ms(5),
-            latency: Duration::ms(10),
-        }
-    }
 }
 
 /// The simulation / animation step.

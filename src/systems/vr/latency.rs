@@ -69,6 +69,7 @@ pub struct MotionRecord {
 /// not needed after it has swapped.
 #[derive(Debug)]
 pub struct Follower {
+    tracker: super::config::TrackerConfig,
     period: u64,
     latency: u64,
     display: u64,
@@ -82,6 +83,7 @@ impl Follower {
     /// A follower for the model's motions.
     pub fn new(cfg: &VrConfig) -> Self {
         Follower {
+            tracker: cfg.tracker.clone(),
             period: cfg.tracker.period.0,
             latency: cfg.tracker.latency.0,
             display: cfg.display_latency().0,
@@ -93,7 +95,7 @@ impl Follower {
 
     /// The sample that captures a motion at `t` (the first at or after it).
     pub fn capturing_sample(&self, t: Time) -> u64 {
-        t.0.div_ceil(self.period.max(1))
+        self.tracker.capturing_sample(t)
     }
 
     /// Bytes the records take now (their stage lists included).

@@ -280,9 +280,7 @@ impl Vr {
 
     /// Newest tracker sample available at `now`.
     pub fn delivered_sample(&self, now: Time) -> Option<u64> {
-        now.0
-            .checked_sub(self.cfg.tracker.latency.0)
-            .map(|x| x / self.cfg.tracker.period.0.max(1))
+        self.cfg.tracker.delivered_sample(now)
     }
 
     /// The first swap opportunity at or after `t`.

@@ -17,7 +17,7 @@ use super::analytic::{Analytic, Bounds, analytic};
 use super::config::{Scheme, VrConfig};
 use super::latency::{MotionRecord, NAIVE_STAGES, WARP_HEAD_STAGES, WARP_OBJECT_STAGES};
 use super::model::Vr;
-use crate::systems::error::SystemError;
+use crate::systems::error::{SystemError, invalid as bad};
 
 /// Everything a run produced.
 #[derive(Debug)]
@@ -36,13 +36,6 @@ pub struct VrRun {
     pub summary: Value,
     /// The trace, when one was asked for: written, not yet closed.
     pub trace: Option<TraceWriter>,
-}
-
-fn bad(key: &str, message: impl Into<String>) -> SystemError {
-    SystemError::Invalid {
-        key: key.to_string(),
-        message: message.into(),
-    }
 }
 
 /// Checks values serde cannot.

@@ -1,0 +1,135 @@
+//! The input side shared by the latency systems (multi-frame-rate, paper 003
+//! §3; VR, paper 001): input events as a Poisson process, captured by a
+//! tracker that samples periodically and delivers each sample a fixed
+//! latency later, and a run measured in input events. Each system gives its
+//! own defaults (the papers' numbers) through [`Defaults`].
+
+use std::marker::PhantomData;
+
+use serde::{Deserialize, Serialize};
+
+use crate::config::Bytes;
+use crate::engine::{Duration, Time};
+
+/// A latency system's defaults for the shared tables.
+pub trait Defaults {
+    /// `run.warmup`, milliseconds.
+    const WARMUP_MS: u64;
+    /// `tracker.period`, milliseconds.
+    const TRACKER_PERIOD_MS: u64;
+    /// `tracker.latency`, milliseconds.
+    const TRACKER_LATENCY_MS: u64;
+}
+
+/// Run length and seed of a latency system: `[run]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default, bound = "")]
+pub struct RunConfig<D: Defaults> {
+    /// Master seed of all RNG streams.
+    pub seed: u64,
+    /// Input events to follow through the pipeline (default 5000).
+    pub events: u64,
+    /// Simulated time before the first input event (every loop running).
+    pub warmup: Duration,
+    /// Safety cap on handled events.
+    pub max_events: Option<u64>,
+    /// Most memory the input records may take: estimated from the inputs
+    /// before simulating and enforced while it runs (default
+    /// [`crate::limits::DEFAULT_MAX_MEMORY`], 8 GiB).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_memory: Option<Bytes>,
+    #[serde(skip)]
+    defaults: PhantomData<fn() -> D>,
+}
+
+impl<D: Defaults> Default for RunConfig<D> {
+    fn default() -> Self {
+        RunConfig {
+            seed: 1,
+            events: 5000,
+            warmup: Duration::ms(D::WARMUP_MS),
+            max_events: None,
+            max_memory: None,
+            defaults: PhantomData,
+        }
+    }
+}
+
+/// Input events: `[input]`, a Poisson process (exponential gaps drawn from
+/// the `input.arrivals` stream), so each event falls at a random phase of
+/// every periodic process.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct InputConfig {
+    /// Mean time between input events (default 97 ms).
+    pub mean_interval: Duration,
+}
+
+impl Default for InputConfig {
+    fn default() -> Self {
+        InputConfig {
+            mean_interval: Duration::ms(97),
+        }
+    }
+}
+
+/// The tracker: `[tracker]`, samples every `period`; a sample reaches the
+/// application `latency` later.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default, bound = "")]
+pub struct TrackerConfig<D: Defaults> {
+    /// Time between tracker samples.
+    pub period: Duration,
+    /// Sample-to-application latency.
+    pub latency: Duration,
+    #[serde(skip)]
+    defaults: PhantomData<fn() -> D>,
+}
+
+impl<D: Defaults> Default for TrackerConfig<D> {
+    fn default() -> Self {
+        TrackerConfig {
+            period: Duration::ms(D::TRACKER_PERIOD_MS),
+            latency: Duration::ms(D::TRACKER_LATENCY_MS),
+            defaults: PhantomData,
+        }
+    }
+}
+
+impl<D: Defaults> TrackerConfig<D> {
+    /// The sample that captures an input at `t`: the first taken at or
+    /// after it (sample `k` is taken at `k * period`).
+    pub fn capturing_sample(&self, t: Time) -> u64 {
+        t.0.div_ceil(self.period.0.max(1))
+    }
+
+    /// The newest sample delivered at `now` (`None` before the first).
+    pub fn delivered_sample(&self, now: Time) -> Option<u64> {
+        now.0.checked_sub(self.latency.0).map(|x| x / self.period.0.max(1))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Debug, Clone)]
+    struct D;
+    impl Defaults for D {
+        const WARMUP_MS: u64 = 500;
+        const TRACKER_PERIOD_MS: u64 = 5;
+        const TRACKER_LATENCY_MS: u64 = 10;
+    }
+
+    #[test]
+    fn defaults_come_from_the_system_and_samples_round_up() {
+        let r: RunConfig<D> = toml::from_str("seed = 3").unwrap();
+        assert_eq!((r.seed, r.events, r.warmup), (3, 5000, Duration::ms(500)));
+        assert!(toml::from_str::<RunConfig<D>>("defaults = 1").is_err());
+        let t = TrackerConfig::<D>::default();
+        assert_eq!(t.capturing_sample(Time(Duration::ms(5).0)), 1);
+        assert_eq!(t.capturing_sample(Time(Duration::ms(5).0 + 1)), 2);
+        assert_eq!(t.delivered_sample(Time(Duration::ms(9).0)), None);
+        assert_eq!(t.delivered_sample(Time(Duration::ms(15).0)), Some(1));
+    }
+}
