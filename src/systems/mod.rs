@@ -132,6 +132,39 @@ pub trait Outcome: std::fmt::Debug + Send {
     fn into_any(self: Box<Self>) -> Box<dyn std::any::Any>;
 }
 
+/// The [`Outcome`] methods every run type implements alike, for a run struct
+/// with `summary: Value` and `trace: Option<TraceWriter>` fields and a
+/// `report::write_report(&Value, w)` beside it: used inside
+/// `impl Outcome for ...` in each system's `system.rs`.
+macro_rules! outcome_basics {
+    () => {
+        fn summary(&self) -> &serde_json::Value {
+            &self.summary
+        }
+
+        fn summary_mut(&mut self) -> &mut serde_json::Value {
+            &mut self.summary
+        }
+
+        fn write_report(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {
+            super::report::write_report(&self.summary, w)
+        }
+
+        fn take_trace(&mut self) -> Option<crate::output::trace::TraceWriter> {
+            self.trace.take()
+        }
+
+        fn as_any(&self) -> &dyn std::any::Any {
+            self
+        }
+
+        fn into_any(self: Box<Self>) -> Box<dyn std::any::Any> {
+            self
+        }
+    };
+}
+pub(crate) use outcome_basics;
+
 /// Every system, by the name a model file gives.
 pub const SYSTEMS: &[&dyn System] = &[
     &frame_pipeline::system::FramePipelineSystem,

@@ -10,6 +10,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::config::Bytes;
 use crate::engine::{Duration, Time};
+use crate::limits::{DEFAULT_MAX_MEMORY, over_memory_message};
+use crate::systems::error::{SystemError, invalid};
 
 /// A latency system's defaults for the shared tables.
 pub trait Defaults {
@@ -107,6 +109,29 @@ impl<D: Defaults> TrackerConfig<D> {
     pub fn delivered_sample(&self, now: Time) -> Option<u64> {
         now.0.checked_sub(self.latency.0).map(|x| x / self.period.0.max(1))
     }
+}
+
+impl<D: Defaults> RunConfig<D> {
+    /// `run.max_memory` in bytes (the default when unset), after checking
+    /// the run's estimate `(bytes, what they are)` against it before
+    /// simulating.
+    pub fn memory_budget(&self, estimate: (u64, String)) -> Result<u64, SystemError> {
+        let max = self.max_memory.map_or(DEFAULT_MAX_MEMORY, |b| b.0);
+        let (bytes, parts) = estimate;
+        if bytes > max {
+            return Err(invalid("run.max_memory", over_memory_message(bytes, &parts, max)));
+        }
+        Ok(max)
+    }
+}
+
+/// Fails, naming `run.max_memory`, once the input records (`used` bytes,
+/// `what` describes them) outgrow `max` while the run goes.
+pub fn check_records(used: u64, max: u64, what: impl FnOnce() -> String) -> Result<(), SystemError> {
+    if used > max {
+        return Err(invalid("run.max_memory", over_memory_message(used, &what(), max)));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -1,14 +1,11 @@
 //! The frame pipeline in the system registry ([`crate::systems::SYSTEMS`]).
 
-use std::any::Any;
 use std::io::Write;
 use std::path::Path;
 
-use serde_json::Value;
-
 use crate::config::{ModelSource, deserialize};
 use crate::output::trace::TraceWriter;
-use crate::systems::{Outcome, SimError, System, resolved_toml};
+use crate::systems::{Outcome, SimError, System, outcome_basics, resolved_toml};
 
 use super::config::{FramePipelineConfig, WorkloadConfig};
 use super::records::{COLUMNS, frame_rows, write_frames_csv};
@@ -35,17 +32,7 @@ impl System for FramePipelineSystem {
 }
 
 impl Outcome for PipelineRun {
-    fn summary(&self) -> &Value {
-        &self.summary
-    }
-
-    fn summary_mut(&mut self) -> &mut Value {
-        &mut self.summary
-    }
-
-    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        super::report::write_report(&self.summary, w)
-    }
+    outcome_basics!();
 
     fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
         (
@@ -74,17 +61,5 @@ impl Outcome for PipelineRun {
             }
         }
         resolved_toml(&cfg)
-    }
-
-    fn take_trace(&mut self) -> Option<TraceWriter> {
-        self.trace.take()
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-
-    fn into_any(self: Box<Self>) -> Box<dyn Any> {
-        self
     }
 }

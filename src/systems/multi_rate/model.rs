@@ -211,21 +211,13 @@ impl MultiRate {
 
     /// Fails once the input records outgrow `run.max_memory`.
     fn check_growth(&self, now: Time) -> Result<(), SystemError> {
-        let used = self.follower.record_bytes();
-        if used > self.max_memory {
-            return Err(SystemError::Invalid {
-                key: "run.max_memory".into(),
-                message: crate::limits::over_memory_message(
-                    used,
-                    &format!(
-                        "records of {} input events after {now} of simulated time",
-                        self.follower.records.len()
-                    ),
-                    self.max_memory,
-                ),
-            });
-        }
-        Ok(())
+        let records = &self.follower.records;
+        crate::systems::tracked_input::check_records(self.follower.record_bytes(), self.max_memory, || {
+            format!(
+                "records of {} input events after {now} of simulated time",
+                records.len()
+            )
+        })
     }
 
     /// Schedules the first event of every process and writes the trace's

@@ -161,14 +161,7 @@ pub fn estimate_memory(cfg: &MultiRateConfig) -> (u64, String) {
 /// back in [`MultiRateRun::trace`], to be closed by the caller.
 pub fn run_multi_rate(cfg: MultiRateConfig, trace: Option<TraceWriter>) -> Result<MultiRateRun, SystemError> {
     validate(&cfg)?;
-    let max_memory = cfg.run.max_memory.map_or(crate::limits::DEFAULT_MAX_MEMORY, |b| b.0);
-    let (estimate, parts) = estimate_memory(&cfg);
-    if estimate > max_memory {
-        return Err(bad(
-            "run.max_memory",
-            crate::limits::over_memory_message(estimate, &parts, max_memory),
-        ));
-    }
+    let max_memory = cfg.run.memory_budget(estimate_memory(&cfg))?;
     let terms = Terms::of(&cfg);
     let a = analytic(&terms);
     let mut model = MultiRate::new(

@@ -1,15 +1,12 @@
 //! The multi-frame-rate system in the system registry
 //! ([`crate::systems::SYSTEMS`]).
 
-use std::any::Any;
 use std::io::Write;
 use std::path::Path;
 
-use serde_json::Value;
-
 use crate::config::{ModelSource, deserialize};
 use crate::output::trace::TraceWriter;
-use crate::systems::{Outcome, SimError, System, resolved_toml};
+use crate::systems::{Outcome, SimError, System, outcome_basics, resolved_toml};
 
 use super::config::MultiRateConfig;
 use super::latency::{COLUMNS, event_rows};
@@ -36,17 +33,7 @@ impl System for MultiRateSystem {
 }
 
 impl Outcome for MultiRateRun {
-    fn summary(&self) -> &Value {
-        &self.summary
-    }
-
-    fn summary_mut(&mut self) -> &mut Value {
-        &mut self.summary
-    }
-
-    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        super::report::write_report(&self.summary, w)
-    }
+    outcome_basics!();
 
     fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
         (
@@ -61,17 +48,5 @@ impl Outcome for MultiRateRun {
 
     fn resolved_model(&self, _base_dir: &Path) -> String {
         resolved_toml(&self.config)
-    }
-
-    fn take_trace(&mut self) -> Option<TraceWriter> {
-        self.trace.take()
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-
-    fn into_any(self: Box<Self>) -> Box<dyn Any> {
-        self
     }
 }

@@ -1,14 +1,11 @@
 //! PixelFlow in the system registry ([`crate::systems::SYSTEMS`]).
 
-use std::any::Any;
 use std::io::Write;
 use std::path::Path;
 
-use serde_json::Value;
-
 use crate::config::{ModelSource, deserialize};
 use crate::output::trace::TraceWriter;
-use crate::systems::{Outcome, SimError, System, resolved_toml};
+use crate::systems::{Outcome, SimError, System, outcome_basics, resolved_toml};
 
 use super::config::PixelFlowConfig;
 use super::run::{COLUMNS, PixelFlowRun, region_rows, run_pixelflow, write_regions_csv, write_trace};
@@ -40,17 +37,7 @@ impl System for PixelFlowSystem {
 }
 
 impl Outcome for PixelFlowRun {
-    fn summary(&self) -> &Value {
-        &self.summary
-    }
-
-    fn summary_mut(&mut self) -> &mut Value {
-        &mut self.summary
-    }
-
-    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        super::report::write_report(&self.summary, w)
-    }
+    outcome_basics!();
 
     fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
         (COLUMNS.iter().map(|s| s.to_string()).collect(), region_rows(self))
@@ -62,17 +49,5 @@ impl Outcome for PixelFlowRun {
 
     fn resolved_model(&self, _base_dir: &Path) -> String {
         resolved_toml(&self.config)
-    }
-
-    fn take_trace(&mut self) -> Option<TraceWriter> {
-        self.trace.take()
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-
-    fn into_any(self: Box<Self>) -> Box<dyn Any> {
-        self
     }
 }

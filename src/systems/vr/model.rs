@@ -206,21 +206,10 @@ impl Vr {
 
     /// Fails once the motion records outgrow `run.max_memory`.
     fn check_growth(&self, now: Time) -> Result<(), SystemError> {
-        let used = self.follower.record_bytes();
-        if used > self.max_memory {
-            return Err(SystemError::Invalid {
-                key: "run.max_memory".into(),
-                message: crate::limits::over_memory_message(
-                    used,
-                    &format!(
-                        "records of {} motions after {now} of simulated time",
-                        self.follower.records.len()
-                    ),
-                    self.max_memory,
-                ),
-            });
-        }
-        Ok(())
+        let records = &self.follower.records;
+        crate::systems::tracked_input::check_records(self.follower.record_bytes(), self.max_memory, || {
+            format!("records of {} motions after {now} of simulated time", records.len())
+        })
     }
 
     /// Schedules the first events and writes the trace's tracks.

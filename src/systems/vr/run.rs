@@ -99,14 +99,7 @@ pub fn estimate_memory(cfg: &VrConfig) -> (u64, String) {
 /// in [`VrRun::trace`], to be closed by the caller.
 pub fn run_vr(cfg: VrConfig, trace: Option<TraceWriter>) -> Result<VrRun, SystemError> {
     validate(&cfg)?;
-    let max_memory = cfg.run.max_memory.map_or(crate::limits::DEFAULT_MAX_MEMORY, |b| b.0);
-    let (estimate, parts) = estimate_memory(&cfg);
-    if estimate > max_memory {
-        return Err(bad(
-            "run.max_memory",
-            crate::limits::over_memory_message(estimate, &parts, max_memory),
-        ));
-    }
+    let max_memory = cfg.run.memory_budget(estimate_memory(&cfg))?;
     let a = analytic(&cfg);
     let mut model = Vr::new(cfg.clone());
     model.max_memory = max_memory;

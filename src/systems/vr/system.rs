@@ -1,15 +1,12 @@
 //! The VR pipeline in the system registry
 //! ([`crate::systems::SYSTEMS`]).
 
-use std::any::Any;
 use std::io::Write;
 use std::path::Path;
 
-use serde_json::Value;
-
 use crate::config::{ModelSource, deserialize};
 use crate::output::trace::TraceWriter;
-use crate::systems::{Outcome, SimError, System, resolved_toml};
+use crate::systems::{Outcome, SimError, System, outcome_basics, resolved_toml};
 
 use super::config::VrConfig;
 use super::run::{COLUMNS, motion_rows};
@@ -36,17 +33,7 @@ impl System for VrSystem {
 }
 
 impl Outcome for VrRun {
-    fn summary(&self) -> &Value {
-        &self.summary
-    }
-
-    fn summary_mut(&mut self) -> &mut Value {
-        &mut self.summary
-    }
-
-    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        super::report::write_report(&self.summary, w)
-    }
+    outcome_basics!();
 
     fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
         (
@@ -61,17 +48,5 @@ impl Outcome for VrRun {
 
     fn resolved_model(&self, _base_dir: &Path) -> String {
         resolved_toml(&self.config)
-    }
-
-    fn take_trace(&mut self) -> Option<TraceWriter> {
-        self.trace.take()
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-
-    fn into_any(self: Box<Self>) -> Box<dyn Any> {
-        self
     }
 }
