@@ -119,10 +119,13 @@ impl<E> EventQueue<E> {
     pub fn push(&mut self, time: Time, event: E) {
         let seq = self.next_seq;
         self.next_seq += 1;
-        let s = Scheduled { time, seq, event };
+        // Built in each arm, not once before the match: one value shared by
+        // both arms would live on the stack and be copied into the queue
+        // with a wide load that cannot be forwarded from the narrow stores
+        // that built it (a stall on every push).
         match &mut self.store {
-            Store::Radix(r) => r.push(s),
-            Store::Binary(h) => h.push(s),
+            Store::Radix(r) => r.push(Scheduled { time, seq, event }),
+            Store::Binary(h) => h.push(Scheduled { time, seq, event }),
         }
     }
 

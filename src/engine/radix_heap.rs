@@ -102,7 +102,7 @@ impl<E> RadixHeap<E> {
 
     /// Small form: inserts `s` after (in pop order) every event due at or
     /// before its time (it has the largest sequence number so far).
-    #[inline]
+    #[inline(always)]
     fn small_insert(&mut self, s: Scheduled<E>) {
         // Appended, then moved down past the earlier ones (usually few: a
         // new event tends to be among the next due); no memmove call.
@@ -160,14 +160,30 @@ impl<E> RadixHeap<E> {
 
     /// Adds an event. Its sequence number must be larger than every one
     /// pushed before (the queue's counter guarantees it).
-    #[inline]
+    /// The small form's path is inlined into the caller (a push passes the
+    /// event in registers instead of through the stack); the rest is not.
+    #[inline(always)]
     pub fn push(&mut self, s: Scheduled<E>) {
+        // The array is made with room for SMALL_MAX, so the second test
+        // always holds with the first; it lets the compiler drop Vec::push's
+        // growing path.
+        if self.is_small && self.small.len() < SMALL_MAX && self.small.len() < self.small.capacity() {
+            self.len += 1;
+            self.small_insert(s);
+            return;
+        }
+        // Passed as fields: handing the whole event to a call that is not
+        // inlined would keep it in memory on the fast path too.
+        let Scheduled { time, seq, event } = s;
+        self.push_large(time, seq, event);
+    }
+
+    /// [`RadixHeap::push`] when the small array is full or not in use.
+    #[inline(never)]
+    fn push_large(&mut self, time: super::time::Time, seq: u64, event: E) {
+        let s = Scheduled { time, seq, event };
         self.len += 1;
         if self.is_small {
-            if self.small.len() < SMALL_MAX {
-                self.small_insert(s);
-                return;
-            }
             self.spill_to_buckets();
         }
         if s.time.0 < self.last {

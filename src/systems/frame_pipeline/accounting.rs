@@ -210,29 +210,54 @@ fn set_traced<const N: usize>(
     (old, spent.0)
 }
 
+/// The CPU state (index into [`CPU_STATES`]) of a phase outside system tasks.
+#[inline]
+fn cpu_state_of(p: CpuPhase) -> usize {
+    // A table, not a match: the phase changes from event to event, and a
+    // jump table's indirect branch would often be mispredicted.
+    const OF: [u8; 8] = {
+        let mut of = [0u8; 8];
+        of[CpuPhase::NextFrame as usize] = 0;
+        of[CpuPhase::WaitFrames as usize] = 3;
+        of[CpuPhase::Ready as usize] = 0;
+        of[CpuPhase::Running as usize] = 0;
+        of[CpuPhase::Push as usize] = 2;
+        of[CpuPhase::Rendezvous as usize] = 2;
+        of[CpuPhase::ZeroTimeWait as usize] = 0;
+        of[CpuPhase::Finished as usize] = 4;
+        of
+    };
+    OF[p as usize] as usize
+}
+
+/// The front-end state (index into [`FRONT_STATES`]) of a phase outside
+/// system tasks.
+#[inline]
+fn front_state_of(p: FrontPhase) -> usize {
+    const OF: [u8; 5] = {
+        let mut of = [0u8; 5];
+        of[FrontPhase::Running as usize] = 0;
+        of[FrontPhase::Idle as usize] = 1;
+        of[FrontPhase::WaitImage as usize] = 2;
+        of[FrontPhase::WaitDrain as usize] = 3;
+        of[FrontPhase::Handoff as usize] = 4;
+        of
+    };
+    OF[p as usize] as usize
+}
+
 impl FramePipeline {
     /// Derives every unit's state at `now` and advances the clocks.
     pub(super) fn account(&mut self, now: Time) {
         let cpu_state = if self.cpu.in_system() {
             1
         } else {
-            match self.cpu_phase {
-                CpuPhase::Running | CpuPhase::Ready | CpuPhase::NextFrame | CpuPhase::ZeroTimeWait => 0,
-                CpuPhase::Push(_) | CpuPhase::Rendezvous => 2,
-                CpuPhase::WaitFrames => 3,
-                CpuPhase::Finished => 4,
-            }
+            cpu_state_of(self.cpu_phase)
         };
         let front_state = if self.front.in_system() {
             5
         } else {
-            match self.front_phase {
-                FrontPhase::Running(_) => 0,
-                FrontPhase::Idle => 1,
-                FrontPhase::WaitImage(_) => 2,
-                FrontPhase::WaitDrain(_) => 3,
-                FrontPhase::Handoff(_) => 4,
-            }
+            front_state_of(self.front_phase)
         };
         let geom_state = if self.geom_busy {
             0
@@ -266,7 +291,23 @@ impl FramePipeline {
             0
         };
 
+        let gpu_state = if gpu_busy { 0 } else { 1 };
+
         let a = &mut self.acct;
+        // Nothing changed since the last event (no state, no frame, no
+        // trace): every step below would add nothing.
+        if a.trace.is_none()
+            && cpu_state == a.cpu.state()
+            && front_state == a.front.state()
+            && geom_state == a.geom.state()
+            && frag_state == a.frag.state()
+            && bottleneck == a.bottleneck.state()
+            && gpu_state == a.gpu.state()
+            && self.cpu_frame == a.cpu_frame
+            && (self.gpu_frame.is_none() || self.gpu_frame == a.gpu_frame)
+        {
+            return;
+        }
         // CPU: attribute the closing interval to the frame it belonged to.
         let (old, spent) = set_traced(
             &mut a.cpu,
@@ -307,7 +348,6 @@ impl FramePipeline {
         set_traced(&mut a.frag, now, frag_state, Track::Fragment, &mut a.trace, 1, None);
         a.bottleneck.set(now, bottleneck);
         // GPU busy per frame (the frame the front end is on).
-        let gpu_state = if gpu_busy { 0 } else { 1 };
         let old = a.gpu.state();
         let spent = a.gpu.set(now, gpu_state).0;
         let frame_changed = self.gpu_frame != a.gpu_frame && self.gpu_frame.is_some();

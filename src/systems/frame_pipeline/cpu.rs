@@ -68,17 +68,24 @@ impl FramePipeline {
                 self.cpu_advance(now)
             }
             Op::NonRender => self.cpu_advance(now),
-            Op::Clear => CpuPhase::Push(Command::Clear { frame }),
+            Op::Clear => self.push_phase(Command::Clear { frame }),
             Op::Fixed => {
                 let gpu = match &mut self.program {
                     Program::Fixed { gpu, gpu_rng, .. } => Duration::from_ps_f64(gpu.sample(gpu_rng)),
                     Program::Scene(_) => Duration::ZERO,
                 };
-                CpuPhase::Push(Command::Fixed { frame, gpu })
+                self.push_phase(Command::Fixed { frame, gpu })
             }
-            Op::Draw(k) => CpuPhase::Push(Command::Draw { frame, draw: k }),
-            Op::Swap => CpuPhase::Push(Command::Swap { frame }),
+            Op::Draw(k) => self.push_phase(Command::Draw { frame, draw: k }),
+            Op::Swap => self.push_phase(Command::Swap { frame }),
         }
+    }
+
+    /// The phase that pushes `c`.
+    #[inline]
+    fn push_phase(&mut self, c: Command) -> CpuPhase {
+        self.cpu_cmd = c;
+        CpuPhase::Push
     }
 
     /// After a completed push or an operation without command: next
@@ -146,7 +153,8 @@ impl FramePipeline {
                     }
                     self.cpu_phase = self.cpu_after_work(now);
                 }
-                CpuPhase::Push(c) => {
+                CpuPhase::Push => {
+                    let c = self.cpu_cmd;
                     let w = self.command_weight(&c);
                     if !self.fifo.can_push(w) {
                         return Ok(progressed);

@@ -35,15 +35,16 @@ impl FramePipeline {
                         return Ok(progressed);
                     };
                     self.commands_executed += self.command_count(&c);
+                    self.front_cmd = c;
                     self.front_phase = self.front_begin(now, c, s)?;
                 }
-                FrontPhase::WaitImage(c) => {
+                FrontPhase::WaitImage => {
                     if !self.chain.acquire() {
                         return Ok(progressed);
                     }
-                    self.front_phase = self.front_start_clear(now, c, s)?;
+                    self.front_phase = self.front_start_clear(now, self.front_cmd, s)?;
                 }
-                FrontPhase::WaitDrain(c) => {
+                FrontPhase::WaitDrain => {
                     if !self.pipeline_drained() {
                         return Ok(progressed);
                     }
@@ -53,20 +54,20 @@ impl FramePipeline {
                         .swap
                         .checked_add(self.cfg.gpu.command)
                         .unwrap_or(Duration(u64::MAX));
-                    self.front_phase = self.front_job(now, c, work, s)?;
+                    self.front_phase = self.front_job(now, self.front_cmd, work, s)?;
                 }
-                FrontPhase::Handoff(c) => {
+                FrontPhase::Handoff => {
                     // Binning: the next draw's geometry waits for the bins to drain.
                     let bins_busy = self.cfg.gpu.fragment.binned() && (self.frag_busy || !self.tri_fifo.is_empty());
                     if self.geom_draw.is_some() || bins_busy {
                         return Ok(progressed);
                     }
-                    if let Command::Draw { draw, .. } = c {
+                    if let Command::Draw { draw, .. } = self.front_cmd {
                         self.geom_start_draw(now, draw, s)?;
                     }
                     self.front_phase = FrontPhase::Idle;
                 }
-                FrontPhase::Running(_) => return Ok(progressed),
+                FrontPhase::Running => return Ok(progressed),
             }
             progressed = true;
         }
@@ -79,7 +80,7 @@ impl FramePipeline {
                 if self.chain.acquire() {
                     self.front_start_clear(now, c, s)
                 } else {
-                    Ok(FrontPhase::WaitImage(c))
+                    Ok(FrontPhase::WaitImage)
                 }
             }
             Command::Fixed { gpu, .. } => {
@@ -93,7 +94,7 @@ impl FramePipeline {
                 };
                 self.front_job(now, c, work, s)
             }
-            Command::Swap { .. } => Ok(FrontPhase::WaitDrain(c)),
+            Command::Swap { .. } => Ok(FrontPhase::WaitDrain),
         }
     }
 
@@ -127,22 +128,22 @@ impl FramePipeline {
         if work.0 > 0 || self.front.in_system() {
             let w = self.front.start_job(now, work)?;
             Self::schedule_wake(s, w, false);
-            return Ok(FrontPhase::Running(c));
+            return Ok(FrontPhase::Running);
         }
         self.front_after(now, c)
     }
 
     /// The running command's work finished.
     pub(super) fn front_command_done(&mut self, now: Time) -> Result<(), PipelineError> {
-        if let FrontPhase::Running(c) = self.front_phase {
-            self.front_phase = self.front_after(now, c)?;
+        if let FrontPhase::Running = self.front_phase {
+            self.front_phase = self.front_after(now, self.front_cmd)?;
         }
         Ok(())
     }
 
     fn front_after(&mut self, now: Time, c: Command) -> Result<FrontPhase, PipelineError> {
         Ok(match c {
-            Command::Draw { .. } => FrontPhase::Handoff(c),
+            Command::Draw { .. } => FrontPhase::Handoff,
             Command::Swap { frame } => {
                 self.frame_completed(now, frame)?;
                 FrontPhase::Idle

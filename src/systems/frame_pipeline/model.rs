@@ -145,7 +145,9 @@ pub enum Program {
     Scene(SceneProgram),
 }
 
-/// What the CPU thread is doing.
+/// What the CPU thread is doing. The phases carry no data (the command
+/// to push is in [`FramePipeline::cpu_cmd`]), so a phase is one byte,
+/// written and read back whole on the hot path.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CpuPhase {
     /// About to start frame `cpu_frame` (transient).
@@ -156,8 +158,9 @@ pub enum CpuPhase {
     Ready,
     /// Running operation `cpu_op` (possibly preempted).
     Running,
-    /// Must push this command; at rest this means the FIFO is full.
-    Push(Command),
+    /// Must push the command in `cpu_cmd`; at rest this means the FIFO is
+    /// full.
+    Push,
     /// Pushed into a FIFO beyond its capacity (rendezvous): waits until taken.
     Rendezvous,
     /// Waits for its [`Ev::ZeroTimeFrame`] event before starting a frame
@@ -167,19 +170,20 @@ pub enum CpuPhase {
     Finished,
 }
 
-/// What the GPU front end is doing.
+/// What the GPU front end is doing (its command is in
+/// [`FramePipeline::front_cmd`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FrontPhase {
     /// Waiting for commands (starved when at rest).
     Idle,
-    /// A clear waits for a free swap-chain image.
-    WaitImage(Command),
-    /// A swap waits for the pipeline to drain.
-    WaitDrain(Command),
-    /// Processing a command (possibly preempted).
-    Running(Command),
-    /// A draw waits for the geometry stage to take it.
-    Handoff(Command),
+    /// A clear (in `front_cmd`) waits for a free swap-chain image.
+    WaitImage,
+    /// A swap (in `front_cmd`) waits for the pipeline to drain.
+    WaitDrain,
+    /// Processing the command in `front_cmd` (possibly preempted).
+    Running,
+    /// A draw (in `front_cmd`) waits for the geometry stage to take it.
+    Handoff,
 }
 
 /// The frame pipeline's full state.
@@ -190,6 +194,8 @@ pub struct FramePipeline {
     // CPU thread
     pub(super) cpu: Preemptible,
     pub(super) cpu_phase: CpuPhase,
+    /// The command of [`CpuPhase::Push`].
+    pub(super) cpu_cmd: Command,
     pub(super) cpu_frame: u64,
     pub(super) cpu_op: u32,
     pub(super) non_render_rng: StreamRng,
@@ -207,6 +213,8 @@ pub struct FramePipeline {
     // GPU
     pub(super) front: Preemptible,
     pub(super) front_phase: FrontPhase,
+    /// The command of every [`FrontPhase`] but `Idle`.
+    pub(super) front_cmd: Command,
     pub(super) gpu_frame: Option<u64>,
     pub(super) gpu_completed: u64,
     pub(super) geom_draw: Option<ActiveDraw>,
@@ -343,6 +351,7 @@ impl FramePipeline {
             frames_total,
             cpu: Preemptible::new(),
             cpu_phase: CpuPhase::NextFrame,
+            cpu_cmd: Command::Clear { frame: 0 },
             cpu_frame: 0,
             cpu_op: 0,
             fifo: BoundedFifo::new(fifo_cap),
@@ -350,6 +359,7 @@ impl FramePipeline {
             commands_executed: 0,
             front: Preemptible::new(),
             front_phase: FrontPhase::Idle,
+            front_cmd: Command::Clear { frame: 0 },
             gpu_frame: None,
             gpu_completed: 0,
             geom_draw: None,
@@ -460,13 +470,19 @@ impl FramePipeline {
     /// A one-line description of the units' states (for stall reports).
     pub fn describe(&self) -> String {
         format!(
-            "cpu {:?} (frame {}, op {}), command fifo {}/{}, front end {:?}, geometry {:?} busy={} held={}, fragment busy={}, frames completed {}, queued for display {}",
-            self.cpu_phase,
+            "cpu {} (frame {}, op {}), command fifo {}/{}, front end {}, geometry {:?} busy={} held={}, fragment busy={}, frames completed {}, queued for display {}",
+            match self.cpu_phase {
+                CpuPhase::Push => format!("Push({:?})", self.cpu_cmd),
+                p => format!("{p:?}"),
+            },
             self.cpu_frame,
             self.cpu_op,
             self.fifo.used(),
             self.fifo.capacity(),
-            self.front_phase,
+            match self.front_phase {
+                FrontPhase::Idle => "Idle".to_string(),
+                p => format!("{p:?}({:?})", self.front_cmd),
+            },
             self.geom_draw,
             self.geom_busy,
             self.geom_held.is_some(),
@@ -477,11 +493,16 @@ impl FramePipeline {
     }
 
     /// Lets the CPU thread and the front end make every step they can now.
+    ///
+    /// Each step runs its unit until it cannot go on, and a step that finds
+    /// nothing to do changes nothing; the CPU's progress depends only on what
+    /// the front end changes (FIFO space, completed frames). So once the front
+    /// end made no progress after a CPU step, another round would change
+    /// nothing: the loop ends there.
     fn settle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         loop {
-            let a = self.cpu_step(now, s)?;
-            let b = self.front_step(now, s)?;
-            if !a && !b {
+            self.cpu_step(now, s)?;
+            if !self.front_step(now, s)? {
                 return Ok(());
             }
         }
