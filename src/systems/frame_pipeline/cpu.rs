@@ -6,8 +6,9 @@
 
 use crate::engine::{Duration, Scheduler, Time};
 
-use super::model::{Command, CpuPhase, Ev, FramePipeline, PipelineError, Program};
+use super::model::{Command, CpuPhase, Ev, FramePipeline, Program};
 use super::records::FrameRecord;
+use crate::systems::error::SystemError;
 
 /// One step of the CPU thread's frame.
 #[derive(Debug, Clone, Copy)]
@@ -110,7 +111,7 @@ impl FramePipeline {
 
     /// Advances the CPU thread as far as it can go now. Returns whether
     /// anything changed.
-    pub(super) fn cpu_step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, PipelineError> {
+    pub(super) fn cpu_step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         let mut progressed = false;
         loop {
             match self.cpu_phase {

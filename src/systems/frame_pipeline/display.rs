@@ -6,11 +6,12 @@
 use crate::components::swap_chain::{Flip, PresentMode};
 use crate::engine::{Scheduler, Time};
 
-use super::model::{Ev, FramePipeline, PipelineError};
+use super::model::{Ev, FramePipeline};
+use crate::systems::error::SystemError;
 
 impl FramePipeline {
     /// The GPU finished frame `frame` (its swap): present it.
-    pub(super) fn frame_completed(&mut self, now: Time, frame: u64) -> Result<(), PipelineError> {
+    pub(super) fn frame_completed(&mut self, now: Time, frame: u64) -> Result<(), SystemError> {
         self.gpu_completed += 1;
         self.records[frame as usize].gpu_end = Some(now);
         self.gpu_frame = None;
@@ -45,7 +46,7 @@ impl FramePipeline {
     }
 
     /// A vertical blank.
-    pub(super) fn vblank(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    pub(super) fn vblank(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         self.vblanks += 1;
         let flip = self.chain.vblank();
         if flip.shown.is_none() && self.last_display.is_some() {

@@ -12,7 +12,8 @@ use crate::engine::{Duration, Scheduler, Time};
 
 use super::closed_form::draw_times;
 use super::config::Fidelity;
-use super::model::{ActiveDraw, Command, Ev, FramePipeline, FrontPhase, PipelineError, Program};
+use super::model::{ActiveDraw, Command, Ev, FramePipeline, FrontPhase, Program};
+use crate::systems::error::SystemError;
 
 impl FramePipeline {
     /// True when no triangle is anywhere between front end and fragment output.
@@ -26,7 +27,7 @@ impl FramePipeline {
 
     /// Advances the front end as far as it can go now. Returns whether
     /// anything changed.
-    pub(super) fn front_step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, PipelineError> {
+    pub(super) fn front_step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         let mut progressed = false;
         loop {
             match self.front_phase {
@@ -73,7 +74,7 @@ impl FramePipeline {
         }
     }
 
-    fn front_begin(&mut self, now: Time, c: Command, s: &mut Scheduler<Ev>) -> Result<FrontPhase, PipelineError> {
+    fn front_begin(&mut self, now: Time, c: Command, s: &mut Scheduler<Ev>) -> Result<FrontPhase, SystemError> {
         let cmd_cost = self.cfg.gpu.command;
         match c {
             Command::Clear { .. } => {
@@ -98,7 +99,7 @@ impl FramePipeline {
         }
     }
 
-    fn front_start_clear(&mut self, now: Time, c: Command, s: &mut Scheduler<Ev>) -> Result<FrontPhase, PipelineError> {
+    fn front_start_clear(&mut self, now: Time, c: Command, s: &mut Scheduler<Ev>) -> Result<FrontPhase, SystemError> {
         if let Command::Clear { frame } = c {
             self.gpu_frame = Some(frame);
             if let Some(start) = &self.pixel_rng_start {
@@ -124,7 +125,7 @@ impl FramePipeline {
         c: Command,
         work: Duration,
         s: &mut Scheduler<Ev>,
-    ) -> Result<FrontPhase, PipelineError> {
+    ) -> Result<FrontPhase, SystemError> {
         if work.0 > 0 || self.front.in_system() {
             let w = self.front.start_job(now, work)?;
             Self::schedule_wake(s, w, false);
@@ -134,14 +135,14 @@ impl FramePipeline {
     }
 
     /// The running command's work finished.
-    pub(super) fn front_command_done(&mut self, now: Time) -> Result<(), PipelineError> {
+    pub(super) fn front_command_done(&mut self, now: Time) -> Result<(), SystemError> {
         if let FrontPhase::Running = self.front_phase {
             self.front_phase = self.front_after(now, self.front_cmd)?;
         }
         Ok(())
     }
 
-    fn front_after(&mut self, now: Time, c: Command) -> Result<FrontPhase, PipelineError> {
+    fn front_after(&mut self, now: Time, c: Command) -> Result<FrontPhase, SystemError> {
         Ok(match c {
             Command::Draw { .. } => FrontPhase::Handoff,
             Command::Swap { frame } => {
@@ -152,7 +153,7 @@ impl FramePipeline {
         })
     }
 
-    fn geom_start_draw(&mut self, now: Time, draw: u32, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    fn geom_start_draw(&mut self, now: Time, draw: u32, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         let Program::Scene(sc) = &self.program else {
             return Ok(());
         };
@@ -224,7 +225,7 @@ impl FramePipeline {
     }
 
     /// Starts the next triangle of the current draw, or finishes the draw.
-    fn geom_next_triangle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    fn geom_next_triangle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         let Some(a) = self.geom_draw else {
             return Ok(());
         };
@@ -258,7 +259,7 @@ impl FramePipeline {
     }
 
     /// `triangle` fidelity: a triangle left the geometry stage.
-    pub(super) fn geom_triangle_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    pub(super) fn geom_triangle_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         self.geom_busy = false;
         let Some(a) = self.geom_draw.as_mut() else {
             return Ok(());
@@ -292,14 +293,14 @@ impl FramePipeline {
         self.geom_next_triangle(now, s)
     }
 
-    fn frag_start(&mut self, now: Time, f: Duration, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    fn frag_start(&mut self, now: Time, f: Duration, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         self.frag_busy = true;
         s.at(now.add(f, "fragments of a triangle")?, Ev::FragTriangle);
         Ok(())
     }
 
     /// `triangle` fidelity: the fragment stage finished a triangle.
-    pub(super) fn frag_triangle_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), PipelineError> {
+    pub(super) fn frag_triangle_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         self.frag_busy = false;
         if let Some(f) = self.tri_fifo.pop() {
             self.frag_start(now, f, s)?;

@@ -15,9 +15,6 @@ use crate::components::preemptible::{Preemptible, Wake};
 use crate::components::swap_chain::{PresentMode, SwapChain};
 use crate::engine::{Control, Duration, EventKind, Model, RngStreams, Scheduler, StreamRng, Time};
 use crate::systems::error::SystemError;
-/// The frame pipeline's former name for [`SystemError`], still used by
-/// `cpu.rs` and `gpu.rs`.
-pub(super) use crate::systems::error::SystemError as PipelineError;
 
 use super::accounting::Accounting;
 use super::config::{Fidelity, FramePipelineConfig, WorkloadConfig};
