@@ -112,6 +112,27 @@ impl<D: Defaults> TrackerConfig<D> {
 }
 
 impl<D: Defaults> RunConfig<D> {
+    /// Checks the run's size before anything is allocated: at least one
+    /// input event (`noun`, e.g. "input event"), at most
+    /// [`crate::limits::MAX_INPUT_EVENTS`], and input events that fit in
+    /// the clock's range at `input`'s mean interval.
+    pub fn validate(&self, input: &InputConfig, noun: &str) -> Result<(), SystemError> {
+        let limit = crate::limits::MAX_INPUT_EVENTS;
+        if self.events == 0 {
+            return Err(invalid("run.events", format!("must be at least 1 {noun}")));
+        }
+        if self.events > limit {
+            return Err(invalid(
+                "run.events",
+                format!("{} {noun}s is more than the limit of {limit}", self.events),
+            ));
+        }
+        match crate::limits::input_span_message(self.events, self.warmup.0, input.mean_interval.0) {
+            Some(message) => Err(invalid(crate::limits::INPUT_SPAN_KEYS, message)),
+            None => Ok(()),
+        }
+    }
+
     /// `run.max_memory` in bytes (the default when unset), after checking
     /// the run's estimate `(bytes, what they are)` against it before
     /// simulating.

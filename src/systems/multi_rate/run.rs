@@ -96,20 +96,7 @@ pub fn validate(cfg: &MultiRateConfig) -> Result<(), SystemError> {
             ),
         });
     }
-    if cfg.run.events == 0 {
-        return Err(bad("run.events", "must be at least 1 input event"));
-    }
-    if cfg.run.events > crate::limits::MAX_INPUT_EVENTS {
-        return Err(bad(
-            "run.events",
-            format!(
-                "{} input events is more than the limit of {}",
-                cfg.run.events,
-                crate::limits::MAX_INPUT_EVENTS
-            ),
-        ));
-    }
-    check_time_range(cfg.run.events, cfg.run.warmup, cfg.input.mean_interval)?;
+    cfg.run.validate(&cfg.input, "input event")?;
     check_span(cfg)?;
     for (i, w) in cfg.migration.script.windows(2).enumerate() {
         if w[1].at < w[0].at {
@@ -487,15 +474,6 @@ fn check_span(cfg: &MultiRateConfig) -> Result<(), SystemError> {
     }
     match crate::limits::span_check(&terms) {
         Some((key, message)) => Err(bad(&key, message)),
-        None => Ok(()),
-    }
-}
-
-/// Refuses, before simulating, a run whose input events alone reach past
-/// the clock's range ([`crate::limits::input_span_message`]).
-fn check_time_range(events: u64, warmup: Duration, mean_interval: Duration) -> Result<(), SystemError> {
-    match crate::limits::input_span_message(events, warmup.0, mean_interval.0) {
-        Some(message) => Err(bad(crate::limits::INPUT_SPAN_KEYS, message)),
         None => Ok(()),
     }
 }

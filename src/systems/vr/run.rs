@@ -63,20 +63,7 @@ pub fn validate(cfg: &VrConfig) -> Result<(), SystemError> {
             ),
         ));
     }
-    if cfg.run.events == 0 {
-        return Err(bad("run.events", "must be at least 1 motion event"));
-    }
-    if cfg.run.events > crate::limits::MAX_INPUT_EVENTS {
-        return Err(bad(
-            "run.events",
-            format!(
-                "{} motion events is more than the limit of {}",
-                cfg.run.events,
-                crate::limits::MAX_INPUT_EVENTS
-            ),
-        ));
-    }
-    check_time_range(cfg.run.events, cfg.run.warmup, cfg.input.mean_interval)?;
+    cfg.run.validate(&cfg.input, "motion event")?;
     check_span(cfg)?;
     Ok(())
 }
@@ -295,15 +282,6 @@ fn check_span(cfg: &VrConfig) -> Result<(), SystemError> {
     ];
     match crate::limits::span_check(&terms) {
         Some((key, message)) => Err(bad(&key, message)),
-        None => Ok(()),
-    }
-}
-
-/// Refuses, before simulating, a run whose input events alone reach past
-/// the clock's range ([`crate::limits::input_span_message`]).
-fn check_time_range(events: u64, warmup: Duration, mean_interval: Duration) -> Result<(), SystemError> {
-    match crate::limits::input_span_message(events, warmup.0, mean_interval.0) {
-        Some(message) => Err(bad(crate::limits::INPUT_SPAN_KEYS, message)),
         None => Ok(()),
     }
 }
