@@ -70,7 +70,6 @@ pub enum QueueKind {
 // and pop.
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
-#[allow(clippy::large_enum_variant)] // one per scheduler, never moved in a hot loop
 enum Store<E> {
     Radix(RadixHeap<E>),
     Binary(BinaryHeap<Scheduled<E>>),
