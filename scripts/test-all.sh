@@ -38,6 +38,17 @@ fi
 cargo build --release --locked --all-targets --features wgpu
 export RENDERSIM_BIN="$root/target/release/rendersim"
 
+step "Formatting and lints (cargo fmt --check; clippy with warnings as errors)"
+for tool in rustfmt clippy; do
+  cargo "${tool/rustfmt/fmt}" --version >/dev/null 2>&1 || rustup component add "$tool" || true
+done
+if cargo fmt --version >/dev/null 2>&1; then cargo fmt --check; else echo "rustfmt unavailable: skipped"; fi
+if cargo clippy --version >/dev/null 2>&1; then
+  cargo clippy --release --locked --all-targets --features wgpu -- -D warnings
+else
+  echo "clippy unavailable: skipped"
+fi
+
 step "Rust tests (unit, property, integration, doc; wgpu measurements on lavapipe)"
 # (The fuzz test runs in its own step below, so that its counts are shown.)
 cargo test --release --locked --no-fail-fast --features wgpu -- --skip every_input_ends_in_a_result_or_a_clean_error 2>&1 | tee "$ci_out/test-output.txt"
