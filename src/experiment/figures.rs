@@ -114,6 +114,7 @@ pub(crate) fn draw(
             bins,
             range,
             filter,
+            marks,
         } => {
             let c = columns.iter().position(|k| k == column);
             let values = points
@@ -130,6 +131,7 @@ pub(crate) fn draw(
                 values,
                 bins: *bins,
                 range: *range,
+                marks: marks.clone(),
             };
             histogram(&base, &h)?;
             Ok(h.outside_range_notes())

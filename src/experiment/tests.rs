@@ -622,6 +622,43 @@ fn line_plot_where_selects_points() {
 }
 
 #[test]
+fn histogram_marks_are_parsed_and_validated() {
+    let plot = |kind: &str, extra: &str| {
+        format!(
+            "name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"{kind}\"\ncolumn = \"FrameTime\"\nx = \"a\"\ny = \"b\"\n{extra}"
+        )
+    };
+    let exp = parse(&plot(
+        "histogram",
+        "marks = [{ at = 337, label = \"paper: best\" }, { at = 390.5, label = \"worst\" }]\n",
+    ));
+    let PlotKind::Histogram { marks, .. } = &exp.plots[0].kind else {
+        panic!("a histogram")
+    };
+    assert_eq!(
+        marks.iter().map(|m| (m.at, m.label.as_str())).collect::<Vec<_>>(),
+        [(337.0, "paper: best"), (390.5, "worst")]
+    );
+    for (kind, bad, want) in [
+        ("histogram", "marks = [{ at = nan, label = \"x\" }]\n", "marks.0.at"),
+        ("histogram", "marks = [{ at = 1, label = \"\" }]\n", "marks.0.label"),
+        ("histogram", "marks = [{ at = 1 }]\n", "label"),
+        (
+            "histogram",
+            "marks = [{ at = 1, label = \"x\", colour = 1 }]\n",
+            "colour",
+        ),
+    ] {
+        let e = parse_err(&plot(kind, bad));
+        assert!(e.contains(want), "{bad}: {e}");
+    }
+    let e = parse_err(
+        "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[plot]]\nfile = \"l\"\nkind = \"line\"\nx = \"a\"\ny = \"metrics.frame_time_ms.mean\"\nmarks = [{ at = 1, label = \"x\" }]\n",
+    );
+    assert!(e.contains("only histogram plots take `marks`"), "{e}");
+}
+
+#[test]
 fn histogram_range_is_parsed_and_validated() {
     let hist = |extra: &str| {
         format!("name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"FrameTime\"\n{extra}")

@@ -31,6 +31,19 @@ pub struct Histogram {
     /// (see [`Histogram::outside_range`]), and densities stay relative to
     /// all of a group's finite values.
     pub range: Option<(f64, f64)>,
+    /// Values marked with a dashed vertical line and a label (a paper's
+    /// numbers beside the simulated distribution); the x axis widens to
+    /// show them.
+    pub marks: Vec<Mark>,
+}
+
+/// A value marked on a histogram.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Mark {
+    /// Where, in the x axis's units.
+    pub at: f64,
+    /// What it is, e.g. "paper: best 337 ms".
+    pub label: String,
 }
 
 impl Histogram {
@@ -158,15 +171,18 @@ fn draw<DB: DrawingBackend>(
     } else {
         1.0
     };
-    let pad = (hi - b.lo) * 0.02;
-    let xt = ticks(b.lo - pad, hi + pad, false, false);
+    let marks: Vec<&Mark> = h.marks.iter().filter(|m| m.at.is_finite()).collect();
+    let lo = marks.iter().map(|m| m.at).fold(b.lo, f64::min);
+    let hi = marks.iter().map(|m| m.at).fold(hi, f64::max);
+    let pad = (hi - lo) * 0.02;
+    let xt = ticks(lo - pad, hi + pad, false, false);
     let yt = ticks(0.0, ymax, false, false);
     let mut chart = ChartBuilder::on(root)
         .caption(&h.title, (FAMILY, 24))
         .margin(20)
         .x_label_area_size(55)
         .y_label_area_size(75)
-        .build_cartesian_2d(coord(b.lo - pad, hi + pad, &xt), coord(0.0, ymax, &yt))
+        .build_cartesian_2d(coord(lo - pad, hi + pad, &xt), coord(0.0, ymax, &yt))
         .map_err(e)?;
     let fx = |v: &f64| xt.label_at(*v);
     let fy = |v: &f64| yt.label_at(*v);
@@ -196,7 +212,7 @@ fn draw<DB: DrawingBackend>(
             outline.push((x0, d));
             outline.push((x0 + b.width, d));
         }
-        outline.push((hi, 0.0));
+        outline.push((b.lo + b.width * bins as f64, 0.0));
         let s = chart
             .draw_series(LineSeries::new(outline, c.stroke_width(2)))
             .map_err(e)?;
@@ -205,6 +221,26 @@ fn draw<DB: DrawingBackend>(
             s.label(name.as_str())
                 .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], c.mix(0.6).filled()));
         }
+    }
+    // Marks: dashed vertical lines, labels stacked down from the top so
+    // that close values stay readable.
+    for (i, m) in marks.iter().enumerate() {
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(m.at, 0.0), (m.at, ymax)],
+                6,
+                4,
+                BLACK.mix(0.75).stroke_width(2),
+            ))
+            .map_err(e)?;
+        let y = ymax * (0.97 - 0.06 * (i % 8) as f64);
+        chart
+            .draw_series(std::iter::once(Text::new(
+                format!(" {}", m.label),
+                (m.at, y),
+                (FAMILY, 13).into_font().color(&BLACK),
+            )))
+            .map_err(e)?;
     }
     if any_legend {
         chart
@@ -242,6 +278,7 @@ mod tests {
             values,
             bins,
             range: None,
+            marks: Vec::new(),
         }
     }
 
@@ -287,6 +324,35 @@ mod tests {
         )
         .unwrap();
         assert_plot_files(&base);
+    }
+
+    #[test]
+    fn marks_widen_the_axis_and_are_drawn() {
+        let dir = tempfile::tempdir().unwrap();
+        let base = dir.path().join("marked");
+        let h = Histogram {
+            marks: vec![
+                Mark {
+                    at: 2.0,
+                    label: "paper: 2".into(),
+                },
+                Mark {
+                    at: 40.0,
+                    label: "far right".into(),
+                },
+            ],
+            ..hist(vec![("a".into(), vec![1.0, 2.0, 3.0])], 3)
+        };
+        histogram(&base, &h).unwrap();
+        assert_plot_files(&base);
+        let svg = std::fs::read_to_string(base.with_extension("svg")).unwrap();
+        assert!(svg.contains("paper: 2") && svg.contains("far right"), "labels drawn");
+        // The axis reaches the far mark: a tick label of 30 or more is drawn.
+        let ticks: Vec<f64> = svg
+            .split('>')
+            .filter_map(|t| t.split('<').next()?.trim().parse::<f64>().ok())
+            .collect();
+        assert!(ticks.iter().any(|&t| t >= 30.0), "axis widened: {ticks:?}");
     }
 
     #[test]

@@ -20,7 +20,7 @@ mod palette;
 mod scatter;
 
 pub use error::PlotError;
-pub use histogram::{Histogram, histogram};
+pub use histogram::{Histogram, Mark, histogram};
 pub use line::{LinePlot, Series, line_plot};
 pub use scatter::{Scatter, ScatterPoint, scatter};
 

@@ -68,6 +68,8 @@ pub enum PlotKind {
         range: Option<(f64, f64)>,
         /// `where` filter: sweep key = value.
         filter: Vec<(String, toml::Value)>,
+        /// Values marked with a labelled vertical line (the paper's numbers).
+        marks: Vec<crate::plot::Mark>,
     },
     /// One labelled point per experiment point; `x` and `y` are metric
     /// paths (replication means) or derived names.

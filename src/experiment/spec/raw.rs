@@ -107,6 +107,15 @@ pub(super) struct RawPlot {
     pub(super) log_y: bool,
     #[serde(rename = "where")]
     pub(super) filter: Option<toml::Table>,
+    pub(super) marks: Option<Vec<RawMark>>,
+}
+
+/// A value marked on a histogram: `{ at = 337.0, label = "paper: best 337 ms" }`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawMark {
+    pub(super) at: f64,
+    pub(super) label: String,
 }
 
 #[derive(Deserialize)]

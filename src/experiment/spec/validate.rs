@@ -323,11 +323,29 @@ impl Validator<'_> {
                             }
                         },
                     };
+                    let mut marks = Vec::new();
+                    for (i, m) in p.marks.iter().flatten().enumerate() {
+                        let mkey = format!("{key}.marks.{i}");
+                        if !m.at.is_finite() {
+                            return Err(self.err(format!("{mkey}.at"), "must be a finite number"));
+                        }
+                        if m.label.trim().is_empty() || m.label.chars().count() > 80 {
+                            return Err(self.err(format!("{mkey}.label"), "must be 1 to 80 characters"));
+                        }
+                        if i >= 16 {
+                            return Err(self.err(format!("{key}.marks"), "at most 16 marks"));
+                        }
+                        marks.push(crate::plot::Mark {
+                            at: m.at,
+                            label: m.label.clone(),
+                        });
+                    }
                     PlotKind::Histogram {
                         column,
                         bins: bins as usize,
                         range,
                         filter: f,
+                        marks,
                     }
                 }
                 "scatter" => {
@@ -356,6 +374,9 @@ impl Validator<'_> {
                     ));
                 }
             };
+            if p.marks.is_some() && !matches!(kind, PlotKind::Histogram { .. }) {
+                return Err(self.err(format!("{key}.marks"), "only histogram plots take `marks`"));
+            }
             if p.range.is_some() && !matches!(kind, PlotKind::Histogram { .. }) {
                 return Err(self.err(format!("{key}.range"), "only histogram plots take `range`"));
             }
