@@ -44,6 +44,8 @@
 //! #   optional range = [lo, hi] (finite, lo < hi): the bins span [lo, hi] instead of
 //! #   the data; values outside are not drawn but counted, per group, in a note on the
 //! #   plot and a line under it in report.md; densities stay relative to all values
+//! #   optional marks = [{ at = 337.0, label = "paper: best 337 ms" }]: values drawn as
+//! #   labelled dashed lines (a paper's numbers; at most 16; the x axis widens to show them)
 //! # scatter: x and y are metric paths or derived names; log_x / log_y
 //! [[derived]]            # interval_width | quantile_width_from_min | relative_error | ratio | speedup
 //! name = "c99"
