@@ -101,6 +101,73 @@ fn prepare(plot: &LinePlot) -> (Vec<Prepared>, usize) {
     (out, dropped)
 }
 
+/// Whether two series draw the same curve (same x, y within 1e-9 relative).
+fn coincide(a: &Prepared, b: &Prepared) -> bool {
+    !a.points.is_empty()
+        && a.points.len() == b.points.len()
+        && a.points
+            .iter()
+            .zip(&b.points)
+            .all(|(p, q)| p.0 == q.0 && (p.1 - q.1).abs() <= 1e-9 * p.1.abs().max(q.1.abs()).max(1e-300))
+}
+
+/// For each series, the earlier series it coincides with, if any.
+fn coinciding(series: &[Prepared]) -> Vec<Option<usize>> {
+    series
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (0..i).find(|&j| coincide(&series[j], s)))
+        .collect()
+}
+
+/// The legend corner covering the fewest drawn points, and how many it
+/// covers: each segment is sampled, and a corner box is about 40% of the
+/// width and a line per entry high. Ties keep the upper left, then upper
+/// right, lower right, lower left.
+fn legend_corner(series: &[Prepared], xr: (f64, f64), yr: (f64, f64), entries: usize) -> (SeriesLabelPosition, usize) {
+    let (w, h) = (xr.1 - xr.0, yr.1 - yr.0);
+    if !(w > 0.0 && h > 0.0) {
+        return (SeriesLabelPosition::UpperLeft, 0);
+    }
+    let bh = legend_height(entries);
+    let mut samples = Vec::new();
+    for s in series {
+        samples.extend(s.points.iter().copied());
+        for p in s.points.windows(2) {
+            for k in 1..10 {
+                let t = k as f64 / 10.0;
+                samples.push((p[0].0 + t * (p[1].0 - p[0].0), p[0].1 + t * (p[1].1 - p[0].1)));
+            }
+        }
+    }
+    let covered = |left: bool, top: bool| {
+        samples
+            .iter()
+            .filter(|&&(x, y)| {
+                let fx = (x - xr.0) / w;
+                let fy = (y - yr.0) / h;
+                let in_x = if left { fx <= 0.42 } else { fx >= 0.58 };
+                let in_y = if top { fy >= 1.0 - bh } else { fy <= bh };
+                in_x && in_y
+            })
+            .count()
+    };
+    [
+        (SeriesLabelPosition::UpperLeft, covered(true, true)),
+        (SeriesLabelPosition::UpperRight, covered(false, true)),
+        (SeriesLabelPosition::LowerRight, covered(false, false)),
+        (SeriesLabelPosition::LowerLeft, covered(true, false)),
+    ]
+    .into_iter()
+    .min_by_key(|c| c.1)
+    .unwrap_or((SeriesLabelPosition::UpperLeft, 0))
+}
+
+/// The legend's height as a fraction of the plot's (a line per entry).
+fn legend_height(entries: usize) -> f64 {
+    (0.05 + 0.065 * entries as f64).min(0.6)
+}
+
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     plot: &LinePlot,
@@ -110,7 +177,7 @@ fn draw<DB: DrawingBackend>(
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let categorical = !plot.x_categories.is_empty() && !plot.log_x;
     let mut xr = padded_range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
-    let yr = padded_range(series.iter().flat_map(|s| {
+    let mut yr = padded_range(series.iter().flat_map(|s| {
         s.points
             .iter()
             .map(|p| p.1)
@@ -125,6 +192,15 @@ fn draw<DB: DrawingBackend>(
     } else {
         ticks(xr.0, xr.1, plot.log_x, x_integer)
     };
+    // The legend goes to a corner free of data; when every corner has some,
+    // the y axis grows by the legend's height so that the top is free.
+    let entries = series.iter().filter(|s| !s.name.is_empty()).count();
+    let (mut legend, covered) = legend_corner(series, xr, yr, entries);
+    if covered > 0 {
+        let bh = legend_height(entries);
+        yr.1 += (yr.1 - yr.0) * bh / (1.0 - bh);
+        legend = SeriesLabelPosition::UpperLeft;
+    }
     let yt = ticks(yr.0, yr.1, plot.log_y, false);
     let mut chart = ChartBuilder::on(root)
         .caption(&plot.title, (FAMILY, 24))
@@ -146,19 +222,38 @@ fn draw<DB: DrawingBackend>(
         .draw()
         .map_err(e)?;
     let mut any_legend = false;
+    let twins = coinciding(series);
     for (i, s) in series.iter().enumerate() {
         let c = color(i);
-        let line = chart
-            .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
-            .map_err(e)?;
+        // A series drawn exactly over an earlier one is dashed, with open
+        // square markers, so that both stay visible (and a note says so).
+        let line = if twins[i].is_some() {
+            chart
+                .draw_series(DashedLineSeries::new(s.points.iter().copied(), 8, 6, c.stroke_width(2)))
+                .map_err(e)?
+        } else {
+            chart
+                .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
+                .map_err(e)?
+        };
         if !s.name.is_empty() {
             any_legend = true;
             line.label(s.name.as_str())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
         }
-        chart
-            .draw_series(s.points.iter().map(|&p| Circle::new(p, 3, c.filled())))
-            .map_err(e)?;
+        if twins[i].is_some() {
+            chart
+                .draw_series(
+                    s.points
+                        .iter()
+                        .map(|&p| EmptyElement::at(p) + Rectangle::new([(-6, -6), (6, 6)], c.stroke_width(2))),
+                )
+                .map_err(e)?;
+        } else {
+            chart
+                .draw_series(s.points.iter().map(|&p| Circle::new(p, 3, c.filled())))
+                .map_err(e)?;
+        }
         chart
             .draw_series(
                 s.bars
@@ -173,7 +268,7 @@ fn draw<DB: DrawingBackend>(
             .label_font((FAMILY, 14))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperLeft)
+            .position(legend)
             .draw()
             .map_err(e)?;
     }
@@ -187,6 +282,19 @@ pub fn line_plot(base: &Path, plot: &LinePlot) -> Result<(), PlotError> {
     if series.iter().all(|s| s.points.is_empty()) {
         notes.push("note: no data".into());
     }
+    for (i, twin) in coinciding(&series).into_iter().enumerate() {
+        if let Some(j) = twin {
+            let name = |k: usize| {
+                let n = &series[k].name;
+                if n.is_empty() {
+                    format!("series {}", k + 1)
+                } else {
+                    n.clone()
+                }
+            };
+            notes.push(format!("note: {} coincides with {} (drawn dashed)", name(i), name(j)));
+        }
+    }
     render_both(
         base,
         |r| draw(r, plot, &series, &notes),
@@ -198,6 +306,60 @@ pub fn line_plot(base: &Path, plot: &LinePlot) -> Result<(), PlotError> {
 mod tests {
     use super::super::output::test_support::assert_plot_files;
     use super::*;
+
+    fn prepared(name: &str, points: &[(f64, f64)]) -> Prepared {
+        Prepared {
+            name: name.into(),
+            points: points.to_vec(),
+            bars: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_legend_goes_to_the_emptiest_corner() {
+        // A curve rising from the lower left to the upper right leaves the
+        // upper left and lower right free; the upper left wins the tie.
+        let rising = prepared("a", &[(0.0, 0.0), (10.0, 10.0)]);
+        let r = ((0.0, 10.0), (0.0, 10.0));
+        assert!(matches!(
+            legend_corner(&[rising], r.0, r.1, 1),
+            (SeriesLabelPosition::UpperLeft, 0)
+        ));
+        // A curve high on the left: the lower right is free.
+        let falling = prepared("b", &[(0.0, 10.0), (10.0, 9.0)]);
+        let high_left = prepared("c", &[(0.0, 0.5), (10.0, 9.5)]);
+        let p = legend_corner(&[falling, high_left], r.0, r.1, 2);
+        assert!(matches!(p, (SeriesLabelPosition::LowerRight, 0)), "{p:?}");
+        // Data in every corner: the fewest covered is reported, not zero.
+        let zigzag = prepared("d", &[(0.0, 0.0), (1.0, 10.0), (9.0, 0.0), (10.0, 10.0)]);
+        assert!(legend_corner(&[zigzag], r.0, r.1, 1).1 > 0);
+    }
+
+    #[test]
+    fn coinciding_series_are_found_and_noted() {
+        let a = prepared("one shader", &[(1.0, 2.0), (2.0, 3.0)]);
+        let b = prepared("four shaders", &[(1.0, 2.0), (2.0, 3.0 + 1e-12)]);
+        let c = prepared("other", &[(1.0, 2.0), (2.0, 3.5)]);
+        assert_eq!(coinciding(&[a, b, c]), vec![None, Some(0), None]);
+        let dir = tempfile::tempdir().unwrap();
+        let base = dir.path().join("twins");
+        let series = |name: &str, y: f64| Series {
+            name: name.into(),
+            points: vec![(1.0, 1.0), (2.0, y)],
+            ci: None,
+        };
+        let plot = LinePlot {
+            title: "t".into(),
+            series: vec![series("one", 2.0), series("four", 2.0)],
+            ..LinePlot::default()
+        };
+        line_plot(&base, &plot).unwrap();
+        let svg = std::fs::read_to_string(base.with_extension("svg")).unwrap();
+        assert!(
+            svg.contains("four coincides with one (drawn dashed)"),
+            "the note is on the plot"
+        );
+    }
 
     fn plot(series: Vec<Series>) -> LinePlot {
         LinePlot {
