@@ -81,6 +81,9 @@ pub struct Follower {
     next_fast: usize,
     next_slow: usize,
     next_conv: usize,
+    /// Stage values held in the records (kept as they are added, so that
+    /// the memory check on every input costs nothing).
+    stage_values: usize,
 }
 
 impl Follower {
@@ -92,6 +95,7 @@ impl Follower {
             next_fast: 0,
             next_slow: 0,
             next_conv: 0,
+            stage_values: 0,
         }
     }
 
@@ -102,16 +106,7 @@ impl Follower {
 
     /// Bytes the records take now (their stage lists included).
     pub fn record_bytes(&self) -> u64 {
-        let stages: usize = self
-            .records
-            .iter()
-            .map(|r| {
-                r.fast.as_ref().map_or(0, |f| f.1.len())
-                    + r.slow.as_ref().map_or(0, |s| s.2.len())
-                    + r.conventional.as_ref().map_or(0, |c| c.1.len())
-            })
-            .sum();
-        (self.records.capacity() * std::mem::size_of::<EventRecord>() + stages * 8) as u64
+        (self.records.capacity() * std::mem::size_of::<EventRecord>() + self.stage_values * 8) as u64
     }
 
     /// An input event happens at `time`.
@@ -146,6 +141,7 @@ impl Follower {
             let [te, sampled, delivered] = self.opening(&self.records[self.next_fast]);
             let mut g = gaps(&[te, sampled, delivered, f.start, f.upload_end, f.end]);
             g.push(disp);
+            self.stage_values += g.len();
             self.records[self.next_fast].fast = Some((index, g));
             self.next_fast += 1;
         }
@@ -166,6 +162,7 @@ impl Follower {
                 f.end,
             ]);
             g.push(disp);
+            self.stage_values += g.len();
             self.records[self.next_slow].slow = Some((index, b, g));
             self.next_slow += 1;
         }
@@ -178,6 +175,7 @@ impl Follower {
             let [te, sampled, delivered] = self.opening(&self.records[self.next_conv]);
             let mut g = gaps(&[te, sampled, delivered, c.start, c.end]);
             g.push(disp);
+            self.stage_values += g.len();
             self.records[self.next_conv].conventional = Some((index, g));
             self.next_conv += 1;
         }

@@ -70,13 +70,14 @@ pub struct MotionRecord {
 #[derive(Debug)]
 pub struct Follower {
     tracker: super::config::TrackerConfig,
-    period: u64,
-    latency: u64,
     display: u64,
     /// Every motion's fate so far.
     pub records: Vec<MotionRecord>,
     next_head: usize,
     next_object: usize,
+    /// Stage values held in the records (kept as they are added, so that
+    /// the memory check on every motion costs nothing).
+    stage_values: usize,
 }
 
 impl Follower {
@@ -84,12 +85,11 @@ impl Follower {
     pub fn new(cfg: &VrConfig) -> Self {
         Follower {
             tracker: cfg.tracker.clone(),
-            period: cfg.tracker.period.0,
-            latency: cfg.tracker.latency.0,
             display: cfg.display_latency().0,
             records: Vec::with_capacity(cfg.run.events.min(1 << 16) as usize),
             next_head: 0,
             next_object: 0,
+            stage_values: 0,
         }
     }
 
@@ -100,12 +100,7 @@ impl Follower {
 
     /// Bytes the records take now (their stage lists included).
     pub fn record_bytes(&self) -> u64 {
-        let stages: usize = self
-            .records
-            .iter()
-            .map(|r| r.head.as_ref().map_or(0, Vec::len) + r.object.as_ref().map_or(0, Vec::len))
-            .sum();
-        (self.records.capacity() * std::mem::size_of::<MotionRecord>() + stages * 8) as u64
+        (self.records.capacity() * std::mem::size_of::<MotionRecord>() + self.stage_values * 8) as u64
     }
 
     /// A motion happens at `time`.
@@ -126,9 +121,9 @@ impl Follower {
     /// delivery, then through `points`, then the display.
     fn stages(&self, i: usize, points: &[Time]) -> Vec<u64> {
         let t = self.records[i].time;
-        let sampled = Time(self.sample_of(i).saturating_mul(self.period));
+        let sampled = Time(self.sample_of(i).saturating_mul(self.tracker.period.0));
         // The simulation scheduled this delivery with checked time, so it fits.
-        let delivered = Time(sampled.0.saturating_add(self.latency));
+        let delivered = Time(sampled.0.saturating_add(self.tracker.latency.0));
         let mut all = vec![t, sampled, delivered];
         all.extend_from_slice(points);
         let mut g: Vec<u64> = all.windows(2).map(|w| w[1].0.saturating_sub(w[0].0)).collect();
@@ -142,6 +137,7 @@ impl Follower {
         while self.next_head < self.records.len() && f.sample >= Some(self.sample_of(self.next_head)) {
             let g = self.stages(self.next_head, &[f.start, f.sim_end, f.render_end, f.swap]);
             let r = &mut self.records[self.next_head];
+            self.stage_values += 2 * g.len();
             r.head = Some(g.clone());
             r.object = Some(g);
             self.next_head += 1;
@@ -154,6 +150,7 @@ impl Follower {
     pub fn warp_swap(&mut self, w: &WarpFrame) {
         while self.next_head < self.records.len() && w.camera >= Some(self.sample_of(self.next_head)) {
             let g = self.stages(self.next_head, &[w.start, w.render_end, w.swap]);
+            self.stage_values += g.len();
             let r = &mut self.records[self.next_head];
             r.head = Some(g);
             r.app_age = w.app.map(|(_, a)| w.swap.0.saturating_sub(a.start.0));
@@ -162,6 +159,7 @@ impl Follower {
         let Some((_, s)) = w.sim else { return };
         while self.next_object < self.records.len() && s.sample >= Some(self.sample_of(self.next_object)) {
             let g = self.stages(self.next_object, &[s.start, s.end, w.start, w.render_end, w.swap]);
+            self.stage_values += g.len();
             self.records[self.next_object].object = Some(g);
             self.next_object += 1;
         }
