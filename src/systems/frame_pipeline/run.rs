@@ -353,22 +353,20 @@ fn ms(ps: u64) -> f64 {
 /// of a vsynced display is an event), before failing at the overflow. Runs
 /// with `run.until` or `run.max_events` may stop earlier and are left to the
 /// clock's own checks.
-fn check_time_range(cfg: &FramePipelineConfig, analytic: &AnalyticTerms) -> Result<(), SystemError> {
-    // Looked up by key, as the summary shows them (a non-finite term is null).
-    let analytic = &to_json(analytic);
+fn check_time_range(cfg: &FramePipelineConfig, a: &AnalyticTerms) -> Result<(), SystemError> {
     let (cpu_key, gpu_key) = match &cfg.workload {
         WorkloadConfig::Fixed(_) => ("workload.cpu", "workload.gpu"),
         WorkloadConfig::Scene(_) => ("workload", "workload"),
     };
     // An expected term that is not a finite number (a distribution whose
     // mean overflows or does not exist) would be written as null.
-    for (k, what) in [
-        ("cpu_ms", "CPU time"),
-        ("gpu_front_end_ms", "GPU front-end time"),
-        ("geometry_ms", "geometry time"),
-        ("fragment_ms", "fragment time"),
+    for (value, is_cpu, what) in [
+        (a.cpu_ms, true, "CPU time"),
+        (a.gpu_front_end_ms, false, "GPU front-end time"),
+        (a.geometry_ms, false, "geometry time"),
+        (a.fragment_ms, false, "fragment time"),
     ] {
-        if analytic[k].as_f64().is_some_and(f64::is_finite) {
+        if value.is_finite() {
             continue;
         }
         let mut keys = vec![];
@@ -393,7 +391,7 @@ fn check_time_range(cfg: &FramePipelineConfig, analytic: &AnalyticTerms) -> Resu
             ),
         }
         if keys.is_empty() {
-            keys.push(if k == "cpu_ms" { cpu_key } else { gpu_key }.to_string());
+            keys.push(if is_cpu { cpu_key } else { gpu_key }.to_string());
         }
         return Err(bad(
             &keys.join("|"),
@@ -406,12 +404,13 @@ fn check_time_range(cfg: &FramePipelineConfig, analytic: &AnalyticTerms) -> Resu
     if cfg.run.until.is_some() || cfg.run.max_events.is_some() {
         return Ok(());
     }
-    let term = |k: &str| analytic[k].as_f64().unwrap_or(0.0) * PS_PER_MS as f64;
+    // (Every term is finite here: the loop above returned otherwise.)
+    let term = |ms: f64| ms * PS_PER_MS as f64;
     let mut terms = vec![
-        ("CPU work", cpu_key, term("cpu_ms")),
-        ("GPU front end work", gpu_key, term("gpu_front_end_ms")),
-        ("geometry work", gpu_key, term("geometry_ms")),
-        ("fragment work", gpu_key, term("fragment_ms")),
+        ("CPU work", cpu_key, term(a.cpu_ms)),
+        ("GPU front end work", gpu_key, term(a.gpu_front_end_ms)),
+        ("geometry work", gpu_key, term(a.geometry_ms)),
+        ("fragment work", gpu_key, term(a.fragment_ms)),
     ];
     // A vsynced FIFO swap chain shows every frame for at least one refresh.
     if cfg.display.vsync && cfg.display.present_mode == PresentMode::Fifo {
