@@ -3,16 +3,37 @@
 
 use rendersim::config::{ModelSource, Overrides, prepare};
 use rendersim::systems::frame_pipeline::PipelineRun;
-use rendersim::systems::run_model;
+use rendersim::systems::{SystemRun, run_model};
 use serde_json::Value;
 
-/// Runs a model given as TOML text with `--set` patches (the command line's
-/// way, [`rendersim::config::prepare`]).
-pub fn try_run(text: &str, sets: &[&str]) -> Result<PipelineRun, String> {
+/// Runs a model of any system given as TOML text with `--set` patches (the
+/// command line's way, [`rendersim::config::prepare`]).
+pub fn try_run_any(text: &str, sets: &[&str]) -> Result<SystemRun, String> {
     let m =
         prepare(ModelSource::from_text("test.toml", text), &Overrides::with_sets(sets)).map_err(|e| e.to_string())?;
-    run_model(&m.source, &m.table, None)
-        .map_err(|e| e.to_string())?
+    run_model(&m.source, &m.table, None).map_err(|e| e.to_string())
+}
+
+/// The summary of a run of any system; panics with the error on failure.
+pub fn summary_of(text: &str, sets: &[&str]) -> Value {
+    try_run_any(text, sets)
+        .unwrap_or_else(|e| panic!("run failed: {e}"))
+        .summary()
+        .clone()
+}
+
+/// A number in a summary by dotted path.
+pub fn num(v: &Value, path: &str) -> f64 {
+    let mut x = v;
+    for p in path.split('.') {
+        x = &x[p];
+    }
+    x.as_f64().unwrap_or_else(|| panic!("{path} is not a number: {x}"))
+}
+
+/// Runs a frame-pipeline model given as TOML text with `--set` patches.
+pub fn try_run(text: &str, sets: &[&str]) -> Result<PipelineRun, String> {
+    try_run_any(text, sets)?
         .downcast::<PipelineRun>()
         .map_err(|other| format!("not a frame-pipeline run: {}", other.summary()["system"]))
 }
@@ -24,11 +45,7 @@ pub fn run(text: &str, sets: &[&str]) -> PipelineRun {
 
 /// A metric by dotted path.
 pub fn metric(r: &PipelineRun, path: &str) -> f64 {
-    let mut v: &Value = &r.summary;
-    for p in path.split('.') {
-        v = &v[p];
-    }
-    v.as_f64().unwrap_or_else(|| panic!("{path} is not a number: {v}"))
+    num(&r.summary, path)
 }
 
 /// The fixed teaching model.

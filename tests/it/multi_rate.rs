@@ -5,32 +5,12 @@
 use std::process::Command;
 
 use rendersim::config::{ModelSource, Overrides, prepare};
-use rendersim::systems::{SystemRun, run_model};
+
+use crate::common::{num, summary_of as summary, try_run_any as try_run};
 use serde_json::Value;
 
 const CLUSTER: &str = include_str!("../../models/mfr-cluster.toml");
 const MULTIGPU: &str = include_str!("../../models/mfr-multigpu.toml");
-
-fn try_run(text: &str, sets: &[&str]) -> Result<SystemRun, String> {
-    let m =
-        prepare(ModelSource::from_text("test.toml", text), &Overrides::with_sets(sets)).map_err(|e| e.to_string())?;
-    run_model(&m.source, &m.table, None).map_err(|e| e.to_string())
-}
-
-fn summary(text: &str, sets: &[&str]) -> Value {
-    try_run(text, sets)
-        .unwrap_or_else(|e| panic!("run failed: {e}"))
-        .summary()
-        .clone()
-}
-
-fn num(v: &Value, path: &str) -> f64 {
-    let mut x = v;
-    for p in path.split('.') {
-        x = &x[p];
-    }
-    x.as_f64().unwrap_or_else(|| panic!("{path} is not a number: {x}"))
-}
 
 fn close(got: f64, want: f64, tol: f64, what: &str) {
     assert!(

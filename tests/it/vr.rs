@@ -2,33 +2,14 @@
 //! warping scheme, closed forms as oracles, simulated distributions inside
 //! the phase bounds, determinism, clear errors.
 
-use rendersim::config::{ModelSource, Overrides, apply_set, prepare};
-use rendersim::systems::{SystemRun, run_model};
+use rendersim::config::{ModelSource, apply_set};
+use rendersim::systems::run_model;
+
+use crate::common::{num, summary_of as summary, try_run_any as try_run};
 use serde_json::Value;
 
 const NAIVE: &str = include_str!("../../models/vr-naive.toml");
 const WARP: &str = include_str!("../../models/vr-warp.toml");
-
-fn try_run(text: &str, sets: &[&str]) -> Result<SystemRun, String> {
-    let m =
-        prepare(ModelSource::from_text("test.toml", text), &Overrides::with_sets(sets)).map_err(|e| e.to_string())?;
-    run_model(&m.source, &m.table, None).map_err(|e| e.to_string())
-}
-
-fn summary(text: &str, sets: &[&str]) -> Value {
-    try_run(text, sets)
-        .unwrap_or_else(|e| panic!("run failed: {e}"))
-        .summary()
-        .clone()
-}
-
-fn num(v: &Value, path: &str) -> f64 {
-    let mut x = v;
-    for p in path.split('.') {
-        x = &x[p];
-    }
-    x.as_f64().unwrap_or_else(|| panic!("{path} is not a number: {x}"))
-}
 
 #[test]
 fn naive_example_of_the_slides() {
