@@ -15,6 +15,47 @@ pub fn fixed(x: f64, decimals: usize) -> String {
     }
 }
 
+/// A summary number, NaN when it is missing or `null`.
+fn number(v: &serde_json::Value) -> f64 {
+    v.as_f64().unwrap_or(f64::NAN)
+}
+
+/// One latency line of a report: `  {head} min .. mean .. p99 .. max .. ms
+/// {bound} best .. worst ..`, from a distribution (`min`, `mean`, `p99`,
+/// `max`) and its bounds (`best`, `worst`) in a summary; the distribution's
+/// numbers take `width` columns.
+pub fn latency_row(
+    w: &mut dyn std::io::Write,
+    head: &str,
+    width: usize,
+    dist: &serde_json::Value,
+    bounds: &serde_json::Value,
+    bound: &str,
+) -> std::io::Result<()> {
+    let d = |k: &str| fixed(number(&dist[k]), 1);
+    writeln!(
+        w,
+        "  {head} min {:>width$} mean {:>width$} p99 {:>width$} max {:>width$} ms   {bound} best {:>6} worst {:>6}",
+        d("min"),
+        d("mean"),
+        d("p99"),
+        d("max"),
+        fixed(number(&bounds["best"]), 1),
+        fixed(number(&bounds["worst"]), 1)
+    )
+}
+
+/// A latency report's last line: kernel events, wall and simulated time.
+pub fn events_line(w: &mut dyn std::io::Write, s: &serde_json::Value) -> std::io::Result<()> {
+    writeln!(
+        w,
+        "  {} events in {:.3} s wall, {:.3} s simulated",
+        s["events"]["total"],
+        number(&s["wall_seconds"]),
+        number(&s["simulated_seconds"])
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::fixed;
