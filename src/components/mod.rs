@@ -1,11 +1,12 @@
 //! Reusable parts that systems compose: distributions, vertex caches, bounded
-//! FIFOs, swap chains, system-task noise, preemptible processors and
-//! state-time accounting.
+//! FIFOs, swap chains, system-task noise, preemptible processors, a unified
+//! shader-core pool and state-time accounting.
 
 pub mod distribution;
 pub mod fifo;
 pub mod noise;
 pub mod preemptible;
+pub mod shader_pool;
 pub mod state_clock;
 pub mod swap_chain;
 pub mod vertex_cache;

@@ -165,6 +165,7 @@ pub fn analyze(setup: H3Setup, m: H3Measured, measure_seconds: f64) -> Result<H3
             depth_order: (*key).into(),
             fifo_depth: 16,
             binning: false,
+            unified: false,
         })?;
         let pass = crate::systems::frame_pipeline::workload::early_z_pass(scene_order(*order), l);
         rows.push(H3Row {

@@ -34,6 +34,9 @@ pub struct PassModel {
     pub fifo_depth: u32,
     /// Sort-middle binning (`gpu.fragment.binning = "draw"`) instead of the FIFO.
     pub binning: bool,
+    /// `gpu.architecture = "unified"` (vertex and fragment shading share
+    /// the shader pool) instead of `"split"`.
+    pub unified: bool,
 }
 
 impl PassModel {
@@ -49,6 +52,8 @@ warmup_frames = 0
 seed = 1
 [cpu]
 max_frames_ahead = 1
+[gpu]
+architecture = "{arch}"
 [gpu.geometry]
 vertex_shader = "{pv}"
 vertex_cache = "{cache}"
@@ -78,6 +83,7 @@ triangle_pixels = {frag:?}
             cache = self.cache,
             fifo = self.fifo_depth,
             binning = if self.binning { "draw" } else { "off" },
+            arch = if self.unified { "unified" } else { "split" },
             pf = self.per_fragment,
             pr = self.per_rejected_fragment,
             order = self.depth_order,
@@ -160,6 +166,7 @@ mod tests {
             depth_order: "front_to_back".into(),
             fifo_depth: 1,
             binning: false,
+            unified: false,
         }
     }
 

@@ -53,7 +53,10 @@ pub const FIXED: &str = include_str!("../../models/fixed.toml");
 /// The default model.
 pub const DEFAULT: &str = include_str!("../../models/default.toml");
 
-/// A scene model with one group, no noise, vsync off, plain costs.
+/// A scene model with one group, no noise, vsync off, plain costs, on the
+/// split architecture (dedicated geometry and fragment units, whose busy
+/// times the oracles below reason about; `tests/it/unified.rs` covers the
+/// unified pool).
 pub fn scene_model(group: &str) -> String {
     format!(
         r#"
@@ -64,6 +67,8 @@ frames = 3
 vsync = false
 [noise]
 enabled = false
+[gpu]
+architecture = "split"
 [gpu.geometry]
 vertex_shader = "1ns"
 [gpu.fragment]

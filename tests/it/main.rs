@@ -20,4 +20,5 @@ mod multi_rate;
 mod outputs;
 mod pipeline_oracles;
 mod pixelflow;
+mod unified;
 mod vr;

@@ -136,7 +136,7 @@ fn studies_h2_to_h4_run_and_their_counters_match_the_simulator() {
     assert_eq!(h2.measured.fs_invocations_geometry_only, 0);
     assert_eq!(h2.measured.triangles, 2 * 24 * 24);
     assert_eq!(h2.cells.len(), 4);
-    assert_eq!(h2.scores.len(), 4);
+    assert_eq!(h2.scores.len(), 5);
     assert!(
         h2.cells
             .iter()

@@ -106,6 +106,39 @@ pub fn draw_times(
     }
 }
 
+/// The draw's times on a unified shader pool (`gpu.architecture =
+/// "unified"`): geometry shader work `g_shader` and fixed-function time
+/// `g_fixed` (fetch and setup), fragment shader work `shade_per_pixel` and
+/// fixed-function time `fixed_per_pixel` per covered pixel.
+///
+/// Each stream's item takes the longer of its fixed-function and shader
+/// parts, so per stream the draw's busy times are G = n max(g_x, g_s) (from
+/// the means) and F = the fragments at max(shade, fixed) per pixel; the
+/// triangle FIFO couples the two streams as in [`draw_times`]. The pool is
+/// work-conserving, so the draw also takes at least all of its shader work,
+/// G_s + F_s: T = max(T_fifo(G, F), G_s + F_s). With no fixed-function
+/// time this is the sum of the shader terms, which is what the triangle
+/// fidelity simulates (the pool never idles while either stream has work).
+pub fn draw_times_unified(
+    n: u64,
+    g_shader: Duration,
+    g_fixed: Duration,
+    pixels: &Dist<f64>,
+    shade_per_pixel: f64,
+    fixed_per_pixel: f64,
+    depth: Option<u32>,
+) -> DrawTimes {
+    let geometry = g_shader.max(g_fixed);
+    let per_pixel = shade_per_pixel.max(fixed_per_pixel);
+    let streams = draw_times(n, geometry, pixels, per_pixel, depth);
+    let f_shader = n as f64 * pixels.mean() * shade_per_pixel;
+    let pool = Duration::from_ps_f64(g_shader.0 as f64 + f_shader);
+    DrawTimes {
+        total: streams.total.max(pool),
+        ..streams
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -143,6 +176,18 @@ mod tests {
             let hi = Duration(t.geometry.0 + t.fragment.0);
             assert!(t.total >= lo && t.total <= hi, "{depth}: {t:?}");
         }
+    }
+
+    #[test]
+    fn unified_pool_sums_the_shader_terms() {
+        // Balanced constant triangles, deep FIFO: split overlaps (max + fill),
+        // the unified pool adds the shader work up.
+        let px = Dist::Const { value: 10.0 };
+        let u = draw_times_unified(1000, Duration(10_000), Duration::ZERO, &px, 1.0, 0.0, Some(16));
+        assert_eq!(u.total, Duration(20_000));
+        // Fixed-function time beyond the shader work bounds the draw instead.
+        let u = draw_times_unified(1000, Duration(1_000), Duration(50_000), &px, 0.1, 0.0, Some(16));
+        assert!(u.total >= Duration(50_000) && u.total < Duration(52_000), "{u:?}");
     }
 
     #[test]

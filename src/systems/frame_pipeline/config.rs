@@ -235,10 +235,117 @@ pub struct GpuConfig {
     pub clear: Duration,
     /// The swap at the end of a frame.
     pub swap: Duration,
+    /// `"unified"` (vertex and fragment shading share one pool of shader
+    /// cores) or `"split"` (dedicated geometry and fragment units).
+    pub architecture: Architecture,
+    /// Unified: cores in the shader pool (default 16). Costs stay the time
+    /// of the whole pool; the count sets how finely it is divided.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shader_cores: Option<u32>,
+    /// Unified: how the pool is divided while vertex and fragment work both
+    /// wait: `"fair"` (default), `"vertex_first"`, `"fragment_first"` or
+    /// `"reserved"` (with `vertex_cores`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scheduling: Option<SchedulingPolicy>,
+    /// Unified with `scheduling = "reserved"`: cores that serve only vertex
+    /// work; the rest serve only fragments.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vertex_cores: Option<u32>,
     /// Vertex processing.
     pub geometry: GeometryConfig,
     /// Rasterization and fragment processing.
     pub fragment: FragmentConfig,
+}
+
+/// The GPU's shader architecture.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Architecture {
+    /// One pool of shader cores runs vertex and fragment shading (every GPU
+    /// since about 2006); fixed-function setup, depth test and blending keep
+    /// their own rates ([`crate::components::shader_pool`]).
+    #[default]
+    Unified,
+    /// A geometry unit and a fragment unit, each with its own rate, joined by
+    /// the triangle FIFO (the GeForce3 of paper 000 §4.5).
+    Split,
+}
+
+/// How a unified pool is divided (see [`crate::components::shader_pool::Scheduling`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum SchedulingPolicy {
+    /// Half each while both wait.
+    #[default]
+    Fair,
+    /// Vertex work first.
+    VertexFirst,
+    /// Fragment work first.
+    FragmentFirst,
+    /// `gpu.vertex_cores` serve only vertices, the rest only fragments.
+    Reserved,
+}
+
+/// Cores of a unified pool when `gpu.shader_cores` is not given.
+pub const DEFAULT_SHADER_CORES: u32 = 16;
+
+impl GpuConfig {
+    /// The unified pool's cores and policy; `None` for the split architecture.
+    pub fn pool(&self) -> Option<(u32, crate::components::shader_pool::Scheduling)> {
+        use crate::components::shader_pool::Scheduling as S;
+        if self.architecture == Architecture::Split {
+            return None;
+        }
+        let cores = self.shader_cores.unwrap_or(DEFAULT_SHADER_CORES);
+        let policy = match self.scheduling.unwrap_or_default() {
+            SchedulingPolicy::Fair => S::Fair,
+            SchedulingPolicy::VertexFirst => S::VertexFirst,
+            SchedulingPolicy::FragmentFirst => S::FragmentFirst,
+            SchedulingPolicy::Reserved => S::Reserved {
+                vertex_cores: self.vertex_cores.unwrap_or(cores / 2),
+            },
+        };
+        Some((cores, policy))
+    }
+
+    /// Checks the architecture keys against each other: `(key, message)`.
+    pub fn check_architecture(&self) -> Result<(), (&'static str, String)> {
+        if self.architecture == Architecture::Split {
+            for (key, given) in [
+                ("gpu.shader_cores", self.shader_cores.is_some()),
+                ("gpu.scheduling", self.scheduling.is_some()),
+                ("gpu.vertex_cores", self.vertex_cores.is_some()),
+            ] {
+                if given {
+                    return Err((
+                        key,
+                        "applies only to gpu.architecture = \"unified\" (this model is \"split\")".into(),
+                    ));
+                }
+            }
+            return Ok(());
+        }
+        let cores = self.shader_cores.unwrap_or(DEFAULT_SHADER_CORES);
+        if !(1..=1 << 20).contains(&cores) {
+            return Err(("gpu.shader_cores", format!("must be between 1 and 1048576, got {cores}")));
+        }
+        let reserved = self.scheduling == Some(SchedulingPolicy::Reserved);
+        match self.vertex_cores {
+            Some(_) if !reserved => Err((
+                "gpu.vertex_cores",
+                "applies only to gpu.scheduling = \"reserved\"".into(),
+            )),
+            Some(k) if k == 0 || k >= cores => Err((
+                "gpu.vertex_cores",
+                format!("must be between 1 and gpu.shader_cores - 1 ({}), got {k}", cores - 1),
+            )),
+            None if reserved && cores < 2 => Err((
+                "gpu.shader_cores",
+                "scheduling = \"reserved\" needs at least 2 cores (some for vertices, some for fragments)".into(),
+            )),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// The geometry stage: index fetch -> vertex cache -> vertex shader per
@@ -297,6 +404,11 @@ pub struct FragmentConfig {
     pub per_fragment: Duration,
     /// Per fragment rejected by the early depth test.
     pub per_rejected_fragment: Duration,
+    /// Fixed-function time (rasterization, depth test, blending) per shaded
+    /// fragment. Unified: runs beside the shader work (`per_fragment`, on the
+    /// pool) and a triangle's fragments take the longer of the two; split:
+    /// added to `per_fragment`.
+    pub fixed_per_fragment: Duration,
 }
 
 impl FragmentConfig {
@@ -321,6 +433,7 @@ impl Default for FragmentConfig {
             binning: Binning::Off,
             per_fragment: Duration::ZERO,
             per_rejected_fragment: Duration::ZERO,
+            fixed_per_fragment: Duration::ZERO,
         }
     }
 }

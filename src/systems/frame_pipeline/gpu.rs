@@ -10,9 +10,10 @@
 
 use crate::engine::{Duration, Scheduler, Time};
 
-use super::closed_form::draw_times;
+use super::workload::closed_times;
 use super::config::Fidelity;
-use super::model::{ActiveDraw, Command, Ev, FramePipeline, FrontPhase, Program};
+use super::model::{ActiveDraw, Command, Ev, FragWork, FramePipeline, FrontPhase, Program};
+use crate::components::shader_pool::Stream;
 use crate::systems::error::SystemError;
 
 impl FramePipeline {
@@ -170,16 +171,7 @@ impl FramePipeline {
             Fidelity::Draw => {
                 let t = match d.closed {
                     Some(t) => t,
-                    None => {
-                        let g = &sc.groups[d.group as usize];
-                        draw_times(
-                            triangles,
-                            mesh.geometry_time,
-                            &g.pixels,
-                            g.cost_per_pixel,
-                            self.cfg.gpu.fragment.depth(),
-                        )
-                    }
+                    None => closed_times(&self.cfg, mesh, &sc.groups[d.group as usize]),
                 };
                 self.draw_fragment_limited = Some(t.fragment >= t.geometry);
                 if self.acct.trace.is_none() {
@@ -245,16 +237,21 @@ impl FramePipeline {
             Some(Duration(0))
         };
         // Checked: a huge per-vertex cost times the vertices must not wrap.
-        let g = fetch
-            .and_then(|f| f.checked_add(geo.triangle_setup))
-            .and_then(|f| geo.vertex_shader.checked_mul(tv).and_then(|v| v.checked_add(f)))
-            .ok_or_else(|| crate::engine::TimeError::Overflow {
-                context: "computing the geometry time of a triangle (gpu.geometry costs)".into(),
-                at: now,
-                by: Duration(u64::MAX),
-            })?;
+        let overflow = || crate::engine::TimeError::Overflow {
+            context: "computing the geometry time of a triangle (gpu.geometry costs)".into(),
+            at: now,
+            by: Duration(u64::MAX),
+        };
+        let fixed = fetch.and_then(|f| f.checked_add(geo.triangle_setup)).ok_or_else(overflow)?;
+        let shader = geo.vertex_shader.checked_mul(tv).ok_or_else(overflow)?;
         self.geom_busy = true;
-        s.at(now.add(g, "geometry of a triangle")?, Ev::GeomTriangle);
+        if let Some(pool) = &mut self.pool {
+            // Unified: fetch and setup beside the vertex shading on the pool.
+            pool.begin(now, Stream::Vertex, shader, fixed)?;
+            return Ok(());
+        }
+        let g = shader.checked_add(fixed).ok_or_else(overflow)?;
+        s.at(now.add(g, "geometry of a triangle")?, Ev::GeomTriangle { tag: 0 });
         Ok(())
     }
 
@@ -272,7 +269,17 @@ impl FramePipeline {
         };
         let g = &sc.groups[sc.draws[draw as usize].group as usize];
         let px = g.pixels.sample(&mut self.pixel_rng);
-        let f = Duration::from_ps_f64(px * g.cost_per_pixel);
+        let f = if self.pool.is_some() {
+            FragWork {
+                shader: Duration::from_ps_f64(px * g.shade_per_pixel),
+                fixed: Duration::from_ps_f64(px * g.fixed_per_pixel),
+            }
+        } else {
+            FragWork {
+                shader: Duration::from_ps_f64(px * g.cost_per_pixel),
+                fixed: Duration::ZERO,
+            }
+        };
         if self.cfg.gpu.fragment.binned() {
             // Sort-middle: bin the triangle; the draw's last triangle opens the bins.
             self.tri_fifo.push(f, 1);
@@ -293,9 +300,44 @@ impl FramePipeline {
         self.geom_next_triangle(now, s)
     }
 
-    fn frag_start(&mut self, now: Time, f: Duration, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+    fn frag_start(&mut self, now: Time, f: FragWork, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         self.frag_busy = true;
-        s.at(now.add(f, "fragments of a triangle")?, Ev::FragTriangle);
+        if let Some(pool) = &mut self.pool {
+            pool.begin(now, Stream::Fragment, f.shader, f.fixed)?;
+            return Ok(());
+        }
+        s.at(now.add(f.shader, "fragments of a triangle")?, Ev::FragTriangle { tag: 0 });
+        Ok(())
+    }
+
+    /// Unified pool: whether a completion event with `tag` is `stream`'s
+    /// current one (and if so, ends the item on the pool). Always true when
+    /// split.
+    pub(super) fn pool_completes(&mut self, now: Time, stream: Stream, tag: u32) -> bool {
+        match &mut self.pool {
+            Some(pool) if !pool.is_current(stream, tag) => false,
+            Some(pool) => {
+                pool.end(now, stream);
+                true
+            }
+            None => true,
+        }
+    }
+
+    /// Unified pool: after an instant's changes, schedules the completions
+    /// whose time moved (stale ones are ignored by their tags).
+    pub(super) fn pool_settle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+        if let Some(pool) = &mut self.pool {
+            for d in pool.settle(now)?.iter() {
+                s.at(
+                    d.at,
+                    match d.stream {
+                        Stream::Vertex => Ev::GeomTriangle { tag: d.tag },
+                        Stream::Fragment => Ev::FragTriangle { tag: d.tag },
+                    },
+                );
+            }
+        }
         Ok(())
     }
 

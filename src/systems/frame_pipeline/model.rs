@@ -12,6 +12,7 @@ use crate::components::distribution::Dist;
 use crate::components::fifo::{BoundedFifo, FifoUnit};
 use crate::components::noise::{Arrivals, NoiseSource, NoiseTarget};
 use crate::components::preemptible::{Preemptible, Wake};
+use crate::components::shader_pool::{ShaderPool, Stream};
 use crate::components::swap_chain::{PresentMode, SwapChain};
 use crate::engine::{Control, Duration, EventKind, Model, RngStreams, Scheduler, StreamRng, Time};
 use crate::systems::error::SystemError;
@@ -34,10 +35,18 @@ pub enum Ev {
         /// Generation tag.
         tag: u32,
     },
-    /// The geometry stage finished a triangle (`triangle` fidelity).
-    GeomTriangle,
-    /// The fragment stage finished a triangle (`triangle` fidelity).
-    FragTriangle,
+    /// The geometry stage finished a triangle (`triangle` fidelity; the tag
+    /// guards the unified pool's rescheduling, 0 when split).
+    GeomTriangle {
+        /// Generation tag.
+        tag: u32,
+    },
+    /// The fragment stage finished a triangle (`triangle` fidelity; tagged
+    /// as [`Ev::GeomTriangle`]).
+    FragTriangle {
+        /// Generation tag.
+        tag: u32,
+    },
     /// The geometry part of a draw ended (`draw` fidelity).
     DrawGeometry,
     /// The fragment part of a draw began (`draw` fidelity).
@@ -82,8 +91,8 @@ impl EventKind for Ev {
         match self {
             Ev::CpuDone { .. } => 0,
             Ev::FrontDone { .. } => 1,
-            Ev::GeomTriangle => 2,
-            Ev::FragTriangle => 3,
+            Ev::GeomTriangle { .. } => 2,
+            Ev::FragTriangle { .. } => 3,
             Ev::DrawGeometry => 4,
             Ev::DrawFragmentStart => 5,
             Ev::DrawDone => 6,
@@ -223,8 +232,12 @@ pub struct FramePipeline {
     /// `draw` fidelity: whether the running draw is fragment-limited (F >= G);
     /// the bottleneck of the whole draw goes to that stage.
     pub(super) draw_fragment_limited: Option<bool>,
-    pub(super) geom_held: Option<Duration>,
-    pub(super) tri_fifo: BoundedFifo<Duration>,
+    /// A finished triangle's fragment work (shader, fixed-function) that
+    /// found the triangle FIFO full.
+    pub(super) geom_held: Option<FragWork>,
+    pub(super) tri_fifo: BoundedFifo<FragWork>,
+    /// The unified architecture's shader-core pool (`None`: split).
+    pub(super) pool: Option<ShaderPool>,
     pub(super) frag_busy: bool,
     pub(super) pixel_rng: StreamRng,
     /// The size stream's state at the start, restored every frame for a static view.
@@ -244,6 +257,16 @@ pub struct FramePipeline {
     // results
     pub(super) records: Vec<FrameRecord>,
     pub(super) acct: Accounting,
+}
+
+/// A triangle's fragment work: shader time (on the pool when unified; all
+/// of it when split) and fixed-function time beside it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FragWork {
+    /// Shader work (split: the whole fragment-stage time).
+    pub shader: Duration,
+    /// Fixed-function time (unified only; zero when split).
+    pub fixed: Duration,
 }
 
 /// A draw in the geometry stage.
@@ -364,6 +387,10 @@ impl FramePipeline {
             draw_split: None,
             draw_fragment_limited: None,
             geom_held: None,
+            pool: match cfg.fidelity {
+                Fidelity::Triangle => cfg.gpu.pool().map(|(n, p)| ShaderPool::new(n, p)),
+                Fidelity::Draw => None,
+            },
             frag_busy: false,
             vblanks: 0,
             repeated_refreshes: 0,
@@ -390,6 +417,7 @@ impl FramePipeline {
             s.at(t, Ev::NoiseArrive { source: i as u16 });
         }
         self.settle(Time::ZERO, s)?;
+        self.pool_settle(Time::ZERO, s)?;
         self.account(Time::ZERO);
         Ok(())
     }
@@ -564,8 +592,16 @@ impl Model for FramePipeline {
                     self.front_command_done(now)?;
                 }
             }
-            Ev::GeomTriangle => self.geom_triangle_done(now, s)?,
-            Ev::FragTriangle => self.frag_triangle_done(now, s)?,
+            Ev::GeomTriangle { tag } => {
+                if self.pool_completes(now, Stream::Vertex, tag) {
+                    self.geom_triangle_done(now, s)?;
+                }
+            }
+            Ev::FragTriangle { tag } => {
+                if self.pool_completes(now, Stream::Fragment, tag) {
+                    self.frag_triangle_done(now, s)?;
+                }
+            }
             Ev::DrawGeometry => self.geom_busy = false,
             Ev::DrawFragmentStart => self.frag_busy = true,
             Ev::DrawDone => self.draw_done(now),
@@ -578,6 +614,7 @@ impl Model for FramePipeline {
             }
         }
         self.settle(now, s)?;
+        self.pool_settle(now, s)?;
         self.account(now);
         Ok(if self.done() { Control::Stop } else { Control::Continue })
     }

@@ -86,6 +86,7 @@ pub fn validate(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
             ),
         ));
     }
+    cfg.gpu.check_architecture().map_err(|(key, message)| bad(key, message))?;
     if cfg.cpu.max_frames_ahead == 0 {
         return Err(bad(
             "cpu.max_frames_ahead",

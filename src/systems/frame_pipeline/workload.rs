@@ -15,7 +15,7 @@ use crate::scene::config::{DepthOrder, MeshRef, SceneWorkload, StateOrder};
 use crate::scene::generators::mesh_from_spec;
 use crate::scene::presets::{PRESETS, preset_groups};
 
-use super::closed_form::{DrawTimes, draw_times};
+use super::closed_form::{DrawTimes, draw_times, draw_times_unified};
 use super::config::{Fidelity, FramePipelineConfig};
 
 /// Errors while building the workload.
@@ -84,6 +84,9 @@ pub struct MeshInfo {
     pub misses: Misses,
     /// Geometry-stage time of one draw of the mesh.
     pub geometry_time: Duration,
+    /// The vertex-shader part of `geometry_time` (the rest is index fetch
+    /// and triangle setup, fixed function on a unified GPU).
+    pub geometry_shader: Duration,
 }
 
 /// A group's fragment-stage parameters.
@@ -93,8 +96,14 @@ pub struct GroupInfo {
     pub name: String,
     /// Screen-space triangle area, pixels.
     pub pixels: Dist<f64>,
-    /// Expected fragment cost per covered pixel, picoseconds (early-z folded in).
+    /// Expected fragment cost per covered pixel, picoseconds (early-z folded
+    /// in): the fragment stage's time per pixel when split.
     pub cost_per_pixel: f64,
+    /// Unified: expected shader work per covered pixel (on the pool), ps.
+    pub shade_per_pixel: f64,
+    /// Unified: expected fixed-function time per covered pixel (depth test
+    /// of rejected fragments, rasterization and blending of shaded ones), ps.
+    pub fixed_per_pixel: f64,
 }
 
 /// One draw call with the commands that precede it.
@@ -188,6 +197,24 @@ fn add(a: Duration, b: Duration, key: &str) -> Result<Duration, WorkloadError> {
         .ok_or_else(|| invalid(key, "sum of costs overflows the 64-bit picosecond range"))
 }
 
+/// The closed-form times of one draw of mesh `m` in group `g` (the `draw`
+/// fidelity), for the model's architecture.
+pub fn closed_times(cfg: &FramePipelineConfig, m: &MeshInfo, g: &GroupInfo) -> DrawTimes {
+    let depth = cfg.gpu.fragment.depth();
+    if cfg.gpu.pool().is_none() {
+        return draw_times(m.triangles, m.geometry_time, &g.pixels, g.cost_per_pixel, depth);
+    }
+    draw_times_unified(
+        m.triangles,
+        m.geometry_shader,
+        m.geometry_time.saturating_sub(m.geometry_shader),
+        &g.pixels,
+        g.shade_per_pixel,
+        g.fixed_per_pixel,
+        depth,
+    )
+}
+
 /// Compiles the scene workload of `cfg`.
 pub fn compile_scene(
     cfg: &FramePipelineConfig,
@@ -220,7 +247,10 @@ pub fn compile_scene(
 
     let pass = early_z_pass(scene.depth_order, scene.depth_complexity);
     let frag = &cfg.gpu.fragment;
-    let cost_per_pixel = pass * frag.per_fragment.0 as f64 + (1.0 - pass) * frag.per_rejected_fragment.0 as f64;
+    let shaded = frag.per_fragment.0 as f64 + frag.fixed_per_fragment.0 as f64;
+    let cost_per_pixel = pass * shaded + (1.0 - pass) * frag.per_rejected_fragment.0 as f64;
+    let shade_per_pixel = pass * frag.per_fragment.0 as f64;
+    let fixed_per_pixel = pass * frag.fixed_per_fragment.0 as f64 + (1.0 - pass) * frag.per_rejected_fragment.0 as f64;
     let geo = &cfg.gpu.geometry;
     let need_per_triangle = cfg.fidelity == Fidelity::Triangle;
 
@@ -253,16 +283,17 @@ pub fn compile_scene(
             Some(&id) => id,
             None => {
                 let info = build_mesh(&g.mesh, g.indexed, &geo.vertex_cache, need_per_triangle, base_dir, &key)?;
+                let geometry_shader = mul(geo.vertex_shader, info.transformed, &key)?;
                 let geometry_time = add(
-                    add(
-                        mul(geo.index_fetch, info.indices, &key)?,
-                        mul(geo.vertex_shader, info.transformed, &key)?,
-                        &key,
-                    )?,
+                    add(mul(geo.index_fetch, info.indices, &key)?, geometry_shader, &key)?,
                     mul(geo.triangle_setup, info.triangles, &key)?,
                     &key,
                 )?;
-                meshes.push(MeshInfo { geometry_time, ..info });
+                meshes.push(MeshInfo {
+                    geometry_time,
+                    geometry_shader,
+                    ..info
+                });
                 let id = (meshes.len() - 1) as u32;
                 mesh_ids.insert(mesh_key, id);
                 id
@@ -272,6 +303,8 @@ pub fn compile_scene(
             name: g.name.clone(),
             pixels: g.triangle_pixels.clone(),
             cost_per_pixel,
+            shade_per_pixel,
+            fixed_per_pixel,
         });
         for i in 0..g.count {
             objects.push(Instance {
@@ -360,16 +393,9 @@ pub fn compile_scene(
         stats.triangles += m.triangles;
         stats.transformed_vertices += m.transformed;
         let closed = (cfg.fidelity == Fidelity::Draw).then(|| {
-            *closed_cache.entry((mesh, group)).or_insert_with(|| {
-                let g = &groups[group as usize];
-                draw_times(
-                    m.triangles,
-                    m.geometry_time,
-                    &g.pixels,
-                    g.cost_per_pixel,
-                    cfg.gpu.fragment.depth(),
-                )
-            })
+            *closed_cache
+                .entry((mesh, group))
+                .or_insert_with(|| closed_times(cfg, m, &groups[group as usize]))
         });
         draws.push(DrawItem {
             group,
@@ -418,6 +444,7 @@ fn build_mesh(
                 indices: if indexed { triangles.saturating_mul(3) } else { 0 },
                 misses,
                 geometry_time: Duration::ZERO,
+                geometry_shader: Duration::ZERO,
             })
         }
         MeshRef::Spec(spec) => {
@@ -435,6 +462,7 @@ fn build_mesh(
                     },
                     misses: Misses::Constant(3),
                     geometry_time: Duration::ZERO,
+                    geometry_shader: Duration::ZERO,
                 });
             }
             let (transformed, misses, indices) = if per_triangle {
@@ -459,6 +487,7 @@ fn build_mesh(
                 indices,
                 misses,
                 geometry_time: Duration::ZERO,
+                geometry_shader: Duration::ZERO,
             })
         }
     }
