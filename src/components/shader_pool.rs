@@ -362,10 +362,7 @@ mod tests {
         let mut p = ShaderPool::new(64, Scheduling::Fair);
         p.begin(Time(u64::MAX - 5), Stream::Vertex, Duration(100), Duration::ZERO)
             .unwrap();
-        assert!(matches!(
-            p.settle(Time(u64::MAX - 5)),
-            Err(TimeError::Overflow { .. })
-        ));
+        assert!(matches!(p.settle(Time(u64::MAX - 5)), Err(TimeError::Overflow { .. })));
         let mut p = ShaderPool::new(64, Scheduling::Fair);
         assert!(
             p.begin(Time(u64::MAX - 5), Stream::Vertex, Duration(1), Duration(100))

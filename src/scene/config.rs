@@ -23,6 +23,21 @@ pub enum DepthOrder {
     Random,
 }
 
+/// The order of a draw's triangle sizes (paper 000 §4.5.1: the bottleneck
+/// moves inside one object when its triangles' sizes come in runs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum SizeOrder {
+    /// Each triangle's size drawn independently.
+    #[default]
+    Random,
+    /// The draw's sampled sizes sorted smallest first: a terrain or street
+    /// in perspective drawn from the horizon towards the viewer.
+    Ascending,
+    /// Largest first (near to far).
+    Descending,
+}
+
 /// Whether consecutive frames show the same view.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -117,6 +132,10 @@ pub struct ObjectGroup {
     pub indexed: bool,
     /// Screen-space triangle area in pixels.
     pub triangle_pixels: Dist<f64>,
+    /// Order of the sizes within a draw: `"random"` (default), `"ascending"`
+    /// or `"descending"` (the draw's sampled sizes sorted).
+    #[serde(default)]
+    pub size_order: SizeOrder,
     /// Distinct shaders cycled over the instances.
     #[serde(default = "one_u64")]
     pub shaders: u64,

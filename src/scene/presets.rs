@@ -29,6 +29,7 @@ pub fn preset_groups(name: &str, scale: f64) -> Option<Vec<ObjectGroup>> {
         mesh: MeshRef::Stats { triangles: tris, acmr },
         indexed: true,
         triangle_pixels: pixels,
+        size_order: Default::default(),
         shaders: 1,
         textures: tex,
         materials: mat,

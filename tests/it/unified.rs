@@ -90,7 +90,10 @@ fn fixed_function_time_runs_beside_the_shader_work() {
     // fixed-function time: the fragment stream is busy as long as a split
     // fragment unit at 1 ns per pixel with the same triangle sizes.
     let m = pool_scene(16)
-        .replace("per_fragment = \"1ns\"", "per_fragment = \"1ps\"\nfixed_per_fragment = \"1ns\"")
+        .replace(
+            "per_fragment = \"1ns\"",
+            "per_fragment = \"1ps\"\nfixed_per_fragment = \"1ns\"",
+        )
         .replace("vertex_shader = \"1ns\"", "vertex_shader = \"1ps\"");
     let u = run(&m, &["run.frames=2"]);
     let s = run(
@@ -115,7 +118,10 @@ fn reserved_cores_are_slower_than_sharing() {
     );
     assert!(reserved.clocks.gpu[0] > fair.clocks.gpu[0]);
     for policy in ["vertex_first", "fragment_first"] {
-        let r = run(&pool_scene(16), &["run.frames=2", &format!("gpu.scheduling=\"{policy}\"")]);
+        let r = run(
+            &pool_scene(16),
+            &["run.frames=2", &format!("gpu.scheduling=\"{policy}\"")],
+        );
         // Priorities reorder the work but the pool stays busy: same total.
         let d = r.clocks.gpu[0].abs_diff(fair.clocks.gpu[0]) as f64;
         assert!(d / (fair.clocks.gpu[0] as f64) < 1e-3, "{policy}");
@@ -150,7 +156,11 @@ fn architecture_keys_are_checked_against_each_other() {
     assert!(e.contains("gpu.vertex_cores") && e.contains("reserved"), "{e}");
     let e = try_run(
         &unified,
-        &["gpu.scheduling=\"reserved\"", "gpu.shader_cores=4", "gpu.vertex_cores=4"],
+        &[
+            "gpu.scheduling=\"reserved\"",
+            "gpu.shader_cores=4",
+            "gpu.vertex_cores=4",
+        ],
     )
     .unwrap_err();
     assert!(e.contains("gpu.vertex_cores") && e.contains("between 1 and"), "{e}");

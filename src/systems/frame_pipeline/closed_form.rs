@@ -139,6 +139,36 @@ pub fn draw_times_unified(
     }
 }
 
+/// The draw's time when its triangles come in a given order: geometry
+/// `geometry[i]` and fragments `fragment[i]` picoseconds for triangle `i`,
+/// through a FIFO of `depth` triangles (`None`: binning, the sum). This is
+/// the exact recursion of the two-stage pipeline the `triangle` fidelity
+/// simulates: triangle i leaves the geometry stage when its geometry is done
+/// and triangle i - depth - 1 has left the fragment stage (the FIFO and the
+/// fragment stage hold depth + 1 triangles), and its fragments start when it
+/// has left geometry and triangle i - 1's fragments are done. Used for sizes
+/// sorted within a draw (`size_order`), where the window approximation of
+/// [`draw_times`] does not apply.
+pub fn ordered_draw_total(geometry: &[f64], fragment: &[f64], depth: Option<u32>) -> f64 {
+    let Some(depth) = depth else {
+        return geometry.iter().sum::<f64>() + fragment.iter().sum::<f64>();
+    };
+    let d = depth as usize + 1;
+    let n = geometry.len().min(fragment.len());
+    // Fragment completion times, a ring of the last d.
+    let mut done = vec![0.0f64; d];
+    let (mut left_geometry, mut last_done) = (0.0f64, 0.0f64);
+    for i in 0..n {
+        let geometry_done = left_geometry + geometry[i];
+        let room = if i >= d { done[i % d] } else { 0.0 };
+        left_geometry = geometry_done.max(room);
+        let start = left_geometry.max(last_done);
+        last_done = start + fragment[i];
+        done[i % d] = last_done;
+    }
+    last_done
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -188,6 +218,23 @@ mod tests {
         // Fixed-function time beyond the shader work bounds the draw instead.
         let u = draw_times_unified(1000, Duration(1_000), Duration(50_000), &px, 0.1, 0.0, Some(16));
         assert!(u.total >= Duration(50_000) && u.total < Duration(52_000), "{u:?}");
+    }
+
+    #[test]
+    fn ordered_recursion_matches_the_window_cases() {
+        // Balanced constant triangles with a deep FIFO: max plus fill.
+        let g = vec![10.0; 1000];
+        assert_eq!(ordered_draw_total(&g, &g, Some(1000)), 10_010.0);
+        // Direct hand-off, alternating sizes: the sum of per-triangle maxima plus fill.
+        let f: Vec<f64> = (0..1000).map(|i| if i % 2 == 0 { 0.0 } else { 20.0 }).collect();
+        let t = ordered_draw_total(&g, &f, Some(0));
+        assert!((10_000.0..=20_000.0).contains(&t), "{t}");
+        // Sorted: all small then all large, the regimes do not overlap.
+        let mut sorted = f.clone();
+        sorted.sort_by(f64::total_cmp);
+        let t = ordered_draw_total(&g, &sorted, Some(16));
+        assert!(t > 14_500.0, "{t}");
+        assert_eq!(ordered_draw_total(&g, &f, None), 20_000.0);
     }
 
     #[test]

@@ -327,7 +327,10 @@ impl GpuConfig {
         }
         let cores = self.shader_cores.unwrap_or(DEFAULT_SHADER_CORES);
         if !(1..=1 << 20).contains(&cores) {
-            return Err(("gpu.shader_cores", format!("must be between 1 and 1048576, got {cores}")));
+            return Err((
+                "gpu.shader_cores",
+                format!("must be between 1 and 1048576, got {cores}"),
+            ));
         }
         let reserved = self.scheduling == Some(SchedulingPolicy::Reserved);
         match self.vertex_cores {

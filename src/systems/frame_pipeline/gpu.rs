@@ -10,10 +10,11 @@
 
 use crate::engine::{Duration, Scheduler, Time};
 
-use super::workload::closed_times;
 use super::config::Fidelity;
 use super::model::{ActiveDraw, Command, Ev, FragWork, FramePipeline, FrontPhase, Program};
+use super::workload::{closed_times, ordered_sizes};
 use crate::components::shader_pool::Stream;
+use crate::scene::config::SizeOrder;
 use crate::systems::error::SystemError;
 
 impl FramePipeline {
@@ -167,7 +168,15 @@ impl FramePipeline {
             triangles,
         });
         match self.cfg.fidelity {
-            Fidelity::Triangle => self.geom_next_triangle(now, s),
+            Fidelity::Triangle => {
+                let g = &sc.groups[d.group as usize];
+                if g.order == SizeOrder::Random {
+                    self.draw_sizes.clear();
+                } else {
+                    ordered_sizes(g, triangles, &mut self.pixel_rng, &mut self.draw_sizes);
+                }
+                self.geom_next_triangle(now, s)
+            }
             Fidelity::Draw => {
                 let t = match d.closed {
                     Some(t) => t,
@@ -242,7 +251,9 @@ impl FramePipeline {
             at: now,
             by: Duration(u64::MAX),
         };
-        let fixed = fetch.and_then(|f| f.checked_add(geo.triangle_setup)).ok_or_else(overflow)?;
+        let fixed = fetch
+            .and_then(|f| f.checked_add(geo.triangle_setup))
+            .ok_or_else(overflow)?;
         let shader = geo.vertex_shader.checked_mul(tv).ok_or_else(overflow)?;
         self.geom_busy = true;
         if let Some(pool) = &mut self.pool {
@@ -268,7 +279,10 @@ impl FramePipeline {
             return Ok(());
         };
         let g = &sc.groups[sc.draws[draw as usize].group as usize];
-        let px = g.pixels.sample(&mut self.pixel_rng);
+        let px = match self.draw_sizes.get((a.next - 1) as usize) {
+            Some(&px) => px,
+            None => g.pixels.sample(&mut self.pixel_rng),
+        };
         let f = if self.pool.is_some() {
             FragWork {
                 shader: Duration::from_ps_f64(px * g.shade_per_pixel),
@@ -306,7 +320,10 @@ impl FramePipeline {
             pool.begin(now, Stream::Fragment, f.shader, f.fixed)?;
             return Ok(());
         }
-        s.at(now.add(f.shader, "fragments of a triangle")?, Ev::FragTriangle { tag: 0 });
+        s.at(
+            now.add(f.shader, "fragments of a triangle")?,
+            Ev::FragTriangle { tag: 0 },
+        );
         Ok(())
     }
 

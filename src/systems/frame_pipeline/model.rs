@@ -238,6 +238,9 @@ pub struct FramePipeline {
     pub(super) tri_fifo: BoundedFifo<FragWork>,
     /// The unified architecture's shader-core pool (`None`: split).
     pub(super) pool: Option<ShaderPool>,
+    /// The running draw's triangle sizes when its group sorts them
+    /// (`size_order`), in drawing order; empty otherwise.
+    pub(super) draw_sizes: Vec<f64>,
     pub(super) frag_busy: bool,
     pub(super) pixel_rng: StreamRng,
     /// The size stream's state at the start, restored every frame for a static view.
@@ -387,6 +390,7 @@ impl FramePipeline {
             draw_split: None,
             draw_fragment_limited: None,
             geom_held: None,
+            draw_sizes: Vec::new(),
             pool: match cfg.fidelity {
                 Fidelity::Triangle => cfg.gpu.pool().map(|(n, p)| ShaderPool::new(n, p)),
                 Fidelity::Draw => None,

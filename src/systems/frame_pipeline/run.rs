@@ -86,7 +86,9 @@ pub fn validate(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
             ),
         ));
     }
-    cfg.gpu.check_architecture().map_err(|(key, message)| bad(key, message))?;
+    cfg.gpu
+        .check_architecture()
+        .map_err(|(key, message)| bad(key, message))?;
     if cfg.cpu.max_frames_ahead == 0 {
         return Err(bad(
             "cpu.max_frames_ahead",

@@ -11,11 +11,11 @@ use std::path::Path;
 use crate::components::distribution::Dist;
 use crate::components::vertex_cache::CachePolicy;
 use crate::engine::Duration;
-use crate::scene::config::{DepthOrder, MeshRef, SceneWorkload, StateOrder};
+use crate::scene::config::{DepthOrder, MeshRef, SceneWorkload, SizeOrder, StateOrder};
 use crate::scene::generators::mesh_from_spec;
 use crate::scene::presets::{PRESETS, preset_groups};
 
-use super::closed_form::{DrawTimes, draw_times, draw_times_unified};
+use super::closed_form::{DrawTimes, draw_times, draw_times_unified, ordered_draw_total};
 use super::config::{Fidelity, FramePipelineConfig};
 
 /// Errors while building the workload.
@@ -99,6 +99,8 @@ pub struct GroupInfo {
     /// Expected fragment cost per covered pixel, picoseconds (early-z folded
     /// in): the fragment stage's time per pixel when split.
     pub cost_per_pixel: f64,
+    /// Order of the sizes within a draw.
+    pub order: SizeOrder,
     /// Unified: expected shader work per covered pixel (on the pool), ps.
     pub shade_per_pixel: f64,
     /// Unified: expected fixed-function time per covered pixel (depth test
@@ -201,6 +203,9 @@ fn add(a: Duration, b: Duration, key: &str) -> Result<Duration, WorkloadError> {
 /// fidelity), for the model's architecture.
 pub fn closed_times(cfg: &FramePipelineConfig, m: &MeshInfo, g: &GroupInfo) -> DrawTimes {
     let depth = cfg.gpu.fragment.depth();
+    if g.order != SizeOrder::Random {
+        return ordered_closed_times(cfg, m, g);
+    }
     if cfg.gpu.pool().is_none() {
         return draw_times(m.triangles, m.geometry_time, &g.pixels, g.cost_per_pixel, depth);
     }
@@ -213,6 +218,57 @@ pub fn closed_times(cfg: &FramePipelineConfig, m: &MeshInfo, g: &GroupInfo) -> D
         g.fixed_per_pixel,
         depth,
     )
+}
+
+/// Triangles a draw may have when its sizes are sorted (`size_order`): the
+/// sizes are held in memory for the draw (8 bytes each).
+pub const MAX_ORDERED_TRIANGLES: u64 = 1 << 24;
+
+/// The sorted sizes of one draw of `n` triangles from `g`'s distribution.
+pub fn ordered_sizes(g: &GroupInfo, n: u64, rng: &mut crate::engine::StreamRng, out: &mut Vec<f64>) {
+    out.clear();
+    out.extend((0..n).map(|_| g.pixels.sample(rng)));
+    out.sort_by(f64::total_cmp);
+    if g.order == SizeOrder::Descending {
+        out.reverse();
+    }
+}
+
+/// [`closed_times`] for sorted sizes: one sample of the draw's sizes (its
+/// own stream, so the same for every draw of the mesh), pushed through the
+/// exact pipeline recursion ([`ordered_draw_total`]); on the unified pool
+/// at least the draw's shader work.
+fn ordered_closed_times(cfg: &FramePipelineConfig, m: &MeshInfo, g: &GroupInfo) -> DrawTimes {
+    let n = m.triangles;
+    let mut rng = crate::engine::RngStreams::new(cfg.run.seed).stream("fragment.pixels.ordered");
+    let mut sizes = Vec::new();
+    ordered_sizes(g, n, &mut rng, &mut sizes);
+    let unified = cfg.gpu.pool().is_some();
+    let g_fixed = m.geometry_time.saturating_sub(m.geometry_shader);
+    let per_triangle = if unified {
+        m.geometry_shader.max(g_fixed).0 as f64 / n.max(1) as f64
+    } else {
+        m.geometry_time.0 as f64 / n.max(1) as f64
+    };
+    let per_pixel = if unified {
+        g.shade_per_pixel.max(g.fixed_per_pixel)
+    } else {
+        g.cost_per_pixel
+    };
+    let geometry = vec![per_triangle; sizes.len()];
+    let fragment: Vec<f64> = sizes.iter().map(|px| px * per_pixel).collect();
+    let mut total = ordered_draw_total(&geometry, &fragment, cfg.gpu.fragment.depth());
+    if unified {
+        let shader = m.geometry_shader.0 as f64 + sizes.iter().sum::<f64>() * g.shade_per_pixel;
+        total = total.max(shader);
+    }
+    let geometry = Duration::from_ps_f64(per_triangle * n as f64);
+    let fragment = Duration::from_ps_f64(fragment.iter().sum());
+    DrawTimes {
+        geometry,
+        fragment,
+        total: Duration::from_ps_f64(total).max(geometry).max(fragment),
+    }
 }
 
 /// Compiles the scene workload of `cfg`.
@@ -299,12 +355,22 @@ pub fn compile_scene(
                 id
             }
         };
+        if g.size_order != SizeOrder::Random && meshes[mesh_id as usize].triangles > MAX_ORDERED_TRIANGLES {
+            return Err(invalid(
+                format!("{key}.size_order"),
+                format!(
+                    "sorting a draw's sizes holds them in memory: at most {MAX_ORDERED_TRIANGLES} triangles per draw, the mesh has {}",
+                    meshes[mesh_id as usize].triangles
+                ),
+            ));
+        }
         groups.push(GroupInfo {
             name: g.name.clone(),
             pixels: g.triangle_pixels.clone(),
             cost_per_pixel,
             shade_per_pixel,
             fixed_per_pixel,
+            order: g.size_order,
         });
         for i in 0..g.count {
             objects.push(Instance {
