@@ -95,7 +95,7 @@ impl From<&IsolateArgs> for Overrides {
 pub struct VcacheArgs {
     /// Mesh: grid:WxH[:shuffled:SEED|:optimized], strip:WxH, random:T:V:SEED, FILE.obj, FILE.idx.
     pub mesh: String,
-    /// Cache policy: none, fifo:N, lru:N, meshopt:CACHE,WARP,PRIMGROUP, batch:V,T, direct:SLOTS,SEGMENT, lavapipe.
+    /// Cache policy: none, fifo:N, lru:N, meshopt:CACHE,WARP,PRIMGROUP, batch:V,T, direct:SLOTS,SEGMENT, lookback:V,T,WINDOW, lavapipe, nvidia.
     #[arg(long, value_parser = Plain::new(parse_policy))]
     pub policy: CachePolicy,
     /// Print JSON.

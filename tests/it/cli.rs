@@ -343,6 +343,20 @@ fn vcache_reports_the_figure_keys() {
     assert!(e.contains("lfu"), "{e}");
 }
 
+#[test]
+fn vcache_nvidia_on_an_icosphere_measured_on_the_h200() {
+    // docs/measurements/nvidia-h200/vertex-reuse.csv: 72,960 invocations.
+    let path = format!(
+        "{}/docs/measurements/nvidia-h200/corpus/ico6-ordered.idx",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = run_ok(&["vcache", &path, "--policy", "nvidia", "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["policy"], "nvidia");
+    assert_eq!(v["transformed"], 72_960);
+    assert_eq!(v["unique_vertices"], 40_962);
+}
+
 /// Paths of JSON nulls (NaN is written as null) in `v`.
 fn nulls(v: &serde_json::Value, path: &str, out: &mut Vec<String>) {
     match v {

@@ -123,6 +123,91 @@ fn policy_string_errors() {
 }
 
 #[test]
+fn lookback_and_nvidia_strings() {
+    for s in ["lookback:32,32,42", "lookback:3,1,1", "nvidia"] {
+        let p: CachePolicy = s.parse().unwrap();
+        assert_eq!(p.to_string(), s);
+    }
+    assert_eq!(
+        " Lookback: 32, 32 ,42 ".parse::<CachePolicy>(),
+        Ok(CachePolicy::Lookback {
+            vertices: 32,
+            triangles: 32,
+            window: 42
+        })
+    );
+    assert_eq!("NVIDIA".parse::<CachePolicy>(), Ok(CachePolicy::Nvidia));
+    let e = |s: &str| s.parse::<CachePolicy>().unwrap_err().to_string();
+    assert!(e("nvidia:3").contains("`nvidia` takes no size"), "{}", e("nvidia:3"));
+    assert!(e("lookback").contains("needs a size"), "{}", e("lookback"));
+    assert!(e("lookback:32,32").contains("lookback:VERTICES,TRIANGLES,WINDOW"));
+    assert!(e("lookback:32,32,42,1").contains("lookback:VERTICES,TRIANGLES,WINDOW"));
+    assert!(e("lookback:2,32,42").contains("VERTICES must be at least 3"));
+    assert!(e("lookback:32,0,42").contains("at least 1"));
+    assert!(e("lookback:32,32,0").contains("at least 1"));
+    assert!(e("lookback:32,x,42").contains("`x`"), "{}", e("lookback:32,x,42"));
+    assert!(e("lfu:3").contains("`nvidia`"), "{}", e("lfu:3"));
+}
+
+/// Misses per triangle and batches under `policy`.
+fn per_triangle(policy: &CachePolicy, tris: &[[u32; 3]]) -> (Vec<u8>, u64) {
+    let mut c = VertexCache::new(policy, 0);
+    let m = tris.iter().map(|&t| c.access_triangle(t)).collect();
+    (m, c.warps())
+}
+
+#[test]
+fn lookback_hand_worked() {
+    // lookback:6,4,4. T0 (positions 0-2): 3 misses, 3 vertices shaded.
+    // T1 (3-5): 2 and 1 were read 1 and 3 indices ago, 3 is new: 1 miss.
+    // T2 (6-8): 0 was read 6 indices ago, beyond the window of 4, so it is
+    // shaded again although the batch holds it; 3 hits; 4 new: 2 misses,
+    // 6 vertices. T3 (9-11): 4 and 3 hit but 5 does not fit (7 > 6): a new
+    // batch begins and all three are shaded.
+    let p: CachePolicy = "lookback:6,4,4".parse().unwrap();
+    let tris = [[0, 1, 2], [2, 1, 3], [0, 3, 4], [4, 3, 5]];
+    assert_eq!(per_triangle(&p, &tris), (vec![3, 1, 2, 3], 2));
+    // With a window as long as the batch, 0 is reused in T2 and T3 fits.
+    let whole: CachePolicy = "lookback:6,4,12".parse().unwrap();
+    assert_eq!(per_triangle(&whole, &tris), (vec![3, 1, 1, 1], 1));
+    // The triangle limit: a fifth triangle starts a new batch.
+    let mut five = tris.to_vec();
+    five.push([5, 4, 3]);
+    assert_eq!(per_triangle(&whole, &five), (vec![3, 1, 1, 1, 3], 2));
+}
+
+#[test]
+fn lookback_repeats_inside_a_triangle_are_shaded_once() {
+    let p: CachePolicy = "lookback:3,32,1".parse().unwrap();
+    // 0 0 1: two vertices; 1 1 1: one (1 was read 1 index ago); 2 0 2: 0 is
+    // beyond the window, 2 is repeated inside the triangle.
+    assert_eq!(per_triangle(&p, &[[0, 0, 1], [1, 1, 1], [2, 0, 2]]), (vec![2, 0, 2], 2));
+}
+
+#[test]
+fn lookback_reset_and_single_indices() {
+    let p = CachePolicy::Nvidia;
+    let mut c = VertexCache::new(&p, 0);
+    assert!(c.is_triangle_level());
+    assert_eq!(c.access_triangle([0, 1, 2]), 3);
+    assert_eq!(c.access_triangle([2, 1, 0]), 0);
+    c.reset();
+    assert_eq!(c.access_triangle([2, 1, 0]), 3);
+    assert_eq!(c.warps(), 2);
+    // Single indices: a window of 42 indices, no batch limits; huge ids too.
+    let mut c = VertexCache::new(&p, 0);
+    assert!(c.access(u32::MAX - 1));
+    for i in 0..41 {
+        assert!(c.access(i));
+    }
+    assert!(!c.access(u32::MAX - 1), "read 42 indices ago");
+    for i in 100..142 {
+        assert!(c.access(i));
+    }
+    assert!(c.access(u32::MAX - 1), "read 43 indices ago");
+}
+
+#[test]
 fn policy_serde_as_string() {
     #[derive(Serialize, Deserialize, PartialEq, Debug)]
     struct H {
@@ -158,6 +243,17 @@ proptest! {
     #[test]
     fn lru_matches_naive(n in 1usize..12, seq in prop::collection::vec(0u32..40, 0..300)) {
         prop_assert_eq!(misses(&CachePolicy::Lru(n as u32), &seq), lru_ref(n, &seq));
+    }
+
+    /// With a window covering a whole batch (3 indices per triangle), and
+    /// no vertex repeated inside a triangle, `lookback:V,T,3T` is `batch:V,T`.
+    #[test]
+    fn long_lookback_is_batch(v in 3u32..40, t in 1u32..40,
+                              raw in prop::collection::vec((0u32..60, 1u32..60, 1u32..60), 0..200)) {
+        let tris: Vec<[u32; 3]> = raw.iter().map(|&(a, b, c)| [a, a + b, a + b + c]).collect();
+        let lookback = CachePolicy::Lookback { vertices: v, triangles: t, window: 3 * t };
+        let batch = CachePolicy::Batch { vertices: v, triangles: t };
+        prop_assert_eq!(per_triangle(&lookback, &tris), per_triangle(&batch, &tris));
     }
 
     #[test]
