@@ -66,11 +66,14 @@ done
 
 step "Studies H1-H4 on this machine's adapter (H1 must predict its validation meshes exactly)"
 if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
-  if ! "$RENDERSIM_BIN" study all --markdown "$ci_out/studies.md" > "$ci_out/studies.txt" 2> "$ci_out/studies.err"; then
+  # --require-exact: on lavapipe an inexact H1 is a regression, not a finding.
+  if ! "$RENDERSIM_BIN" study all --require-exact --markdown "$ci_out/studies.md" --csv "$ci_out/study-passes.csv" \
+      > "$ci_out/studies.txt" 2> "$ci_out/studies.err"; then
     cat "$ci_out/studies.txt" "$ci_out/studies.err"
     exit 1
   fi
   head -n 4 "$ci_out/studies.txt"
+  echo "$(($(wc -l < "$ci_out/study-passes.csv") - 1)) measured passes in the pass CSV"
 else
   echo "no Vulkan driver installed: studies skipped"
 fi
@@ -88,6 +91,10 @@ for nb in notebooks/*.ipynb; do
   echo "-- $nb"
   .venv/bin/jupyter execute "$nb"
 done
+
+step "Device script: bash -n, and its dry run lists the commands"
+bash -n scripts/device-studies.sh
+DRY_RUN=1 bash scripts/device-studies.sh collect "$ci_out/device" | tail -n 3
 
 step "Benchmarks (quick scale, printed for the log)"
 "$RENDERSIM_BIN" bench all --scale 0.05

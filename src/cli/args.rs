@@ -139,6 +139,10 @@ pub struct MeasureArgs {
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
+    /// Append the pass as a row to FILE (header `mesh,size,vs_loops,...,pass_time_ns`,
+    /// written when FILE is new or empty; a file with another header is refused).
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
 }
 
 #[cfg(feature = "wgpu")]
@@ -175,6 +179,15 @@ pub struct StudyArgs {
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
+    /// Append every pass the studies measured to FILE, one row per distinct
+    /// pass (as `measure --csv`; H1's probes and layered passes are left out).
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
+    /// Fail (exit status 2) when H1's fitted policy does not predict every
+    /// validation mesh exactly; without it that is a finding, printed with
+    /// its residuals, and the exit status is 0. For CI on lavapipe.
+    #[arg(long)]
+    pub require_exact: bool,
 }
 
 /// `rendersim bench`.

@@ -7,6 +7,7 @@ use wgpu::util::DeviceExt;
 use crate::scene::mesh::Mesh;
 
 use super::geometry::{DepthOrder, mesh_positions};
+use super::passes::{PassRow, pool};
 
 /// Errors of a measurement.
 #[derive(Debug, thiserror::Error)]
@@ -130,6 +131,22 @@ pub struct Gpu {
     queue: wgpu::Queue,
     /// The adapter that measures.
     pub adapter: AdapterSummary,
+    /// Every pass measured on this device: its row and recorded pass times,
+    /// or `None` for a pass the pass CSV cannot describe.
+    log: std::sync::Mutex<Vec<Option<LoggedPass>>>,
+}
+
+/// A pass's row and its recorded pass times.
+type LoggedPass = (PassRow, Vec<f64>);
+
+/// The passes one [`Gpu`] measured, for `--csv`.
+#[derive(Debug, Clone)]
+pub struct MeasuredPasses {
+    /// One row per distinct pass (times of repeated measurements pooled).
+    pub rows: Vec<PassRow>,
+    /// Measurements left out: layered or depth-tested passes, and meshes no
+    /// spec names (H1's probes).
+    pub left_out: usize,
 }
 
 impl Gpu {
@@ -178,7 +195,18 @@ impl Gpu {
             device,
             queue,
             adapter: summary,
+            log: std::sync::Mutex::new(Vec::new()),
         })
+    }
+
+    /// Every pass measured so far, one row per distinct pass, in the order
+    /// each was first measured (see [`super::passes::pool`]).
+    pub fn measured_passes(&self) -> MeasuredPasses {
+        let log = self.log.lock().unwrap_or_else(|e| e.into_inner());
+        MeasuredPasses {
+            rows: pool(log.iter().flatten().cloned()),
+            left_out: log.iter().filter(|p| p.is_none()).count(),
+        }
     }
 
     /// One line naming the adapter: name (driver, driver info, device type).
@@ -199,8 +227,16 @@ pub fn measure(mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measure
 }
 
 impl Gpu {
-    /// Draws `mesh` on this device and measures it.
+    /// Draws `mesh` on this device and measures it; the pass is kept for
+    /// [`Gpu::measured_passes`].
     pub fn measure(&self, mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measurement, MeasureError> {
+        let r = self.draw(mesh, spec, opts)?;
+        let row = PassRow::from_measurement(spec, &r).map(|row| (row, r.pass_times_ns.clone()));
+        self.log.lock().unwrap_or_else(|e| e.into_inner()).push(row);
+        Ok(r)
+    }
+
+    fn draw(&self, mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measurement, MeasureError> {
         if opts.layers == 0 || opts.repeats == 0 || opts.size.0 == 0 || opts.size.1 == 0 {
             return Err(MeasureError::Option(
                 "layers, repeats and size must be at least 1".into(),

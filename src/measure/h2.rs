@@ -24,6 +24,7 @@
 use serde::Serialize;
 
 use super::fit::rel_error_pct;
+use super::loops::LoopSearch;
 use super::predict::{PassModel, PredictError, duration_ps, simulate_pass};
 
 /// What H2 draws.
@@ -47,6 +48,10 @@ pub struct H2Setup {
     /// reaches G(complex), where sum and max differ most. Any device then
     /// gets a balanced, measurable 2x2.
     pub auto_target_ms: Option<f64>,
+    /// Where the vertex shader's loop search ended (set by the search).
+    pub vs_search: Option<LoopSearch>,
+    /// Where the fragment shader's loop search ended (set by the search).
+    pub fs_search: Option<LoopSearch>,
 }
 
 impl Default for H2Setup {
@@ -59,6 +64,8 @@ impl Default for H2Setup {
             cache: "lavapipe".into(),
             fifo_depth: 16,
             auto_target_ms: Some(15.0),
+            vs_search: None,
+            fs_search: None,
         }
     }
 }
@@ -243,15 +250,23 @@ impl H2 {
         self.scores.first().map_or("none", |s| s.hypothesis.as_str())
     }
 
-    /// One line: the best hypothesis and its error.
+    /// One line: the best hypothesis and its error (and a loop search that
+    /// fell short).
     pub fn verdict(&self) -> String {
-        match self.scores.first() {
+        let mut v = match self.scores.first() {
             Some(b) => format!(
                 "sum vs max: **{}** fits best ({:.1}% mean error on the test cells)",
                 b.hypothesis, b.mean_abs_error_pct
             ),
             None => "sum vs max: no hypothesis scored".into(),
+        };
+        let s = &self.setup;
+        for (shader, search) in [("vertex", &s.vs_search), ("fragment", &s.fs_search)] {
+            if let Some(f) = search.filter(|f| !f.reached()) {
+                v += &format!("; {shader} shader loop search {}", f.shortfall());
+            }
         }
+        v
     }
 
     /// The result as a Markdown section.
@@ -274,12 +289,14 @@ impl H2 {
             s.vs_loops[1],
             s.fs_loops[0],
             s.fs_loops[1],
-            match s.auto_target_ms {
-                Some(t) => format!(
-                    "The complex loop counts were found on this device: the vertex shader's so that geometry alone takes at least {t} ms, \
-                     then the fragment shader's so that F(complex) reaches G(complex), where sum and max differ most. "
+            match (&s.vs_search, &s.fs_search) {
+                (Some(v), Some(f)) => format!(
+                    "The complex loop counts were searched on this device: the vertex shader's, {}; \
+                     then the fragment shader's so that F(complex) reaches G(complex), where sum and max differ most, {}. ",
+                    v.describe("geometry alone"),
+                    f.describe("F(complex)")
                 ),
-                None => String::new(),
+                _ => String::new(),
             },
             m.overhead_ns / 1e6,
             self.geometry_ms[0],
@@ -386,6 +403,45 @@ mod tests {
         );
         assert!((r.vs_increase_ms[0] - r.vs_increase_ms[1]).abs() < 1e-9);
         assert!(r.markdown().contains("Best: **"));
+    }
+
+    #[test]
+    fn the_loop_search_is_reported_as_measured_and_a_shortfall_in_the_verdict() {
+        let found = |loops, target_ms, reached_ms| LoopSearch {
+            target_ms,
+            loops,
+            reached_ms,
+            tries: 3,
+        };
+        let s = H2Setup {
+            vs_search: Some(found(67390, 15.0, 19.01)),
+            fs_search: Some(found(7681, 19.01, 22.84)),
+            ..setup()
+        };
+        let r = analyze(s, measured(|a, b| a + b), 0.0).unwrap();
+        let md = r.markdown();
+        assert!(
+            md.contains("the vertex shader's, 67390 loops (geometry alone took 19.01 ms there, target at least 15 ms)"),
+            "{md}"
+        );
+        assert!(
+            md.contains("7681 loops (F(complex) took 22.84 ms there, target at least 19.01 ms)"),
+            "{md}"
+        );
+        assert!(!r.verdict().contains("fell short"));
+        let s = H2Setup {
+            vs_search: Some(found(4194304, 15.0, 3.5)),
+            fs_search: Some(found(10, 3.5, 3.6)),
+            ..setup()
+        };
+        let r = analyze(s, measured(|a, b| a + b), 0.0).unwrap();
+        assert!(
+            r.verdict()
+                .contains("vertex shader loop search fell short: reached 3.5 ms at 4194304 loops (target 15 ms)"),
+            "{}",
+            r.verdict()
+        );
+        assert!(r.markdown().contains("fell short: reached 3.5 ms at 4194304 loops"));
     }
 
     #[test]

@@ -20,6 +20,7 @@ use serde::Serialize;
 
 use super::fit::rel_error_pct;
 use super::geometry::DepthOrder;
+use super::loops::LoopSearch;
 use super::predict::{PassModel, PredictError, duration_ps, simulate_pass};
 use crate::engine::Duration;
 
@@ -39,6 +40,8 @@ pub struct H3Setup {
     /// When set, the fragment loop count is found on the device before
     /// measuring, so that shading one layer takes at least this long (ms).
     pub auto_target_ms: Option<f64>,
+    /// Where the fragment shader's loop search ended (set by the search).
+    pub fs_search: Option<LoopSearch>,
 }
 
 impl Default for H3Setup {
@@ -50,6 +53,7 @@ impl Default for H3Setup {
             fs_loops: 40,
             cache: "lavapipe".into(),
             auto_target_ms: Some(5.0),
+            fs_search: None,
         }
     }
 }
@@ -214,12 +218,17 @@ impl H3 {
         e.iter().sum::<f64>() / e.len().max(1) as f64
     }
 
-    /// One line: how well the calibrated costs predict the other orders.
+    /// One line: how well the calibrated costs predict the other orders
+    /// (and a loop search that fell short).
     pub fn verdict(&self) -> String {
-        format!(
+        let mut v = format!(
             "draw order: calibrated early-z costs predict the other orders within {:.1}% (mean)",
             self.prediction_error_pct()
-        )
+        );
+        if let Some(f) = self.setup.fs_search.filter(|f| !f.reached()) {
+            v += &format!("; fragment shader loop search {}", f.shortfall());
+        }
+        v
     }
 
     /// The result as a Markdown section.
@@ -238,8 +247,9 @@ impl H3 {
             s.size.0,
             s.size.1,
             s.fs_loops,
-            s.auto_target_ms.map_or(String::new(), |t| format!(
-                " (found on this device: shading one layer takes at least {t} ms)"
+            s.fs_search.map_or(String::new(), |f| format!(
+                " (searched on this device: {})",
+                f.outcome("shading one layer")
             )),
             m.one_layer.time_ns / 1e6,
             m.one_layer.fs_invocations,

@@ -14,6 +14,7 @@
 use serde::Serialize;
 
 use super::fit::{LineFit, fit_line, leave_one_out, rel_error_pct};
+use super::loops::LoopSearch;
 
 /// What H4 draws.
 #[derive(Debug, Clone, Serialize)]
@@ -30,6 +31,8 @@ pub struct H4Setup {
     /// measuring, so that the geometry-only pass of the cache-optimized order
     /// takes at least this long (ms).
     pub auto_target_ms: Option<f64>,
+    /// Where the vertex shader's loop search ended (set by the search).
+    pub vs_search: Option<LoopSearch>,
 }
 
 impl Default for H4Setup {
@@ -40,6 +43,7 @@ impl Default for H4Setup {
             vs_loops: 300,
             cache: "lavapipe".into(),
             auto_target_ms: Some(10.0),
+            vs_search: None,
         }
     }
 }
@@ -148,8 +152,17 @@ pub fn analyze(setup: H4Setup, mut rows: Vec<H4Row>, measure_seconds: f64, simul
 }
 
 impl H4 {
-    /// One line: the cost per transformed vertex, alone and in full passes.
+    /// One line: the cost per transformed vertex, alone and in full passes
+    /// (and a loop search that fell short).
     pub fn verdict(&self) -> String {
+        let mut v = self.fit_verdict();
+        if let Some(f) = self.setup.vs_search.filter(|f| !f.reached()) {
+            v += &format!("; vertex shader loop search {}", f.shortfall());
+        }
+        v
+    }
+
+    fn fit_verdict(&self) -> String {
         match (&self.geometry_fit, &self.fit) {
             (Some(g), Some(f)) => format!(
                 "cost per transformed vertex: {:.1} ns alone (R^2 {:.3}, leave-one-out error {:.1}%), \
@@ -187,8 +200,9 @@ impl H4 {
             s.size.0,
             s.size.1,
             s.vs_loops,
-            s.auto_target_ms.map_or(String::new(), |t| format!(
-                " (found on this device: the cache-optimized order's geometry takes at least {t} ms)"
+            s.vs_search.map_or(String::new(), |f| format!(
+                " (searched on this device: {})",
+                f.outcome("the cache-optimized order's geometry-only pass")
             )),
             line(&self.geometry_fit),
             line(&self.fit),
@@ -249,6 +263,57 @@ mod tests {
         assert!(
             md.contains("2000.0 ns per invocation") && md.contains("1000.0 ns per invocation"),
             "{md}"
+        );
+    }
+
+    #[test]
+    fn the_loop_search_reports_the_time_it_measured_or_its_shortfall() {
+        let rows = |setup: H4Setup| {
+            let rows = [1000u64, 2000, 3000]
+                .iter()
+                .map(|&vs| H4Row {
+                    mesh: "m".into(),
+                    measured_vs: vs,
+                    simulated_vs: vs,
+                    fs_invocations: 0,
+                    geometry_ms: 0.001 * vs as f64,
+                    measured_ms: 0.001 * vs as f64,
+                    predicted_geometry_ms: None,
+                    predicted_ms: None,
+                })
+                .collect();
+            analyze(setup, rows, 0.0, 0.0)
+        };
+        let search = |loops, reached_ms| LoopSearch {
+            target_ms: 10.0,
+            loops,
+            reached_ms,
+            tries: 2,
+        };
+        let h = rows(H4Setup {
+            vs_loops: 23530,
+            vs_search: Some(search(23530, 11.4)),
+            ..H4Setup::default()
+        });
+        let md = h.markdown();
+        assert!(md.contains("vertex shader 23530 loop iterations"), "{md}");
+        assert!(
+            md.contains(
+                "vertex shader 23530 loop iterations (searched on this device: the cache-optimized order's \
+                 geometry-only pass took 11.4 ms there, target at least 10 ms)"
+            ),
+            "{md}"
+        );
+        assert!(!h.verdict().contains("fell short"));
+        let h = rows(H4Setup {
+            vs_search: Some(search(300, 0.153)),
+            ..H4Setup::default()
+        });
+        assert!(
+            h.verdict()
+                .ends_with("; vertex shader loop search fell short: reached 0.153 ms at 300 loops (target 10 ms)"),
+            "{}",
+            h.verdict()
         );
     }
 

@@ -14,6 +14,10 @@
 //! - H3 (`h3.rs`): draw order and early-z, paper 000 §4.5.2 and Table 3;
 //! - H4 (`h4.rs`): cost per transformed vertex over index orders.
 //!
+//! Every measured pass can be written as a row of one CSV format
+//! (`passes.rs`; `measure --csv`, `study --csv`), and the loop counts the
+//! studies need are searched on the device by `loops.rs`.
+//!
 //! The analysis of each study (fits, predictions by the simulator, errors) is
 //! plain code compiled in every build and tested on synthetic measurements;
 //! only the parts that talk to a device need the `wgpu` feature.
@@ -24,6 +28,8 @@ pub mod fit;
 pub mod h2;
 pub mod h3;
 pub mod h4;
+pub mod loops;
+pub mod passes;
 pub mod predict;
 pub mod report;
 
@@ -36,5 +42,5 @@ pub mod h1;
 pub mod studies;
 
 #[cfg(feature = "wgpu")]
-pub use device::{AdapterSummary, Gpu, MeasureError, MeasureOptions, Measurement, measure};
+pub use device::{AdapterSummary, Gpu, MeasureError, MeasureOptions, MeasuredPasses, Measurement, measure};
 pub use geometry::{DepthOrder, UnknownDepthOrder, mesh_positions};

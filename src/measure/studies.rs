@@ -16,6 +16,7 @@ use super::h1;
 use super::h2::{self, H2, H2Measured, H2Setup};
 use super::h3::{self, H3, H3Measured, H3Pass, H3Setup};
 use super::h4::{self, H4, H4Row, H4Setup};
+use super::loops::search_loops;
 use super::predict::PredictError;
 use super::report::{StudySection, device_document};
 
@@ -79,38 +80,6 @@ fn interleaved(gpu: &Gpu, conds: &[Condition], rounds: u32) -> Result<Vec<Measur
         .collect())
 }
 
-/// The largest loop count any calibration tries.
-const MAX_LOOPS: u32 = 1 << 22;
-
-/// Finds a loop count whose `cost` (ns, roughly proportional to the loops)
-/// lies between `target_ns` and 1.5 times it: from `start`, rescale by
-/// target / cost (aiming 20% above the target), at most five tries, within
-/// 1..=[`MAX_LOOPS`]. Returns the last count tried.
-fn loops_for(
-    start: u32,
-    target_ns: f64,
-    mut cost: impl FnMut(u32) -> Result<f64, StudyError>,
-) -> Result<u32, StudyError> {
-    let mut loops = start.clamp(1, MAX_LOOPS);
-    for _ in 0..5 {
-        let c = cost(loops)?;
-        if c >= target_ns && c <= 1.5 * target_ns {
-            break;
-        }
-        let next = if c > 0.0 {
-            (f64::from(loops) * 1.2 * target_ns / c).ceil()
-        } else {
-            f64::from(loops) * 4.0
-        };
-        let next = next.clamp(1.0, f64::from(MAX_LOOPS)) as u32;
-        if next == loops {
-            break;
-        }
-        loops = next;
-    }
-    Ok(loops)
-}
-
 /// A short measurement (a warm-up, then the median of three passes), ns.
 fn quick(gpu: &Gpu, spec: &str, m: &Mesh, opts: MeasureOptions) -> Result<f64, StudyError> {
     Ok(interleaved(gpu, &[(spec, m, opts)], 3)?[0].pass_time_ns)
@@ -140,16 +109,18 @@ pub fn run_h2(gpu: &Gpu, mut setup: H2Setup, rounds: u32) -> Result<H2, StudyErr
         let [vs, _] = setup.vs_loops;
         let [fs, _] = setup.fs_loops;
         let geo_simple = quick(gpu, &spec, &grid, geometry_only(vs))?;
-        let vc = loops_for(setup.vs_loops[1], target * 1e6, |l| {
-            Ok(quick(gpu, &spec, &grid, geometry_only(l))? - geo_simple)
+        let vc = search_loops(setup.vs_loops[1], target * 1e6, |l| {
+            Ok::<_, StudyError>(quick(gpu, &spec, &grid, geometry_only(l))? - geo_simple)
         })?;
-        let g_complex = quick(gpu, &spec, &grid, geometry_only(vc))? - geo_simple;
+        // F(complex) aims at G(complex) as measured in the search.
         let frag_simple = quick(gpu, &spec, &grid, full(vs, fs))?;
-        let fc = loops_for(setup.fs_loops[1], g_complex, |l| {
-            Ok(quick(gpu, &spec, &grid, full(vs, l))? - frag_simple)
+        let fc = search_loops(setup.fs_loops[1], vc.reached_ms * 1e6, |l| {
+            Ok::<_, StudyError>(quick(gpu, &spec, &grid, full(vs, l))? - frag_simple)
         })?;
-        setup.vs_loops[1] = vc;
-        setup.fs_loops[1] = fc;
+        setup.vs_loops[1] = vc.loops;
+        setup.fs_loops[1] = fc.loops;
+        setup.vs_search = Some(vc);
+        setup.fs_search = Some(fc);
     }
     let [vs, vc] = setup.vs_loops;
     let [fs, fc] = setup.fs_loops;
@@ -192,9 +163,11 @@ pub fn run_h3(gpu: &Gpu, mut setup: H3Setup, rounds: u32) -> Result<H3, StudyErr
             ..MeasureOptions::default()
         };
         let plain = quick(gpu, &setup.mesh, &m, one(0))?;
-        setup.fs_loops = loops_for(setup.fs_loops, target * 1e6, |l| {
-            Ok(quick(gpu, &setup.mesh, &m, one(l))? - plain)
+        let found = search_loops(setup.fs_loops, target * 1e6, |l| {
+            Ok::<_, StudyError>(quick(gpu, &setup.mesh, &m, one(l))? - plain)
         })?;
+        setup.fs_loops = found.loops;
+        setup.fs_search = Some(found);
     }
     let base = MeasureOptions {
         size: setup.size,
@@ -232,7 +205,7 @@ pub fn run_h3(gpu: &Gpu, mut setup: H3Setup, rounds: u32) -> Result<H3, StudyErr
 }
 
 /// Measures and analyses H4 (cost per transformed vertex).
-pub fn run_h4(gpu: &Gpu, setup: H4Setup, rounds: u32) -> Result<H4, StudyError> {
+pub fn run_h4(gpu: &Gpu, mut setup: H4Setup, rounds: u32) -> Result<H4, StudyError> {
     let policy: crate::components::vertex_cache::CachePolicy = setup
         .cache
         .parse()
@@ -240,6 +213,20 @@ pub fn run_h4(gpu: &Gpu, setup: H4Setup, rounds: u32) -> Result<H4, StudyError> 
     let specs = setup.orders();
     let meshes: Vec<Mesh> = specs.iter().map(|s| mesh(s)).collect::<Result<_, _>>()?;
     let t = Instant::now();
+    if let Some(target) = setup.auto_target_ms {
+        // The cache-optimized order's geometry-only pass, as a whole.
+        let geometry = |vs_loops| MeasureOptions {
+            size: setup.size,
+            vs_loops,
+            geometry_only: true,
+            ..MeasureOptions::default()
+        };
+        let found = search_loops(setup.vs_loops, target * 1e6, |l| {
+            quick(gpu, &specs[0], &meshes[0], geometry(l))
+        })?;
+        setup.vs_loops = found.loops;
+        setup.vs_search = Some(found);
+    }
     let opts = |geometry_only| MeasureOptions {
         size: setup.size,
         vs_loops: setup.vs_loops,
@@ -297,9 +284,40 @@ pub struct StudiesRun {
     pub json: serde_json::Map<String, serde_json::Value>,
     /// The per-device Markdown document.
     pub document: String,
-    /// H1's chosen policy when it ran and did not predict every validation
-    /// mesh exactly (the one outcome that makes the command fail).
-    pub h1_inexact: Option<String>,
+    /// H1's chosen policy and its residuals when it ran and did not predict
+    /// every validation mesh exactly (a finding; `--require-exact` makes the
+    /// command fail on it).
+    pub h1_inexact: Option<H1Inexact>,
+}
+
+/// H1's fitted policy did not predict every validation mesh exactly.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct H1Inexact {
+    /// The chosen policy.
+    pub chosen: String,
+    /// Per validation mesh: spec, measured and predicted vertex-shader
+    /// invocations.
+    pub validation: Vec<(String, u64, u64)>,
+}
+
+impl H1Inexact {
+    /// The finding's lines: the policy, then one line per validation mesh
+    /// with its residual (predicted - measured).
+    pub fn describe(&self) -> String {
+        let width = self.validation.iter().map(|(m, _, _)| m.len()).max().unwrap_or(0);
+        let mut s = format!(
+            "H1: the fitted policy `{}` does not predict every validation mesh exactly; \
+             residuals (predicted - measured vertex-shader invocations):",
+            self.chosen
+        );
+        for (mesh, measured, predicted) in &self.validation {
+            s += &format!(
+                "\n  {mesh:<width$}  {:+7}  ({measured} measured, {predicted} predicted)",
+                *predicted as i64 - *measured as i64
+            );
+        }
+        s
+    }
 }
 
 fn to_json<T: serde::Serialize>(v: &T) -> serde_json::Value {
@@ -341,7 +359,14 @@ pub fn run_studies(
                     None => h1::h1(gpu, 1)?,
                 };
                 if !r.exact {
-                    h1_inexact = Some(r.chosen.clone());
+                    h1_inexact = Some(H1Inexact {
+                        chosen: r.chosen.clone(),
+                        validation: r
+                            .validation
+                            .iter()
+                            .map(|v| (v.mesh.clone(), v.measured, v.predicted))
+                            .collect(),
+                    });
                 }
                 (r.verdict(), r.markdown(), to_json(&r))
             }
@@ -395,4 +420,29 @@ pub fn run_studies(
         document,
         h1_inexact,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_inexact_h1_lists_every_validation_mesh_with_its_residual() {
+        let f = H1Inexact {
+            chosen: "meshopt:32,32,32".into(),
+            validation: vec![
+                ("grid:16x16".into(), 576, 576),
+                ("grid:48x48:optimized".into(), 3883, 3873),
+            ],
+        };
+        let text = f.describe();
+        assert!(
+            text.starts_with("H1: the fitted policy `meshopt:32,32,32` does not predict"),
+            "{text}"
+        );
+        let lines: Vec<Vec<&str>> = text.lines().skip(1).map(|l| l.split_whitespace().collect()).collect();
+        assert_eq!(lines.len(), 2, "{text}");
+        assert_eq!(lines[0][..3], ["grid:16x16", "+0", "(576"], "{text}");
+        assert_eq!(lines[1][..3], ["grid:48x48:optimized", "-10", "(3883"], "{text}");
+    }
 }

@@ -213,3 +213,161 @@ fn study_cli_rejects_unknown_names_and_zero_repeats() {
     let e = run(&["study", "h2", "--repeats", "0"]);
     assert!(e.contains("--repeats must be at least 1"), "{e}");
 }
+
+/// Runs the binary; `None` (and a SKIPPED line) when it reports that this
+/// machine has no Vulkan adapter.
+fn rendersim(args: &[&str]) -> Option<std::process::Output> {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+        .args(args)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    if err.contains("no Vulkan adapter found") {
+        eprintln!("SKIPPED: no Vulkan adapter on this machine ({})", err.trim());
+        return None;
+    }
+    Some(o)
+}
+
+#[test]
+fn measure_csv_appends_one_row_per_pass_and_the_header_once() {
+    use rendersim::measure::passes::{PASS_HEADER, read_passes};
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("passes.csv");
+    let csv_arg = csv.to_str().unwrap();
+    for fs_loops in ["0", "3"] {
+        let args = [
+            "measure",
+            "grid:8x8",
+            "--size",
+            "32x32",
+            "--repeats",
+            "1",
+            "--warmup",
+            "0",
+            "--fs-loops",
+            fs_loops,
+            "--csv",
+            csv_arg,
+        ];
+        let Some(o) = rendersim(&args) else { return };
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!(text.lines().next(), Some(PASS_HEADER), "{text}");
+    assert_eq!(text.matches(PASS_HEADER).count(), 1, "{text}");
+    let rows = read_passes(&csv).unwrap();
+    assert_eq!(rows.len(), 2, "{text}");
+    assert_eq!((rows[0].fs_loops, rows[1].fs_loops), (0, 3));
+    for r in &rows {
+        assert_eq!(r.mesh, "grid:8x8");
+        assert_eq!(r.size.to_string(), "32x32");
+        assert!(!r.geometry_only && r.vs_invocations > 0 && r.fs_invocations > 0 && r.pass_time_ns > 0.0);
+    }
+}
+
+#[test]
+fn csv_with_another_header_is_refused_untouched_before_measuring() {
+    // Refused before the adapter is opened: no device needed.
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("other.csv");
+    std::fs::write(&csv, "a,b\n1,2\n").unwrap();
+    for args in [
+        vec!["measure", "grid:4x4", "--csv", csv.to_str().unwrap()],
+        vec!["study", "h1", "--csv", csv.to_str().unwrap()],
+    ] {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(&format!("{} has the header \"a,b\"", csv.display())) && err.contains("mesh,size,vs_loops"),
+            "{err}"
+        );
+        assert_eq!(std::fs::read_to_string(&csv).unwrap(), "a,b\n1,2\n");
+    }
+    // A layered pass has no row in the format.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+        .args(["measure", "grid:4x4", "--layers", "2", "--csv", csv.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no column for layers"));
+}
+
+#[test]
+fn study_takes_require_exact_and_csv() {
+    let help = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+        .args(["study", "--help"])
+        .output()
+        .unwrap();
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(
+        help.contains("--require-exact") && help.contains("--csv <FILE>"),
+        "{help}"
+    );
+    // On an adapter whose reuse H1 predicts exactly (lavapipe) the flag
+    // passes; the validation meshes' passes are written, the probes are not.
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("h1.csv");
+    let Some(o) = rendersim(&[
+        "study",
+        "h1",
+        "--require-exact",
+        "--json",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]) else {
+        return;
+    };
+    let err = String::from_utf8_lossy(&o.stderr);
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let exact = json["h1"]["exact"].as_bool().unwrap();
+    assert_eq!(o.status.success(), exact, "{err}");
+    if !exact {
+        assert!(err.contains("residuals") && err.contains("--require-exact"), "{err}");
+    }
+    let rows = rendersim::measure::passes::read_passes(&csv).unwrap();
+    let validation = json["h1"]["validation"].as_array().unwrap();
+    assert_eq!(rows.len(), validation.len(), "{rows:?}");
+    for (r, v) in rows.iter().zip(validation) {
+        assert_eq!(r.mesh, v["mesh"].as_str().unwrap());
+        assert_eq!(r.vs_invocations, v["measured"].as_u64().unwrap());
+    }
+    assert!(err.contains("probes or of layered"), "{err}");
+}
+
+#[test]
+fn h4_searches_its_loop_count_and_reports_what_it_measured() {
+    use rendersim::measure::{h4::H4Setup, studies};
+    let Some(g) = gpu() else { return };
+    let h4 = studies::run_h4(
+        &g,
+        H4Setup {
+            grid: 16,
+            size: (64, 64),
+            vs_loops: 10,
+            auto_target_ms: Some(1.0),
+            ..H4Setup::default()
+        },
+        1,
+    )
+    .unwrap();
+    let found = h4.setup.vs_search.expect("H4 searched its loop count");
+    assert_eq!(found.loops, h4.setup.vs_loops);
+    assert!(found.tries >= 1 && found.reached_ms > 0.0, "{found:?}");
+    let md = h4.markdown();
+    assert!(
+        md.contains(&format!("vertex shader {} loop iterations", found.loops)),
+        "{md}"
+    );
+    assert!(
+        md.contains(&found.outcome("the cache-optimized order's geometry-only pass")),
+        "{md}"
+    );
+    // The search's passes are kept for --csv, one row per distinct pass.
+    let passes = g.measured_passes();
+    assert!(passes.rows.iter().any(|r| r.vs_loops == found.loops && r.geometry_only));
+}
