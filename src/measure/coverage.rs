@@ -124,12 +124,12 @@ pub fn coverage(mesh: &Mesh, spec: &str, width: u32, height: u32) -> Coverage {
                 frags += u64::from(s.1 - s.0 + 1);
             }
             let q = |s: (u32, u32)| (s.0 / 2, s.1 / 2);
-            let ranges: Vec<(u32, u32)> = match (a.map(q), b.map(q)) {
-                (Some(x), Some(y)) if x.0 <= y.1 && y.0 <= x.1 => vec![(x.0.min(y.0), x.1.max(y.1))],
-                (x, y) => x.into_iter().chain(y).collect(),
+            let ranges: [Option<(u32, u32)>; 2] = match (a.map(q), b.map(q)) {
+                (Some(x), Some(y)) if x.0 <= y.1 && y.0 <= x.1 => [Some((x.0.min(y.0), x.1.max(y.1))), None],
+                (x, y) => [x, y],
             };
             let trow = (qr as u32 / tile_quads) * tiles_x;
-            for (q0, q1) in ranges {
+            for (q0, q1) in ranges.into_iter().flatten() {
                 quads += u64::from(q1 - q0 + 1);
                 let mut s = q0;
                 while s <= q1 {

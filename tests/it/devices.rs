@@ -12,7 +12,9 @@ use rendersim::measure::calibrate::{
 use rendersim::measure::device_profile::{DeviceCosts, DeviceProfile};
 
 fn h200(file: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/measurements/nvidia-h200").join(file)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("docs/measurements/nvidia-h200")
+        .join(file)
 }
 
 fn bin() -> Command {
@@ -42,7 +44,14 @@ fn calibrate_recovers_known_costs_from_synthetic_passes() {
     let (mut loads, mut y) = (Vec::new(), Vec::new());
     for mesh in ["grid:16x16", "grid:48x48", "grid:32x32:shuffled:3", "strip:24x24"] {
         for size in [64, 256, 1024] {
-            for (vs, fs, geo) in [(0, 0, false), (2000, 0, false), (0, 300, false), (500, 100, false), (0, 0, true), (20000, 0, true)] {
+            for (vs, fs, geo) in [
+                (0, 0, false),
+                (2000, 0, false),
+                (0, 300, false),
+                (500, 100, false),
+                (0, 0, true),
+                (20000, 0, true),
+            ] {
                 let row = PassRow {
                     mesh: mesh.into(),
                     width: size,
@@ -66,7 +75,11 @@ fn calibrate_recovers_known_costs_from_synthetic_passes() {
         assert!((got - want).abs() <= 0.01 * want, "{k}: fitted {got}, true {want}");
     }
     assert!(f.objective < 1e-12, "{}", f.objective);
-    assert!(f.std_errors.iter().all(|(_, s)| s.is_finite() && *s < 1e-3), "{:?}", f.std_errors);
+    assert!(
+        f.std_errors.iter().all(|(_, s)| s.is_finite() && *s < 1e-3),
+        "{:?}",
+        f.std_errors
+    );
 }
 
 #[test]
@@ -97,15 +110,26 @@ fn calibrate_and_predict_through_the_command_line() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("devices/h200.toml");
     let o = bin()
-        .args(["calibrate", h200("load-grid.csv").to_str().unwrap(), h200("load-sweep.csv").to_str().unwrap(), "--out"])
+        .args([
+            "calibrate",
+            h200("load-grid.csv").to_str().unwrap(),
+            h200("load-sweep.csv").to_str().unwrap(),
+            "--out",
+        ])
         .arg(&out)
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{stdout}{}", String::from_utf8_lossy(&o.stderr));
-    assert!(stdout.contains("lane_per_loop_ns") && stdout.contains("median"), "{stdout}");
+    assert!(
+        stdout.contains("lane_per_loop_ns") && stdout.contains("median"),
+        "{stdout}"
+    );
     let text = std::fs::read_to_string(&out).unwrap();
-    assert!(text.starts_with("# Device profile h200") && text.contains("Rows: 95"), "{text}");
+    assert!(
+        text.starts_with("# Device profile h200") && text.contains("Rows: 95"),
+        "{text}"
+    );
     let profile = DeviceProfile::read(&out).unwrap();
     assert_eq!(profile.fit.rows, 95);
 
@@ -158,6 +182,11 @@ fn calibrate_and_predict_through_the_command_line() {
     assert!(e.contains("bad.toml") && e.contains("vertex_nanos"), "{e}");
     let csv = d.path().join("rows.csv");
     std::fs::write(&csv, "mesh,size\n").unwrap();
-    let e = err(&["calibrate", csv.to_str().unwrap(), "--out", d.path().join("x.toml").to_str().unwrap()]);
+    let e = err(&[
+        "calibrate",
+        csv.to_str().unwrap(),
+        "--out",
+        d.path().join("x.toml").to_str().unwrap(),
+    ]);
     assert!(e.contains("rows.csv:1"), "{e}");
 }
