@@ -8,7 +8,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use cli::args::{BenchArgs, ExperimentArgs, IsolateArgs, MeasureArgs, RunArgs, StudyArgs, VcacheArgs};
+use cli::args::{
+    BenchArgs, CalibrateArgs, ExperimentArgs, IsolateArgs, MeasureArgs, PredictArgs, RunArgs, StudyArgs, VcacheArgs,
+};
 use cli::commands::{self, ChecksFailed};
 
 #[derive(Parser)]
@@ -37,6 +39,10 @@ enum Cmd {
     /// Hypothesis studies against real measurements (build with `--features wgpu`):
     /// h1 vertex reuse, h2 sum vs max, h3 draw order, h4 cost per vertex, or all.
     Study(StudyArgs),
+    /// Fit a device profile (models/devices/NAME.toml) to measured passes (CSV).
+    Calibrate(CalibrateArgs),
+    /// Predict one pass on a calibrated device with the frame-pipeline model.
+    Predict(PredictArgs),
     /// Speed benchmarks, printed as ratios against baselines measured in the same run.
     Bench(BenchArgs),
 }
@@ -60,6 +66,8 @@ fn main() -> ExitCode {
         Cmd::Vcache(a) => commands::vcache(a),
         Cmd::Measure(a) => commands::measure(a),
         Cmd::Study(a) => commands::study(a),
+        Cmd::Calibrate(a) => commands::calibrate(a),
+        Cmd::Predict(a) => commands::predict(a),
         Cmd::Bench(a) => commands::bench(a),
     };
     match result {

@@ -162,6 +162,66 @@ impl From<&MeasureArgs> for rendersim::measure::MeasureOptions {
     }
 }
 
+/// `rendersim calibrate`.
+#[derive(Args)]
+pub struct CalibrateArgs {
+    /// Measured passes (CSV: mesh,size,vs_loops,fs_loops,geometry_only,vs_invocations,fs_invocations,pass_time_ns).
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+    /// Where to write the profile (TOML), e.g. models/devices/NAME.toml.
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Device name in the profile (default: the file name of --out).
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Vertex-cache policy predicting the device's vertex-shader invocations.
+    #[arg(long, value_parser = Plain::new(parse_policy), default_value = "meshopt:32,32,32")]
+    pub vertex_cache: CachePolicy,
+    /// Shader cores of the unified pool (the H200 has 132 SMs).
+    #[arg(long, default_value_t = 132)]
+    pub shader_cores: u32,
+    /// Also predict each row from a fit to the others (leave-one-out) and report it.
+    #[arg(long)]
+    pub loo: bool,
+    /// Print JSON instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `rendersim predict`.
+#[derive(Args)]
+pub struct PredictArgs {
+    /// Mesh spec (as for `measure`).
+    pub mesh: String,
+    /// Device profile (TOML) written by `rendersim calibrate`.
+    #[arg(long, value_name = "FILE")]
+    pub device: PathBuf,
+    /// Render target size, WxH.
+    #[arg(long, default_value = "512x512", value_parser = Plain::new(parse_size))]
+    pub size: Size,
+    /// Extra vertex-shader ALU loop iterations.
+    #[arg(long, default_value_t = 0)]
+    pub vs_loops: u32,
+    /// Extra fragment-shader ALU loop iterations.
+    #[arg(long, default_value_t = 0)]
+    pub fs_loops: u32,
+    /// Collapse every vertex to one point: no fragments.
+    #[arg(long)]
+    pub geometry_only: bool,
+    /// Copies of the mesh drawn.
+    #[arg(long, default_value_t = 1)]
+    pub layers: u32,
+    /// Depth order of the layers: front_to_back, back_to_front, random.
+    #[arg(long, default_value = "front_to_back", value_parser = Choice::<Order>::new(unknown_order))]
+    pub order: Order,
+    /// Early depth test on.
+    #[arg(long)]
+    pub depth_test: bool,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
 /// `rendersim study`.
 #[derive(Args)]
 #[cfg_attr(not(feature = "wgpu"), allow(dead_code))] // read only with the `wgpu` feature

@@ -14,8 +14,10 @@ use rendersim::output::text::fixed;
 use rendersim::output::trace::TraceWriter;
 use rendersim::systems::run_model;
 
-use super::args::{BenchArgs, ExperimentArgs, IsolateArgs, MeasureArgs, RunArgs, StudyArgs, VcacheArgs};
-use super::print;
+use super::args::{
+    BenchArgs, CalibrateArgs, ExperimentArgs, IsolateArgs, MeasureArgs, PredictArgs, RunArgs, StudyArgs, VcacheArgs,
+};
+use super::{device, print};
 
 /// An experiment ran, but some of its reference checks failed (exit
 /// status 1).
@@ -239,6 +241,16 @@ pub fn vcache(args: VcacheArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// `rendersim calibrate`.
+pub fn calibrate(args: CalibrateArgs) -> Result<()> {
+    device::calibrate(&args)
+}
+
+/// `rendersim predict`.
+pub fn predict(args: PredictArgs) -> Result<()> {
+    device::predict(&args)
 }
 
 /// `rendersim measure`.

@@ -1,8 +1,9 @@
 //! The `rendersim` command line behind `main.rs`: its arguments in clap's
 //! terms ([`args`]), what each command does ([`commands`]) and the lines it
-//! prints for benchmarks and measurements ([`print`]). All simulation logic
+//! prints for benchmarks and measurements ([`print`]), device profiles ([`device`]). All simulation logic
 //! lives in the library.
 
 pub mod args;
 pub mod commands;
+pub mod device;
 pub mod print;

@@ -22,8 +22,16 @@
 //! plain code compiled in every build and tested on synthetic measurements;
 //! only the parts that talk to a device need the `wgpu` feature.
 //!
+//! Device profiles (issue 10): `calibrate.rs` fits a `device_profile.rs`
+//! to measured passes (what they cover: `coverage.rs`), `device_predict.rs`
+//! runs one pass on it through the frame-pipeline model (`predict.rs`).
+//!
 //! What lavapipe's counters mean is noted in `docs/measurements/README.md`.
 
+pub mod calibrate;
+pub mod coverage;
+pub mod device_predict;
+pub mod device_profile;
 pub mod fit;
 pub mod h2;
 pub mod h3;

@@ -9,6 +9,7 @@ mod cli;
 mod common;
 mod conservation;
 mod determinism;
+mod devices;
 mod display_oracles;
 mod extreme;
 mod fuzz;

@@ -1,0 +1,238 @@
+//! `rendersim calibrate` and `rendersim predict`: device profiles fitted to
+//! measured passes and passes predicted on them (the library's
+//! `measure::calibrate`, `measure::device_profile`, `measure::device_predict`).
+
+use std::fmt::Write as _;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use serde_json::json;
+
+use rendersim::measure::calibrate::{
+    LoadCache, error_summary, fit, leave_one_out, linear_baseline_loo, read_rows, row_load,
+};
+use rendersim::measure::device_predict::{DevicePass, predict_on_device};
+use rendersim::measure::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy};
+use rendersim::measure::fit::rel_error_pct;
+
+use super::args::{CalibrateArgs, PredictArgs};
+
+/// Today's date (UTC), `YYYY-MM-DD`.
+fn today() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs())
+        .unwrap_or(0);
+    // Howard Hinnant's civil_from_days.
+    let z = (secs / 86_400) as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02}")
+}
+
+/// `rendersim calibrate`.
+pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
+    let mut rows = Vec::new();
+    for f in &args.files {
+        rows.extend(read_rows(f)?);
+    }
+    let start = Instant::now();
+    let mut cache = LoadCache::default();
+    let mut fit_loads = Vec::with_capacity(rows.len());
+    let mut predict_loads = Vec::with_capacity(rows.len());
+    for r in &rows {
+        fit_loads.push(row_load(r, &mut cache, None)?);
+        let v = cache.vertices(&r.mesh, &args.vertex_cache)?;
+        predict_loads.push(row_load(r, &mut cache, Some(v))?);
+    }
+    let y: Vec<f64> = rows.iter().map(|r| r.pass_time_ns).collect();
+    let f = fit(&fit_loads, &y)?;
+    let fit_seconds = start.elapsed().as_secs_f64();
+    let fitted: Vec<f64> = fit_loads.iter().map(|l| f.costs.cost(l).pass_ns).collect();
+    let errors: Vec<f64> = fitted.iter().zip(&y).map(|(p, m)| rel_error_pct(*p, *m)).collect();
+    let (median, p90, worst) = error_summary(&errors);
+    let loo = if args.loo {
+        let t = Instant::now();
+        let e = leave_one_out(&fit_loads, &predict_loads, &y)?;
+        let b = linear_baseline_loo(&predict_loads, &y);
+        Some((e, b, t.elapsed().as_secs_f64()))
+    } else {
+        None
+    };
+    let name = args.name.clone().unwrap_or_else(|| {
+        args.out
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "device".into())
+    });
+    let loo_summary = loo.as_ref().map(|(e, b, _)| (error_summary(e), error_summary(b)));
+    let profile = DeviceProfile {
+        device: DeviceInfo {
+            name: name.clone(),
+            vertex_cache: args.vertex_cache.to_string(),
+            shader_cores: args.shader_cores,
+        },
+        costs: f.costs,
+        uncertainty: f.std_errors.iter().cloned().collect(),
+        fit: FitAccuracy {
+            rows: rows.len(),
+            median_pct: median,
+            p90_pct: p90,
+            worst_pct: worst,
+            loo_median_pct: loo_summary.map(|s| s.0.0),
+            loo_p90_pct: loo_summary.map(|s| s.0.1),
+        },
+    };
+    let files: Vec<String> = args.files.iter().map(|p| p.display().to_string()).collect();
+    let mut header = vec![
+        format!(
+            "Device profile {name}: fitted by rendersim calibrate (rendersim {}) on {}.",
+            env!("CARGO_PKG_VERSION"),
+            today()
+        ),
+        format!("Files: {}.", files.join(", ")),
+        format!("Rows: {}. Vertex cache: {}.", rows.len(), args.vertex_cache),
+        format!(
+            "Fit (relative error over the fitted rows): median {median:.1}%, 90th percentile {p90:.1}%, worst {worst:.1}%."
+        ),
+    ];
+    if let Some(((m, p, w), (bm, bp, _))) = loo_summary {
+        header.push(format!(
+            "Leave-one-out (each row predicted by a fit to the others, vertex invocations from the cache policy): median {m:.1}%, 90th percentile {p:.1}%, worst {w:.1}%; a plain linear fit: median {bm:.1}%, 90th percentile {bp:.1}%."
+        ));
+    }
+    header.push("Cost formula and keys: docs/models.md (Device profiles). Regenerate with the command in docs/measurements/README.md.".into());
+    if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    std::fs::write(&args.out, profile.to_toml(&header)).with_context(|| format!("writing {}", args.out.display()))?;
+
+    if args.json {
+        let rows_json: Vec<_> = rows
+            .iter()
+            .zip(&fitted)
+            .zip(&errors)
+            .enumerate()
+            .map(|(i, ((r, p), e))| {
+                json!({"mesh": r.mesh, "size": format!("{}x{}", r.width, r.height), "vs_loops": r.vs_loops,
+                "fs_loops": r.fs_loops, "geometry_only": r.geometry_only, "measured_ns": r.pass_time_ns,
+                "fitted_ns": p, "error_pct": e, "loo_error_pct": loo.as_ref().map(|l| l.0[i])})
+            })
+            .collect();
+        let v = json!({"profile": profile, "out": args.out, "fit_seconds": fit_seconds,
+            "loo_seconds": loo.as_ref().map(|l| l.2),
+            "linear_baseline_loo": loo_summary.map(|s| json!({"median_pct": s.1.0, "p90_pct": s.1.1, "worst_pct": s.1.2})),
+            "rows": rows_json});
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    let mut s = String::new();
+    writeln!(
+        s,
+        "{} rows from {}; fit in {:.3} s",
+        rows.len(),
+        files.join(", "),
+        fit_seconds
+    )?;
+    writeln!(s, "{:<28} {:>14} {:>12}", "constant", "value", "std error")?;
+    for (k, v) in f.costs.entries() {
+        let se = f
+            .std_errors
+            .iter()
+            .find(|(n, _)| n == k)
+            .map(|(_, s)| format!("{s:.4e}"))
+            .unwrap_or_else(|| "grid".into());
+        writeln!(s, "{k:<28} {v:>14.6e} {se:>12}")?;
+    }
+    writeln!(
+        s,
+        "\n{:<24} {:>9} {:>6} {:>6} {:>4} {:>14} {:>14} {:>8}{}",
+        "mesh",
+        "size",
+        "vs",
+        "fs",
+        "geo",
+        "measured ns",
+        "fitted ns",
+        "err %",
+        if loo.is_some() { "   loo %" } else { "" }
+    )?;
+    for (i, ((r, p), e)) in rows.iter().zip(&fitted).zip(&errors).enumerate() {
+        let l = loo.as_ref().map(|l| format!(" {:>7.1}", l.0[i])).unwrap_or_default();
+        writeln!(
+            s,
+            "{:<24} {:>9} {:>6} {:>6} {:>4} {:>14.0} {:>14.0} {:>8.1}{l}",
+            r.mesh,
+            format!("{}x{}", r.width, r.height),
+            r.vs_loops,
+            r.fs_loops,
+            if r.geometry_only { "yes" } else { "" },
+            r.pass_time_ns,
+            p,
+            e
+        )?;
+    }
+    writeln!(
+        s,
+        "\nfit |error|: median {median:.1}%, p90 {p90:.1}%, worst {worst:.1}%"
+    )?;
+    if let (Some(((m, p, w), (bm, bp, bw))), Some(l)) = (loo_summary, loo.as_ref()) {
+        writeln!(
+            s,
+            "leave-one-out |error|: median {m:.1}%, p90 {p:.1}%, worst {w:.1}% ({:.2} s)",
+            l.2
+        )?;
+        writeln!(
+            s,
+            "linear baseline leave-one-out: median {bm:.1}%, p90 {bp:.1}%, worst {bw:.1}%"
+        )?;
+    }
+    writeln!(s, "wrote {}", args.out.display())?;
+    print!("{s}");
+    Ok(())
+}
+
+/// `rendersim predict`.
+pub fn predict(args: &PredictArgs) -> Result<()> {
+    let profile = DeviceProfile::read(&args.device)?;
+    let pass = DevicePass {
+        mesh: args.mesh.clone(),
+        size: (args.size.width, args.size.height),
+        vs_loops: args.vs_loops,
+        fs_loops: args.fs_loops,
+        geometry_only: args.geometry_only,
+        layers: args.layers,
+        order: args.order.into(),
+        depth_test: args.depth_test,
+    };
+    let p = predict_on_device(&profile, &pass)?;
+    if args.json {
+        let v = json!({
+            "mesh": args.mesh, "device": args.device, "device_name": profile.device.name,
+            "size": format!("{}x{}", args.size.width, args.size.height),
+            "vs_loops": args.vs_loops, "fs_loops": args.fs_loops, "geometry_only": args.geometry_only,
+            "layers": args.layers, "depth_test": args.depth_test,
+            "predicted": p, "wall_seconds": p.sim_wall_seconds,
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        println!(
+            "{} on {} at {}x{}: {:.4} ms predicted ({} vertex-shader, {} fragment-shader invocations; simulated in {:.3} s)",
+            args.mesh,
+            profile.device.name,
+            args.size.width,
+            args.size.height,
+            p.pass_time_ns / 1e6,
+            p.vs_invocations,
+            p.fs_invocations,
+            p.sim_wall_seconds
+        );
+    }
+    Ok(())
+}

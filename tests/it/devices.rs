@@ -1,0 +1,192 @@
+//! Device profiles (issue 10 item 3): `calibrate` recovers known costs from
+//! synthetic passes, beats the plain linear fit on the shared H200 rows when
+//! each row is held out, and `predict` prints what it promises; bad inputs
+//! give clear errors, never a panic.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use rendersim::measure::calibrate::{
+    LoadCache, PassRow, error_summary, fit, leave_one_out, linear_baseline_loo, read_rows, row_load,
+};
+use rendersim::measure::device_profile::{DeviceCosts, DeviceProfile};
+
+fn h200(file: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("docs/measurements/nvidia-h200")
+        .join(file)
+}
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_rendersim"))
+}
+
+fn truth() -> DeviceCosts {
+    DeviceCosts {
+        pass_overhead_ns: 5_000.0,
+        clear_store_per_pixel_ns: 0.15,
+        vertex_ns: 2.0,
+        vertex_per_loop_ns: 0.015,
+        vertex_loop_latency_ns: 15.0,
+        triangle_ns: 1.0,
+        lane_ns: 0.05,
+        lane_per_loop_ns: 0.0035,
+        fragment_loop_latency_ns: 40.0,
+        helper_lane_weight: 0.5,
+        warp_waste_weight: 0.3,
+    }
+}
+
+#[test]
+fn calibrate_recovers_known_costs_from_synthetic_passes() {
+    let t = truth();
+    let mut cache = LoadCache::default();
+    let (mut loads, mut y) = (Vec::new(), Vec::new());
+    for mesh in ["grid:16x16", "grid:48x48", "grid:32x32:shuffled:3", "strip:24x24"] {
+        for size in [64, 256, 1024] {
+            for (vs, fs, geo) in [
+                (0, 0, false),
+                (2000, 0, false),
+                (0, 300, false),
+                (500, 100, false),
+                (0, 0, true),
+                (20000, 0, true),
+            ] {
+                let row = PassRow {
+                    mesh: mesh.into(),
+                    width: size,
+                    height: size,
+                    vs_loops: vs,
+                    fs_loops: fs,
+                    geometry_only: geo,
+                    vs_invocations: 0,
+                    fs_invocations: 0,
+                    pass_time_ns: 1.0,
+                };
+                let v = cache.vertices(mesh, &"meshopt:32,32,32".parse().unwrap()).unwrap();
+                let l = row_load(&row, &mut cache, Some(v)).unwrap();
+                y.push(t.cost(&l).pass_ns);
+                loads.push(l);
+            }
+        }
+    }
+    let f = fit(&loads, &y).unwrap();
+    for ((k, got), (_, want)) in f.costs.entries().iter().zip(t.entries()) {
+        assert!((got - want).abs() <= 0.01 * want, "{k}: fitted {got}, true {want}");
+    }
+    assert!(f.objective < 1e-12, "{}", f.objective);
+    assert!(
+        f.std_errors.iter().all(|(_, s)| s.is_finite() && *s < 1e-3),
+        "{:?}",
+        f.std_errors
+    );
+}
+
+#[test]
+fn h200_leave_one_out_beats_the_linear_baseline() {
+    let mut rows = read_rows(&h200("load-grid.csv")).unwrap();
+    rows.extend(read_rows(&h200("load-sweep.csv")).unwrap());
+    assert_eq!(rows.len(), 95);
+    let mut cache = LoadCache::default();
+    let policy = "meshopt:32,32,32".parse().unwrap();
+    let fit_loads: Vec<_> = rows.iter().map(|r| row_load(r, &mut cache, None).unwrap()).collect();
+    let pred_loads: Vec<_> = rows
+        .iter()
+        .map(|r| {
+            let v = cache.vertices(&r.mesh, &policy).unwrap();
+            row_load(r, &mut cache, Some(v)).unwrap()
+        })
+        .collect();
+    let y: Vec<f64> = rows.iter().map(|r| r.pass_time_ns).collect();
+    let (m, p90, _) = error_summary(&leave_one_out(&fit_loads, &pred_loads, &y).unwrap());
+    let (bm, bp90, _) = error_summary(&linear_baseline_loo(&pred_loads, &y));
+    eprintln!("H200 leave-one-out: profile median {m:.1}% p90 {p90:.1}%; linear median {bm:.1}% p90 {bp90:.1}%");
+    assert!(m.is_finite() && p90.is_finite());
+    assert!(m < bm && p90 < bp90, "profile {m}/{p90} vs linear {bm}/{bp90}");
+}
+
+#[test]
+fn calibrate_and_predict_through_the_command_line() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("devices/h200.toml");
+    let o = bin()
+        .args([
+            "calibrate",
+            h200("load-grid.csv").to_str().unwrap(),
+            h200("load-sweep.csv").to_str().unwrap(),
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{stdout}{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        stdout.contains("lane_per_loop_ns") && stdout.contains("median"),
+        "{stdout}"
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        text.starts_with("# Device profile h200") && text.contains("Rows: 95"),
+        "{text}"
+    );
+    let profile = DeviceProfile::read(&out).unwrap();
+    assert_eq!(profile.fit.rows, 95);
+
+    let o = bin()
+        .args(["predict", "grid:32x32", "--device"])
+        .arg(&out)
+        .args(["--size", "128x128", "--fs-loops", "300", "--json"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for k in ["pass_time_ns", "vs_invocations", "fs_invocations", "sim_wall_seconds"] {
+        assert!(v["predicted"][k].is_number(), "{k} in {v}");
+    }
+    assert_eq!(v["predicted"]["fs_invocations"], 16384);
+    assert!(v["wall_seconds"].is_number());
+    let t = v["predicted"]["pass_time_ns"].as_f64().unwrap();
+    // Measured 108,032 ns on the H200.
+    assert!(t > 50_000.0 && t < 200_000.0, "{t}");
+
+    let err = |args: &[&str]| {
+        let o = bin().args(args).output().unwrap();
+        assert!(!o.status.success(), "{args:?} succeeded");
+        let e = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert!(!e.contains("panicked"), "{e}");
+        e
+    };
+    let dev = out.to_str().unwrap();
+    assert!(err(&["predict", "grid:oops", "--device", dev]).contains("grid:oops"));
+    assert!(err(&["predict", "grid:8x8", "--device", dev, "--size", "12"]).contains("--size"));
+    assert!(err(&["predict", "grid:8x8", "--device", "/nonexistent/x.toml"]).contains("/nonexistent/x.toml"));
+    let bad = d.path().join("bad.toml");
+    let mut seen = false;
+    let negative: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("lane_ns = ") && !seen {
+                seen = true;
+                "lane_ns = -1.0\n".to_string()
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    std::fs::write(&bad, negative).unwrap();
+    let e = err(&["predict", "grid:8x8", "--device", bad.to_str().unwrap()]);
+    assert!(e.contains("bad.toml") && e.contains("costs.lane_ns"), "{e}");
+    std::fs::write(&bad, text.replace("vertex_ns", "vertex_nanos")).unwrap();
+    let e = err(&["predict", "grid:8x8", "--device", bad.to_str().unwrap()]);
+    assert!(e.contains("bad.toml") && e.contains("vertex_nanos"), "{e}");
+    let csv = d.path().join("rows.csv");
+    std::fs::write(&csv, "mesh,size\n").unwrap();
+    let e = err(&[
+        "calibrate",
+        csv.to_str().unwrap(),
+        "--out",
+        d.path().join("x.toml").to_str().unwrap(),
+    ]);
+    assert!(e.contains("rows.csv:1"), "{e}");
+}
