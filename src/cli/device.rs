@@ -120,7 +120,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
             .zip(&errors)
             .enumerate()
             .map(|(i, ((r, p), e))| {
-                json!({"mesh": r.mesh, "size": format!("{}x{}", r.width, r.height), "vs_loops": r.vs_loops,
+                json!({"mesh": r.mesh, "size": format!("{}x{}", r.size.width, r.size.height), "vs_loops": r.vs_loops,
                 "fs_loops": r.fs_loops, "geometry_only": r.geometry_only, "measured_ns": r.pass_time_ns,
                 "fitted_ns": p, "error_pct": e, "loo_error_pct": loo.as_ref().map(|l| l.0[i])})
             })
@@ -169,7 +169,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
             s,
             "{:<24} {:>9} {:>6} {:>6} {:>4} {:>14.0} {:>14.0} {:>8.1}{l}",
             r.mesh,
-            format!("{}x{}", r.width, r.height),
+            format!("{}x{}", r.size.width, r.size.height),
             r.vs_loops,
             r.fs_loops,
             if r.geometry_only { "yes" } else { "" },

@@ -12,7 +12,7 @@
 //! policy, as `rendersim predict` would.
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::Serialize;
 
@@ -22,51 +22,14 @@ use super::fit::rel_error_pct;
 use crate::components::vertex_cache::CachePolicy;
 use crate::scene::generators::mesh_from_spec;
 
-/// One measured pass (a row of the shared CSV format).
-// TODO(studies): replace by `measure::passes::PassRow` once merged.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PassRow {
-    /// Mesh generator spec.
-    pub mesh: String,
-    /// Target width.
-    pub width: u32,
-    /// Target height.
-    pub height: u32,
-    /// Vertex loop iterations.
-    pub vs_loops: u32,
-    /// Fragment loop iterations.
-    pub fs_loops: u32,
-    /// Every vertex collapsed to one point.
-    pub geometry_only: bool,
-    /// Measured vertex-shader invocations.
-    pub vs_invocations: u64,
-    /// Measured fragment-shader invocations.
-    pub fs_invocations: u64,
-    /// Measured pass time.
-    pub pass_time_ns: f64,
-}
+pub use super::passes::PassRow;
 
 /// Errors of a calibration.
 #[derive(Debug, thiserror::Error)]
 pub enum CalibrateError {
-    /// A file cannot be read.
-    #[error("cannot read {path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
-    /// A row does not parse.
-    #[error("{path}:{line}: {message}")]
-    Row {
-        /// The file.
-        path: PathBuf,
-        /// 1-based line.
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
+    /// A pass CSV cannot be read or does not parse (names file, line and column).
+    #[error(transparent)]
+    Csv(#[from] super::passes::PassCsvError),
     /// A mesh spec the generators do not know.
     #[error("mesh {spec:?}: {message}")]
     Mesh {
@@ -80,65 +43,10 @@ pub enum CalibrateError {
     TooFewRows(usize),
 }
 
-const HEADER: &str = "mesh,size,vs_loops,fs_loops,geometry_only,vs_invocations,fs_invocations,pass_time_ns";
-
-/// Reads the rows of one CSV file.
+/// Reads the rows of one CSV file (the one pass-CSV reader,
+/// [`super::passes::read_passes`]).
 pub fn read_rows(path: &Path) -> Result<Vec<PassRow>, CalibrateError> {
-    let text = std::fs::read_to_string(path).map_err(|source| CalibrateError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let err = |line: usize, message: String| CalibrateError::Row {
-        path: path.to_path_buf(),
-        line,
-        message,
-    };
-    let mut lines = text.lines().enumerate();
-    match lines.next() {
-        Some((_, h)) if h.trim() == HEADER => {}
-        _ => return Err(err(1, format!("expected the header {HEADER}"))),
-    }
-    let mut rows = Vec::new();
-    for (i, l) in lines {
-        if l.trim().is_empty() {
-            continue;
-        }
-        let f: Vec<&str> = l.split(',').map(str::trim).collect();
-        if f.len() != 8 {
-            return Err(err(i + 1, format!("expected 8 fields, found {}", f.len())));
-        }
-        let num = |k: usize, name: &str| -> Result<u64, CalibrateError> {
-            f[k].parse()
-                .map_err(|_| err(i + 1, format!("{name} {:?} is not a whole number", f[k])))
-        };
-        let (width, height) = f[1]
-            .split_once('x')
-            .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
-            .filter(|(w, h)| *w > 0 && *h > 0)
-            .ok_or_else(|| err(i + 1, format!("size {:?} is not WxH", f[1])))?;
-        let geometry_only = match f[4] {
-            "true" => true,
-            "false" => false,
-            o => return Err(err(i + 1, format!("geometry_only {o:?} is not true or false"))),
-        };
-        let pass_time_ns: f64 = f[7]
-            .parse()
-            .ok()
-            .filter(|t: &f64| t.is_finite() && *t > 0.0)
-            .ok_or_else(|| err(i + 1, format!("pass_time_ns {:?} is not a positive number", f[7])))?;
-        rows.push(PassRow {
-            mesh: f[0].to_string(),
-            width,
-            height,
-            vs_loops: u32::try_from(num(2, "vs_loops")?).map_err(|_| err(i + 1, "vs_loops too large".into()))?,
-            fs_loops: u32::try_from(num(3, "fs_loops")?).map_err(|_| err(i + 1, "fs_loops too large".into()))?,
-            geometry_only,
-            vs_invocations: num(5, "vs_invocations")?,
-            fs_invocations: num(6, "fs_invocations")?,
-            pass_time_ns,
-        });
-    }
-    Ok(rows)
+    Ok(super::passes::read_passes(path)?)
 }
 
 /// Coverage and predicted vertex invocations, computed once per mesh and size.
@@ -182,14 +90,14 @@ fn mesh(spec: &str) -> Result<crate::scene::mesh::Mesh, CalibrateError> {
 /// The load of a row; `vertices` overrides the measured invocations.
 pub fn row_load(row: &PassRow, cache: &mut LoadCache, vertices: Option<u64>) -> Result<PassLoad, CalibrateError> {
     Ok(PassLoad {
-        pixels: f64::from(row.width) * f64::from(row.height),
+        pixels: f64::from(row.size.width) * f64::from(row.size.height),
         vertices: vertices.unwrap_or(row.vs_invocations) as f64,
         vs_loops: f64::from(row.vs_loops),
         fs_loops: f64::from(row.fs_loops),
         coverage: if row.geometry_only {
             Coverage::default()
         } else {
-            cache.coverage(&row.mesh, row.width, row.height)?
+            cache.coverage(&row.mesh, row.size.width, row.size.height)?
         },
     })
 }

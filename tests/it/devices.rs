@@ -54,8 +54,7 @@ fn calibrate_recovers_known_costs_from_synthetic_passes() {
             ] {
                 let row = PassRow {
                     mesh: mesh.into(),
-                    width: size,
-                    height: size,
+                    size: (size, size).into(),
                     vs_loops: vs,
                     fs_loops: fs,
                     geometry_only: geo,
