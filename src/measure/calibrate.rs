@@ -193,9 +193,9 @@ fn solve(mut a: Vec<f64>, mut b: Vec<f64>, n: usize) -> Option<Vec<f64>> {
 fn nnls(rows: &[[f64; P]], y: &[f64]) -> ([f64; P], [f64; P], f64) {
     // Scale columns to unit norm for conditioning.
     let mut scale = [0.0f64; P];
-    for r in rows.iter().zip(y) {
-        for j in 0..P {
-            scale[j] += (r.0[j] / r.1).powi(2);
+    for (r, yi) in rows.iter().zip(y) {
+        for (s, v) in scale.iter_mut().zip(r) {
+            *s += (v / yi).powi(2);
         }
     }
     let mut active: Vec<usize> = (0..P).filter(|&j| scale[j] > 0.0).collect();
