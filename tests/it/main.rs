@@ -17,6 +17,7 @@ mod lavapipe_policy;
 mod measure;
 mod meshopt_crosscheck;
 mod multi_rate;
+mod obj_files;
 mod outputs;
 mod pipeline_oracles;
 mod pixelflow;
