@@ -5,6 +5,7 @@
 
 mod architecture;
 mod binning;
+mod bottleneck;
 mod cli;
 mod common;
 mod conservation;
