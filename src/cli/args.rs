@@ -79,6 +79,9 @@ pub struct IsolateArgs {
     /// Keep vsync on (by default it is switched off so quantization does not hide changes).
     #[arg(long)]
     pub keep_vsync: bool,
+    /// Reductions of the frame time within this fraction of the best reduction are reported as a tie.
+    #[arg(long, default_value_t = rendersim::systems::frame_pipeline::isolate::DEFAULT_TIE_TOLERANCE)]
+    pub tie_tolerance: f64,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,

@@ -12,6 +12,7 @@ use rendersim::output::files::open_output;
 use rendersim::output::result_set::ResultSet;
 use rendersim::output::text::fixed;
 use rendersim::output::trace::TraceWriter;
+use rendersim::systems::frame_pipeline::isolate::IsolateOptions;
 use rendersim::systems::run_model;
 
 use super::args::{
@@ -193,7 +194,12 @@ pub fn isolate(args: IsolateArgs) -> Result<()> {
     }
     let cfg: rendersim::systems::frame_pipeline::FramePipelineConfig = rendersim::config::deserialize(table, src)?;
     let (factor, keep_vsync) = (args.factor, args.keep_vsync);
-    let iso = rendersim::systems::frame_pipeline::isolate::isolate(&cfg, &src.base_dir, factor, keep_vsync)?;
+    let options = IsolateOptions {
+        factor,
+        keep_vsync,
+        tie_tolerance: args.tie_tolerance,
+    };
+    let iso = rendersim::systems::frame_pipeline::isolate::isolate(&cfg, &src.base_dir, options)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&iso)?);
         return Ok(());
@@ -211,7 +217,16 @@ pub fn isolate(args: IsolateArgs) -> Result<()> {
             if change.starts_with('-') { "" } else { "+" }
         );
     }
-    println!("  => bottleneck: {}   ({:.2} s wall)", iso.bottleneck, iso.wall_seconds);
+    let verdict = if iso.tied.len() > 1 {
+        format!(
+            "tie: {} (within {}% of the best reduction)",
+            iso.tied.join(", "),
+            100.0 * iso.tie_tolerance
+        )
+    } else {
+        iso.bottleneck.clone()
+    };
+    println!("  => bottleneck: {verdict}   ({:.2} s wall)", iso.wall_seconds);
     Ok(())
 }
 

@@ -14,7 +14,6 @@
 //! corners `a = (i, j)`, `b = (i+1, j)`, `c = (i, j+1)`, `d = (i+1, j+1)` is
 //! the two counter-clockwise triangles `a b c` and `c b d`.
 
-use std::io::BufRead;
 use std::path::Path;
 
 use rand::seq::SliceRandom;
@@ -22,6 +21,7 @@ use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
 use super::mesh::{Mesh, MeshError, RESTART, Topology};
+use super::obj::read_obj;
 use super::optimize::optimize_vertex_cache;
 
 /// The most indices a generated mesh may have ([`crate::limits::MAX_MESH_INDICES`]).
@@ -235,119 +235,19 @@ fn random(t: u64, v: u32, seed: u64, name: &str) -> Mesh {
     }
 }
 
-/// A reader that counts the lines it has handed out, so tobj's parse errors
-/// can be given a line number.
-struct LineCounter<R> {
-    inner: R,
-    newlines: usize,
-    mid_line: bool,
-}
-
-impl<R: BufRead> std::io::Read for LineCounter<R> {
-    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let n = self.inner.read(buf)?;
-        self.count(&buf[..n]);
-        Ok(n)
-    }
-}
-
-impl<R> LineCounter<R> {
-    fn count(&mut self, bytes: &[u8]) {
-        if let Some(&last) = bytes.last() {
-            self.newlines += bytes.iter().filter(|&&b| b == b'\n').count();
-            self.mid_line = last != b'\n';
-        }
-    }
-
-    /// The line being parsed when an error occurred.
-    fn current_line(&self) -> usize {
-        self.newlines + usize::from(self.mid_line)
-    }
-}
-
-impl<R: BufRead> BufRead for LineCounter<R> {
-    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
-        self.inner.fill_buf()
-    }
-    fn consume(&mut self, amt: usize) {
-        if let Ok(buf) = self.inner.fill_buf() {
-            let consumed = &buf[..amt.min(buf.len())];
-            if let Some(&last) = consumed.last() {
-                self.newlines += consumed.iter().filter(|&&b| b == b'\n').count();
-                self.mid_line = last != b'\n';
-            }
-        }
-        self.inner.consume(amt);
-    }
-}
-
-/// Loads an OBJ file's faces, triangulated, all models concatenated.
-/// tobj's `single_index` gives one vertex per distinct position/texcoord/
-/// normal combination, as a GPU vertex buffer would hold them.
+/// Loads an OBJ file's faces as one triangle list, keeping the file's vertex
+/// numbering where faces reference positions only (see [`super::obj`]).
 fn load_obj(path: &Path, name: &str) -> Result<Mesh, MeshError> {
     let file = std::fs::File::open(path).map_err(|source| MeshError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    let mut reader = LineCounter {
-        inner: std::io::BufReader::new(file),
-        newlines: 0,
-        mid_line: false,
-    };
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ..Default::default()
-    };
-    let loaded = tobj::load_obj_buf(&mut reader, &options, |_| Err(tobj::LoadError::OpenFileFailed));
-    let (models, _materials) = loaded.map_err(|e| {
-        use tobj::LoadError as L;
-        // Errors found while parsing a line; the others come at the end of
-        // an object, where the line would mislead.
-        let per_line = matches!(
-            e,
-            L::UnrecognizedCharacter
-                | L::PositionParseError
-                | L::ScalingByZeroError
-                | L::ColorParseError
-                | L::NormalParseError
-                | L::TexcoordParseError
-                | L::FaceParseError
-                | L::InvalidObjectName
-                | L::InvalidPolygon
-                | L::ReadError
-        );
-        MeshError::Obj {
-            path: path.to_path_buf(),
-            line: per_line.then(|| reader.current_line()),
-            message: e.to_string(),
-        }
-    })?;
-    let mut indices = Vec::new();
-    let mut offset = 0u64;
-    for model in &models {
-        let base = u32::try_from(offset).ok().filter(|b| *b < RESTART);
-        let Some(base) = base else {
-            return Err(too_big_obj(path));
-        };
-        for &i in &model.mesh.indices {
-            match base.checked_add(i).filter(|x| *x < RESTART) {
-                Some(x) => indices.push(x),
-                None => return Err(too_big_obj(path)),
-            }
-        }
-        offset += (model.mesh.positions.len() / 3) as u64;
-    }
-    let vertex_count = u32::try_from(offset).map_err(|_| too_big_obj(path))?;
-    finish_file(path, name, indices, vertex_count)
-}
-
-fn too_big_obj(path: &Path) -> MeshError {
-    MeshError::Obj {
+    let t = read_obj(std::io::BufReader::new(file)).map_err(|f| MeshError::Obj {
         path: path.to_path_buf(),
-        line: None,
-        message: "more vertices than 32-bit indices can address".into(),
-    }
+        line: f.line,
+        source: f.error,
+    })?;
+    finish_file(path, name, t.indices, t.vertex_count)
 }
 
 /// Loads whitespace-separated triangle-list indices (`#` starts a comment).

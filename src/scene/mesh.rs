@@ -95,16 +95,16 @@ pub enum MeshError {
         /// The I/O error.
         source: std::io::Error,
     },
-    /// tobj rejected an OBJ file.
-    #[error("malformed OBJ file `{}`{}: {message}", path.display(),
+    /// An OBJ file that cannot be read as triangles.
+    #[error("malformed OBJ file `{}`{}: {source}", path.display(),
         line.map(|l| format!(" at line {l}")).unwrap_or_default())]
     Obj {
         /// The file.
         path: PathBuf,
-        /// The line of the error, where known.
+        /// The line of the error, where it belongs to one.
         line: Option<usize>,
-        /// tobj's message.
-        message: String,
+        /// What is wrong.
+        source: crate::scene::obj::ObjError,
     },
     /// A token in an `.idx` file is not a vertex index.
     #[error("bad index `{token}` in `{}` line {line}: expected an integer below 4294967295",

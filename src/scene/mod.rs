@@ -4,5 +4,6 @@
 pub mod config;
 pub mod generators;
 pub mod mesh;
+pub mod obj;
 pub mod optimize;
 pub mod presets;

@@ -5,6 +5,7 @@
 
 mod architecture;
 mod binning;
+mod bottleneck;
 mod cli;
 mod common;
 mod conservation;
@@ -19,6 +20,7 @@ mod measure;
 mod meshopt_crosscheck;
 mod multi_rate;
 mod nvidia_policy;
+mod obj_files;
 mod outputs;
 mod pipeline_oracles;
 mod pixelflow;

@@ -1,23 +1,19 @@
 //! Time accounting: after every event each unit's state is derived from the
-//! model and its [`StateClock`] advanced, so CPU busy + wait, GPU busy + idle
-//! and the bottleneck shares each add up to the elapsed time exactly. The same
-//! transitions become Perfetto spans when tracing.
+//! model and its [`StateClock`] advanced, so CPU busy + wait and GPU busy +
+//! idle each add up to the elapsed time exactly. The same transitions become
+//! Perfetto spans when tracing.
 //!
-//! Bottleneck attribution (the unit limiting progress at each instant):
-//! GPU waiting for a swap image -> display (vsync); at `draw` fidelity, a
-//! running draw -> the stage with the larger total (F >= G: fragment);
-//! fragment busy with the
-//! geometry stage blocked or idle -> fragment; geometry busy with the
-//! fragment stage idle -> geometry; both busy -> the one the triangle FIFO
-//! leans towards (at least half full: fragment); front end preempted ->
-//! system; front end processing -> GPU front end; GPU idle -> the CPU (or
-//! system, when a system task holds the CPU); after the last frame is
-//! submitted and drawn -> display.
+//! Bottleneck attribution follows the critical path
+//! ([`super::critical_path`]): after every event each unit's mode (working,
+//! or waiting for which unit) is derived here and the path carried forward,
+//! so the bottleneck shares also add up to the elapsed time exactly and a
+//! unit that works off the critical path is not blamed.
 
 use crate::components::state_clock::StateClock;
 use crate::engine::{Duration, Time};
 use crate::output::trace::TraceWriter;
 
+use super::critical_path::{Blame, CriticalPath, Mode, Modes, Unit};
 use super::model::{CpuPhase, FramePipeline, FrontPhase};
 use super::records::FrameRecord;
 
@@ -161,8 +157,8 @@ pub struct Accounting {
     pub frag: StateClock<2>,
     /// GPU busy (index 0) / idle (1).
     pub gpu: StateClock<2>,
-    /// Bottleneck clock.
-    pub bottleneck: StateClock<6>,
+    /// Bottleneck attribution along the critical path.
+    pub path: CriticalPath,
     cpu_frame: u64,
     gpu_frame: Option<u64>,
     /// The trace, when one is written.
@@ -170,15 +166,16 @@ pub struct Accounting {
 }
 
 impl Accounting {
-    /// Fresh clocks (everything idle at time zero).
-    pub fn new(trace: Option<TraceWriter>) -> Self {
+    /// Fresh clocks (everything idle at time zero); `pacing`: the refresh
+    /// period when frames are shown at vertical blanks.
+    pub fn new(trace: Option<TraceWriter>, pacing: Option<Duration>) -> Self {
         Accounting {
             cpu: StateClock::new(4),
             front: StateClock::new(1),
             geom: StateClock::new(2),
             frag: StateClock::new(1),
             gpu: StateClock::new(1),
-            bottleneck: StateClock::new(0),
+            path: CriticalPath::new(pacing),
             cpu_frame: 0,
             gpu_frame: None,
             trace: trace.map(PipelineTrace::new),
@@ -268,28 +265,8 @@ impl FramePipeline {
         };
         let frag_state = if self.frag_busy { 0 } else { 1 };
         let gpu_busy = front_state == 0 || geom_state == 0 || frag_state == 0;
-        let bottleneck = if front_state == 2 {
-            5
-        } else if let Some(fragment_limited) = self.draw_fragment_limited {
-            if fragment_limited { 4 } else { 3 }
-        } else if frag_state == 0 && geom_state != 0 {
-            4
-        } else if geom_state == 0 && frag_state != 0 {
-            3
-        } else if geom_state == 0 && frag_state == 0 {
-            let depth = self.tri_fifo.capacity().max(1);
-            if self.tri_fifo.len() as u64 * 2 >= depth { 4 } else { 3 }
-        } else if front_state == 5 {
-            1
-        } else if front_state == 0 {
-            2
-        } else if cpu_state == 1 {
-            1
-        } else if cpu_state == 4 {
-            5
-        } else {
-            0
-        };
+        let modes = self.path_modes();
+        self.acct.path.update(now, modes);
 
         let gpu_state = if gpu_busy { 0 } else { 1 };
 
@@ -301,7 +278,6 @@ impl FramePipeline {
             && front_state == a.front.state()
             && geom_state == a.geom.state()
             && frag_state == a.frag.state()
-            && bottleneck == a.bottleneck.state()
             && gpu_state == a.gpu.state()
             && self.cpu_frame == a.cpu_frame
             && (self.gpu_frame.is_none() || self.gpu_frame == a.gpu_frame)
@@ -346,7 +322,6 @@ impl FramePipeline {
         set_traced(&mut a.front, now, front_state, Track::Front, &mut a.trace, 1, None);
         set_traced(&mut a.geom, now, geom_state, Track::Geometry, &mut a.trace, 2, None);
         set_traced(&mut a.frag, now, frag_state, Track::Fragment, &mut a.trace, 1, None);
-        a.bottleneck.set(now, bottleneck);
         // GPU busy per frame (the frame the front end is on).
         let old = a.gpu.state();
         let spent = a.gpu.set(now, gpu_state).0;
@@ -367,5 +342,47 @@ impl FramePipeline {
         if let Some(t) = &mut a.trace {
             t.fifo_levels(now, self.fifo.used(), self.tri_fifo.len() as u64);
         }
+    }
+}
+
+impl FramePipeline {
+    /// Each unit's mode for the critical path (see [`super::critical_path`]).
+    fn path_modes(&self) -> Modes {
+        let cpu = match self.cpu_phase {
+            CpuPhase::WaitFrames | CpuPhase::Push | CpuPhase::Rendezvous => Mode::wait(Unit::Front),
+            CpuPhase::Finished => Mode::wait(Unit::Display),
+            _ if self.cpu.in_system() => Mode::work(Blame::System),
+            _ => Mode::work(Blame::Cpu),
+        };
+        let front = match self.front_phase {
+            FrontPhase::Running if self.front.in_system() => Mode::work(Blame::System),
+            FrontPhase::Running => Mode::work(Blame::FrontEnd),
+            FrontPhase::Idle => Mode::wait(Unit::Cpu),
+            FrontPhase::WaitImage => Mode::wait(Unit::Display),
+            FrontPhase::WaitDrain => Mode::wait(Unit::Fragment),
+            // Binning: no draw in geometry, the bins still being shaded.
+            FrontPhase::Handoff if self.geom_draw.is_none() => Mode::wait(Unit::Fragment),
+            FrontPhase::Handoff => Mode::wait(Unit::Geometry),
+        };
+        let (geometry, fragment) = match self.draw_fragment_limited {
+            // `draw` fidelity: the running draw is the limiting stage's.
+            Some(true) => (Mode::work(Blame::Fragment), Mode::work(Blame::Fragment)),
+            Some(false) => (Mode::work(Blame::Geometry), Mode::work(Blame::Geometry)),
+            None => (
+                if self.geom_busy {
+                    Mode::work(Blame::Geometry)
+                } else if self.geom_held.is_some() {
+                    Mode::wait(Unit::Fragment)
+                } else {
+                    Mode::wait(Unit::Front)
+                },
+                if self.frag_busy {
+                    Mode::work(Blame::Fragment)
+                } else {
+                    Mode::wait(Unit::Geometry)
+                },
+            ),
+        };
+        [cpu, front, geometry, fragment]
     }
 }

@@ -15,6 +15,7 @@ impl FramePipeline {
         self.gpu_completed += 1;
         self.records[frame as usize].gpu_end = Some(now);
         self.gpu_frame = None;
+        self.acct.path.presented(frame);
         let flip = self.chain.present(frame);
         self.apply_flip(now, flip);
         Ok(())
@@ -35,6 +36,7 @@ impl FramePipeline {
                 self.repeated_refreshes += crossed.saturating_sub(1);
             }
             self.records[f as usize].displayed = Some(now);
+            self.acct.path.shown(f);
             self.last_display = Some(now);
             self.resolved += 1;
             let warm = self.cfg.run.warmup_frames;

@@ -4,6 +4,14 @@
 //! triangle; raster work per fragment) and see which reduction moves the
 //! frame time. Vsync is switched off by default, as §4.2 advises, so refresh
 //! quantization does not hide a change.
+//!
+//! The verdict: a reduction counts when it moves the mean frame time down by
+//! more than [`MIN_CHANGE`] (1%); the one that moves it most is the
+//! bottleneck, unless others come within the tie tolerance of it (by
+//! default [`DEFAULT_TIE_TOLERANCE`]: reductions within 2% of the best
+//! frame-time reduction, relative to it) — then the result is a tie listing
+//! them all, since one run cannot tell them apart (two stages in series,
+//! say, with equal loads).
 
 use std::path::Path;
 
@@ -37,11 +45,45 @@ pub struct Isolation {
     pub vsync: bool,
     /// Baseline and the reductions.
     pub variants: Vec<Variant>,
-    /// The subsystem whose reduction moved the frame time most (`none` if
-    /// no reduction moved it by more than 1%).
+    /// The subsystem whose reduction moved the frame time most; `tie` when
+    /// several are tied (see `tied`); `none` if no reduction moved it by
+    /// more than 1%.
     pub bottleneck: String,
+    /// Every subsystem whose reduction came within the tie tolerance of the
+    /// best (the bottleneck alone when there is no tie; empty for `none`).
+    pub tied: Vec<String>,
+    /// Reductions of the frame time within this fraction of the best
+    /// reduction are tied.
+    pub tie_tolerance: f64,
     /// Wall time of all runs, seconds.
     pub wall_seconds: f64,
+}
+
+/// A reduction must lower the mean frame time by more than this fraction
+/// to count.
+pub const MIN_CHANGE: f64 = 0.01;
+/// The default tie tolerance: reductions within 2% of the best one are tied.
+pub const DEFAULT_TIE_TOLERANCE: f64 = 0.02;
+
+/// How to isolate.
+#[derive(Debug, Clone, Copy)]
+pub struct IsolateOptions {
+    /// Load factor of the reduced subsystem, in (0, 1).
+    pub factor: f64,
+    /// Keep vsync on.
+    pub keep_vsync: bool,
+    /// Reductions within this fraction of the best reduction are tied, in [0, 1).
+    pub tie_tolerance: f64,
+}
+
+impl Default for IsolateOptions {
+    fn default() -> Self {
+        IsolateOptions {
+            factor: 0.5,
+            keep_vsync: false,
+            tie_tolerance: DEFAULT_TIE_TOLERANCE,
+        }
+    }
 }
 
 fn scale(d: Duration, k: f64) -> Duration {
@@ -105,19 +147,53 @@ pub fn reduced(cfg: &FramePipelineConfig, which: &str, k: f64) -> FramePipelineC
     c
 }
 
-/// Runs the baseline and each reduction.
-pub fn isolate(
-    cfg: &FramePipelineConfig,
-    base_dir: &Path,
-    factor: f64,
-    keep_vsync: bool,
-) -> Result<Isolation, SystemError> {
-    if !(factor.is_finite() && factor > 0.0 && factor < 1.0) {
+/// The verdict over the reductions (`variants` without the baseline):
+/// (bottleneck, tied subsystems), see the module docs.
+pub fn verdict(reductions: &[Variant], tie_tolerance: f64) -> (String, Vec<String>) {
+    let best = reductions
+        .iter()
+        .map(|v| v.change)
+        .filter(|c| *c < -MIN_CHANGE)
+        .min_by(f64::total_cmp);
+    let Some(best) = best else {
+        return ("none".to_string(), Vec::new());
+    };
+    let tied: Vec<String> = reductions
+        .iter()
+        .filter(|v| v.change < -MIN_CHANGE && v.change - best <= tie_tolerance * best.abs())
+        .map(|v| v.name.clone())
+        .collect();
+    let bottleneck = match tied.as_slice() {
+        [one] => one.clone(),
+        _ => "tie".to_string(),
+    };
+    (bottleneck, tied)
+}
+
+fn check_options(o: &IsolateOptions) -> Result<(), SystemError> {
+    if !(o.factor.is_finite() && o.factor > 0.0 && o.factor < 1.0) {
         return Err(SystemError::Invalid {
             key: "--factor".into(),
-            message: format!("must be between 0 and 1 (exclusive), got {factor}"),
+            message: format!("must be between 0 and 1 (exclusive), got {}", o.factor),
         });
     }
+    if !(o.tie_tolerance.is_finite() && (0.0..1.0).contains(&o.tie_tolerance)) {
+        return Err(SystemError::Invalid {
+            key: "--tie-tolerance".into(),
+            message: format!("must be at least 0 and less than 1, got {}", o.tie_tolerance),
+        });
+    }
+    Ok(())
+}
+
+/// Runs the baseline and each reduction.
+pub fn isolate(cfg: &FramePipelineConfig, base_dir: &Path, options: IsolateOptions) -> Result<Isolation, SystemError> {
+    check_options(&options)?;
+    let IsolateOptions {
+        factor,
+        keep_vsync,
+        tie_tolerance,
+    } = options;
     let start = std::time::Instant::now();
     let mut base = cfg.clone();
     if !keep_vsync {
@@ -148,16 +224,45 @@ pub fn isolate(
             change: if base_ft > 0.0 { (ft - base_ft) / base_ft } else { 0.0 },
         });
     }
-    let best = variants.iter().skip(1).min_by(|a, b| a.change.total_cmp(&b.change));
-    let bottleneck = match best {
-        Some(v) if v.change < -0.01 => v.name.clone(),
-        _ => "none".to_string(),
-    };
+    let (bottleneck, tied) = verdict(&variants[1..], tie_tolerance);
     Ok(Isolation {
         factor,
         vsync: keep_vsync,
         variants,
         bottleneck,
+        tied,
+        tie_tolerance,
         wall_seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn reductions(changes: &[(&str, f64)]) -> Vec<Variant> {
+        changes
+            .iter()
+            .map(|(n, c)| Variant {
+                name: n.to_string(),
+                frame_time_ms: 10.0 * (1.0 + c),
+                display_interval_ms: 0.0,
+                change: *c,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn one_winner_a_tie_or_none() {
+        let v = reductions(&[("cpu", -0.40), ("front_end", 0.0), ("geometry", -0.05)]);
+        assert_eq!(verdict(&v, 0.02), ("cpu".into(), vec!["cpu".into()]));
+        // -0.395 is within 2% of -0.40 (0.008); -0.39 is not.
+        let v = reductions(&[("cpu", -0.40), ("geometry", -0.395), ("raster", -0.39)]);
+        assert_eq!(verdict(&v, 0.02), ("tie".into(), vec!["cpu".into(), "geometry".into()]));
+        assert_eq!(verdict(&v, 0.0).0, "cpu");
+        assert_eq!(verdict(&v, 0.05).1.len(), 3);
+        // Changes of 1% or less do not count, tied or not.
+        let v = reductions(&[("cpu", -0.01), ("raster", -0.005), ("geometry", 0.02)]);
+        assert_eq!(verdict(&v, 0.5), ("none".into(), vec![]));
+    }
 }

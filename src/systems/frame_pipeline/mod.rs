@@ -7,7 +7,8 @@
 //! - `model`: the kernel model (state and event dispatch);
 //! - `cpu`, `gpu`, `display`: the units' event handlers;
 //! - `closed_form`: the `draw`-fidelity formula;
-//! - `accounting`: state clocks, bottleneck attribution, trace timeline;
+//! - `accounting`: state clocks, trace timeline, each unit's mode;
+//! - `critical_path`: bottleneck attribution along the critical path;
 //! - `records`: per-frame records and the PresentMon-style table;
 //! - `report`: the human-readable report of a run;
 //! - `run`: validate, build, run, summarize.
@@ -16,6 +17,7 @@ pub mod accounting;
 pub mod closed_form;
 pub mod config;
 mod cpu;
+pub mod critical_path;
 mod display;
 mod gpu;
 pub mod isolate;

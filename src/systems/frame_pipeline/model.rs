@@ -403,7 +403,10 @@ impl FramePipeline {
             resolved: 0,
             noise,
             records: Vec::with_capacity(frames_total.min(1 << 16) as usize),
-            acct: Accounting::new(trace),
+            acct: Accounting::new(
+                trace,
+                (mode != PresentMode::Immediate).then_some(cfg.display.refresh.period),
+            ),
             cfg,
         })
     }

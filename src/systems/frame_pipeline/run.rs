@@ -311,7 +311,7 @@ pub fn run_pipeline(
         geometry: a.geom.totals_at(end),
         fragment: a.frag.totals_at(end),
         gpu: a.gpu.totals_at(end),
-        bottleneck: a.bottleneck.totals_at(end),
+        bottleneck: a.path.totals_at(end, model.done()),
         elapsed: end.0,
     };
     let commands = model.command_counts();
@@ -574,7 +574,8 @@ pub struct PipelineMetrics {
     pub displayed_frames: usize,
     /// Frames replaced before they were shown.
     pub dropped_frames: usize,
-    /// Share of the run each unit was the bottleneck.
+    /// Share of the run each unit was on the critical path (the time
+    /// shortening its work would save; see `critical_path.rs`).
     pub bottleneck: BTreeMap<String, f64>,
     /// Time per state of each unit.
     pub states_ms: StatesMs,
@@ -646,7 +647,7 @@ fn summarize(
     let geom = m.acct.geom.totals_at(end);
     let frag = m.acct.frag.totals_at(end);
     let gpu = m.acct.gpu.totals_at(end);
-    let bott = m.acct.bottleneck.totals_at(end);
+    let bott = m.acct.path.totals_at(end, m.done());
     let displayed = m.records.iter().skip(warm).filter(|r| r.displayed.is_some()).count();
     let dropped = m.records.iter().skip(warm).filter(|r| r.dropped).count();
     let (mark_vblanks, mark_repeated, mark_time) = m.refresh_mark.unwrap_or((0, 0, crate::engine::Time::ZERO));
