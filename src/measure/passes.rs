@@ -185,6 +185,14 @@ pub enum PassCsvError {
         /// Its first line.
         found: String,
     },
+    /// A file read as pass rows does not start with [`PASS_HEADER`].
+    #[error("{path}: line 1 is the header {found:?}, not the pass CSV header {PASS_HEADER:?}")]
+    NotPasses {
+        /// The file.
+        path: PathBuf,
+        /// Its first line.
+        found: String,
+    },
     /// A row that does not parse.
     #[error("{path}: line {line}, column {column} ({name}): {message}")]
     Row {
@@ -296,7 +304,7 @@ pub fn read_passes_from(reader: impl std::io::Read, path: &Path) -> Result<Vec<P
     let mut r = csv::ReaderBuilder::new().has_headers(true).from_reader(reader);
     let header = r.headers().map_err(|e| row_error(e, path))?.clone();
     if header.iter().ne(COLUMNS) {
-        return Err(PassCsvError::Header {
+        return Err(PassCsvError::NotPasses {
             path: path.to_path_buf(),
             found: header.iter().collect::<Vec<_>>().join(","),
         });

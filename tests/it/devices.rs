@@ -187,5 +187,5 @@ fn calibrate_and_predict_through_the_command_line() {
         "--out",
         d.path().join("x.toml").to_str().unwrap(),
     ]);
-    assert!(e.contains("rows.csv:1"), "{e}");
+    assert!(e.contains("rows.csv: line 1") && e.contains("header"), "{e}");
 }
