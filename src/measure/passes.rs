@@ -529,7 +529,7 @@ mod tests {
             "{e}"
         );
         let e = bad("mesh,size,time\ngrid:8x8,64x64,1.0\n");
-        assert!(e.contains("x.csv has the header \"mesh,size,time\""), "{e}");
+        assert!(e.contains("x.csv: line 1 is the header \"mesh,size,time\""), "{e}");
         let missing = read_passes(Path::new("/nonexistent/passes.csv"))
             .unwrap_err()
             .to_string();
