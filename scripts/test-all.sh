@@ -21,7 +21,9 @@ if ! ls /usr/share/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1; then
 fi
 
 step "Python environment for notebooks"
-if [ ! -x .venv/bin/python ]; then
+# A venv left half made by an interrupted run has python but no pip: remake it.
+if [ ! -x .venv/bin/pip ]; then
+  rm -rf .venv
   python3 -m venv .venv
 fi
 .venv/bin/pip install --quiet --disable-pip-version-check -r notebooks/requirements.txt
@@ -78,8 +80,8 @@ if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
   # fit to the others (a report: lavapipe's pass times scatter with the
   # machine's load), then one pass the studies did not measure.
   "$RENDERSIM_BIN" calibrate "$ci_out/study-passes.csv" --out "$ci_out/llvmpipe.toml" \
-    --vertex-cache lavapipe --loo > "$ci_out/calibrate.txt"
-  grep -E '^(fit|leave-one-out|linear baseline)' "$ci_out/calibrate.txt"
+    --vertex-cache lavapipe --loo --holdout > "$ci_out/calibrate.txt"
+  grep -E '^(fit|leave-one-out|linear baseline|held-out half)' "$ci_out/calibrate.txt"
   measured=$("$RENDERSIM_BIN" measure grid:64x64 --size 384x384 --vs-loops 500 --fs-loops 20 --json 2>/dev/null \
     | python3 -c 'import json,sys; print(json.load(sys.stdin)["pass_time_ns"])')
   predicted=$("$RENDERSIM_BIN" predict grid:64x64 --device "$ci_out/llvmpipe.toml" --size 384x384 \

@@ -186,6 +186,10 @@ pub struct CalibrateArgs {
     /// Also predict each row from a fit to the others (leave-one-out) and report it.
     #[arg(long)]
     pub loo: bool,
+    /// Also fit on a fixed pseudo-random half of the rows and report the
+    /// errors of predicting the other half.
+    #[arg(long)]
+    pub holdout: bool,
     /// Print JSON instead of the table.
     #[arg(long)]
     pub json: bool,

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use serde_json::json;
 
 use rendersim::measure::calibrate::{
-    LoadCache, error_summary, fit, leave_one_out, linear_baseline_loo, read_rows, row_load,
+    LoadCache, error_summary, fit, held_out_half, leave_one_out, linear_baseline_loo, read_rows, row_load,
 };
 use rendersim::measure::device_predict::{DevicePass, predict_on_device};
 use rendersim::measure::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy};
@@ -62,6 +62,12 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         let e = leave_one_out(&fit_loads, &predict_loads, &y)?;
         let b = linear_baseline_loo(&predict_loads, &y);
         Some((e, b, t.elapsed().as_secs_f64()))
+    } else {
+        None
+    };
+    let half = if args.holdout {
+        let e = held_out_half(&fit_loads, &predict_loads, &y)?;
+        Some((error_summary(&e), e.len()))
     } else {
         None
     };
@@ -128,6 +134,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         let v = json!({"profile": profile, "out": args.out, "fit_seconds": fit_seconds,
             "loo_seconds": loo.as_ref().map(|l| l.2),
             "linear_baseline_loo": loo_summary.map(|s| json!({"median_pct": s.1.0, "p90_pct": s.1.1, "worst_pct": s.1.2})),
+            "held_out_half": half.map(|((m, p, w), n)| json!({"rows": n, "median_pct": m, "p90_pct": p, "worst_pct": w})),
             "rows": rows_json});
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
@@ -191,6 +198,12 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         writeln!(
             s,
             "linear baseline leave-one-out: median {bm:.1}%, p90 {bp:.1}%, worst {bw:.1}%"
+        )?;
+    }
+    if let Some(((m, p, w), n)) = half {
+        writeln!(
+            s,
+            "held-out half (fit on a fixed pseudo-random half, the other {n} rows predicted) |error|: median {m:.1}%, p90 {p:.1}%, worst {w:.1}%"
         )?;
     }
     writeln!(s, "wrote {}", args.out.display())?;

@@ -355,6 +355,42 @@ pub fn leave_one_out(
         .collect()
 }
 
+/// Whether row `i` is in the fitted half of [`held_out_half`]: a fixed
+/// pseudo-random half (splitmix64 of the row's position), so passes
+/// measured in pairs or in a sweep's order fall on both sides.
+pub fn in_fitted_half(i: usize) -> bool {
+    let mut z = (i as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    (z ^ (z >> 31)) & 1 == 0
+}
+
+/// Fits on one half of the rows ([`in_fitted_half`]) and predicts the
+/// others, each from its mesh's vertex count under the profile's cache
+/// policy (`predict_loads`): the held-out rows' relative errors in percent,
+/// in row order.
+pub fn held_out_half(
+    fit_loads: &[PassLoad],
+    predict_loads: &[PassLoad],
+    y: &[f64],
+) -> Result<Vec<f64>, CalibrateError> {
+    let (l, t): (Vec<PassLoad>, Vec<f64>) = fit_loads
+        .iter()
+        .zip(y)
+        .enumerate()
+        .filter(|(i, _)| in_fitted_half(*i))
+        .map(|(_, (l, t))| (*l, *t))
+        .unzip();
+    let f = fit(&l, &t)?;
+    Ok(predict_loads
+        .iter()
+        .zip(y)
+        .enumerate()
+        .filter(|(i, _)| !in_fitted_half(*i))
+        .map(|(_, (l, t))| rel_error_pct(f.costs.cost(l).pass_ns, *t))
+        .collect())
+}
+
 /// The baseline the profile must beat: time linear in vertex invocations,
 /// invocations x loops, fragments and fragments x loops (weighted by
 /// 1 / time, no structure); leave-one-out relative errors in percent.

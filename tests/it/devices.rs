@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use rendersim::measure::calibrate::{
-    LoadCache, PassRow, error_summary, fit, leave_one_out, linear_baseline_loo, read_rows, row_load,
+    LoadCache, PassRow, error_summary, fit, held_out_half, leave_one_out, linear_baseline_loo, read_rows, row_load,
 };
 use rendersim::measure::device_profile::{DeviceCosts, DeviceProfile};
 
@@ -69,6 +69,14 @@ fn calibrate_recovers_known_costs_from_synthetic_passes() {
             }
         }
     }
+    // Fitted on half the passes, the other half is predicted exactly too.
+    let half = held_out_half(&loads, &loads, &y).unwrap();
+    assert!(
+        half.len() >= y.len() / 4 && half.len() <= 3 * y.len() / 4,
+        "{}",
+        half.len()
+    );
+    assert!(half.iter().all(|e| e.abs() < 1.0), "{half:?}");
     let f = fit(&loads, &y).unwrap();
     for ((k, got), (_, want)) in f.costs.entries().iter().zip(t.entries()) {
         assert!((got - want).abs() <= 0.01 * want, "{k}: fitted {got}, true {want}");
@@ -102,6 +110,14 @@ fn h200_leave_one_out_beats_the_linear_baseline() {
     eprintln!("H200 leave-one-out: profile median {m:.1}% p90 {p90:.1}%; linear median {bm:.1}% p90 {bp90:.1}%");
     assert!(m.is_finite() && p90.is_finite());
     assert!(m < bm && p90 < bp90, "profile {m}/{p90} vs linear {bm}/{bp90}");
+    // Fitted on every other row, the rest predicted: also below the
+    // linear baseline's leave-one-out errors.
+    let (hm, hp90, _) = error_summary(&held_out_half(&fit_loads, &pred_loads, &y).unwrap());
+    eprintln!("H200 held-out half: median {hm:.1}% p90 {hp90:.1}%");
+    assert!(
+        hm < bm && hp90 < bp90,
+        "held-out half {hm}/{hp90} vs linear {bm}/{bp90}"
+    );
 }
 
 #[test]
