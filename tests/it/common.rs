@@ -102,3 +102,14 @@ pub fn null_paths(v: &Value, path: &str, out: &mut Vec<String>) {
         _ => {}
     }
 }
+
+/// A triangle-list probe mesh of `indices` (vertices 0 ..= the largest index).
+pub fn list(indices: Vec<u32>) -> rendersim::scene::mesh::Mesh {
+    let vertex_count = indices.iter().copied().max().unwrap_or(0) + 1;
+    rendersim::scene::mesh::Mesh {
+        name: "probe".into(),
+        topology: rendersim::scene::mesh::Topology::TriangleList,
+        indices,
+        vertex_count,
+    }
+}

@@ -3,19 +3,10 @@
 //! llvmpipe-mesa-22.3.6.md, study H1). These run without a device: the
 //! measured numbers are the oracle.
 
+use crate::common::list;
 use rendersim::components::vertex_cache::CachePolicy;
 use rendersim::scene::generators::mesh_from_spec;
-use rendersim::scene::mesh::{Mesh, Topology};
-
-fn list(indices: Vec<u32>) -> Mesh {
-    let vc = indices.iter().copied().max().unwrap_or(0) + 1;
-    Mesh {
-        name: "probe".into(),
-        topology: Topology::TriangleList,
-        indices,
-        vertex_count: vc,
-    }
-}
+use rendersim::scene::mesh::Mesh;
 
 fn tv(m: &Mesh) -> u64 {
     m.cache_stats(&CachePolicy::Lavapipe).transformed

@@ -5,11 +5,12 @@
 //! study H1's probes and validation meshes in `studies.md`. These run
 //! without a device: the measured numbers are the oracle.
 
+use crate::common::list;
 use std::path::{Path, PathBuf};
 
 use rendersim::components::vertex_cache::CachePolicy;
 use rendersim::scene::generators::mesh_from_spec;
-use rendersim::scene::mesh::{Mesh, Topology};
+use rendersim::scene::mesh::Mesh;
 
 fn data_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/measurements/nvidia-h200")
@@ -67,16 +68,6 @@ fn misses(rows: &[Row], policy: &str) -> Vec<(String, i64)> {
             (d != 0).then(|| (r.file.clone(), d))
         })
         .collect()
-}
-
-fn list(indices: Vec<u32>) -> Mesh {
-    let vc = indices.iter().copied().max().unwrap_or(0) + 1;
-    Mesh {
-        name: "probe".into(),
-        topology: Topology::TriangleList,
-        indices,
-        vertex_count: vc,
-    }
 }
 
 #[test]

@@ -139,8 +139,9 @@ pub fn draw_times_unified(
     }
 }
 
-/// The draw's time when its triangles come in a given order: geometry
-/// `geometry[i]` and fragments `fragment[i]` picoseconds for triangle `i`,
+/// The draw's time when its triangles come in a given order: `geometry`
+/// picoseconds of geometry per triangle and `fragment[i]` of fragments for
+/// triangle `i`,
 /// through a FIFO of `depth` triangles (`None`: binning, the sum). This is
 /// the exact recursion of the two-stage pipeline the `triangle` fidelity
 /// simulates: triangle i leaves the geometry stage when its geometry is done
@@ -149,21 +150,20 @@ pub fn draw_times_unified(
 /// has left geometry and triangle i - 1's fragments are done. Used for sizes
 /// sorted within a draw (`size_order`), where the window approximation of
 /// [`draw_times`] does not apply.
-pub fn ordered_draw_total(geometry: &[f64], fragment: &[f64], depth: Option<u32>) -> f64 {
+pub fn ordered_draw_total(geometry: f64, fragment: &[f64], depth: Option<u32>) -> f64 {
     let Some(depth) = depth else {
-        return geometry.iter().sum::<f64>() + fragment.iter().sum::<f64>();
+        return geometry * fragment.len() as f64 + fragment.iter().sum::<f64>();
     };
     let d = depth as usize + 1;
-    let n = geometry.len().min(fragment.len());
     // Fragment completion times, a ring of the last d.
     let mut done = vec![0.0f64; d];
     let (mut left_geometry, mut last_done) = (0.0f64, 0.0f64);
-    for i in 0..n {
-        let geometry_done = left_geometry + geometry[i];
+    for (i, f) in fragment.iter().enumerate() {
+        let geometry_done = left_geometry + geometry;
         let room = if i >= d { done[i % d] } else { 0.0 };
         left_geometry = geometry_done.max(room);
         let start = left_geometry.max(last_done);
-        last_done = start + fragment[i];
+        last_done = start + f;
         done[i % d] = last_done;
     }
     last_done
@@ -223,18 +223,18 @@ mod tests {
     #[test]
     fn ordered_recursion_matches_the_window_cases() {
         // Balanced constant triangles with a deep FIFO: max plus fill.
-        let g = vec![10.0; 1000];
-        assert_eq!(ordered_draw_total(&g, &g, Some(1000)), 10_010.0);
+        let g = 10.0;
+        assert_eq!(ordered_draw_total(g, &[10.0; 1000], Some(1000)), 10_010.0);
         // Direct hand-off, alternating sizes: the sum of per-triangle maxima plus fill.
         let f: Vec<f64> = (0..1000).map(|i| if i % 2 == 0 { 0.0 } else { 20.0 }).collect();
-        let t = ordered_draw_total(&g, &f, Some(0));
+        let t = ordered_draw_total(g, &f, Some(0));
         assert!((10_000.0..=20_000.0).contains(&t), "{t}");
         // Sorted: all small then all large, the regimes do not overlap.
         let mut sorted = f.clone();
         sorted.sort_by(f64::total_cmp);
-        let t = ordered_draw_total(&g, &sorted, Some(16));
+        let t = ordered_draw_total(g, &sorted, Some(16));
         assert!(t > 14_500.0, "{t}");
-        assert_eq!(ordered_draw_total(&g, &f, None), 20_000.0);
+        assert_eq!(ordered_draw_total(g, &f, None), 20_000.0);
     }
 
     #[test]

@@ -290,7 +290,7 @@ impl FramePipeline {
             }
         } else {
             FragWork {
-                shader: Duration::from_ps_f64(px * g.cost_per_pixel),
+                shader: Duration::from_ps_f64(px * g.cost_per_pixel()),
                 fixed: Duration::ZERO,
             }
         };

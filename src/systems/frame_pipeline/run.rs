@@ -470,7 +470,7 @@ fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProgram>) -> An
                 .iter()
                 .map(|d| {
                     let g = &s.groups[d.group as usize];
-                    s.meshes[d.mesh as usize].triangles as f64 * g.pixels.mean() * g.cost_per_pixel
+                    s.meshes[d.mesh as usize].triangles as f64 * g.pixels.mean() * g.cost_per_pixel()
                 })
                 .sum();
             (base_cpu + cpu, base_front + front, geo, frag)

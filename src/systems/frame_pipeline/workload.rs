@@ -96,9 +96,6 @@ pub struct GroupInfo {
     pub name: String,
     /// Screen-space triangle area, pixels.
     pub pixels: Dist<f64>,
-    /// Expected fragment cost per covered pixel, picoseconds (early-z folded
-    /// in): the fragment stage's time per pixel when split.
-    pub cost_per_pixel: f64,
     /// Order of the sizes within a draw.
     pub order: SizeOrder,
     /// Unified: expected shader work per covered pixel (on the pool), ps.
@@ -106,6 +103,15 @@ pub struct GroupInfo {
     /// Unified: expected fixed-function time per covered pixel (depth test
     /// of rejected fragments, rasterization and blending of shaded ones), ps.
     pub fixed_per_pixel: f64,
+}
+
+impl GroupInfo {
+    /// Expected fragment cost per covered pixel, picoseconds (early-z folded
+    /// in): the split fragment stage's time per pixel, shader and
+    /// fixed-function parts one after the other.
+    pub fn cost_per_pixel(&self) -> f64 {
+        self.shade_per_pixel + self.fixed_per_pixel
+    }
 }
 
 /// One draw call with the commands that precede it.
@@ -207,7 +213,7 @@ pub fn closed_times(cfg: &FramePipelineConfig, m: &MeshInfo, g: &GroupInfo) -> D
         return ordered_closed_times(cfg, m, g);
     }
     if cfg.gpu.pool().is_none() {
-        return draw_times(m.triangles, m.geometry_time, &g.pixels, g.cost_per_pixel, depth);
+        return draw_times(m.triangles, m.geometry_time, &g.pixels, g.cost_per_pixel(), depth);
     }
     draw_times_unified(
         m.triangles,
@@ -253,11 +259,10 @@ fn ordered_closed_times(cfg: &FramePipelineConfig, m: &MeshInfo, g: &GroupInfo) 
     let per_pixel = if unified {
         g.shade_per_pixel.max(g.fixed_per_pixel)
     } else {
-        g.cost_per_pixel
+        g.cost_per_pixel()
     };
-    let geometry = vec![per_triangle; sizes.len()];
     let fragment: Vec<f64> = sizes.iter().map(|px| px * per_pixel).collect();
-    let mut total = ordered_draw_total(&geometry, &fragment, cfg.gpu.fragment.depth());
+    let mut total = ordered_draw_total(per_triangle, &fragment, cfg.gpu.fragment.depth());
     if unified {
         let shader = m.geometry_shader.0 as f64 + sizes.iter().sum::<f64>() * g.shade_per_pixel;
         total = total.max(shader);
@@ -303,8 +308,6 @@ pub fn compile_scene(
 
     let pass = early_z_pass(scene.depth_order, scene.depth_complexity);
     let frag = &cfg.gpu.fragment;
-    let shaded = frag.per_fragment.0 as f64 + frag.fixed_per_fragment.0 as f64;
-    let cost_per_pixel = pass * shaded + (1.0 - pass) * frag.per_rejected_fragment.0 as f64;
     let shade_per_pixel = pass * frag.per_fragment.0 as f64;
     let fixed_per_pixel = pass * frag.fixed_per_fragment.0 as f64 + (1.0 - pass) * frag.per_rejected_fragment.0 as f64;
     let geo = &cfg.gpu.geometry;
@@ -367,7 +370,6 @@ pub fn compile_scene(
         groups.push(GroupInfo {
             name: g.name.clone(),
             pixels: g.triangle_pixels.clone(),
-            cost_per_pixel,
             shade_per_pixel,
             fixed_per_pixel,
             order: g.size_order,
