@@ -76,17 +76,18 @@ if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
   fi
   head -n 4 "$ci_out/studies.txt"
   echo "$(($(wc -l < "$ci_out/study-passes.csv") - 1)) measured passes in the pass CSV"
-  # A device profile fitted afresh on these passes, each pass predicted by a
-  # fit to the others (a report: lavapipe's pass times scatter with the
-  # machine's load), then one pass the studies did not measure.
+  # A device profile fitted afresh on these passes: each pass predicted by a
+  # fit to the others (reported), and a fit on a fixed half predicting the
+  # other half (checked: its median |error| must stay under 40%; lavapipe's
+  # pass times scatter with the machine's load, 10-25% seen so far).
   "$RENDERSIM_BIN" calibrate "$ci_out/study-passes.csv" --out "$ci_out/llvmpipe.toml" \
-    --vertex-cache lavapipe --loo --holdout > "$ci_out/calibrate.txt"
+    --vertex-cache lavapipe --loo --holdout --holdout-max-median 40 > "$ci_out/calibrate.txt" \
+    || { cat "$ci_out/calibrate.txt"; exit 1; }
   grep -E '^(fit|leave-one-out|linear baseline|held-out half)' "$ci_out/calibrate.txt"
-  measured=$("$RENDERSIM_BIN" measure grid:64x64 --size 384x384 --vs-loops 500 --fs-loops 20 --json 2>/dev/null \
-    | python3 -c 'import json,sys; print(json.load(sys.stdin)["pass_time_ns"])')
-  predicted=$("$RENDERSIM_BIN" predict grid:64x64 --device "$ci_out/llvmpipe.toml" --size 384x384 \
-    --vs-loops 500 --fs-loops 20 --json | python3 -c 'import json,sys; print(json.load(sys.stdin)["predicted"]["pass_time_ns"])')
-  python3 -c "m, p = $measured, $predicted; print(f'a pass not in the CSV (grid:64x64, 384x384, 500/20 loops): measured {m/1e6:.3f} ms, predicted {p/1e6:.3f} ms ({(p/m-1)*100:+.1f}%)')"
+  # A pass the studies did not measure, predicted and measured in one run
+  # (the prediction's error, and measuring vs simulating wall time).
+  "$RENDERSIM_BIN" predict grid:96x96 --device "$ci_out/llvmpipe.toml" --size 384x384 \
+    --vs-loops 500 --fs-loops 20 --measure 2>/dev/null
 else
   echo "no Vulkan driver installed: studies skipped"
 fi

@@ -190,6 +190,10 @@ pub struct CalibrateArgs {
     /// errors of predicting the other half.
     #[arg(long)]
     pub holdout: bool,
+    /// With --holdout: fail (exit status 1) when the held-out half's median
+    /// |error| exceeds PCT percent (the profile is still written).
+    #[arg(long, value_name = "PCT", requires = "holdout")]
+    pub holdout_max_median: Option<f64>,
     /// Print JSON instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -224,6 +228,14 @@ pub struct PredictArgs {
     /// Early depth test on.
     #[arg(long)]
     pub depth_test: bool,
+    /// Also measure the same pass on this machine's adapter (feature `wgpu`)
+    /// and print the prediction's error and the wall times of measuring and
+    /// simulating, both timed in this run.
+    #[arg(long)]
+    pub measure: bool,
+    /// Recorded passes of --measure (the median is used; 2 warm-ups before).
+    #[arg(long, default_value_t = 5)]
+    pub repeats: u32,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,

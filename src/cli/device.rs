@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use serde_json::json;
 
 use rendersim::measure::calibrate::{
-    LoadCache, error_summary, fit, held_out_half, leave_one_out, linear_baseline_loo, read_rows, row_load,
+    Invocations, LoadCache, error_summary, fit, held_out_half, leave_one_out, linear_baseline_loo, read_rows, row_load,
 };
 use rendersim::measure::device_predict::{DevicePass, predict_on_device};
 use rendersim::measure::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy};
@@ -47,9 +47,8 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     let mut fit_loads = Vec::with_capacity(rows.len());
     let mut predict_loads = Vec::with_capacity(rows.len());
     for r in &rows {
-        fit_loads.push(row_load(r, &mut cache, None)?);
-        let v = cache.vertices(&r.mesh, &args.vertex_cache)?;
-        predict_loads.push(row_load(r, &mut cache, Some(v))?);
+        fit_loads.push(row_load(r, &mut cache, &args.vertex_cache, Invocations::Measured)?);
+        predict_loads.push(row_load(r, &mut cache, &args.vertex_cache, Invocations::Predicted)?);
     }
     let y: Vec<f64> = rows.iter().map(|r| r.pass_time_ns).collect();
     let f = fit(&fit_loads, &y)?;
@@ -137,7 +136,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
             "held_out_half": half.map(|((m, p, w), n)| json!({"rows": n, "median_pct": m, "p90_pct": p, "worst_pct": w})),
             "rows": rows_json});
         println!("{}", serde_json::to_string_pretty(&v)?);
-        return Ok(());
+        return check_holdout(args, half.map(|h| h.0.0));
     }
     let mut s = String::new();
     writeln!(
@@ -154,7 +153,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
             .iter()
             .find(|(n, _)| n == k)
             .map(|(_, s)| format!("{s:.4e}"))
-            .unwrap_or_else(|| "grid".into());
+            .unwrap_or_else(|| "-".into());
         writeln!(s, "{k:<28} {v:>14.6e} {se:>12}")?;
     }
     writeln!(
@@ -208,7 +207,18 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     }
     writeln!(s, "wrote {}", args.out.display())?;
     print!("{s}");
-    Ok(())
+    check_holdout(args, half.map(|h| h.0.0))
+}
+
+/// `--holdout-max-median`: the held-out half's median against the bound.
+fn check_holdout(args: &CalibrateArgs, median: Option<f64>) -> Result<()> {
+    match (args.holdout_max_median, median) {
+        (Some(bound), Some(m)) if m > bound || m.is_nan() => anyhow::bail!(
+            "held-out half: median |error| {m:.1}% exceeds --holdout-max-median {bound}% (profile written to {})",
+            args.out.display()
+        ),
+        _ => Ok(()),
+    }
 }
 
 /// `rendersim predict`.
@@ -225,13 +235,21 @@ pub fn predict(args: &PredictArgs) -> Result<()> {
         depth_test: args.depth_test,
     };
     let p = predict_on_device(&profile, &pass)?;
+    let measured = if args.measure { Some(measure_pass(args)?) } else { None };
+    // The comparison: measured pass time and wall time of measuring
+    // (opening the adapter, warm-ups, repeats) against the simulation's.
+    let comparison = measured.as_ref().map(|(ns, wall, adapter)| {
+        json!({"adapter": adapter, "pass_time_ns": ns, "error_pct": rel_error_pct(p.pass_time_ns, *ns),
+            "measure_wall_seconds": wall, "simulate_wall_seconds": p.sim_wall_seconds,
+            "speedup": wall / p.sim_wall_seconds.max(1e-9)})
+    });
     if args.json {
         let v = json!({
             "mesh": args.mesh, "device": args.device, "device_name": profile.device.name,
             "size": format!("{}x{}", args.size.width, args.size.height),
             "vs_loops": args.vs_loops, "fs_loops": args.fs_loops, "geometry_only": args.geometry_only,
             "layers": args.layers, "depth_test": args.depth_test,
-            "predicted": p, "wall_seconds": p.sim_wall_seconds,
+            "predicted": p, "wall_seconds": p.sim_wall_seconds, "measured": comparison,
         });
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
@@ -246,6 +264,42 @@ pub fn predict(args: &PredictArgs) -> Result<()> {
             p.fs_invocations,
             p.sim_wall_seconds
         );
+        if let Some((ns, wall, adapter)) = &measured {
+            println!(
+                "measured on {adapter}: {:.4} ms (prediction {:+.1}%); measuring took {wall:.3} s, simulating {:.3} s: {:.1}x faster",
+                ns / 1e6,
+                rel_error_pct(p.pass_time_ns, *ns),
+                p.sim_wall_seconds,
+                wall / p.sim_wall_seconds.max(1e-9)
+            );
+        }
     }
     Ok(())
+}
+
+/// `predict --measure`: the pass measured on this machine's adapter:
+/// (median pass time ns, wall seconds of the whole measurement, adapter).
+#[cfg(feature = "wgpu")]
+fn measure_pass(args: &PredictArgs) -> Result<(f64, f64, String)> {
+    let m = rendersim::scene::generators::mesh_from_spec(&args.mesh, std::path::Path::new("."))?;
+    let opts = rendersim::measure::MeasureOptions {
+        vs_loops: args.vs_loops,
+        fs_loops: args.fs_loops,
+        depth_test: args.depth_test,
+        layers: args.layers,
+        order: args.order.into(),
+        size: (args.size.width, args.size.height),
+        repeats: args.repeats,
+        geometry_only: args.geometry_only,
+        ..Default::default()
+    };
+    let start = Instant::now();
+    let r = rendersim::measure::measure(&m, &args.mesh, &opts)?;
+    Ok((r.pass_time_ns, start.elapsed().as_secs_f64(), r.adapter.name))
+}
+
+/// `predict --measure` without the `wgpu` feature.
+#[cfg(not(feature = "wgpu"))]
+fn measure_pass(_args: &PredictArgs) -> Result<(f64, f64, String)> {
+    anyhow::bail!("--measure needs a rendersim built with `--features wgpu`")
 }

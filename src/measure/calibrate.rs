@@ -1,15 +1,15 @@
 //! Fitting a device profile (`device_profile.rs`) to measured passes: the
 //! CSV rows `rendersim measure` produces (`mesh,size,vs_loops,fs_loops,
 //! geometry_only,vs_invocations,fs_invocations,pass_time_ns`), each turned
-//! into a [`PassLoad`] (measured vertex invocations, coverage counted from
-//! the mesh and target size), then weighted least squares on the relative
-//! error: the nine costs are linear once the two lane weights (a grid search,
-//! coarse then fine) and which side of `max(clear, geometry)` each row is on
-//! (iterated to a fixed point) are fixed; a cost that comes out negative is
-//! pinned to zero and the rest refitted. Standard errors come from the
-//! covariance of the final linear fit. Leave-one-out predicts each row from a
-//! fit to the others, with vertex invocations from the profile's vertex-cache
-//! policy, as `rendersim predict` would.
+//! into a [`PassLoad`] (measured vertex invocations; vertex batches from
+//! the profile's cache policy; coverage counted from the mesh and target
+//! size), then non-negative least squares on the relative error (Lawson and
+//! Hanson's active-set method): every cost is linear once it is fixed which
+//! side of `max(clear, geometry)` each row is on, and that is iterated to a
+//! fixed point. Standard errors come from the covariance of the final fit.
+//! Leave-one-out predicts each row from a fit to the others, with vertex
+//! invocations from the profile's vertex-cache policy, as `rendersim
+//! predict` would.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -17,9 +17,9 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::coverage::{Coverage, coverage};
-use super::device_profile::{DeviceCosts, PassLoad};
+use super::device_profile::{COSTS as P, DeviceCosts, PassLoad};
 use super::fit::rel_error_pct;
-use crate::components::vertex_cache::CachePolicy;
+use crate::components::vertex_cache::{CachePolicy, VertexCache};
 use crate::scene::generators::mesh_from_spec;
 
 pub use super::passes::PassRow;
@@ -49,11 +49,33 @@ pub fn read_rows(path: &Path) -> Result<Vec<PassRow>, CalibrateError> {
     Ok(super::passes::read_passes(path)?)
 }
 
-/// Coverage and predicted vertex invocations, computed once per mesh and size.
+/// The vertex work of one draw of a mesh under a cache policy.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct VertexWork {
+    /// Vertex-shader invocations.
+    pub invocations: u64,
+    /// Batches (warps of up to 32 vertices): as the policy cuts them where
+    /// it does (`nvidia`, `lookback:`, `batch:`, `meshopt:`), else (FIFO,
+    /// LRU, direct-mapped, lavapipe) the invocations packed 32 to a warp.
+    pub batches: u64,
+    /// Triangles drawn.
+    pub triangles: u64,
+}
+
+/// Which vertex invocations a row's load uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Invocations {
+    /// The row's measured count (fitting).
+    Measured,
+    /// The cache policy's count (predicting, as `rendersim predict` does).
+    Predicted,
+}
+
+/// Coverage and vertex work, computed once per mesh (and size).
 #[derive(Default)]
 pub struct LoadCache {
     coverage: HashMap<(String, u32, u32), Coverage>,
-    vertices: HashMap<String, u64>,
+    vertices: HashMap<String, VertexWork>,
 }
 
 impl LoadCache {
@@ -69,14 +91,40 @@ impl LoadCache {
         Ok(c)
     }
 
-    /// Vertex invocations of one draw of `spec` under `policy`.
-    pub fn vertices(&mut self, spec: &str, policy: &CachePolicy) -> Result<u64, CalibrateError> {
+    /// Vertex work of one draw of `spec` under `policy`.
+    pub fn vertex_work(&mut self, spec: &str, policy: &CachePolicy) -> Result<VertexWork, CalibrateError> {
         if let Some(v) = self.vertices.get(spec) {
             return Ok(*v);
         }
-        let v = mesh(spec)?.cache_stats(policy).transformed;
+        let v = vertex_work(&mesh(spec)?, policy);
         self.vertices.insert(spec.to_string(), v);
         Ok(v)
+    }
+
+    /// Vertex invocations of one draw of `spec` under `policy`.
+    pub fn vertices(&mut self, spec: &str, policy: &CachePolicy) -> Result<u64, CalibrateError> {
+        Ok(self.vertex_work(spec, policy)?.invocations)
+    }
+}
+
+/// Vertex work of one draw of `mesh` under `policy` (its triangle list).
+pub fn vertex_work(mesh: &crate::scene::mesh::Mesh, policy: &CachePolicy) -> VertexWork {
+    let list = mesh.to_triangle_list();
+    let mut cache = VertexCache::new(policy, list.vertex_count as usize);
+    let mut invocations = 0u64;
+    for t in list.indices.chunks_exact(3) {
+        invocations += u64::from(cache.access_triangle([t[0], t[1], t[2]]));
+    }
+    // Direct-mapped caches count their flush segments as warps; those are
+    // not shader batches.
+    let batches = match (policy, cache.warps()) {
+        (CachePolicy::Direct { .. } | CachePolicy::Lavapipe, _) | (_, 0) => invocations.div_ceil(32),
+        (_, w) => w,
+    };
+    VertexWork {
+        invocations,
+        batches,
+        triangles: list.indices.len() as u64 / 3,
     }
 }
 
@@ -87,11 +135,24 @@ fn mesh(spec: &str) -> Result<crate::scene::mesh::Mesh, CalibrateError> {
     })
 }
 
-/// The load of a row; `vertices` overrides the measured invocations.
-pub fn row_load(row: &PassRow, cache: &mut LoadCache, vertices: Option<u64>) -> Result<PassLoad, CalibrateError> {
+/// The load of a row: vertex batches and triangles from `policy`, the
+/// vertex invocations measured or predicted.
+pub fn row_load(
+    row: &PassRow,
+    cache: &mut LoadCache,
+    policy: &CachePolicy,
+    invocations: Invocations,
+) -> Result<PassLoad, CalibrateError> {
+    let work = cache.vertex_work(&row.mesh, policy)?;
+    let vertices = match invocations {
+        Invocations::Measured => row.vs_invocations,
+        Invocations::Predicted => work.invocations,
+    };
     Ok(PassLoad {
         pixels: f64::from(row.size.width) * f64::from(row.size.height),
-        vertices: vertices.unwrap_or(row.vs_invocations) as f64,
+        vertices: vertices as f64,
+        vertex_batches: work.batches as f64,
+        triangles: work.triangles as f64,
         vs_loops: f64::from(row.vs_loops),
         fs_loops: f64::from(row.fs_loops),
         coverage: if row.geometry_only {
@@ -113,51 +174,16 @@ pub struct Fit {
     pub objective: f64,
 }
 
-const P: usize = 9;
-const KEYS: [&str; P] = [
-    "pass_overhead_ns",
-    "clear_store_per_pixel_ns",
-    "vertex_ns",
-    "vertex_per_loop_ns",
-    "vertex_loop_latency_ns",
-    "triangle_ns",
-    "lane_ns",
-    "lane_per_loop_ns",
-    "fragment_loop_latency_ns",
-];
-
-fn costs_of(b: &[f64; P], helper: f64, waste: f64) -> DeviceCosts {
-    DeviceCosts {
-        pass_overhead_ns: b[0],
-        clear_store_per_pixel_ns: b[1],
-        vertex_ns: b[2],
-        vertex_per_loop_ns: b[3],
-        vertex_loop_latency_ns: b[4],
-        triangle_ns: b[5],
-        lane_ns: b[6],
-        lane_per_loop_ns: b[7],
-        fragment_loop_latency_ns: b[8],
-        helper_lane_weight: helper,
-        warp_waste_weight: waste,
+/// Design row: the load's regressors with the clear term (side 2) or the
+/// geometry terms (side 1) zeroed; side 0 (the first pass) keeps both.
+fn design(l: &PassLoad, side: u8) -> [f64; P] {
+    let mut x = l.regressors();
+    match side {
+        1 => x[2..=6].fill(0.0),
+        2 => x[1] = 0.0,
+        _ => {}
     }
-}
-
-/// Design row; `side`: 0 both terms (the first pass), 1 clear, 2 geometry.
-fn design(l: &PassLoad, lanes: f64, side: u8) -> [f64; P] {
-    let (c, g) = (side != 2, side != 1);
-    let gz = |v: f64| if g { v } else { 0.0 };
-    let frag = l.coverage.fragments > 0;
-    [
-        1.0,
-        if c { l.pixels } else { 0.0 },
-        gz(l.vertices),
-        gz(l.vertices * l.vs_loops),
-        gz(l.vs_loops),
-        gz(l.coverage.triangles as f64),
-        if frag { lanes } else { 0.0 },
-        if frag { lanes * l.fs_loops } else { 0.0 },
-        if frag { l.fs_loops } else { 0.0 },
-    ]
+    x
 }
 
 /// Solves `a x = b` (n x n, row-major) by Gaussian elimination with partial
@@ -188,85 +214,120 @@ fn solve(mut a: Vec<f64>, mut b: Vec<f64>, n: usize) -> Option<Vec<f64>> {
     Some(x)
 }
 
-/// Non-negative weighted least squares of `1 = x_i . b / y_i`; returns the
-/// coefficients, the standard errors and the objective.
+/// Non-negative weighted least squares of `1 = x_i . b / y_i` (Lawson and
+/// Hanson's active-set method on the normal equations of unit-norm
+/// columns); returns the coefficients, their standard errors and the
+/// objective (sum of squared relative errors).
 fn nnls(rows: &[[f64; P]], y: &[f64]) -> ([f64; P], [f64; P], f64) {
-    // Scale columns to unit norm for conditioning.
     let mut scale = [0.0f64; P];
     for (r, yi) in rows.iter().zip(y) {
         for (s, v) in scale.iter_mut().zip(r) {
             *s += (v / yi).powi(2);
         }
     }
-    let mut active: Vec<usize> = (0..P).filter(|&j| scale[j] > 0.0).collect();
+    let usable: Vec<bool> = scale.iter().map(|&s| s > 0.0).collect();
     for s in &mut scale {
         *s = if *s > 0.0 { s.sqrt() } else { 1.0 };
     }
-    loop {
-        let n = active.len();
-        let (mut a, mut b) = (vec![0.0; n * n], vec![0.0; n]);
-        for (r, yi) in rows.iter().zip(y) {
-            let x: Vec<f64> = active.iter().map(|&j| r[j] / yi / scale[j]).collect();
-            for i in 0..n {
-                b[i] += x[i];
-                for k in 0..n {
-                    a[i * n + k] += x[i] * x[k];
-                }
+    // Gram matrix and right-hand side of the scaled system.
+    let (mut g, mut c) = ([[0.0f64; P]; P], [0.0f64; P]);
+    for (r, yi) in rows.iter().zip(y) {
+        let x: [f64; P] = std::array::from_fn(|j| r[j] / yi / scale[j]);
+        for i in 0..P {
+            c[i] += x[i];
+            for k in 0..P {
+                g[i][k] += x[i] * x[k];
             }
         }
-        let sol = solve(a.clone(), b, n);
-        let Some(sol) = sol else {
-            // Singular: drop the last active column and retry.
-            active.pop();
-            continue;
-        };
-        if let Some(worst) = (0..n)
-            .filter(|&i| sol[i] < 0.0)
-            .min_by(|&i, &j| sol[i].total_cmp(&sol[j]))
-        {
-            active.remove(worst);
-            continue;
-        }
-        let mut beta = [0.0; P];
-        for (i, &j) in active.iter().enumerate() {
-            beta[j] = sol[i] / scale[j];
-        }
-        let obj: f64 = rows
-            .iter()
-            .zip(y)
-            .map(|(r, yi)| {
-                let p: f64 = r.iter().zip(&beta).map(|(a, b)| a * b).sum();
-                (p / yi - 1.0).powi(2)
-            })
-            .sum();
-        let dof = rows.len().saturating_sub(n).max(1) as f64;
-        let s2 = obj / dof;
-        let mut se = [0.0; P];
-        for (i, &j) in active.iter().enumerate() {
-            let mut e = vec![0.0; n];
-            e[i] = 1.0;
-            if let Some(col) = solve(a.clone(), e, n) {
-                se[j] = (s2 * col[i]).max(0.0).sqrt() / scale[j];
-            }
-        }
-        return (beta, se, obj);
     }
+    let solve_on = |set: &[usize]| -> Option<Vec<f64>> {
+        let n = set.len();
+        let a: Vec<f64> = set.iter().flat_map(|&i| set.iter().map(move |&k| g[i][k])).collect();
+        solve(a, set.iter().map(|&i| c[i]).collect(), n)
+    };
+    let mut x = [0.0f64; P];
+    let mut passive: Vec<usize> = Vec::new();
+    let mut excluded = [false; P];
+    for _ in 0..10 * P {
+        let w: [f64; P] = std::array::from_fn(|j| c[j] - (0..P).map(|k| g[j][k] * x[k]).sum::<f64>());
+        let Some(j) = (0..P)
+            .filter(|&j| usable[j] && !excluded[j] && !passive.contains(&j) && w[j] > 1e-10)
+            .max_by(|&a, &b| w[a].total_cmp(&w[b]))
+        else {
+            break;
+        };
+        passive.push(j);
+        loop {
+            let Some(sol) = solve_on(&passive) else {
+                // Dependent on the columns already in: leave it out.
+                passive.retain(|&k| k != j);
+                excluded[j] = true;
+                break;
+            };
+            if sol.iter().all(|&v| v > 0.0) {
+                for (&k, v) in passive.iter().zip(&sol) {
+                    x[k] = *v;
+                }
+                break;
+            }
+            let alpha = passive
+                .iter()
+                .zip(&sol)
+                .filter(|(_, s)| **s <= 0.0)
+                .map(|(&k, s)| x[k] / (x[k] - s))
+                .fold(f64::INFINITY, f64::min);
+            for (&k, s) in passive.iter().zip(&sol) {
+                x[k] += alpha * (s - x[k]);
+            }
+            passive.retain(|&k| {
+                if x[k] <= 1e-15 {
+                    x[k] = 0.0;
+                    false
+                } else {
+                    true
+                }
+            });
+        }
+    }
+    let beta: [f64; P] = std::array::from_fn(|j| x[j] / scale[j]);
+    let obj: f64 = rows
+        .iter()
+        .zip(y)
+        .map(|(r, yi)| {
+            let p: f64 = r.iter().zip(&beta).map(|(a, b)| a * b).sum();
+            (p / yi - 1.0).powi(2)
+        })
+        .sum();
+    let n = passive.len();
+    let s2 = obj / rows.len().saturating_sub(n).max(1) as f64;
+    let mut se = [0.0; P];
+    let a: Vec<f64> = passive
+        .iter()
+        .flat_map(|&i| passive.iter().map(move |&k| g[i][k]))
+        .collect();
+    for (i, &j) in passive.iter().enumerate() {
+        let mut e = vec![0.0; n];
+        e[i] = 1.0;
+        if let Some(col) = solve(a.clone(), e, n) {
+            se[j] = (s2 * col[i]).max(0.0).sqrt() / scale[j];
+        }
+    }
+    (beta, se, obj)
 }
 
-/// Fits the linear costs for fixed lane weights.
-fn fit_linear(loads: &[PassLoad], y: &[f64], helper: f64, waste: f64) -> ([f64; P], [f64; P], f64) {
-    let lanes: Vec<f64> = loads.iter().map(|l| l.lanes(helper, waste)).collect();
+/// Fits a profile's costs to `loads` measured at `y` ns: which side of
+/// `max(clear, geometry)` each row is on is iterated to a fixed point
+/// (starting from both terms summed), keeping the best fit visited.
+pub fn fit(loads: &[PassLoad], y: &[f64]) -> Result<Fit, CalibrateError> {
+    if loads.len() < 12 {
+        return Err(CalibrateError::TooFewRows(loads.len()));
+    }
     let mut side = vec![0u8; loads.len()];
-    let mut best = None;
+    let mut best: Option<([f64; P], [f64; P], f64)> = None;
     for _ in 0..12 {
-        let rows: Vec<[f64; P]> = loads
-            .iter()
-            .zip(&lanes)
-            .zip(&side)
-            .map(|((l, n), s)| design(l, *n, *s))
-            .collect();
+        let rows: Vec<[f64; P]> = loads.iter().zip(&side).map(|(l, s)| design(l, *s)).collect();
         let (b, se, obj) = nnls(&rows, y);
-        let c = costs_of(&b, helper, waste);
+        let c = DeviceCosts::from_array(&b);
         let next: Vec<u8> = loads
             .iter()
             .map(|l| {
@@ -275,8 +336,6 @@ fn fit_linear(loads: &[PassLoad], y: &[f64], helper: f64, waste: f64) -> ([f64; 
             })
             .collect();
         let done = next == side;
-        // Keep the best objective among the fixed points visited (side 0 is
-        // only a start: it sums both terms).
         if !side.contains(&0) && best.as_ref().is_none_or(|(_, _, o)| obj < *o) {
             best = Some((b, se, obj));
         }
@@ -285,39 +344,16 @@ fn fit_linear(loads: &[PassLoad], y: &[f64], helper: f64, waste: f64) -> ([f64; 
             break;
         }
     }
-    best.unwrap_or(([0.0; P], [0.0; P], f64::INFINITY))
-}
-
-/// Fits a profile's costs to `loads` measured at `y` ns.
-pub fn fit(loads: &[PassLoad], y: &[f64]) -> Result<Fit, CalibrateError> {
-    if loads.len() < 12 {
-        return Err(CalibrateError::TooFewRows(loads.len()));
-    }
-    let mut best = (f64::INFINITY, 0.0, 0.0, [0.0; P], [0.0; P]);
-    let try_w = |h: f64, w: f64, best: &mut (f64, f64, f64, [f64; P], [f64; P])| {
-        let (b, se, obj) = fit_linear(loads, y, h, w);
-        if obj < best.0 {
-            *best = (obj, h, w, b, se);
-        }
-    };
-    for i in 0..=10 {
-        for j in 0..=10 {
-            try_w(f64::from(i) / 10.0, f64::from(j) / 10.0, &mut best);
-        }
-    }
-    let (h0, w0) = (best.1, best.2);
-    for i in -5..=5 {
-        for j in -5..=5 {
-            let (h, w) = (h0 + f64::from(i) * 0.02, w0 + f64::from(j) * 0.02);
-            if (0.0..=1.0).contains(&h) && (0.0..=1.0).contains(&w) {
-                try_w(h, w, &mut best);
-            }
-        }
-    }
-    let (objective, h, w, b, se) = best;
+    let (b, se, objective) = best.unwrap_or(([0.0; P], [0.0; P], f64::INFINITY));
+    let costs = DeviceCosts::from_array(&b);
     Ok(Fit {
-        costs: costs_of(&b, h, w),
-        std_errors: KEYS.iter().zip(se).map(|(k, s)| (k.to_string(), s)).collect(),
+        costs,
+        std_errors: costs
+            .entries()
+            .iter()
+            .zip(se)
+            .map(|((k, _), s)| (k.to_string(), s))
+            .collect(),
         objective,
     })
 }

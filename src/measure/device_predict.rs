@@ -12,7 +12,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::calibrate::CalibrateError;
+use super::calibrate::{CalibrateError, vertex_work};
 use super::coverage::{Coverage, coverage};
 use super::device_profile::{DeviceProfile, PassCost, PassLoad};
 use super::geometry::DepthOrder;
@@ -97,7 +97,8 @@ pub fn predict_on_device(profile: &DeviceProfile, pass: &DevicePass) -> Result<D
         .vertex_cache
         .parse()
         .map_err(|e| DevicePredictError::Option(format!("device.vertex_cache: {e}")))?;
-    let vertices = mesh.cache_stats(&policy).transformed;
+    let work = vertex_work(&mesh, &policy);
+    let vertices = work.invocations;
     let cov = if pass.geometry_only {
         Coverage::default()
     } else {
@@ -106,6 +107,8 @@ pub fn predict_on_device(profile: &DeviceProfile, pass: &DevicePass) -> Result<D
     let load = PassLoad {
         pixels: f64::from(w) * f64::from(h),
         vertices: vertices as f64,
+        vertex_batches: work.batches as f64,
+        triangles: work.triangles as f64,
         vs_loops: f64::from(pass.vs_loops),
         fs_loops: f64::from(pass.fs_loops),
         coverage: cov,
@@ -124,7 +127,7 @@ pub fn predict_on_device(profile: &DeviceProfile, pass: &DevicePass) -> Result<D
         layers: pass.layers,
         per_vertex: duration_ps(1e3 * per_ns(terms.geometry_ns, vertices as f64)),
         per_fragment: duration_ps(1e3 * frag_cost),
-        per_rejected_fragment: duration_ps(1e3 * per_ns(c.lane_ns * terms.lanes, cov.fragments as f64)),
+        per_rejected_fragment: duration_ps(1e3 * per_ns(terms.fragment_base_ns, cov.fragments as f64)),
         fragments_per_triangle: cov.fragments as f64 / drawn,
         depth_order: match (pass.depth_test, pass.order) {
             (false, _) | (true, DepthOrder::BackToFront) => "back_to_front",

@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use rendersim::measure::calibrate::{
-    LoadCache, PassRow, error_summary, fit, held_out_half, leave_one_out, linear_baseline_loo, read_rows, row_load,
+    Invocations, LoadCache, PassRow, error_summary, fit, held_out_half, leave_one_out, linear_baseline_loo, read_rows,
+    row_load,
 };
 use rendersim::measure::device_profile::{DeviceCosts, DeviceProfile};
 
@@ -26,14 +27,17 @@ fn truth() -> DeviceCosts {
         pass_overhead_ns: 5_000.0,
         clear_store_per_pixel_ns: 0.15,
         vertex_ns: 2.0,
-        vertex_per_loop_ns: 0.015,
+        triangle_ns: 0.5,
+        covered_triangle_ns: 1.5,
         vertex_loop_latency_ns: 15.0,
-        triangle_ns: 1.0,
-        lane_ns: 0.05,
-        lane_per_loop_ns: 0.0035,
+        vertex_lane_per_loop_ns: 0.013,
+        fragment_ns: 0.05,
+        helper_lane_ns: 0.09,
+        empty_lane_ns: 0.01,
+        fragment_per_loop_ns: 0.0035,
+        helper_lane_per_loop_ns: 0.002,
+        empty_lane_per_loop_ns: 0.001,
         fragment_loop_latency_ns: 40.0,
-        helper_lane_weight: 0.5,
-        warp_waste_weight: 0.3,
     }
 }
 
@@ -41,6 +45,7 @@ fn truth() -> DeviceCosts {
 fn calibrate_recovers_known_costs_from_synthetic_passes() {
     let t = truth();
     let mut cache = LoadCache::default();
+    let policy = "meshopt:32,32,32".parse().unwrap();
     let (mut loads, mut y) = (Vec::new(), Vec::new());
     for mesh in ["grid:16x16", "grid:48x48", "grid:32x32:shuffled:3", "strip:24x24"] {
         for size in [64, 256, 1024] {
@@ -62,8 +67,7 @@ fn calibrate_recovers_known_costs_from_synthetic_passes() {
                     fs_invocations: 0,
                     pass_time_ns: 1.0,
                 };
-                let v = cache.vertices(mesh, &"meshopt:32,32,32".parse().unwrap()).unwrap();
-                let l = row_load(&row, &mut cache, Some(v)).unwrap();
+                let l = row_load(&row, &mut cache, &policy, Invocations::Predicted).unwrap();
                 y.push(t.cost(&l).pass_ns);
                 loads.push(l);
             }
@@ -90,19 +94,19 @@ fn calibrate_recovers_known_costs_from_synthetic_passes() {
 }
 
 #[test]
-fn h200_leave_one_out_beats_the_linear_baseline() {
+fn h200_leave_one_out_meets_the_goal_and_beats_the_linear_baseline() {
     let mut rows = read_rows(&h200("load-grid.csv")).unwrap();
     rows.extend(read_rows(&h200("load-sweep.csv")).unwrap());
     assert_eq!(rows.len(), 95);
     let mut cache = LoadCache::default();
-    let policy = "meshopt:32,32,32".parse().unwrap();
-    let fit_loads: Vec<_> = rows.iter().map(|r| row_load(r, &mut cache, None).unwrap()).collect();
+    let policy = "nvidia".parse().unwrap();
+    let fit_loads: Vec<_> = rows
+        .iter()
+        .map(|r| row_load(r, &mut cache, &policy, Invocations::Measured).unwrap())
+        .collect();
     let pred_loads: Vec<_> = rows
         .iter()
-        .map(|r| {
-            let v = cache.vertices(&r.mesh, &policy).unwrap();
-            row_load(r, &mut cache, Some(v)).unwrap()
-        })
+        .map(|r| row_load(r, &mut cache, &policy, Invocations::Predicted).unwrap())
         .collect();
     let y: Vec<f64> = rows.iter().map(|r| r.pass_time_ns).collect();
     let (m, p90, _) = error_summary(&leave_one_out(&fit_loads, &pred_loads, &y).unwrap());
@@ -110,6 +114,9 @@ fn h200_leave_one_out_beats_the_linear_baseline() {
     eprintln!("H200 leave-one-out: profile median {m:.1}% p90 {p90:.1}%; linear median {bm:.1}% p90 {bp90:.1}%");
     assert!(m.is_finite() && p90.is_finite());
     assert!(m < bm && p90 < bp90, "profile {m}/{p90} vs linear {bm}/{bp90}");
+    // The accuracy goal (median at most 5%, 90th percentile at most
+    // 15%), met here on the shared rows, each predicted without itself.
+    assert!(m <= 5.0 && p90 <= 15.0, "leave-one-out median {m:.2}% p90 {p90:.2}%");
     // Fitted on every other row, the rest predicted: also below the
     // linear baseline's leave-one-out errors.
     let (hm, hp90, _) = error_summary(&held_out_half(&fit_loads, &pred_loads, &y).unwrap());
@@ -181,9 +188,9 @@ fn calibrate_and_predict_through_the_command_line() {
     let negative: String = text
         .lines()
         .map(|l| {
-            if l.starts_with("lane_ns = ") && !seen {
+            if l.starts_with("fragment_ns = ") && !seen {
                 seen = true;
-                "lane_ns = -1.0\n".to_string()
+                "fragment_ns = -1.0\n".to_string()
             } else {
                 format!("{l}\n")
             }
@@ -191,7 +198,7 @@ fn calibrate_and_predict_through_the_command_line() {
         .collect();
     std::fs::write(&bad, negative).unwrap();
     let e = err(&["predict", "grid:8x8", "--device", bad.to_str().unwrap()]);
-    assert!(e.contains("bad.toml") && e.contains("costs.lane_ns"), "{e}");
+    assert!(e.contains("bad.toml") && e.contains("costs.fragment_ns"), "{e}");
     std::fs::write(&bad, text.replace("vertex_ns", "vertex_nanos")).unwrap();
     let e = err(&["predict", "grid:8x8", "--device", bad.to_str().unwrap()]);
     assert!(e.contains("bad.toml") && e.contains("vertex_nanos"), "{e}");
