@@ -194,6 +194,11 @@ pub struct CalibrateArgs {
     /// |error| exceeds PCT percent (the profile is still written).
     #[arg(long, value_name = "PCT", requires = "holdout")]
     pub holdout_max_median: Option<f64>,
+    /// Also write a Markdown report: every row measured against its
+    /// leave-one-out prediction and against `predict`'s simulation, with
+    /// the wall time of measuring vs simulating.
+    #[arg(long, value_name = "FILE.md")]
+    pub report: Option<PathBuf>,
     /// Print JSON instead of the table.
     #[arg(long)]
     pub json: bool,

@@ -8,6 +8,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use serde_json::json;
 
+use rendersim::measure::calibrate::PassRow;
 use rendersim::measure::calibrate::{
     Invocations, LoadCache, error_summary, fit, held_out_half, leave_one_out, linear_baseline_loo, read_rows, row_load,
 };
@@ -44,6 +45,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     }
     let start = Instant::now();
     let mut cache = LoadCache::default();
+    cache.prefetch(&rows, &args.vertex_cache)?;
     let mut fit_loads = Vec::with_capacity(rows.len());
     let mut predict_loads = Vec::with_capacity(rows.len());
     for r in &rows {
@@ -116,7 +118,16 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    std::fs::write(&args.out, profile.to_toml(&header)).with_context(|| format!("writing {}", args.out.display()))?;
+    let text = profile.to_toml(&header);
+    rendersim::output::files::write_output(&args.out, |w| w.write_all(text.as_bytes()))?;
+    if let Some(path) = &args.report {
+        let errors = match &loo {
+            Some((e, _, _)) => e.clone(),
+            None => leave_one_out(&fit_loads, &predict_loads, &y)?,
+        };
+        let md = report_markdown(&profile, &rows, &errors)?;
+        rendersim::output::files::write_output(path, |w| w.write_all(md.as_bytes()))?;
+    }
 
     if args.json {
         let rows_json: Vec<_> = rows
@@ -208,6 +219,73 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     writeln!(s, "wrote {}", args.out.display())?;
     print!("{s}");
     check_holdout(args, half.map(|h| h.0.0))
+}
+
+/// `calibrate --report`: every row measured against its leave-one-out
+/// prediction (the closed form fitted without the row) and against the
+/// full profile's simulation (`predict`'s frame-pipeline run), with the wall
+/// time of simulating each pass beside the device time measuring it took.
+fn report_markdown(profile: &DeviceProfile, rows: &[PassRow], loo: &[f64]) -> Result<String> {
+    let mut s = String::new();
+    let name = &profile.device.name;
+    writeln!(s, "# Predicted against measured: {name}\n")?;
+    writeln!(
+        s,
+        "Written by `rendersim calibrate --report` (rendersim {}). `loo %`: the pass predicted by the \
+         profile fitted to every other row (the cost formula of docs/models.md); `sim %`: the pass \
+         simulated with the full profile by the frame-pipeline model at triangle fidelity, as \
+         `rendersim predict` does. `measuring s`: the device time of the 7 passes a measurement \
+         records (2 warm-ups, 5 repeats; a lower bound: setup and readback are not in the CSV); \
+         `simulating s`: this machine's wall time for the simulation.\n",
+        env!("CARGO_PKG_VERSION")
+    )?;
+    writeln!(
+        s,
+        "| mesh | size | vs loops | fs loops | geometry only | measured ms | loo % | simulated ms | sim % | measuring s | simulating s |"
+    )?;
+    writeln!(s, "|---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|")?;
+    let (mut sim_errors, mut measure_s, mut simulate_s) = (Vec::new(), 0.0, 0.0);
+    for (r, e) in rows.iter().zip(loo) {
+        let pass = DevicePass {
+            mesh: r.mesh.clone(),
+            size: (r.size.width, r.size.height),
+            vs_loops: r.vs_loops,
+            fs_loops: r.fs_loops,
+            geometry_only: r.geometry_only,
+            layers: 1,
+            order: rendersim::measure::DepthOrder::FrontToBack,
+            depth_test: false,
+        };
+        let p = predict_on_device(profile, &pass)?;
+        let se = rel_error_pct(p.pass_time_ns, r.pass_time_ns);
+        let m = 7.0 * r.pass_time_ns * 1e-9;
+        sim_errors.push(se);
+        measure_s += m;
+        simulate_s += p.sim_wall_seconds;
+        writeln!(
+            s,
+            "| {} | {}x{} | {} | {} | {} | {:.4} | {e:+.1} | {:.4} | {se:+.1} | {m:.4} | {:.4} |",
+            r.mesh,
+            r.size.width,
+            r.size.height,
+            r.vs_loops,
+            r.fs_loops,
+            if r.geometry_only { "yes" } else { "" },
+            r.pass_time_ns / 1e6,
+            p.pass_time_ns / 1e6,
+            p.sim_wall_seconds
+        )?;
+    }
+    let (lm, lp, lw) = error_summary(loo);
+    let (sm, sp, sw) = error_summary(&sim_errors);
+    writeln!(
+        s,
+        "\n{} rows. Leave-one-out |error|: median {lm:.1}%, 90th percentile {lp:.1}%, worst {lw:.1}%. \
+         Simulated with the full profile: median {sm:.1}%, 90th percentile {sp:.1}%, worst {sw:.1}%. \
+         Measuring took at least {measure_s:.2} s of device time; simulating took {simulate_s:.2} s here.",
+        rows.len()
+    )?;
+    Ok(s)
 }
 
 /// `--holdout-max-median`: the held-out half's median against the bound.

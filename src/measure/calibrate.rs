@@ -101,6 +101,35 @@ impl LoadCache {
         Ok(v)
     }
 
+    /// Computes the coverage and vertex work of every distinct mesh and
+    /// size of `rows` at once, in parallel (rayon); later lookups hit the
+    /// cache. Coverage counting dominates a calibration's time.
+    pub fn prefetch(&mut self, rows: &[PassRow], policy: &CachePolicy) -> Result<(), CalibrateError> {
+        use rayon::prelude::*;
+        let mut keys: Vec<(String, u32, u32)> = rows
+            .iter()
+            .filter(|r| !r.geometry_only)
+            .map(|r| (r.mesh.clone(), r.size.width, r.size.height))
+            .filter(|k| !self.coverage.contains_key(k))
+            .collect();
+        keys.sort();
+        keys.dedup();
+        let mut specs: Vec<&str> = rows.iter().map(|r| r.mesh.as_str()).collect();
+        specs.sort_unstable();
+        specs.dedup();
+        let covs: Vec<Coverage> = keys
+            .par_iter()
+            .map(|(spec, w, h)| Ok(coverage(&mesh(spec)?, spec, *w, *h)))
+            .collect::<Result<_, CalibrateError>>()?;
+        let works: Vec<VertexWork> = specs
+            .par_iter()
+            .map(|spec| Ok(vertex_work(&mesh(spec)?, policy)))
+            .collect::<Result<_, CalibrateError>>()?;
+        self.coverage.extend(keys.into_iter().zip(covs));
+        self.vertices.extend(specs.into_iter().map(str::to_string).zip(works));
+        Ok(())
+    }
+
     /// Vertex invocations of one draw of `spec` under `policy`.
     pub fn vertices(&mut self, spec: &str, policy: &CachePolicy) -> Result<u64, CalibrateError> {
         Ok(self.vertex_work(spec, policy)?.invocations)

@@ -131,6 +131,7 @@ fn h200_leave_one_out_meets_the_goal_and_beats_the_linear_baseline() {
 fn calibrate_and_predict_through_the_command_line() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("devices/h200.toml");
+    let report = d.path().join("h200-predictions.md");
     let o = bin()
         .args([
             "calibrate",
@@ -139,6 +140,8 @@ fn calibrate_and_predict_through_the_command_line() {
             "--out",
         ])
         .arg(&out)
+        .arg("--report")
+        .arg(&report)
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&o.stdout);
@@ -154,6 +157,20 @@ fn calibrate_and_predict_through_the_command_line() {
     );
     let profile = DeviceProfile::read(&out).unwrap();
     assert_eq!(profile.fit.rows, 95);
+    // The report: one table row per pass (simulated by `predict`'s model),
+    // then the summary with measuring against simulating time.
+    let md = std::fs::read_to_string(&report).unwrap();
+    assert_eq!(
+        md.lines()
+            .filter(|l| l.starts_with("| grid") || l.starts_with("| random") || l.starts_with("| strip"))
+            .count(),
+        95,
+        "{md}"
+    );
+    assert!(
+        md.contains("95 rows. Leave-one-out |error|: median") && md.contains("simulating took"),
+        "{md}"
+    );
 
     let o = bin()
         .args(["predict", "grid:32x32", "--device"])
