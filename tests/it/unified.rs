@@ -130,11 +130,26 @@ fn reserved_cores_are_slower_than_sharing() {
 
 #[test]
 fn draw_fidelity_follows_the_triangle_simulation_within_two_percent() {
-    for (name, text) in [
+    let models = [
         ("default", DEFAULT),
         ("city", include_str!("../../models/city.toml")),
         ("one-mesh", include_str!("../../models/one-mesh.toml")),
-    ] {
+        ("single-view", include_str!("../../models/single-view.toml")),
+        ("terrain", include_str!("../../models/terrain.toml")),
+        ("h2-pass", include_str!("../../models/h2-pass.toml")),
+    ];
+    // Every shipped frame-pipeline model with a scene is in the list (a
+    // new one must be added here; `fixed` has no scene, so no fidelity).
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap_or_default();
+        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
+        if text.contains("system = \"frame_pipeline\"") && text.contains("kind = \"scene\"") {
+            assert!(models.iter().any(|(n, _)| *n == stem), "{stem} is not checked here");
+        }
+    }
+    for (name, text) in models {
         let sets = ["run.frames=4", "run.warmup_frames=1", "noise.enabled=false"];
         let tri = run(text, &[&sets[..], &["fidelity=\"triangle\""]].concat());
         let draw = run(text, &[&sets[..], &["fidelity=\"draw\""]].concat());
