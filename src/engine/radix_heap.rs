@@ -14,9 +14,9 @@
 //! bucket becomes the next run: a level-0 bucket holds one single time and
 //! is the run as it is; a level-1 bucket (256 ps) is distributed by its low
 //! byte into the level-0 buckets and these are appended in digit order (a
-//! counting sort, no comparisons); a higher bucket of at most [`SORT_MAX`]
-//! events is sorted, a larger one spread around its minimum into lower
-//! buckets. `last` moves only then (moving it while the run is popped could
+//! counting sort, no comparisons); a bucket of at most [`SORT_MAX`] events
+//! is sorted instead, and a larger one above level 1 spread around its
+//! minimum into lower buckets. `last` moves only then (moving it while the run is popped could
 //! file a later event into a lower bucket than an earlier one). An event
 //! therefore moves at most eight times in all, and for the nanosecond
 //! delays of a GPU model (below 2^24 ps) at most three times: the cost per
@@ -55,9 +55,9 @@ const BUCKETS: usize = LEVELS * DIGITS;
 pub const SMALL_MAX: usize = 32;
 /// Pending events at or below which the heap returns to the small array.
 pub const SMALL_BACK: usize = 8;
-/// A bucket above level 1 is sorted into the run when it holds at most
-/// this many events; a larger one is spread into lower buckets.
-pub const SORT_MAX: usize = 32;
+/// A bucket is sorted into the run when it holds at most this many events;
+/// a larger one is counting-sorted (level 1) or spread into lower buckets.
+pub const SORT_MAX: usize = 64;
 
 /// The radix heap (see the module documentation).
 #[derive(Debug)]
@@ -331,12 +331,12 @@ impl<E> RadixHeap<E> {
     }
 
     /// The run is empty: the earliest bucket becomes the run. A level-0
-    /// bucket holds one time and is in order already; a level-1 bucket is
+    /// bucket holds one time and is in order already; one of at most
+    /// [`SORT_MAX`] events is sorted; a larger level-1 bucket is
     /// distributed by its low byte into the (empty) level-0 buckets, which
     /// are then appended to the run in digit order (a stable counting sort:
-    /// no comparisons); a higher one is sorted when it holds at most
-    /// [`SORT_MAX`] events, else spread around its minimum, which becomes
-    /// the new `last`, into lower buckets.
+    /// no comparisons); a larger one above is spread around its minimum,
+    /// which becomes the new `last`, into lower buckets.
     fn refill(&mut self) {
         debug_assert!(self.run.is_empty());
         let Some((l, v)) = self.first_bucket() else {
@@ -344,12 +344,12 @@ impl<E> RadixHeap<E> {
         };
         let mut moving = std::mem::take(&mut self.buckets[l * DIGITS + v]);
         self.clear_bucket(l, v);
-        if l == 0 || (l > 1 && moving.len() <= SORT_MAX) {
-            // In sequence order already: a level-0 bucket needs nothing,
-            // and for a higher one sorting by time alone would be enough
-            // (stable); times and sequence numbers are unique together, so
-            // the unstable sort on both gives the same order.
-            if l > 0 {
+        if l == 0 || moving.len() <= SORT_MAX {
+            // In sequence order already: a level-0 bucket (one time) or a
+            // single event needs nothing. Times and sequence numbers are
+            // unique together, so the unstable sort on both gives the
+            // `(time, seq)` order.
+            if l > 0 && moving.len() > 1 {
                 moving.sort_unstable_by_key(|s| (s.time.0, s.seq));
             }
             self.last = moving.first().map_or(self.last, |s| s.time.0);
