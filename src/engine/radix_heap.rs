@@ -57,7 +57,7 @@ pub const SMALL_MAX: usize = 32;
 pub const SMALL_BACK: usize = 8;
 /// A bucket is sorted into the run when it holds at most this many events;
 /// a larger one is counting-sorted (level 1) or spread into lower buckets.
-pub const SORT_MAX: usize = 64;
+pub const SORT_MAX: usize = 16;
 
 /// The radix heap (see the module documentation).
 #[derive(Debug)]
@@ -295,8 +295,18 @@ impl<E> RadixHeap<E> {
             return self.pop_stale();
         }
         if self.run.is_empty() {
-            if self.levels == 0 {
-                return None;
+            let (l, v) = self.first_bucket()?;
+            let i = (l * DIGITS + v) & (BUCKETS - 1);
+            if self.buckets[i].len() == 1 {
+                // A single event (common when the pending events are
+                // sparse): it is the next one, and its time the new `last`
+                // (the earliest bucket's minimum, as when spreading).
+                let s = self.buckets[i].pop()?;
+                self.clear_bucket(l, v);
+                self.last = s.time.0;
+                self.run_hi = self.last;
+                self.len -= 1;
+                return Some(s);
             }
             self.refill();
         }
