@@ -245,6 +245,58 @@ mod tests {
         same_order(&ops, &initial);
     }
 
+    /// Many pending (the bucket form throughout), with delays that fill
+    /// every kind of bucket: the same instant, within one level-1 bucket's
+    /// 256 ps, within a level-2 bucket's 65,536 ps (small ones are sorted,
+    /// large ones spread) and far away; pushes often land inside the run
+    /// being popped. Same pop order as the binary heap, element for element.
+    #[test]
+    fn the_radix_queue_keeps_its_order_with_many_pending_and_mixed_delays() {
+        use rand::Rng;
+        for (seed, population) in [(1u64, 40usize), (2, 300), (3, 3_000), (4, 20_000)] {
+            let mut rng = crate::engine::RngStreams::new(seed).stream("queue test");
+            let mut r = EventQueue::of_kind(QueueKind::Radix);
+            let mut b = EventQueue::of_kind(QueueKind::Binary);
+            for i in 0..population {
+                let t = rng.random_range(0..100_000u64);
+                r.push(Time(t), i);
+                b.push(Time(t), i);
+            }
+            let mut id = population;
+            for step in 0..(20 * population) {
+                let (x, y) = (r.pop(), b.pop());
+                assert_eq!(
+                    x.as_ref().map(|s| (s.time, s.seq, s.event)),
+                    y.as_ref().map(|s| (s.time, s.seq, s.event)),
+                    "seed {seed}, step {step}"
+                );
+                let now = x.expect("never empty").time.0;
+                // One push per pop on average, so the population stays.
+                let pushes = [0, 1, 1, 2][rng.random_range(0..4usize)];
+                for _ in 0..pushes {
+                    let d = match rng.random_range(0..6u32) {
+                        0 => 0,
+                        1 => rng.random_range(0..256u64),
+                        2 => rng.random_range(0..4_000u64),
+                        3 => rng.random_range(0..70_000u64),
+                        4 => rng.random_range(0..20_000_000u64),
+                        _ => 1u64 << rng.random_range(20..44u32),
+                    };
+                    r.push(Time(now + d), id);
+                    b.push(Time(now + d), id);
+                    id += 1;
+                }
+                assert_eq!(r.len(), b.len());
+                assert_eq!(r.peek_time(), b.peek_time());
+            }
+            while let Some(x) = r.pop() {
+                let y = b.pop().expect("same length");
+                assert_eq!((x.time, x.seq), (y.time, y.seq));
+            }
+            assert!(b.pop().is_none());
+        }
+    }
+
     proptest::proptest! {
         #[test]
         fn radix_and_binary_heaps_pop_in_the_same_order(

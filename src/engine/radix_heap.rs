@@ -2,24 +2,34 @@
 //!
 //! A discrete-event loop only ever schedules events at or after the time it
 //! last popped, so keys are monotone (Ahuja, Mehlhorn, Orlin & Tarjan's
-//! radix heap exploits exactly that). Here a time is read as eight bytes. An
-//! event due at `t` is kept in the bucket (level `l`, digit `v`): `l` is the
-//! highest byte in which `t` differs from the last popped time `last`, and
-//! `v` is `t`'s value of that byte (events due at `last` itself wait in the
-//! "now" list). Buckets of a lower level hold earlier events, and within a
-//! level a lower digit means earlier, so the earliest bucket is found from
-//! two bit masks. A level-0 bucket holds one single time and becomes the
-//! "now" list as it is; a higher one is spread around its minimum into lower
-//! buckets. An event therefore moves at most eight times in all, and for the
-//! nanosecond delays of a GPU model (below 2^24 ps) at most twice: the cost
-//! per event stays flat however many are pending and however far apart
-//! their times are (picosecond costs next to one-second periods), where a
-//! binary heap pays log n cache misses.
+//! radix heap exploits exactly that). Here a time is read as eight bytes.
+//!
+//! The earliest events wait in the *run*, sorted by `(time, seq)`; every
+//! other event is due after the run's last one and is kept in the bucket
+//! (level `l`, digit `v`): `l` is the highest byte in which its time `t`
+//! differs from `last` (the run's first time when the run was made), and
+//! `v` is `t`'s value of that byte. Buckets of a lower level hold earlier
+//! events, and within a level a lower digit means earlier, so the earliest
+//! bucket is found from two bit masks. When the run is empty the earliest
+//! bucket becomes the next run: a level-0 bucket holds one single time and
+//! is the run as it is; a level-1 bucket (256 ps) is distributed by its low
+//! byte into the level-0 buckets and these are appended in digit order (a
+//! counting sort, no comparisons); a bucket of at most [`SORT_MAX`] events
+//! is sorted instead, and a larger one above level 1 spread around its
+//! minimum into lower buckets. `last` moves only then (moving it while the run is popped could
+//! file a later event into a lower bucket than an earlier one). An event
+//! therefore moves at most eight times in all, and for the nanosecond
+//! delays of a GPU model (below 2^24 ps) at most three times: the cost per
+//! event stays flat however many are pending and however far apart their
+//! times are (picosecond costs next to one-second periods), where a binary
+//! heap pays log n cache misses. A new event due no later than the run's
+//! last one is inserted into the run in its place (usually at its end).
 //!
 //! Same-time events leave in scheduling order: every bucket is in sequence
 //! order (a new event has the largest sequence number so far and is
 //! appended; a bucket is only spread into buckets that are empty, in its own
-//! order), so the pop order is exactly the binary heap's `(time, seq)` order.
+//! order; the counting sort is stable), so the pop order is exactly the
+//! binary heap's `(time, seq)` order.
 //!
 //! An event scheduled before the last popped time (a model bug the run loop
 //! reports) is kept aside and popped first, so the loop sees it at once.
@@ -39,29 +49,41 @@ use super::queue::Scheduled;
 
 const LEVELS: usize = 8;
 const DIGITS: usize = 256;
+/// Buckets in all: (level l, digit v) at index `l * 256 + v`.
+const BUCKETS: usize = LEVELS * DIGITS;
 /// Pending events the small sorted array holds before the heap uses its buckets.
 pub const SMALL_MAX: usize = 32;
 /// Pending events at or below which the heap returns to the small array.
 pub const SMALL_BACK: usize = 8;
+/// A bucket is sorted into the run when it holds at most this many events;
+/// a larger one is counting-sorted (level 1) or spread into lower buckets.
+pub const SORT_MAX: usize = 16;
 
 /// The radix heap (see the module documentation).
 #[derive(Debug)]
 pub struct RadixHeap<E> {
-    /// The last popped time: every pending event is due at or after it.
+    /// Small form: the last popped time. Bucket form: the run's first time
+    /// when it was made (the buckets are relative to it). Every pending
+    /// event but the stale ones is due at or after it.
     last: u64,
-    /// Due at `last`, in sequence order.
-    now: VecDeque<Scheduled<E>>,
-    /// Bucket (level l, digit v) at index l * 256 + v.
-    buckets: Box<[Vec<Scheduled<E>>]>,
+    /// The run: the earliest events, sorted by `(time, seq)`, earliest first.
+    run: VecDeque<Scheduled<E>>,
+    /// The latest time in the run (`last` when it is empty): every event in
+    /// the buckets is due after it.
+    run_hi: u64,
+    /// Bucket (level l, digit v) at index l * 256 + v (a fixed-size array,
+    /// indexed under a mask: no bounds checks).
+    buckets: Box<[Vec<Scheduled<E>>; BUCKETS]>,
     /// Bit l set when level l has a non-empty bucket.
     levels: u32,
-    /// Per level, bit v set when bucket (l, v) is non-empty.
-    digits: [[u64; 4]; LEVELS],
+    /// Bit `i % 64` of word `i / 64` set when bucket `i` is non-empty (four
+    /// words per level).
+    digits: [u64; BUCKETS / 64],
     /// Events scheduled before `last` (model bugs), popped first.
     stale: Vec<Scheduled<E>>,
     len: usize,
     /// True while the events are in `small` (and nothing is in the buckets,
-    /// `now` or `stale`).
+    /// the run or `stale`).
     is_small: bool,
     /// Small form: pending events sorted by `(time, seq)`, latest first.
     small: Vec<Scheduled<E>>,
@@ -73,15 +95,13 @@ impl<E> Default for RadixHeap<E> {
     }
 }
 
-/// The bucket of `time` relative to `last` (`None`: due at `last`).
+/// The bucket of `time` relative to `last` (`time` must differ from `last`).
 #[inline]
-fn slot(time: u64, last: u64) -> Option<(usize, usize)> {
+fn slot(time: u64, last: u64) -> (usize, usize) {
     let x = time ^ last;
-    if x == 0 {
-        return None;
-    }
+    debug_assert!(x != 0);
     let level = (63 - x.leading_zeros() as usize) / 8;
-    Some((level, ((time >> (8 * level)) & 0xff) as usize))
+    (level, ((time >> (8 * level)) & 0xff) as usize)
 }
 
 impl<E> RadixHeap<E> {
@@ -89,10 +109,16 @@ impl<E> RadixHeap<E> {
     pub fn new() -> Self {
         RadixHeap {
             last: 0,
-            now: VecDeque::new(),
-            buckets: (0..LEVELS * DIGITS).map(|_| Vec::new()).collect(),
+            run: VecDeque::new(),
+            run_hi: 0,
+            buckets: (0..BUCKETS)
+                .map(|_| Vec::new())
+                .collect::<Vec<_>>()
+                .into_boxed_slice()
+                .try_into()
+                .unwrap_or_else(|_| unreachable!("BUCKETS buckets made")),
             levels: 0,
-            digits: [[0; 4]; LEVELS],
+            digits: [0; BUCKETS / 64],
             stale: Vec::new(),
             len: 0,
             is_small: true,
@@ -115,18 +141,15 @@ impl<E> RadixHeap<E> {
         }
     }
 
-    /// Leaves the small form: files its events into the buckets in
-    /// `(time, seq)` order.
+    /// Leaves the small form: files its events into the run and the buckets
+    /// in `(time, seq)` order.
     #[cold]
     fn spill_to_buckets(&mut self) {
         self.is_small = false;
+        self.run_hi = self.last;
         let mut small = std::mem::take(&mut self.small);
         while let Some(s) = small.pop() {
-            if s.time.0 < self.last {
-                self.stale.push(s);
-            } else {
-                self.file(s);
-            }
+            self.place(s);
         }
         self.small = small;
     }
@@ -146,16 +169,50 @@ impl<E> RadixHeap<E> {
         self.is_small = true;
     }
 
+    /// Bucket form: puts a new event (the largest sequence number so far)
+    /// where it belongs: aside if stale, into the run if due no later than
+    /// the run's last event, else into its bucket.
+    #[inline(always)]
+    fn place(&mut self, s: Scheduled<E>) {
+        let t = s.time.0;
+        if t > self.run_hi {
+            self.file(s);
+        } else if t >= self.last {
+            self.run_insert(s);
+        } else {
+            self.stale.push(s);
+        }
+    }
+
+    /// Inserts into the run after every event due at or before its time.
+    #[inline]
+    fn run_insert(&mut self, s: Scheduled<E>) {
+        let t = s.time;
+        // Usually due at the run's end or after (the same instant).
+        if self.run.back().is_none_or(|b| b.time <= t) {
+            self.run_hi = t.0;
+            self.run.push_back(s);
+        } else {
+            self.run_insert_inside(s);
+        }
+    }
+
+    /// [`RadixHeap::run_insert`] before the run's last event.
+    #[inline(never)]
+    fn run_insert_inside(&mut self, s: Scheduled<E>) {
+        let t = s.time;
+        let i = self.run.partition_point(|x| x.time <= t);
+        self.run.insert(i, s);
+    }
+
+    /// Files an event due after `run_hi` into its bucket.
     #[inline]
     fn file(&mut self, s: Scheduled<E>) {
-        match slot(s.time.0, self.last) {
-            None => self.now.push_back(s),
-            Some((l, v)) => {
-                self.buckets[l * DIGITS + v].push(s);
-                self.levels |= 1 << l;
-                self.digits[l][v / 64] |= 1 << (v % 64);
-            }
-        }
+        let (l, v) = slot(s.time.0, self.last);
+        let i = (l * DIGITS + v) & (BUCKETS - 1);
+        self.buckets[i].push(s);
+        self.levels |= 1 << l;
+        self.digits[(i / 64) & (BUCKETS / 64 - 1)] |= 1 << (i % 64);
     }
 
     /// Adds an event. Its sequence number must be larger than every one
@@ -186,28 +243,28 @@ impl<E> RadixHeap<E> {
         if self.is_small {
             self.spill_to_buckets();
         }
-        if s.time.0 < self.last {
-            self.stale.push(s);
-        } else {
-            self.file(s);
-        }
+        self.place(s);
     }
 
     /// Puts back the event just popped (it goes before every other event
     /// due at the same time, as it was).
     pub fn restore(&mut self, s: Scheduled<E>) {
+        self.len += 1;
         if self.is_small {
             // It was the earliest: it goes back to the end.
-            self.len += 1;
             self.small.push(s);
             return;
         }
-        if s.time.0 == self.last {
-            self.len += 1;
-            self.now.push_front(s);
-        } else {
-            self.push(s);
+        if s.time.0 < self.last {
+            // It was stale (and the earliest of them).
+            self.stale.push(s);
+            return;
         }
+        // It was the earliest: first in the run.
+        if self.run.is_empty() {
+            self.run_hi = s.time.0;
+        }
+        self.run.push_front(s);
     }
 
     /// Removes the earliest event (ties: the first scheduled).
@@ -223,6 +280,10 @@ impl<E> RadixHeap<E> {
         let s = self.pop_buckets();
         if self.len <= SMALL_BACK {
             self.gather_to_small();
+            // The small form's `last` is the time just popped.
+            if let Some(p) = &s {
+                self.last = p.time.0;
+            }
         }
         s
     }
@@ -233,25 +294,28 @@ impl<E> RadixHeap<E> {
         if !self.stale.is_empty() {
             return self.pop_stale();
         }
-        if self.now.is_empty() {
-            if self.levels == 0 {
-                return None;
-            }
-            // The earliest bucket holds a single event (the common case when
-            // few are pending): it is the next one, no need to spread it.
+        if self.run.is_empty() {
             let (l, v) = self.first_bucket()?;
-            let b = &mut self.buckets[l * DIGITS + v];
-            if b.len() == 1 {
-                let s = b.pop()?;
+            let i = (l * DIGITS + v) & (BUCKETS - 1);
+            if self.buckets[i].len() == 1 {
+                // A single event (common when the pending events are
+                // sparse): it is the next one, and its time the new `last`
+                // (the earliest bucket's minimum, as when spreading).
+                let s = self.buckets[i].pop()?;
                 self.clear_bucket(l, v);
                 self.last = s.time.0;
+                self.run_hi = self.last;
                 self.len -= 1;
                 return Some(s);
             }
             self.refill();
         }
+        // `last` stays the run's first time: the buckets are relative to
+        // it, and moving it inside the run could file a later event below
+        // an earlier one.
+        let s = self.run.pop_front()?;
         self.len -= 1;
-        self.now.pop_front()
+        Some(s)
     }
 
     /// The earliest non-empty bucket, as (level, digit).
@@ -260,8 +324,8 @@ impl<E> RadixHeap<E> {
         if self.levels == 0 {
             return None;
         }
-        let l = self.levels.trailing_zeros() as usize;
-        let words = &self.digits[l];
+        let l = self.levels.trailing_zeros() as usize & (LEVELS - 1);
+        let words = &self.digits[l * 4..l * 4 + 4];
         let w = words.iter().position(|&w| w != 0)?;
         Some((l, w * 64 + words[w].trailing_zeros() as usize))
     }
@@ -269,34 +333,81 @@ impl<E> RadixHeap<E> {
     /// Marks bucket (l, v) empty in the masks.
     #[inline]
     fn clear_bucket(&mut self, l: usize, v: usize) {
-        self.digits[l][v / 64] &= !(1 << (v % 64));
-        if self.digits[l].iter().all(|&w| w == 0) {
+        let i = (l * DIGITS + v) & (BUCKETS - 1);
+        self.digits[(i / 64) & (BUCKETS / 64 - 1)] &= !(1 << (i % 64));
+        if self.digits[l * 4..l * 4 + 4].iter().all(|&w| w == 0) {
             self.levels &= !(1 << l);
         }
     }
 
-    /// Moves the earliest bucket to "now" (level 0: one time) or spreads it
-    /// around its minimum, which becomes the new `last`.
+    /// The run is empty: the earliest bucket becomes the run. A level-0
+    /// bucket holds one time and is in order already; one of at most
+    /// [`SORT_MAX`] events is sorted; a larger level-1 bucket is
+    /// distributed by its low byte into the (empty) level-0 buckets, which
+    /// are then appended to the run in digit order (a stable counting sort:
+    /// no comparisons); a larger one above is spread around its minimum,
+    /// which becomes the new `last`, into lower buckets.
     fn refill(&mut self) {
+        debug_assert!(self.run.is_empty());
         let Some((l, v)) = self.first_bucket() else {
             return;
         };
         let mut moving = std::mem::take(&mut self.buckets[l * DIGITS + v]);
         self.clear_bucket(l, v);
-        if l == 0 {
-            self.last = (self.last & !0xff) | v as u64;
-            self.now.extend(moving.drain(..));
-        } else {
-            self.last = moving.iter().map(|s| s.time.0).min().unwrap_or(self.last);
+        if l == 0 || moving.len() <= SORT_MAX {
+            // In sequence order already: a level-0 bucket (one time) or a
+            // single event needs nothing. Times and sequence numbers are
+            // unique together, so the unstable sort on both gives the
+            // `(time, seq)` order.
+            if l > 0 && moving.len() > 1 {
+                moving.sort_unstable_by_key(|s| (s.time.0, s.seq));
+            }
+            self.last = moving.first().map_or(self.last, |s| s.time.0);
+            self.run_hi = moving.last().map_or(self.last, |s| s.time.0);
+            // The bucket keeps the run's old (empty) allocation, the run
+            // takes the bucket's: no copying, no allocation.
+            let old = std::mem::replace(&mut self.run, VecDeque::from(moving));
+            self.buckets[l * DIGITS + v] = Vec::from(old);
+            return;
+        }
+        if l == 1 {
+            // Every level-0 bucket is empty (level 1 is the earliest).
+            let mut mask = [0u64; 4];
             for s in moving.drain(..) {
-                // Lands below level l: it agreed with the old `last` above
-                // byte l, and so does the new one.
+                let d = (s.time.0 & 0xff) as usize;
+                mask[d / 64] |= 1 << (d % 64);
+                self.buckets[d].push(s);
+            }
+            self.buckets[DIGITS + v] = moving;
+            // The run is built as a vector (appending a bucket is one copy)
+            // on the run's own allocation, then made the run again.
+            let mut run = Vec::from(std::mem::take(&mut self.run));
+            for (w, mut bits) in mask.into_iter().enumerate() {
+                while bits != 0 {
+                    let d = w * 64 + bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    run.append(&mut self.buckets[d]);
+                }
+            }
+            self.last = run.first().map_or(self.last, |s| s.time.0);
+            self.run_hi = run.last().map_or(self.last, |s| s.time.0);
+            self.run = VecDeque::from(run);
+            return;
+        }
+        self.last = moving.iter().map(|s| s.time.0).min().unwrap_or(self.last);
+        self.run_hi = self.last;
+        for s in moving.drain(..) {
+            // Lands below level l: it agreed with the old `last` above byte
+            // l, and so does the new one. Due at the new `last`: into the
+            // run, in sequence order.
+            if s.time.0 == self.last {
+                self.run.push_back(s);
+            } else {
                 self.file(s);
             }
         }
         // Keep the allocation for the next time this bucket fills.
         self.buckets[l * DIGITS + v] = moving;
-        debug_assert!(self.now.iter().zip(self.now.iter().skip(1)).all(|(a, b)| a.seq < b.seq));
     }
 
     #[cold]
@@ -314,7 +425,7 @@ impl<E> RadixHeap<E> {
         if let Some(s) = self.stale.iter().min_by_key(|s| (s.time, s.seq)) {
             return Some(s.time);
         }
-        if let Some(s) = self.now.front() {
+        if let Some(s) = self.run.front() {
             return Some(s.time);
         }
         let (l, v) = self.first_bucket()?;
