@@ -101,14 +101,18 @@
 //! the check tally and the wall time.
 
 mod check;
+pub mod cost;
 mod derived;
 mod dotted;
 mod error;
 mod figures;
+pub mod fingerprint;
 pub mod inverse;
 mod report;
 mod run;
 mod runner;
+mod shard;
+mod slurm;
 mod sim_runner;
 mod spec;
 mod sweep;
@@ -121,7 +125,9 @@ pub use check::{Bound, CheckOutcome, evaluate_between};
 pub use derived::{interval_width, quantile_width_from_min, ratio, relative_error, speedup};
 pub use dotted::{MetricPathError, json_number, json_path};
 pub use error::ExperimentError;
-pub use run::{ExperimentResult, PathStat, PointResult, RunRecord, point_model, run_experiment};
+pub use run::{ExperimentResult, PathStat, PointResult, RunRecord, ShardCost, point_model, run_experiment};
+pub use shard::{SHARD_FORMAT, SHARDS_DIR, ShardId, ShardIdError, ShardOutcome, merge_shards, run_shard};
+pub use slurm::{SlurmError, SlurmOptions, SlurmScripts, sbatch, slurm_scripts};
 pub use runner::{FrameTable, RunError, RunOutput, Runner};
 pub use sim_runner::SimRunner;
 pub use spec::{

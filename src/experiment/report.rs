@@ -252,7 +252,28 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
     }
 
     let _ = writeln!(s, "## Timing\n");
-    let _ = writeln!(s, "- experiment wall time: {:.3} s", r.wall_seconds);
+    match &r.shards {
+        None => {
+            let _ = writeln!(s, "- experiment wall time: {:.3} s", r.wall_seconds);
+            if let Some(cpu) = r.cpu_seconds {
+                let _ = writeln!(s, "- CPU time: {cpu:.3} s (user + system, one process)");
+            }
+        }
+        Some(c) => {
+            let _ = writeln!(
+                s,
+                "- array wall time: {:.3} s ({} shards, from the first shard's start to the last shard's end)",
+                c.array_wall_seconds, c.shards
+            );
+            let _ = write!(s, "- total CPU time over all shards: {:.3} s (user + system)", c.cpu_seconds);
+            match r.cpu_seconds {
+                Some(m) => {
+                    let _ = writeln!(s, ", plus {m:.3} s to merge");
+                }
+                None => s.push('\n'),
+            }
+        }
+    }
     let _ = writeln!(
         s,
         "- summed simulation wall time: {:.3} s over {} runs\n",
