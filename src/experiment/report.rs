@@ -111,7 +111,47 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
         }
     }
 
-    let keys: Vec<&str> = exp.sweeps.iter().map(|s| s.key.as_str()).collect();
+    if let Some(sample) = &exp.sample {
+        use super::sample::{SampleMethod, Scale};
+        let how = match sample.method {
+            SampleMethod::LatinHypercube => format!("Latin hypercube of {} points", sample.n),
+            SampleMethod::Sobol => format!(
+                "Saltelli's design for Sobol' indices: n = {} rows of A and B (one Latin hypercube in {} dimensions) \
+                 and A_B^(i) per parameter, n (k + 2) = {} points; {} bootstrap resamples",
+                sample.n,
+                2 * sample.params.len(),
+                sample.points(),
+                sample.bootstrap
+            ),
+        };
+        let _ = writeln!(
+            s,
+            "\nSampled parameters ({how}; seed {}):\n\n| key | from | to | scale | values |\n|---|---|---|---|---|",
+            sample.seed
+        );
+        for p in &sample.params {
+            let scale = match p.scale {
+                Scale::Linear => "linear",
+                Scale::Log => "log",
+            };
+            let kind = match (&p.unit, p.integer) {
+                (Some(u), true) => format!("integers, in {u}"),
+                (Some(u), false) => format!("real, in {u}"),
+                (None, true) => "integers".into(),
+                (None, false) => "real".into(),
+            };
+            let _ = writeln!(
+                s,
+                "| `{}` | {} | {} | {scale} | {kind} |",
+                p.key,
+                fmt_num(p.from),
+                fmt_num(p.to)
+            );
+        }
+    }
+
+    let point_keys = exp.point_keys();
+    let keys: Vec<&str> = point_keys.iter().map(|s| s.as_str()).collect();
     let head = |extra: &[String]| {
         let cols: Vec<String> = keys
             .iter()
@@ -187,6 +227,42 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
             let _ = writeln!(s, "| {} |", row.join(" | "));
         }
         s.push('\n');
+    }
+
+    if !r.sensitivity.is_empty() {
+        let _ = writeln!(
+            s,
+            "## Sensitivity (Sobol' indices)\n\nWhich parameters drive each metric: the first-order index S_i is the share of \
+             the metric's variance (over the sampled ranges, of the replication means) that parameter i explains alone; the \
+             total index S_Ti adds its interactions with the others. Estimators of Saltelli et al. (2010): S_i from \
+             f(B)·(f(A_B^(i)) − f(A)), S_Ti from Jansen's (f(A) − f(A_B^(i)))²; {}% percentile bootstrap intervals. \
+             Small negative values are estimation noise around 0.\n",
+            exp.confidence * 100.0
+        );
+        for sens in &r.sensitivity {
+            let _ = writeln!(s, "### {} (`{}`)\n", sens.label, sens.path);
+            let Some(indices) = &sens.indices else {
+                let _ = writeln!(s, "Not computed: fewer than two complete rows, or the metric does not vary.\n");
+                continue;
+            };
+            let _ = writeln!(
+                s,
+                "| parameter | first order S_i | CI | total S_Ti | CI |\n|---|---|---|---|---|"
+            );
+            for (key, i) in indices {
+                let _ = writeln!(
+                    s,
+                    "| `{key}` | {} | [{}, {}] | {} | [{}, {}] |",
+                    fmt_num(i.first),
+                    fmt_num(i.first_ci.0),
+                    fmt_num(i.first_ci.1),
+                    fmt_num(i.total),
+                    fmt_num(i.total_ci.0),
+                    fmt_num(i.total_ci.1)
+                );
+            }
+            let _ = writeln!(s, "\n![Sobol' indices of {}]({f}.svg)\n", sens.label, f = sens.plot);
+        }
     }
 
     let claims = r.claims();

@@ -114,6 +114,8 @@ pub struct ExperimentResult {
     pub plot_captions: Vec<(String, String)>,
     /// Inverse what-ifs, in file order.
     pub searches: Vec<super::inverse::SearchResult>,
+    /// Sobol' indices per metric (`[sample] method = "sobol"`; else empty).
+    pub sensitivity: Vec<super::sobol::Sensitivity>,
 }
 
 impl ExperimentResult {
@@ -463,6 +465,39 @@ pub(crate) fn finish(
         files.push(PathBuf::from(format!("{}.png", plot.file)));
     }
 
+    let sensitivity = super::sobol::analyse(exp, &point_results);
+    if !sensitivity.is_empty() {
+        let path = out_dir.join("sensitivity.csv");
+        std::fs::write(&path, super::sobol::csv(&sensitivity)).map_err(|source| ExperimentError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        files.push(PathBuf::from("sensitivity.csv"));
+    }
+    for s in &sensitivity {
+        let Some(indices) = &s.indices else { continue };
+        let series = |name: &str, v: fn(&super::sobol::SobolIndex) -> (f64, (f64, f64))| crate::plot::BarSeries {
+            name: name.into(),
+            values: indices.iter().map(|(_, i)| v(i).0).collect(),
+            ci: Some(indices.iter().map(|(_, i)| v(i).1).collect()),
+        };
+        let chart = crate::plot::BarChart {
+            title: format!("Sobol' indices of {}", s.label),
+            y_label: "index (share of the output variance)".into(),
+            categories: indices.iter().map(|(k, _)| k.clone()).collect(),
+            series: vec![
+                series("first order S_i", |i| (i.first, i.first_ci)),
+                series("total S_Ti", |i| (i.total, i.total_ci)),
+            ],
+        };
+        crate::plot::bar_chart(&out_dir.join(&s.plot), &chart).map_err(|source| ExperimentError::Plot {
+            file: s.plot.clone(),
+            source,
+        })?;
+        files.push(PathBuf::from(format!("{}.svg", s.plot)));
+        files.push(PathBuf::from(format!("{}.png", s.plot)));
+    }
+
     let mut search_base = base_model.clone();
     for (k, v) in &exp.set {
         set_dotted(&mut search_base, k, v.clone())?;
@@ -502,6 +537,7 @@ pub(crate) fn finish(
         files,
         plot_captions,
         searches,
+        sensitivity,
     };
     match timing {
         Timing::Single(started) => result.wall_seconds = started.elapsed().as_secs_f64(),
