@@ -141,9 +141,9 @@ mod run;
 mod runner;
 pub mod sample;
 mod shard;
+mod sim_runner;
 mod slurm;
 pub mod sobol;
-mod sim_runner;
 mod spec;
 mod sweep;
 mod tables;
@@ -156,10 +156,10 @@ pub use derived::{interval_width, quantile_width_from_min, ratio, relative_error
 pub use dotted::{MetricPathError, json_number, json_path};
 pub use error::ExperimentError;
 pub use run::{ExperimentResult, PathStat, PointResult, RunRecord, ShardCost, point_model, run_experiment};
-pub use shard::{SHARD_FORMAT, SHARDS_DIR, ShardId, ShardIdError, ShardOutcome, merge_shards, run_shard};
-pub use slurm::{SlurmError, SlurmOptions, SlurmScripts, sbatch, slurm_scripts};
 pub use runner::{FrameTable, RunError, RunOutput, Runner};
+pub use shard::{SHARD_FORMAT, SHARDS_DIR, ShardId, ShardIdError, ShardOutcome, merge_shards, run_shard};
 pub use sim_runner::SimRunner;
+pub use slurm::{SlurmError, SlurmOptions, SlurmScripts, sbatch, slurm_scripts};
 pub use spec::{
     BoundRef, Check, Derived, DerivedKind, Expect, Experiment, Metric, ModelSource, PlotKind, PlotSpec, Tolerance,
     load_experiment, parse_experiment,

@@ -242,7 +242,10 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
         for sens in &r.sensitivity {
             let _ = writeln!(s, "### {} (`{}`)\n", sens.label, sens.path);
             let Some(indices) = &sens.indices else {
-                let _ = writeln!(s, "Not computed: fewer than two complete rows, or the metric does not vary.\n");
+                let _ = writeln!(
+                    s,
+                    "Not computed: fewer than two complete rows, or the metric does not vary.\n"
+                );
                 continue;
             };
             let _ = writeln!(
@@ -341,7 +344,11 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
                 "- array wall time: {:.3} s ({} shards, from the first shard's start to the last shard's end)",
                 c.array_wall_seconds, c.shards
             );
-            let _ = write!(s, "- total CPU time over all shards: {:.3} s (user + system)", c.cpu_seconds);
+            let _ = write!(
+                s,
+                "- total CPU time over all shards: {:.3} s (user + system)",
+                c.cpu_seconds
+            );
             match r.cpu_seconds {
                 Some(m) => {
                     let _ = writeln!(s, ", plus {m:.3} s to merge");

@@ -330,7 +330,15 @@ pub fn run_experiment(
         tables::write_runs(&out_dir.join("runs.csv"), exp, &plan.points, &plan.paths, &runs)?;
         return Err(e);
     }
-    finish(exp, base_model, runner, &plan, outputs, out_dir, Timing::Single(started))
+    finish(
+        exp,
+        base_model,
+        runner,
+        &plan,
+        outputs,
+        out_dir,
+        Timing::Single(started),
+    )
 }
 
 /// Everything after the runs: `runs.csv`, aggregation per point, derived

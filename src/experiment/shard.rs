@@ -175,7 +175,13 @@ impl ShardRun {
         let values = self
             .values
             .split_ascii_whitespace()
-            .map(|t| if t == "null" { Ok(None) } else { parse_float(t).map(Some) })
+            .map(|t| {
+                if t == "null" {
+                    Ok(None)
+                } else {
+                    parse_float(t).map(Some)
+                }
+            })
             .collect::<Result<Vec<_>, _>>()?;
         if values.len() != paths {
             return Err(format!("{} values where the experiment tracks {paths}", values.len()));
@@ -240,8 +246,8 @@ fn read_shard(path: &Path) -> Result<ShardFile, ExperimentError> {
         path: path.to_path_buf(),
         source,
     })?;
-    let file: ShardFile = serde_json::from_slice(&text)
-        .map_err(|e| shard_error(path, format!("not a readable shard file ({e})")))?;
+    let file: ShardFile =
+        serde_json::from_slice(&text).map_err(|e| shard_error(path, format!("not a readable shard file ({e})")))?;
     if file.format != SHARD_FORMAT {
         return Err(shard_error(
             path,
@@ -330,10 +336,7 @@ pub fn run_shard(
         };
         match why {
             None => {
-                return Ok(ShardOutcome::Complete {
-                    path,
-                    runs: mine.len(),
-                });
+                return Ok(ShardOutcome::Complete { path, runs: mine.len() });
             }
             Some(why) => Some(why),
         }
@@ -395,7 +398,10 @@ pub fn merge_shards(
             .flatten()
             .map(|e| e.path())
             .filter(|p| {
-                let n = p.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+                let n = p
+                    .file_name()
+                    .map(|n| n.to_string_lossy().to_string())
+                    .unwrap_or_default();
                 !n.starts_with('.') && n.ends_with(".json")
             })
             .collect(),
@@ -479,7 +485,10 @@ pub fn merge_shards(
         );
     }
     let start = files.iter().map(|f| f.1.started_unix).fold(f64::INFINITY, f64::min);
-    let end = files.iter().map(|f| f.1.finished_unix).fold(f64::NEG_INFINITY, f64::max);
+    let end = files
+        .iter()
+        .map(|f| f.1.finished_unix)
+        .fold(f64::NEG_INFINITY, f64::max);
     let cost = ShardCost {
         shards: n,
         cpu_seconds: files.iter().map(|f| f.1.cpu_seconds).sum(),

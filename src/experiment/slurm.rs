@@ -151,7 +151,13 @@ pub fn slurm_scripts(exp: &Experiment, opts: &SlurmOptions) -> Result<SlurmScrip
     let name: String = exp
         .name
         .chars()
-        .map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "-_.".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
         .take(48)
         .collect();
     let n = opts.shards;
@@ -226,11 +232,7 @@ pub fn sbatch(script: &Path, after_ok: Option<&str>) -> Result<String, SlurmErro
     if !out.status.success() {
         return Err(SlurmError::Submit {
             script: shown,
-            message: format!(
-                "{} ({})",
-                String::from_utf8_lossy(&out.stderr).trim(),
-                out.status
-            ),
+            message: format!("{} ({})", String::from_utf8_lossy(&out.stderr).trim(), out.status),
         });
     }
     parse_job_id(&stdout).ok_or_else(|| SlurmError::Submit {

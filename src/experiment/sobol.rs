@@ -167,8 +167,20 @@ mod tests {
         assert!((st[0] - 0.5576).abs() < 1e-4 && (st[2] - 0.2437).abs() < 1e-4);
         let idx = run(8192, 11);
         for i in 0..3 {
-            assert!((idx[i].first - s1[i]).abs() < 0.04, "S{} = {} vs {}", i + 1, idx[i].first, s1[i]);
-            assert!((idx[i].total - st[i]).abs() < 0.04, "ST{} = {} vs {}", i + 1, idx[i].total, st[i]);
+            assert!(
+                (idx[i].first - s1[i]).abs() < 0.04,
+                "S{} = {} vs {}",
+                i + 1,
+                idx[i].first,
+                s1[i]
+            );
+            assert!(
+                (idx[i].total - st[i]).abs() < 0.04,
+                "ST{} = {} vs {}",
+                i + 1,
+                idx[i].total,
+                st[i]
+            );
             let (lo, hi) = idx[i].first_ci;
             assert!(lo <= s1[i] + 0.01 && s1[i] - 0.01 <= hi, "S{} CI {lo}..{hi}", i + 1);
             let (lo, hi) = idx[i].total_ci;
@@ -195,7 +207,14 @@ mod tests {
         assert!(sobol_indices(&[1.0], &[2.0], &[vec![1.0]], 10, 0.95, 1).is_none());
         assert!(sobol_indices(&[1.0, 1.0], &[1.0, 1.0], &[vec![1.0, 1.0]], 10, 0.95, 1).is_none());
         // Non-finite rows are left out.
-        let r = sobol_indices(&[0.0, 1.0, f64::NAN], &[1.0, 0.0, 1.0], &[vec![1.0, 0.0, 2.0]], 10, 0.95, 1);
+        let r = sobol_indices(
+            &[0.0, 1.0, f64::NAN],
+            &[1.0, 0.0, 1.0],
+            &[vec![1.0, 0.0, 2.0]],
+            10,
+            0.95,
+            1,
+        );
         assert!(r.is_some());
     }
 }
@@ -217,10 +236,7 @@ pub struct Sensitivity {
 
 /// Sobol' indices of every `[[metric]]` of `exp` from the replication means
 /// of its points (empty unless `exp` samples with `method = "sobol"`).
-pub(crate) fn analyse(
-    exp: &super::spec::Experiment,
-    results: &[super::run::PointResult],
-) -> Vec<Sensitivity> {
+pub(crate) fn analyse(exp: &super::spec::Experiment, results: &[super::run::PointResult]) -> Vec<Sensitivity> {
     use super::sample::SampleMethod;
     let Some(s) = exp.sample.as_ref().filter(|s| s.method == SampleMethod::Sobol) else {
         return Vec::new();

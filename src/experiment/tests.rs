@@ -892,8 +892,14 @@ fn a_sobol_sample_runs_saltellis_points_and_ranks_the_parameters() {
     let pts = expand_points(&exp);
     assert_eq!(pts.len(), 64 * 5);
     assert_eq!(pts[0].assignments.len(), 3);
-    assert!(pts.iter().all(|p| p.assignments[0].1.as_str().is_some_and(|s| s.ends_with("ms"))));
-    assert!(pts.iter().all(|p| matches!(p.assignments[1].1.as_integer(), Some(2 | 3))));
+    assert!(
+        pts.iter()
+            .all(|p| p.assignments[0].1.as_str().is_some_and(|s| s.ends_with("ms")))
+    );
+    assert!(
+        pts.iter()
+            .all(|p| matches!(p.assignments[1].1.as_integer(), Some(2 | 3)))
+    );
     let dir = tempfile::tempdir().unwrap();
     let res = run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap();
     let runs = read(dir.path(), "runs.csv");
@@ -911,7 +917,10 @@ fn a_sobol_sample_runs_saltellis_points_and_ranks_the_parameters() {
     // The display interval depends on the GPU cost and the buffers (and the
     // unused key has no effect).
     let di = res.sensitivity[1].indices.as_ref().unwrap();
-    assert!(di[0].1.total > 0.5 && di[1].1.total > 0.001 && di[2].1.total < 1e-9, "{di:?}");
+    assert!(
+        di[0].1.total > 0.5 && di[1].1.total > 0.001 && di[2].1.total < 1e-9,
+        "{di:?}"
+    );
     let report = read(dir.path(), "report.md");
     assert!(report.contains("## Sensitivity (Sobol' indices)"), "{report}");
     assert!(report.contains("Sampled parameters (Saltelli's design"), "{report}");
@@ -948,13 +957,34 @@ fn a_latin_hypercube_has_n_points_and_no_indices() {
 #[test]
 fn sample_errors_name_the_entry() {
     let cases = [
-        (SOBOL.replace("\"sobol\"", "\"morris\""), "`sample.method`: unknown method `morris`"),
-        (SOBOL.replace("n = 64", "n = 1"), "`sample.n`: must be between 2 and 1000000"),
-        (SOBOL.replace("from = 1\nto = 100", "from = 0\nto = 100"), "`sample.param[2].scale`: `log` needs `from` > 0"),
-        (SOBOL.replace("from = 2\nto = 3", "from = 2.5\nto = 3"), "`sample.param[1]`: `integer = true` needs whole numbers"),
-        (SOBOL.replace("from = 5\nto = 40", "from = 40\nto = 5"), "`sample.param[0]`: needs finite `from` < `to`"),
-        (SOBOL.replace("unit = \"ms\"", "unit = \"m s\""), "`sample.param[0].unit`: `m s` is not a unit"),
-        (SOBOL.replace("key = \"display.buffers\"", "key = \"workload.gpu\""), "is sampled twice"),
+        (
+            SOBOL.replace("\"sobol\"", "\"morris\""),
+            "`sample.method`: unknown method `morris`",
+        ),
+        (
+            SOBOL.replace("n = 64", "n = 1"),
+            "`sample.n`: must be between 2 and 1000000",
+        ),
+        (
+            SOBOL.replace("from = 1\nto = 100", "from = 0\nto = 100"),
+            "`sample.param[2].scale`: `log` needs `from` > 0",
+        ),
+        (
+            SOBOL.replace("from = 2\nto = 3", "from = 2.5\nto = 3"),
+            "`sample.param[1]`: `integer = true` needs whole numbers",
+        ),
+        (
+            SOBOL.replace("from = 5\nto = 40", "from = 40\nto = 5"),
+            "`sample.param[0]`: needs finite `from` < `to`",
+        ),
+        (
+            SOBOL.replace("unit = \"ms\"", "unit = \"m s\""),
+            "`sample.param[0].unit`: `m s` is not a unit",
+        ),
+        (
+            SOBOL.replace("key = \"display.buffers\"", "key = \"workload.gpu\""),
+            "is sampled twice",
+        ),
         (SOBOL.replace("bootstrap = 200", "bootstrap = -1"), "`sample.bootstrap`"),
         (
             SOBOL.replace("[sample]", "[[sweep]]\nkey = \"x\"\nvalues = [1]\n[sample]"),

@@ -491,7 +491,12 @@ mod tests {
         s.commit().unwrap();
         assert_eq!(
             files(&out),
-            vec![MARKER.to_string(), "job.sbatch".into(), "runs.csv".into(), "shards".into()]
+            vec![
+                MARKER.to_string(),
+                "job.sbatch".into(),
+                "runs.csv".into(),
+                "shards".into()
+            ]
         );
         assert_eq!(std::fs::read_to_string(out.join("shards/a.json")).unwrap(), "shard");
         // A folder holding other files is not claimed.

@@ -122,8 +122,12 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &BarChart) -> Resu
     let font = TextStyle::from((FAMILY, 15).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
     for (i, name) in c.categories.iter().enumerate() {
         let (x, y) = chart.backend_coord(&(i as f64, lo));
-        root.draw_text(name, &font, (x - root.get_base_pixel().0, y + 8 - root.get_base_pixel().1))
-            .map_err(e)?;
+        root.draw_text(
+            name,
+            &font,
+            (x - root.get_base_pixel().0, y + 8 - root.get_base_pixel().1),
+        )
+        .map_err(e)?;
     }
     if !c.series.is_empty() {
         chart

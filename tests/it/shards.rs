@@ -163,7 +163,15 @@ fn merged_shards_write_what_one_process_writes() {
     ok(&["experiment", s(&exp), "--quiet", "--out", s(&single)]);
     let out = d.path().join("sharded");
     for k in 1..=3 {
-        let line = ok(&["experiment", s(&exp), "--quiet", "--out", s(&out), "--shard", &format!("{k}/3")]);
+        let line = ok(&[
+            "experiment",
+            s(&exp),
+            "--quiet",
+            "--out",
+            s(&out),
+            "--shard",
+            &format!("{k}/3"),
+        ]);
         assert!(line.contains(&format!("shard {k}/3: 4 runs")), "{line}");
     }
     let shard2 = out.join("shards/shard-2-of-3.json");
@@ -184,7 +192,10 @@ fn merged_shards_write_what_one_process_writes() {
     // A damaged one (half a file) is redone, and the merge is whole again.
     std::fs::write(&shard2, &before[..before.len() / 2]).unwrap();
     let e = err(&["experiment", s(&exp), "--quiet", "--out", s(&out), "--merge"]);
-    assert!(e.contains("shard-2-of-3.json") && e.contains("not a readable shard file"), "{e}");
+    assert!(
+        e.contains("shard-2-of-3.json") && e.contains("not a readable shard file"),
+        "{e}"
+    );
     let o = run(&["experiment", s(&exp), "--quiet", "--out", s(&out), "--shard", "2/3"]);
     assert!(o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("redone"));
@@ -201,7 +212,15 @@ fn a_merge_refuses_missing_duplicated_and_mismatched_shards() {
     let e = merge();
     assert!(e.contains("no shard files"), "{e}");
     for k in [1, 3] {
-        ok(&["experiment", s(&exp), "--quiet", "--out", s(&out), "--shard", &format!("{k}/3")]);
+        ok(&[
+            "experiment",
+            s(&exp),
+            "--quiet",
+            "--out",
+            s(&out),
+            "--shard",
+            &format!("{k}/3"),
+        ]);
     }
     let e = merge();
     assert!(e.contains("1 of 3 shards missing: shard-2-of-3.json"), "{e}");
@@ -215,12 +234,19 @@ fn a_merge_refuses_missing_duplicated_and_mismatched_shards() {
     // A shard of another split.
     ok(&["experiment", s(&exp), "--quiet", "--out", s(&out), "--shard", "1/2"]);
     let e = merge();
-    assert!(e.contains("two different splits") && e.contains("shard-1-of-2.json"), "{e}");
+    assert!(
+        e.contains("two different splits") && e.contains("shard-1-of-2.json"),
+        "{e}"
+    );
     std::fs::remove_file(shards.join("shard-1-of-2.json")).unwrap();
     // Another rendersim version.
     let p = shards.join("shard-3-of-3.json");
     let text = std::fs::read_to_string(&p).unwrap();
-    std::fs::write(&p, text.replace("\"rendersim_version\":\"", "\"rendersim_version\":\"9")).unwrap();
+    std::fs::write(
+        &p,
+        text.replace("\"rendersim_version\":\"", "\"rendersim_version\":\"9"),
+    )
+    .unwrap();
     let e = merge();
     assert!(e.contains("shard-3-of-3.json: made by rendersim 9"), "{e}");
     std::fs::write(&p, &text).unwrap();
@@ -229,10 +255,7 @@ fn a_merge_refuses_missing_duplicated_and_mismatched_shards() {
     let t = std::fs::read_to_string(&exp).unwrap();
     std::fs::write(&exp, t.replace("bins = 20", "bins = 21")).unwrap();
     let e = merge();
-    assert!(
-        e.contains("shard-1-of-3.json: made from a different experiment"),
-        "{e}"
-    );
+    assert!(e.contains("shard-1-of-3.json: made from a different experiment"), "{e}");
     // The earlier merged outputs are untouched by the refused merges.
     assert!(out.join("report.md").is_file());
     // A shard run again after the change is redone, not kept.
@@ -306,7 +329,10 @@ fn slurm_writes_an_array_and_a_merge_and_submit_chains_them() {
     ] {
         assert!(job.contains(line), "{line} not in\n{job}");
     }
-    assert!(job.contains(&format!("--out '{}'", out.canonicalize().unwrap().display())), "{job}");
+    assert!(
+        job.contains(&format!("--out '{}'", out.canonicalize().unwrap().display())),
+        "{job}"
+    );
     let merge = std::fs::read_to_string(out.join("merge.sbatch")).unwrap();
     assert!(merge.contains(" --merge") && !merge.contains("--array"), "{merge}");
     assert!(out.join("logs").is_dir());
@@ -325,20 +351,42 @@ fn slurm_writes_an_array_and_a_merge_and_submit_chains_them() {
     .unwrap();
     std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
     let o = bin()
-        .args(["experiment", s(&exp), "--out", s(&out), "--slurm", "--shards", "4", "--submit"])
+        .args([
+            "experiment",
+            s(&exp),
+            "--out",
+            s(&out),
+            "--slurm",
+            "--shards",
+            "4",
+            "--submit",
+        ])
         .env("RENDERSIM_SBATCH", &fake)
         .output()
         .unwrap();
     let said = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(said.contains("submitted array job 101 (4 tasks) and merge job 102"), "{said}");
+    assert!(
+        said.contains("submitted array job 101 (4 tasks) and merge job 102"),
+        "{said}"
+    );
     let calls = std::fs::read_to_string(&log).unwrap();
     let calls: Vec<&str> = calls.lines().collect();
     assert_eq!(calls.len(), 2);
-    assert!(calls[0].starts_with("--parsable ") && calls[0].ends_with("job.sbatch"), "{calls:?}");
-    assert!(calls[1].contains("--dependency=afterok:101 ") && calls[1].ends_with("merge.sbatch"), "{calls:?}");
+    assert!(
+        calls[0].starts_with("--parsable ") && calls[0].ends_with("job.sbatch"),
+        "{calls:?}"
+    );
+    assert!(
+        calls[1].contains("--dependency=afterok:101 ") && calls[1].ends_with("merge.sbatch"),
+        "{calls:?}"
+    );
     // sbatch refusing is an error that says so.
-    std::fs::write(&fake, "#!/bin/sh\necho 'sbatch: error: invalid partition' >&2\nexit 1\n").unwrap();
+    std::fs::write(
+        &fake,
+        "#!/bin/sh\necho 'sbatch: error: invalid partition' >&2\nexit 1\n",
+    )
+    .unwrap();
     let o = bin()
         .args(["experiment", s(&exp), "--out", s(&out), "--slurm", "--submit"])
         .env("RENDERSIM_SBATCH", &fake)
