@@ -424,7 +424,7 @@ pub(crate) fn finish(
         })
         .collect();
     let mut files = vec![PathBuf::from("runs.csv")];
-    tables::write_points(&out_dir.join("points.csv"), exp, &points, &point_results)?;
+    tables::write_points(&out_dir.join("points.csv"), exp, points, &point_results)?;
     files.push(PathBuf::from("points.csv"));
 
     let mut checks = Vec::new();
