@@ -177,6 +177,28 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
     let level = format!("{}%", exp.confidence * 100.0);
     for m in &exp.metrics {
         let _ = writeln!(s, "### {} (`{}`)\n", m.label, m.path);
+        if exp.sample.is_some() {
+            // Sampled points are many and unordered: a summary here, every
+            // point in points.csv.
+            let means: Vec<f64> = r.points.iter().filter_map(|p| p.mean(&m.path)).collect();
+            if means.is_empty() {
+                let _ = writeln!(s, "No values.\n");
+            } else {
+                let (lo, hi) = means
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+                let _ = writeln!(
+                    s,
+                    "Over the {} sampled points with a value (replication means; each point in `points.csv`): \
+                     min {}, mean {}, max {}.\n",
+                    means.len(),
+                    fmt_num(lo),
+                    fmt_num(means.iter().sum::<f64>() / means.len() as f64),
+                    fmt_num(hi)
+                );
+            }
+            continue;
+        }
         s.push_str(&head(&[format!("mean ± {level} CI"), "n".into()]));
         for p in &r.points {
             let mut row = key_cells(p);

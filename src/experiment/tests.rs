@@ -924,6 +924,7 @@ fn a_sobol_sample_runs_saltellis_points_and_ranks_the_parameters() {
     let report = read(dir.path(), "report.md");
     assert!(report.contains("## Sensitivity (Sobol' indices)"), "{report}");
     assert!(report.contains("Sampled parameters (Saltelli's design"), "{report}");
+    assert!(report.contains("Over the 320 sampled points with a value"), "{report}");
     assert!(report.contains("![Sobol' indices of metrics.frame_time_ms.mean](sensitivity-1.svg)"));
     assert!(dir.path().join("sensitivity-2.png").is_file());
     let csv = read(dir.path(), "sensitivity.csv");
