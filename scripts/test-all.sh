@@ -106,6 +106,9 @@ for nb in notebooks/*.ipynb; do
   .venv/bin/jupyter execute "$nb"
 done
 
+step "Slurm: a 4-task job array and its merge on a one-machine Slurm, compared with one process"
+bash scripts/slurm-test.sh
+
 step "Device script: bash -n, and its dry run lists the commands"
 bash -n scripts/device-studies.sh
 DRY_RUN=1 bash scripts/device-studies.sh collect "$ci_out/device" | tail -n 3

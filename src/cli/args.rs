@@ -63,6 +63,32 @@ pub struct ExperimentArgs {
     /// Hide the progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// Run only shard K of N of the (point, seed) runs, into DIR/shards/
+    /// (a complete shard file is kept; merge them with --merge).
+    #[arg(long, value_name = "K/N", conflicts_with_all = ["merge", "slurm"])]
+    pub shard: Option<rendersim::experiment::ShardId>,
+    /// Merge the shard files in DIR/shards/ into the outputs of one process.
+    #[arg(long, conflicts_with = "slurm")]
+    pub merge: bool,
+    /// Write DIR/job.sbatch (a Slurm job array, one task per shard) and
+    /// DIR/merge.sbatch (the merge, after the array).
+    #[arg(long)]
+    pub slurm: bool,
+    /// With --slurm: the number of shards (default: the runs, at most 16).
+    #[arg(long, value_name = "N", requires = "slurm")]
+    pub shards: Option<usize>,
+    /// With --slurm: the Slurm partition.
+    #[arg(long, value_name = "P", requires = "slurm")]
+    pub partition: Option<String>,
+    /// With --slurm: the time limit per task (e.g. 30:00, 2-00:00:00).
+    #[arg(long, value_name = "T", requires = "slurm")]
+    pub time: Option<String>,
+    /// With --slurm: CPUs per task (default 1).
+    #[arg(long, value_name = "C", requires = "slurm")]
+    pub cpus_per_task: Option<u32>,
+    /// With --slurm: submit both scripts with sbatch and print the job ids.
+    #[arg(long, requires = "slurm")]
+    pub submit: bool,
 }
 
 /// `rendersim isolate`.

@@ -25,8 +25,8 @@ use super::{device, print};
 #[derive(Debug, thiserror::Error)]
 #[error("{failed} reference check(s) failed; see {report}")]
 pub struct ChecksFailed {
-    failed: usize,
-    report: String,
+    pub(crate) failed: usize,
+    pub(crate) report: String,
 }
 
 /// The files `run --out` writes (a folder holding only these, written
@@ -123,7 +123,10 @@ pub fn experiment(args: ExperimentArgs) -> Result<()> {
     use rendersim::experiment::{SimRunner, load_experiment, run_experiment};
     let exp = load_experiment(&args.file)?;
     let base = exp.resolve_model(&ModelSource::embedded_default().table()?)?;
-    let out = args.out.unwrap_or_else(|| PathBuf::from("out").join(&exp.name));
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("out").join(&exp.name));
+    if args.shard.is_some() || args.merge || args.slurm {
+        return super::cluster::experiment(&args, &exp, &base, &out, experiment_file);
+    }
     let set = ResultSet::begin(&out, experiment_file)?;
     let runner = SimRunner::for_experiment(&exp);
     let result = match run_experiment(&exp, &base, &runner, set.dir(), !args.quiet) {

@@ -4,6 +4,7 @@
 //! lives in the library.
 
 pub mod args;
+pub mod cluster;
 pub mod commands;
 pub mod device;
 pub mod print;

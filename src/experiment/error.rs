@@ -66,4 +66,23 @@ pub enum ExperimentError {
         /// The plotting error.
         source: PlotError,
     },
+    /// A shard file cannot be used (`--shard`, `--merge`).
+    #[error("{}: {message}", file.display())]
+    Shard {
+        /// The shard file.
+        file: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// The shard files of an experiment do not make a whole (`--merge`).
+    #[error("{}: {message}", dir.display())]
+    Shards {
+        /// The folder of shard files.
+        dir: PathBuf,
+        /// What is missing or twice.
+        message: String,
+    },
+    /// An output file could not be written.
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
 }

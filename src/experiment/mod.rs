@@ -81,6 +81,34 @@
 //! Searches are described in [`inverse`]; their results go to
 //! `searches.csv` and a section of `report.md`.
 //!
+//! Instead of sweeps, points can be drawn from parameter ranges
+//! ([`sample`]; sweeps and a sample do not mix):
+//!
+//! ```toml
+//! [sample]
+//! method = "sobol"       # or "latin_hypercube" (n points)
+//! n = 256                # sobol: Saltelli's n (k + 2) points for k parameters
+//! seed = 1               # default 1; the same seed gives the same points
+//! bootstrap = 1000       # resamples for the indices' intervals (default 1000)
+//! [[sample.param]]
+//! key = "workload.gpu"
+//! from = 4
+//! to = 20
+//! unit = "ms"            # optional: values are strings "12.5ms"
+//! scale = "linear"       # or "log" (from > 0)
+//! integer = false        # true: every whole number of from..=to equally likely
+//! ```
+//!
+//! With `sobol`, every `[[metric]]` gets first-order and total Sobol'
+//! indices ([`sobol`]) in `sensitivity.csv`, a table in `report.md` and a
+//! bar plot `sensitivity-<metric number>.svg`/`.png`. Line plots and `where`
+//! filters need sweeps; scatter plots and histograms work on samples.
+//!
+//! The runs can be split into shards (`--shard K/N`) run by separate
+//! processes, e.g. the tasks of a Slurm job array (`--slurm`), and merged
+//! (`--merge`) into the files one process writes (see `shard.rs` and
+//! `slurm.rs`).
+//!
 //! A check with `claim = "text"` is a **verdict**: it is evaluated like any
 //! check, but `report.md` lists it under "Claims" as holds / does not hold
 //! (per claim: HOLDS, DOES NOT HOLD or HOLDS IN PART), with the measured
@@ -101,15 +129,21 @@
 //! the check tally and the wall time.
 
 mod check;
+pub mod cost;
 mod derived;
 mod dotted;
 mod error;
 mod figures;
+pub mod fingerprint;
 pub mod inverse;
 mod report;
 mod run;
 mod runner;
+pub mod sample;
+mod shard;
 mod sim_runner;
+mod slurm;
+pub mod sobol;
 mod spec;
 mod sweep;
 mod tables;
@@ -121,9 +155,11 @@ pub use check::{Bound, CheckOutcome, evaluate_between};
 pub use derived::{interval_width, quantile_width_from_min, ratio, relative_error, speedup};
 pub use dotted::{MetricPathError, json_number, json_path};
 pub use error::ExperimentError;
-pub use run::{ExperimentResult, PathStat, PointResult, RunRecord, point_model, run_experiment};
+pub use run::{ExperimentResult, PathStat, PointResult, RunRecord, ShardCost, point_model, run_experiment};
 pub use runner::{FrameTable, RunError, RunOutput, Runner};
+pub use shard::{SHARD_FORMAT, SHARDS_DIR, ShardId, ShardIdError, ShardOutcome, merge_shards, run_shard};
 pub use sim_runner::SimRunner;
+pub use slurm::{SlurmError, SlurmOptions, SlurmScripts, sbatch, slurm_scripts};
 pub use spec::{
     BoundRef, Check, Derived, DerivedKind, Expect, Experiment, Metric, ModelSource, PlotKind, PlotSpec, Tolerance,
     load_experiment, parse_experiment,

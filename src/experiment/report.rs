@@ -111,7 +111,47 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
         }
     }
 
-    let keys: Vec<&str> = exp.sweeps.iter().map(|s| s.key.as_str()).collect();
+    if let Some(sample) = &exp.sample {
+        use super::sample::{SampleMethod, Scale};
+        let how = match sample.method {
+            SampleMethod::LatinHypercube => format!("Latin hypercube of {} points", sample.n),
+            SampleMethod::Sobol => format!(
+                "Saltelli's design for Sobol' indices: n = {} rows of A and B (one Latin hypercube in {} dimensions) \
+                 and A_B^(i) per parameter, n (k + 2) = {} points; {} bootstrap resamples",
+                sample.n,
+                2 * sample.params.len(),
+                sample.points(),
+                sample.bootstrap
+            ),
+        };
+        let _ = writeln!(
+            s,
+            "\nSampled parameters ({how}; seed {}):\n\n| key | from | to | scale | values |\n|---|---|---|---|---|",
+            sample.seed
+        );
+        for p in &sample.params {
+            let scale = match p.scale {
+                Scale::Linear => "linear",
+                Scale::Log => "log",
+            };
+            let kind = match (&p.unit, p.integer) {
+                (Some(u), true) => format!("integers, in {u}"),
+                (Some(u), false) => format!("real, in {u}"),
+                (None, true) => "integers".into(),
+                (None, false) => "real".into(),
+            };
+            let _ = writeln!(
+                s,
+                "| `{}` | {} | {} | {scale} | {kind} |",
+                p.key,
+                fmt_num(p.from),
+                fmt_num(p.to)
+            );
+        }
+    }
+
+    let point_keys = exp.point_keys();
+    let keys: Vec<&str> = point_keys.iter().map(|s| s.as_str()).collect();
     let head = |extra: &[String]| {
         let cols: Vec<String> = keys
             .iter()
@@ -137,6 +177,28 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
     let level = format!("{}%", exp.confidence * 100.0);
     for m in &exp.metrics {
         let _ = writeln!(s, "### {} (`{}`)\n", m.label, m.path);
+        if exp.sample.is_some() {
+            // Sampled points are many and unordered: a summary here, every
+            // point in points.csv.
+            let means: Vec<f64> = r.points.iter().filter_map(|p| p.mean(&m.path)).collect();
+            if means.is_empty() {
+                let _ = writeln!(s, "No values.\n");
+            } else {
+                let (lo, hi) = means
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+                let _ = writeln!(
+                    s,
+                    "Over the {} sampled points with a value (replication means; each point in `points.csv`): \
+                     min {}, mean {}, max {}.\n",
+                    means.len(),
+                    fmt_num(lo),
+                    fmt_num(means.iter().sum::<f64>() / means.len() as f64),
+                    fmt_num(hi)
+                );
+            }
+            continue;
+        }
         s.push_str(&head(&[format!("mean ± {level} CI"), "n".into()]));
         for p in &r.points {
             let mut row = key_cells(p);
@@ -187,6 +249,45 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
             let _ = writeln!(s, "| {} |", row.join(" | "));
         }
         s.push('\n');
+    }
+
+    if !r.sensitivity.is_empty() {
+        let _ = writeln!(
+            s,
+            "## Sensitivity (Sobol' indices)\n\nWhich parameters drive each metric: the first-order index S_i is the share of \
+             the metric's variance (over the sampled ranges, of the replication means) that parameter i explains alone; the \
+             total index S_Ti adds its interactions with the others. Estimators of Saltelli et al. (2010): S_i from \
+             f(B)·(f(A_B^(i)) − f(A)), S_Ti from Jansen's (f(A) − f(A_B^(i)))²; {}% percentile bootstrap intervals. \
+             Small negative values are estimation noise around 0.\n",
+            exp.confidence * 100.0
+        );
+        for sens in &r.sensitivity {
+            let _ = writeln!(s, "### {} (`{}`)\n", sens.label, sens.path);
+            let Some(indices) = &sens.indices else {
+                let _ = writeln!(
+                    s,
+                    "Not computed: fewer than two complete rows, or the metric does not vary.\n"
+                );
+                continue;
+            };
+            let _ = writeln!(
+                s,
+                "| parameter | first order S_i | CI | total S_Ti | CI |\n|---|---|---|---|---|"
+            );
+            for (key, i) in indices {
+                let _ = writeln!(
+                    s,
+                    "| `{key}` | {} | [{}, {}] | {} | [{}, {}] |",
+                    fmt_num(i.first),
+                    fmt_num(i.first_ci.0),
+                    fmt_num(i.first_ci.1),
+                    fmt_num(i.total),
+                    fmt_num(i.total_ci.0),
+                    fmt_num(i.total_ci.1)
+                );
+            }
+            let _ = writeln!(s, "\n![Sobol' indices of {}]({f}.svg)\n", sens.label, f = sens.plot);
+        }
     }
 
     let claims = r.claims();
@@ -252,7 +353,32 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
     }
 
     let _ = writeln!(s, "## Timing\n");
-    let _ = writeln!(s, "- experiment wall time: {:.3} s", r.wall_seconds);
+    match &r.shards {
+        None => {
+            let _ = writeln!(s, "- experiment wall time: {:.3} s", r.wall_seconds);
+            if let Some(cpu) = r.cpu_seconds {
+                let _ = writeln!(s, "- CPU time: {cpu:.3} s (user + system, one process)");
+            }
+        }
+        Some(c) => {
+            let _ = writeln!(
+                s,
+                "- array wall time: {:.3} s ({} shards, from the first shard's start to the last shard's end)",
+                c.array_wall_seconds, c.shards
+            );
+            let _ = write!(
+                s,
+                "- total CPU time over all shards: {:.3} s (user + system)",
+                c.cpu_seconds
+            );
+            match r.cpu_seconds {
+                Some(m) => {
+                    let _ = writeln!(s, ", plus {m:.3} s to merge");
+                }
+                None => s.push('\n'),
+            }
+        }
+    }
     let _ = writeln!(
         s,
         "- summed simulation wall time: {:.3} s over {} runs\n",

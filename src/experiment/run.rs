@@ -101,6 +101,12 @@ pub struct ExperimentResult {
     pub wall_seconds: f64,
     /// Sum of the runs' `wall_seconds`.
     pub sim_wall_seconds: f64,
+    /// CPU time (user + system) of this process, in seconds, where the
+    /// system reports it (for a merge: the merging process alone).
+    pub cpu_seconds: Option<f64>,
+    /// For outputs merged from shards: their count and cost
+    /// (`wall_seconds` is then the array's wall time).
+    pub shards: Option<ShardCost>,
     /// Files written, relative to the output directory.
     pub files: Vec<PathBuf>,
     /// Caption lines for the plots, as `(plot file, line)` in plot order
@@ -108,6 +114,8 @@ pub struct ExperimentResult {
     pub plot_captions: Vec<(String, String)>,
     /// Inverse what-ifs, in file order.
     pub searches: Vec<super::inverse::SearchResult>,
+    /// Sobol' indices per metric (`[sample] method = "sobol"`; else empty).
+    pub sensitivity: Vec<super::sobol::Sensitivity>,
 }
 
 impl ExperimentResult {
@@ -183,10 +191,11 @@ impl ExperimentResult {
 }
 
 /// What one job returns.
-struct JobOutput {
-    record: RunRecord,
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct JobOutput {
+    pub(crate) record: RunRecord,
     /// Frame columns in `Experiment::frame_columns` order.
-    frames: Vec<Vec<f64>>,
+    pub(crate) frames: Vec<Vec<f64>>,
 }
 
 /// The model for `point`: `base` with `[set]` then the point's sweep values applied.
@@ -196,6 +205,91 @@ pub fn point_model(exp: &Experiment, base: &toml::Table, point: &Point) -> Resul
         set_dotted(&mut model, k, v.clone())?;
     }
     Ok(model)
+}
+
+/// The runs of an experiment, resolved: its points, the model of each
+/// point, the tracked summary paths and the frame columns.
+pub(crate) struct Plan {
+    pub(crate) points: Vec<Point>,
+    pub(crate) models: Vec<toml::Table>,
+    pub(crate) paths: Vec<String>,
+    pub(crate) columns: Vec<String>,
+}
+
+impl Plan {
+    /// Expands the points of `exp` and patches a model for each.
+    pub(crate) fn new(exp: &Experiment, base_model: &toml::Table) -> Result<Plan, ExperimentError> {
+        let points = expand_points(exp);
+        let models = points
+            .iter()
+            .map(|p| point_model(exp, base_model, p))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Plan {
+            points,
+            models,
+            paths: exp.tracked_paths(),
+            columns: exp.frame_columns(),
+        })
+    }
+
+    /// Every (point, seed) run, in output order: by point, then seed.
+    pub(crate) fn jobs(&self, exp: &Experiment) -> Vec<(usize, u64)> {
+        let seeds = exp.seeds();
+        self.points
+            .iter()
+            .flat_map(|p| seeds.iter().map(move |&s| (p.index, s)))
+            .collect()
+    }
+
+    /// Runs `jobs` in parallel (a progress bar on stderr if `progress`);
+    /// the results are in the order of `jobs`.
+    pub(crate) fn run(
+        &self,
+        runner: &dyn Runner,
+        jobs: &[(usize, u64)],
+        progress: bool,
+    ) -> Vec<Result<JobOutput, ExperimentError>> {
+        let want_frames = !self.columns.is_empty();
+        let bar = progress_bar(jobs.len() as u64, progress);
+        let results = jobs
+            .par_iter()
+            .map(|&(pi, seed)| {
+                let r = run_job(
+                    runner,
+                    &self.models[pi],
+                    &self.points[pi],
+                    seed,
+                    &self.paths,
+                    &self.columns,
+                    want_frames,
+                );
+                bar.inc(1);
+                r
+            })
+            .collect();
+        bar.finish_and_clear();
+        results
+    }
+}
+
+/// Where the time of an experiment went, for the report.
+pub(crate) enum Timing {
+    /// One process, started at this instant.
+    Single(Instant),
+    /// Merged from shards.
+    Shards(ShardCost),
+}
+
+/// The cost of an experiment run as shards (`--shard K/N`, merged with
+/// `--merge`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ShardCost {
+    /// Number of shards.
+    pub shards: usize,
+    /// CPU time (user + system) summed over the shard processes, in seconds.
+    pub cpu_seconds: f64,
+    /// From the start of the first shard to the end of the last, in seconds.
+    pub array_wall_seconds: f64,
 }
 
 /// Run `exp` on `base_model` through `runner`, writing `runs.csv`,
@@ -213,34 +307,13 @@ pub fn run_experiment(
     progress: bool,
 ) -> Result<ExperimentResult, ExperimentError> {
     let started = Instant::now();
-    let points = expand_points(exp);
-    let paths = exp.tracked_paths();
-    let columns = exp.frame_columns();
-    let want_frames = !columns.is_empty();
-    let models = points
-        .iter()
-        .map(|p| point_model(exp, base_model, p))
-        .collect::<Result<Vec<_>, _>>()?;
+    let plan = Plan::new(exp, base_model)?;
     std::fs::create_dir_all(out_dir).map_err(|source| ExperimentError::Io {
         path: out_dir.to_path_buf(),
         source,
     })?;
-
-    let seeds = exp.seeds();
-    let jobs: Vec<(usize, u64)> = points
-        .iter()
-        .flat_map(|p| seeds.iter().map(move |&s| (p.index, s)))
-        .collect();
-    let bar = progress_bar(jobs.len() as u64, progress);
-    let results: Vec<Result<JobOutput, ExperimentError>> = jobs
-        .par_iter()
-        .map(|&(pi, seed)| {
-            let r = run_job(runner, &models[pi], &points[pi], seed, &paths, &columns, want_frames);
-            bar.inc(1);
-            r
-        })
-        .collect();
-    bar.finish_and_clear();
+    let jobs = plan.jobs(exp);
+    let results = plan.run(runner, &jobs, progress);
 
     let mut outputs = Vec::with_capacity(results.len());
     let mut first_error = None;
@@ -252,18 +325,51 @@ pub fn run_experiment(
             }
         }
     }
-    let runs: Vec<RunRecord> = outputs.iter().map(|o| o.record.clone()).collect();
-    tables::write_runs(&out_dir.join("runs.csv"), exp, &points, &paths, &runs)?;
     if let Some(e) = first_error {
+        let runs: Vec<RunRecord> = outputs.iter().map(|o| o.record.clone()).collect();
+        tables::write_runs(&out_dir.join("runs.csv"), exp, &plan.points, &plan.paths, &runs)?;
         return Err(e);
     }
+    finish(
+        exp,
+        base_model,
+        runner,
+        &plan,
+        outputs,
+        out_dir,
+        Timing::Single(started),
+    )
+}
 
-    // Aggregate per point (jobs are in point, seed order).
+/// Everything after the runs: `runs.csv`, aggregation per point, derived
+/// values, checks, plots, searches and `report.md`. `outputs` hold every
+/// run of the plan, in point then seed order (what a single process and a
+/// merge of shards both hand over, so both write the same files).
+pub(crate) fn finish(
+    exp: &Experiment,
+    base_model: &toml::Table,
+    runner: &dyn Runner,
+    plan: &Plan,
+    outputs: Vec<JobOutput>,
+    out_dir: &Path,
+    timing: Timing,
+) -> Result<ExperimentResult, ExperimentError> {
+    let (points, paths, columns) = (&plan.points, plan.paths.clone(), &plan.columns);
+    let runs: Vec<RunRecord> = outputs.iter().map(|o| o.record.clone()).collect();
+    tables::write_runs(&out_dir.join("runs.csv"), exp, points, &paths, &runs)?;
+
+    // Aggregate per point (runs are in point, seed order).
     let n_paths = paths.len();
     let mut point_stats: Vec<Vec<MeanCi>> = Vec::with_capacity(points.len());
     let mut pooled: Vec<Vec<Vec<f64>>> = vec![vec![Vec::new(); columns.len()]; points.len()];
-    for p in &points {
-        let mine: Vec<&JobOutput> = outputs.iter().filter(|o| o.record.point == p.index).collect();
+    let mut by_point: Vec<Vec<&JobOutput>> = vec![Vec::new(); points.len()];
+    for o in &outputs {
+        if let Some(v) = by_point.get_mut(o.record.point) {
+            v.push(o);
+        }
+    }
+    for p in points {
+        let mine = &by_point[p.index];
         let stats = (0..n_paths)
             .map(|k| {
                 let vals: Vec<f64> = mine.iter().filter_map(|o| o.record.values[k]).collect();
@@ -271,7 +377,7 @@ pub fn run_experiment(
             })
             .collect();
         point_stats.push(stats);
-        for o in &mine {
+        for o in mine {
             for (c, col) in o.frames.iter().enumerate() {
                 pooled[p.index][c].extend_from_slice(col);
             }
@@ -284,11 +390,11 @@ pub fn run_experiment(
     let derived = compute(
         exp,
         &DerivedInputs {
-            points: &points,
+            points,
             means: &means,
             paths: &paths,
             frames: &pooled,
-            frame_columns: &columns,
+            frame_columns: columns,
         },
     );
     let point_results: Vec<PointResult> = points
@@ -318,7 +424,7 @@ pub fn run_experiment(
         })
         .collect();
     let mut files = vec![PathBuf::from("runs.csv")];
-    tables::write_points(&out_dir.join("points.csv"), exp, &points, &point_results)?;
+    tables::write_points(&out_dir.join("points.csv"), exp, points, &point_results)?;
     files.push(PathBuf::from("points.csv"));
 
     let mut checks = Vec::new();
@@ -356,7 +462,7 @@ pub fn run_experiment(
     let mut plot_captions = Vec::new();
     for plot in &exp.plots {
         let captions =
-            figures::draw(exp, plot, &points, &point_results, &pooled, &columns, out_dir).map_err(|source| {
+            figures::draw(exp, plot, points, &point_results, &pooled, columns, out_dir).map_err(|source| {
                 ExperimentError::Plot {
                     file: plot.file.clone(),
                     source,
@@ -365,6 +471,39 @@ pub fn run_experiment(
         plot_captions.extend(captions.into_iter().map(|c| (plot.file.clone(), c)));
         files.push(PathBuf::from(format!("{}.svg", plot.file)));
         files.push(PathBuf::from(format!("{}.png", plot.file)));
+    }
+
+    let sensitivity = super::sobol::analyse(exp, &point_results);
+    if !sensitivity.is_empty() {
+        let path = out_dir.join("sensitivity.csv");
+        std::fs::write(&path, super::sobol::csv(&sensitivity)).map_err(|source| ExperimentError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        files.push(PathBuf::from("sensitivity.csv"));
+    }
+    for s in &sensitivity {
+        let Some(indices) = &s.indices else { continue };
+        let series = |name: &str, v: fn(&super::sobol::SobolIndex) -> (f64, (f64, f64))| crate::plot::BarSeries {
+            name: name.into(),
+            values: indices.iter().map(|(_, i)| v(i).0).collect(),
+            ci: Some(indices.iter().map(|(_, i)| v(i).1).collect()),
+        };
+        let chart = crate::plot::BarChart {
+            title: format!("Sobol' indices of {}", s.label),
+            y_label: "index (share of the output variance)".into(),
+            categories: indices.iter().map(|(k, _)| k.clone()).collect(),
+            series: vec![
+                series("first order S_i", |i| (i.first, i.first_ci)),
+                series("total S_Ti", |i| (i.total, i.total_ci)),
+            ],
+        };
+        crate::plot::bar_chart(&out_dir.join(&s.plot), &chart).map_err(|source| ExperimentError::Plot {
+            file: s.plot.clone(),
+            source,
+        })?;
+        files.push(PathBuf::from(format!("{}.svg", s.plot)));
+        files.push(PathBuf::from(format!("{}.png", s.plot)));
     }
 
     let mut search_base = base_model.clone();
@@ -401,11 +540,21 @@ pub fn run_experiment(
         checks,
         checks_failed,
         wall_seconds: 0.0,
+        cpu_seconds: None,
+        shards: None,
         files,
         plot_captions,
         searches,
+        sensitivity,
     };
-    result.wall_seconds = started.elapsed().as_secs_f64();
+    match timing {
+        Timing::Single(started) => result.wall_seconds = started.elapsed().as_secs_f64(),
+        Timing::Shards(cost) => {
+            result.wall_seconds = cost.array_wall_seconds;
+            result.shards = Some(cost);
+        }
+    }
+    result.cpu_seconds = super::cost::process_cpu_seconds();
     let report_path = out_dir.join("report.md");
     let report_text = report::render(exp, &result) + &super::inverse::report_section(&exp.searches, &result.searches);
     std::fs::write(&report_path, report_text).map_err(|source| ExperimentError::Io {

@@ -219,8 +219,21 @@ impl Point {
 }
 
 /// The cartesian product of all sweeps in file order, the first sweep
-/// varying slowest. No sweeps give one point.
+/// varying slowest. No sweeps give one point. With a `[sample]`, its
+/// points instead ([`super::sample::Sample::assignments`]).
 pub fn expand_points(exp: &Experiment) -> Vec<Point> {
+    if let Some(sample) = &exp.sample {
+        return sample
+            .assignments()
+            .into_iter()
+            .enumerate()
+            .map(|(index, assignments)| Point {
+                index,
+                assignments,
+                value_indices: Vec::new(),
+            })
+            .collect();
+    }
     let total: usize = exp.sweeps.iter().map(|s| s.values.len()).product();
     (0..total)
         .map(|index| {

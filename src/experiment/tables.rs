@@ -30,7 +30,7 @@ pub(crate) fn write_runs(
     runs: &[RunRecord],
 ) -> Result<(), ExperimentError> {
     let mut header = vec!["point".to_string()];
-    header.extend(exp.sweeps.iter().map(|s| s.key.clone()));
+    header.extend(exp.point_keys());
     header.push("seed".into());
     let shown: Vec<usize> = (0..paths.len()).filter(|&k| paths[k] != "wall_seconds").collect();
     header.extend(shown.iter().map(|&k| paths[k].clone()));
@@ -59,7 +59,7 @@ pub(crate) fn write_points(
     results: &[PointResult],
 ) -> Result<(), ExperimentError> {
     let mut header = vec!["point".to_string()];
-    header.extend(exp.sweeps.iter().map(|s| s.key.clone()));
+    header.extend(exp.point_keys());
     if let Some(first) = results.first() {
         for s in &first.stats {
             for suffix in ["mean", "ci_low", "ci_high", "n"] {

@@ -307,6 +307,73 @@ impl ResultSet {
     }
 }
 
+/// Makes `target` a folder of rendersim's without replacing it: checks it
+/// as [`ResultSet::begin`] does (absent, empty, marked, or holding only files
+/// `legacy` names), creates it and writes the marker. For outputs written
+/// into the folder piece by piece by several processes (the shards of an
+/// experiment, `DIR/shards/`), which a later result set in the same folder
+/// keeps with [`ResultSet::keep`]. Returns the folder (links resolved).
+pub fn claim_folder(target: &Path, legacy: impl Fn(&str) -> bool) -> Result<PathBuf, OutputError> {
+    let target = absolute_folder(&resolve_links(target)?)?;
+    check_replaceable(&target, &legacy)?;
+    std::fs::create_dir_all(&target).map_err(OutputError::io("creating folder", &target))?;
+    let marker = target.join(MARKER);
+    if !marker.is_file() {
+        super::files::write_output(&marker, |w| {
+            w.write_all(
+                format!(
+                    "This folder is a result set written by rendersim {}; rendersim replaces it as a whole when it writes here again.\n",
+                    env!("CARGO_PKG_VERSION")
+                )
+                .as_bytes(),
+            )
+        })?;
+    }
+    Ok(target)
+}
+
+/// Puts a copy of `from` (a file or a folder tree) at `to`, by hard links
+/// where the file system allows (no data copied; a file still open for
+/// writing elsewhere, such as a job's log, keeps growing under both names),
+/// else by copying.
+fn link_tree(from: &Path, to: &Path) -> std::io::Result<()> {
+    let meta = std::fs::symlink_metadata(from)?;
+    if meta.is_dir() {
+        std::fs::create_dir_all(to)?;
+        for e in std::fs::read_dir(from)? {
+            let e = e?;
+            link_tree(&e.path(), &to.join(e.file_name()))?;
+        }
+        Ok(())
+    } else if meta.file_type().is_symlink() {
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(std::fs::read_link(from)?, to)
+        }
+        #[cfg(not(unix))]
+        {
+            std::fs::copy(from, to).map(|_| ())
+        }
+    } else {
+        std::fs::hard_link(from, to).or_else(|_| std::fs::copy(from, to).map(|_| ()))
+    }
+}
+
+impl ResultSet {
+    /// Carries the entry `name` (a file or folder) of the current target
+    /// into the staged set, so the swap keeps it (the shard files of an
+    /// experiment, its Slurm scripts and logs). Nothing happens if the
+    /// target has no such entry or the set already holds one.
+    pub fn keep(&self, name: &str) -> Result<(), OutputError> {
+        let from = self.target.join(name);
+        let to = self.staging.join(name);
+        if std::fs::symlink_metadata(&from).is_err() || std::fs::symlink_metadata(&to).is_ok() {
+            return Ok(());
+        }
+        link_tree(&from, &to).map_err(OutputError::io("keeping", from))
+    }
+}
+
 impl Drop for ResultSet {
     fn drop(&mut self) {
         if self.registered.is_some() {
@@ -403,6 +470,41 @@ mod tests {
         s.commit().unwrap();
         assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
         assert_eq!(std::fs::read_to_string(real.join("a.csv")).unwrap(), "1");
+    }
+
+    #[test]
+    fn a_claimed_folder_keeps_its_kept_entries_through_a_new_set() {
+        let d = tempfile::tempdir().unwrap();
+        let out = d.path().join("out");
+        let claimed = claim_folder(&out, |_| false).unwrap();
+        assert!(claimed.join(MARKER).is_file());
+        std::fs::create_dir_all(out.join("shards")).unwrap();
+        std::fs::write(out.join("shards/a.json"), "shard").unwrap();
+        std::fs::write(out.join("job.sbatch"), "job").unwrap();
+        // Claiming again is fine (the marker is there now).
+        claim_folder(&out, |_| false).unwrap();
+        let s = ResultSet::begin(&out, |_| false).unwrap();
+        std::fs::write(s.dir().join("runs.csv"), "1").unwrap();
+        s.keep("shards").unwrap();
+        s.keep("job.sbatch").unwrap();
+        s.keep("absent").unwrap();
+        s.commit().unwrap();
+        assert_eq!(
+            files(&out),
+            vec![
+                MARKER.to_string(),
+                "job.sbatch".into(),
+                "runs.csv".into(),
+                "shards".into()
+            ]
+        );
+        assert_eq!(std::fs::read_to_string(out.join("shards/a.json")).unwrap(), "shard");
+        // A folder holding other files is not claimed.
+        std::fs::write(d.path().join("thesis.tex"), "mine").unwrap();
+        assert!(matches!(
+            claim_folder(d.path(), |_| false),
+            Err(OutputError::ForeignFolder { .. })
+        ));
     }
 
     #[test]

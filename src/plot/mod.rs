@@ -1,7 +1,7 @@
 //! Plots written as SVG and PNG side by side.
 //!
 //! A small API shared by the experiment runner and other code:
-//! [`line_plot`], [`histogram`] and [`scatter`] each take a base path without
+//! [`line_plot`], [`histogram`], [`scatter`] and [`bar_chart`] each take a base path without
 //! extension and write `<base>.svg` and `<base>.png` (1024x640). Text is
 //! drawn with the embedded DejaVu Sans font, so no system fonts are needed.
 //!
@@ -11,6 +11,7 @@
 //! are not positive are dropped in the same way.
 
 mod axis;
+mod bar;
 mod error;
 mod font;
 mod histogram;
@@ -19,6 +20,7 @@ mod output;
 mod palette;
 mod scatter;
 
+pub use bar::{BarChart, BarSeries, bar_chart};
 pub use error::PlotError;
 pub use histogram::{Histogram, Mark, histogram};
 pub use line::{LinePlot, Series, line_plot};

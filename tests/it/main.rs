@@ -24,5 +24,6 @@ mod obj_files;
 mod outputs;
 mod pipeline_oracles;
 mod pixelflow;
+mod shards;
 mod unified;
 mod vr;

@@ -239,6 +239,8 @@ pub struct Experiment {
     pub checks: Vec<Check>,
     /// Inverse what-ifs (`[[search]]`).
     pub searches: Vec<super::inverse::Search>,
+    /// Points drawn from parameter ranges (`[sample]`) instead of sweeps.
+    pub sample: Option<super::sample::Sample>,
 }
 
 impl Experiment {
@@ -318,6 +320,15 @@ impl Experiment {
         out
     }
 
+    /// The keys every point assigns: the sweep keys, or the sampled
+    /// parameters' keys.
+    pub fn point_keys(&self) -> Vec<String> {
+        match &self.sample {
+            Some(s) => s.params.iter().map(|p| p.key.clone()).collect(),
+            None => self.sweeps.iter().map(|s| s.key.clone()).collect(),
+        }
+    }
+
     /// The label of a metric path (its `[[metric]]` label, else the path).
     pub fn label_of(&self, path: &str) -> String {
         self.metrics
@@ -349,6 +360,13 @@ impl Experiment {
             origins.push((
                 k.clone(),
                 format!("[[sweep]] of {k} in {}", at(&format!("sweep.{i}.key"))),
+            ));
+        }
+        for (i, p) in self.sample.iter().flat_map(|s| &s.params).enumerate() {
+            let k = &p.key;
+            origins.push((
+                k.clone(),
+                format!("[[sample.param]] of {k} in {}", at(&format!("sample.param.{i}.key"))),
             ));
         }
         origins

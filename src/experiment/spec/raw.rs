@@ -31,6 +31,33 @@ pub(super) struct RawExperiment {
     pub(super) check: Vec<RawCheck>,
     #[serde(default)]
     pub(super) search: Vec<crate::experiment::inverse::RawSearch>,
+    pub(super) sample: Option<RawSample>,
+}
+
+/// `[sample]`: points drawn from parameter ranges.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSample {
+    pub(super) method: String,
+    pub(super) n: i64,
+    #[serde(default = "default_seed")]
+    pub(super) seed: u64,
+    pub(super) bootstrap: Option<i64>,
+    #[serde(default)]
+    pub(super) param: Vec<RawParam>,
+}
+
+/// `[[sample.param]]`: one sampled key and its range.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawParam {
+    pub(super) key: String,
+    pub(super) from: f64,
+    pub(super) to: f64,
+    pub(super) scale: Option<String>,
+    #[serde(default)]
+    pub(super) integer: bool,
+    pub(super) unit: Option<String>,
 }
 
 pub(super) fn default_model() -> String {

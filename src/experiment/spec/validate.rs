@@ -125,12 +125,24 @@ impl Validator<'_> {
             };
             sweeps.push(sweep);
         }
-        // Runs = points (the product of the sweeps' sizes) x replications,
-        // checked before the points are expanded.
-        let points = sweeps
-            .iter()
-            .try_fold(1u64, |n, s| n.checked_mul(s.values.len() as u64))
-            .unwrap_or(u64::MAX);
+        let sample = match raw.sample {
+            None => None,
+            Some(s) => {
+                if !sweeps.is_empty() {
+                    return Err(self.err("sample", "give either `[[sweep]]`s or `[sample]`, not both"));
+                }
+                Some(self.sample(s)?)
+            }
+        };
+        // Runs = points (the product of the sweeps' sizes, or the sample's
+        // points) x replications, checked before the points are expanded.
+        let points = match &sample {
+            Some(s) => s.points() as u64,
+            None => sweeps
+                .iter()
+                .try_fold(1u64, |n, s| n.checked_mul(s.values.len() as u64))
+                .unwrap_or(u64::MAX),
+        };
         let runs = points.saturating_mul(raw.replications as u64);
         if runs > crate::limits::MAX_EXPERIMENT_RUNS {
             let sizes: Vec<String> = sweeps.iter().map(|s| s.values.len().to_string()).collect();
@@ -517,6 +529,89 @@ impl Validator<'_> {
             derived,
             checks,
             searches,
+            sample,
+        })
+    }
+
+    fn sample(&self, s: RawSample) -> Result<crate::experiment::sample::Sample, ExperimentError> {
+        use crate::experiment::sample::{Sample, SampleMethod, SampleParam, Scale};
+        let method = match s.method.as_str() {
+            "latin_hypercube" => SampleMethod::LatinHypercube,
+            "sobol" => SampleMethod::Sobol,
+            other => {
+                return Err(self.err(
+                    "sample.method",
+                    format!("unknown method `{other}` (expected latin_hypercube or sobol)"),
+                ));
+            }
+        };
+        if !(2..=1_000_000).contains(&s.n) {
+            return Err(self.err("sample.n", format!("must be between 2 and 1000000, got {}", s.n)));
+        }
+        let bootstrap = s.bootstrap.unwrap_or(1000);
+        if !(0..=100_000).contains(&bootstrap) {
+            return Err(self.err(
+                "sample.bootstrap",
+                format!("must be between 0 and 100000, got {bootstrap}"),
+            ));
+        }
+        if s.param.is_empty() {
+            return Err(self.err("sample", "needs at least one `[[sample.param]]`"));
+        }
+        let mut params: Vec<SampleParam> = Vec::new();
+        for (i, p) in s.param.into_iter().enumerate() {
+            let key = format!("sample.param[{i}]");
+            if p.key.split('.').any(|x| x.trim().is_empty()) {
+                return Err(self.err(format!("{key}.key"), format!("`{}` is not a dotted key", p.key)));
+            }
+            if params.iter().any(|o| o.key == p.key) {
+                return Err(self.err(format!("{key}.key"), format!("`{}` is sampled twice", p.key)));
+            }
+            if !(p.from.is_finite() && p.to.is_finite() && p.from < p.to) {
+                return Err(self.err(
+                    &key,
+                    format!("needs finite `from` < `to`, got from = {}, to = {}", p.from, p.to),
+                ));
+            }
+            let scale = match p.scale.as_deref().unwrap_or("linear") {
+                "linear" => Scale::Linear,
+                "log" if p.from > 0.0 => Scale::Log,
+                "log" => {
+                    return Err(self.err(format!("{key}.scale"), "`log` needs `from` > 0"));
+                }
+                other => {
+                    return Err(self.err(
+                        format!("{key}.scale"),
+                        format!("unknown scale `{other}` (expected linear or log)"),
+                    ));
+                }
+            };
+            if p.integer && (p.from.fract() != 0.0 || p.to.fract() != 0.0) {
+                return Err(self.err(&key, "`integer = true` needs whole numbers for `from` and `to`"));
+            }
+            if let Some(u) = &p.unit
+                && (u.is_empty() || !u.chars().all(|c| c.is_ascii_alphabetic() || c == '/'))
+            {
+                return Err(self.err(
+                    format!("{key}.unit"),
+                    format!("`{u}` is not a unit (letters, e.g. ms, us, Hz)"),
+                ));
+            }
+            params.push(SampleParam {
+                key: p.key,
+                from: p.from,
+                to: p.to,
+                scale,
+                integer: p.integer,
+                unit: p.unit,
+            });
+        }
+        Ok(Sample {
+            method,
+            n: s.n as usize,
+            seed: s.seed,
+            bootstrap: bootstrap as usize,
+            params,
         })
     }
 }

@@ -1,0 +1,192 @@
+//! Grouped bar charts with interval whiskers: one group of bars per
+//! category, one bar per series (e.g. first-order and total Sobol indices
+//! per parameter, with their bootstrap confidence intervals).
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use super::PlotError;
+use super::axis::widen;
+use super::font::FAMILY;
+use super::output::{draw_notes, render_both};
+use super::palette::color;
+
+/// One series of a [`BarChart`]: a value per category.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BarSeries {
+    /// Legend text.
+    pub name: String,
+    /// One value per category (NaN or infinite: no bar, noted).
+    pub values: Vec<f64>,
+    /// An interval per category, drawn as a whisker (optional).
+    pub ci: Option<Vec<(f64, f64)>>,
+}
+
+/// A grouped bar chart description.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BarChart {
+    /// Title above the plot.
+    pub title: String,
+    /// Y axis description.
+    pub y_label: String,
+    /// Category names along the x axis.
+    pub categories: Vec<String>,
+    /// The series, each in its own colour.
+    pub series: Vec<BarSeries>,
+}
+
+fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &BarChart) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let n = c.categories.len().max(1);
+    let finite = |v: &f64| v.is_finite();
+    let mut lo: f64 = 0.0;
+    let mut hi: f64 = 0.0;
+    let mut dropped = 0usize;
+    for s in &c.series {
+        for v in &s.values {
+            if finite(v) {
+                lo = lo.min(*v);
+                hi = hi.max(*v);
+            } else {
+                dropped += 1;
+            }
+        }
+        for (a, b) in s.ci.iter().flatten() {
+            for v in [a, b].into_iter().filter(|v| finite(v)) {
+                lo = lo.min(*v);
+                hi = hi.max(*v);
+            }
+        }
+    }
+    let (lo, hi) = if hi > lo {
+        (lo - (hi - lo) * 0.02, hi + (hi - lo) * 0.08)
+    } else {
+        widen(lo, hi, 0.05)
+    };
+    let mut chart = ChartBuilder::on(root)
+        .margin(20)
+        .caption(&c.title, (FAMILY, 24))
+        .x_label_area_size(50)
+        .y_label_area_size(60)
+        .build_cartesian_2d(-0.5..(n as f64 - 0.5), lo..hi)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(0)
+        .y_desc(c.y_label.as_str())
+        .label_style((FAMILY, 14))
+        .axis_desc_style((FAMILY, 16))
+        .draw()
+        .map_err(e)?;
+    let k = c.series.len().max(1) as f64;
+    let group = 0.8;
+    let w = group / k;
+    for (j, s) in c.series.iter().enumerate() {
+        let col = color(j);
+        let left = |i: usize| i as f64 - group / 2.0 + j as f64 * w;
+        chart
+            .draw_series(
+                s.values
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, v)| v.is_finite())
+                    .map(|(i, &v)| Rectangle::new([(left(i) + w * 0.05, 0.0), (left(i) + w * 0.95, v)], col.filled())),
+            )
+            .map_err(e)?
+            .label(s.name.as_str())
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], col.filled()));
+        if let Some(ci) = &s.ci {
+            for (i, &(a, b)) in ci.iter().enumerate() {
+                if !(a.is_finite() && b.is_finite()) {
+                    continue;
+                }
+                let x = left(i) + w / 2.0;
+                let cap = w * 0.2;
+                for path in [
+                    vec![(x, a), (x, b)],
+                    vec![(x - cap, a), (x + cap, a)],
+                    vec![(x - cap, b), (x + cap, b)],
+                ] {
+                    chart
+                        .draw_series(std::iter::once(PathElement::new(path, BLACK.stroke_width(2))))
+                        .map_err(e)?;
+                }
+            }
+        }
+    }
+    // Category names under the groups.
+    let font = TextStyle::from((FAMILY, 15).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
+    for (i, name) in c.categories.iter().enumerate() {
+        let (x, y) = chart.backend_coord(&(i as f64, lo));
+        root.draw_text(
+            name,
+            &font,
+            (x - root.get_base_pixel().0, y + 8 - root.get_base_pixel().1),
+        )
+        .map_err(e)?;
+    }
+    if !c.series.is_empty() {
+        chart
+            .configure_series_labels()
+            .label_font((FAMILY, 14))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(e)?;
+    }
+    let notes: Vec<String> = if dropped > 0 {
+        vec![format!("{dropped} value(s) not finite: no bar drawn")]
+    } else {
+        Vec::new()
+    };
+    draw_notes(root, &notes)
+}
+
+/// Write `c` to `<base>.svg` and `<base>.png`.
+pub fn bar_chart(base: &Path, c: &BarChart) -> Result<(), PlotError> {
+    render_both(base, |r| draw(r, c), |r| draw(r, c))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plot::output::test_support::assert_plot_files;
+
+    #[test]
+    fn bars_with_whiskers_and_awkward_values() {
+        let d = tempfile::tempdir().unwrap();
+        let base = d.path().join("bars");
+        bar_chart(
+            &base,
+            &BarChart {
+                title: "indices".into(),
+                y_label: "index".into(),
+                categories: vec!["a".into(), "b".into(), "c".into()],
+                series: vec![
+                    BarSeries {
+                        name: "first order".into(),
+                        values: vec![0.3, 0.44, -0.01],
+                        ci: Some(vec![(0.25, 0.35), (0.4, 0.5), (-0.05, 0.03)]),
+                    },
+                    BarSeries {
+                        name: "total".into(),
+                        values: vec![0.55, f64::NAN, 0.24],
+                        ci: None,
+                    },
+                ],
+            },
+        )
+        .unwrap();
+        assert_plot_files(&base);
+        let svg = std::fs::read_to_string(d.path().join("bars.svg")).unwrap();
+        assert!(svg.contains("not finite"), "the NaN is noted");
+        // Nothing at all still draws.
+        bar_chart(&d.path().join("empty"), &BarChart::default()).unwrap();
+        assert_plot_files(&d.path().join("empty"));
+    }
+}
