@@ -14,6 +14,7 @@ mod axis;
 mod error;
 mod font;
 mod histogram;
+mod legend;
 mod line;
 mod output;
 mod palette;
