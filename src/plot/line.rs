@@ -144,15 +144,15 @@ fn legend_box(series: &[Prepared], entries: usize) -> (f64, f64) {
 fn occupied(series: &[Prepared], xr: (f64, f64), yr: (f64, f64)) -> Vec<Occupied> {
     let (w, h) = (xr.1 - xr.0, yr.1 - yr.0);
     let mut samples = Vec::new();
-    let mut push = |x: f64, y: f64| samples.push(Occupied::point((x - xr.0) / w, (y - yr.0) / h));
+    let at = |x: f64, y: f64| Occupied::point((x - xr.0) / w, (y - yr.0) / h);
     for s in series {
         for p in &s.points {
-            push(p.0, p.1);
+            samples.push(at(p.0, p.1));
         }
         for p in s.points.windows(2) {
             for k in 1..10 {
                 let t = k as f64 / 10.0;
-                push(p[0].0 + t * (p[1].0 - p[0].0), p[0].1 + t * (p[1].1 - p[0].1));
+                samples.push(at(p[0].0 + t * (p[1].0 - p[0].0), p[0].1 + t * (p[1].1 - p[0].1)));
             }
         }
         for b in &s.bars {
