@@ -8,10 +8,10 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+use cli::args::TimelineArgs;
 use cli::args::{
     BenchArgs, CalibrateArgs, ExperimentArgs, IsolateArgs, MeasureArgs, PredictArgs, RunArgs, StudyArgs, VcacheArgs,
 };
-use cli::args::TimelineArgs;
 use cli::commands::{self, ChecksFailed};
 
 #[derive(Parser)]

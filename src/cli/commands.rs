@@ -15,10 +15,10 @@ use rendersim::output::trace::TraceWriter;
 use rendersim::systems::frame_pipeline::isolate::IsolateOptions;
 use rendersim::systems::run_model;
 
+use super::args::TimelineArgs;
 use super::args::{
     BenchArgs, CalibrateArgs, ExperimentArgs, IsolateArgs, MeasureArgs, PredictArgs, RunArgs, StudyArgs, VcacheArgs,
 };
-use super::args::TimelineArgs;
 use super::{device, print};
 
 /// An experiment ran, but some of its reference checks failed (exit
@@ -411,7 +411,10 @@ pub fn timeline(args: TimelineArgs) -> Result<()> {
     use rendersim::systems::frame_pipeline::timeline::{TimelineOptions, timeline_of};
     // The extension is checked before simulating.
     rendersim::plot::ImageFormat::of(&args.out)?;
-    let model = load_model(args.model.as_deref(), &rendersim::config::Overrides::with_sets(&args.sets))?;
+    let model = load_model(
+        args.model.as_deref(),
+        &rendersim::config::Overrides::with_sets(&args.sets),
+    )?;
     let opts = TimelineOptions {
         first: args.from,
         frames: args.frames,

@@ -211,7 +211,11 @@ fn layout(h: &Histogram, b: &Binned) -> Layout {
                 if d > 0.0 {
                     for k in 0..4 {
                         let xv = b.lo + b.width * (i as f64 + (k as f64 + 0.5) / 4.0);
-                        occ.push(Occupied { x: fx(xv), y0: 0.0, y1: d / ymax });
+                        occ.push(Occupied {
+                            x: fx(xv),
+                            y0: 0.0,
+                            y1: d / ymax,
+                        });
                     }
                 }
             }
@@ -478,7 +482,11 @@ mod tests {
             for (i, &d) in dens.iter().enumerate() {
                 if d > 0.0 {
                     let xv = b.lo + b.width * (i as f64 + 0.5);
-                    occ.push(Occupied { x: fx(xv), y0: 0.0, y1: d / l.ymax });
+                    occ.push(Occupied {
+                        x: fx(xv),
+                        y0: 0.0,
+                        y1: d / l.ymax,
+                    });
                 }
             }
         }
@@ -486,7 +494,10 @@ mod tests {
         for (i, m) in h.marks.iter().enumerate() {
             let chars = m.label.chars().count() as f64 + 1.0;
             for k in 0..=8 {
-                occ.push(Occupied::point(fx(m.at) + k as f64 / 8.0 * chars * 7.0 / 900.0, mark_label_y(i, band)));
+                occ.push(Occupied::point(
+                    fx(m.at) + k as f64 / 8.0 * chars * 7.0 / 900.0,
+                    mark_label_y(i, band),
+                ));
             }
         }
         let (left, top) = match l.legend {

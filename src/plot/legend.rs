@@ -69,6 +69,7 @@ pub(crate) fn corner(occupied: &[Occupied], w: f64, h: f64) -> (SeriesLabelPosit
 /// something, with the y axis grown by `grow` so that the data keep to the
 /// lower `1 - h` of the plot area), covers none of `occupied`: the check
 /// the plots' layouts are tested against.
+#[cfg(test)]
 pub(crate) fn is_clear(occupied: &[Occupied], w: f64, h: f64) -> bool {
     let (_, n) = corner(occupied, w, h);
     if n == 0 {

@@ -336,7 +336,10 @@ mod tests {
         let p = legend_corner(&[falling, high_left], r.0, r.1, 2);
         assert!(matches!(p, (SeriesLabelPosition::LowerRight, 0)), "{p:?}");
         // Data in every corner: the fewest covered is reported, not zero.
-        let zigzag = prepared("d", &[(0.0, 0.0), (1.0, 10.0), (9.0, 0.0), (10.0, 10.0)]);
+        let zigzag = prepared(
+            "a zigzag with a long name",
+            &[(0.0, 0.0), (1.0, 10.0), (9.0, 0.0), (10.0, 10.0)],
+        );
         assert!(legend_corner(&[zigzag], r.0, r.1, 1).1 > 0);
     }
 
@@ -347,13 +350,20 @@ mod tests {
         let xs: Vec<f64> = (0..14).map(|i| -1.0 + i as f64 * 0.25).collect();
         let geometry = prepared(
             "geometry bottleneck share",
-            &xs.iter().map(|&x| (x, 1.0 / (1.0 + (4.0 * (x - 1.2)).exp()))).collect::<Vec<_>>(),
+            &xs.iter()
+                .map(|&x| (x, 1.0 / (1.0 + (4.0 * (x - 1.2)).exp())))
+                .collect::<Vec<_>>(),
         );
         let fragment = prepared(
             "fragment bottleneck share",
-            &xs.iter().map(|&x| (x, 1.0 - 1.0 / (1.0 + (4.0 * (x - 1.2)).exp()))).collect::<Vec<_>>(),
+            &xs.iter()
+                .map(|&x| (x, 1.0 - 1.0 / (1.0 + (4.0 * (x - 1.2)).exp())))
+                .collect::<Vec<_>>(),
         );
-        let front = prepared("front-end bottleneck share", &xs.iter().map(|&x| (x, 0.01)).collect::<Vec<_>>());
+        let front = prepared(
+            "front-end bottleneck share",
+            &xs.iter().map(|&x| (x, 0.01)).collect::<Vec<_>>(),
+        );
         let series = [geometry, fragment, front];
         let xr = padded_range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
         let yr = padded_range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));

@@ -95,7 +95,11 @@ pub enum ImageFormat {
 impl ImageFormat {
     /// The format named by `path`'s extension (case-insensitive).
     pub fn of(path: &Path) -> Result<ImageFormat, PlotError> {
-        match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase())
+        {
             Some(e) if e == "svg" => Ok(ImageFormat::Svg),
             Some(e) if e == "png" => Ok(ImageFormat::Png),
             _ => Err(PlotError::Extension {
@@ -241,8 +245,11 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline) -> Resu
     key(
         &mut x,
         &|x| {
-            root.draw(&Rectangle::new([(x, key_y - 7), (x + 20, key_y + 7)], color(1).filled()))
-                .map_err(e)
+            root.draw(&Rectangle::new(
+                [(x, key_y - 7), (x + 20, key_y + 7)],
+                color(1).filled(),
+            ))
+            .map_err(e)
         },
         "work on frame n (colour and number)",
     )?;

@@ -24,6 +24,6 @@ mod obj_files;
 mod outputs;
 mod pipeline_oracles;
 mod pixelflow;
+mod timeline;
 mod unified;
 mod vr;
-mod timeline;

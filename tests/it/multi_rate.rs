@@ -567,7 +567,10 @@ fn closed_forms_say_where_they_hold_with_stereo_on() {
         );
         let x = num(&s, "metrics.terms_ms.transfer");
         assert!((bound - (phase_max + x)).abs() < 1e-6, "{bound} vs {phase_max} + {x}");
-        assert!(max <= bound + 1e-6, "{sets:?}: simulated max {max} over the bound that holds {bound}");
+        assert!(
+            max <= bound + 1e-6,
+            "{sets:?}: simulated max {max} over the bound that holds {bound}"
+        );
         let caveats = s["metrics"]["closed_form_caveats"].as_array().unwrap();
         assert_eq!(caveats.len(), 1, "{caveats:?}");
         assert!(caveats[0].as_str().unwrap().contains("does not keep up"));
@@ -587,7 +590,14 @@ fn closed_forms_say_where_they_hold_with_stereo_on() {
     let model = dir.path().join("mfr.toml");
     std::fs::write(&model, CLUSTER).unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_rendersim"))
-        .args(["run", model.to_str().unwrap(), "--set", "stereo=true", "--set", "run.events=300"])
+        .args([
+            "run",
+            model.to_str().unwrap(),
+            "--set",
+            "stereo=true",
+            "--set",
+            "run.events=300",
+        ])
         .output()
         .unwrap();
     assert!(o.status.success());

@@ -178,7 +178,8 @@ pub fn timeline_of(
     let writer = TraceWriter::new(Box::new(collector.clone()));
     let mut run = run_pipeline(cfg, &src.base_dir, Some(writer)).map_err(|e| SimError::of(src, e))?;
     if let Some(w) = run.trace.take() {
-        w.finish().map_err(|e| TimelineError::Trace(format!("tracing the run: {e}")))?;
+        w.finish()
+            .map_err(|e| TimelineError::Trace(format!("tracing the run: {e}")))?;
     }
     let read = collector.take().map_err(TimelineError::Trace)?;
     let to_ms = |t: crate::engine::Time| t.0 as f64 / PS_PER_MS as f64;
@@ -243,13 +244,18 @@ pub fn timeline_of(
     let marks = if refresh_ms > 0.0 {
         let first = (range.0 / refresh_ms).ceil() as u64;
         let last = (range.1 / refresh_ms).floor() as u64;
-        (first..=last.min(first + 10_000)).map(|k| k as f64 * refresh_ms).collect()
+        (first..=last.min(first + 10_000))
+            .map(|k| k as f64 * refresh_ms)
+            .collect()
     } else {
         Vec::new()
     };
     let last = opts.first + opts.frames - 1;
     let timeline = Timeline {
-        title: format!("Frames {}-{last}: who works on which frame (cf. paper 000 Figure 4)", opts.first),
+        title: format!(
+            "Frames {}-{last}: who works on which frame (cf. paper 000 Figure 4)",
+            opts.first
+        ),
         x_label: "simulated time (ms)".into(),
         range,
         lanes,
@@ -284,7 +290,11 @@ mod tests {
     #[test]
     fn gpu_work_is_split_by_the_frames_intervals() {
         let windows = [(1.0, 3.0, 0), (4.0, 6.0, 1)];
-        let s = [span("busy", 2.0, 5.0), span("busy", 0.5, 1.5), span("blocked", 2.0, 2.5)];
+        let s = [
+            span("busy", 2.0, 5.0),
+            span("busy", 0.5, 1.5),
+            span("blocked", 2.0, 2.5),
+        ];
         let refs: Vec<&ReadSpan> = s.iter().collect();
         let bars = gpu_bars(&refs, &windows);
         let got: Vec<(f64, f64, Fill)> = bars.iter().map(|b| (b.start, b.end, b.fill)).collect();

@@ -273,7 +273,10 @@ mod tests {
         assert!((a.slow.bound_max - (a.slow.phase_max + x)).abs() < 1e-9);
         let c = a.caveats(&t);
         assert_eq!(c.len(), 1);
-        assert!(c[0].contains("does not keep up") && c[0].contains(&format!("{:.1}", a.slow.bound_max)), "{c:?}");
+        assert!(
+            c[0].contains("does not keep up") && c[0].contains(&format!("{:.1}", a.slow.bound_max)),
+            "{c:?}"
+        );
     }
 
     #[test]

@@ -35,7 +35,10 @@ pub fn write_report(s: &Value, w: &mut dyn Write) -> io::Result<()> {
             writeln!(
                 w,
                 "    closed forms do not hold here (see below); the bound that holds: max <= {} ms",
-                crate::output::text::fixed(m["analytic_latency_ms"][path]["bound_max"].as_f64().unwrap_or(f64::NAN), 1)
+                crate::output::text::fixed(
+                    m["analytic_latency_ms"][path]["bound_max"].as_f64().unwrap_or(f64::NAN),
+                    1
+                )
             )?;
         }
     }
