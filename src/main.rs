@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+use cli::args::TimelineArgs;
 use cli::args::{
     BenchArgs, CalibrateArgs, ExperimentArgs, IsolateArgs, MeasureArgs, PredictArgs, RunArgs, StudyArgs, VcacheArgs,
 };
@@ -45,6 +46,8 @@ enum Cmd {
     Predict(PredictArgs),
     /// Speed benchmarks, printed as ratios against baselines measured in the same run.
     Bench(BenchArgs),
+    /// Draw a few frames as a timeline (paper 000 Figure 4): one lane per unit, frames by colour, vertical blanks marked.
+    Timeline(TimelineArgs),
 }
 
 fn main() -> ExitCode {
@@ -69,6 +72,7 @@ fn main() -> ExitCode {
         Cmd::Calibrate(a) => commands::calibrate(a),
         Cmd::Predict(a) => commands::predict(a),
         Cmd::Bench(a) => commands::bench(a),
+        Cmd::Timeline(a) => commands::timeline(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -511,3 +511,22 @@ mod tests {
         );
     }
 }
+
+/// `rendersim timeline`.
+#[derive(Args)]
+pub struct TimelineArgs {
+    /// Model file (TOML, a frame pipeline); the default model when omitted.
+    pub model: Option<PathBuf>,
+    /// Override a model key (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+    /// Frames to draw.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=rendersim::systems::frame_pipeline::timeline::MAX_TIMELINE_FRAMES))]
+    pub frames: u64,
+    /// The first frame drawn (the frames before it are simulated, not drawn).
+    #[arg(long, value_name = "F", default_value_t = 0)]
+    pub from: u64,
+    /// The picture to write: FILE.png or FILE.svg.
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+}

@@ -15,6 +15,7 @@ use rendersim::output::trace::TraceWriter;
 use rendersim::systems::frame_pipeline::isolate::IsolateOptions;
 use rendersim::systems::run_model;
 
+use super::args::TimelineArgs;
 use super::args::{
     BenchArgs, CalibrateArgs, ExperimentArgs, IsolateArgs, MeasureArgs, PredictArgs, RunArgs, StudyArgs, VcacheArgs,
 };
@@ -405,5 +406,31 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         bench::plot_kernel(&cases, &path)?;
         println!("kernel scaling plot: {}", path.display());
     }
+    Ok(())
+}
+
+/// `rendersim timeline`: the picture of paper 000 Figure 4 for a few frames.
+pub fn timeline(args: TimelineArgs) -> Result<()> {
+    use rendersim::systems::frame_pipeline::timeline::{TimelineOptions, timeline_of};
+    // The extension is checked before simulating.
+    rendersim::plot::ImageFormat::of(&args.out)?;
+    let model = load_model(
+        args.model.as_deref(),
+        &rendersim::config::Overrides::with_sets(&args.sets),
+    )?;
+    let opts = TimelineOptions {
+        first: args.from,
+        frames: args.frames,
+    };
+    let (picture, _run) = timeline_of(&model.source, &model.table, opts)?;
+    rendersim::plot::timeline(&args.out, &picture)?;
+    println!(
+        "wrote {}: frames {}-{}, {:.3}-{:.3} ms",
+        args.out.display(),
+        opts.first,
+        opts.first + opts.frames - 1,
+        picture.range.0,
+        picture.range.1
+    );
     Ok(())
 }

@@ -10,6 +10,8 @@
 //! - [`table`]: per-row tables as CSV through the `csv` crate.
 //! - [`text`]: numbers in human-readable reports.
 //! - [`trace`]: Chrome/Perfetto trace JSON, streamed.
+//! - [`trace_read`]: a trace read back as it is written (merged spans per
+//!   track), for pictures.
 
 pub mod cleanup;
 pub mod error;
@@ -18,5 +20,6 @@ pub mod result_set;
 pub mod table;
 pub mod text;
 pub mod trace;
+pub mod trace_read;
 
 pub use error::OutputError;

@@ -24,4 +24,19 @@ pub enum PlotError {
         /// The backend's message.
         message: String,
     },
+    /// A single-file picture was asked for with an extension that names
+    /// no format it is written in.
+    #[error("{path}: the picture's extension must be .png or .svg")]
+    Extension {
+        /// The file asked for.
+        path: PathBuf,
+    },
+    /// The finished picture could not be written.
+    #[error("writing {path}: {message}")]
+    Write {
+        /// The file being written.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
 }

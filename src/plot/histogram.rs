@@ -8,6 +8,7 @@ use plotters::prelude::*;
 use super::PlotError;
 use super::axis::{coord, format_number, omitted_note, ticks, widen};
 use super::font::FAMILY;
+use super::legend::{self, Occupied};
 use super::output::{draw_notes, render_both};
 use super::palette::color;
 
@@ -156,6 +157,101 @@ fn bin(h: &Histogram) -> (Binned, usize) {
     (Binned { lo, width, groups }, dropped)
 }
 
+/// The y axis's description: a density per unit of x, the unit taken from
+/// the x label's last parenthesis ("frame time (ms)" gives "density (1/ms)").
+pub(crate) fn density_label(x_label: &str) -> String {
+    let unit = x_label
+        .rfind('(')
+        .and_then(|i| x_label[i + 1..].split(')').next())
+        .map(|u| u.split(',').next().unwrap_or(u).trim())
+        .filter(|u| !u.is_empty() && u.len() <= 12 && !u.contains(' '));
+    match unit {
+        Some(u) => format!("density (1/{u})"),
+        None => "density (per unit of x)".into(),
+    }
+}
+
+/// The layout of a histogram's plot area: x range, y maximum, and where
+/// the legend goes so that it covers no bar and no mark label (see
+/// [`super::legend`]).
+struct Layout {
+    x: (f64, f64),
+    ymax: f64,
+    legend: SeriesLabelPosition,
+    /// Legend box size (plot-area fractions).
+    legend_box: (f64, f64),
+    /// Whether the y axis grew to free a top band for the legend.
+    grown: bool,
+}
+
+/// Where mark `i`'s label is drawn: its height as a fraction of the plot
+/// area (stacked down from the top, below a legend band `band`).
+fn mark_label_y(i: usize, band: f64) -> f64 {
+    0.97 - band - 0.06 * (i % 8) as f64
+}
+
+fn layout(h: &Histogram, b: &Binned) -> Layout {
+    let bins = h.bins.max(1);
+    let hi = b.lo + b.width * bins as f64;
+    let top = b.groups.iter().flat_map(|g| g.1.iter().copied()).fold(0.0f64, f64::max);
+    let mut ymax = if top > 0.0 && top.is_finite() { top * 1.08 } else { 1.0 };
+    let marks: Vec<&Mark> = h.marks.iter().filter(|m| m.at.is_finite()).collect();
+    let lo = marks.iter().map(|m| m.at).fold(b.lo, f64::min);
+    let hi = marks.iter().map(|m| m.at).fold(hi, f64::max);
+    let pad = (hi - lo) * 0.02;
+    let x = (lo - pad, hi + pad);
+    let named: Vec<&String> = b.groups.iter().map(|g| &g.0).filter(|n| !n.is_empty()).collect();
+    let longest = named.iter().map(|n| n.chars().count()).max().unwrap_or(0);
+    let (bw, bh) = legend::legend_size(named.len(), longest);
+    let occupied = |ymax: f64, band: f64| {
+        let fx = |v: f64| (v - x.0) / (x.1 - x.0);
+        let mut occ = Vec::new();
+        for (_, dens) in &b.groups {
+            for (i, &d) in dens.iter().enumerate() {
+                if d > 0.0 {
+                    for k in 0..4 {
+                        let xv = b.lo + b.width * (i as f64 + (k as f64 + 0.5) / 4.0);
+                        occ.push(Occupied {
+                            x: fx(xv),
+                            y0: 0.0,
+                            y1: d / ymax,
+                        });
+                    }
+                }
+            }
+        }
+        // Mark labels: about 7 px per character right of the line.
+        for (i, m) in marks.iter().enumerate() {
+            let y = mark_label_y(i, band);
+            let chars = m.label.chars().count() as f64 + 1.0;
+            for k in 0..=8 {
+                occ.push(Occupied::point(fx(m.at) + k as f64 / 8.0 * chars * 7.0 / 900.0, y));
+            }
+        }
+        occ
+    };
+    let (mut legend, covered) = legend::corner(&occupied(ymax, 0.0), bw, bh);
+    let grown = covered > 0 && !named.is_empty();
+    if grown {
+        // No free corner: the y axis grows so that bars and mark labels keep
+        // below a top band, where the legend goes.
+        ymax = legend::grow((0.0, ymax), bh).1;
+        let occ = occupied(ymax, bh);
+        legend = if legend::covered(&occ, true, true, bw, bh) < legend::covered(&occ, false, true, bw, bh) {
+            SeriesLabelPosition::UpperLeft
+        } else {
+            SeriesLabelPosition::UpperRight
+        };
+    }
+    Layout {
+        x,
+        ymax,
+        legend,
+        legend_box: (bw, bh),
+        grown,
+    }
+}
+
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     h: &Histogram,
@@ -164,32 +260,27 @@ fn draw<DB: DrawingBackend>(
 ) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let bins = h.bins.max(1);
-    let hi = b.lo + b.width * bins as f64;
-    let ymax = b.groups.iter().flat_map(|g| g.1.iter().copied()).fold(0.0f64, f64::max);
-    let ymax = if ymax > 0.0 && ymax.is_finite() {
-        ymax * 1.08
-    } else {
-        1.0
-    };
+    let l = layout(h, b);
+    let ymax = l.ymax;
     let marks: Vec<&Mark> = h.marks.iter().filter(|m| m.at.is_finite()).collect();
-    let lo = marks.iter().map(|m| m.at).fold(b.lo, f64::min);
-    let hi = marks.iter().map(|m| m.at).fold(hi, f64::max);
-    let pad = (hi - lo) * 0.02;
-    let xt = ticks(lo - pad, hi + pad, false, false);
+    // Mark labels go below the legend's band when the axis grew for it.
+    let band = if l.grown { l.legend_box.1 } else { 0.0 };
+    let xt = ticks(l.x.0, l.x.1, false, false);
     let yt = ticks(0.0, ymax, false, false);
     let mut chart = ChartBuilder::on(root)
         .caption(&h.title, (FAMILY, 24))
         .margin(20)
+        .margin_bottom(20 + 16 * notes.len() as u32)
         .x_label_area_size(55)
         .y_label_area_size(75)
-        .build_cartesian_2d(coord(lo - pad, hi + pad, &xt), coord(0.0, ymax, &yt))
+        .build_cartesian_2d(coord(l.x.0, l.x.1, &xt), coord(0.0, ymax, &yt))
         .map_err(e)?;
     let fx = |v: &f64| xt.label_at(*v);
     let fy = |v: &f64| yt.label_at(*v);
     chart
         .configure_mesh()
         .x_desc(h.x_label.as_str())
-        .y_desc("density")
+        .y_desc(density_label(&h.x_label))
         .label_style((FAMILY, 14))
         .axis_desc_style((FAMILY, 16))
         .x_label_formatter(&fx)
@@ -233,7 +324,7 @@ fn draw<DB: DrawingBackend>(
                 BLACK.mix(0.75).stroke_width(2),
             ))
             .map_err(e)?;
-        let y = ymax * (0.97 - 0.06 * (i % 8) as f64);
+        let y = ymax * mark_label_y(i, band);
         chart
             .draw_series(std::iter::once(Text::new(
                 format!(" {}", m.label),
@@ -248,7 +339,7 @@ fn draw<DB: DrawingBackend>(
             .label_font((FAMILY, 14))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
+            .position(l.legend)
             .draw()
             .map_err(e)?;
     }
@@ -353,6 +444,72 @@ mod tests {
             .filter_map(|t| t.split('<').next()?.trim().parse::<f64>().ok())
             .collect();
         assert!(ticks.iter().any(|&t| t >= 30.0), "axis widened: {ticks:?}");
+    }
+
+    #[test]
+    fn the_legend_covers_no_bar_and_no_mark_label() {
+        // The system-noise case: two groups with long names, spikes and a
+        // mark label near the right edge where the legend used to sit.
+        let spiky: Vec<f64> = (0..1000).map(|i| [12.1, 12.6, 13.1][i % 3]).collect();
+        let smooth: Vec<f64> = (0..1000).map(|i| 12.2 + (i as f64 / 1000.0) * 1.5).collect();
+        let h = Histogram {
+            range: Some((11.8, 14.1)),
+            marks: vec![
+                Mark {
+                    at: 11.92,
+                    label: "paper Fig. 3 axis from 11.92 ms".into(),
+                },
+                Mark {
+                    at: 13.96,
+                    label: "to 13.96 ms".into(),
+                },
+            ],
+            ..hist(
+                vec![
+                    ("noise.enabled=true, variation.enabled=false".into(), spiky),
+                    ("noise.enabled=true, variation.enabled=true".into(), smooth),
+                ],
+                92,
+            )
+        };
+        let (b, _) = bin(&h);
+        let l = layout(&h, &b);
+        // Re-derive what is drawn in plot-area fractions and check the box.
+        let (bw, bh) = l.legend_box;
+        let fx = |v: f64| (v - l.x.0) / (l.x.1 - l.x.0);
+        let mut occ = Vec::new();
+        for (_, dens) in &b.groups {
+            for (i, &d) in dens.iter().enumerate() {
+                if d > 0.0 {
+                    let xv = b.lo + b.width * (i as f64 + 0.5);
+                    occ.push(Occupied {
+                        x: fx(xv),
+                        y0: 0.0,
+                        y1: d / l.ymax,
+                    });
+                }
+            }
+        }
+        let band = if l.grown { bh } else { 0.0 };
+        for (i, m) in h.marks.iter().enumerate() {
+            let chars = m.label.chars().count() as f64 + 1.0;
+            for k in 0..=8 {
+                occ.push(Occupied::point(
+                    fx(m.at) + k as f64 / 8.0 * chars * 7.0 / 900.0,
+                    mark_label_y(i, band),
+                ));
+            }
+        }
+        let (left, top) = match l.legend {
+            SeriesLabelPosition::UpperLeft => (true, true),
+            SeriesLabelPosition::UpperRight => (false, true),
+            SeriesLabelPosition::LowerLeft => (true, false),
+            _ => (false, false),
+        };
+        assert_eq!(legend::covered(&occ, left, top, bw, bh), 0, "{:?}", l.legend);
+        assert_eq!(density_label("frame time (ms)"), "density (1/ms)");
+        assert_eq!(density_label("latency (ms, log)"), "density (1/ms)");
+        assert_eq!(density_label("size"), "density (per unit of x)");
     }
 
     #[test]

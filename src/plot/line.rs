@@ -8,6 +8,7 @@ use plotters::prelude::*;
 use super::PlotError;
 use super::axis::{Ticks, all_integers, coord, omitted_note, padded_range, ticks, to_axis};
 use super::font::FAMILY;
+use super::legend::{self, Occupied};
 use super::output::{draw_notes, render_both};
 use super::palette::color;
 
@@ -121,51 +122,48 @@ fn coinciding(series: &[Prepared]) -> Vec<Option<usize>> {
 }
 
 /// The legend corner covering the fewest drawn points, and how many it
-/// covers: each segment is sampled, and a corner box is about 40% of the
-/// width and a line per entry high. Ties keep the upper left, then upper
-/// right, lower right, lower left.
+/// covers ([`super::legend::corner`]): each segment is sampled, and the box
+/// is as wide as the longest name and a line per entry high.
 fn legend_corner(series: &[Prepared], xr: (f64, f64), yr: (f64, f64), entries: usize) -> (SeriesLabelPosition, usize) {
     let (w, h) = (xr.1 - xr.0, yr.1 - yr.0);
     if !(w > 0.0 && h > 0.0) {
         return (SeriesLabelPosition::UpperLeft, 0);
     }
-    let bh = legend_height(entries);
+    let occupied = occupied(series, xr, yr);
+    let (bw, bh) = legend_box(series, entries);
+    legend::corner(&occupied, bw, bh)
+}
+
+/// The legend box's size for these series (plot-area fractions).
+fn legend_box(series: &[Prepared], entries: usize) -> (f64, f64) {
+    let longest = series.iter().map(|s| s.name.chars().count()).max().unwrap_or(0);
+    legend::legend_size(entries, longest)
+}
+
+/// The drawn points and samples of every segment, in plot-area fractions.
+fn occupied(series: &[Prepared], xr: (f64, f64), yr: (f64, f64)) -> Vec<Occupied> {
+    let (w, h) = (xr.1 - xr.0, yr.1 - yr.0);
     let mut samples = Vec::new();
+    let at = |x: f64, y: f64| Occupied::point((x - xr.0) / w, (y - yr.0) / h);
     for s in series {
-        samples.extend(s.points.iter().copied());
+        for p in &s.points {
+            samples.push(at(p.0, p.1));
+        }
         for p in s.points.windows(2) {
             for k in 1..10 {
                 let t = k as f64 / 10.0;
-                samples.push((p[0].0 + t * (p[1].0 - p[0].0), p[0].1 + t * (p[1].1 - p[0].1)));
+                samples.push(at(p[0].0 + t * (p[1].0 - p[0].0), p[0].1 + t * (p[1].1 - p[0].1)));
             }
         }
+        for b in &s.bars {
+            samples.push(Occupied {
+                x: (b.0 - xr.0) / w,
+                y0: (b.1 - yr.0) / h,
+                y1: (b.3 - yr.0) / h,
+            });
+        }
     }
-    let covered = |left: bool, top: bool| {
-        samples
-            .iter()
-            .filter(|&&(x, y)| {
-                let fx = (x - xr.0) / w;
-                let fy = (y - yr.0) / h;
-                let in_x = if left { fx <= 0.42 } else { fx >= 0.58 };
-                let in_y = if top { fy >= 1.0 - bh } else { fy <= bh };
-                in_x && in_y
-            })
-            .count()
-    };
-    [
-        (SeriesLabelPosition::UpperLeft, covered(true, true)),
-        (SeriesLabelPosition::UpperRight, covered(false, true)),
-        (SeriesLabelPosition::LowerRight, covered(false, false)),
-        (SeriesLabelPosition::LowerLeft, covered(true, false)),
-    ]
-    .into_iter()
-    .min_by_key(|c| c.1)
-    .unwrap_or((SeriesLabelPosition::UpperLeft, 0))
-}
-
-/// The legend's height as a fraction of the plot's (a line per entry).
-fn legend_height(entries: usize) -> f64 {
-    (0.05 + 0.065 * entries as f64).min(0.6)
+    samples
 }
 
 fn draw<DB: DrawingBackend>(
@@ -197,14 +195,21 @@ fn draw<DB: DrawingBackend>(
     let entries = series.iter().filter(|s| !s.name.is_empty()).count();
     let (mut legend, covered) = legend_corner(series, xr, yr, entries);
     if covered > 0 {
-        let bh = legend_height(entries);
-        yr.1 += (yr.1 - yr.0) * bh / (1.0 - bh);
-        legend = SeriesLabelPosition::UpperLeft;
+        let (bw, bh) = legend_box(series, entries);
+        yr = legend::grow(yr, bh);
+        // The top band is free now: the upper corner the box fits best.
+        let occ = occupied(series, xr, yr);
+        legend = if legend::covered(&occ, true, true, bw, bh) < legend::covered(&occ, false, true, bw, bh) {
+            SeriesLabelPosition::UpperLeft
+        } else {
+            SeriesLabelPosition::UpperRight
+        };
     }
     let yt = ticks(yr.0, yr.1, plot.log_y, false);
     let mut chart = ChartBuilder::on(root)
         .caption(&plot.title, (FAMILY, 24))
         .margin(20)
+        .margin_bottom(20 + 16 * notes.len() as u32)
         .x_label_area_size(55)
         .y_label_area_size(75)
         .build_cartesian_2d(coord(xr.0, xr.1, &xt), coord(yr.0, yr.1, &yt))
@@ -331,8 +336,56 @@ mod tests {
         let p = legend_corner(&[falling, high_left], r.0, r.1, 2);
         assert!(matches!(p, (SeriesLabelPosition::LowerRight, 0)), "{p:?}");
         // Data in every corner: the fewest covered is reported, not zero.
-        let zigzag = prepared("d", &[(0.0, 0.0), (1.0, 10.0), (9.0, 0.0), (10.0, 10.0)]);
+        let zigzag = prepared(
+            "a zigzag with a long name",
+            &[(0.0, 0.0), (1.0, 10.0), (9.0, 0.0), (10.0, 10.0)],
+        );
         assert!(legend_corner(&[zigzag], r.0, r.1, 1).1 > 0);
+    }
+
+    #[test]
+    fn the_legend_covers_no_data_after_layout() {
+        // bottleneck-share: geometry falls from 1 to 0 while fragment rises
+        // and the front end stays near 0, so curves touch every corner.
+        let xs: Vec<f64> = (0..14).map(|i| -1.0 + i as f64 * 0.25).collect();
+        let geometry = prepared(
+            "geometry bottleneck share",
+            &xs.iter()
+                .map(|&x| (x, 1.0 / (1.0 + (4.0 * (x - 1.2)).exp())))
+                .collect::<Vec<_>>(),
+        );
+        let fragment = prepared(
+            "fragment bottleneck share",
+            &xs.iter()
+                .map(|&x| (x, 1.0 - 1.0 / (1.0 + (4.0 * (x - 1.2)).exp())))
+                .collect::<Vec<_>>(),
+        );
+        let front = prepared(
+            "front-end bottleneck share",
+            &xs.iter().map(|&x| (x, 0.01)).collect::<Vec<_>>(),
+        );
+        let series = [geometry, fragment, front];
+        let xr = padded_range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
+        let yr = padded_range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
+        let (bw, bh) = legend_box(&series, 3);
+        assert!(legend_corner(&series, xr, yr, 3).1 > 0, "every corner has data");
+        assert!(legend::is_clear(&occupied(&series, xr, yr), bw, bh));
+        // And the plot draws with the legend inside the grown top band.
+        let dir = tempfile::tempdir().unwrap();
+        let base = dir.path().join("share");
+        let plot = LinePlot {
+            title: "t".into(),
+            series: series
+                .iter()
+                .map(|s| Series {
+                    name: s.name.clone(),
+                    points: s.points.clone(),
+                    ci: None,
+                })
+                .collect(),
+            ..LinePlot::default()
+        };
+        line_plot(&base, &plot).unwrap();
     }
 
     #[test]

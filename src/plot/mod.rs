@@ -15,16 +15,19 @@ mod bar;
 mod error;
 mod font;
 mod histogram;
+mod legend;
 mod line;
 mod output;
 mod palette;
 mod scatter;
+mod timeline;
 
 pub use bar::{BarChart, BarSeries, bar_chart};
 pub use error::PlotError;
 pub use histogram::{Histogram, Mark, histogram};
 pub use line::{LinePlot, Series, line_plot};
 pub use scatter::{Scatter, ScatterPoint, scatter};
+pub use timeline::{Bar, Fill, ImageFormat, Lane, Level, Timeline, timeline};
 
 /// Width of written plots in pixels.
 pub const WIDTH: u32 = 1024;

@@ -25,5 +25,6 @@ mod outputs;
 mod pipeline_oracles;
 mod pixelflow;
 mod shards;
+mod timeline;
 mod unified;
 mod vr;

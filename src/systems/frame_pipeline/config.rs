@@ -61,6 +61,10 @@ pub struct FramePipelineConfig {
     /// System tasks.
     #[serde(default)]
     pub noise: NoiseConfig,
+    /// Per-frame variation of the CPU's and the GPU's times (none unless
+    /// given; written to the resolved model only when given).
+    #[serde(default, skip_serializing_if = "VariationConfig::is_off")]
+    pub variation: VariationConfig,
     /// What is rendered.
     pub workload: WorkloadConfig,
 }
@@ -481,6 +485,56 @@ pub struct NoiseConfig {
 
 fn yes() -> bool {
     true
+}
+
+/// Per-frame variation of the units' times (paper 000 §4.2, Figure 3).
+///
+/// Besides system tasks, a real frame's CPU and GPU times vary from frame to
+/// frame (cache and TLB state, driver work, memory traffic, clock changes):
+/// Figure 3's density is smooth between its two modes, not two spikes. Each
+/// frame draws one extra CPU time (added to its non-rendering work) and one
+/// extra GPU time (added to its clear on the front end), each from its own
+/// distribution and its own RNG stream (`variation.cpu`, `variation.gpu`),
+/// so switching one on changes no other draw. None is drawn unless given:
+/// the teaching models, where exact periods are the point, have none.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct VariationConfig {
+    /// Master switch (on when the section is given).
+    pub enabled: bool,
+    /// Extra CPU time per frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cpu: Option<Dist<Duration>>,
+    /// Extra GPU (front-end) time per frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gpu: Option<Dist<Duration>>,
+}
+
+impl Default for VariationConfig {
+    fn default() -> Self {
+        VariationConfig {
+            enabled: true,
+            cpu: None,
+            gpu: None,
+        }
+    }
+}
+
+impl VariationConfig {
+    /// Whether no unit varies (nothing given, or switched off).
+    pub fn is_off(&self) -> bool {
+        !self.enabled || (self.cpu.is_none() && self.gpu.is_none())
+    }
+
+    /// The extra CPU time's distribution, when on.
+    pub fn cpu(&self) -> Option<&Dist<Duration>> {
+        self.cpu.as_ref().filter(|_| self.enabled)
+    }
+
+    /// The extra GPU time's distribution, when on.
+    pub fn gpu(&self) -> Option<&Dist<Duration>> {
+        self.gpu.as_ref().filter(|_| self.enabled)
+    }
 }
 
 /// A periodic system task.

@@ -46,7 +46,16 @@ impl FramePipeline {
         let c = &self.cfg.cpu;
         match op {
             Op::Input => c.input_sampling,
-            Op::NonRender => Duration::from_ps_f64(c.non_render.sample(&mut self.non_render_rng)),
+            Op::NonRender => {
+                let work = Duration::from_ps_f64(c.non_render.sample(&mut self.non_render_rng));
+                // Per-frame variation (config `variation.cpu`), drawn only when given.
+                match &self.cfg.variation.cpu() {
+                    Some(v) => work
+                        .checked_add(Duration::from_ps_f64(v.sample(&mut self.variation_rng[0])))
+                        .unwrap_or(Duration(u64::MAX)),
+                    None => work,
+                }
+            }
             Op::Clear => c.clear,
             Op::Swap => c.swap,
             Op::Fixed => match &mut self.program {

@@ -110,12 +110,18 @@ impl FramePipeline {
             }
             self.records[frame as usize].gpu_start = Some(now);
         }
-        let work = self
+        let mut work = self
             .cfg
             .gpu
             .clear
             .checked_add(self.cfg.gpu.command)
             .unwrap_or(Duration(u64::MAX));
+        // Per-frame variation (config `variation.gpu`), drawn only when given.
+        if let (Command::Clear { .. }, Some(v)) = (c, self.cfg.variation.gpu()) {
+            work = work
+                .checked_add(Duration::from_ps_f64(v.sample(&mut self.variation_rng[1])))
+                .unwrap_or(Duration(u64::MAX));
+        }
         self.front_job(now, c, work, s)
     }
 

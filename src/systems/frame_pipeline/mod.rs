@@ -11,6 +11,7 @@
 //! - `critical_path`: bottleneck attribution along the critical path;
 //! - `records`: per-frame records and the PresentMon-style table;
 //! - `report`: the human-readable report of a run;
+//! - `timeline`: the picture of paper 000 Figure 4, from the run's trace;
 //! - `run`: validate, build, run, summarize.
 
 pub mod accounting;
@@ -26,6 +27,7 @@ pub mod records;
 pub mod report;
 pub mod run;
 pub mod system;
+pub mod timeline;
 pub mod workload;
 
 pub use config::{Fidelity, FramePipelineConfig};

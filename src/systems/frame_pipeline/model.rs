@@ -205,6 +205,8 @@ pub struct FramePipeline {
     pub(super) cpu_frame: u64,
     pub(super) cpu_op: u32,
     pub(super) non_render_rng: StreamRng,
+    /// Per-frame variation streams: CPU, GPU (`variation.cpu`, `variation.gpu`).
+    pub(super) variation_rng: [StreamRng; 2],
     /// The instant the CPU thread last started a frame, and how many
     /// frames it started then.
     pub(super) frames_at_instant: (Time, u64),
@@ -360,6 +362,7 @@ impl FramePipeline {
                 cfg.gpu.fragment.fifo_depth as u64
             }),
             non_render_rng: streams.stream("cpu.non_render"),
+            variation_rng: [streams.stream("variation.cpu"), streams.stream("variation.gpu")],
             frames_at_instant: (Time::ZERO, 0),
             zero_time_after: u64::from(cfg.cpu.max_frames_ahead) + u64::from(cfg.display.buffers) + 1,
             zero_time_go: false,

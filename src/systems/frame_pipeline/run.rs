@@ -125,6 +125,14 @@ pub fn validate(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
             .validate()
             .map_err(|e| bad(&format!("noise.random.{i}.duration"), e.to_string()))?;
     }
+    for (key, d) in [
+        ("variation.cpu", &cfg.variation.cpu),
+        ("variation.gpu", &cfg.variation.gpu),
+    ] {
+        if let Some(d) = d {
+            d.validate().map_err(|e| bad(key, e.to_string()))?;
+        }
+    }
     if let WorkloadConfig::Scene(sc) = &cfg.workload {
         check_scene_sizes(sc)?;
     }

@@ -19,6 +19,17 @@
 //! and an event can wait almost a whole client frame for that frame to
 //! start. The paper gives no worst case for FC; we apply its own slow-client
 //! rule (one tracker period plus one FC frame): 73 + 20 + 33 = 126 ms.
+//!
+//! Where the closed forms hold: the slow path's `worst`, `phase_max` and
+//! `phase_mean` assume the link carries SC's images as fast as SC makes
+//! them (`T_send <= SC interval`, [`Analytic::link_keeps_up`]). When it does
+//! not (a stereo image over Gigabit Ethernet: 222 ms against 206 ms), the
+//! link sends back to back and a buffer read back while a send is in
+//! progress waits up to one more `T_send`; newer buffers replacing it carry
+//! the event too, so the event still leaves on the next send. The bound that
+//! holds for any link is `phase_max + T_send` ([`Bounds::bound_max`]);
+//! [`Bounds::holds`] says whether the closed forms' assumptions hold, and
+//! [`Analytic::caveats`] says in words what fails.
 
 use serde::Serialize;
 
@@ -126,6 +137,15 @@ pub struct Bounds {
     pub phase_max: f64,
     /// Mean over independent uniform phases.
     pub phase_mean: f64,
+    /// Whether the assumptions of `worst`, `phase_max` and `phase_mean`
+    /// hold for this model (the slow path: the link keeps up with SC).
+    /// When false, those three are not bounds of the simulated latency.
+    pub holds: bool,
+    /// The largest latency any phase can give whether or not the
+    /// assumptions hold: `phase_max` when they do; on a slow path whose link
+    /// does not keep up, `phase_max + T_send` (see the module
+    /// documentation).
+    pub bound_max: f64,
 }
 
 fn ms(ps: u64) -> f64 {
@@ -159,6 +179,8 @@ pub fn analytic(t: &Terms) -> Analytic {
     let x = t.transfer.0;
     let cv = t.conventional_frame.0;
     let half = |v: u64| v as f64 / 2.0;
+    let keeps_up = x <= si;
+    let slow_max = p + l + si + sc + x + fi + fc + d;
     let fast_best = l + fc;
     let slow_best = l + sc + x;
     let conv_best = l + cv;
@@ -169,13 +191,17 @@ pub fn analytic(t: &Terms) -> Analytic {
             phase_min: ms(l + fc + d),
             phase_max: ms(p + l + fi + fc + d),
             phase_mean: (half(p) + (l + fc + d) as f64 + half(fi)) / 1e9,
+            holds: true,
+            bound_max: ms(p + l + fi + fc + d),
         },
         slow: Bounds {
             best: ms(slow_best + d),
             worst: ms(slow_best + p + fi + d),
             phase_min: ms(slow_best + fc + d),
-            phase_max: ms(p + l + si + sc + x + fi + fc + d),
+            phase_max: ms(slow_max),
             phase_mean: (half(p) + (slow_best + fc + d) as f64 + half(si) + half(fi)) / 1e9,
+            holds: keeps_up,
+            bound_max: ms(if keeps_up { slow_max } else { slow_max + x }),
         },
         conventional: Bounds {
             best: ms(conv_best + d),
@@ -183,8 +209,33 @@ pub fn analytic(t: &Terms) -> Analytic {
             phase_min: ms(conv_best + d),
             phase_max: ms(p + l + 2 * cv + d),
             phase_mean: (half(p) + (conv_best + d) as f64 + half(cv)) / 1e9,
+            holds: true,
+            bound_max: ms(p + l + 2 * cv + d),
         },
-        link_keeps_up: x <= si,
+        link_keeps_up: keeps_up,
+    }
+}
+
+impl Analytic {
+    /// One sentence per path whose closed forms do not hold, saying why and
+    /// which bound holds instead (empty when every closed form holds).
+    pub fn caveats(&self, t: &Terms) -> Vec<String> {
+        let mut out = Vec::new();
+        if !self.slow.holds {
+            out.push(format!(
+                "slow path: the link does not keep up with SC (T_send {:.1} ms > SC frame interval {:.1} ms), \
+                 so buffers wait for the link; the closed forms assume they do not: worst {:.1}, phase_max {:.1} \
+                 and phase_mean {:.1} ms do not hold; the bound that holds is max <= {:.1} ms \
+                 (phase_max + one T_send, the send in progress)",
+                t.transfer.as_ms_f64(),
+                t.sc_interval().as_ms_f64(),
+                self.slow.worst,
+                self.slow.phase_max,
+                self.slow.phase_mean,
+                self.slow.bound_max
+            ));
+        }
+        out
     }
 }
 
@@ -207,6 +258,25 @@ mod tests {
         assert!((a.slow.best - 337.0).abs() < 0.2, "{}", a.slow.best);
         assert!((a.slow.worst - 390.0).abs() < 0.2, "{}", a.slow.worst);
         assert!(a.link_keeps_up);
+        assert!(a.slow.holds && a.slow.bound_max == a.slow.phase_max);
+        assert!(a.caveats(&Terms::of(&cfg("system = \"multi_rate\""))).is_empty());
+    }
+
+    #[test]
+    fn a_link_slower_than_sc_is_flagged_with_the_bound_that_holds() {
+        // Stereo over Gigabit Ethernet: 20 MiB in 222.2 ms, SC 166 + 40 ms.
+        let t = Terms::of(&cfg("system = \"multi_rate\"\nstereo = true"));
+        let a = analytic(&t);
+        assert!(!a.link_keeps_up && !a.slow.holds);
+        assert!(a.fast.holds && a.conventional.holds);
+        let x = t.transfer.as_ms_f64();
+        assert!((a.slow.bound_max - (a.slow.phase_max + x)).abs() < 1e-9);
+        let c = a.caveats(&t);
+        assert_eq!(c.len(), 1);
+        assert!(
+            c[0].contains("does not keep up") && c[0].contains(&format!("{:.1}", a.slow.bound_max)),
+            "{c:?}"
+        );
     }
 
     #[test]

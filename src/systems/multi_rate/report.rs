@@ -31,6 +31,19 @@ pub fn write_report(s: &Value, w: &mut dyn Write) -> io::Result<()> {
             &m["analytic_latency_ms"][path],
             "paper",
         )?;
+        if m["analytic_latency_ms"][path]["holds"] == false {
+            writeln!(
+                w,
+                "    closed forms do not hold here (see below); the bound that holds: max <= {} ms",
+                crate::output::text::fixed(
+                    m["analytic_latency_ms"][path]["bound_max"].as_f64().unwrap_or(f64::NAN),
+                    1
+                )
+            )?;
+        }
+    }
+    for c in m["closed_form_caveats"].as_array().into_iter().flatten() {
+        writeln!(w, "  note: {}", c.as_str().unwrap_or(""))?;
     }
     events_line(w, s)
 }

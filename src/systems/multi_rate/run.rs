@@ -289,6 +289,10 @@ pub struct MultiRateMetrics {
     pub buffers: BufferCounts,
     /// Whether the link carries SC's images as fast as SC makes them.
     pub link_keeps_up: bool,
+    /// One sentence per path whose closed forms' assumptions fail, with the
+    /// bound that holds instead (empty when all hold; each path's
+    /// `analytic_latency_ms` says the same in `holds` and `bound_max`).
+    pub closed_form_caveats: Vec<String>,
     /// Migration artifacts (when the model has a migration script).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub migration: Option<ArtifactCounts>,
@@ -404,6 +408,7 @@ fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &A
                 replaced_before_sending: m.replaced,
             },
             link_keeps_up: a.link_keeps_up,
+            closed_form_caveats: a.caveats(t),
             migration: m.migration.as_ref().map(|x| x.counts()),
         },
     };

@@ -1,0 +1,129 @@
+//! Where a legend goes: the corner of the plot area whose box covers the
+//! fewest drawn things (points and line samples, histogram bars, labels of
+//! marked values), every plot kind using the same rule; when every corner
+//! covers something, the caller grows the y axis by the legend's height so
+//! that the top band is free.
+
+use plotters::prelude::SeriesLabelPosition;
+
+/// Something drawn, in plot-area fractions (`0..1` left to right, bottom to
+/// top): a vertical extent at one x (a point is `y0 == y1`; a histogram bar
+/// from 0 to its height).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Occupied {
+    /// Horizontal position.
+    pub x: f64,
+    /// Bottom.
+    pub y0: f64,
+    /// Top.
+    pub y1: f64,
+}
+
+impl Occupied {
+    /// A point.
+    pub(crate) fn point(x: f64, y: f64) -> Self {
+        Occupied { x, y0: y, y1: y }
+    }
+}
+
+/// The legend box's size in plot-area fractions: about 8 px per character
+/// of the longest label plus the swatch, on a plot area about 900 x 500 px;
+/// a line per entry.
+pub(crate) fn legend_size(entries: usize, longest_label: usize) -> (f64, f64) {
+    let w = ((longest_label as f64 * 8.0 + 60.0) / 900.0).min(0.95);
+    (w, legend_height(entries))
+}
+
+/// The legend's height as a fraction of the plot area's (a line per entry).
+pub(crate) fn legend_height(entries: usize) -> f64 {
+    (0.05 + 0.065 * entries as f64).min(0.6)
+}
+
+/// How many `occupied` things a legend box of `w` x `h` in a corner covers.
+pub(crate) fn covered(occupied: &[Occupied], left: bool, top: bool, w: f64, h: f64) -> usize {
+    occupied
+        .iter()
+        .filter(|o| {
+            let in_x = if left { o.x <= w } else { o.x >= 1.0 - w };
+            let in_y = if top { o.y1 >= 1.0 - h } else { o.y0 <= h };
+            in_x && in_y
+        })
+        .count()
+}
+
+/// The corner covering the fewest occupied things, and how many it covers.
+/// Ties keep the upper right, then upper left, lower right, lower left.
+pub(crate) fn corner(occupied: &[Occupied], w: f64, h: f64) -> (SeriesLabelPosition, usize) {
+    [
+        (SeriesLabelPosition::UpperRight, covered(occupied, false, true, w, h)),
+        (SeriesLabelPosition::UpperLeft, covered(occupied, true, true, w, h)),
+        (SeriesLabelPosition::LowerRight, covered(occupied, false, false, w, h)),
+        (SeriesLabelPosition::LowerLeft, covered(occupied, true, false, w, h)),
+    ]
+    .into_iter()
+    .min_by_key(|c| c.1)
+    .unwrap_or((SeriesLabelPosition::UpperRight, 0))
+}
+
+/// Whether the legend, placed by [`corner`] (and, when that covers
+/// something, with the y axis grown by `grow` so that the data keep to the
+/// lower `1 - h` of the plot area), covers none of `occupied`: the check
+/// the plots' layouts are tested against.
+#[cfg(test)]
+pub(crate) fn is_clear(occupied: &[Occupied], w: f64, h: f64) -> bool {
+    let (_, n) = corner(occupied, w, h);
+    if n == 0 {
+        return true;
+    }
+    // Grown: every y scales by 1 - h, so the top band holds nothing.
+    let grown: Vec<Occupied> = occupied
+        .iter()
+        .map(|o| Occupied {
+            x: o.x,
+            y0: o.y0 * (1.0 - h),
+            y1: o.y1 * (1.0 - h) - 1e-12,
+        })
+        .collect();
+    covered(&grown, false, true, w, h) == 0 || covered(&grown, true, true, w, h) == 0
+}
+
+/// The y-axis range grown so that the data keep below a top band of
+/// `h` (a fraction of the plot area).
+pub(crate) fn grow(yr: (f64, f64), h: f64) -> (f64, f64) {
+    (yr.0, yr.1 + (yr.1 - yr.0) * h / (1.0 - h))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_legend_avoids_bars_and_points() {
+        // Bars high on the right, low on the left: the upper left is free.
+        let bars: Vec<Occupied> = (0..20)
+            .map(|i| Occupied {
+                x: i as f64 / 19.0,
+                y0: 0.0,
+                y1: i as f64 / 19.0 * 0.95,
+            })
+            .collect();
+        let (w, h) = legend_size(2, 20);
+        let (pos, n) = corner(&bars, w, h);
+        assert_eq!(n, 0);
+        assert!(matches!(pos, SeriesLabelPosition::UpperLeft), "{pos:?}");
+        // Bars reach the top everywhere: no corner is free, but growing the
+        // y axis frees the top band.
+        let full: Vec<Occupied> = (0..20)
+            .map(|i| Occupied {
+                x: i as f64 / 19.0,
+                y0: 0.0,
+                y1: 1.0,
+            })
+            .collect();
+        assert!(corner(&full, w, h).1 > 0);
+        assert!(is_clear(&full, w, h));
+        let (lo, hi) = grow((0.0, 10.0), h);
+        assert_eq!(lo, 0.0);
+        assert!((10.0 / hi - (1.0 - h)).abs() < 1e-12);
+    }
+}
