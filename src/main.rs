@@ -45,6 +45,10 @@ enum Cmd {
     Predict(PredictArgs),
     /// Speed benchmarks, printed as ratios against baselines measured in the same run.
     Bench(BenchArgs),
+    /// Level-of-detail selection on one knapsack instance (paper 001, Funkhouser & Sequin): greedy, incremental, optimal.
+    LodSelect(cli::args::LodSelectArgs),
+    /// State sorting with a small buffer (paper 001): state changes of LRU, bounded-waste, random, round-robin.
+    Sortbuf(cli::args::SortbufArgs),
 }
 
 fn main() -> ExitCode {
@@ -69,6 +73,8 @@ fn main() -> ExitCode {
         Cmd::Calibrate(a) => commands::calibrate(a),
         Cmd::Predict(a) => commands::predict(a),
         Cmd::Bench(a) => commands::bench(a),
+        Cmd::LodSelect(a) => commands::lod_select(a),
+        Cmd::Sortbuf(a) => commands::sortbuf(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -404,3 +404,13 @@ pub fn bench(args: BenchArgs) -> Result<()> {
     }
     Ok(())
 }
+
+/// `rendersim lod-select`.
+pub fn lod_select(args: super::args::LodSelectArgs) -> Result<()> {
+    super::lod::lod_select(&args)
+}
+
+/// `rendersim sortbuf`.
+pub fn sortbuf(args: super::args::SortbufArgs) -> Result<()> {
+    super::lod::sortbuf(&args)
+}
