@@ -484,8 +484,9 @@ impl From<LodAlgorithm> for rendersim::components::lod_select::Algorithm {
 /// `rendersim sortbuf`.
 #[derive(Args)]
 pub struct SortbufArgs {
-    /// State ids: a file of whitespace-separated non-negative integers (# comments), or
-    /// lru-worst:M (the lecture's worst case for LRU, meant for a buffer of M*M+1 slots).
+    /// State ids: a file of whitespace-separated non-negative integers (# comments);
+    /// lru-worst:M (the lecture's worst case for LRU, meant for a buffer of M*M+1 slots);
+    /// or scene:MODEL.toml[:state|shader|texture|material] (a scene's objects in submission order).
     pub sequence: String,
     /// Buffer slots K (>= 1).
     #[arg(long, conflicts_with = "sweep", required_unless_present = "sweep")]

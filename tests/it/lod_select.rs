@@ -78,7 +78,8 @@ fn optimal_equals_brute_force_and_beats_greedy() {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
     let mut strictly_better = 0;
     for case in 0..400 {
-        let inst = random_instance(&mut rng, rng.random_range(0..=7), 4);
+        let n = rng.random_range(0..=7);
+        let inst = random_instance(&mut rng, n, 4);
         let g = greedy(&inst);
         let o = optimal(&inst).unwrap();
         let b = brute_force(&inst);
@@ -223,8 +224,9 @@ fn cli_errors_name_what_is_wrong() {
     );
     err(&one(r#"{ cost = "1ms" }"#), &[], &["benefit"]);
     err("budget = 5\n", &[], &["budget", "unit"]);
-    err(HAND, &["--previous", "0,1"], &["previous selection has 2 entries"]);
-    err(HAND, &["--previous", "0,x,1"], &["entry 2"]);
+    err(HAND, &["--algorithm", "incremental", "--previous", "0,1"], &["previous selection has 2 entries"]);
+    err(HAND, &["--algorithm", "incremental", "--previous", "0,x,1"], &["entry 2"]);
+    err(HAND, &["--algorithm", "incremental", "--previous", "0,1,5"], &["\"C\"", "level 5"]);
     err(HAND, &["--previous", "0,1,-"], &["only --algorithm incremental"]);
     let many: String = std::iter::once("budget = \"1ms\"\n".to_string())
         .chain((0..31).map(|i| format!("[[objects]]\nname = \"o{i}\"\nlevels = [{{ cost = \"1ms\", benefit = 1.0 }}]\n")))

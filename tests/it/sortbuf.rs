@@ -171,3 +171,35 @@ fn cli_errors_name_what_is_wrong() {
     err(&["sortbuf", "lru-worst:x", "--buffer", "2", "--strategy", "lru"], &["lru-worst:M"]);
     err(&["sortbuf", dir.path().to_str().unwrap(), "--buffer", "2", "--strategy", "lru"], &["folder"]);
 }
+
+#[test]
+fn scene_sequences_match_the_pipelines_state_changes() {
+    // With one slot nothing is reordered: the changes of each attribute's
+    // sequence are the frame pipeline's own counts for the same scene.
+    let dir = tempfile::tempdir().unwrap();
+    let city = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/models/city.toml")).unwrap();
+    let mixed = format!(
+        "{city}\n[[workload.groups]]\nname = \"extra\"\ncount = 40\nmesh = {{ triangles = 10, acmr = 1.0 }}\ntriangle_pixels = 4.0\nshaders = 3\ntextures = 5\nmaterials = 2\n"
+    );
+    let sorted = mixed.replace("state_order = \"as_listed\"", "state_order = \"sorted\"");
+    assert_ne!(sorted, mixed);
+    for (name, text) in [("city.toml", &city), ("mixed.toml", &mixed), ("sorted.toml", &sorted)] {
+        let path = write(dir.path(), name, text);
+        let summary = crate::common::summary_of(text, &["run.frames=1", "run.warmup_frames=0", "fidelity=\"draw\""]);
+        for attr in ["shader", "texture", "material"] {
+            let spec = format!("scene:{path}:{attr}");
+            let o = bin().args(["sortbuf", &spec, "--buffer", "1", "--strategy", "lru", "--json"]).output().unwrap();
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+            assert_eq!(v["state_changes"], summary["scene"][format!("{attr}_changes")], "{name} {attr}");
+            assert_eq!(v["sequence_length"], summary["scene"]["objects"], "{name}");
+        }
+    }
+    let o = bin()
+        .args(["sortbuf", "scene:models/fixed.toml", "--buffer", "1", "--strategy", "lru"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("not \"scene\""), "{}", String::from_utf8_lossy(&o.stderr));
+}
