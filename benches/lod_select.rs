@@ -45,7 +45,12 @@ fn main() {
     let mut inc_warm = vec![];
     let mut inc_cold = vec![];
     let mut check = (0, 0.0);
+    let mut table = vec![];
     for _ in 0..9 {
+        let t = Instant::now();
+        let tb: toml::Table = toml::from_str(&text).expect("toml");
+        table.push(t.elapsed().as_secs_f64());
+        assert_eq!(tb["objects"].as_array().map(|a| a.len()), Some(10_000));
         let t = Instant::now();
         let inst = parse_instance(&text).expect("instance");
         parse.push(t.elapsed().as_secs_f64());
@@ -81,6 +86,10 @@ fn main() {
         (p + s) * 1e3,
         b * 1e3,
         s / b
+    );
+    println!(
+        "the toml crate alone (text to a toml::Table): {:.2} ms",
+        median(table) * 1e3
     );
     println!(
         "incremental: from the greedy's selection {:.2} ms, from nothing {:.2} ms",

@@ -14,9 +14,9 @@ use rendersim::components::sorting_buffer::{
     SortbufSummary, SortbufSweep, StateId, Strategy, sequence::sequence_from_spec,
 };
 use rendersim::config::{Overrides, load_model};
+use rendersim::output::text::fixed;
 use rendersim::scene::config::SceneWorkload;
 use rendersim::scene::states::state_sequence;
-use rendersim::output::text::fixed;
 
 use super::args::{LodSelectArgs, SortbufArgs};
 
@@ -33,7 +33,10 @@ fn parse_previous(text: &str) -> Result<Vec<Option<u32>>> {
                 Ok(None)
             } else {
                 t.parse::<u32>().map(Some).map_err(|_| {
-                    anyhow::anyhow!("--previous: entry {} is {t:?}, expected a level index or - (not drawn)", i + 1)
+                    anyhow::anyhow!(
+                        "--previous: entry {} is {t:?}, expected a level index or - (not drawn)",
+                        i + 1
+                    )
                 })
             }
         })
@@ -72,7 +75,10 @@ pub fn lod_select(args: &LodSelectArgs) -> Result<()> {
         summary.objects
     );
     let width = inst.objects().iter().map(|o| o.name.len()).max().unwrap_or(6).max(6);
-    println!("{:<width$}  {:>5}  {:>10}  {:>10}", "object", "level", "cost ms", "benefit");
+    println!(
+        "{:<width$}  {:>5}  {:>10}  {:>10}",
+        "object", "level", "cost ms", "benefit"
+    );
     for (o, l) in inst.objects().iter().zip(&summary.selection) {
         match l {
             Some(l) => {

@@ -6,5 +6,5 @@
 pub mod args;
 pub mod commands;
 pub mod device;
-pub mod print;
 pub mod lod;
+pub mod print;

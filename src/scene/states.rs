@@ -45,7 +45,11 @@ pub fn state_sequence(scene: &SceneWorkload) -> Result<Vec<ObjectState>, String>
     let mut out = Vec::with_capacity(total as usize);
     let (mut sb, mut tb, mut mb) = (0u64, 0u64, 0u64);
     for (gi, g) in groups.iter().enumerate() {
-        for (what, v) in [("shaders", g.shaders), ("textures", g.textures), ("materials", g.materials)] {
+        for (what, v) in [
+            ("shaders", g.shaders),
+            ("textures", g.textures),
+            ("materials", g.materials),
+        ] {
             if v == 0 {
                 return Err(format!("group {gi} ({}): {what} must be at least 1", g.name));
             }

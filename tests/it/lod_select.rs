@@ -9,7 +9,9 @@ use std::process::Command;
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
-use rendersim::components::lod_select::{Algorithm, Instance, Level, LodObject, Selection, greedy, incremental, optimal};
+use rendersim::components::lod_select::{
+    Algorithm, Instance, Level, LodObject, Selection, greedy, incremental, optimal,
+};
 use rendersim::engine::Duration;
 
 fn bin() -> Command {
@@ -85,14 +87,21 @@ fn optimal_equals_brute_force_and_beats_greedy() {
         let b = brute_force(&inst);
         check_valid(&inst, &g);
         check_valid(&inst, &o);
-        assert!((o.total_benefit - b).abs() <= 1e-9 * b.max(1.0), "case {case}: optimal {} brute force {b}", o.total_benefit);
+        assert!(
+            (o.total_benefit - b).abs() <= 1e-9 * b.max(1.0),
+            "case {case}: optimal {} brute force {b}",
+            o.total_benefit
+        );
         assert!(o.total_benefit >= g.total_benefit, "case {case}");
         if o.total_benefit > g.total_benefit + 1e-9 {
             strictly_better += 1;
         }
     }
     // The greedy is not optimal: on these instances it often leaves benefit.
-    assert!(strictly_better > 20, "greedy was optimal almost always ({strictly_better} gaps)");
+    assert!(
+        strictly_better > 20,
+        "greedy was optimal almost always ({strictly_better} gaps)"
+    );
 }
 
 #[test]
@@ -172,13 +181,24 @@ fn cli_reports_the_hand_worked_example() {
     let v = json(&["lod-select", &f, "--json", "--algorithm", "optimal"]);
     assert_eq!(v["selection"], serde_json::json!([null, 1, 0]));
     assert_eq!(v["total_cost_ms"], 10.0);
-    let v = json(&["lod-select", &f, "--json", "--algorithm", "incremental", "--previous", "1,1,0"]);
+    let v = json(&[
+        "lod-select",
+        &f,
+        "--json",
+        "--algorithm",
+        "incremental",
+        "--previous",
+        "1,1,0",
+    ]);
     assert_eq!(v["selection"], serde_json::json!([1, null, 0]));
     assert_eq!(v["total_benefit"], 13.0);
     // The readable table.
     let o = bin().args(["lod-select", &f]).output().unwrap();
     let text = String::from_utf8(o.stdout).unwrap();
-    assert!(text.contains("greedy selection, budget 10.000 ms: 2 of 3 objects drawn"), "{text}");
+    assert!(
+        text.contains("greedy selection, budget 10.000 ms: 2 of 3 objects drawn"),
+        "{text}"
+    );
     assert!(text.contains("optimal benefit 15.0000 (gap 2.0000)"), "{text}");
 }
 
@@ -193,7 +213,10 @@ fn cli_reports_a_budget_below_every_level() {
     let v = json(&["lod-select", &f, "--json"]);
     assert_eq!(v["selection"], serde_json::json!([null]));
     assert_eq!(v["unaffordable"], serde_json::json!(["tree-1"]));
-    assert!(v["notes"][0].as_str().unwrap().contains("no level of any object fits"), "{v}");
+    assert!(
+        v["notes"][0].as_str().unwrap().contains("no level of any object fits"),
+        "{v}"
+    );
     let f = write(dir.path(), "empty.toml", "budget = \"1ms\"\n");
     let v = json(&["lod-select", &f, "--json", "--algorithm", "optimal"]);
     assert_eq!(v["selection"], serde_json::json!([]));
@@ -216,7 +239,11 @@ fn cli_errors_name_what_is_wrong() {
         }
     };
     let one = |levels: &str| format!("budget = \"1ms\"\n[[objects]]\nname = \"tree-7\"\nlevels = [{levels}]\n");
-    err(&one(r#"{ cost = "-1ms", benefit = 1.0 }"#), &[], &["tree-7", "level 0", "negative"]);
+    err(
+        &one(r#"{ cost = "-1ms", benefit = 1.0 }"#),
+        &[],
+        &["tree-7", "level 0", "negative"],
+    );
     err(
         &one(r#"{ cost = "1ms", benefit = 1.0 }, { cost = "1ms", benefit = -2.0 }"#),
         &[],
@@ -224,12 +251,26 @@ fn cli_errors_name_what_is_wrong() {
     );
     err(&one(r#"{ cost = "1ms" }"#), &[], &["benefit"]);
     err("budget = 5\n", &[], &["budget", "unit"]);
-    err(HAND, &["--algorithm", "incremental", "--previous", "0,1"], &["previous selection has 2 entries"]);
-    err(HAND, &["--algorithm", "incremental", "--previous", "0,x,1"], &["entry 2"]);
-    err(HAND, &["--algorithm", "incremental", "--previous", "0,1,5"], &["\"C\"", "level 5"]);
+    err(
+        HAND,
+        &["--algorithm", "incremental", "--previous", "0,1"],
+        &["previous selection has 2 entries"],
+    );
+    err(
+        HAND,
+        &["--algorithm", "incremental", "--previous", "0,x,1"],
+        &["entry 2"],
+    );
+    err(
+        HAND,
+        &["--algorithm", "incremental", "--previous", "0,1,5"],
+        &["\"C\"", "level 5"],
+    );
     err(HAND, &["--previous", "0,1,-"], &["only --algorithm incremental"]);
     let many: String = std::iter::once("budget = \"1ms\"\n".to_string())
-        .chain((0..31).map(|i| format!("[[objects]]\nname = \"o{i}\"\nlevels = [{{ cost = \"1ms\", benefit = 1.0 }}]\n")))
+        .chain(
+            (0..31).map(|i| format!("[[objects]]\nname = \"o{i}\"\nlevels = [{{ cost = \"1ms\", benefit = 1.0 }}]\n")),
+        )
         .collect();
     err(&many, &["--algorithm", "optimal"], &["limited to 30 objects", "has 31"]);
     let o = bin().args(["lod-select", "/nonexistent/x.toml"]).output().unwrap();

@@ -7,7 +7,7 @@ use std::process::Command;
 
 use proptest::prelude::*;
 use rendersim::components::sorting_buffer::sequence::lru_worst;
-use rendersim::components::sorting_buffer::{Strategy, StateId, lower_bound, offline_optimum, simulate};
+use rendersim::components::sorting_buffer::{StateId, Strategy, lower_bound, offline_optimum, simulate};
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_rendersim"))
@@ -114,7 +114,9 @@ fn lru_worst_case_ratio_grows_with_the_buffer() {
         let lru = simulate(&seq, k, Strategy::Lru, 1, false).unwrap().state_changes;
         assert_eq!(lru, m * (m + 1), "m={m}");
         // Bounded waste is not fooled by the fresh stamps of the fat runs.
-        let bw = simulate(&seq, k, Strategy::BoundedWaste, 1, false).unwrap().state_changes;
+        let bw = simulate(&seq, k, Strategy::BoundedWaste, 1, false)
+            .unwrap()
+            .state_changes;
         assert!(bw < lru, "m={m}: bounded waste {bw}, lru {lru}");
     }
     // m = 1 is small enough for the exhaustive search: optimum 2m = 2.
@@ -125,17 +127,25 @@ fn lru_worst_case_ratio_grows_with_the_buffer() {
 fn cli_single_run_and_sweep() {
     let dir = tempfile::tempdir().unwrap();
     let f = write(dir.path(), "seq.txt", "# states\n1 2 1 2\n3 1\n");
-    let o = bin().args(["sortbuf", &f, "--buffer", "2", "--strategy", "lru", "--json"]).output().unwrap();
+    let o = bin()
+        .args(["sortbuf", &f, "--buffer", "2", "--strategy", "lru", "--json"])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["strategy"], "lru");
     assert_eq!(v["buffer"], 2);
     assert_eq!(v["sequence_length"], 6);
-    let expect = simulate(&[1, 2, 1, 2, 3, 1], 2, Strategy::Lru, 1, false).unwrap().state_changes;
+    let expect = simulate(&[1, 2, 1, 2, 3, 1], 2, Strategy::Lru, 1, false)
+        .unwrap()
+        .state_changes;
     assert_eq!(v["state_changes"], expect);
     assert_eq!(v["lower_bound"], lower_bound(&[1, 2, 1, 2, 3, 1], 2));
     assert_eq!(v["offline_optimum"], offline_optimum(&[1, 2, 1, 2, 3, 1], 2).unwrap());
-    let o = bin().args(["sortbuf", "lru-worst:4", "--sweep", "1,17", "--json"]).output().unwrap();
+    let o = bin()
+        .args(["sortbuf", "lru-worst:4", "--sweep", "1,17", "--json"])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["rows"][1]["buffer"], 17);
@@ -159,17 +169,48 @@ fn cli_errors_name_what_is_wrong() {
     let good = write(dir.path(), "good.txt", "1 2 3\n");
     let bad = write(dir.path(), "bad.txt", "1 2\n3 red 4\n");
     let empty = write(dir.path(), "empty.txt", "# nothing here\n\n");
-    err(&["sortbuf", &good, "--buffer", "0", "--strategy", "lru"], &["at least 1 slot"]);
-    err(&["sortbuf", &bad, "--buffer", "2", "--strategy", "lru"], &["bad.txt:2:3", "\"red\""]);
-    err(&["sortbuf", &empty, "--buffer", "2", "--strategy", "lru"], &["no state ids"]);
+    err(
+        &["sortbuf", &good, "--buffer", "0", "--strategy", "lru"],
+        &["at least 1 slot"],
+    );
+    err(
+        &["sortbuf", &bad, "--buffer", "2", "--strategy", "lru"],
+        &["bad.txt:2:3", "\"red\""],
+    );
+    err(
+        &["sortbuf", &empty, "--buffer", "2", "--strategy", "lru"],
+        &["no state ids"],
+    );
     err(&["sortbuf", &good, "--buffer", "2"], &["--strategy"]);
     err(&["sortbuf", &good, "--buffer", "2", "--strategy", "fifo"], &["fifo"]);
-    err(&["sortbuf", &good, "--buffer", "2", "--strategy", "lru,random"], &["one strategy"]);
+    err(
+        &["sortbuf", &good, "--buffer", "2", "--strategy", "lru,random"],
+        &["one strategy"],
+    );
     err(&["sortbuf", &good, "--sweep", "1,0"], &["at least 1 slot"]);
-    err(&["sortbuf", "/nonexistent/seq.txt", "--buffer", "2", "--strategy", "lru"], &["/nonexistent/seq.txt"]);
-    err(&["sortbuf", "lru-worst:0", "--buffer", "2", "--strategy", "lru"], &["lru-worst:0"]);
-    err(&["sortbuf", "lru-worst:x", "--buffer", "2", "--strategy", "lru"], &["lru-worst:M"]);
-    err(&["sortbuf", dir.path().to_str().unwrap(), "--buffer", "2", "--strategy", "lru"], &["folder"]);
+    err(
+        &["sortbuf", "/nonexistent/seq.txt", "--buffer", "2", "--strategy", "lru"],
+        &["/nonexistent/seq.txt"],
+    );
+    err(
+        &["sortbuf", "lru-worst:0", "--buffer", "2", "--strategy", "lru"],
+        &["lru-worst:0"],
+    );
+    err(
+        &["sortbuf", "lru-worst:x", "--buffer", "2", "--strategy", "lru"],
+        &["lru-worst:M"],
+    );
+    err(
+        &[
+            "sortbuf",
+            dir.path().to_str().unwrap(),
+            "--buffer",
+            "2",
+            "--strategy",
+            "lru",
+        ],
+        &["folder"],
+    );
 }
 
 #[test]
@@ -188,18 +229,36 @@ fn scene_sequences_match_the_pipelines_state_changes() {
         let summary = crate::common::summary_of(text, &["run.frames=1", "run.warmup_frames=0", "fidelity=\"draw\""]);
         for attr in ["shader", "texture", "material"] {
             let spec = format!("scene:{path}:{attr}");
-            let o = bin().args(["sortbuf", &spec, "--buffer", "1", "--strategy", "lru", "--json"]).output().unwrap();
+            let o = bin()
+                .args(["sortbuf", &spec, "--buffer", "1", "--strategy", "lru", "--json"])
+                .output()
+                .unwrap();
             assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
             let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-            assert_eq!(v["state_changes"], summary["scene"][format!("{attr}_changes")], "{name} {attr}");
+            assert_eq!(
+                v["state_changes"],
+                summary["scene"][format!("{attr}_changes")],
+                "{name} {attr}"
+            );
             assert_eq!(v["sequence_length"], summary["scene"]["objects"], "{name}");
         }
     }
     let o = bin()
-        .args(["sortbuf", "scene:models/fixed.toml", "--buffer", "1", "--strategy", "lru"])
+        .args([
+            "sortbuf",
+            "scene:models/fixed.toml",
+            "--buffer",
+            "1",
+            "--strategy",
+            "lru",
+        ])
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("not \"scene\""), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("not \"scene\""),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 }

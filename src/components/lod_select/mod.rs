@@ -176,7 +176,9 @@ pub enum LodSelectError {
         got: usize,
     },
     /// The previous selection names a level an object does not have.
-    #[error("the previous selection gives object {object:?} (objects[{index}]) level {level}, but it has {levels} level(s)")]
+    #[error(
+        "the previous selection gives object {object:?} (objects[{index}]) level {level}, but it has {levels} level(s)"
+    )]
     PreviousLevel {
         /// Object name.
         object: String,

@@ -1,6 +1,6 @@
 //! Unit tests of LOD selection: a hand-worked instance and the edges.
 
-use super::file::parse_instance;
+use super::file::{parse_instance, parse_instance_json};
 use super::*;
 
 fn lv(ms: u64, benefit: f64) -> Level {
@@ -119,7 +119,11 @@ fn empty_and_unaffordable() {
 #[test]
 fn unordered_levels_are_identifiers() {
     // Level 0 costs more and gives less than level 1 (dominated).
-    let inst = Instance::new(Duration::ms(10), vec![obj("x", vec![lv(5, 1.0), lv(2, 3.0), lv(9, 4.0)])]).unwrap();
+    let inst = Instance::new(
+        Duration::ms(10),
+        vec![obj("x", vec![lv(5, 1.0), lv(2, 3.0), lv(9, 4.0)])],
+    )
+    .unwrap();
     assert_eq!(greedy(&inst).levels, vec![Some(1)]);
     assert_eq!(optimal(&inst).unwrap().levels, vec![Some(2)]);
 }
@@ -127,10 +131,16 @@ fn unordered_levels_are_identifiers() {
 #[test]
 fn bad_benefits_name_object_and_level() {
     for (b, what) in [(-1.0, "negative"), (f64::NAN, "NaN"), (f64::INFINITY, "infinite")] {
-        let e = Instance::new(Duration::ms(1), vec![obj("ok", vec![lv(1, 1.0)]), obj("bad", vec![lv(1, 1.0), lv(2, b)])])
-            .unwrap_err();
+        let e = Instance::new(
+            Duration::ms(1),
+            vec![obj("ok", vec![lv(1, 1.0)]), obj("bad", vec![lv(1, 1.0), lv(2, b)])],
+        )
+        .unwrap_err();
         let m = e.to_string();
-        assert!(m.contains("\"bad\"") && m.contains("objects[1]") && m.contains("level 1") && m.contains(what), "{m}");
+        assert!(
+            m.contains("\"bad\"") && m.contains("objects[1]") && m.contains("level 1") && m.contains(what),
+            "{m}"
+        );
     }
     let e = Instance::new(Duration::ms(1), vec![obj("none", vec![])]).unwrap_err();
     assert!(e.to_string().contains("no levels"), "{e}");
@@ -141,7 +151,10 @@ fn optimal_refuses_large_instances() {
     let objects = (0..31).map(|i| obj(&format!("o{i}"), vec![lv(1, 1.0)])).collect();
     let inst = Instance::new(Duration::ms(10), objects).unwrap();
     let e = optimal(&inst).unwrap_err();
-    assert!(matches!(e, LodSelectError::TooLargeForOptimal { objects: 31, limit: 30 }), "{e}");
+    assert!(
+        matches!(e, LodSelectError::TooLargeForOptimal { objects: 31, limit: 30 }),
+        "{e}"
+    );
 }
 
 #[test]
@@ -168,10 +181,16 @@ levels = [{ cost = 0, benefit = 1 }]
         }
     };
     let one = |levels: &str| format!("budget = \"1ms\"\n[[objects]]\nname = \"t\"\nlevels = [{levels}]\n");
-    bad(&one(r#"{ cost = "-1ms", benefit = 1.0 }"#), &["\"t\"", "level 0", "negative"]);
+    bad(
+        &one(r#"{ cost = "-1ms", benefit = 1.0 }"#),
+        &["\"t\"", "level 0", "negative"],
+    );
     bad(&one(r#"{ cost = "1", benefit = 1.0 }"#), &["\"t\"", "level 0", "unit"]);
     bad(&one(r#"{ cost = 2, benefit = 1.0 }"#), &["level 0", "needs a unit"]);
-    bad(&one(r#"{ cost = "1ms", benefit = -0.5 }"#), &["\"t\"", "level 0", "negative"]);
+    bad(
+        &one(r#"{ cost = "1ms", benefit = -0.5 }"#),
+        &["\"t\"", "level 0", "negative"],
+    );
     bad(&one(r#"{ cost = "1ms", benefit = nan }"#), &["NaN"]);
     bad(&one(r#"{ cost = "1ms", benefit = 1.0, colour = 1 }"#), &["colour"]);
     bad(&one(""), &["no levels"]);
@@ -180,5 +199,26 @@ levels = [{ cost = 0, benefit = 1 }]
     bad(
         "budget = \"1ms\"\n[[objects]]\nname = \"a\"\nlevels = [{ cost = \"1ms\", benefit = 1.0 }]\n[[objects]]\nname = \"a\"\nlevels = [{ cost = \"1ms\", benefit = 1.0 }]\n",
         &["objects[0]", "objects[1]", "\"a\"", "unique"],
+    );
+}
+
+#[test]
+fn json_instances_read_like_toml() {
+    let j = parse_instance_json(
+        r#"{"budget": "10ms", "objects": [{"name": "t", "levels": [{"cost": "0.4ms", "benefit": 1}, {"cost": 0, "benefit": 0.5}]}]}"#,
+    )
+    .unwrap();
+    let t = parse_instance(
+        "budget = \"10ms\"\n[[objects]]\nname = \"t\"\nlevels = [{ cost = \"0.4ms\", benefit = 1.0 }, { cost = 0, benefit = 0.5 }]\n",
+    )
+    .unwrap();
+    assert_eq!(j, t);
+    let e = parse_instance_json(
+        r#"{"budget": "1ms", "objects": [{"name": "t", "levels": [{"cost": "-1ms", "benefit": 1}]}]}"#,
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("\"t\"") && e.to_string().contains("negative"),
+        "{e}"
     );
 }

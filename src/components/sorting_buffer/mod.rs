@@ -46,8 +46,8 @@
 mod bound;
 pub mod sequence;
 
-use std::collections::{BinaryHeap, HashMap};
 use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashMap};
 
 use rand::Rng;
 use serde::Serialize;
@@ -330,7 +330,10 @@ pub fn simulate(
 
 /// Runs of equal states in `seq` (the changes without a buffer, `K = 1`).
 pub fn input_runs(seq: &[StateId]) -> u64 {
-    seq.iter().enumerate().filter(|&(i, s)| i == 0 || seq[i - 1] != *s).count() as u64
+    seq.iter()
+        .enumerate()
+        .filter(|&(i, s)| i == 0 || seq[i - 1] != *s)
+        .count() as u64
 }
 
 /// Distinct states in `seq`.

@@ -78,21 +78,26 @@ pub fn lru_worst(m: u64) -> Result<Vec<StateId>, SortBufferError> {
 /// from `base`). Returns the sequence and the name to report.
 pub fn sequence_from_spec(spec: &str, base: &Path) -> Result<Vec<StateId>, SortBufferError> {
     if let Some(m) = spec.strip_prefix("lru-worst:") {
-        let m: u64 = m
-            .parse()
-            .map_err(|_| SortBufferError::Source(format!("{spec:?}: expected lru-worst:M with M a positive integer")))?;
+        let m: u64 = m.parse().map_err(|_| {
+            SortBufferError::Source(format!("{spec:?}: expected lru-worst:M with M a positive integer"))
+        })?;
         return lru_worst(m);
     }
     let path = base.join(spec);
-    let meta = std::fs::metadata(&path)
-        .map_err(|e| SortBufferError::Source(format!("reading sequence file {spec}: {e}")))?;
+    let meta =
+        std::fs::metadata(&path).map_err(|e| SortBufferError::Source(format!("reading sequence file {spec}: {e}")))?;
     if meta.is_dir() {
         return Err(SortBufferError::Source(format!(
             "{spec} is a folder; give a file of state ids or lru-worst:M"
         )));
     }
-    let bytes = std::fs::read(&path).map_err(|e| SortBufferError::Source(format!("reading sequence file {spec}: {e}")))?;
-    let text = String::from_utf8(bytes)
-        .map_err(|e| SortBufferError::Source(format!("{spec}: not UTF-8 text (byte {})", e.utf8_error().valid_up_to())))?;
+    let bytes =
+        std::fs::read(&path).map_err(|e| SortBufferError::Source(format!("reading sequence file {spec}: {e}")))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        SortBufferError::Source(format!(
+            "{spec}: not UTF-8 text (byte {})",
+            e.utf8_error().valid_up_to()
+        ))
+    })?;
     parse_sequence(&text, spec)
 }

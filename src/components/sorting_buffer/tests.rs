@@ -27,7 +27,7 @@ fn a_buffer_as_large_as_the_sequence_groups_everything() {
 #[test]
 fn lru_sends_the_oldest_state() {
     // K = 3: [1 2 3] full -> LRU sends 1; [2 3 2] full (stamp 2 newest) -> sends 3;
-    // [2 2 1]... 
+    // [2 2 1]...
     let r = simulate(&[1, 2, 3, 2, 1], 3, Strategy::Lru, 0, true).unwrap();
     assert_eq!(r.output.unwrap(), vec![(1, 1), (3, 1), (2, 2), (1, 1)]);
 }
@@ -59,13 +59,18 @@ fn random_is_reproducible_per_seed() {
     let a = simulate(&seq, 8, Strategy::Random, 5, true).unwrap();
     let b = simulate(&seq, 8, Strategy::Random, 5, true).unwrap();
     assert_eq!(a, b);
-    let others: Vec<_> = (6..12).map(|s| simulate(&seq, 8, Strategy::Random, s, true).unwrap()).collect();
+    let others: Vec<_> = (6..12)
+        .map(|s| simulate(&seq, 8, Strategy::Random, s, true).unwrap())
+        .collect();
     assert!(others.iter().any(|o| o.output != a.output));
 }
 
 #[test]
 fn buffer_sizes_are_checked() {
-    assert_eq!(simulate(&[1], 0, Strategy::Lru, 0, false), Err(SortBufferError::ZeroBuffer));
+    assert_eq!(
+        simulate(&[1], 0, Strategy::Lru, 0, false),
+        Err(SortBufferError::ZeroBuffer)
+    );
     assert!(matches!(
         simulate(&[1], MAX_BUFFER + 1, Strategy::Lru, 0, false),
         Err(SortBufferError::BufferTooLarge { .. })
@@ -95,10 +100,19 @@ fn lru_worst_case_costs_m_times_m_plus_1() {
 
 #[test]
 fn parsing() {
-    assert_eq!(parse_sequence("1 2\n3\t4 # five\n\n 6", "f").unwrap(), vec![1, 2, 3, 4, 6]);
+    assert_eq!(
+        parse_sequence("1 2\n3\t4 # five\n\n 6", "f").unwrap(),
+        vec![1, 2, 3, 4, 6]
+    );
     let e = parse_sequence("1 2\n3 x4 5\n", "seq.txt").unwrap_err();
-    assert_eq!(e.to_string(), "seq.txt:2:3: \"x4\" is not a state id (a non-negative integer)");
+    assert_eq!(
+        e.to_string(),
+        "seq.txt:2:3: \"x4\" is not a state id (a non-negative integer)"
+    );
     let e = parse_sequence("1 -2", "f").unwrap_err();
     assert!(e.to_string().contains("f:1:3"), "{e}");
-    assert!(matches!(parse_sequence("# nothing\n\n", "f"), Err(SortBufferError::Empty { .. })));
+    assert!(matches!(
+        parse_sequence("# nothing\n\n", "f"),
+        Err(SortBufferError::Empty { .. })
+    ));
 }
