@@ -445,7 +445,8 @@ impl<T: Clone + Send + Sync + 'static> TypedValueParser for Plain<T> {
 /// `rendersim lod-select`.
 #[derive(Args)]
 pub struct LodSelectArgs {
-    /// Knapsack instance (TOML): budget = "10ms", [[objects]] name, levels = [{ cost, benefit }].
+    /// Knapsack instance (TOML, or JSON with the same keys when named *.json):
+    /// budget = "10ms", [[objects]] name, levels = [{ cost, benefit }].
     pub instance: PathBuf,
     /// Selection algorithm: greedy (the lecture's), incremental (frame to frame), optimal (exact, <= 30 objects).
     #[arg(long, value_enum, default_value = "greedy")]

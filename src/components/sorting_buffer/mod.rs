@@ -39,6 +39,10 @@
 //! - [`Strategy::RoundRobin`]: like random, but the slot is the one a
 //!   pointer shows, and the pointer moves on by one slot each time.
 //!
+//! Cost: LRU, random and round robin take O(log K) per element; bounded
+//! waste looks at every buffered state on each overflow, O(distinct states
+//! in the buffer).
+//!
 //! [`lower_bound`] bounds the offline optimum from below; [`offline_optimum`]
 //! finds it exactly for tiny sequences; [`sequence`] reads sequences and
 //! builds the lecture's worst case for LRU.
@@ -47,7 +51,7 @@ mod bound;
 pub mod sequence;
 
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::{BTreeMap, BinaryHeap, HashMap};
 
 use rand::Rng;
 use serde::Serialize;
@@ -177,6 +181,8 @@ struct Buffer {
     present: Vec<u32>,
     pos: Vec<usize>,
     stamp: Vec<u64>,
+    /// Buffered states by stamp, oldest first (LRU in O(log K)).
+    by_stamp: BTreeMap<u64, u32>,
     waste: Vec<u64>,
     last: Option<u32>,
     changes: u64,
@@ -190,9 +196,12 @@ impl Buffer {
         if self.slots_of[c as usize].is_empty() {
             self.pos[c as usize] = self.present.len();
             self.present.push(c);
+        } else {
+            self.by_stamp.remove(&self.stamp[c as usize]);
         }
         self.slots_of[c as usize].push(s);
         self.stamp[c as usize] = now;
+        self.by_stamp.insert(now, c);
     }
 
     fn send(&mut self, c: u32) {
@@ -205,6 +214,7 @@ impl Buffer {
         let mut list = list;
         list.clear();
         self.slots_of[c as usize] = list;
+        self.by_stamp.remove(&self.stamp[c as usize]);
         let p = self.pos[c as usize];
         self.present.swap_remove(p);
         if let Some(&moved) = self.present.get(p) {
@@ -224,11 +234,7 @@ impl Buffer {
     }
 
     fn oldest(&self) -> u32 {
-        *self
-            .present
-            .iter()
-            .min_by_key(|&&c| self.stamp[c as usize])
-            .expect("a full buffer holds a state")
+        *self.by_stamp.first_key_value().expect("a full buffer holds a state").1
     }
 }
 
@@ -263,6 +269,7 @@ pub fn simulate(
         present: Vec::new(),
         pos: vec![0; d],
         stamp: vec![0; d],
+        by_stamp: BTreeMap::new(),
         waste: vec![0; d],
         last: None,
         changes: 0,
