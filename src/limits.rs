@@ -54,6 +54,14 @@ pub const MAX_PIXELFLOW_BINS: u64 = 1 << 26;
 /// Most per-region records of a PixelFlow run (`frames` x regions).
 pub const MAX_PIXELFLOW_REGION_RECORDS: u64 = 1 << 24;
 
+/// Most slots of a state-sorting buffer (`rendersim sortbuf --buffer`,
+/// `--sweep`): one 4-byte entry each.
+pub const MAX_SORT_BUFFER: usize = 1 << 24;
+
+/// Largest m of the sorting buffer's `lru-worst:M` sequence (m (m + m² + 1)
+/// elements: about 16.8 million at 256).
+pub const MAX_LRU_WORST_M: u64 = 256;
+
 /// Formats a byte count for messages: `8 GiB`, `1.5 MiB`, `512 bytes`.
 pub fn show_bytes(b: u64) -> String {
     const UNITS: [(&str, u64); 4] = [("TiB", 1 << 40), ("GiB", 1 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)];

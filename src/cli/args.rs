@@ -485,6 +485,95 @@ impl<T: Clone + Send + Sync + 'static> TypedValueParser for Plain<T> {
     }
 }
 
+/// `rendersim lod-select`.
+#[derive(Args)]
+pub struct LodSelectArgs {
+    /// Knapsack instance (TOML, or JSON with the same keys when named *.json):
+    /// budget = "10ms", [[objects]] name, levels = [{ cost, benefit }].
+    pub instance: PathBuf,
+    /// Selection algorithm: greedy (the lecture's), incremental (frame to frame), optimal (exact, <= 30 objects).
+    #[arg(long, value_enum, default_value = "greedy")]
+    pub algorithm: LodAlgorithm,
+    /// Incremental only: the previous frame's selection, one entry per object, comma separated
+    /// (a level index, or - for not drawn); default nothing drawn.
+    #[arg(long, value_name = "LIST")]
+    pub previous: Option<String>,
+    /// Print the JSON result.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The algorithms of `rendersim lod-select`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LodAlgorithm {
+    /// Tuples by benefit/cost, highest first; one per object, while they fit.
+    Greedy,
+    /// From the previous selection: repair over budget, then upgrade by marginal value.
+    Incremental,
+    /// Exact branch and bound (at most 30 objects).
+    Optimal,
+}
+
+impl From<LodAlgorithm> for rendersim::components::lod_select::Algorithm {
+    fn from(a: LodAlgorithm) -> Self {
+        use rendersim::components::lod_select::Algorithm;
+        match a {
+            LodAlgorithm::Greedy => Algorithm::Greedy,
+            LodAlgorithm::Incremental => Algorithm::Incremental,
+            LodAlgorithm::Optimal => Algorithm::Optimal,
+        }
+    }
+}
+
+/// `rendersim sortbuf`.
+#[derive(Args)]
+pub struct SortbufArgs {
+    /// State ids: a file of whitespace-separated non-negative integers (# comments);
+    /// lru-worst:M (the lecture's worst case for LRU, meant for a buffer of M*M+1 slots);
+    /// or scene:MODEL.toml[:state|shader|texture|material] (a scene's objects in submission order).
+    pub sequence: String,
+    /// Buffer slots K (>= 1).
+    #[arg(long, conflicts_with = "sweep", required_unless_present = "sweep")]
+    pub buffer: Option<usize>,
+    /// Strategy: lru, bounded-waste, random, round-robin (with --sweep: a comma list, default all).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub strategy: Vec<SortStrategy>,
+    /// Buffer sizes to sweep, comma separated (a table of every strategy at every size).
+    #[arg(long, value_delimiter = ',', value_name = "K,K,...")]
+    pub sweep: Vec<usize>,
+    /// Master seed of the random strategy's stream.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print the JSON result.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The strategies of `rendersim sortbuf`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SortStrategy {
+    /// Send the least recently written state.
+    Lru,
+    /// Send the state with the largest waste counter.
+    BoundedWaste,
+    /// Send the state of a random slot.
+    Random,
+    /// Send the state of the slot a round-robin pointer shows.
+    RoundRobin,
+}
+
+impl From<SortStrategy> for rendersim::components::sorting_buffer::Strategy {
+    fn from(s: SortStrategy) -> Self {
+        use rendersim::components::sorting_buffer::Strategy;
+        match s {
+            SortStrategy::Lru => Strategy::Lru,
+            SortStrategy::BoundedWaste => Strategy::BoundedWaste,
+            SortStrategy::Random => Strategy::Random,
+            SortStrategy::RoundRobin => Strategy::RoundRobin,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

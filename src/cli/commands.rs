@@ -434,3 +434,13 @@ pub fn timeline(args: TimelineArgs) -> Result<()> {
     );
     Ok(())
 }
+
+/// `rendersim lod-select`.
+pub fn lod_select(args: super::args::LodSelectArgs) -> Result<()> {
+    super::lod::lod_select(&args)
+}
+
+/// `rendersim sortbuf`.
+pub fn sortbuf(args: super::args::SortbufArgs) -> Result<()> {
+    super::lod::sortbuf(&args)
+}

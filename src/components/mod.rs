@@ -4,9 +4,11 @@
 
 pub mod distribution;
 pub mod fifo;
+pub mod lod_select;
 pub mod noise;
 pub mod preemptible;
 pub mod shader_pool;
+pub mod sorting_buffer;
 pub mod state_clock;
 pub mod swap_chain;
 pub mod vertex_cache;

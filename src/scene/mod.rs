@@ -7,3 +7,4 @@ pub mod mesh;
 pub mod obj;
 pub mod optimize;
 pub mod presets;
+pub mod states;

@@ -1,0 +1,216 @@
+//! `rendersim lod-select` and `rendersim sortbuf`: paper 001's LOD selection
+//! on one knapsack instance and its state-sorting buffer on one sequence
+//! (the library's `components::lod_select` and `components::sorting_buffer`).
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use anyhow::{Context, Result, anyhow, bail};
+
+use rendersim::components::lod_select::{
+    Algorithm, MAX_OPTIMAL_OBJECTS, SelectionSummary, file::read_instance, optimal,
+};
+use rendersim::components::sorting_buffer::{
+    SortbufSummary, SortbufSweep, StateId, Strategy, sequence::sequence_from_spec,
+};
+use rendersim::config::{Overrides, load_model};
+use rendersim::output::text::fixed;
+use rendersim::scene::config::SceneWorkload;
+use rendersim::scene::states::state_sequence;
+
+use super::args::{LodSelectArgs, SortbufArgs};
+
+/// `--previous 0,1,-,2`: one entry per object, a level or `-` (not drawn).
+fn parse_previous(text: &str) -> Result<Vec<Option<u32>>> {
+    if text.trim().is_empty() {
+        return Ok(Vec::new());
+    }
+    text.split(',')
+        .enumerate()
+        .map(|(i, t)| {
+            let t = t.trim();
+            if t == "-" || t == "null" {
+                Ok(None)
+            } else {
+                t.parse::<u32>().map(Some).map_err(|_| {
+                    anyhow::anyhow!(
+                        "--previous: entry {} is {t:?}, expected a level index or - (not drawn)",
+                        i + 1
+                    )
+                })
+            }
+        })
+        .collect()
+}
+
+/// `rendersim lod-select`.
+pub fn lod_select(args: &LodSelectArgs) -> Result<()> {
+    let inst = read_instance(&args.instance)?;
+    let algorithm: Algorithm = args.algorithm.into();
+    let previous = match &args.previous {
+        Some(p) if algorithm != Algorithm::Incremental => {
+            bail!("--previous {p:?}: only --algorithm incremental starts from a previous selection")
+        }
+        Some(p) => Some(parse_previous(p)?),
+        None => None,
+    };
+    let sel = inst.select(algorithm, previous.as_deref())?;
+    let optimum = if algorithm == Algorithm::Optimal {
+        Some(sel.total_benefit)
+    } else if inst.objects().len() <= MAX_OPTIMAL_OBJECTS {
+        optimal(&inst).ok().map(|s| s.total_benefit)
+    } else {
+        None
+    };
+    let summary = SelectionSummary::new(&inst, algorithm, &sel, optimum);
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+        return Ok(());
+    }
+    println!(
+        "{} selection, budget {} ms: {} of {} objects drawn",
+        algorithm.name(),
+        fixed(summary.budget_ms, 3),
+        summary.drawn,
+        summary.objects
+    );
+    let width = inst.objects().iter().map(|o| o.name.len()).max().unwrap_or(6).max(6);
+    println!(
+        "{:<width$}  {:>5}  {:>10}  {:>10}",
+        "object", "level", "cost ms", "benefit"
+    );
+    for (o, l) in inst.objects().iter().zip(&summary.selection) {
+        match l {
+            Some(l) => {
+                let lv = &o.levels[*l as usize];
+                println!(
+                    "{:<width$}  {:>5}  {:>10}  {:>10}",
+                    o.name,
+                    l,
+                    fixed(lv.cost.as_ms_f64(), 4),
+                    fixed(lv.benefit, 4)
+                );
+            }
+            None => println!("{:<width$}  {:>5}  {:>10}  {:>10}", o.name, "-", "-", "-"),
+        }
+    }
+    println!(
+        "total: cost {} ms of {} ms, benefit {}",
+        fixed(summary.total_cost_ms, 4),
+        fixed(summary.budget_ms, 4),
+        fixed(summary.total_benefit, 4)
+    );
+    if let (Some(opt), Some(gap)) = (summary.optimal_benefit, summary.gap)
+        && algorithm != Algorithm::Optimal
+    {
+        println!("optimal benefit {} (gap {})", fixed(opt, 4), fixed(gap, 4));
+    }
+    for n in &summary.notes {
+        println!("note: {n}");
+    }
+    Ok(())
+}
+
+/// `scene:MODEL.toml[:state|shader|texture|material]`: the state ids of a
+/// model's scene in submission order (`scene::states`), numbered by first
+/// appearance; `state` (the default) is the whole (shader, texture,
+/// material) triple, the others one attribute.
+fn scene_sequence(spec: &str) -> Result<Vec<StateId>> {
+    let rest = &spec["scene:".len()..];
+    let (path, attr) = match rest.rsplit_once(':') {
+        Some((p, a)) if ["state", "shader", "texture", "material"].contains(&a) => (p, a),
+        _ => (rest, "state"),
+    };
+    let model = load_model(Some(Path::new(path)), &Overrides::default())?;
+    let Some(w) = model.table.get("workload").and_then(|v| v.as_table()) else {
+        bail!("{path}: the model has no [workload] table, so no scene to take states from");
+    };
+    if w.get("kind").and_then(|k| k.as_str()) != Some("scene") {
+        bail!("{path}: workload.kind is not \"scene\", so there is no scene to take states from");
+    }
+    let mut w = w.clone();
+    w.remove("kind");
+    let scene: SceneWorkload = toml::Value::Table(w)
+        .try_into()
+        .with_context(|| format!("{path}: reading [workload]"))?;
+    let states = state_sequence(&scene).map_err(|e| anyhow!("{path}: {e}"))?;
+    let mut ids: HashMap<(u64, u64, u64), StateId> = HashMap::new();
+    Ok(states
+        .into_iter()
+        .map(|(sh, tx, mt)| {
+            let key = match attr {
+                "shader" => (sh, 0, 0),
+                "texture" => (0, tx, 0),
+                "material" => (0, 0, mt),
+                _ => (sh, tx, mt),
+            };
+            let n = ids.len() as StateId;
+            *ids.entry(key).or_insert(n)
+        })
+        .collect())
+}
+
+/// `rendersim sortbuf`.
+pub fn sortbuf(args: &SortbufArgs) -> Result<()> {
+    let seq = if args.sequence.starts_with("scene:") {
+        scene_sequence(&args.sequence)?
+    } else {
+        sequence_from_spec(&args.sequence, Path::new("."))?
+    };
+    let strategies: Vec<Strategy> = args.strategy.iter().map(|&s| s.into()).collect();
+    if !args.sweep.is_empty() {
+        let strategies = if strategies.is_empty() {
+            Strategy::ALL.to_vec()
+        } else {
+            strategies
+        };
+        let sweep = SortbufSweep::run(&args.sequence, &seq, &args.sweep, &strategies, args.seed)?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&sweep)?);
+            return Ok(());
+        }
+        println!(
+            "{}: {} elements, {} distinct states, {} changes without a buffer",
+            sweep.sequence, sweep.sequence_length, sweep.distinct_states, sweep.input_runs
+        );
+        let mut head = format!("{:>8}  {:>11}", "buffer", "lower_bound");
+        for s in &strategies {
+            head.push_str(&format!("  {:>13}", s.name()));
+        }
+        println!("{head}");
+        for r in &sweep.rows {
+            let mut line = format!("{:>8}  {:>11}", r.buffer, r.lower_bound);
+            for s in &strategies {
+                line.push_str(&format!("  {:>13}", r.state_changes[s.name()]));
+            }
+            println!("{line}");
+        }
+        return Ok(());
+    }
+    let Some(k) = args.buffer else {
+        bail!("give --buffer K (or --sweep K,K,...)");
+    };
+    let strategy = match strategies.as_slice() {
+        [s] => *s,
+        [] => bail!("give --strategy lru|bounded-waste|random|round-robin"),
+        _ => bail!("--strategy: give one strategy (several only with --sweep)"),
+    };
+    let s = SortbufSummary::run(&args.sequence, &seq, k, strategy, args.seed)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&s)?);
+        return Ok(());
+    }
+    println!(
+        "{} with {} slots over {} ({} elements, {} distinct states): {} state changes; {} without a buffer; offline optimum >= {}{}",
+        strategy.name(),
+        k,
+        s.sequence,
+        s.sequence_length,
+        s.distinct_states,
+        s.state_changes,
+        s.input_runs,
+        s.lower_bound,
+        s.offline_optimum.map(|o| format!(" (exactly {o})")).unwrap_or_default()
+    );
+    Ok(())
+}

@@ -1,0 +1,118 @@
+//! Unit tests of the sorting buffer.
+
+use super::sequence::{lru_worst, parse_sequence};
+use super::*;
+
+fn changes(seq: &[StateId], k: usize, s: Strategy) -> u64 {
+    simulate(seq, k, s, 1, false).unwrap().state_changes
+}
+
+#[test]
+fn one_slot_reorders_nothing() {
+    let seq = [1, 1, 2, 1, 3, 3, 2];
+    for s in Strategy::ALL {
+        assert_eq!(changes(&seq, 1, s), input_runs(&seq), "{s:?}");
+    }
+    assert_eq!(input_runs(&seq), 5);
+}
+
+#[test]
+fn a_buffer_as_large_as_the_sequence_groups_everything() {
+    let seq = [1, 2, 3, 1, 2, 3, 1, 2, 3];
+    for s in Strategy::ALL {
+        assert_eq!(changes(&seq, seq.len() + 1, s), 3, "{s:?}");
+    }
+}
+
+#[test]
+fn lru_sends_the_oldest_state() {
+    // K = 3: [1 2 3] full -> LRU sends 1; [2 3 2] full (stamp 2 newest) -> sends 3;
+    // [2 2 1]...
+    let r = simulate(&[1, 2, 3, 2, 1], 3, Strategy::Lru, 0, true).unwrap();
+    assert_eq!(r.output.unwrap(), vec![(1, 1), (3, 1), (2, 2), (1, 1)]);
+}
+
+#[test]
+fn output_is_a_permutation_of_the_input() {
+    let seq: Vec<StateId> = (0..200u64).map(|i| (i * 7919) % 13).collect();
+    for s in Strategy::ALL {
+        for k in [1, 2, 5, 16] {
+            let r = simulate(&seq, k, s, 3, true).unwrap();
+            let out = r.output.unwrap();
+            let mut counts = std::collections::HashMap::new();
+            for (c, n) in &out {
+                *counts.entry(*c).or_insert(0u64) += n;
+            }
+            for c in &seq {
+                *counts.get_mut(c).unwrap() -= 1;
+            }
+            assert!(counts.values().all(|&v| v == 0));
+            assert_eq!(out.len() as u64, r.state_changes);
+            assert!(out.windows(2).all(|w| w[0].0 != w[1].0));
+        }
+    }
+}
+
+#[test]
+fn random_is_reproducible_per_seed() {
+    let seq: Vec<StateId> = (0..500u64).map(|i| (i * i + 3 * i) % 17).collect();
+    let a = simulate(&seq, 8, Strategy::Random, 5, true).unwrap();
+    let b = simulate(&seq, 8, Strategy::Random, 5, true).unwrap();
+    assert_eq!(a, b);
+    let others: Vec<_> = (6..12)
+        .map(|s| simulate(&seq, 8, Strategy::Random, s, true).unwrap())
+        .collect();
+    assert!(others.iter().any(|o| o.output != a.output));
+}
+
+#[test]
+fn buffer_sizes_are_checked() {
+    assert_eq!(
+        simulate(&[1], 0, Strategy::Lru, 0, false),
+        Err(SortBufferError::ZeroBuffer)
+    );
+    assert!(matches!(
+        simulate(&[1], MAX_BUFFER + 1, Strategy::Lru, 0, false),
+        Err(SortBufferError::BufferTooLarge { .. })
+    ));
+}
+
+#[test]
+fn lower_bound_examples() {
+    // a b a b, K = 1: D = 2, S max = 2 (after the second element) -> 3.
+    assert_eq!(lower_bound(&[1, 2, 1, 2], 1), 3);
+    assert_eq!(lower_bound(&[1, 2, 1, 2], 2), 2);
+    assert_eq!(offline_optimum(&[1, 2, 1, 2], 1).unwrap(), 4);
+    // K = 2: 1 is sent on the first overflow, the second 1 joins its run.
+    assert_eq!(offline_optimum(&[1, 2, 1, 2], 2).unwrap(), 2);
+    assert_eq!(offline_optimum(&[1, 2, 1, 2], 3).unwrap(), 2);
+}
+
+#[test]
+fn lru_worst_case_costs_m_times_m_plus_1() {
+    for m in [2u64, 3, 4, 6, 8] {
+        let seq = lru_worst(m).unwrap();
+        let k = (m * m + 1) as usize;
+        assert_eq!(lower_bound(&seq, k), 2 * m, "m={m}");
+        assert_eq!(changes(&seq, k, Strategy::Lru), m * (m + 1), "m={m}");
+    }
+}
+
+#[test]
+fn parsing() {
+    assert_eq!(
+        parse_sequence("1 2\n3\t4 # five\n\n 6", "f").unwrap(),
+        vec![1, 2, 3, 4, 6]
+    );
+    let e = parse_sequence("1 2\n3 x4 5\n", "seq.txt").unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "seq.txt:2:3: \"x4\" is not a state id (a non-negative integer)"
+    );
+    let e = parse_sequence("1 -2", "f").unwrap_err();
+    assert!(e.to_string().contains("f:1:3"), "{e}");
+    assert!(matches!(
+        parse_sequence("# nothing\n\n", "f"),
+        Err(SortBufferError::Empty { .. })
+    ));
+}
