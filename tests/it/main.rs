@@ -26,3 +26,4 @@ mod pipeline_oracles;
 mod pixelflow;
 mod unified;
 mod vr;
+mod walkthrough;

@@ -11,8 +11,11 @@
 //! here is a box standing on the ground (buildings, tree crowns, the
 //! terrain slab); instances of a prototype share its mesh statistics and
 //! shape, and differ in position, rotation about the vertical and state.
-//! Triangle counts per prototype are scaled so the scene's total matches
-//! Table 5 (to rounding, reported in the summary).
+//! Triangle counts and transformed vertices per triangle vary between
+//! prototypes and are scaled so the scene's totals match Table 5 (to
+//! rounding, reported in the summary). Transformed vertices are statistics
+//! (what a vertex cache achieved on the paper's meshes), not simulated
+//! index buffers.
 
 use rand::Rng;
 
@@ -333,12 +336,26 @@ fn listed(o: &ObjectConfig, i: usize) -> Result<(Prototype, Object), SystemError
 }
 
 /// Scales the prototypes' finest triangle counts so that the instances add
-/// up to `target` (to rounding), then builds their chains.
-fn scale_to_total(raw: &[f64], counts: &[u64], target: f64, acmr: f64, cfg: &SceneConfig) -> Vec<Vec<Level>> {
+/// up to `target` triangles, and their transformed vertices per triangle
+/// (`acmr`, each prototype's own: vertex-cache efficiency differs between
+/// meshes) so that they add up to `target_tv` (both to rounding), then
+/// builds their chains.
+fn scale_to_total(
+    raw: &[f64],
+    acmr: &[f64],
+    counts: &[u64],
+    target: f64,
+    target_tv: f64,
+    cfg: &SceneConfig,
+) -> Vec<Vec<Level>> {
     let total: f64 = raw.iter().zip(counts).map(|(t, c)| t * *c as f64).sum();
     let k = if total > 0.0 { target / total } else { 1.0 };
-    raw.iter()
-        .map(|t| chain((t * k).round().max(1.0) as u64, acmr, cfg.lod_levels, cfg.lod_ratio))
+    let tris: Vec<u64> = raw.iter().map(|t| (t * k).round().max(1.0) as u64).collect();
+    let tv: f64 = tris.iter().zip(acmr).zip(counts).map(|((t, a), c)| *t as f64 * a * *c as f64).sum();
+    let ka = if tv > 0.0 { target_tv / tv } else { 1.0 };
+    tris.iter()
+        .zip(acmr)
+        .map(|(t, a)| chain(*t, (a * ka).clamp(0.0, 3.0), cfg.lod_levels, cfg.lod_ratio))
         .collect()
 }
 
@@ -353,7 +370,9 @@ fn city(cfg: &SceneConfig, n: u64, streams: &RngStreams) -> Scene {
     let mut rng = streams.stream("scene.city.prototypes");
     let mut sizes = Vec::new();
     let mut raw = Vec::new();
+    let mut acmr = Vec::new();
     for _ in 0..PROTOS {
+        acmr.push(rng.random_range(0.6..1.4));
         let w = rng.random_range(16.0..26.0);
         let d = rng.random_range(16.0..26.0);
         let h = 8.0 * (rng.random_range(0.0f64..1.0) * (40.0f64 / 8.0).ln()).exp();
@@ -382,7 +401,7 @@ fn city(cfg: &SceneConfig, n: u64, streams: &RngStreams) -> Scene {
             block: b,
         });
     }
-    let chains = scale_to_total(&raw, &counts, 3_453_465.0 * cfg.scale, 1.86, cfg);
+    let chains = scale_to_total(&raw, &acmr, &counts, 3_453_465.0 * cfg.scale, 6_419_303.0 * cfg.scale, cfg);
     let protos: Vec<Prototype> = chains
         .into_iter()
         .enumerate()
@@ -414,7 +433,9 @@ fn forest(cfg: &SceneConfig, n: u64, streams: &RngStreams) -> Scene {
     let mut rng = streams.stream("scene.forest.prototypes");
     let mut sizes = Vec::new();
     let mut raw = Vec::new();
+    let mut acmr = Vec::new();
     for _ in 0..PROTOS {
+        acmr.push(rng.random_range(0.6..1.4));
         let w = rng.random_range(4.0..10.0);
         let h = rng.random_range(8.0..20.0);
         sizes.push([w, w * rng.random_range(0.8..1.2), h]);
@@ -446,7 +467,7 @@ fn forest(cfg: &SceneConfig, n: u64, streams: &RngStreams) -> Scene {
             block: u32::MAX,
         });
     }
-    let chains = scale_to_total(&raw, &counts, 579_644.0 * cfg.scale, 1.78, cfg);
+    let chains = scale_to_total(&raw, &acmr, &counts, 579_644.0 * cfg.scale, 1_028_978.0 * cfg.scale, cfg);
     let protos: Vec<Prototype> = chains
         .into_iter()
         .enumerate()
