@@ -48,7 +48,10 @@ fn resolve(cfg: &CameraConfig, scene: &Scene) -> Result<(&'static str, f64), Sys
         }
     };
     if kind == "street" && !matches!(scene.layout, Layout::City { .. }) {
-        return Err(invalid("camera.path", "a \"street\" walk needs the city preset's streets"));
+        return Err(invalid(
+            "camera.path",
+            "a \"street\" walk needs the city preset's streets",
+        ));
     }
     if kind == "forest" && !matches!(scene.layout, Layout::Forest { .. }) {
         return Err(invalid("camera.path", "a \"forest\" path needs the forest preset"));
@@ -87,7 +90,10 @@ pub fn resolved_kind(cfg: &CameraConfig, scene: &Scene) -> Result<&'static str, 
 /// Checks the camera keys (view and path) against the scene.
 pub fn validate(cfg: &CameraConfig, scene: &Scene) -> Result<(), SystemError> {
     if !(cfg.fov.is_finite() && cfg.fov >= 1.0 && cfg.fov <= 170.0) {
-        return Err(invalid("camera.fov", format!("must be between 1 and 170 degrees, got {}", cfg.fov)));
+        return Err(invalid(
+            "camera.fov",
+            format!("must be between 1 and 170 degrees, got {}", cfg.fov),
+        ));
     }
     for (key, v) in [("camera.width", cfg.width), ("camera.height", cfg.height)] {
         if !(1..=16384).contains(&v) {
@@ -126,7 +132,9 @@ pub fn path(cfg: &CameraConfig, scene: &Scene, frames: u64, dt: f64, seed: u64) 
     let step = speed * dt;
     let mut rng = RngStreams::new(seed).stream("camera.path");
     Ok(match (kind, scene.layout) {
-        ("street", Layout::City { blocks, block, street }) => street_walk(frames, step, dt, blocks, block + street, street, &mut rng),
+        ("street", Layout::City { blocks, block, street }) => {
+            street_walk(frames, step, dt, blocks, block + street, street, &mut rng)
+        }
         ("forest", Layout::Forest { side }) => forest_walk(frames, step, side, &mut rng),
         ("flight", Layout::Terrain { side }) => (0..frames)
             .map(|f| {
@@ -221,7 +229,8 @@ fn forest_walk(frames: u64, step: f64, side: f64, rng: &mut crate::engine::Strea
         rate = 0.98 * rate + rng.random_range(-0.002..0.002);
         if ((x - c).powi(2) + (y - c).powi(2)).sqrt() > 0.4 * side {
             let to_centre = (c - y).atan2(c - x);
-            let diff = (to_centre - heading + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+            let diff =
+                (to_centre - heading + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
             rate = 0.02 * diff.signum();
         }
         heading += rate;
@@ -243,7 +252,10 @@ fn keyframe_path(cfg: &CameraConfig, frames: u64, step: f64) -> Vec<Pose> {
     };
     let mut lengths = Vec::with_capacity(k.len());
     for w in k.windows(2) {
-        let d: f64 = (0..3).map(|a| (w[1].position[a] - w[0].position[a]).powi(2)).sum::<f64>().sqrt();
+        let d: f64 = (0..3)
+            .map(|a| (w[1].position[a] - w[0].position[a]).powi(2))
+            .sum::<f64>()
+            .sqrt();
         lengths.push(d);
     }
     let total: f64 = lengths.iter().sum();
@@ -259,7 +271,11 @@ fn keyframe_path(cfg: &CameraConfig, frames: u64, step: f64) -> Vec<Pose> {
                     let (a, b) = (pose(i), pose(i + 1));
                     let lerp = |p: f64, q: f64| p + t * (q - p);
                     return Pose {
-                        eye: [lerp(a.eye[0], b.eye[0]), lerp(a.eye[1], b.eye[1]), lerp(a.eye[2], b.eye[2])],
+                        eye: [
+                            lerp(a.eye[0], b.eye[0]),
+                            lerp(a.eye[1], b.eye[1]),
+                            lerp(a.eye[2], b.eye[2]),
+                        ],
                         yaw: lerp(a.yaw, b.yaw),
                         pitch: lerp(a.pitch, b.pitch),
                     };

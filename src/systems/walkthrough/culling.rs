@@ -127,7 +127,10 @@ pub fn disk_in_rect(cx: f64, cy: f64, r: f64, w: f64, h: f64) -> f64 {
         return std::f64::consts::PI * r * r;
     }
     let corners = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)];
-    if corners.iter().all(|(x, y)| (x - cx).powi(2) + (y - cy).powi(2) <= r * r) {
+    if corners
+        .iter()
+        .all(|(x, y)| (x - cx).powi(2) + (y - cy).powi(2) <= r * r)
+    {
         return w * h;
     }
     let (x0, x1) = ((cx - r).max(0.0), (cx + r).min(w));
@@ -220,7 +223,15 @@ pub fn project(view: &View, o: &Object, proto: &Prototype) -> Projection {
 /// direction (`gamma`, `phi`), its disk centred (the preprocess's sample
 /// views: the eye at distance R / sin(α/2) on that direction, looking at
 /// the centre; a disk larger than the viewport is clipped).
-pub fn sample_projection(proto: &Prototype, alpha: f64, gamma: f64, phi: f64, focal: f64, w: f64, h: f64) -> Projection {
+pub fn sample_projection(
+    proto: &Prototype,
+    alpha: f64,
+    gamma: f64,
+    phi: f64,
+    focal: f64,
+    w: f64,
+    h: f64,
+) -> Projection {
     let r = focal * (0.5 * alpha).tan();
     let disk = disk_in_rect(0.5 * w, 0.5 * h, r, w, h);
     let vo = direction(gamma, phi);
@@ -301,7 +312,9 @@ fn compute(scene: &Scene, cell: f64, key: (i64, i64), far: f64) -> Vec<u32> {
             (bx + block - 1.0, by + block - 1.0),
             (bx + 0.5 * block, by + 0.5 * block),
         ];
-        let near_edge = ((mid.0 - (bx + 0.5 * block)).abs() - 0.5 * block).max(0.0).hypot(((mid.1 - (by + 0.5 * block)).abs() - 0.5 * block).max(0.0));
+        let near_edge = ((mid.0 - (bx + 0.5 * block)).abs() - 0.5 * block)
+            .max(0.0)
+            .hypot(((mid.1 - (by + 0.5 * block)).abs() - 0.5 * block).max(0.0));
         if near_edge > reach {
             continue;
         }

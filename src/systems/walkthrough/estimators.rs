@@ -101,7 +101,9 @@ fn solve(x: &[Vec<f64>], y: &[f64], active: &[usize]) -> Vec<f64> {
         a[r][k] = x[i].iter().zip(y).map(|(p, q)| p * q).sum();
     }
     for col in 0..k {
-        let piv = (col..k).max_by(|&p, &q| a[p][col].abs().total_cmp(&a[q][col].abs())).unwrap_or(col);
+        let piv = (col..k)
+            .max_by(|&p, &q| a[p][col].abs().total_cmp(&a[q][col].abs()))
+            .unwrap_or(col);
         a.swap(col, piv);
         let d = a[col][col];
         if d.abs() <= 1e-300 {
@@ -137,7 +139,11 @@ pub fn fit(samples: &[(Features, f64)]) -> Constants {
     let h4 = nonnegative_least_squares(&[tv.clone(), pix.clone()], &y);
     // h3 by alternation.
     let g0 = nonnegative_least_squares(&[tris.clone(), verts.clone()], &y);
-    let mut c = [g0[0], g0[1], nonnegative_least_squares(std::slice::from_ref(&pix), &y)[0]];
+    let mut c = [
+        g0[0],
+        g0[1],
+        nonnegative_least_squares(std::slice::from_ref(&pix), &y)[0],
+    ];
     let mut assign: Vec<bool> = Vec::new();
     for _ in 0..50 {
         let next: Vec<bool> = (0..y.len())
@@ -147,7 +153,13 @@ pub fn fit(samples: &[(Features, f64)]) -> Constants {
             break;
         }
         assign = next;
-        let pick = |v: &[f64], geo: bool| -> Vec<f64> { v.iter().zip(&assign).filter(|(_, a)| **a == geo).map(|(x, _)| *x).collect() };
+        let pick = |v: &[f64], geo: bool| -> Vec<f64> {
+            v.iter()
+                .zip(&assign)
+                .filter(|(_, a)| **a == geo)
+                .map(|(x, _)| *x)
+                .collect()
+        };
         if assign.iter().any(|a| *a) {
             let g = nonnegative_least_squares(&[pick(&tris, true), pick(&verts, true)], &pick(&y, true));
             c[0] = g[0];

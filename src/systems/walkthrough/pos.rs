@@ -32,7 +32,9 @@ pub fn alphas(cfg: &PosConfig, focal: f64, w: f64, h: f64) -> Vec<f64> {
     let lo = alpha_of_disk(std::f64::consts::PI * 0.25, focal).ln();
     let hi = alpha_of_disk(w * h, focal).ln();
     let n = cfg.alpha_steps.max(2) as usize;
-    (0..n).map(|i| (lo + (hi - lo) * i as f64 / (n - 1) as f64).exp()).collect()
+    (0..n)
+        .map(|i| (lo + (hi - lo) * i as f64 / (n - 1) as f64).exp())
+        .collect()
 }
 
 fn phis(cfg: &PosConfig) -> Vec<f64> {
@@ -86,7 +88,9 @@ pub fn build(
                 grid.push(sample(a[i], gamma, phi, &mut renders)?);
             }
         }
-        let (lo, hi) = grid.iter().fold((f64::INFINITY, 0.0f64), |(l, u), v| (l.min(*v), u.max(*v)));
+        let (lo, hi) = grid
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(l, u), v| (l.min(*v), u.max(*v)));
         if hi <= 0.0 || (hi - lo) / hi < cfg.prune_tolerance {
             pruned = true;
         }

@@ -127,7 +127,9 @@ impl Renderer {
                     geometry_time: Duration::ZERO,
                     geometry_shader: Duration::ZERO,
                 };
-                levels.push(timed_mesh(&template, info, &format!("scene ({} level {l})", p.name)).map_err(workload_error)?);
+                levels.push(
+                    timed_mesh(&template, info, &format!("scene ({} level {l})", p.name)).map_err(workload_error)?,
+                );
             }
             meshes.push(levels);
         }

@@ -48,7 +48,10 @@ pub fn write_report(s: &Value, w: &mut dyn Write) -> io::Result<()> {
         fixed(f(&e["empty_frame_ms"]), 3),
         e["fit_samples"]
     )?;
-    writeln!(w, "  estimator   mse (ms^2)   mean error (ms)   underestimated   cost (us/frame)")?;
+    writeln!(
+        w,
+        "  estimator   mse (ms^2)   mean error (ms)   underestimated   cost (us/frame)"
+    )?;
     for name in super::estimators::ESTIMATORS {
         let x = &e[name];
         if x.is_null() {

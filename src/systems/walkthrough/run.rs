@@ -52,7 +52,10 @@ pub struct WalkthroughRun {
 /// Checks the keys serde cannot.
 pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
     if cfg.system != "walkthrough" {
-        return Err(invalid("system", format!("expected \"walkthrough\", got {:?}", cfg.system)));
+        return Err(invalid(
+            "system",
+            format!("expected \"walkthrough\", got {:?}", cfg.system),
+        ));
     }
     match cfg.lod.policy.as_str() {
         "none" => {}
@@ -77,7 +80,10 @@ pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
             ));
         }
         if cfg.estimation.estimators[..i].contains(e) {
-            return Err(invalid(&format!("estimation.estimators.{i}"), format!("{e:?} is listed twice")));
+            return Err(invalid(
+                &format!("estimation.estimators.{i}"),
+                format!("{e:?} is listed twice"),
+            ));
         }
     }
     if cfg.run.frames > MAX_FRAMES {
@@ -115,10 +121,18 @@ pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
             return Err(invalid(key, format!("must be between {lo} and 256, got {v}")));
         }
     }
-    if !(p.phi_min.is_finite() && p.phi_max.is_finite() && -90.0 <= p.phi_min && p.phi_min <= p.phi_max && p.phi_max <= 90.0) {
+    if !(p.phi_min.is_finite()
+        && p.phi_max.is_finite()
+        && -90.0 <= p.phi_min
+        && p.phi_min <= p.phi_max
+        && p.phi_max <= 90.0)
+    {
         return Err(invalid(
             "estimation.pos.phi_min|estimation.pos.phi_max",
-            format!("need -90 <= phi_min <= phi_max <= 90 degrees, got {} and {}", p.phi_min, p.phi_max),
+            format!(
+                "need -90 <= phi_min <= phi_max <= 90 degrees, got {} and {}",
+                p.phi_min, p.phi_max
+            ),
         ));
     }
     if !(p.prune_tolerance.is_finite() && (0.0..=1.0).contains(&p.prune_tolerance)) {
@@ -396,7 +410,11 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
             if !used[i] {
                 continue;
             }
-            let state = scene.objects.iter().find(|o| o.proto as usize == i).map_or((0, 0, 0), |o| o.state);
+            let state = scene
+                .objects
+                .iter()
+                .find(|o| o.proto as usize == i)
+                .map_or((0, 0, 0), |o| o.state);
             let (table, r) = build_table(&cfg.estimation.pos, proto, 0, (focal, w, h), |_, covered| {
                 let d = Draw {
                     proto: i as u32,
@@ -415,7 +433,11 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
             tables: n,
             renders,
             full_renders: full,
-            pruned_fraction: if full > 0 { 1.0 - renders as f64 / full as f64 } else { 0.0 },
+            pruned_fraction: if full > 0 {
+                1.0 - renders as f64 / full as f64
+            } else {
+                0.0
+            },
         });
     }
     let build_seconds = t0.elapsed().as_secs_f64();
@@ -579,7 +601,11 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
             frames_inside_an_object: inside_frames,
             estimation: EstimationSummary {
                 empty_frame_ms: ms(empty),
-                fit_samples: if constants.is_some() { cfg.estimation.fit_samples } else { 0 },
+                fit_samples: if constants.is_some() {
+                    cfg.estimation.fit_samples
+                } else {
+                    0
+                },
                 constants,
                 pos_tables,
                 h1: score(0),

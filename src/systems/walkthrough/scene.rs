@@ -183,7 +183,10 @@ fn chain(triangles: u64, acmr: f64, levels: u32, ratio: f64) -> Vec<Level> {
 /// Checks the scene keys and builds the scene.
 pub fn build_scene(cfg: &SceneConfig, seed: u64) -> Result<Scene, SystemError> {
     if !(cfg.scale.is_finite() && cfg.scale > 0.0 && cfg.scale <= 100.0) {
-        return Err(invalid("scene.scale", format!("must be > 0 and at most 100, got {}", cfg.scale)));
+        return Err(invalid(
+            "scene.scale",
+            format!("must be > 0 and at most 100, got {}", cfg.scale),
+        ));
     }
     if !(1..=16).contains(&cfg.lod_levels) {
         return Err(invalid(
@@ -241,7 +244,10 @@ pub fn build_scene(cfg: &SceneConfig, seed: u64) -> Result<Scene, SystemError> {
             if objects > MAX_OBJECTS {
                 return Err(invalid(
                     "scene.scale",
-                    format!("preset {p:?} at scale {} has {objects} objects, more than the limit of {MAX_OBJECTS}", cfg.scale),
+                    format!(
+                        "preset {p:?} at scale {} has {objects} objects, more than the limit of {MAX_OBJECTS}",
+                        cfg.scale
+                    ),
                 ));
             }
             match p {
@@ -291,18 +297,28 @@ fn listed(o: &ObjectConfig, i: usize) -> Result<(Prototype, Object), SystemError
         if lc.triangles == 0 || lc.triangles > crate::limits::MAX_MESH_INDICES / 3 {
             return Err(invalid(
                 &format!("{lk}.triangles"),
-                format!("must be between 1 and {}, got {}", crate::limits::MAX_MESH_INDICES / 3, lc.triangles),
+                format!(
+                    "must be between 1 and {}, got {}",
+                    crate::limits::MAX_MESH_INDICES / 3,
+                    lc.triangles
+                ),
             ));
         }
         if !(lc.acmr.is_finite() && (0.0..=3.0).contains(&lc.acmr)) {
-            return Err(invalid(&format!("{lk}.acmr"), format!("must be between 0 and 3, got {}", lc.acmr)));
+            return Err(invalid(
+                &format!("{lk}.acmr"),
+                format!("must be between 0 and 3, got {}", lc.acmr),
+            ));
         }
         if let Some(prev) = levels.last().map(|p: &Level| p.triangles)
             && lc.triangles >= prev
         {
             return Err(invalid(
                 &format!("{lk}.triangles"),
-                format!("levels must get coarser: {} triangles is not fewer than the level before ({prev})", lc.triangles),
+                format!(
+                    "levels must get coarser: {} triangles is not fewer than the level before ({prev})",
+                    lc.triangles
+                ),
             ));
         }
         levels.push(Level {
@@ -312,10 +328,16 @@ fn listed(o: &ObjectConfig, i: usize) -> Result<(Prototype, Object), SystemError
         });
     }
     if !(o.overdraw.is_finite() && o.overdraw > 0.0 && o.overdraw <= 1000.0) {
-        return Err(invalid(&format!("{key}.overdraw"), format!("must be > 0 and at most 1000, got {}", o.overdraw)));
+        return Err(invalid(
+            &format!("{key}.overdraw"),
+            format!("must be > 0 and at most 1000, got {}", o.overdraw),
+        ));
     }
     if !(o.size_sigma.is_finite() && (0.0..=5.0).contains(&o.size_sigma)) {
-        return Err(invalid(&format!("{key}.size_sigma"), format!("must be between 0 and 5, got {}", o.size_sigma)));
+        return Err(invalid(
+            &format!("{key}.size_sigma"),
+            format!("must be between 0 and 5, got {}", o.size_sigma),
+        ));
     }
     let proto = Prototype {
         name: o.name.clone(),
@@ -351,7 +373,12 @@ fn scale_to_total(
     let total: f64 = raw.iter().zip(counts).map(|(t, c)| t * *c as f64).sum();
     let k = if total > 0.0 { target / total } else { 1.0 };
     let tris: Vec<u64> = raw.iter().map(|t| (t * k).round().max(1.0) as u64).collect();
-    let tv: f64 = tris.iter().zip(acmr).zip(counts).map(|((t, a), c)| *t as f64 * a * *c as f64).sum();
+    let tv: f64 = tris
+        .iter()
+        .zip(acmr)
+        .zip(counts)
+        .map(|((t, a), c)| *t as f64 * a * *c as f64)
+        .sum();
     let ka = if tv > 0.0 { target_tv / tv } else { 1.0 };
     tris.iter()
         .zip(acmr)
@@ -401,7 +428,14 @@ fn city(cfg: &SceneConfig, n: u64, streams: &RngStreams) -> Scene {
             block: b,
         });
     }
-    let chains = scale_to_total(&raw, &acmr, &counts, 3_453_465.0 * cfg.scale, 6_419_303.0 * cfg.scale, cfg);
+    let chains = scale_to_total(
+        &raw,
+        &acmr,
+        &counts,
+        3_453_465.0 * cfg.scale,
+        6_419_303.0 * cfg.scale,
+        cfg,
+    );
     let protos: Vec<Prototype> = chains
         .into_iter()
         .enumerate()
@@ -467,7 +501,14 @@ fn forest(cfg: &SceneConfig, n: u64, streams: &RngStreams) -> Scene {
             block: u32::MAX,
         });
     }
-    let chains = scale_to_total(&raw, &acmr, &counts, 579_644.0 * cfg.scale, 1_028_978.0 * cfg.scale, cfg);
+    let chains = scale_to_total(
+        &raw,
+        &acmr,
+        &counts,
+        579_644.0 * cfg.scale,
+        1_028_978.0 * cfg.scale,
+        cfg,
+    );
     let protos: Vec<Prototype> = chains
         .into_iter()
         .enumerate()
