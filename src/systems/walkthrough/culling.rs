@@ -9,9 +9,9 @@
 //!   viewport, what an estimator can compute cheaply (the heuristics'
 //!   #pix);
 //! - `covered_pixels`, the simulator's truth: the box's share of its
-//!   sphere's disk seen from that direction, κ(γ, φ) = (|v_x| d h + |v_y| w h
-//!   + max(v_z, 0) w d) / (π R²) (the parallel projection of a box, bottom
-//!   hidden by the ground), times the clipped disk, times the object's own
+//!   sphere's disk seen from that direction, κ(γ, φ) = (|v_x| d h +
+//!   |v_y| w h + max(v_z, 0) w d) / (π R²) (the parallel projection of a
+//!   box, bottom hidden by the ground), times the clipped disk, times the object's own
 //!   overdraw. The ratio depends on the object and the direction: what
 //!   per-object sampling captures and a single constant per pixel cannot.
 //!

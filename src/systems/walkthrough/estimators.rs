@@ -109,12 +109,13 @@ fn solve(x: &[Vec<f64>], y: &[f64], active: &[usize]) -> Vec<f64> {
         if d.abs() <= 1e-300 {
             continue;
         }
-        for r in 0..k {
+        let pivot_row = a[col].clone();
+        for (r, row) in a.iter_mut().enumerate() {
             if r != col {
-                let f = a[r][col] / d;
+                let f = row[col] / d;
                 if f != 0.0 {
-                    for c in col..=k {
-                        a[r][c] -= f * a[col][c];
+                    for (x, p) in row.iter_mut().zip(&pivot_row).skip(col) {
+                        *x -= f * p;
                     }
                 }
             }
