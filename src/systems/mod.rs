@@ -10,6 +10,7 @@ pub mod pixelflow;
 pub mod summary;
 pub mod tracked_input;
 pub mod vr;
+pub mod walkthrough;
 
 use std::io::Write;
 
@@ -171,6 +172,7 @@ pub const SYSTEMS: &[&dyn System] = &[
     &multi_rate::system::MultiRateSystem,
     &vr::system::VrSystem,
     &pixelflow::system::PixelFlowSystem,
+    &walkthrough::system::WalkthroughSystem,
 ];
 
 /// A resolved model's TOML with the header every system writes.

@@ -30,3 +30,4 @@ mod sortbuf;
 mod timeline;
 mod unified;
 mod vr;
+mod walkthrough;

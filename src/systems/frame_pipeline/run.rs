@@ -725,3 +725,27 @@ fn summarize(
         scene,
     }
 }
+
+/// Runs a program built by the caller ([`super::workload::build_program`])
+/// for `cfg.run.frames` frames, without validating, summarizing or
+/// tracing: the kernel statistics and the per-frame records. For systems
+/// that draw their own frames through the pipeline (the walkthrough draws
+/// each frame's visible objects as a one-frame run); `cfg` must have been
+/// checked with [`validate`] and its workload must be a scene.
+pub fn simulate_program(
+    cfg: FramePipelineConfig,
+    program: SceneProgram,
+) -> Result<(RunStats, Vec<FrameRecord>), SystemError> {
+    let mut model = FramePipeline::new(cfg, Some(program), None)?;
+    let mut sched = Scheduler::new();
+    model.start(&mut sched)?;
+    let stats = run(&mut model, &mut sched, Limits::default())?;
+    if !model.done() {
+        return Err(SystemError::Unfinished {
+            at: stats.end_time,
+            missing: "every frame was done".into(),
+            state: model.describe(),
+        });
+    }
+    Ok((stats, std::mem::take(&mut model.records)))
+}

@@ -172,12 +172,17 @@ pub struct SceneProgram {
 /// One object instance before ordering: its group, mesh, state ids
 /// (shader, texture, material), own matrix, and upload bytes per frame.
 #[derive(Debug, Clone, Copy)]
-struct Instance {
-    group: u32,
-    mesh: u32,
-    state: (u64, u64, u64),
-    matrix: bool,
-    upload: u64,
+pub struct Instance {
+    /// Index into the program's groups.
+    pub group: u32,
+    /// Index into the program's meshes.
+    pub mesh: u32,
+    /// Shader, texture and material ids.
+    pub state: (u64, u64, u64),
+    /// Whether the instance sets its own matrix.
+    pub matrix: bool,
+    /// Upload bytes per frame.
+    pub upload: u64,
 }
 
 /// Probability that a fragment is shaded (passes early-z) given the depth
@@ -307,9 +312,7 @@ pub fn compile_scene(
     groups_cfg.extend(scene.groups.iter().cloned());
 
     let pass = early_z_pass(scene.depth_order, scene.depth_complexity);
-    let frag = &cfg.gpu.fragment;
-    let shade_per_pixel = pass * frag.per_fragment.0 as f64;
-    let fixed_per_pixel = pass * frag.fixed_per_fragment.0 as f64 + (1.0 - pass) * frag.per_rejected_fragment.0 as f64;
+    let (shade_per_pixel, fixed_per_pixel) = fragment_costs(cfg, pass);
     let geo = &cfg.gpu.geometry;
     let need_per_triangle = cfg.fidelity == Fidelity::Triangle;
 
@@ -342,17 +345,7 @@ pub fn compile_scene(
             Some(&id) => id,
             None => {
                 let info = build_mesh(&g.mesh, g.indexed, &geo.vertex_cache, need_per_triangle, base_dir, &key)?;
-                let geometry_shader = mul(geo.vertex_shader, info.transformed, &key)?;
-                let geometry_time = add(
-                    add(mul(geo.index_fetch, info.indices, &key)?, geometry_shader, &key)?,
-                    mul(geo.triangle_setup, info.triangles, &key)?,
-                    &key,
-                )?;
-                meshes.push(MeshInfo {
-                    geometry_time,
-                    geometry_shader,
-                    ..info
-                });
+                meshes.push(timed_mesh(cfg, info, &key)?);
                 let id = (meshes.len() - 1) as u32;
                 mesh_ids.insert(mesh_key, id);
                 id
@@ -395,6 +388,50 @@ pub fn compile_scene(
         objects.sort_by_key(|o| o.state);
     }
 
+    build_program(cfg, meshes, groups, &objects, pass)
+}
+
+/// The fragment costs per covered pixel for an early-z pass probability
+/// `pass`: (shader work, fixed-function time), picoseconds (see
+/// [`GroupInfo`]).
+pub fn fragment_costs(cfg: &FramePipelineConfig, pass: f64) -> (f64, f64) {
+    let frag = &cfg.gpu.fragment;
+    let shade_per_pixel = pass * frag.per_fragment.0 as f64;
+    let fixed_per_pixel = pass * frag.fixed_per_fragment.0 as f64 + (1.0 - pass) * frag.per_rejected_fragment.0 as f64;
+    (shade_per_pixel, fixed_per_pixel)
+}
+
+/// `info` with its geometry-stage times from the model's costs (index
+/// fetch, vertex shader per transformed vertex, triangle setup); `key`
+/// names the mesh in errors.
+pub fn timed_mesh(cfg: &FramePipelineConfig, info: MeshInfo, key: &str) -> Result<MeshInfo, WorkloadError> {
+    let geo = &cfg.gpu.geometry;
+    let geometry_shader = mul(geo.vertex_shader, info.transformed, key)?;
+    let geometry_time = add(
+        add(mul(geo.index_fetch, info.indices, key)?, geometry_shader, key)?,
+        mul(geo.triangle_setup, info.triangles, key)?,
+        key,
+    )?;
+    Ok(MeshInfo {
+        geometry_time,
+        geometry_shader,
+        ..info
+    })
+}
+
+/// The draws of `objects` in the order given, with their CPU and GPU
+/// front-end costs (state changes against the previous draw, uploads, the
+/// draw command) and, at `draw` fidelity, their closed-form times; `pass` is
+/// the early-z pass probability reported in the statistics. Used by
+/// [`compile_scene`] and by systems that build a frame's objects themselves
+/// (the walkthrough).
+pub fn build_program(
+    cfg: &FramePipelineConfig,
+    meshes: Vec<MeshInfo>,
+    groups: Vec<GroupInfo>,
+    objects: &[Instance],
+    pass: f64,
+) -> Result<SceneProgram, WorkloadError> {
     let cpu = &cfg.cpu;
     let gpu = &cfg.gpu;
     let bytes = &cfg.command_fifo.bytes;
@@ -406,7 +443,7 @@ pub fn compile_scene(
     let mut prev: Option<(u64, u64, u64)> = None;
     // Closed forms per (mesh, group): computed once, only at `draw` fidelity.
     let mut closed_cache: HashMap<(u32, u32), DrawTimes> = HashMap::new();
-    for o in &objects {
+    for o in objects {
         let Instance {
             group,
             mesh,

@@ -1,0 +1,309 @@
+//! The walkthrough's model file: the frame pipeline's hardware sections
+//! (`[cpu]`, `[bus]`, `[command_fifo]`, `[gpu]`, `[display]`, `[noise]`,
+//! the same structs and keys), plus the scene, the camera path, the
+//! estimators and the level-of-detail policy (paper 000 §5-7). Lengths are
+//! metres, angles degrees, speeds metres per second.
+
+use serde::{Deserialize, Serialize};
+
+use crate::config::Bytes;
+use crate::scene::config::DepthOrder;
+use crate::systems::frame_pipeline::config::{
+    BusConfig, CommandFifoConfig, CpuConfig, DisplayConfig, Fidelity, GpuConfig, NoiseConfig,
+};
+
+/// The whole model.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WalkthroughConfig {
+    /// Always `"walkthrough"`.
+    pub system: String,
+    /// A one-line description.
+    #[serde(default)]
+    pub description: String,
+    /// How each frame is drawn by the frame pipeline: `"draw"` (default,
+    /// one closed form per draw call) or `"triangle"`.
+    #[serde(default = "draw_fidelity")]
+    pub fidelity: Fidelity,
+    /// Frames and seed.
+    #[serde(default)]
+    pub run: WalkRun,
+    /// The application/driver thread (frame pipeline keys).
+    #[serde(default)]
+    pub cpu: CpuConfig,
+    /// The bus (frame pipeline keys).
+    #[serde(default)]
+    pub bus: BusConfig,
+    /// The command buffer (frame pipeline keys).
+    #[serde(default)]
+    pub command_fifo: CommandFifoConfig,
+    /// The GPU (frame pipeline keys; unified shader pool by default).
+    #[serde(default)]
+    pub gpu: GpuConfig,
+    /// The display; its refresh is the frame budget.
+    #[serde(default)]
+    pub display: DisplayConfig,
+    /// System tasks (frame pipeline keys).
+    #[serde(default)]
+    pub noise: NoiseConfig,
+    /// The scene.
+    #[serde(default)]
+    pub scene: SceneConfig,
+    /// The camera path and view.
+    #[serde(default)]
+    pub camera: CameraConfig,
+    /// The estimators and their preprocess.
+    #[serde(default)]
+    pub estimation: EstimationConfig,
+    /// Level-of-detail selection.
+    #[serde(default)]
+    pub lod: LodConfig,
+}
+
+fn draw_fidelity() -> Fidelity {
+    Fidelity::Draw
+}
+
+/// Run length.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WalkRun {
+    /// Frames along the camera path (one per display refresh).
+    pub frames: u64,
+    /// Master seed of all RNG streams.
+    pub seed: u64,
+    /// Most memory the run may need (default 8 GiB).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_memory: Option<Bytes>,
+}
+
+impl Default for WalkRun {
+    fn default() -> Self {
+        WalkRun {
+            frames: 1000,
+            seed: 1,
+            max_memory: None,
+        }
+    }
+}
+
+/// The scene: a preset after paper 000 Table 5 and/or listed objects.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SceneConfig {
+    /// `"city"`, `"forest"` or `"terrain"` (paper 000 Table 5), or none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
+    /// Fraction of the preset's objects and triangles (1.0 = the paper's).
+    pub scale: f64,
+    /// Levels of detail of each preset object (1 = a single level).
+    pub lod_levels: u32,
+    /// Triangles of each level relative to the one before (0 < r < 1).
+    pub lod_ratio: f64,
+    /// Surfaces per pixel behind each object's own coverage, for the
+    /// early-z pass probability (as the frame pipeline's `workload`).
+    pub depth_complexity: f64,
+    /// Drawing order relative to depth (early-z).
+    pub depth_order: DepthOrder,
+    /// View-cell size of a listed-object scene (metres; 0 = no view cells;
+    /// presets set their own: the city 10 m).
+    pub view_cell: f64,
+    /// Objects added after the preset's.
+    pub objects: Vec<ObjectConfig>,
+}
+
+impl Default for SceneConfig {
+    fn default() -> Self {
+        SceneConfig {
+            preset: None,
+            scale: 1.0,
+            lod_levels: 4,
+            lod_ratio: 0.5,
+            depth_complexity: 1.0,
+            depth_order: DepthOrder::FrontToBack,
+            view_cell: 0.0,
+            objects: Vec::new(),
+        }
+    }
+}
+
+/// One listed object: a box standing on the ground (its bounding sphere
+/// encloses the box), with a chain of levels of detail.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectConfig {
+    /// Name, for errors.
+    pub name: String,
+    /// Centre of the box's base, `[x, y, z]` (z up).
+    pub position: [f64; 3],
+    /// Box width (x), depth (y) and height (z) before rotation.
+    pub size: [f64; 3],
+    /// Rotation about the vertical axis, degrees.
+    #[serde(default)]
+    pub yaw: f64,
+    /// Levels of detail, finest first.
+    pub levels: Vec<LevelConfig>,
+    /// Shader id.
+    #[serde(default)]
+    pub shader: u64,
+    /// Texture id.
+    #[serde(default)]
+    pub texture: u64,
+    /// Material id.
+    #[serde(default)]
+    pub material: u64,
+    /// Surfaces of the object itself per covered pixel (leaves: > 1).
+    #[serde(default = "one")]
+    pub overdraw: f64,
+    /// Spread (lognormal sigma) of the object's triangle sizes on screen.
+    #[serde(default = "one")]
+    pub size_sigma: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// One level of detail as mesh statistics.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LevelConfig {
+    /// Triangles.
+    pub triangles: u64,
+    /// Actually transformed vertices per triangle under the vertex cache
+    /// (0..=3; paper 000 Table 5's #tv/tri).
+    pub acmr: f64,
+    /// Distinct vertices (default triangles / 2 + 2, a closed mesh).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vertices: Option<u64>,
+}
+
+/// The camera path and the view.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CameraConfig {
+    /// `"preset"` (the scene preset's own path: a street walk in the city,
+    /// a forest path, a flight over the terrain), `"street"`, `"forest"`,
+    /// `"flight"` or `"keyframes"`.
+    pub path: String,
+    /// Speed along the path, metres per second (0 = standing still).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub speed: Option<f64>,
+    /// Keyframes of a `"keyframes"` path, visited in order at `speed`.
+    pub keyframes: Vec<Keyframe>,
+    /// Horizontal field of view, degrees.
+    pub fov: f64,
+    /// Viewport width, pixels.
+    pub width: u32,
+    /// Viewport height, pixels.
+    pub height: u32,
+    /// Near plane, metres.
+    pub near: f64,
+    /// Far plane, metres.
+    pub far: f64,
+}
+
+impl Default for CameraConfig {
+    fn default() -> Self {
+        CameraConfig {
+            path: "preset".into(),
+            speed: None,
+            keyframes: Vec::new(),
+            fov: 60.0,
+            width: 1024,
+            height: 768,
+            near: 0.5,
+            far: 1500.0,
+        }
+    }
+}
+
+/// A camera keyframe.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Keyframe {
+    /// Eye position `[x, y, z]`.
+    pub position: [f64; 3],
+    /// Heading, degrees (0 = +x, counter-clockwise).
+    #[serde(default)]
+    pub yaw: f64,
+    /// Pitch, degrees (positive looks up).
+    #[serde(default)]
+    pub pitch: f64,
+}
+
+/// The estimators (paper 000 §5) and their preprocess.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct EstimationConfig {
+    /// Estimators to run: any of `h1`, `h2`, `h3`, `h4`, `pos`.
+    pub estimators: Vec<String>,
+    /// Single-object renders the heuristics' constants are fitted to.
+    pub fit_samples: u64,
+    /// Copies of the object drawn in each single-object render (its state
+    /// set once), the time divided among them (paper 000 §7.1 rendered
+    /// each timed object several times between the two readings).
+    pub repeats: u32,
+    /// Per-object sampling tables.
+    pub pos: PosConfig,
+}
+
+impl Default for EstimationConfig {
+    fn default() -> Self {
+        EstimationConfig {
+            estimators: super::estimators::ESTIMATORS.iter().map(|s| s.to_string()).collect(),
+            fit_samples: 10_000,
+            repeats: 4,
+            pos: PosConfig::default(),
+        }
+    }
+}
+
+/// The per-object sampling (pos) tables over the angles α, γ, φ.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PosConfig {
+    /// Sizes α (log-spaced from one pixel to the whole screen).
+    pub alpha_steps: u32,
+    /// Directions γ around the object (azimuth).
+    pub gamma_steps: u32,
+    /// Elevations φ (from `phi_min` to `phi_max`).
+    pub phi_steps: u32,
+    /// Lowest elevation sampled, degrees.
+    pub phi_min: f64,
+    /// Highest elevation sampled, degrees.
+    pub phi_max: f64,
+    /// Pruning: once the renders of one α differ by less than this share
+    /// over all directions, smaller α are sampled in one direction only
+    /// (the object is geometry-limited there).
+    pub prune_tolerance: f64,
+}
+
+impl Default for PosConfig {
+    fn default() -> Self {
+        PosConfig {
+            alpha_steps: 12,
+            gamma_steps: 8,
+            phi_steps: 4,
+            phi_min: -30.0,
+            phi_max: 60.0,
+            prune_tolerance: 0.01,
+        }
+    }
+}
+
+/// Level-of-detail selection.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LodConfig {
+    /// `"none"`: every object at its finest level (the only policy built
+    /// so far; `reactive`, `predictive` and `predictive+branch` are
+    /// refused as not yet built).
+    pub policy: String,
+}
+
+impl Default for LodConfig {
+    fn default() -> Self {
+        LodConfig { policy: "none".into() }
+    }
+}

@@ -1,0 +1,30 @@
+//! A walkthrough with rendering-time estimation (paper 000 §5-7): a scene of
+//! objects with bounding spheres and LOD chains (presets after Table 5), a
+//! recorded camera path, per frame view-cell PVS and frustum culling, the
+//! estimators h1-h4 and per-object sampling (pos) with their cost, and the
+//! frame drawn by the frame pipeline's GPU model (its real time recorded).
+//! Table 6 compares the estimators' errors (`experiments/table6.toml`).
+//!
+//! - `config`: the model file (the frame pipeline's hardware sections, plus
+//!   scene, camera, estimation, lod);
+//! - `scene`: objects, prototypes, LOD chains, the presets;
+//! - `camera`: the camera paths;
+//! - `culling`: frustum, PVS, projections (α, γ, φ, pixels);
+//! - `render`: one frame through the frame pipeline;
+//! - `estimators`: h1-h4, their least-squares fit, the scores;
+//! - `pos`: per-object sampling tables;
+//! - `run`, `report`, `system`: run and summary, the report, the registry.
+
+pub mod camera;
+pub mod config;
+pub mod culling;
+pub mod estimators;
+pub mod pos;
+pub mod render;
+pub mod report;
+pub mod run;
+pub mod scene;
+pub mod system;
+
+pub use config::WalkthroughConfig;
+pub use run::{WalkthroughRun, run_walkthrough};

@@ -1,0 +1,78 @@
+//! The human-readable report of a walkthrough (`rendersim run`), from its
+//! summary.
+
+use std::io::{self, Write};
+
+use serde_json::Value;
+
+use crate::output::text::fixed;
+
+/// Writes the report of the run whose summary is `s`.
+pub fn write_report(s: &Value, w: &mut dyn Write) -> io::Result<()> {
+    let f = |v: &Value| v.as_f64().unwrap_or(f64::NAN);
+    let m = &s["metrics"];
+    let sc = &s["scene"];
+    writeln!(
+        w,
+        "{} (walkthrough, {}), {} frames along a {} path of {} m, seed {}",
+        s["model"].as_str().unwrap_or(""),
+        s["fidelity"].as_str().unwrap_or(""),
+        s["frames"],
+        s["camera"]["path"].as_str().unwrap_or(""),
+        fixed(f(&s["camera"]["length_m"]), 1),
+        s["seed"]
+    )?;
+    writeln!(
+        w,
+        "scene: {} ({} objects, {} triangles, {} transformed vertices/triangle, {} view cells visited)",
+        s["preset"].as_str().unwrap_or("listed objects"),
+        sc["objects"],
+        sc["triangles"],
+        fixed(f(&sc["transformed_per_triangle"]), 2),
+        s["camera"]["view_cells_visited"]
+    )?;
+    writeln!(
+        w,
+        "frame time: mean {} ms, p99 {} ms, max {} ms; budget {} ms, {} frames over budget; {} objects drawn per frame on average",
+        fixed(f(&m["frame_time_ms"]["mean"]), 3),
+        fixed(f(&m["frame_time_ms"]["p99"]), 3),
+        fixed(f(&m["frame_time_ms"]["max"]), 3),
+        fixed(f(&m["budget_ms"]), 3),
+        m["frames_over_budget"],
+        fixed(f(&m["visible_objects"]["mean"]), 1)
+    )?;
+    let e = &m["estimation"];
+    writeln!(
+        w,
+        "estimation (empty frame {} ms, {} fit samples):",
+        fixed(f(&e["empty_frame_ms"]), 3),
+        e["fit_samples"]
+    )?;
+    writeln!(
+        w,
+        "  estimator   mse (ms^2)   mean error (ms)   underestimated   cost (us/frame)"
+    )?;
+    for name in super::estimators::ESTIMATORS {
+        let x = &e[name];
+        if x.is_null() {
+            continue;
+        }
+        writeln!(
+            w,
+            "  {name:<9} {:>12} {:>17} {:>16} {:>17}",
+            fixed(f(&x["mse_ms2"]), 4),
+            fixed(f(&x["mean_error_ms"]), 4),
+            fixed(f(&x["underestimated_fraction"]), 3),
+            fixed(f(&x["cost_us_per_frame"]), 2)
+        )?;
+    }
+    writeln!(
+        w,
+        "{} events in {} frame-pipeline runs, {} s wall ({} s preprocess, {} s frames)",
+        s["events"]["total"],
+        s["pipeline_runs"],
+        fixed(f(&s["wall_seconds"]), 3),
+        fixed(f(&s["build_seconds"]), 3),
+        fixed(f(&s["simulate_seconds"]), 3)
+    )
+}

@@ -1,0 +1,51 @@
+//! The walkthrough in the system registry ([`crate::systems::SYSTEMS`]).
+
+use std::io::Write;
+use std::path::Path;
+
+use crate::config::{ModelSource, deserialize};
+use crate::output::trace::TraceWriter;
+use crate::systems::{Outcome, SimError, System, outcome_basics, resolved_toml};
+
+use super::config::WalkthroughConfig;
+use super::run::{WalkthroughRun, run_walkthrough};
+
+/// `system = "walkthrough"`.
+pub struct WalkthroughSystem;
+
+impl System for WalkthroughSystem {
+    fn name(&self) -> &'static str {
+        "walkthrough"
+    }
+
+    fn run(
+        &self,
+        src: &ModelSource,
+        table: &toml::Table,
+        trace: Option<TraceWriter>,
+    ) -> Result<Box<dyn Outcome>, SimError> {
+        let cfg: WalkthroughConfig = deserialize(table, src)?;
+        let mut run = run_walkthrough(cfg).map_err(|e| SimError::of(src, e))?;
+        // No trace of its own: a requested trace file is closed empty.
+        run.trace = trace;
+        Ok(Box::new(run))
+    }
+}
+
+impl Outcome for WalkthroughRun {
+    outcome_basics!();
+
+    fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
+        (self.columns.clone(), self.rows.clone())
+    }
+
+    fn write_table(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        use crate::output::table::{number, write_table};
+        let rows = self.rows.iter().map(|r| r.iter().map(|&v| number(v)).collect());
+        write_table(std::io::BufWriter::new(w), &self.columns, rows)
+    }
+
+    fn resolved_model(&self, _base_dir: &Path) -> String {
+        resolved_toml(&self.config)
+    }
+}

@@ -1,0 +1,323 @@
+//! The walkthrough (paper 000 §5-7): determinism, estimator oracles,
+//! culling against brute force, the presets against Table 5, extremes,
+//! and errors naming the key.
+
+use std::process::Command;
+
+use rendersim::systems::walkthrough::camera::Pose;
+use rendersim::systems::walkthrough::config::CameraConfig;
+use rendersim::systems::walkthrough::culling::{View, disk_in_rect};
+use serde_json::Value;
+
+use crate::common::{num, summary_of, try_run_any};
+
+const CITY: &str = include_str!("../../models/walkthrough-city.toml");
+const FOREST: &str = include_str!("../../models/walkthrough-forest.toml");
+
+/// A small scene of listed objects on a GPU whose only cost is triangle
+/// setup (split architecture, no CPU costs, no noise, no vsync): a frame's
+/// time is linear in its triangles by construction.
+const LINEAR: &str = r#"
+system = "walkthrough"
+[run]
+frames = 40
+seed = 3
+[gpu]
+architecture = "split"
+[gpu.geometry]
+triangle_setup = "10ns"
+[display]
+vsync = false
+present_mode = "immediate"
+[noise]
+enabled = false
+[estimation]
+fit_samples = 200
+[estimation.pos]
+alpha_steps = 4
+gamma_steps = 2
+phi_steps = 1
+[camera]
+speed = 150.0
+[[camera.keyframes]]
+position = [0.0, -60.0, 1.7]
+yaw = 90
+[[camera.keyframes]]
+position = [0.0, 60.0, 1.7]
+yaw = 90
+[[scene.objects]]
+name = "a"
+position = [15.0, 0.0, 0.0]
+size = [8.0, 8.0, 12.0]
+levels = [{ triangles = 3000, acmr = 1.2 }, { triangles = 700, acmr = 1.2 }]
+[[scene.objects]]
+name = "b"
+position = [-20.0, 30.0, 0.0]
+size = [10.0, 6.0, 20.0]
+levels = [{ triangles = 1200, acmr = 1.2 }]
+texture = 1
+[[scene.objects]]
+name = "c"
+position = [12.0, 80.0, 0.0]
+size = [4.0, 4.0, 4.0]
+levels = [{ triangles = 50000, acmr = 1.2 }]
+"#;
+
+fn without_wall(mut v: Value) -> Value {
+    fn strip(v: &mut Value) {
+        if let Value::Object(m) = v {
+            for k in ["wall_seconds", "build_seconds", "simulate_seconds", "cost_us_per_frame"] {
+                m.remove(k);
+            }
+            m.values_mut().for_each(strip);
+        }
+    }
+    strip(&mut v);
+    v
+}
+
+const SMALL_CITY: [&str; 4] = [
+    "scene.scale=0.05",
+    "run.frames=60",
+    "estimation.fit_samples=300",
+    "estimation.pos.alpha_steps=5",
+];
+
+#[test]
+fn same_seed_same_bytes_other_seed_other_frames() {
+    let a = try_run_any(CITY, &SMALL_CITY).unwrap();
+    let b = try_run_any(CITY, &SMALL_CITY).unwrap();
+    assert_eq!(without_wall(a.summary().clone()), without_wall(b.summary().clone()));
+    let (mut ta, mut tb) = (Vec::new(), Vec::new());
+    a.write_frames_csv(&mut ta).unwrap();
+    b.write_frames_csv(&mut tb).unwrap();
+    assert_eq!(ta, tb);
+    let mut sets = SMALL_CITY.to_vec();
+    sets.push("run.seed=2");
+    let c = try_run_any(CITY, &sets).unwrap();
+    assert_ne!(a.frame_table().1, c.frame_table().1);
+}
+
+#[test]
+fn h1_is_exact_when_time_is_linear_in_triangles() {
+    let s = summary_of(LINEAR, &[]);
+    let c = num(&s, "metrics.estimation.constants.h1_per_triangle_ps");
+    assert!((c - 10_000.0).abs() < 1e-6, "{c}");
+    assert!(num(&s, "metrics.estimation.h1.mse_ms2") < 1e-18);
+    // Every transformed vertex comes with 1/1.2 triangles: h2 is exact too.
+    assert!(num(&s, "metrics.estimation.h2.mse_ms2") < 1e-12);
+    // Frames see different objects: the path is not trivial.
+    let t = &s["metrics"]["triangles"];
+    assert!(t["max"].as_f64().unwrap() > t["min"].as_f64().unwrap(), "{t}");
+    // pos tables hold the same linear time at every size (pruned to one direction).
+    assert!(num(&s, "metrics.estimation.pos.mse_ms2") < 1e-12);
+    assert!(num(&s, "metrics.estimation.pos_tables.pruned_fraction") > 0.3);
+}
+
+#[test]
+fn presets_match_table_5() {
+    let s = summary_of(CITY, &["run.frames=1", "estimation.estimators=[]"]);
+    assert_eq!(num(&s, "scene.objects"), 5609.0);
+    let t = num(&s, "scene.triangles");
+    assert!((t / 3_453_465.0 - 1.0).abs() < 0.001, "{t}");
+    let tv = num(&s, "scene.transformed_vertices");
+    assert!((tv / 6_419_303.0 - 1.0).abs() < 0.002, "{tv}");
+    assert_eq!(num(&s, "scene.view_cell_m"), 10.0);
+    let f = summary_of(FOREST, &["run.frames=1", "estimation.estimators=[]"]);
+    assert_eq!(num(&f, "scene.objects"), 157.0);
+    assert!((num(&f, "scene.triangles") / 579_644.0 - 1.0).abs() < 0.001);
+    assert!((num(&f, "scene.transformed_vertices") / 1_028_978.0 - 1.0).abs() < 0.002);
+    let terrain = summary_of(
+        CITY,
+        &[
+            "run.frames=2",
+            "scene.preset=\"terrain\"",
+            "camera.path=\"preset\"",
+            "estimation.fit_samples=50",
+        ],
+    );
+    assert_eq!(num(&terrain, "scene.objects"), 1.0);
+    assert_eq!(num(&terrain, "scene.triangles"), 86_400.0);
+}
+
+/// Culling against brute force: a sphere any of whose sampled points lies
+/// in the frustum must be kept; a sphere that is culled has no point in it.
+#[test]
+fn frustum_culling_keeps_every_sphere_a_brute_force_search_sees() {
+    let cam = CameraConfig {
+        near: 0.5,
+        far: 200.0,
+        ..CameraConfig::default()
+    };
+    let mut x: u64 = 12345;
+    let mut rnd = || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut kept = 0;
+    for _ in 0..300 {
+        let pose = Pose {
+            eye: [rnd() * 10.0, rnd() * 10.0, rnd() * 5.0],
+            yaw: rnd() * std::f64::consts::TAU,
+            pitch: (rnd() - 0.5) * 1.0,
+        };
+        let view = View::new(&pose, &cam);
+        let c = [rnd() * 400.0 - 200.0, rnd() * 400.0 - 200.0, rnd() * 40.0 - 20.0];
+        let r = rnd() * 30.0 + 0.1;
+        let mut brute = false;
+        'search: for i in 0..12 {
+            for j in 0..24 {
+                for k in 1..=4 {
+                    let (th, ph) = (
+                        std::f64::consts::PI * (i as f64 + 0.5) / 12.0,
+                        std::f64::consts::TAU * j as f64 / 24.0,
+                    );
+                    let rr = r * k as f64 / 4.0;
+                    let p = [
+                        c[0] + rr * th.sin() * ph.cos(),
+                        c[1] + rr * th.sin() * ph.sin(),
+                        c[2] + rr * th.cos(),
+                    ];
+                    if view.contains_point(p) {
+                        brute = true;
+                        break 'search;
+                    }
+                }
+            }
+        }
+        let test = view.sees_sphere(c, r);
+        assert!(
+            !brute || test,
+            "a sphere with a point inside was culled: {c:?} r {r} {pose:?}"
+        );
+        kept += test as u32;
+    }
+    assert!(kept > 10, "{kept}");
+}
+
+#[test]
+fn clipped_disk_area_against_a_pixel_count() {
+    for (cx, cy, r) in [
+        (512.0, 384.0, 100.0),
+        (0.0, 0.0, 300.0),
+        (1000.0, 100.0, 250.0),
+        (512.0, 384.0, 5000.0),
+        (-50.0, 384.0, 80.0),
+    ] {
+        let mut n = 0u64;
+        for y in 0..768 {
+            for x in 0..1024 {
+                let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+                if (px - cx).powi(2) + (py - cy).powi(2) <= r * r {
+                    n += 1;
+                }
+            }
+        }
+        let a = disk_in_rect(cx, cy, r, 1024.0, 768.0);
+        assert!(
+            (a - n as f64).abs() <= 0.005 * n as f64 + 20.0,
+            "{cx} {cy} {r}: {a} vs {n}"
+        );
+    }
+}
+
+#[test]
+fn an_empty_scene_is_estimated_exactly() {
+    let text = r#"
+system = "walkthrough"
+[run]
+frames = 10
+[gpu]
+clear = "0.3ms"
+swap = "20us"
+[display]
+vsync = false
+present_mode = "immediate"
+[noise]
+enabled = false
+[[camera.keyframes]]
+position = [0.0, 0.0, 1.7]
+"#;
+    let s = summary_of(text, &[]);
+    assert_eq!(num(&s, "scene.objects"), 0.0);
+    assert_eq!(num(&s, "metrics.visible_objects.max"), 0.0);
+    for e in ["h1", "h2", "h3", "h4", "pos"] {
+        assert_eq!(num(&s, &format!("metrics.estimation.{e}.mse_ms2")), 0.0, "{e}");
+    }
+    assert!((num(&s, "metrics.frame_time_ms.mean") - 0.32).abs() < 1e-9);
+}
+
+#[test]
+fn a_camera_standing_still_inside_an_object() {
+    // Zero-length path (speed 0) inside the bounding sphere of object "a":
+    // every frame the same, the object covering the whole viewport.
+    let mut sets = vec!["camera.speed=0", "run.frames=5"];
+    sets.push("camera.keyframes=[{ position = [15.0, 0.0, 3.0], yaw = 0 }]");
+    let s = summary_of(LINEAR, &sets);
+    assert_eq!(num(&s, "camera.length_m"), 0.0);
+    assert_eq!(num(&s, "metrics.frames_inside_an_object"), 5.0);
+    assert_eq!(num(&s, "metrics.frame_time_ms.std"), 0.0);
+    // Single-level objects and single-level presets run.
+    let one = summary_of(
+        CITY,
+        &[
+            "scene.scale=0.02",
+            "scene.lod_levels=1",
+            "run.frames=5",
+            "estimation.fit_samples=20",
+        ],
+    );
+    assert_eq!(num(&one, "scene.lod_levels"), 1.0);
+}
+
+fn err(text: &str, sets: &[&str]) -> String {
+    try_run_any(text, sets).map(|_| ()).unwrap_err()
+}
+
+#[test]
+fn bad_keys_name_the_key() {
+    let e = err(CITY, &["scene.presett=\"city\""]);
+    assert!(e.contains("presett"), "{e}");
+    let e = err(CITY, &["lod.policy=\"reactive\""]);
+    assert!(e.contains("lod.policy") && e.contains("not built yet"), "{e}");
+    let e = err(CITY, &["lod.policy=\"fastest\""]);
+    assert!(e.contains("lod.policy") && e.contains("unknown policy"), "{e}");
+    let e = err(CITY, &["estimation.estimators=[\"h1\", \"h5\"]"]);
+    assert!(e.contains("estimation.estimators.1") && e.contains("h5"), "{e}");
+    let e = err(CITY, &["scene.preset=\"town\""]);
+    assert!(e.contains("scene.preset") && e.contains("town"), "{e}");
+    let e = err(FOREST, &["camera.path=\"street\""]);
+    assert!(e.contains("camera.path"), "{e}");
+    let e = err(
+        LINEAR,
+        &["scene.objects.0.levels=[{ triangles = 10, acmr = 1.0 }, { triangles = 20, acmr = 1.0 }]"],
+    );
+    assert!(
+        e.contains("scene.objects.0.levels.1.triangles") && e.contains("coarser"),
+        "{e}"
+    );
+    let e = err(LINEAR, &["scene.objects.1.levels=[]"]);
+    assert!(e.contains("scene.objects.1.levels"), "{e}");
+    let e = err(LINEAR, &["camera.keyframes=[]"]);
+    assert!(e.contains("camera.keyframes"), "{e}");
+    let e = err(CITY, &["scene.lod_ratio=1.5"]);
+    assert!(e.contains("scene.lod_ratio"), "{e}");
+    let e = err(CITY, &["gpu.shader_cores=0"]);
+    assert!(e.contains("gpu.shader_cores"), "{e}");
+}
+
+#[test]
+fn cli_reports_a_bad_key_with_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.toml");
+    std::fs::write(&path, CITY.replace("lod_ratio = 0.5", "lod_ratio = 0")).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_rendersim"))
+        .args(["run", path.to_str().unwrap(), "--json"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("scene.lod_ratio") && e.contains("bad.toml:80"), "{e}");
+}
