@@ -99,6 +99,7 @@ impl Renderer {
             gpu: cfg.gpu.clone(),
             display: cfg.display.clone(),
             noise: noise_cfg,
+            variation: Default::default(),
             workload: WorkloadConfig::Scene(SceneWorkload {
                 view: View::Static,
                 preset: None,
