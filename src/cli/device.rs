@@ -246,17 +246,7 @@ fn report_markdown(profile: &DeviceProfile, rows: &[PassRow], loo: &[f64]) -> Re
     writeln!(s, "|---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|")?;
     let (mut sim_errors, mut measure_s, mut simulate_s) = (Vec::new(), 0.0, 0.0);
     for (r, e) in rows.iter().zip(loo) {
-        let pass = DevicePass {
-            mesh: r.mesh.clone(),
-            size: (r.size.width, r.size.height),
-            vs_loops: r.vs_loops,
-            fs_loops: r.fs_loops,
-            geometry_only: r.geometry_only,
-            layers: 1,
-            order: rendersim::measure::DepthOrder::FrontToBack,
-            depth_test: false,
-        };
-        let p = predict_on_device(profile, &pass)?;
+        let p = predict_on_device(profile, &DevicePass::from(r))?;
         let se = rel_error_pct(p.pass_time_ns, r.pass_time_ns);
         let m = 7.0 * r.pass_time_ns * 1e-9;
         sim_errors.push(se);

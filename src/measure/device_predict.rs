@@ -41,6 +41,22 @@ pub struct DevicePass {
     pub depth_test: bool,
 }
 
+impl From<&super::passes::PassRow> for DevicePass {
+    /// The pass a CSV row measured: one layer, no depth test.
+    fn from(r: &super::passes::PassRow) -> Self {
+        DevicePass {
+            mesh: r.mesh.clone(),
+            size: (r.size.width, r.size.height),
+            vs_loops: r.vs_loops,
+            fs_loops: r.fs_loops,
+            geometry_only: r.geometry_only,
+            layers: 1,
+            order: DepthOrder::FrontToBack,
+            depth_test: false,
+        }
+    }
+}
+
 /// What `rendersim predict` prints.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DevicePrediction {

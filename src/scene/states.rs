@@ -2,8 +2,8 @@
 //! (shader, texture, material) ids, for the state-sorting buffer (paper 001,
 //! "State Sorting"; `rendersim sortbuf scene:MODEL.toml`).
 //!
-//! The ids follow the frame pipeline's rule for scenes
-//! (`systems::frame_pipeline::workload::compile_scene`, described in
+//! The ids follow the rule for scenes that the frame pipeline's
+//! `compile_scene` also uses ([`scene_groups`], [`StateNumbering`];
 //! `docs/models.md`, "Scenes"): a preset's groups first, then
 //! `[[workload.groups]]`; instance i of a group gets shader
 //! `i % shaders`, texture `i % textures`, material `i % materials`, each
@@ -13,11 +13,52 @@
 //! counts.
 
 use crate::limits::{MAX_SCENE_OBJECTS, MAX_SCENE_SCALE};
-use crate::scene::config::{SceneWorkload, StateOrder};
+use crate::scene::config::{ObjectGroup, SceneWorkload, StateOrder};
 use crate::scene::presets::{PRESETS, preset_groups};
 
 /// (shader, texture, material) of one object.
 pub type ObjectState = (u64, u64, u64);
+
+/// A scene's groups in submission order: the preset's (if any), then
+/// `[[workload.groups]]`. The error is the message for `workload.preset`.
+pub fn scene_groups(scene: &SceneWorkload) -> Result<Vec<ObjectGroup>, String> {
+    let mut groups = Vec::new();
+    if let Some(p) = &scene.preset {
+        groups.extend(
+            preset_groups(p, scene.scale)
+                .ok_or_else(|| format!("unknown preset {p:?} (known: {})", PRESETS.join(", ")))?,
+        );
+    }
+    groups.extend(scene.groups.iter().cloned());
+    Ok(groups)
+}
+
+/// The state numbering of a scene: instance `i` of a group gets shader
+/// `i % shaders`, texture `i % textures`, material `i % materials`, each
+/// numbered after the previous groups' ids. Walk the groups in order,
+/// calling [`StateNumbering::next_group`] after each.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StateNumbering {
+    base: ObjectState,
+}
+
+impl StateNumbering {
+    /// The state of instance `i` of group `g` (the current group).
+    pub fn state(&self, g: &ObjectGroup, i: u64) -> ObjectState {
+        (
+            self.base.0 + i % g.shaders,
+            self.base.1 + i % g.textures,
+            self.base.2 + i % g.materials,
+        )
+    }
+
+    /// Moves past group `g`'s ids.
+    pub fn next_group(&mut self, g: &ObjectGroup) {
+        self.base.0 += g.shaders;
+        self.base.1 += g.textures;
+        self.base.2 += g.materials;
+    }
+}
 
 /// The scene's objects' states in submission order, or why the scene is
 /// not valid.
@@ -28,14 +69,7 @@ pub fn state_sequence(scene: &SceneWorkload) -> Result<Vec<ObjectState>, String>
             scene.scale
         ));
     }
-    let mut groups = Vec::new();
-    if let Some(p) = &scene.preset {
-        groups.extend(
-            preset_groups(p, scene.scale)
-                .ok_or_else(|| format!("workload.preset: unknown preset {p:?} (known: {})", PRESETS.join(", ")))?,
-        );
-    }
-    groups.extend(scene.groups.iter().cloned());
+    let groups = scene_groups(scene).map_err(|e| format!("workload.preset: {e}"))?;
     let total: u64 = groups.iter().map(|g| g.count).fold(0, u64::saturating_add);
     if total > MAX_SCENE_OBJECTS {
         return Err(format!(
@@ -43,7 +77,7 @@ pub fn state_sequence(scene: &SceneWorkload) -> Result<Vec<ObjectState>, String>
         ));
     }
     let mut out = Vec::with_capacity(total as usize);
-    let (mut sb, mut tb, mut mb) = (0u64, 0u64, 0u64);
+    let mut numbering = StateNumbering::default();
     for (gi, g) in groups.iter().enumerate() {
         for (what, v) in [
             ("shaders", g.shaders),
@@ -54,12 +88,8 @@ pub fn state_sequence(scene: &SceneWorkload) -> Result<Vec<ObjectState>, String>
                 return Err(format!("group {gi} ({}): {what} must be at least 1", g.name));
             }
         }
-        for i in 0..g.count {
-            out.push((sb + i % g.shaders, tb + i % g.textures, mb + i % g.materials));
-        }
-        sb += g.shaders;
-        tb += g.textures;
-        mb += g.materials;
+        out.extend((0..g.count).map(|i| numbering.state(g, i)));
+        numbering.next_group(g);
     }
     if scene.state_order == StateOrder::Sorted {
         out.sort();

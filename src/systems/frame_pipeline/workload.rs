@@ -13,7 +13,7 @@ use crate::components::vertex_cache::CachePolicy;
 use crate::engine::Duration;
 use crate::scene::config::{DepthOrder, MeshRef, SceneWorkload, SizeOrder, StateOrder};
 use crate::scene::generators::mesh_from_spec;
-use crate::scene::presets::{PRESETS, preset_groups};
+use crate::scene::states::{StateNumbering, scene_groups};
 
 use super::closed_form::{DrawTimes, draw_times, draw_times_unified, ordered_draw_total};
 use super::config::{Fidelity, FramePipelineConfig};
@@ -299,17 +299,7 @@ pub fn compile_scene(
             format!("must be a number > 0, got {}", scene.scale),
         ));
     }
-    let mut groups_cfg = Vec::new();
-    if let Some(p) = &scene.preset {
-        let g = preset_groups(p, scene.scale).ok_or_else(|| {
-            invalid(
-                "workload.preset",
-                format!("unknown preset {p:?} (known: {})", PRESETS.join(", ")),
-            )
-        })?;
-        groups_cfg.extend(g);
-    }
-    groups_cfg.extend(scene.groups.iter().cloned());
+    let groups_cfg = scene_groups(scene).map_err(|e| invalid("workload.preset", e))?;
 
     let pass = early_z_pass(scene.depth_order, scene.depth_complexity);
     let (shade_per_pixel, fixed_per_pixel) = fragment_costs(cfg, pass);
@@ -320,7 +310,7 @@ pub fn compile_scene(
     let mut mesh_ids: HashMap<(String, bool), u32> = HashMap::new();
     let mut groups = Vec::new();
     let mut objects: Vec<Instance> = Vec::new();
-    let (mut shader_base, mut texture_base, mut material_base) = (0u64, 0u64, 0u64);
+    let mut numbering = StateNumbering::default();
 
     for (gi, g) in groups_cfg.iter().enumerate() {
         let key = if gi >= groups_cfg.len() - scene.groups.len() {
@@ -371,18 +361,12 @@ pub fn compile_scene(
             objects.push(Instance {
                 group: gi as u32,
                 mesh: mesh_id,
-                state: (
-                    shader_base + i % g.shaders,
-                    texture_base + i % g.textures,
-                    material_base + i % g.materials,
-                ),
+                state: numbering.state(g, i),
                 matrix: g.matrix_per_object,
                 upload: g.geometry_upload.0.saturating_add(g.texture_upload.0),
             });
         }
-        shader_base += g.shaders;
-        texture_base += g.textures;
-        material_base += g.materials;
+        numbering.next_group(g);
     }
     if scene.state_order == StateOrder::Sorted {
         objects.sort_by_key(|o| o.state);

@@ -436,26 +436,41 @@ fn city(cfg: &SceneConfig, n: u64, streams: &RngStreams) -> Scene {
         6_419_303.0 * cfg.scale,
         cfg,
     );
-    let protos: Vec<Prototype> = chains
-        .into_iter()
-        .enumerate()
-        .map(|(i, levels)| Prototype {
-            name: format!("building-{i}"),
-            size: sizes[i],
-            levels,
-            overdraw: 1.0,
-            size_sigma: 1.5,
-        })
-        .collect();
-    for o in &mut objects {
-        o.radius = protos[o.proto as usize].radius();
-    }
+    let protos = prototypes(chains, &sizes, "building", 1.0, 1.5, &mut objects);
     Scene {
         protos,
         objects,
         layout: Layout::City { blocks, block, street },
         view_cell: Some(10.0),
     }
+}
+
+/// The prototypes `<kind>-<i>` of `chains` (LOD levels) and `sizes`, and
+/// each object's bounding radius from its prototype.
+fn prototypes(
+    chains: Vec<Vec<Level>>,
+    sizes: &[[f64; 3]],
+    kind: &str,
+    overdraw: f64,
+    size_sigma: f64,
+    objects: &mut [Object],
+) -> Vec<Prototype> {
+    let protos: Vec<Prototype> = chains
+        .into_iter()
+        .zip(sizes)
+        .enumerate()
+        .map(|(i, (levels, size))| Prototype {
+            name: format!("{kind}-{i}"),
+            size: *size,
+            levels,
+            overdraw,
+            size_sigma,
+        })
+        .collect();
+    for o in objects {
+        o.radius = protos[o.proto as usize].radius();
+    }
+    protos
 }
 
 /// Trees (crowns as boxes) scattered over a square at about 16 m spacing,
@@ -509,20 +524,7 @@ fn forest(cfg: &SceneConfig, n: u64, streams: &RngStreams) -> Scene {
         1_028_978.0 * cfg.scale,
         cfg,
     );
-    let protos: Vec<Prototype> = chains
-        .into_iter()
-        .enumerate()
-        .map(|(i, levels)| Prototype {
-            name: format!("tree-{i}"),
-            size: sizes[i],
-            levels,
-            overdraw: 2.5,
-            size_sigma: 2.0,
-        })
-        .collect();
-    for o in &mut objects {
-        o.radius = protos[o.proto as usize].radius();
-    }
+    let protos = prototypes(chains, &sizes, "tree", 2.5, 2.0, &mut objects);
     Scene {
         protos,
         objects,
