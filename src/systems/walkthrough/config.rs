@@ -7,10 +7,13 @@
 use serde::{Deserialize, Serialize};
 
 use crate::config::Bytes;
+use crate::engine::Duration;
 use crate::scene::config::DepthOrder;
 use crate::systems::frame_pipeline::config::{
     BusConfig, CommandFifoConfig, CpuConfig, DisplayConfig, Fidelity, GpuConfig, NoiseConfig,
 };
+
+use super::timing::TimingMode;
 
 /// The whole model.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -236,7 +239,9 @@ pub struct Keyframe {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EstimationConfig {
-    /// Estimators to run: any of `h1`, `h2`, `h3`, `h4`, `pos`.
+    /// Estimators to run: any of `h1`, `h2`, `h3`, `h4`, `pos`, `vcs`,
+    /// `pvc` (default: the per-viewpoint five; `vcs` and `pvc` need view
+    /// cells).
     pub estimators: Vec<String>,
     /// Single-object renders the heuristics' constants are fitted to.
     pub fit_samples: u64,
@@ -246,15 +251,80 @@ pub struct EstimationConfig {
     pub repeats: u32,
     /// Per-object sampling tables.
     pub pos: PosConfig,
+    /// How the preprocess's renders are timed: `"timestamps"` (exact GPU
+    /// time, default) or `"cpu_clock"` (a CPU clock around a synchronising
+    /// finish, paper 000 §6.1; see `timing.rs`).
+    #[serde(skip_serializing_if = "is_timestamps")]
+    pub timing: TimingMode,
+    /// `cpu_clock`: the finish's round trip added to each reading.
+    #[serde(skip_serializing_if = "is_default_overhead")]
+    pub clock_overhead: Duration,
+    /// `cpu_clock`: standard deviation of each reading's zero-mean normal
+    /// jitter.
+    #[serde(skip_serializing_if = "is_default_noise")]
+    pub clock_noise: Duration,
+    /// View-cell sampling (`vcs`) and per-view-cell estimation (`pvc`).
+    #[serde(skip_serializing_if = "ViewCellEstimation::is_default")]
+    pub view_cells: ViewCellEstimation,
+}
+
+/// Default `estimation.clock_overhead` (20 us).
+pub const DEFAULT_CLOCK_OVERHEAD: Duration = Duration(20_000_000);
+/// Default `estimation.clock_noise` (5 us).
+pub const DEFAULT_CLOCK_NOISE: Duration = Duration(5_000_000);
+
+fn is_timestamps(t: &TimingMode) -> bool {
+    *t == TimingMode::Timestamps
+}
+fn is_default_overhead(d: &Duration) -> bool {
+    *d == DEFAULT_CLOCK_OVERHEAD
+}
+fn is_default_noise(d: &Duration) -> bool {
+    *d == DEFAULT_CLOCK_NOISE
+}
+
+/// The view-cell estimators' preprocess (paper 000 §5.1, §5.2): view
+/// directions are discretized into `directions` equal sectors of heading
+/// (bin k centred on k · 360° / directions).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ViewCellEstimation {
+    /// Discretized view directions per cell (heading sectors).
+    pub directions: u32,
+    /// `vcs`: sample views rendered per cell and direction (their maximum
+    /// is the estimate).
+    pub samples: u32,
+}
+
+impl Default for ViewCellEstimation {
+    fn default() -> Self {
+        ViewCellEstimation {
+            directions: 8,
+            samples: 16,
+        }
+    }
+}
+
+impl ViewCellEstimation {
+    fn is_default(&self) -> bool {
+        *self == ViewCellEstimation::default()
+    }
 }
 
 impl Default for EstimationConfig {
     fn default() -> Self {
         EstimationConfig {
-            estimators: super::estimators::ESTIMATORS.iter().map(|s| s.to_string()).collect(),
+            estimators: super::estimators::ESTIMATORS[..5]
+                .iter()
+                .map(|s| s.to_string())
+                .collect(),
             fit_samples: 10_000,
             repeats: 4,
             pos: PosConfig::default(),
+            timing: TimingMode::Timestamps,
+            clock_overhead: DEFAULT_CLOCK_OVERHEAD,
+            clock_noise: DEFAULT_CLOCK_NOISE,
+            view_cells: ViewCellEstimation::default(),
         }
     }
 }

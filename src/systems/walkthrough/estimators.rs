@@ -20,8 +20,10 @@
 
 use serde::Serialize;
 
-/// The estimators by name, in report order.
-pub const ESTIMATORS: [&str; 5] = ["h1", "h2", "h3", "h4", "pos"];
+/// The estimators by name, in report order: the per-viewpoint five, then
+/// the view-cell estimators (`view_cells.rs`): view-cell sampling and
+/// per-view-cell estimation.
+pub const ESTIMATORS: [&str; 7] = ["h1", "h2", "h3", "h4", "pos", "vcs", "pvc"];
 
 /// What the heuristics read of an object in a view.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -13,7 +13,11 @@
 //! - `render`: one frame through the frame pipeline;
 //! - `estimators`: h1-h4, their least-squares fit, the scores;
 //! - `pos`: per-object sampling tables;
-//! - `run`, `report`, `system`: run and summary, the report, the registry.
+//! - `run`, `report`, `system`: run and summary, the report, the registry;
+//! - `timing`: how preprocess renders are timed (time stamps or a CPU clock
+//!   around a synchronising finish, §6.1-6.2);
+//! - `view_cells`: view-cell sampling (vcs) and per-view-cell estimation
+//!   (pvc), §5.1-5.2, compared in `experiments/view-cells.toml` (§7.3).
 
 pub mod camera;
 pub mod config;
@@ -25,6 +29,8 @@ pub mod report;
 pub mod run;
 pub mod scene;
 pub mod system;
+pub mod timing;
+pub mod view_cells;
 
 pub use config::WalkthroughConfig;
 pub use run::{WalkthroughRun, run_walkthrough};

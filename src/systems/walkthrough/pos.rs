@@ -160,3 +160,80 @@ impl PosTable {
         self.at_level(k, gamma, phi, reads) * (1.0 - t) + self.at_level(k + 1, gamma, phi, reads) * t
     }
 }
+
+/// Bounds for per-view-cell estimation (`view_cells.rs`).
+impl PosTable {
+    /// The largest entry of α level `i` over azimuths `gamma` (an interval
+    /// `[lo, hi]`, radians, `hi - lo >= 2π` for all) and elevations `phi`
+    /// (`[lo, hi]`): every entry an interpolated lookup in that region could
+    /// read.
+    fn level_max(&self, i: usize, gamma: (f64, f64), phi: (f64, f64), reads: &mut u64) -> f64 {
+        let v = &self.values[i];
+        if v.len() == 1 {
+            *reads += 1;
+            return v[0];
+        }
+        let gs = self.gamma_steps;
+        let g: Vec<usize> = if gamma.1 - gamma.0 >= std::f64::consts::TAU {
+            (0..gs).collect()
+        } else {
+            let lo = (gamma.0.rem_euclid(std::f64::consts::TAU) / std::f64::consts::TAU * gs as f64).floor() as usize;
+            let span = ((gamma.1 - gamma.0) / std::f64::consts::TAU * gs as f64).ceil() as usize + 1;
+            (lo..=lo + span.min(gs)).map(|k| k % gs).collect()
+        };
+        let np = self.phis.len();
+        let idx = |x: f64, up: bool| -> usize {
+            if np == 1 || x <= self.phis[0] {
+                return 0;
+            }
+            if x >= self.phis[np - 1] {
+                return np - 1;
+            }
+            let step = self.phis[1] - self.phis[0];
+            let t = (x - self.phis[0]) / step;
+            (if up { t.ceil() } else { t.floor() } as usize).min(np - 1)
+        };
+        let (p0, p1) = (idx(phi.0, false), idx(phi.1.max(phi.0), true));
+        let mut best = 0.0f64;
+        for &gi in &g {
+            for p in p0..=p1 {
+                *reads += 1;
+                best = best.max(v[gi * np + p]);
+            }
+        }
+        best
+    }
+
+    /// An upper bound of [`PosTable::lookup`] over every α up to `alpha`
+    /// and every direction in the given azimuth and elevation intervals:
+    /// the interpolation in ln α of the levels' maxima at `alpha`, or the
+    /// largest maximum of any level below, whichever is larger (so the bound
+    /// holds even where the table does not grow with α).
+    pub fn lookup_max(&self, alpha: f64, gamma: (f64, f64), phi: (f64, f64), reads: &mut u64) -> f64 {
+        let n = self.ln_alpha.len();
+        let la = alpha.max(1e-300).ln();
+        let (k, t) = if la <= self.ln_alpha[0] {
+            (0, 0.0)
+        } else if la >= self.ln_alpha[n - 1] {
+            (n - 1, 0.0)
+        } else {
+            let step = self.ln_alpha[1] - self.ln_alpha[0];
+            let x = (la - self.ln_alpha[0]) / step;
+            let k = (x.floor() as usize).min(n - 2);
+            (k, x - k as f64)
+        };
+        let mut below = 0.0f64;
+        let mut at_k = 0.0;
+        for i in 0..=k {
+            let m = self.level_max(i, gamma, phi, reads);
+            below = below.max(m);
+            at_k = m;
+        }
+        if t > 0.0 && k + 1 < n {
+            let next = self.level_max(k + 1, gamma, phi, reads);
+            below.max(at_k * (1.0 - t) + next * t)
+        } else {
+            below
+        }
+    }
+}

@@ -66,6 +66,30 @@ pub fn write_report(s: &Value, w: &mut dyn Write) -> io::Result<()> {
             fixed(f(&x["cost_us_per_frame"]), 2)
         )?;
     }
+    let v = &e["view_cells"];
+    if !v.is_null() {
+        writeln!(
+            w,
+            "view cells: {} of {} cells built (those the path visits), {} directions; vcs {} sample views ({} s), pvc {} object bounds ({} s)",
+            v["cells"],
+            v["cells_in_grid"],
+            v["directions"],
+            v["vcs_renders"],
+            fixed(f(&v["vcs_preprocess_seconds"]), 3),
+            v["pvc_bounds"],
+            fixed(f(&v["pvc_preprocess_seconds"]), 3)
+        )?;
+    }
+    let t = &e["timing"];
+    if !t.is_null() {
+        writeln!(
+            w,
+            "preprocess timed with a CPU clock around a finish: overhead {} ms, jitter {} ms, {} readings",
+            fixed(f(&t["overhead_ms"]), 4),
+            fixed(f(&t["noise_ms"]), 4),
+            t["readings"]
+        )?;
+    }
     writeln!(
         w,
         "{} events in {} frame-pipeline runs, {} s wall ({} s preprocess, {} s frames)",

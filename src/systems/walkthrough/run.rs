@@ -27,6 +27,8 @@ use super::estimators::{Constants, ESTIMATORS, Features, Score, fit};
 use super::pos::{PosTable, build as build_table};
 use super::render::{Draw, Renderer, frame_seeds, next_seed};
 use super::scene::{Scene, SceneTotals, build_scene};
+use super::timing::{Clock, TimingMode, TimingSummary};
+use super::view_cells::{PVC, VCS, ViewCellSummary, ViewCellTables};
 
 /// LOD policies known by name; only `none` is built so far.
 pub const LOD_POLICIES: [&str; 4] = ["none", "reactive", "predictive", "predictive+branch"];
@@ -92,7 +94,11 @@ pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
             format!("{} frames is more than the limit of {MAX_FRAMES}", cfg.run.frames),
         ));
     }
-    let heuristics = cfg.estimation.estimators.iter().any(|e| e != "pos");
+    let heuristics = cfg
+        .estimation
+        .estimators
+        .iter()
+        .any(|e| ESTIMATORS[..4].contains(&e.as_str()));
     if cfg.estimation.fit_samples > MAX_FRAMES {
         return Err(invalid(
             "estimation.fit_samples",
@@ -141,6 +147,20 @@ pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
             format!("must be between 0 and 1, got {}", p.prune_tolerance),
         ));
     }
+    let v = &cfg.estimation.view_cells;
+    if !(1..=360).contains(&v.directions) {
+        return Err(invalid(
+            "estimation.view_cells.directions",
+            format!("must be between 1 and 360, got {}", v.directions),
+        ));
+    }
+    if !(1..=4096).contains(&v.samples) {
+        return Err(invalid(
+            "estimation.view_cells.samples",
+            format!("must be between 1 and 4096, got {}", v.samples),
+        ));
+    }
+    super::timing::validate(cfg.estimation.clock_overhead, cfg.estimation.clock_noise)?;
     check_memory(cfg)
 }
 
@@ -211,6 +231,18 @@ pub struct EstimationSummary {
     /// Per-object sampling.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pos: Option<Score>,
+    /// View-cell sampling.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vcs: Option<Score>,
+    /// Per-view-cell estimation.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pvc: Option<Score>,
+    /// The view-cell preprocess (absent without vcs and pvc).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub view_cells: Option<ViewCellSummary>,
+    /// The CPU clock the preprocess was timed with (absent with time stamps).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub timing: Option<TimingSummary>,
 }
 
 /// `metrics` of a walkthrough summary.
@@ -349,15 +381,31 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
         Ok((t.rt as f64, t.gpu as f64))
     };
     let (empty, empty_gpu) = render_exact(&[], &mut count)?;
+    // The clocks the preprocess's renders are read with (timing.rs).
+    let est_cfg = &cfg.estimation;
+    let clock = |stream: &str| {
+        Clock::new(
+            est_cfg.timing,
+            est_cfg.clock_overhead,
+            est_cfg.clock_noise,
+            cfg.run.seed,
+            stream,
+        )
+    };
+    let (mut fit_clock, mut pos_clock, mut vcs_clock) = (
+        clock("estimation.clock.fit"),
+        clock("estimation.clock.pos"),
+        clock("estimation.clock.vcs"),
+    );
     // One object's GPU time: `repeats` copies drawn (state set once), the
     // GPU time beyond the empty frame's divided among them.
     let repeats = cfg.estimation.repeats as usize;
     let mut copies: Vec<Draw> = Vec::with_capacity(repeats);
-    let mut object_time = |d: Draw, count: &mut Counter| -> Result<f64, SystemError> {
+    let mut object_time = |d: Draw, count: &mut Counter, clock: &mut Clock| -> Result<f64, SystemError> {
         copies.clear();
         copies.resize(repeats, d);
         let (_, gpu) = render_exact(&copies, count)?;
-        Ok((gpu - empty_gpu) / repeats as f64)
+        Ok((clock.read(gpu) - empty_gpu) / repeats as f64)
     };
     let wants: Vec<bool> = ESTIMATORS
         .iter()
@@ -387,7 +435,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 pixels: pr.covered_pixels,
                 state: o.state,
             };
-            let y = object_time(d, &mut count)?;
+            let y = object_time(d, &mut count, &mut fit_clock)?;
             samples.push((features(&scene, o.proto, level, &pr), y));
         }
         Some(fit(&samples))
@@ -400,7 +448,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
     // The pos tables, one per prototype in use, finest level (lod.policy = "none").
     let mut tables: Vec<Option<PosTable>> = vec![None; scene.protos.len()];
     let mut pos_tables = None;
-    if wants[4] {
+    if wants[4] || wants[PVC] {
         let mut used = vec![false; scene.protos.len()];
         for o in &scene.objects {
             used[o.proto as usize] = true;
@@ -422,7 +470,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                     pixels: covered,
                     state,
                 };
-                object_time(d, &mut count)
+                object_time(d, &mut count, &mut pos_clock)
             })?;
             renders += r;
             full += table.full_size();
@@ -440,16 +488,63 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
             },
         });
     }
+    // The view-cell estimators, for the cells the path visits.
+    let mut pvs = Pvs::default();
+    let mut view_cells: Option<(ViewCellTables, ViewCellSummary)> = None;
+    if wants[VCS] || wants[PVC] {
+        let Some(cell) = scene.view_cell else {
+            let i = cfg
+                .estimation
+                .estimators
+                .iter()
+                .position(|e| e == "vcs" || e == "pvc")
+                .unwrap_or(0);
+            return Err(invalid(
+                &format!("estimation.estimators.{i}"),
+                format!(
+                    "{:?} needs view cells (the city preset, or scene.view_cell > 0 with listed objects)",
+                    cfg.estimation.estimators[i]
+                ),
+            ));
+        };
+        let cells = super::view_cells::visited(&poses, cell).len() as u64;
+        let v = &cfg.estimation.view_cells;
+        let renders = cells * v.directions as u64 * v.samples as u64;
+        if wants[VCS] && renders > MAX_FRAMES {
+            return Err(invalid(
+                "estimation.view_cells.samples",
+                format!(
+                    "{cells} cells x {} directions x {} samples = {renders} sample views is more than the limit of {MAX_FRAMES}",
+                    v.directions, v.samples
+                ),
+            ));
+        }
+        let inputs = super::view_cells::Inputs {
+            cfg: v,
+            cam: &cfg.camera,
+            cell,
+            poses: &poses,
+            tables: &tables,
+            want: (wants[VCS], wants[PVC]),
+            seed: cfg.run.seed,
+        };
+        view_cells = Some(super::view_cells::build(
+            &inputs,
+            &scene,
+            &mut pvs,
+            &mut vcs_clock,
+            |draws| render_exact(draws, &mut count).map(|(rt, _)| rt),
+        )?);
+    }
     let build_seconds = t0.elapsed().as_secs_f64();
 
     // The frames.
     let t1 = Instant::now();
-    let mut pvs = Pvs::default();
     let mut seeds = frame_seeds(cfg.run.seed);
     let all: Vec<u32> = (0..scene.objects.len() as u32).collect();
     let mut est: Vec<Vec<f64>> = vec![Vec::with_capacity(poses.len()); ESTIMATORS.len()];
-    let mut wall = [0.0f64; 5];
-    let mut ops = [0u64; 5];
+    let mut wall = [0.0f64; ESTIMATORS.len()];
+    let mut ops = [0u64; ESTIMATORS.len()];
     let mut rows = Vec::with_capacity(poses.len());
     let (mut actual_ms, mut gpu_ms, mut visible_n, mut tris_n, mut pix_n) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -484,7 +579,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
         if visible.iter().any(|(_, p)| p.inside) {
             inside_frames += 1;
         }
-        let mut sums = [0.0f64; 5];
+        let mut sums = [0.0f64; ESTIMATORS.len()];
         for k in 0..4 {
             if !wants[k] {
                 continue;
@@ -510,13 +605,28 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
             ops[4] += reads;
             sums[4] = sum;
         }
+        if let Some((vc, _)) = &view_cells {
+            for k in [VCS, PVC] {
+                if wants[k] {
+                    let t = Instant::now();
+                    sums[k] = vc.lookup(k, pose);
+                    wall[k] += t.elapsed().as_secs_f64();
+                    ops[k] += 1;
+                }
+            }
+        }
         let (timing, by_kind, names) = actual.render_counted(&draws, next_seed(&mut seeds), start)?;
         count.add(timing.events, &by_kind, names);
         // RT = the frame's own terms + max(ET_cpu, ET_gpu) (paper 000 §4.1):
         // the empty frame, the CPU's submission work (known), the estimate.
-        for k in 0..5 {
+        for k in 0..ESTIMATORS.len() {
             if wants[k] {
-                est[k].push(ms(empty + sums[k].max(timing.cpu_submit as f64)));
+                // vcs measured whole frames: its table holds RT itself.
+                est[k].push(if k == VCS {
+                    ms(sums[k])
+                } else {
+                    ms(empty + sums[k].max(timing.cpu_submit as f64))
+                });
             }
         }
         let interval = if cfg.display.vsync {
@@ -543,7 +653,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
             ms(timing.gpu as f64),
             ms(refresh as f64),
         ];
-        for k in 0..5 {
+        for k in 0..ESTIMATORS.len() {
             if wants[k] {
                 row.push(est[k][f]);
             }
@@ -613,6 +723,16 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 h3: score(2),
                 h4: score(3),
                 pos: score(4),
+                vcs: score(VCS),
+                pvc: score(PVC),
+                view_cells: view_cells.map(|(_, s)| s),
+                timing: (cfg.estimation.timing == TimingMode::CpuClock).then(|| TimingSummary {
+                    mode: TimingMode::CpuClock.name(),
+                    overhead_ms: ms(cfg.estimation.clock_overhead.0 as f64),
+                    noise_ms: ms(cfg.estimation.clock_noise.0 as f64),
+                    readings: fit_clock.readings() + pos_clock.readings() + vcs_clock.readings(),
+                    per_object_bias_ms: ms(cfg.estimation.clock_overhead.0 as f64) / cfg.estimation.repeats as f64,
+                }),
             },
         },
     };
