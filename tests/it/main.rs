@@ -29,5 +29,6 @@ mod shards;
 mod sortbuf;
 mod timeline;
 mod unified;
+mod view_cells;
 mod vr;
 mod walkthrough;
