@@ -21,9 +21,9 @@ const WHOLE_LIMIT: usize = 16 * 1024;
 /// Summary keys that measure the machine, not the model.
 const WALL_KEYS: [&str; 4] = ["wall_seconds", "build_seconds", "simulate_seconds", "events_per_second"];
 /// Keys at any depth that measure the machine (the walkthrough's estimator
-/// costs), removed wherever they occur; experiment columns naming one are
+/// costs and view-cell preprocess times), removed wherever they occur; experiment columns naming one are
 /// left out too.
-const NESTED_WALL_KEYS: [&str; 1] = ["cost_us_per_frame"];
+const NESTED_WALL_KEYS: [&str; 3] = ["cost_us_per_frame", "vcs_preprocess_seconds", "pvc_preprocess_seconds"];
 
 fn remove_nested(v: &mut serde_json::Value) {
     match v {

@@ -8,7 +8,7 @@ use std::process::Command;
 
 use serde_json::Value;
 
-use crate::common::{num, summary_of, try_run_any};
+use crate::common::{num, try_run_any};
 
 const CITY: &str = include_str!("../../models/walkthrough-city.toml");
 
@@ -198,7 +198,7 @@ fn a_cpu_clock_without_overhead_or_jitter_reads_the_time_stamps() {
     sets.push("estimation.clock_overhead=\"40us\"");
     let slow = try_run_any(CITY, &sets).unwrap();
     let (p0, p1) = (column(&stamps, "EstPOSMs"), column(&slow, "EstPOSMs"));
-    assert!(p0.iter().zip(&p1).all(|(a, b)| b > a));
+    assert!(p0.iter().zip(&p1).all(|(a, b)| b >= a));
     assert!(
         num(slow.summary(), "metrics.estimation.pos.mean_error_ms")
             > num(stamps.summary(), "metrics.estimation.pos.mean_error_ms")

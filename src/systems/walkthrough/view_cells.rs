@@ -39,8 +39,10 @@
 //! clipped to the viewport (the largest over 17 offset directions: the
 //! clipped area falls along every ray from the centre, by Brunn-Minkowski),
 //! is the bound. An object is left out when β's bound exceeds the frustum's
-//! half-diagonal angle plus the angle of 1.5 R at distance d (a sphere the
-//! frustum's plane test can keep lies within that cone).
+//! half-diagonal angle plus the angle of R / sin ψ at distance d, ψ the
+//! smaller half field of view: the centres the frustum's plane test keeps
+//! (within R of each side plane) lie in the frustum's pyramid moved back by
+//! R / sin ψ along the axis, so within that distance of the pyramid.
 
 use std::collections::HashMap;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -152,6 +154,9 @@ pub struct Lens {
     pub far: f64,
     /// Half the diagonal field of view, radians.
     pub half_diagonal: f64,
+    /// 1 / sin of the smaller half field of view: how far (in radii) a
+    /// centre the plane test keeps may lie from the frustum's pyramid.
+    pub reach: f64,
 }
 
 impl Lens {
@@ -165,6 +170,7 @@ impl Lens {
             h,
             far: cam.far,
             half_diagonal: ((0.5 * w).hypot(0.5 * h) / focal).atan(),
+            reach: 1.0 / (0.5 * w.min(h) / focal).atan().sin(),
         }
     }
 }
@@ -254,7 +260,11 @@ pub fn object_bound(
     let cos_beta = eps.cos() - cos_min(e) * cos_min(nav.pitch) * (1.0 - delta_min.cos());
     let beta_min = cos_beta.clamp(-1.0, 1.0).acos();
     let inside = d_min <= r;
-    let margin = if inside { PI } else { (1.5 * r / d_min).min(1.0).asin() };
+    let margin = if inside {
+        PI
+    } else {
+        (lens.reach * r / d_min).min(1.0).asin()
+    };
     let beta_cap = (lens.half_diagonal + margin).min(PI);
     if beta_min > beta_cap {
         return None;
