@@ -12,9 +12,9 @@
 //! events, and within a level a lower digit means earlier, so the earliest
 //! bucket is found from two bit masks. When the run is empty the earliest
 //! bucket becomes the next run: a level-0 bucket holds one single time and
-//! is the run as it is; a level-1 bucket (256 ps) is distributed by its low
-//! byte into the level-0 buckets and these are appended in digit order (a
-//! counting sort, no comparisons); a bucket of at most [`SORT_MAX`] events
+//! is the run as it is; a level-1 bucket (256 ps) is sorted in place by its
+//! low byte (a stable counting sort, no comparisons) and becomes the run; a
+//! bucket of at most [`SORT_MAX`] events
 //! is sorted instead, and a larger one above level 1 spread around its
 //! minimum into lower buckets. `last` moves only then (moving it while the run is popped could
 //! file a later event into a lower bucket than an earlier one). An event
@@ -87,6 +87,8 @@ pub struct RadixHeap<E> {
     is_small: bool,
     /// Small form: pending events sorted by `(time, seq)`, latest first.
     small: Vec<Scheduled<E>>,
+    /// The counting sort's destinations (kept for its allocation).
+    scratch: Vec<u32>,
 }
 
 impl<E> Default for RadixHeap<E> {
@@ -123,6 +125,7 @@ impl<E> RadixHeap<E> {
             len: 0,
             is_small: true,
             small: Vec::with_capacity(SMALL_MAX),
+            scratch: Vec::new(),
         }
     }
 
@@ -277,6 +280,22 @@ impl<E> RadixHeap<E> {
             self.last = self.last.max(s.time.0);
             return Some(s);
         }
+        // The common case first, returned straight from the run: nothing
+        // stale, the run not empty, and enough left not to go back to the
+        // small form. (Keeping the popped event in a local across the rest
+        // would put it on the stack and read it back with wider loads than
+        // the stores that wrote it: a store-forwarding stall on every pop.)
+        if self.len > SMALL_BACK + 1 && self.stale.is_empty() && !self.run.is_empty() {
+            self.len -= 1;
+            return self.run.pop_front();
+        }
+        self.pop_slow()
+    }
+
+    /// [`RadixHeap::pop`] in the bucket form when the run is empty, an
+    /// event is stale, or the heap goes back to the small form.
+    #[inline(never)]
+    fn pop_slow(&mut self) -> Option<Scheduled<E>> {
         let s = self.pop_buckets();
         if self.len <= SMALL_BACK {
             self.gather_to_small();
@@ -343,9 +362,8 @@ impl<E> RadixHeap<E> {
     /// The run is empty: the earliest bucket becomes the run. A level-0
     /// bucket holds one time and is in order already; one of at most
     /// [`SORT_MAX`] events is sorted; a larger level-1 bucket is
-    /// distributed by its low byte into the (empty) level-0 buckets, which
-    /// are then appended to the run in digit order (a stable counting sort:
-    /// no comparisons); a larger one above is spread around its minimum,
+    /// sorted in place by its low byte (a stable counting sort: no
+    /// comparisons, no allocation); a larger one above is spread around its minimum,
     /// which becomes the new `last`, into lower buckets.
     fn refill(&mut self) {
         debug_assert!(self.run.is_empty());
@@ -371,27 +389,42 @@ impl<E> RadixHeap<E> {
             return;
         }
         if l == 1 {
-            // Every level-0 bucket is empty (level 1 is the earliest).
-            let mut mask = [0u64; 4];
-            for s in moving.drain(..) {
-                let d = (s.time.0 & 0xff) as usize;
-                mask[d / 64] |= 1 << (d % 64);
-                self.buckets[d].push(s);
+            // A stable counting sort on the low byte, in place: each event's
+            // place from the counts of the smaller digits (and of the
+            // earlier events of its own digit), then every event swapped
+            // into its place along the permutation's cycles. No comparisons
+            // and no allocation: the bucket becomes the run.
+            let mut count = [0u32; DIGITS];
+            for s in &moving {
+                count[(s.time.0 & 0xff) as usize] += 1;
             }
-            self.buckets[DIGITS + v] = moving;
-            // The run is built as a vector (appending a bucket is one copy)
-            // on the run's own allocation, then made the run again.
-            let mut run = Vec::from(std::mem::take(&mut self.run));
-            for (w, mut bits) in mask.into_iter().enumerate() {
-                while bits != 0 {
-                    let d = w * 64 + bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    run.append(&mut self.buckets[d]);
+            let mut at = 0u32;
+            for c in count.iter_mut() {
+                let n = *c;
+                *c = at;
+                at += n;
+            }
+            let dest = &mut self.scratch;
+            dest.clear();
+            dest.extend(moving.iter().map(|s| {
+                let c = &mut count[(s.time.0 & 0xff) as usize];
+                *c += 1;
+                *c - 1
+            }));
+            for i in 0..moving.len() {
+                loop {
+                    let j = dest[i] as usize;
+                    if j == i {
+                        break;
+                    }
+                    moving.swap(i, j);
+                    dest.swap(i, j);
                 }
             }
-            self.last = run.first().map_or(self.last, |s| s.time.0);
-            self.run_hi = run.last().map_or(self.last, |s| s.time.0);
-            self.run = VecDeque::from(run);
+            self.last = moving.first().map_or(self.last, |s| s.time.0);
+            self.run_hi = moving.last().map_or(self.last, |s| s.time.0);
+            let old = std::mem::replace(&mut self.run, VecDeque::from(moving));
+            self.buckets[l * DIGITS + v] = Vec::from(old);
             return;
         }
         self.last = moving.iter().map(|s| s.time.0).min().unwrap_or(self.last);

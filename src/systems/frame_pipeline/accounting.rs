@@ -271,17 +271,20 @@ impl FramePipeline {
         let gpu_state = if gpu_busy { 0 } else { 1 };
 
         let a = &mut self.acct;
-        // Nothing changed since the last event (no state, no frame, no
-        // trace): every step below would add nothing.
-        if a.trace.is_none()
-            && cpu_state == a.cpu.state()
-            && front_state == a.front.state()
-            && geom_state == a.geom.state()
-            && frag_state == a.frag.state()
-            && gpu_state == a.gpu.state()
-            && self.cpu_frame == a.cpu_frame
-            && (self.gpu_frame.is_none() || self.gpu_frame == a.gpu_frame)
-        {
+        if a.trace.is_none() {
+            // Nothing changed since the last event (no state, no frame):
+            // every step would add nothing.
+            if cpu_state == a.cpu.state()
+                && front_state == a.front.state()
+                && geom_state == a.geom.state()
+                && frag_state == a.frag.state()
+                && gpu_state == a.gpu.state()
+                && self.cpu_frame == a.cpu_frame
+                && (self.gpu_frame.is_none() || self.gpu_frame == a.gpu_frame)
+            {
+                return;
+            }
+            self.account_untraced(now, [cpu_state, front_state, geom_state, frag_state, gpu_state]);
             return;
         }
         // CPU: attribute the closing interval to the frame it belonged to.
@@ -346,6 +349,57 @@ impl FramePipeline {
 }
 
 impl FramePipeline {
+    /// [`FramePipeline::account`] without a trace (every long run): the
+    /// same clock moves and per-frame attribution, with no trace checks
+    /// between them. `states`: CPU, front end, geometry, fragment, GPU.
+    #[inline]
+    fn account_untraced(&mut self, now: Time, states: [usize; 5]) {
+        let [cpu_state, front_state, geom_state, frag_state, gpu_state] = states;
+        let a = &mut self.acct;
+        let records = &mut self.records;
+        let attribute_cpu = |records: &mut Vec<FrameRecord>, old: usize, spent: u64, frame: u64| {
+            if let Some(r) = records.get_mut(frame as usize) {
+                match old {
+                    0 | 1 => r.cpu_busy += spent,
+                    2 | 3 => r.cpu_wait += spent,
+                    _ => {}
+                }
+            }
+        };
+        // CPU: attribute the closing interval to the frame it belonged to.
+        let old = a.cpu.state();
+        let spent = a.cpu.set(now, cpu_state).0;
+        if spent > 0 {
+            attribute_cpu(records, old, spent, a.cpu_frame);
+        }
+        if self.cpu_frame != a.cpu_frame {
+            let st = a.cpu.state();
+            let spent = a.cpu.split(now).0;
+            attribute_cpu(records, st, spent, a.cpu_frame);
+            a.cpu_frame = self.cpu_frame;
+        }
+        a.front.set(now, front_state);
+        a.geom.set(now, geom_state);
+        a.frag.set(now, frag_state);
+        // GPU busy per frame (the frame the front end is on).
+        let old = a.gpu.state();
+        let spent = a.gpu.set(now, gpu_state).0;
+        let frame_changed = self.gpu_frame != a.gpu_frame && self.gpu_frame.is_some();
+        let spent = if frame_changed && old == gpu_state {
+            spent + a.gpu.split(now).0
+        } else {
+            spent
+        };
+        if old == 0
+            && let Some(r) = a.gpu_frame.and_then(|f| records.get_mut(f as usize))
+        {
+            r.gpu_busy += spent;
+        }
+        if self.gpu_frame.is_some() {
+            a.gpu_frame = self.gpu_frame;
+        }
+    }
+
     /// Each unit's mode for the critical path (see [`super::critical_path`]).
     fn path_modes(&self) -> Modes {
         let cpu = match self.cpu_phase {

@@ -349,7 +349,18 @@ impl FramePipeline {
 
     /// Unified pool: after an instant's changes, schedules the completions
     /// whose time moved (stale ones are ignored by their tags).
+    #[inline]
     pub(super) fn pool_settle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+        // Split (and `draw` fidelity): no pool, nothing to do, no call.
+        if self.pool.is_none() {
+            return Ok(());
+        }
+        self.pool_settle_unified(now, s)
+    }
+
+    /// [`FramePipeline::pool_settle`] with a pool.
+    #[inline(never)]
+    fn pool_settle_unified(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         if let Some(pool) = &mut self.pool {
             for d in pool.settle(now)?.iter() {
                 s.at(
