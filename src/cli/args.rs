@@ -281,7 +281,7 @@ pub struct StudyArgs {
     #[arg(value_parser = Choice::<Study>::new(unknown_study))]
     pub name: Study,
     /// Recorded passes per timed measurement, interleaved across a study's
-    /// passes (the median is used). Default 5; estimation: 3.
+    /// passes (the median is used). Default 5.
     #[arg(long)]
     pub repeats: Option<u32>,
     /// Also write the device's Markdown document to FILE (e.g. docs/measurements/<adapter>.md).

@@ -120,7 +120,7 @@ impl Default for EstimationSetup {
             overhead_passes: 16,
             min_side: 8.0,
             target: [256, 256],
-            repeats: 3,
+            repeats: 5,
             load_scale: 1.0,
             max_vs_loops: 300,
             max_fs_loops: 30,
@@ -548,6 +548,8 @@ pub struct EstimationStudy {
     pub checks: EstimationChecks,
     /// The prototypes with their counts and tables.
     pub prototypes: Vec<PrototypeResult>,
+    /// Notes on the adapter (a software rasterizer's times vary with load).
+    pub notes: String,
 }
 
 const PIXELS: &str =
@@ -774,6 +776,7 @@ pub fn analyze(
         },
         checks,
         prototypes,
+        notes: String::new(),
     };
     for (name, set) in [("single", &single), ("multi", &multi)] {
         let passes: Vec<&PlannedPass> = set.iter().map(|(p, _)| *p).collect();
@@ -909,6 +912,10 @@ impl EstimationStudy {
             self.command,
             env!("CARGO_PKG_VERSION")
         );
+        if !self.notes.is_empty() {
+            d += self.notes.trim_end();
+            d += "\n\n";
+        }
         d += &format!(
             "**Verdict.** {}.\n\n\
              What was measured (paper 000 §5; issue 11 item 8): {} prototypes (a generator mesh with its own \

@@ -26,6 +26,12 @@ const OBJECT_BYTES: u64 = 32;
 /// Bytes of one pipeline-statistics result (four counters).
 const STATS_BYTES: u64 = 32;
 
+/// The note on a software rasterizer's times.
+const CPU_NOTE: &str = "The adapter is a software rasterizer on this machine's CPU: a pass time is the CPU time it \
+    spends plus any time its threads wait for a core. On a busy machine a long pass is likely to be stretched more \
+    than a short one (its threads are more likely to be preempted), which estimators fitted to single-object passes \
+    (mostly short) cannot know: compare the mean errors on single- and multi-object passes.";
+
 /// The study's result with what it was computed from.
 #[derive(Debug)]
 pub struct EstimationRun {
@@ -43,8 +49,11 @@ pub fn run_estimation(gpu: &Gpu, plan: Plan, command: &str) -> Result<Estimation
     let start = Instant::now();
     let measured = measure_plan(gpu, &plan)?;
     let wall = start.elapsed().as_secs_f64();
-    let study =
+    let mut study =
         analyze(&plan, &measured, &gpu.describe(), command, wall).map_err(|e| StudyError::Mesh(e.to_string()))?;
+    if gpu.adapter.device_type == "Cpu" {
+        study.notes = CPU_NOTE.to_string();
+    }
     Ok(EstimationRun { plan, measured, study })
 }
 
