@@ -98,7 +98,7 @@ if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
   "$RENDERSIM_BIN" study estimation --single 1000 --multi 300 --repeats 5 --markdown "$ci_out/estimation.md" \
     --csv "$ci_out/estimation-passes.csv" > "$ci_out/estimation.txt" 2> "$ci_out/estimation.err" \
     || { cat "$ci_out/estimation.txt" "$ci_out/estimation.err"; exit 1; }
-  grep -m 1 '^**Verdict' "$ci_out/estimation.md"
+  grep -m 1 -F '**Verdict.**' "$ci_out/estimation.md"
 else
   echo "no Vulkan driver installed: estimation study skipped"
 fi
