@@ -15,6 +15,8 @@
 #   adapter.json adapter.txt              the adapter as wgpu reports it; nvidia-smi, uname, rendersim version
 #   studies.md studies.json studies.err   `rendersim study all` (an inexact H1 is a finding: exit status 0)
 #   studies-passes.csv                    every pass the studies measured (pass CSV format)
+#   estimation.md estimation.json         `rendersim study estimation` (h1-h4 and pos fitted on measured
+#   estimation-passes.csv estimation.err  single-object passes, scored on multi-object passes; one CSV row per object)
 #   load-grid.csv                         the passes of docs/measurements/nvidia-h200/load-grid.csv
 #   load-sweep.csv                        every pass of the H200 sweep's lists (6 meshes x 3 sizes x 7 loads),
 #                                         the rows the shared file held out included, less the capped ones
@@ -28,12 +30,18 @@
 # each, the studies about 10 s); every measurement is limited to
 # PASS_TIMEOUT seconds (60) and no new one starts after DEADLINE seconds
 # (450), so a slower device still ends within the device tool's 10 minutes.
+# The estimation study (1,412 passes x 5 rounds at --load-scale
+# EST_LOAD_SCALE, default 10: loop counts from the H200 files' ns per loop,
+# at most ~1 ms per object there) is estimated at under 30 s and limited to
+# 240 s.
 #
 # Environment: RENDERSIM (binary; default dist/rendersim, else
 # target/release/rendersim), QUICK=1 (a scaled-down run for lavapipe: small
 # meshes and targets, loop counts / 100, H1 only, one pass per measurement),
 # DRY_RUN=1 (print the commands, measure nothing), PASS_TIMEOUT, DEADLINE,
-# CORPUS (default docs/measurements/nvidia-h200/corpus).
+# CORPUS (default docs/measurements/nvidia-h200/corpus), EST_LOAD_SCALE
+# (the estimation study's --load-scale; QUICK=1: 1, with 100 single and 30
+# multi-object passes, one round).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -61,6 +69,7 @@ collect() {
   local sweep_loads=("0 0" "1000 0" "0 300" "1000 300" "10000 3000" "1000 0 geo" "10000 0 geo")
   local passes=(--repeats 5 --warmup 2) heavy_passes=(--repeats 3 --warmup 1)
   local study=all corpus_files
+  local est_args=(--load-scale "${EST_LOAD_SCALE:-10}" --repeats 5)
   corpus_files=$(ls "$corpus"/*.idx 2>/dev/null || true)
   if [ -n "$quick" ]; then
     grid_mesh=grid:16x16:optimized grid_size=64x64
@@ -71,6 +80,7 @@ collect() {
     sweep_loads=("0 0" "10 0" "0 3" "10 3" "100 30" "10 0 geo" "100 0 geo")
     passes=(--repeats 1 --warmup 0) heavy_passes=(--repeats 1 --warmup 0)
     study=h1
+    est_args=(--load-scale "${EST_LOAD_SCALE:-1}" --single 100 --multi 30 --repeats 1)
     corpus_files=$(printf '%s\n' $corpus_files | head -n 4)
   fi
 
@@ -161,6 +171,18 @@ collect() {
       "$study_rc" "$((SECONDS - t0))" >> "$dir/commands.txt"
   fi
 
+  # 2b. Rendering-time estimation: h1-h4 and pos on measured passes.
+  local est_rc=0
+  if [ -n "$dry" ]; then
+    echo "$bin study estimation ${est_args[*]} --markdown $dir/estimation.md --json --csv $dir/estimation-passes.csv > $dir/estimation.json 2> $dir/estimation.err"
+  else
+    local t0=$SECONDS
+    limit 240 "$bin" study estimation "${est_args[@]}" --markdown "$dir/estimation.md" --json \
+      --csv "$dir/estimation-passes.csv" > "$dir/estimation.json" 2> "$dir/estimation.err" || est_rc=$?
+    printf '%s\t# exit %s, %s s\n' "$bin study estimation ${est_args[*]} --markdown estimation.md --json --csv estimation-passes.csv" \
+      "$est_rc" "$((SECONDS - t0))" >> "$dir/commands.txt"
+  fi
+
   # 3. The load grid, in the shared file's order.
   local vs fs mesh size
   for vs in "${grid_vs[@]}"; do
@@ -215,7 +237,8 @@ collect() {
   done
 
   [ -z "$dry" ] || return 0
-  write_readme "$dir" "$bin" "$study" "$study_rc" "$((SECONDS - start))" "${passes[*]}" "${heavy_passes[*]}"
+  write_readme "$dir" "$bin" "$study" "$study_rc" "$((SECONDS - start))" "${passes[*]}" "${heavy_passes[*]}" \
+    "${est_args[*]}" "$est_rc"
   echo "collected into $dir in $((SECONDS - start)) s:"
   (cd "$dir" && wc -l ./*.csv skipped.txt | sed 's/^/  /')
   head -c 3000 "$dir/studies.md" 2>/dev/null || true
@@ -223,7 +246,7 @@ collect() {
 
 # README.md: how each file of DIR was produced.
 write_readme() {
-  local dir=$1 bin=$2 study=$3 study_rc=$4 secs=$5 passes=$6 heavy=$7
+  local dir=$1 bin=$2 study=$3 study_rc=$4 secs=$5 passes=$6 heavy=$7 est_args=$8 est_rc=$9
   local rows
   rows() { if [ -f "$dir/$1" ]; then echo $(($(wc -l < "$dir/$1") - 1)); else echo 0; fi; }
   cat > "$dir/README.md" <<EOF
@@ -239,6 +262,8 @@ queries around the render pass, medians of the recorded passes.
 | \`adapter.json\`, \`adapter.txt\` | the adapter as wgpu reports it; nvidia-smi, uname, rendersim version and commit | \`rendersim measure grid:1x1 --size 64x64 --repeats 1 --warmup 0 --json\` |
 | \`studies.md\`, \`studies.json\`, \`studies.err\` | \`rendersim study $study\` (exit status $study_rc; an inexact H1 is printed to \`studies.err\` with its residuals and exits 0) | \`rendersim study $study --repeats 5 --markdown studies.md --json --csv studies-passes.csv\` |
 | \`studies-passes.csv\` | $(rows studies-passes.csv) passes the studies measured, loop searches included (pass CSV: \`$(head -n 1 "$dir/studies-passes.csv" 2>/dev/null)\`); H1's probes and H3's layered passes have no row | as above |
+| \`estimation.md\`, \`estimation.json\`, \`estimation.err\` | \`rendersim study estimation\` (exit status $est_rc): h1-h4 fitted on measured single-object passes, pos tables from table passes, both scored on multi-object passes | \`rendersim study estimation $est_args --markdown estimation.md --json --csv estimation-passes.csv\` |
+| \`estimation-passes.csv\` | $(rows estimation-passes.csv) rows: one per object drawn (one per empty pass) with the pass's time and counters and each estimator's estimate | as above |
 | \`load-grid.csv\` | $(rows load-grid.csv) passes: the lists of \`docs/measurements/nvidia-h200/load-grid.csv\` | \`rendersim measure MESH --size S --vs-loops V --fs-loops F [--geometry-only] $passes --csv load-grid.csv\` |
 | \`load-sweep.csv\` | $(rows load-sweep.csv) passes: every mesh, size and load of \`docs/measurements/nvidia-h200/load-sweep.csv\`'s lists, held-out rows included; the capped ones are in \`skipped.txt\` | as above (the random mesh: \`$heavy\`), \`--csv load-sweep.csv\` |
 | \`vertex-reuse.csv\`, \`corpus-passes.csv\` | $(rows vertex-reuse.csv) corpus meshes: indices, unique vertices, vertex-shader invocations of one draw (compare with \`docs/measurements/nvidia-h200/vertex-reuse.csv\`) | \`rendersim measure CORPUS/X.idx --size 256x256 --repeats 1 --warmup 0 --json --csv corpus-passes.csv\` (the measured shaders; counters do not depend on them) |

@@ -92,6 +92,17 @@ else
   echo "no Vulkan driver installed: studies skipped"
 fi
 
+step "Rendering-time estimation on this machine's adapter (h1-h4 and pos; 1000 single-, 300 multi-object passes)"
+if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
+  # 10-13 s on lavapipe on the 2-core machine (1,412 passes x 5 rounds).
+  "$RENDERSIM_BIN" study estimation --single 1000 --multi 300 --repeats 5 --markdown "$ci_out/estimation.md" \
+    --csv "$ci_out/estimation-passes.csv" > "$ci_out/estimation.txt" 2> "$ci_out/estimation.err" \
+    || { cat "$ci_out/estimation.txt" "$ci_out/estimation.err"; exit 1; }
+  grep -m 1 -F '**Verdict.**' "$ci_out/estimation.md"
+else
+  echo "no Vulkan driver installed: estimation study skipped"
+fi
+
 step "Experiments"
 for f in experiments/*.toml; do
   name=$(basename "$f" .toml)

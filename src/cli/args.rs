@@ -276,13 +276,14 @@ pub struct PredictArgs {
 #[derive(Args)]
 #[cfg_attr(not(feature = "wgpu"), allow(dead_code))] // read only with the `wgpu` feature
 pub struct StudyArgs {
-    /// Study name: h1, h2, h3, h4 or all.
+    /// Study name: h1, h2, h3, h4, all (H1-H4), or estimation (h1-h4 and pos
+    /// fitted on single-object passes, scored on multi-object passes).
     #[arg(value_parser = Choice::<Study>::new(unknown_study))]
     pub name: Study,
     /// Recorded passes per timed measurement, interleaved across a study's
-    /// passes (the median is used).
-    #[arg(long, default_value_t = 5)]
-    pub repeats: u32,
+    /// passes (the median is used). Default 5.
+    #[arg(long)]
+    pub repeats: Option<u32>,
     /// Also write the device's Markdown document to FILE (e.g. docs/measurements/<adapter>.md).
     #[arg(long, value_name = "FILE")]
     pub markdown: Option<PathBuf>,
@@ -298,6 +299,19 @@ pub struct StudyArgs {
     /// its residuals, and the exit status is 0. For CI on lavapipe.
     #[arg(long)]
     pub require_exact: bool,
+    /// estimation: single-object passes measured to fit h1-h4 (default 1000).
+    #[arg(long, value_name = "N")]
+    pub single: Option<usize>,
+    /// estimation: multi-object passes measured to score the estimators (default 300).
+    #[arg(long, value_name = "M")]
+    pub multi: Option<usize>,
+    /// estimation: master seed of the pass generator (default 1).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// estimation: multiplies every prototype's shader loop counts (default 1,
+    /// for lavapipe; a GPU needs more work for measurable times).
+    #[arg(long, value_name = "X")]
+    pub load_scale: Option<f64>,
 }
 
 /// `rendersim bench`.
@@ -357,6 +371,8 @@ pub enum Study {
     H4,
     /// All four.
     All,
+    /// Rendering-time estimation: h1-h4 and pos on measured passes.
+    Estimation,
 }
 
 #[cfg_attr(not(feature = "wgpu"), allow(dead_code))]
@@ -370,7 +386,7 @@ impl Study {
 }
 
 fn unknown_study(s: &str) -> String {
-    format!("unknown study {s:?} (available: h1, h2, h3, h4, all)")
+    format!("unknown study {s:?} (available: h1, h2, h3, h4, all, estimation)")
 }
 
 /// The benchmarks of `rendersim bench`.

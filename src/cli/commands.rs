@@ -316,7 +316,13 @@ pub fn measure(_args: MeasureArgs) -> Result<()> {
 pub fn study(args: StudyArgs) -> Result<()> {
     use rendersim::measure::passes::{append_passes, check_appendable};
     use rendersim::measure::{Gpu, studies};
-    let (name, repeats, json) = (args.name.name(), args.repeats, args.json);
+    if args.name == super::args::Study::Estimation {
+        return study_estimation(args);
+    }
+    if args.single.is_some() || args.multi.is_some() || args.seed.is_some() || args.load_scale.is_some() {
+        bail!("--single, --multi, --seed and --load-scale belong to `rendersim study estimation`");
+    }
+    let (name, repeats, json) = (args.name.name(), args.repeats.unwrap_or(5), args.json);
     let names = studies::study_names(&name)?;
     if repeats == 0 {
         bail!("--repeats must be at least 1");
@@ -369,6 +375,59 @@ pub fn study(args: StudyArgs) -> Result<()> {
         } else {
             println!("finding: {}", finding.describe());
         }
+    }
+    Ok(())
+}
+
+/// `rendersim study estimation`: h1-h4 fitted on measured single-object
+/// passes, pos tables from table passes, both scored on multi-object passes.
+#[cfg(feature = "wgpu")]
+fn study_estimation(args: StudyArgs) -> Result<()> {
+    use rendersim::measure::Gpu;
+    use rendersim::measure::estimation::{CSV_HEADER, EstimationSetup, Plan, csv_rows};
+    use rendersim::measure::estimation_device::run_estimation;
+    use rendersim::output::files::write_output;
+    if args.require_exact {
+        bail!("--require-exact belongs to study H1 (`study h1` or `study all`), not to `study estimation`");
+    }
+    let d = EstimationSetup::default();
+    let setup = EstimationSetup {
+        seed: args.seed.unwrap_or(d.seed),
+        single: args.single.unwrap_or(d.single),
+        multi: args.multi.unwrap_or(d.multi),
+        repeats: args.repeats.unwrap_or(d.repeats),
+        load_scale: args.load_scale.unwrap_or(d.load_scale),
+        ..d
+    };
+    // Validated (and every pass generated) before the adapter is opened.
+    let plan = Plan::new(&setup)?;
+    let gpu = Gpu::open()?;
+    let command = format!(
+        "rendersim study estimation --single {} --multi {} --repeats {} --seed {} --load-scale {}",
+        setup.single, setup.multi, setup.repeats, setup.seed, setup.load_scale
+    );
+    if !args.json {
+        eprintln!(
+            "measuring {} passes ({} objects) x {} rounds on {}",
+            plan.passes.len(),
+            plan.objects(),
+            setup.repeats,
+            gpu.describe()
+        );
+    }
+    let run = run_estimation(&gpu, plan, &command)?;
+    if let Some(path) = &args.csv {
+        let rows = csv_rows(&run.plan, &run.measured, &run.study);
+        write_output(path, |w| rendersim::output::table::write_table(w, &CSV_HEADER, rows))?;
+    }
+    let document = run.study.markdown();
+    if let Some(path) = &args.markdown {
+        write_output(path, |w| w.write_all(document.as_bytes()))?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&run.study)?);
+    } else {
+        println!("{document}");
     }
     Ok(())
 }

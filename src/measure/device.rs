@@ -209,6 +209,11 @@ impl Gpu {
         }
     }
 
+    /// The opened device and its queue (for the estimation study's own pipeline).
+    pub(super) fn device_queue(&self) -> (&wgpu::Device, &wgpu::Queue) {
+        (&self.device, &self.queue)
+    }
+
     /// One line naming the adapter: name (driver, driver info, device type).
     pub fn describe(&self) -> String {
         let a = &self.adapter;

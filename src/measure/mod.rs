@@ -26,12 +26,18 @@
 //! to measured passes (what they cover: `coverage.rs`), `device_predict.rs`
 //! runs one pass on it through the frame-pipeline model (`predict.rs`).
 //!
+//! Rendering-time estimation (issue 11 item 8, paper 000 §5): `estimation.rs`
+//! plans single- and multi-object passes, fits h1-h4 and builds pos tables,
+//! and scores them; `estimation_device.rs` measures the plan
+//! (`rendersim study estimation`).
+//!
 //! What lavapipe's counters mean is noted in `docs/measurements/README.md`.
 
 pub mod calibrate;
 pub mod coverage;
 pub mod device_predict;
 pub mod device_profile;
+pub mod estimation;
 pub mod fit;
 pub mod h2;
 pub mod h3;
@@ -43,6 +49,8 @@ pub mod report;
 
 #[cfg(feature = "wgpu")]
 mod device;
+#[cfg(feature = "wgpu")]
+pub mod estimation_device;
 mod geometry;
 #[cfg(feature = "wgpu")]
 pub mod h1;

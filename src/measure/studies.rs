@@ -260,7 +260,7 @@ pub fn run_h4(gpu: &Gpu, mut setup: H4Setup, rounds: u32) -> Result<H4, StudyErr
 
 /// A study name that is not one.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown study {0:?} (available: h1, h2, h3, h4, all)")]
+#[error("unknown study {0:?} (available: h1, h2, h3, h4, all, estimation)")]
 pub struct UnknownStudy(pub String);
 
 /// The studies `name` stands for: `h1` .. `h4`, or `all`.

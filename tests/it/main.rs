@@ -12,6 +12,7 @@ mod conservation;
 mod determinism;
 mod devices;
 mod display_oracles;
+mod estimation;
 mod extreme;
 mod fuzz;
 mod golden;
