@@ -24,7 +24,9 @@
 //!
 //! Device profiles (issue 10): `calibrate.rs` fits a `device_profile.rs`
 //! to measured passes (what they cover: `coverage.rs`), `device_predict.rs`
-//! runs one pass on it through the frame-pipeline model (`predict.rs`).
+//! runs one pass on it through the frame-pipeline model (`predict.rs`), and
+//! `predictions.rs` predicts every measured row (leave-one-out and
+//! simulated) for the per-device report.
 //!
 //! What lavapipe's counters mean is noted in `docs/measurements/README.md`.
 
@@ -39,6 +41,7 @@ pub mod h4;
 pub mod loops;
 pub mod passes;
 pub mod predict;
+pub mod predictions;
 pub mod report;
 
 #[cfg(feature = "wgpu")]
