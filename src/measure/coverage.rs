@@ -256,11 +256,68 @@ impl TileRow {
     }
 }
 
+/// Triangles counted per parallel chunk, and chunks per batch (the
+/// per-triangle tile summaries of one batch are held at once).
+const CHUNK: usize = 4096;
+const BATCH: usize = 64;
+
+/// What the warp packing needs of one triangle that touched a tile: its
+/// first tile and quads, its last tile and quads, and the warps of every
+/// tile after the first.
+#[derive(Clone, Copy)]
+struct Touch {
+    first: (u32, u32),
+    last: (u32, u32),
+    more: bool,
+    rest_warps: u64,
+}
+
 /// Counts what one draw of `mesh` (generator spec `spec`) covers on a
-/// `width` x `height` target.
+/// `width` x `height` target. Triangles are counted in parallel chunks
+/// (rayon); the warp packing, which carries an open warp from one triangle
+/// to the next, then runs over their summaries in draw order, so the
+/// counts do not depend on the threads.
 pub fn coverage(mesh: &Mesh, spec: &str, width: u32, height: u32) -> Coverage {
+    use rayon::prelude::*;
     let list = mesh.to_triangle_list();
     let pos = mesh_positions(mesh, spec);
+    let mut pack = Packer {
+        tile: None,
+        fill: 0,
+        warps: 0,
+    };
+    let mut c = Coverage::default();
+    for batch in list.indices.chunks(3 * CHUNK * BATCH) {
+        let parts: Vec<(Coverage, Vec<Touch>)> = batch
+            .par_chunks(3 * CHUNK)
+            .map(|chunk| count_chunk(chunk, &pos, width, height))
+            .collect();
+        for (part, touches) in parts {
+            c.drawn_triangles += part.drawn_triangles;
+            c.triangles += part.triangles;
+            c.fragments += part.fragments;
+            c.quads += part.quads;
+            for t in touches {
+                // The first tile may continue the previous triangle's open
+                // warp; every later tile differs from the open warp's tile,
+                // so it starts its own warps, and the last one stays open.
+                pack.emit(t.first.0, t.first.1);
+                if t.more {
+                    let (tk, nk) = t.last;
+                    pack.warps += t.rest_warps;
+                    pack.tile = Some(tk);
+                    pack.fill = nk - WARP_QUADS * (nk.div_ceil(WARP_QUADS) - 1);
+                }
+            }
+        }
+    }
+    c.warps = pack.warps;
+    c
+}
+
+/// Fragments, quads and covered triangles of the triangles in `indices`
+/// (a triangle list), and the tile summary of each that touched a tile.
+fn count_chunk(indices: &[u32], pos: &[[f32; 2]], width: u32, height: u32) -> (Coverage, Vec<Touch>) {
     let (w, h) = (f64::from(width), f64::from(height));
     let tiles_x = width.div_ceil(TILE_PIXELS);
     let cols = tiles_x as usize + 1;
@@ -269,15 +326,11 @@ pub fn coverage(mesh: &Mesh, spec: &str, width: u32, height: u32) -> Coverage {
         part: vec![0; cols],
         seen: vec![false; cols],
     };
-    let mut pack = Packer {
-        tile: None,
-        fill: 0,
-        warps: 0,
-    };
     let mut c = Coverage::default();
+    let mut touches = Vec::new();
     let tile_quads = TILE_PIXELS / 2;
     let mut ranges_buf: Vec<(u32, u32)> = Vec::with_capacity(2 * tile_quads as usize);
-    for t in list.indices.chunks_exact(3) {
+    for t in indices.chunks_exact(3) {
         c.drawn_triangles += 1;
         let p = [0, 1, 2].map(|k| {
             let v = pos.get(t[k] as usize).copied().unwrap_or([0.0, 0.0]);
@@ -293,9 +346,8 @@ pub fn coverage(mesh: &Mesh, spec: &str, width: u32, height: u32) -> Coverage {
         }
         let (mut frags, mut quads) = (0u64, 0u64);
         let mut acc = TriangleTiles::default();
-        // The ranges of the tile row being gathered, and of the last one
-        // that had any (flushed once a later one has ranges too).
-        let mut cur_trow: Option<u32> = None;
+        // The tile row whose ranges are gathered in `ranges_buf` (flushed
+        // once a later tile row has ranges too, or at the end as the last).
         let mut pending: Option<u32> = None;
         ranges_buf.clear();
         let spans = Spans::new(p);
@@ -319,12 +371,11 @@ pub fn coverage(mesh: &Mesh, spec: &str, width: u32, height: u32) -> Coverage {
             };
             let trow = qr as u32 / tile_quads;
             for r in ranges.into_iter().flatten() {
-                if cur_trow != Some(trow) {
-                    if let Some(done) = pending.take() {
-                        row.flush(done, tiles_x, &ranges_buf, false, &mut acc);
-                        ranges_buf.clear();
-                    }
-                    cur_trow = Some(trow);
+                if let Some(done) = pending
+                    && done != trow
+                {
+                    row.flush(done, tiles_x, &ranges_buf, false, &mut acc);
+                    ranges_buf.clear();
                 }
                 pending = Some(trow);
                 quads += u64::from(r.1 - r.0 + 1);
@@ -335,16 +386,13 @@ pub fn coverage(mesh: &Mesh, spec: &str, width: u32, height: u32) -> Coverage {
         if let Some(done) = pending {
             row.flush(done, tiles_x, &ranges_buf, true, &mut acc);
         }
-        if let (Some((t1, n1)), Some((tk, nk))) = (acc.first, acc.last) {
-            // The first tile may continue the previous triangle's open
-            // warp; every later tile differs from the open warp's tile, so
-            // it starts its own warps, and the last one stays open.
-            pack.emit(t1, n1);
-            if acc.tiles > 1 {
-                pack.warps += acc.warps - u64::from(n1.div_ceil(WARP_QUADS));
-                pack.tile = Some(tk);
-                pack.fill = nk - WARP_QUADS * (nk.div_ceil(WARP_QUADS) - 1);
-            }
+        if let (Some(first), Some(last)) = (acc.first, acc.last) {
+            touches.push(Touch {
+                first,
+                last,
+                more: acc.tiles > 1,
+                rest_warps: acc.warps - u64::from(first.1.div_ceil(WARP_QUADS)),
+            });
         }
         if frags > 0 {
             c.triangles += 1;
@@ -352,8 +400,7 @@ pub fn coverage(mesh: &Mesh, spec: &str, width: u32, height: u32) -> Coverage {
         c.fragments += frags;
         c.quads += quads;
     }
-    c.warps = pack.warps;
-    c
+    (c, touches)
 }
 
 #[cfg(test)]
