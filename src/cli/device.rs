@@ -12,10 +12,10 @@ use rendersim::measure::calibrate::{
     Invocations, LoadCache, error_summary, fit, held_out_half, leave_one_out, leave_one_out_ns, linear_baseline_loo,
     read_rows, row_load,
 };
-use rendersim::measure::predictions::predict_rows;
 use rendersim::measure::device_predict::{DevicePass, predict_on_device};
 use rendersim::measure::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy};
 use rendersim::measure::fit::rel_error_pct;
+use rendersim::measure::predictions::predict_rows;
 
 use super::args::{CalibrateArgs, PredictArgs};
 

@@ -513,11 +513,23 @@ mod tests {
         // Every mesh and size of the shipped pass CSVs (H200 and llvmpipe),
         // and odd target sizes, thin and off-screen triangles.
         let cases: &[(&str, &[(u32, u32)])] = &[
-            ("grid:256x256", &[(64, 64), (128, 128), (512, 512), (1024, 1024), (2048, 2048)]),
-            ("grid:32x32", &[(64, 64), (128, 128), (512, 512), (1024, 1024), (2048, 2048), (37, 101)]),
+            (
+                "grid:256x256",
+                &[(64, 64), (128, 128), (512, 512), (1024, 1024), (2048, 2048)],
+            ),
+            (
+                "grid:32x32",
+                &[(64, 64), (128, 128), (512, 512), (1024, 1024), (2048, 2048), (37, 101)],
+            ),
             ("grid:64x64:shuffled:1", &[(128, 128), (512, 512), (2048, 2048)]),
-            ("grid:96x96:optimized", &[(128, 128), (384, 384), (512, 512), (2048, 2048)]),
-            ("random:30000:5000:7", &[(128, 128), (512, 512), (2048, 2048), (333, 77)]),
+            (
+                "grid:96x96:optimized",
+                &[(128, 128), (384, 384), (512, 512), (2048, 2048)],
+            ),
+            (
+                "random:30000:5000:7",
+                &[(128, 128), (512, 512), (2048, 2048), (333, 77)],
+            ),
             ("strip:64x64", &[(128, 128), (512, 512), (2048, 2048)]),
             ("grid:100x40", &[(256, 256)]),
             ("grid:128x128:local:64:1", &[(256, 256)]),
@@ -530,7 +542,11 @@ mod tests {
         for (spec, sizes) in cases {
             let mesh = mesh_from_spec(spec, std::path::Path::new(".")).unwrap();
             for &(w, h) in *sizes {
-                assert_eq!(coverage(&mesh, spec, w, h), reference(&mesh, spec, w, h), "{spec} at {w}x{h}");
+                assert_eq!(
+                    coverage(&mesh, spec, w, h),
+                    reference(&mesh, spec, w, h),
+                    "{spec} at {w}x{h}"
+                );
             }
         }
     }

@@ -79,10 +79,20 @@ fn each_point_runs_on_the_model_file_its_sweep_names() {
     assert!(out.contains("checks: 4 passed, 0 failed"), "{out}");
     // `[set]` applies to every model: 12 frames, 2 of them warm-up.
     let points = std::fs::read_to_string(d.path().join("out/points.csv")).unwrap();
-    assert!(points.lines().next().unwrap().starts_with("point,model,display.buffers"), "{points}");
+    assert!(
+        points
+            .lines()
+            .next()
+            .unwrap()
+            .starts_with("point,model,display.buffers"),
+        "{points}"
+    );
     assert_eq!(points.lines().count(), 5, "{points}");
     let runs = std::fs::read_to_string(d.path().join("out/runs.csv")).unwrap();
-    assert!(runs.contains("models/a.toml") && runs.contains("models/b.toml"), "{runs}");
+    assert!(
+        runs.contains("models/a.toml") && runs.contains("models/b.toml"),
+        "{runs}"
+    );
 }
 
 #[test]
@@ -139,7 +149,9 @@ fn device_predictions_report_the_leave_one_out_errors_of_the_calibration() {
     let (med, p90, worst) = error_summary(&leave_one_out(&fit_loads, &pred_loads, &y).unwrap());
     let (bm, _, _) = error_summary(&linear_baseline_loo(&pred_loads, &y));
     let got = |k: &str| m["loo_error_pct"][k].as_f64().unwrap();
-    assert!((got("median") - med).abs() < 1e-9 && (got("p90") - p90).abs() < 1e-9 && (got("worst") - worst).abs() < 1e-9);
+    assert!(
+        (got("median") - med).abs() < 1e-9 && (got("p90") - p90).abs() < 1e-9 && (got("worst") - worst).abs() < 1e-9
+    );
     assert!((m["linear_baseline_loo_pct"]["median"].as_f64().unwrap() - bm).abs() < 1e-9);
     // Measuring: 7 passes per row.
     let measuring: f64 = y.iter().map(|t| 7.0 * t * 1e-9).sum();
@@ -148,7 +160,12 @@ fn device_predictions_report_the_leave_one_out_errors_of_the_calibration() {
     let o = bin().arg("run").arg(&model).output().unwrap();
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.starts_with("# Predicted against measured: nvidia-h200"), "{text}");
-    assert_eq!(text.lines().filter(|l| l.starts_with("| grid") || l.starts_with("| random") || l.starts_with("| strip")).count(), 95);
+    assert_eq!(
+        text.lines()
+            .filter(|l| l.starts_with("| grid") || l.starts_with("| random") || l.starts_with("| strip"))
+            .count(),
+        95
+    );
 }
 
 #[test]
@@ -164,7 +181,10 @@ fn a_bad_device_predictions_model_is_an_error_naming_the_key() {
         ("files = [\"missing.csv\"]\nvertex_cache = \"nvidia\"\n", "files[0]"),
         ("files = []\nvertex_cache = \"nvidia\"\n", "files"),
         ("files = [\"missing.csv\"]\nvertex_cache = \"bogus\"\n", "vertex_cache"),
-        ("files = [\"missing.csv\"]\nvertex_cache = \"nvidia\"\ncolour = 1\n", "colour"),
+        (
+            "files = [\"missing.csv\"]\nvertex_cache = \"nvidia\"\ncolour = 1\n",
+            "colour",
+        ),
     ] {
         let p = write(&format!("{head}{body}"));
         let o = bin().arg("run").arg(&p).output().unwrap();

@@ -87,7 +87,10 @@ pub fn run_device_predictions(
     };
     let start = Instant::now();
     if cfg.system != "device_predictions" {
-        return Err(bad("system", format!("expected \"device_predictions\", got {:?}", cfg.system)));
+        return Err(bad(
+            "system",
+            format!("expected \"device_predictions\", got {:?}", cfg.system),
+        ));
     }
     if cfg.files.is_empty() {
         return Err(bad("files", "names no pass CSV".into()));
@@ -105,8 +108,8 @@ pub fn run_device_predictions(
         rows.extend(read_rows(&path).map_err(|e| bad(&format!("files[{i}]"), e.to_string()))?);
     }
     let cal = calibrate_rows(&rows, &cfg.device, &policy, cfg.shader_cores).map_err(|e| bad("files", e.to_string()))?;
-    let predictions = predict_rows(&cal.profile, &rows, &cal.loo_ns, &cal.linear_loo_pct)
-        .map_err(|e| bad("files", e.to_string()))?;
+    let predictions =
+        predict_rows(&cal.profile, &rows, &cal.loo_ns, &cal.linear_loo_pct).map_err(|e| bad("files", e.to_string()))?;
     let fit = &cal.profile.fit;
     let metrics = Metrics {
         rows: rows.len(),
