@@ -8,13 +8,14 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use serde_json::json;
 
-use rendersim::measure::calibrate::PassRow;
 use rendersim::measure::calibrate::{
-    Invocations, LoadCache, error_summary, fit, held_out_half, leave_one_out, linear_baseline_loo, read_rows, row_load,
+    Invocations, LoadCache, error_summary, fit, held_out_half, leave_one_out, leave_one_out_ns, linear_baseline_loo,
+    read_rows, row_load,
 };
 use rendersim::measure::device_predict::{DevicePass, predict_on_device};
 use rendersim::measure::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy};
 use rendersim::measure::fit::rel_error_pct;
+use rendersim::measure::predictions::predict_rows;
 
 use super::args::{CalibrateArgs, PredictArgs};
 
@@ -121,11 +122,12 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     let text = profile.to_toml(&header);
     rendersim::output::files::write_output(&args.out, |w| w.write_all(text.as_bytes()))?;
     if let Some(path) = &args.report {
-        let errors = match &loo {
-            Some((e, _, _)) => e.clone(),
-            None => leave_one_out(&fit_loads, &predict_loads, &y)?,
+        let loo_ns = leave_one_out_ns(&fit_loads, &predict_loads, &y)?;
+        let linear = match &loo {
+            Some((_, b, _)) => b.clone(),
+            None => linear_baseline_loo(&predict_loads, &y),
         };
-        let md = report_markdown(&profile, &rows, &errors)?;
+        let md = predict_rows(&profile, &rows, &loo_ns, &linear)?.markdown("`rendersim calibrate --report`");
         rendersim::output::files::write_output(path, |w| w.write_all(md.as_bytes()))?;
     }
 
@@ -219,63 +221,6 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     writeln!(s, "wrote {}", args.out.display())?;
     print!("{s}");
     check_holdout(args, half.map(|h| h.0.0))
-}
-
-/// `calibrate --report`: every row measured against its leave-one-out
-/// prediction (the closed form fitted without the row) and against the
-/// full profile's simulation (`predict`'s frame-pipeline run), with the wall
-/// time of simulating each pass beside the device time measuring it took.
-fn report_markdown(profile: &DeviceProfile, rows: &[PassRow], loo: &[f64]) -> Result<String> {
-    let mut s = String::new();
-    let name = &profile.device.name;
-    writeln!(s, "# Predicted against measured: {name}\n")?;
-    writeln!(
-        s,
-        "Written by `rendersim calibrate --report` (rendersim {}). `loo %`: the pass predicted by the \
-         profile fitted to every other row (the cost formula of docs/models.md); `sim %`: the pass \
-         simulated with the full profile by the frame-pipeline model at triangle fidelity, as \
-         `rendersim predict` does. `measuring s`: the device time of the 7 passes a measurement \
-         records (2 warm-ups, 5 repeats; a lower bound: setup and readback are not in the CSV); \
-         `simulating s`: this machine's wall time for the simulation.\n",
-        env!("CARGO_PKG_VERSION")
-    )?;
-    writeln!(
-        s,
-        "| mesh | size | vs loops | fs loops | geometry only | measured ms | loo % | simulated ms | sim % | measuring s | simulating s |"
-    )?;
-    writeln!(s, "|---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|")?;
-    let (mut sim_errors, mut measure_s, mut simulate_s) = (Vec::new(), 0.0, 0.0);
-    for (r, e) in rows.iter().zip(loo) {
-        let p = predict_on_device(profile, &DevicePass::from(r))?;
-        let se = rel_error_pct(p.pass_time_ns, r.pass_time_ns);
-        let m = 7.0 * r.pass_time_ns * 1e-9;
-        sim_errors.push(se);
-        measure_s += m;
-        simulate_s += p.sim_wall_seconds;
-        writeln!(
-            s,
-            "| {} | {}x{} | {} | {} | {} | {:.4} | {e:+.1} | {:.4} | {se:+.1} | {m:.4} | {:.4} |",
-            r.mesh,
-            r.size.width,
-            r.size.height,
-            r.vs_loops,
-            r.fs_loops,
-            if r.geometry_only { "yes" } else { "" },
-            r.pass_time_ns / 1e6,
-            p.pass_time_ns / 1e6,
-            p.sim_wall_seconds
-        )?;
-    }
-    let (lm, lp, lw) = error_summary(loo);
-    let (sm, sp, sw) = error_summary(&sim_errors);
-    writeln!(
-        s,
-        "\n{} rows. Leave-one-out |error|: median {lm:.1}%, 90th percentile {lp:.1}%, worst {lw:.1}%. \
-         Simulated with the full profile: median {sm:.1}%, 90th percentile {sp:.1}%, worst {sw:.1}%. \
-         Measuring took at least {measure_s:.2} s of device time; simulating took {simulate_s:.2} s here.",
-        rows.len()
-    )?;
-    Ok(s)
 }
 
 /// `--holdout-max-median`: the held-out half's median against the bound.

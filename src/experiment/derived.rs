@@ -121,9 +121,9 @@ pub(crate) fn compute(exp: &Experiment, inp: &DerivedInputs<'_>) -> Vec<Vec<Opti
                         let r = reference_point(exp, p, reference)?;
                         ratio(mean(p.index, path)?, mean(r, path)?)
                     }
-                    DerivedKind::Speedup { reference } => {
+                    DerivedKind::Speedup { path, reference } => {
                         let r = reference_point(exp, p, reference)?;
-                        speedup(mean(p.index, "wall_seconds")?, mean(r, "wall_seconds")?)
+                        speedup(mean(p.index, path)?, mean(r, path)?)
                     }
                 })
                 .collect()

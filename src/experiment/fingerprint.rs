@@ -68,7 +68,8 @@ pub fn sha256_hex(data: &[u8]) -> String {
 
 /// The fingerprint of `exp` resolved on `base_model`: SHA-256 of the
 /// experiment file's bytes, a NUL, and the base model as TOML. Anything
-/// that changes a run (a sweep, a `[set]` value, the model file) or the
+/// that changes a run (a sweep, a `[set]` value, the model file or the
+/// files a model sweep names) or the
 /// outputs (a plot, a check) changes it.
 pub fn experiment_fingerprint(exp: &Experiment, base_model: &toml::Table) -> Result<String, ExperimentError> {
     let text = std::fs::read(&exp.source).map_err(|source| ExperimentError::Io {
@@ -78,6 +79,12 @@ pub fn experiment_fingerprint(exp: &Experiment, base_model: &toml::Table) -> Res
     let mut data = text;
     data.push(0);
     data.extend_from_slice(base_model.to_string().as_bytes());
+    // The model files a `[[sweep]] key = "model"` runs on.
+    for path in exp.swept_files() {
+        let text = std::fs::read(&path).map_err(|source| ExperimentError::Io { path, source })?;
+        data.push(0);
+        data.extend_from_slice(&text);
+    }
     Ok(sha256_hex(&data))
 }
 

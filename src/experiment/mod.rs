@@ -48,6 +48,7 @@
 //! #   labelled dashed lines (a paper's numbers; at most 16; the x axis widens to show them)
 //! # scatter: x and y are metric paths or derived names; log_x / log_y
 //! [[derived]]            # interval_width | quantile_width_from_min | relative_error | ratio | speedup
+//!                        # (speedup: reference / this of `path`, default "wall_seconds")
 //! name = "c99"
 //! kind = "interval_width"
 //! column = "FrameTime"
@@ -77,6 +78,14 @@
 //! target = 186572        # or target_from = { path = "...", set = { ... }, scale = 1.125 }
 //! set = { architecture = "presort" }   # overrides for this search only
 //! ```
+//!
+//! A sweep over `key = "model"` runs each point on another model file:
+//! `values = ["../models/city.toml", "default"]` (paths relative to the
+//! experiment file, `"default"` the embedded default model; `labels` name
+//! them on plots). The top-level `model` is then left out, `[set]` and the
+//! other sweeps apply to every model, and `[[search]]`es are refused (they
+//! need one base model). Relative paths inside each model resolve against
+//! its own folder.
 //!
 //! Searches are described in [`inverse`]; their results go to
 //! `searches.csv` and a section of `report.md`.

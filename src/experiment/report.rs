@@ -233,8 +233,8 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
                 DerivedKind::Ratio { path, reference } => {
                     format!("mean `{path}` / reference, reference at {}", filter_text(reference))
                 }
-                DerivedKind::Speedup { reference } => format!(
-                    "reference `wall_seconds` / this `wall_seconds`, reference at {}",
+                DerivedKind::Speedup { path, reference } => format!(
+                    "reference `{path}` / this `{path}`, reference at {}",
                     filter_text(reference)
                 ),
             };

@@ -14,7 +14,7 @@ use super::check::{Bound, CheckOutcome, evaluate, evaluate_between};
 use super::derived::{DerivedInputs, compute};
 use super::dotted::json_number;
 use super::runner::Runner;
-use super::spec::{BoundRef, Expect, Experiment};
+use super::spec::{BoundRef, Expect, Experiment, MODEL_SWEEP_KEY, ModelSource};
 use super::sweep::{Point, expand_points};
 use super::{ExperimentError, figures, report, tables};
 use crate::config::set_dotted;
@@ -198,10 +198,13 @@ pub(crate) struct JobOutput {
     pub(crate) frames: Vec<Vec<f64>>,
 }
 
-/// The model for `point`: `base` with `[set]` then the point's sweep values applied.
+/// The model for `point`: `base` (or the model file a `[[sweep]] key =
+/// "model"` picks for the point) with `[set]` then the point's other sweep
+/// values applied.
 pub fn point_model(exp: &Experiment, base: &toml::Table, point: &Point) -> Result<toml::Table, ExperimentError> {
-    let mut model = base.clone();
-    for (k, v) in exp.set.iter().chain(&point.assignments) {
+    let mut model = exp.point_base(point, base)?;
+    let swept = point.assignments.iter().filter(|(k, _)| k != MODEL_SWEEP_KEY);
+    for (k, v) in exp.set.iter().chain(swept) {
         set_dotted(&mut model, k, v.clone())?;
     }
     Ok(model)
@@ -212,6 +215,9 @@ pub fn point_model(exp: &Experiment, base: &toml::Table, point: &Point) -> Resul
 pub(crate) struct Plan {
     pub(crate) points: Vec<Point>,
     pub(crate) models: Vec<toml::Table>,
+    /// Per point, the model file a model sweep picked (`None`: the
+    /// experiment's base model).
+    pub(crate) sources: Vec<Option<ModelSource>>,
     pub(crate) paths: Vec<String>,
     pub(crate) columns: Vec<String>,
 }
@@ -224,9 +230,11 @@ impl Plan {
             .iter()
             .map(|p| point_model(exp, base_model, p))
             .collect::<Result<Vec<_>, _>>()?;
+        let sources = points.iter().map(|p| exp.point_source(p)).collect();
         Ok(Plan {
             points,
             models,
+            sources,
             paths: exp.tracked_paths(),
             columns: exp.frame_columns(),
         })
@@ -256,6 +264,7 @@ impl Plan {
             .map(|&(pi, seed)| {
                 let r = run_job(
                     runner,
+                    self.sources[pi].as_ref(),
                     &self.models[pi],
                     &self.points[pi],
                     seed,
@@ -576,8 +585,10 @@ fn progress_bar(len: u64, show: bool) -> ProgressBar {
     bar
 }
 
+#[allow(clippy::too_many_arguments)]
 fn run_job(
     runner: &dyn Runner,
+    source: Option<&ModelSource>,
     model: &toml::Table,
     point: &Point,
     seed: u64,
@@ -592,7 +603,11 @@ fn run_job(
         message,
     };
     let t0 = Instant::now();
-    let out = runner.run(model, seed, want_frames).map_err(|e| fail(e.to_string()))?;
+    let out = match source {
+        None => runner.run(model, seed, want_frames),
+        Some(src) => runner.run_from(src, model, seed, want_frames),
+    }
+    .map_err(|e| fail(e.to_string()))?;
     let measured = t0.elapsed().as_secs_f64();
     let wall_seconds = match json_number(&out.summary, "wall_seconds") {
         Ok(Some(w)) => w,

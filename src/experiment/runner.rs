@@ -37,6 +37,21 @@ pub trait Runner: Sync {
         let _ = origins;
         self.run(model, seed, want_frames)
     }
+
+    /// [`Runner::run`] for a point whose model a `[[sweep]] key = "model"`
+    /// took from `source` (another file than the experiment's base model),
+    /// so that relative paths inside it and errors in it refer to that
+    /// file. Runners that do not read files ignore it.
+    fn run_from(
+        &self,
+        source: &super::ModelSource,
+        model: &toml::Table,
+        seed: u64,
+        want_frames: bool,
+    ) -> Result<RunOutput, RunError> {
+        let _ = source;
+        self.run(model, seed, want_frames)
+    }
 }
 
 /// What one run produced.

@@ -33,7 +33,13 @@ impl SimRunner {
     /// The runner for `exp`'s base model: its file (relative paths inside
     /// it resolve against the file's folder), or the embedded default.
     pub fn for_experiment(exp: &Experiment) -> SimRunner {
-        let (name, base_dir, text) = match &exp.model {
+        SimRunner::for_source(&exp.model, exp.value_origins())
+    }
+
+    /// The runner for one model source (the experiment's, or a file a
+    /// `[[sweep]] key = "model"` picks), with the experiment's value origins.
+    fn for_source(source: &ExperimentModel, origins: Vec<(String, String)>) -> SimRunner {
+        let (name, base_dir, text) = match source {
             ExperimentModel::Default => (
                 DEFAULT_MODEL_NAME.to_string(),
                 PathBuf::from("."),
@@ -49,7 +55,7 @@ impl SimRunner {
             name,
             base_dir,
             text,
-            origins: exp.value_origins(),
+            origins,
         }
     }
 }
@@ -57,6 +63,16 @@ impl SimRunner {
 impl Runner for SimRunner {
     fn run(&self, model: &toml::Table, seed: u64, want_frames: bool) -> Result<RunOutput, RunError> {
         self.run_noted(model, seed, want_frames, &[])
+    }
+
+    fn run_from(
+        &self,
+        source: &ExperimentModel,
+        model: &toml::Table,
+        seed: u64,
+        want_frames: bool,
+    ) -> Result<RunOutput, RunError> {
+        SimRunner::for_source(source, self.origins.clone()).run_noted(model, seed, want_frames, &[])
     }
 
     fn run_noted(

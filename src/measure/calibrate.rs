@@ -405,6 +405,16 @@ pub fn leave_one_out(
     predict_loads: &[PassLoad],
     y: &[f64],
 ) -> Result<Vec<f64>, CalibrateError> {
+    let p = leave_one_out_ns(fit_loads, predict_loads, y)?;
+    Ok(p.iter().zip(y).map(|(p, m)| rel_error_pct(*p, *m)).collect())
+}
+
+/// Leave-one-out as [`leave_one_out`], the predicted pass times (ns).
+pub fn leave_one_out_ns(
+    fit_loads: &[PassLoad],
+    predict_loads: &[PassLoad],
+    y: &[f64],
+) -> Result<Vec<f64>, CalibrateError> {
     (0..y.len())
         .map(|i| {
             let (l, t): (Vec<PassLoad>, Vec<f64>) = fit_loads
@@ -415,7 +425,7 @@ pub fn leave_one_out(
                 .map(|(_, (l, t))| (*l, *t))
                 .unzip();
             let f = fit(&l, &t)?;
-            Ok(rel_error_pct(f.costs.cost(&predict_loads[i]).pass_ns, y[i]))
+            Ok(f.costs.cost(&predict_loads[i]).pass_ns)
         })
         .collect()
 }

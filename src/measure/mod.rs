@@ -24,7 +24,9 @@
 //!
 //! Device profiles (issue 10): `calibrate.rs` fits a `device_profile.rs`
 //! to measured passes (what they cover: `coverage.rs`), `device_predict.rs`
-//! runs one pass on it through the frame-pipeline model (`predict.rs`).
+//! runs one pass on it through the frame-pipeline model (`predict.rs`), and
+//! `predictions.rs` predicts every measured row (leave-one-out and
+//! simulated) for the per-device report.
 //!
 //! Rendering-time estimation (issue 11 item 8, paper 000 §5): `estimation.rs`
 //! plans single- and multi-object passes, fits h1-h4 and builds pos tables,
@@ -45,6 +47,7 @@ pub mod h4;
 pub mod loops;
 pub mod passes;
 pub mod predict;
+pub mod predictions;
 pub mod report;
 
 #[cfg(feature = "wgpu")]

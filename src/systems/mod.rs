@@ -3,6 +3,7 @@
 //! `frame_pipeline`); [`run_model`] is the one entry point the CLI and the
 //! experiment runner use.
 
+pub mod device_predictions;
 pub mod error;
 pub mod frame_pipeline;
 pub mod multi_rate;
@@ -173,6 +174,7 @@ pub const SYSTEMS: &[&dyn System] = &[
     &vr::system::VrSystem,
     &pixelflow::system::PixelFlowSystem,
     &walkthrough::system::WalkthroughSystem,
+    &device_predictions::system::DevicePredictionsSystem,
 ];
 
 /// A resolved model's TOML with the header every system writes.

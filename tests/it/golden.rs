@@ -6,7 +6,8 @@
 //! Compared: each model's `summary.json` (without its wall-time keys),
 //! `frames.csv` and `model.toml` (the repository's path written `$ROOT`);
 //! each experiment's `runs.csv` and `points.csv` without their wall-time
-//! columns (`wall_seconds*`, `speedup`), and its `searches.csv` if any. A file of at most 16 KiB is stored
+//! columns (`wall_seconds*`, `*speedup`, build, simulation and calibration
+//! times), and its `searches.csv` if any. A file of at most 16 KiB is stored
 //! whole (so a failure shows a diff); a larger one as its length and FNV-1a
 //! hash (`NAME.fnv`). `RENDERSIM_BLESS=1 cargo test --release --test it golden::` rewrites
 //! the stored outputs after an intended change: say why in the commit.
@@ -24,6 +25,16 @@ const WALL_KEYS: [&str; 4] = ["wall_seconds", "build_seconds", "simulate_seconds
 /// costs and view-cell preprocess times), removed wherever they occur; experiment columns naming one are
 /// left out too.
 const NESTED_WALL_KEYS: [&str; 3] = ["cost_us_per_frame", "vcs_preprocess_seconds", "pvc_preprocess_seconds"];
+/// Experiment columns (metric paths) that measure the machine: the
+/// fidelity-models experiment's build and simulation times, the
+/// device-predictions experiment's simulating and calibration times.
+const COLUMN_WALL_KEYS: [&str; 5] = [
+    "build_seconds",
+    "simulate_seconds",
+    "simulating_seconds",
+    "calibrate_seconds",
+    "measuring_over_simulating",
+];
 
 fn remove_nested(v: &mut serde_json::Value) {
     match v {
@@ -86,7 +97,10 @@ fn without_wall_columns(path: &Path) -> Vec<u8> {
         .iter()
         .enumerate()
         .filter(|(_, h)| {
-            !(h.starts_with("wall_seconds") || *h == "speedup" || NESTED_WALL_KEYS.iter().any(|k| h.contains(k)))
+            !(h.starts_with("wall_seconds")
+                || h.ends_with("speedup")
+                || NESTED_WALL_KEYS.iter().any(|k| h.contains(k))
+                || COLUMN_WALL_KEYS.iter().any(|k| h.contains(k)))
         })
         .map(|(i, _)| i)
         .collect();

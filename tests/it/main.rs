@@ -20,6 +20,7 @@ mod lavapipe_policy;
 mod lod_select;
 mod measure;
 mod meshopt_crosscheck;
+mod model_sweep;
 mod multi_rate;
 mod nvidia_policy;
 mod obj_files;

@@ -28,6 +28,13 @@ pub enum ModelSource {
     File(PathBuf),
 }
 
+/// The sweep key that picks each point's model file instead of a model
+/// value: `[[sweep]] key = "model"`, `values = ["../models/city.toml",
+/// "default", ...]` (paths relative to the experiment file; `"default"` is
+/// the embedded default model). The experiment's own `model` key is then
+/// left out, and `[set]` and the other sweeps apply to every model alike.
+pub const MODEL_SWEEP_KEY: &str = "model";
+
 /// One reported metric: a dotted path into the run summary.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Metric {
@@ -136,9 +143,12 @@ pub enum DerivedKind {
         /// Sweep key = value identifying the reference point.
         reference: Vec<(String, toml::Value)>,
     },
-    /// `wall_ref / wall` on the replication means of `wall_seconds`, with the
-    /// reference point chosen as for `RelativeError`.
+    /// `wall_ref / wall` on the replication means of `path` (a wall time:
+    /// `wall_seconds` unless the file gives another, e.g. `simulate_seconds`),
+    /// with the reference point chosen as for `RelativeError`.
     Speedup {
+        /// The wall-time path.
+        path: String,
         /// Sweep key = value identifying the reference point.
         reference: Vec<(String, toml::Value)>,
     },
@@ -303,7 +313,7 @@ impl Experiment {
         for d in &self.derived {
             match &d.kind {
                 DerivedKind::RelativeError { path, .. } | DerivedKind::Ratio { path, .. } => add(path),
-                DerivedKind::Speedup { .. } => add("wall_seconds"),
+                DerivedKind::Speedup { path, .. } => add(path),
                 _ => {}
             }
         }
@@ -355,7 +365,7 @@ impl Experiment {
         for (k, _) in &self.set {
             origins.push((k.clone(), format!("[set] {k} in {}", at(&format!("set.{k}")))));
         }
-        for (i, s) in self.sweeps.iter().enumerate() {
+        for (i, s) in self.sweeps.iter().enumerate().filter(|(_, s)| s.key != MODEL_SWEEP_KEY) {
             let k = &s.key;
             origins.push((
                 k.clone(),
@@ -372,21 +382,69 @@ impl Experiment {
         origins
     }
 
+    /// The model file a point runs on when a `[[sweep]] key = "model"`
+    /// picks it ([`MODEL_SWEEP_KEY`]); `None` without such a sweep (every
+    /// point runs on [`Experiment::model`]).
+    pub fn point_source(&self, point: &super::Point) -> Option<ModelSource> {
+        point
+            .assignments
+            .iter()
+            .find(|(k, _)| k == MODEL_SWEEP_KEY)
+            .and_then(|(_, v)| v.as_str())
+            .map(|v| self.swept_source(v))
+    }
+
+    /// The model source a value of the model sweep names.
+    fn swept_source(&self, value: &str) -> ModelSource {
+        if value == "default" {
+            ModelSource::Default
+        } else {
+            let dir = self.source.parent().unwrap_or(std::path::Path::new(""));
+            ModelSource::File(dir.join(value))
+        }
+    }
+
+    /// The model files of the model sweep, in sweep order (empty without
+    /// one; the embedded default is not a file).
+    pub fn swept_files(&self) -> Vec<PathBuf> {
+        self.sweeps
+            .iter()
+            .filter(|s| s.key == MODEL_SWEEP_KEY)
+            .flat_map(|s| &s.values)
+            .filter_map(|v| match self.swept_source(v.as_str()?) {
+                ModelSource::File(p) => Some(p),
+                ModelSource::Default => None,
+            })
+            .collect()
+    }
+
+    /// The base model of a point: `base_model` (the experiment's resolved
+    /// `model`), or the file the model sweep names for it.
+    pub fn point_base(&self, point: &super::Point, base_model: &toml::Table) -> Result<toml::Table, ExperimentError> {
+        match self.point_source(point) {
+            None | Some(ModelSource::Default) => Ok(base_model.clone()),
+            Some(ModelSource::File(path)) => read_model(&path),
+        }
+    }
+
     /// The base model: a clone of `default_model` for `model = "default"`,
     /// else the TOML file named by `model` (relative to the experiment file).
     pub fn resolve_model(&self, default_model: &toml::Table) -> Result<toml::Table, ExperimentError> {
         match &self.model {
             ModelSource::Default => Ok(default_model.clone()),
-            ModelSource::File(path) => {
-                let text = std::fs::read_to_string(path).map_err(|source| ExperimentError::Io {
-                    path: path.clone(),
-                    source,
-                })?;
-                text.parse::<toml::Table>().map_err(|e| ExperimentError::Parse {
-                    file: path.clone(),
-                    message: e.to_string(),
-                })
-            }
+            ModelSource::File(path) => read_model(path),
         }
     }
+}
+
+/// A model file as a TOML table.
+fn read_model(path: &std::path::Path) -> Result<toml::Table, ExperimentError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ExperimentError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    text.parse::<toml::Table>().map_err(|e| ExperimentError::Parse {
+        file: path.to_path_buf(),
+        message: e.to_string(),
+    })
 }

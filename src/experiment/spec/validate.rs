@@ -123,7 +123,16 @@ impl Validator<'_> {
                     .map_err(|m| self.err(format!("{key}.labels"), m.to_string()))?,
                 None => sweep,
             };
+            if sweep.key == MODEL_SWEEP_KEY {
+                self.model_sweep(&key, &sweep, &raw.model)?;
+            }
             sweeps.push(sweep);
+        }
+        if sweeps.iter().any(|s| s.key == MODEL_SWEEP_KEY) && !raw.search.is_empty() {
+            return Err(self.err(
+                "search[0]",
+                "searches run on one base model; an experiment that sweeps `model` cannot have them",
+            ));
         }
         let sample = match raw.sample {
             None => None,
@@ -250,7 +259,10 @@ impl Validator<'_> {
                         .ok_or_else(|| self.err(&key, "kind `ratio` needs `path`"))?,
                     reference: need_ref()?,
                 },
-                "speedup" => DerivedKind::Speedup { reference: need_ref()? },
+                "speedup" => DerivedKind::Speedup {
+                    path: d.path.clone().unwrap_or_else(|| "wall_seconds".into()),
+                    reference: need_ref()?,
+                },
                 other => {
                     return Err(self.err(
                         format!("{key}.kind"),
@@ -531,6 +543,37 @@ impl Validator<'_> {
             searches,
             sample,
         })
+    }
+
+    /// A `[[sweep]] key = "model"`: every value a model file relative to
+    /// the experiment file (that exists) or `"default"`, and no top-level
+    /// `model` beside it.
+    fn model_sweep(&self, key: &str, sweep: &Sweep, model: &str) -> Result<(), ExperimentError> {
+        if model != "default" {
+            return Err(self.err(
+                "model",
+                format!("`{key}` sweeps `model` (the model file of each point); leave out the top-level `model`"),
+            ));
+        }
+        let dir = self.file.parent().unwrap_or(Path::new(""));
+        for v in &sweep.values {
+            let Some(name) = v.as_str().filter(|n| !n.trim().is_empty()) else {
+                return Err(self.err(
+                    format!("{key}.values"),
+                    format!("a `model` sweep takes model file paths or \"default\", got {v}"),
+                ));
+            };
+            if name != "default" && !dir.join(name).is_file() {
+                return Err(self.err(
+                    format!("{key}.values"),
+                    format!(
+                        "model file {name:?} not found (looked for {}; paths are relative to the experiment file)",
+                        dir.join(name).display()
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     fn sample(&self, s: RawSample) -> Result<crate::experiment::sample::Sample, ExperimentError> {
