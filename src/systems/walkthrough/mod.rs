@@ -13,12 +13,19 @@
 //! - `render`: one frame through the frame pipeline;
 //! - `estimators`: h1-h4, their least-squares fit, the scores;
 //! - `pos`: per-object sampling tables;
+//! - `lod`: the level-of-detail policies (reactive, predictive) and
+//!   paper 001's benefit;
+//! - `branch`: paper 000 §6.4's conditional branch in the frame's GPU work;
+//! - `perceived`: perceived speed per displayed refresh (Figure 6);
 //! - `run`, `report`, `system`: run and summary, the report, the registry.
 
+pub mod branch;
 pub mod camera;
 pub mod config;
 pub mod culling;
 pub mod estimators;
+pub mod lod;
+pub mod perceived;
 pub mod pos;
 pub mod render;
 pub mod report;

@@ -20,16 +20,17 @@ use crate::output::trace::TraceWriter;
 use crate::systems::error::{SystemError, invalid};
 use crate::systems::summary::{Dist, EventCounts, to_json};
 
+use super::branch::{BranchStats, Switchable, evaluate};
 use super::camera::{self, Pose};
 use super::config::WalkthroughConfig;
 use super::culling::{Projection, Pvs, View, project, sample_projection};
 use super::estimators::{Constants, ESTIMATORS, Features, Score, fit};
+use super::lod::{BenefitTerms, Offer, Policy, Reactive, select};
 use super::pos::{PosTable, build as build_table};
 use super::render::{Draw, Renderer, frame_seeds, next_seed};
 use super::scene::{Scene, SceneTotals, build_scene};
 
-/// LOD policies known by name; only `none` is built so far.
-pub const LOD_POLICIES: [&str; 4] = ["none", "reactive", "predictive", "predictive+branch"];
+pub use super::lod::LOD_POLICIES;
 
 /// Most frames and fit samples a run may ask for.
 pub const MAX_FRAMES: u64 = 10_000_000;
@@ -56,21 +57,6 @@ pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
             "system",
             format!("expected \"walkthrough\", got {:?}", cfg.system),
         ));
-    }
-    match cfg.lod.policy.as_str() {
-        "none" => {}
-        p if LOD_POLICIES.contains(&p) => {
-            return Err(invalid(
-                "lod.policy",
-                format!("{p:?} is not built yet (issue 11 item 5); only \"none\" runs so far"),
-            ));
-        }
-        p => {
-            return Err(invalid(
-                "lod.policy",
-                format!("unknown policy {p:?} (known: {})", LOD_POLICIES.join(", ")),
-            ));
-        }
     }
     for (i, e) in cfg.estimation.estimators.iter().enumerate() {
         if !ESTIMATORS.contains(&e.as_str()) {
@@ -141,17 +127,18 @@ pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
             format!("must be between 0 and 1, got {}", p.prune_tolerance),
         ));
     }
+    super::lod::validate(&cfg.lod, &cfg.estimation.estimators)?;
     check_memory(cfg)
 }
 
 fn check_memory(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
     use crate::limits::{DEFAULT_MAX_MEMORY, add_bytes, over_memory_message, show_bytes};
     let mut total = 0u64;
-    add_bytes(&mut total, cfg.run.frames, 16 * 8 + 64);
+    add_bytes(&mut total, cfg.run.frames, 512);
     let mut fit = 0u64;
     add_bytes(&mut fit, cfg.estimation.fit_samples, 48);
     let parts = format!(
-        "{} frames x 192 bytes = {}, {} fit samples x 48 bytes = {}",
+        "{} frames x 512 bytes = {}, {} fit samples x 48 bytes = {}",
         cfg.run.frames,
         show_bytes(total),
         cfg.estimation.fit_samples,
@@ -163,6 +150,10 @@ fn check_memory(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
         return Err(invalid("run.max_memory", over_memory_message(total, &parts, limit)));
     }
     Ok(())
+}
+
+fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 fn ms(ps: f64) -> f64 {
@@ -236,6 +227,74 @@ pub struct WalkMetrics {
     pub frames_inside_an_object: u64,
     /// The estimators.
     pub estimation: EstimationSummary,
+    /// Display refreshes at which no new frame was ready (a frame of
+    /// rendering time RT is shown ceil(RT / refresh) refreshes after its
+    /// start: ceil(RT / refresh) - 1 skips).
+    pub frame_skips: u64,
+    /// Frame skips per minute of displayed walkthrough (paper 000 §6.3's
+    /// goal: 1-2 at 60 Hz).
+    pub frame_skips_per_minute: f64,
+    /// The walkthrough's length on the display (refreshes x period), s.
+    pub displayed_seconds: f64,
+    /// Mean per frame of the drawn objects' image benefit (paper 001's
+    /// benefit without hysteresis; `lod.rs`).
+    pub benefit_mean: f64,
+    /// The drawn benefit's share of the benefit of every visible object at
+    /// its finest level, summed over the frames (1 with nothing visible).
+    pub benefit_fraction: f64,
+    /// Level changes of objects visible in two consecutive frames (not
+    /// drawn counts as a level), per displayed second: popping.
+    pub lod_switches_per_second: f64,
+    /// The level-of-detail policy as run.
+    pub lod: LodSummary,
+}
+
+/// `metrics.lod`: the level-of-detail policy as run.
+#[derive(Debug, Clone, Serialize)]
+pub struct LodSummary {
+    /// The policy.
+    pub policy: String,
+    /// The estimator of the predictive policies' costs.
+    pub estimator: String,
+    /// The predictive policies' knapsack algorithm.
+    pub algorithm: String,
+    /// What the policies aim at: refresh x (1 - margin), ms.
+    pub target_ms: f64,
+    /// The knapsack's budget: the target less the empty frame, ms.
+    pub knapsack_budget_ms: f64,
+    /// Mean level of the drawn objects (0 = finest).
+    pub mean_level: f64,
+    /// Objects drawn per frame at each level (mean), finest first.
+    pub objects_per_level: Vec<f64>,
+    /// Visible objects not drawn per frame (mean; predictive policies).
+    pub dropped_per_frame: f64,
+    /// Visible (object, frame) pairs none of whose levels fit the
+    /// knapsack's budget alone (never drawn).
+    pub unaffordable_object_frames: u64,
+    /// Level changes in all (see `lod_switches_per_second`).
+    pub switches: u64,
+    /// Reactive: the detail level k (triangles per pixel of disk) per frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reactive_k: Option<Dist>,
+    /// predictive+branch: what the conditional branches did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub branch: Option<BranchSummary>,
+    /// Edge cases met (nothing fits, objects never drawn).
+    pub notes: Vec<String>,
+}
+
+/// `metrics.lod.branch`.
+#[derive(Debug, Clone, Serialize)]
+pub struct BranchSummary {
+    /// Branch tokens (switchable objects) per frame, mean.
+    pub tokens_per_frame: f64,
+    /// Objects switched to a coarser level by a branch, in all.
+    pub switched_objects: u64,
+    /// Frames with at least one switch.
+    pub frames_with_switch: u64,
+    /// Prefix runs of the frame pipeline made to find when the GPU reached
+    /// the tokens.
+    pub prefix_runs: u64,
 }
 
 /// The camera path as run.
@@ -292,6 +351,30 @@ pub const BASE_COLUMNS: [&str; 8] = [
     "ActualMs",
     "GpuMs",
     "BudgetMs",
+];
+
+/// Columns of the per-frame table after the estimates (then `AtLevel<l>`,
+/// the objects drawn at each level): refreshes skipped before the frame was
+/// shown, the refresh it was shown at, the camera's move since the frame
+/// before (m), the drawn and the all-finest image benefit, the drawn
+/// objects' mean level, objects drawn and dropped, level switches, the
+/// policy estimator's GPU estimate of the planned selection plus the empty
+/// frame (predictive; ms), the reactive detail level k, branch tokens and
+/// objects the branches switched.
+pub const LOD_COLUMNS: [&str; 13] = [
+    "Skips",
+    "ShownAtRefresh",
+    "MovedM",
+    "Benefit",
+    "BenefitFinest",
+    "MeanLevel",
+    "Drawn",
+    "Dropped",
+    "Switches",
+    "PlanEstMs",
+    "DetailK",
+    "BranchTokens",
+    "BranchSwitched",
 ];
 
 struct Counter {
@@ -397,8 +480,13 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
         None
     };
 
-    // The pos tables, one per prototype in use, finest level (lod.policy = "none").
-    let mut tables: Vec<Option<PosTable>> = vec![None; scene.protos.len()];
+    // The pos tables, one per prototype in use, at its finest level (every
+    // level when a policy other than "none" draws coarser ones).
+    let (policy, lod_est, algorithm) = super::lod::validate(&cfg.lod, &cfg.estimation.estimators)?;
+    let table_levels = |p: &super::scene::Prototype| {
+        if policy == Policy::None { 1 } else { p.levels.len() }
+    };
+    let mut tables: Vec<Vec<Option<PosTable>>> = scene.protos.iter().map(|p| vec![None; table_levels(p)]).collect();
     let mut pos_tables = None;
     if wants[4] {
         let mut used = vec![false; scene.protos.len()];
@@ -415,19 +503,21 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 .iter()
                 .find(|o| o.proto as usize == i)
                 .map_or((0, 0, 0), |o| o.state);
-            let (table, r) = build_table(&cfg.estimation.pos, proto, 0, (focal, w, h), |_, covered| {
-                let d = Draw {
-                    proto: i as u32,
-                    level: 0,
-                    pixels: covered,
-                    state,
-                };
-                object_time(d, &mut count)
-            })?;
-            renders += r;
-            full += table.full_size();
-            n += 1;
-            tables[i] = Some(table);
+            for level in 0..table_levels(proto) {
+                let (table, r) = build_table(&cfg.estimation.pos, proto, level, (focal, w, h), |_, covered| {
+                    let d = Draw {
+                        proto: i as u32,
+                        level: level as u32,
+                        pixels: covered,
+                        state,
+                    };
+                    object_time(d, &mut count)
+                })?;
+                renders += r;
+                full += table.full_size();
+                n += 1;
+                tables[i][level] = Some(table);
+            }
         }
         pos_tables = Some(PosTables {
             tables: n,
@@ -458,6 +548,31 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
     let mut visible: Vec<(u32, Projection)> = Vec::new();
     let mut feats: Vec<Features> = Vec::new();
     let mut draws: Vec<Draw> = Vec::new();
+    // Level of detail: the policy's state across frames.
+    let lod = &cfg.lod;
+    let target = refresh as f64 * (1.0 - lod.margin);
+    let knapsack_budget = (target - empty).max(0.0);
+    let mut reactive = Reactive::new(lod, target);
+    let c = constants.unwrap_or_default();
+    let n_objects = scene.objects.len();
+    let mut prev_level: Vec<Option<u32>> = vec![None; n_objects];
+    let mut prev_seen: Vec<bool> = vec![false; n_objects];
+    let mut prev_list: Vec<u32> = Vec::new();
+    let mut prev_view: Option<View> = None;
+    let mut prev_eye: Option<[f64; 3]> = None;
+    let max_levels = scene.protos.iter().map(|p| p.levels.len()).max().unwrap_or(1);
+    let mut terms: Vec<BenefitTerms> = Vec::new();
+    let mut chosen: Vec<Option<u32>> = Vec::new();
+    let mut order: Vec<usize> = Vec::new();
+    let mut lod_reads = 0u64;
+    let (mut skips, mut refreshes, mut switches) = (0u64, 0u64, 0u64);
+    let (mut benefit_sum, mut finest_sum) = (0.0f64, 0.0f64);
+    let mut level_counts = vec![0u64; max_levels];
+    let (mut dropped_total, mut unaffordable_total) = (0u64, 0u64);
+    let mut k_series: Vec<f64> = Vec::new();
+    let mut branch_total = BranchStats::default();
+    let mut branch_frames = 0u64;
+    let gpu_swap = cfg.gpu.swap.0 as f64;
     for (f, pose) in poses.iter().enumerate() {
         let view = View::new(pose, &cfg.camera);
         let candidates: &[u32] = match scene.view_cell {
@@ -465,24 +580,187 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
             None => &all,
         };
         visible.clear();
-        feats.clear();
-        draws.clear();
         for &i in candidates {
             let o = &scene.objects[i as usize];
             if view.sees_sphere(o.center, o.radius) {
                 let p = project(&view, o, &scene.protos[o.proto as usize]);
                 visible.push((i, p));
-                feats.push(features(&scene, o.proto, 0, &p));
-                draws.push(Draw {
-                    proto: o.proto,
-                    level: 0,
-                    pixels: p.covered_pixels,
-                    state: o.state,
-                });
             }
         }
         if visible.iter().any(|(_, p)| p.inside) {
             inside_frames += 1;
+        }
+        // The benefit's view-dependent terms.
+        terms.clear();
+        for (i, p) in &visible {
+            let o = &scene.objects[*i as usize];
+            let v = view.to_view(o.center);
+            terms.push(BenefitTerms::of(
+                lod,
+                p.disk_pixels,
+                v,
+                prev_view.map(|pv| pv.to_view(o.center)),
+                dt,
+            ));
+        }
+        // The cost of object `vi` at `level` under the policy's estimator (ps).
+        let cost_of = |vi: usize, level: usize, reads: &mut u64| -> f64 {
+            let (i, p) = &visible[vi];
+            let o = &scene.objects[*i as usize];
+            if lod_est < 4 {
+                c.object(lod_est, &features(&scene, o.proto, level, p))
+            } else {
+                tables[o.proto as usize]
+                    .get(level)
+                    .and_then(|t| t.as_ref())
+                    .map_or(0.0, |t| t.lookup(p.alpha, p.gamma, p.phi, reads))
+                    .max(0.0)
+            }
+        };
+        // The levels chosen (None: not drawn), per visible object.
+        chosen.clear();
+        let mut plan_cost = f64::NAN;
+        let mut dropped = 0u64;
+        match policy {
+            Policy::None => chosen.extend(visible.iter().map(|_| Some(0))),
+            Policy::Reactive => {
+                for (i, p) in &visible {
+                    let proto = &scene.protos[scene.objects[*i as usize].proto as usize];
+                    chosen.push(Some(
+                        reactive.level(proto.levels.iter().map(|l| l.triangles), p.disk_pixels),
+                    ));
+                }
+            }
+            Policy::Predictive | Policy::PredictiveBranch => {
+                let mut offers = Vec::with_capacity(visible.len());
+                let mut previous = Vec::with_capacity(visible.len());
+                for (vi, (i, _)) in visible.iter().enumerate() {
+                    let proto = &scene.protos[scene.objects[*i as usize].proto as usize];
+                    let before = prev_level[*i as usize];
+                    offers.push(Offer {
+                        levels: proto
+                            .levels
+                            .iter()
+                            .enumerate()
+                            .map(|(l, lv)| {
+                                (
+                                    cost_of(vi, l, &mut lod_reads),
+                                    terms[vi].selection(lod, lv.triangles, l as u32, before),
+                                )
+                            })
+                            .collect(),
+                    });
+                    previous.push(before);
+                }
+                let (sel, unaffordable) = select(&offers, knapsack_budget as u64, algorithm, &previous)?;
+                unaffordable_total += unaffordable as u64;
+                plan_cost = sel.total_cost as f64;
+                chosen.extend(sel.levels.iter().copied());
+                // Dropped: on screen (positive size) and not drawn; an
+                // object whose disk is clipped away has no benefit and is
+                // never drawn by the knapsack (not counted).
+                dropped = chosen
+                    .iter()
+                    .zip(&terms)
+                    .filter(|(l, t)| l.is_none() && t.size > 0.0)
+                    .count() as u64;
+            }
+        }
+        // The draw order: the visible objects in scene order; with the
+        // branch, its switchable objects last, nearest first (branch.rs).
+        order.clear();
+        order.extend((0..visible.len()).filter(|&vi| chosen[vi].is_some()));
+        let mut switchable: Vec<Switchable> = Vec::new();
+        let mut draw_cost: Vec<f64> = Vec::new();
+        if policy == Policy::PredictiveBranch && lod.branch_objects > 0 {
+            let dist = |vi: usize| {
+                let o = &scene.objects[visible[vi].0 as usize];
+                let d = sub3(o.center, pose.eye);
+                (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+            };
+            // Candidates: (cost at the chosen level, vi, alternatives).
+            let mut cands: Vec<(f64, usize, Vec<(u32, f64)>)> = Vec::new();
+            for &vi in &order {
+                let l = chosen[vi].unwrap_or(0) as usize;
+                let levels = scene.protos[scene.objects[visible[vi].0 as usize].proto as usize]
+                    .levels
+                    .len();
+                if dist(vi) < lod.branch_min_distance || l + 1 >= levels {
+                    continue;
+                }
+                let c0 = cost_of(vi, l, &mut lod_reads);
+                let mut alts = vec![(l as u32, c0)];
+                let mut last = c0;
+                for m in l + 1..levels {
+                    if alts.len() > lod.branch_levels as usize {
+                        break;
+                    }
+                    let cm = cost_of(vi, m, &mut lod_reads);
+                    if cm < last {
+                        alts.push((m as u32, cm));
+                        last = cm;
+                    }
+                }
+                if alts.len() > 1 {
+                    cands.push((c0, vi, alts));
+                }
+            }
+            cands.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            cands.truncate(lod.branch_objects as usize);
+            cands.sort_by(|a, b| dist(a.1).total_cmp(&dist(b.1)).then(a.1.cmp(&b.1)));
+            let marked: Vec<usize> = cands.iter().map(|c| c.1).collect();
+            order.retain(|vi| !marked.contains(vi));
+            let first = order.len();
+            for (k, (_, vi, alts)) in cands.into_iter().enumerate() {
+                order.push(vi);
+                switchable.push(Switchable {
+                    draw: first + k,
+                    alternatives: alts,
+                });
+            }
+            for &vi in &order {
+                draw_cost.push(cost_of(vi, chosen[vi].unwrap_or(0) as usize, &mut lod_reads));
+            }
+        }
+        draws.clear();
+        for &vi in &order {
+            let (i, p) = &visible[vi];
+            let o = &scene.objects[*i as usize];
+            draws.push(Draw {
+                proto: o.proto,
+                level: chosen[vi].unwrap_or(0),
+                pixels: p.covered_pixels,
+                state: o.state,
+            });
+        }
+        let seed = next_seed(&mut seeds);
+        let mut bstats = BranchStats::default();
+        if !switchable.is_empty() {
+            bstats = evaluate(
+                &mut draws,
+                &switchable,
+                &mut draw_cost,
+                refresh as f64,
+                gpu_swap,
+                |prefix| {
+                    let (t, by_kind, names) = actual.render_counted(prefix, seed, start)?;
+                    count.add(t.events, &by_kind, names);
+                    Ok((t.rt as f64 - gpu_swap).max(0.0))
+                },
+            )?;
+            for (d, &vi) in draws.iter().zip(&order) {
+                chosen[vi] = Some(d.level);
+            }
+            branch_total.switched += bstats.switched;
+            branch_total.tokens += bstats.tokens;
+            branch_total.prefix_runs += bstats.prefix_runs;
+            if bstats.switched > 0 {
+                branch_frames += 1;
+            }
+        }
+        feats.clear();
+        for (d, &vi) in draws.iter().zip(&order) {
+            feats.push(features(&scene, d.proto, d.level as usize, &visible[vi].1));
         }
         let mut sums = [0.0f64; 5];
         for k in 0..4 {
@@ -500,9 +778,9 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
             let t = Instant::now();
             let mut reads = 0u64;
             let mut sum = 0.0;
-            for (i, p) in &visible {
-                let o = &scene.objects[*i as usize];
-                if let Some(tb) = &tables[o.proto as usize] {
+            for (d, &vi) in draws.iter().zip(&order) {
+                let p = &visible[vi].1;
+                if let Some(Some(tb)) = tables[d.proto as usize].get(d.level as usize) {
                     sum += tb.lookup(p.alpha, p.gamma, p.phi, &mut reads);
                 }
             }
@@ -510,7 +788,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
             ops[4] += reads;
             sums[4] = sum;
         }
-        let (timing, by_kind, names) = actual.render_counted(&draws, next_seed(&mut seeds), start)?;
+        let (timing, by_kind, names) = actual.render_counted(&draws, seed, start)?;
         count.add(timing.events, &by_kind, names);
         // RT = the frame's own terms + max(ET_cpu, ET_gpu) (paper 000 §4.1):
         // the empty frame, the CPU's submission work (known), the estimate.
@@ -519,15 +797,66 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 est[k].push(ms(empty + sums[k].max(timing.cpu_submit as f64)));
             }
         }
+        // The display: the frame started at a vertical blank and is shown at
+        // the first one after its rendering time; the refreshes in between
+        // show the frame before again (skips).
+        let shown = timing.rt.div_ceil(refresh).max(1);
+        skips += shown - 1;
+        refreshes += shown;
         let interval = if cfg.display.vsync {
-            timing.rt.div_ceil(refresh).max(1) * refresh
+            shown * refresh
         } else {
             timing.rt.max(1)
         };
+        if policy == Policy::Reactive {
+            k_series.push(reactive.k);
+            reactive.record(timing.rt as f64);
+        }
         let rt = ms(timing.rt as f64);
         if timing.rt > refresh {
             over += 1;
         }
+        // Benefit, levels, popping.
+        let (mut frame_benefit, mut frame_finest, mut level_sum) = (0.0f64, 0.0f64, 0u64);
+        let mut frame_switches = 0u64;
+        let mut at_level = vec![0u64; max_levels];
+        for (vi, (i, _)) in visible.iter().enumerate() {
+            let proto = &scene.protos[scene.objects[*i as usize].proto as usize];
+            frame_finest += terms[vi].image(lod, proto.levels[0].triangles);
+            if let Some(l) = chosen[vi] {
+                frame_benefit += terms[vi].image(lod, proto.levels[l as usize].triangles);
+                level_sum += l as u64;
+                at_level[l as usize] += 1;
+            }
+            // Popping: a level change of an object on screen (an object
+            // whose disk is clipped away entirely is not seen).
+            if terms[vi].size > 0.0 && prev_seen[*i as usize] && prev_level[*i as usize] != chosen[vi] {
+                frame_switches += 1;
+            }
+        }
+        for &j in &prev_list {
+            prev_seen[j as usize] = false;
+            prev_level[j as usize] = None;
+        }
+        prev_list.clear();
+        for (vi, (i, _)) in visible.iter().enumerate() {
+            prev_seen[*i as usize] = true;
+            prev_level[*i as usize] = chosen[vi];
+            prev_list.push(*i);
+        }
+        prev_view = Some(view);
+        switches += frame_switches;
+        benefit_sum += frame_benefit;
+        finest_sum += frame_finest;
+        dropped_total += dropped;
+        for (a, b) in level_counts.iter_mut().zip(&at_level) {
+            *a += b;
+        }
+        let moved = prev_eye.map_or(0.0, |e| {
+            let d = sub3(pose.eye, e);
+            (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+        });
+        prev_eye = Some(pose.eye);
         let tris: u64 = draws
             .iter()
             .map(|d| scene.protos[d.proto as usize].levels[d.level as usize].triangles)
@@ -548,6 +877,30 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 row.push(est[k][f]);
             }
         }
+        row.extend([
+            (shown - 1) as f64,
+            refreshes as f64,
+            moved,
+            frame_benefit,
+            frame_finest,
+            if draws.is_empty() {
+                0.0
+            } else {
+                level_sum as f64 / draws.len() as f64
+            },
+            draws.len() as f64,
+            dropped as f64,
+            frame_switches as f64,
+            ms(empty + plan_cost),
+            if policy == Policy::Reactive {
+                *k_series.last().unwrap_or(&f64::NAN)
+            } else {
+                f64::NAN
+            },
+            bstats.tokens as f64,
+            bstats.switched as f64,
+        ]);
+        row.extend(at_level.iter().map(|&n| n as f64));
         rows.push(row);
         actual_ms.push(rt);
         gpu_ms.push(ms(timing.gpu as f64));
@@ -559,6 +912,51 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
     let simulate_seconds = t1.elapsed().as_secs_f64();
     let score = |k: usize| wants[k].then(|| Score::of(&est[k], &actual_ms, wall[k], ops[k]));
     let frames = poses.len() as u64;
+    let per_frame = |x: f64| if frames > 0 { x / frames as f64 } else { 0.0 };
+    let displayed_seconds = refreshes as f64 * refresh as f64 * 1e-12;
+    let drawn_total: u64 = level_counts.iter().sum();
+    let mut notes = Vec::new();
+    if policy.predictive() && knapsack_budget <= 0.0 && !visible_n.iter().all(|v| *v == 0.0) {
+        notes.push(format!(
+            "the target {:.3} ms (refresh x (1 - lod.margin)) is not above the empty frame's {:.3} ms: no object fits the knapsack, nothing is drawn",
+            ms(target),
+            ms(empty)
+        ));
+    } else if unaffordable_total > 0 {
+        notes.push(format!(
+            "{unaffordable_total} visible (object, frame) pairs had no level within the knapsack budget of {:.3} ms and were not drawn",
+            ms(knapsack_budget)
+        ));
+    }
+    let lod_summary = LodSummary {
+        policy: cfg.lod.policy.clone(),
+        estimator: cfg.lod.estimator.clone(),
+        algorithm: cfg.lod.algorithm.clone(),
+        target_ms: ms(target),
+        knapsack_budget_ms: ms(knapsack_budget),
+        mean_level: if drawn_total > 0 {
+            level_counts
+                .iter()
+                .enumerate()
+                .map(|(l, n)| l as f64 * *n as f64)
+                .sum::<f64>()
+                / drawn_total as f64
+        } else {
+            0.0
+        },
+        objects_per_level: level_counts.iter().map(|n| per_frame(*n as f64)).collect(),
+        dropped_per_frame: per_frame(dropped_total as f64),
+        unaffordable_object_frames: unaffordable_total,
+        switches,
+        reactive_k: (policy == Policy::Reactive).then(|| Dist::of(&k_series)),
+        branch: (policy == Policy::PredictiveBranch).then_some(BranchSummary {
+            tokens_per_frame: per_frame(branch_total.tokens as f64),
+            switched_objects: branch_total.switched as u64,
+            frames_with_switch: branch_frames,
+            prefix_runs: branch_total.prefix_runs as u64,
+        }),
+        notes,
+    };
     let length: f64 = poses
         .windows(2)
         .map(|p: &[Pose]| (0..3).map(|a| (p[1].eye[a] - p[0].eye[a]).powi(2)).sum::<f64>().sqrt())
@@ -614,6 +1012,25 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 h4: score(3),
                 pos: score(4),
             },
+            frame_skips: skips,
+            frame_skips_per_minute: if displayed_seconds > 0.0 {
+                skips as f64 / (displayed_seconds / 60.0)
+            } else {
+                0.0
+            },
+            displayed_seconds,
+            benefit_mean: per_frame(benefit_sum),
+            benefit_fraction: if finest_sum > 0.0 {
+                benefit_sum / finest_sum
+            } else {
+                1.0
+            },
+            lod_switches_per_second: if displayed_seconds > 0.0 {
+                switches as f64 / displayed_seconds
+            } else {
+                0.0
+            },
+            lod: lod_summary,
         },
     };
     let mut columns: Vec<String> = BASE_COLUMNS.iter().map(|s| s.to_string()).collect();
@@ -622,6 +1039,8 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
             columns.push(format!("Est{}Ms", e.to_uppercase()));
         }
     }
+    columns.extend(LOD_COLUMNS.iter().map(|s| s.to_string()));
+    columns.extend((0..max_levels).map(|l| format!("AtLevel{l}")));
     Ok(WalkthroughRun {
         config: cfg,
         summary: to_json(&summary),
