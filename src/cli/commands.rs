@@ -456,7 +456,7 @@ pub fn perceived_speed(args: super::args::PerceivedSpeedArgs) -> Result<()> {
     let fig = figure6(&model.source, &model.table, args.around, &args.out)?;
     match fig.first_skip {
         Some(r) => println!(
-            "wrote {} (.png and .svg): refreshes {}-{}, first frame skip at refresh {r}, {} skips in the run",
+            "wrote {} (.png and .svg): refreshes {}-{}, centred on the frame skip at refresh {r}, {} skips in the run",
             args.out.with_extension("").display(),
             fig.range.0,
             fig.range.1,

@@ -31,3 +31,4 @@ mod timeline;
 mod unified;
 mod vr;
 mod walkthrough;
+mod walkthrough_lod;

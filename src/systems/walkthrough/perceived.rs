@@ -104,7 +104,8 @@ pub fn refreshes(columns: &[String], rows: &[Vec<f64>], period_s: f64) -> Result
 /// What [`figure6`] drew.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Figure6 {
-    /// The first refresh that repeated a frame (None: no skip in the run).
+    /// The refresh that repeated a frame the figure is centred on (None:
+    /// no skip in the run).
     pub first_skip: Option<u64>,
     /// Refreshes drawn (first, last).
     pub range: (u64, u64),
@@ -113,8 +114,9 @@ pub struct Figure6 {
 }
 
 /// Runs the walkthrough `src`/`table` and draws the perceived speed per
-/// refresh for `around` refreshes either side of its first skip (from the
-/// start without a skip) into `out` (its extension is replaced: `.svg`
+/// refresh for `around` refreshes either side of its first skip that has
+/// `around` refreshes before it (else its first skip; from the start
+/// without a skip) into `out` (its extension is replaced: `.svg`
 /// and `.png` are written).
 pub fn figure6(src: &ModelSource, table: &toml::Table, around: u64, out: &Path) -> Result<Figure6, PerceivedError> {
     if !(1..=10_000).contains(&around) {
@@ -138,7 +140,10 @@ pub fn figure6(src: &ModelSource, table: &toml::Table, around: u64, out: &Path) 
     let run = run_walkthrough(cfg).map_err(|e| SimError::of(src, e))?;
     let all = refreshes(&run.columns, &run.rows, period_s)?;
     let repeated = |i: usize| i > 0 && all[i].frame == all[i - 1].frame;
-    let first = (0..all.len()).find(|&i| repeated(i));
+    // The first skip with `around` refreshes before it, else the first.
+    let first = (around as usize..all.len())
+        .find(|&i| repeated(i))
+        .or_else(|| (0..all.len()).find(|&i| repeated(i)));
     let skips = (0..all.len()).filter(|&i| repeated(i)).count() as u64;
     let centre = first.unwrap_or(around as usize);
     let lo = centre.saturating_sub(around as usize);
@@ -151,7 +156,7 @@ pub fn figure6(src: &ModelSource, table: &toml::Table, around: u64, out: &Path) 
     };
     let title = match first {
         Some(i) => format!(
-            "Perceived speed per refresh around the first frame skip (refresh {}, frame {} repeated)",
+            "Perceived speed per refresh around a frame skip (refresh {}, frame {} repeated)",
             all[i].index, all[i].frame
         ),
         None => "Perceived speed per refresh (no frame skip in this run)".to_string(),
