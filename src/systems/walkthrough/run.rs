@@ -828,8 +828,8 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 level_sum += l as u64;
                 at_level[l as usize] += 1;
             }
-            // Popping: a level change of an object on screen (an object
-            // whose disk is clipped away entirely is not seen).
+            // Popping: a level change of an object on screen in both frames
+            // (an object whose disk is clipped away entirely is not seen).
             if terms[vi].size > 0.0 && prev_seen[*i as usize] && prev_level[*i as usize] != chosen[vi] {
                 frame_switches += 1;
             }
@@ -840,7 +840,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
         }
         prev_list.clear();
         for (vi, (i, _)) in visible.iter().enumerate() {
-            prev_seen[*i as usize] = true;
+            prev_seen[*i as usize] = terms[vi].size > 0.0;
             prev_level[*i as usize] = chosen[vi];
             prev_list.push(*i);
         }
