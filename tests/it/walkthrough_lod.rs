@@ -72,10 +72,16 @@ fn table(text: &str, sets: &[&str]) -> (Vec<String>, Vec<Vec<f64>>) {
 }
 
 fn col(cols: &[String], name: &str) -> usize {
-    cols.iter().position(|c| c == name).unwrap_or_else(|| panic!("no column {name}"))
+    cols.iter()
+        .position(|c| c == name)
+        .unwrap_or_else(|| panic!("no column {name}"))
 }
 
-const SMALL_FOREST: [&str; 3] = ["run.frames=200", "estimation.fit_samples=500", "estimation.pos.alpha_steps=5"];
+const SMALL_FOREST: [&str; 3] = [
+    "run.frames=200",
+    "estimation.fit_samples=500",
+    "estimation.pos.alpha_steps=5",
+];
 
 #[test]
 fn every_policy_runs_and_reports_the_soft_real_time_metrics() {
@@ -179,7 +185,12 @@ fn reactive_pops_more_than_predictive_in_the_city_at_165_hz() {
         let ps = policy(p);
         summary_of(
             CITY,
-            &["run.frames=300", "display.refresh=\"165Hz\"", "estimation.fit_samples=2000", &ps],
+            &[
+                "run.frames=300",
+                "display.refresh=\"165Hz\"",
+                "estimation.fit_samples=2000",
+                &ps,
+            ],
         )
     };
     let none = run("none");
@@ -219,7 +230,11 @@ fn a_budget_below_an_objects_cheapest_level_leaves_it_undrawn() {
     // A target below the empty frame: nothing fits, nothing is drawn.
     let s = summary_of(
         LINEAR,
-        &["lod.policy=\"predictive+branch\"", "display.refresh=\"10kHz\"", "gpu.clear=\"0.3ms\""],
+        &[
+            "lod.policy=\"predictive+branch\"",
+            "display.refresh=\"10kHz\"",
+            "gpu.clear=\"0.3ms\"",
+        ],
     );
     assert_eq!(num(&s, "metrics.benefit_mean"), 0.0);
     let notes = s["metrics"]["lod"]["notes"].as_array().unwrap();
@@ -239,12 +254,7 @@ fn single_levels_rising_costs_and_empty_scenes_are_defined() {
         let ps = policy(p);
         let s = summary_of(
             LINEAR,
-            &[
-                &ps,
-                rising,
-                "estimation.estimators=[\"h2\"]",
-                "lod.estimator=\"h2\"",
-            ],
+            &[&ps, rising, "estimation.estimators=[\"h2\"]", "lod.estimator=\"h2\""],
         );
         if p.starts_with("predictive") {
             assert_eq!(s["metrics"]["lod"]["objects_per_level"][1].as_f64(), Some(0.0), "{p}");
@@ -298,7 +308,10 @@ fn bad_lod_keys_name_the_key() {
         "lod.estimator=\"pos\"",
         "estimation.estimators=[\"h4\"]",
     ]);
-    assert!(e.contains("lod.estimator") && e.contains("not in estimation.estimators"), "{e}");
+    assert!(
+        e.contains("lod.estimator") && e.contains("not in estimation.estimators"),
+        "{e}"
+    );
     let e = err(&["lod.polcy=\"none\""]);
     assert!(e.contains("polcy"), "{e}");
 }

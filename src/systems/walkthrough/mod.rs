@@ -17,7 +17,8 @@
 //!   paper 001's benefit;
 //! - `branch`: paper 000 §6.4's conditional branch in the frame's GPU work;
 //! - `perceived`: perceived speed per displayed refresh (Figure 6);
-//! - `run`, `report`, `system`: run and summary, the report, the registry.
+//! - `run`, `summary`, `report`, `system`: the run, the summary's structs,
+//!   the report, the registry.
 
 pub mod branch;
 pub mod camera;
@@ -31,6 +32,7 @@ pub mod render;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod summary;
 pub mod system;
 
 pub use config::WalkthroughConfig;
