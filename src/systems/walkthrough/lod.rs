@@ -94,7 +94,7 @@ pub fn validate(cfg: &LodConfig, estimators: &[String]) -> Result<(Policy, usize
             ),
         )
     })?;
-    if policy.predictive() && !estimators.iter().any(|e| *e == cfg.estimator) {
+    if policy.predictive() && !estimators.contains(&cfg.estimator) {
         return Err(invalid(
             "lod.estimator",
             format!(

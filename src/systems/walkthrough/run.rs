@@ -155,6 +155,10 @@ fn check_memory(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
     Ok(())
 }
 
+/// A candidate for a branch token: its estimated cost at the chosen level
+/// (ps), its index among the visible objects, its alternatives.
+type BranchCandidate = (f64, usize, Vec<(u32, f64)>);
+
 fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
@@ -289,7 +293,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 .iter()
                 .find(|o| o.proto as usize == i)
                 .map_or((0, 0, 0), |o| o.state);
-            for level in 0..table_levels(proto) {
+            for (level, slot) in tables[i].iter_mut().enumerate() {
                 let (table, r) = build_table(&cfg.estimation.pos, proto, level, (focal, w, h), |_, covered| {
                     let d = Draw {
                         proto: i as u32,
@@ -302,7 +306,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 renders += r;
                 full += table.full_size();
                 n += 1;
-                tables[i][level] = Some(table);
+                *slot = Some(table);
             }
         }
         pos_tables = Some(PosTables {
@@ -465,7 +469,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
             };
             // Candidates: (cost at the chosen level, vi, alternatives).
-            let mut cands: Vec<(f64, usize, Vec<(u32, f64)>)> = Vec::new();
+            let mut cands: Vec<BranchCandidate> = Vec::new();
             for &vi in &order {
                 let l = chosen[vi].unwrap_or(0) as usize;
                 let levels = scene.protos[scene.objects[visible[vi].0 as usize].proto as usize]
