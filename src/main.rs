@@ -52,6 +52,8 @@ enum Cmd {
     LodSelect(cli::args::LodSelectArgs),
     /// State sorting with a small buffer (paper 001): state changes of LRU, bounded-waste, random, round-robin.
     Sortbuf(cli::args::SortbufArgs),
+    /// Perceived movement speed per displayed refresh around a walkthrough's first frame skip (paper 000 Figure 6).
+    PerceivedSpeed(cli::args::PerceivedSpeedArgs),
 }
 
 fn main() -> ExitCode {
@@ -79,6 +81,7 @@ fn main() -> ExitCode {
         Cmd::Timeline(a) => commands::timeline(a),
         Cmd::LodSelect(a) => commands::lod_select(a),
         Cmd::Sortbuf(a) => commands::sortbuf(a),
+        Cmd::PerceivedSpeed(a) => commands::perceived_speed(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

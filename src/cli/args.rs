@@ -635,3 +635,19 @@ pub struct TimelineArgs {
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
 }
+
+/// `rendersim perceived-speed`.
+#[derive(Args)]
+pub struct PerceivedSpeedArgs {
+    /// Walkthrough model file (TOML, system = "walkthrough").
+    pub model: PathBuf,
+    /// Override a model key (repeatable), e.g. --set lod.policy=predictive.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+    /// Refreshes drawn either side of the first frame skip.
+    #[arg(long, value_name = "N", default_value_t = 8)]
+    pub around: u64,
+    /// The picture to write: FILE.png (an .svg is written beside it, and the reverse).
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+}

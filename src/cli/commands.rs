@@ -503,3 +503,30 @@ pub fn lod_select(args: super::args::LodSelectArgs) -> Result<()> {
 pub fn sortbuf(args: super::args::SortbufArgs) -> Result<()> {
     super::lod::sortbuf(&args)
 }
+
+/// `rendersim perceived-speed`: paper 000 Figure 6 from a walkthrough.
+pub fn perceived_speed(args: super::args::PerceivedSpeedArgs) -> Result<()> {
+    use rendersim::systems::walkthrough::perceived::figure6;
+    rendersim::plot::ImageFormat::of(&args.out)?;
+    let model = load_model(
+        Some(args.model.as_path()),
+        &rendersim::config::Overrides::with_sets(&args.sets),
+    )?;
+    let fig = figure6(&model.source, &model.table, args.around, &args.out)?;
+    match fig.first_skip {
+        Some(r) => println!(
+            "wrote {} (.png and .svg): refreshes {}-{}, centred on the frame skip at refresh {r}, {} skips in the run",
+            args.out.with_extension("").display(),
+            fig.range.0,
+            fig.range.1,
+            fig.skips
+        ),
+        None => println!(
+            "wrote {} (.png and .svg): refreshes {}-{}, no frame skip in the run",
+            args.out.with_extension("").display(),
+            fig.range.0,
+            fig.range.1
+        ),
+    }
+    Ok(())
+}

@@ -34,3 +34,4 @@ mod unified;
 mod view_cells;
 mod vr;
 mod walkthrough;
+mod walkthrough_lod;

@@ -280,8 +280,6 @@ fn err(text: &str, sets: &[&str]) -> String {
 fn bad_keys_name_the_key() {
     let e = err(CITY, &["scene.presett=\"city\""]);
     assert!(e.contains("presett"), "{e}");
-    let e = err(CITY, &["lod.policy=\"reactive\""]);
-    assert!(e.contains("lod.policy") && e.contains("not built yet"), "{e}");
     let e = err(CITY, &["lod.policy=\"fastest\""]);
     assert!(e.contains("lod.policy") && e.contains("unknown policy"), "{e}");
     let e = err(CITY, &["estimation.estimators=[\"h1\", \"h5\"]"]);

@@ -362,18 +362,78 @@ impl Default for PosConfig {
     }
 }
 
-/// Level-of-detail selection.
+/// Level-of-detail selection and the soft real-time frame (paper 001's
+/// reactive and predictive selection, paper 000 §6.4's conditional branch;
+/// `src/systems/walkthrough/lod.rs` and `branch.rs`). Every key is read by
+/// the policy named; the others ignore it.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct LodConfig {
-    /// `"none"`: every object at its finest level (the only policy built
-    /// so far; `reactive`, `predictive` and `predictive+branch` are
-    /// refused as not yet built).
+    /// `"none"` (every object at its finest level), `"reactive"` (a global
+    /// detail level steered by past frame times), `"predictive"` (per frame
+    /// a cost/benefit knapsack over every visible object's levels) or
+    /// `"predictive+branch"` (predictive, plus the GPU's conditional branch
+    /// to coarser levels when the frame runs late).
     pub policy: String,
+    /// Share of the frame budget (one display refresh) kept free as a
+    /// safety margin: the policies aim at `refresh x (1 - margin)`.
+    pub margin: f64,
+    /// Predictive: the estimator giving each (object, level)'s cost (`h1`,
+    /// `h2`, `h3`, `h4` or `pos`; it must be in `estimation.estimators`).
+    pub estimator: String,
+    /// Predictive: `"greedy"` (the lecture's, from scratch every frame) or
+    /// `"incremental"` (from the previous frame's selection).
+    pub algorithm: String,
+    /// Reactive: frames of rendering-time history averaged into the
+    /// prediction of the next frame.
+    pub history: u32,
+    /// Reactive: the correction's exponent: the detail level (triangles
+    /// allowed per pixel of an object's disk) is multiplied by
+    /// `(target / predicted)^gain` every frame.
+    pub gain: f64,
+    /// Benefit: the accuracy term `1 - c / triangles` of paper 001
+    /// (Funkhouser & Séquin's flat-shading reading), `c` in triangles.
+    pub accuracy_triangles: f64,
+    /// Benefit: objects within this angle of the view axis are in focus
+    /// (paper 001: b1 = 15 degrees).
+    pub focus_angle: f64,
+    /// Benefit: beyond `focus_angle` the benefit falls as
+    /// `exp(-(angle - focus_angle) / focus_falloff)`, degrees.
+    pub focus_falloff: f64,
+    /// Benefit: angular speed across the view (degrees per second) at which
+    /// the velocity term halves: `1 / (1 + speed / velocity_half)`.
+    pub velocity_half: f64,
+    /// Benefit: hysteresis weight h: `(1 - h) + h / (1 + |L - L'|)` with L'
+    /// the object's level in the frame before (0 = none).
+    pub hysteresis: f64,
+    /// Branch: objects per frame given coarser alternatives (the costliest
+    /// drawn objects farther than `branch_min_distance` that have a
+    /// cheaper coarser level).
+    pub branch_objects: u32,
+    /// Branch: coarser alternatives per switchable object.
+    pub branch_levels: u32,
+    /// Branch: objects nearer than this (metres) are never switched (to
+    /// reduce popping, paper 000 §6.5).
+    pub branch_min_distance: f64,
 }
 
 impl Default for LodConfig {
     fn default() -> Self {
-        LodConfig { policy: "none".into() }
+        LodConfig {
+            policy: "none".into(),
+            margin: 0.1,
+            estimator: "h4".into(),
+            algorithm: "greedy".into(),
+            history: 4,
+            gain: 1.0,
+            accuracy_triangles: 32.0,
+            focus_angle: 15.0,
+            focus_falloff: 20.0,
+            velocity_half: 90.0,
+            hysteresis: 0.2,
+            branch_objects: 4,
+            branch_levels: 2,
+            branch_min_distance: 20.0,
+        }
     }
 }

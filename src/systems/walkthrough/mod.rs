@@ -13,21 +13,30 @@
 //! - `render`: one frame through the frame pipeline;
 //! - `estimators`: h1-h4, their least-squares fit, the scores;
 //! - `pos`: per-object sampling tables;
-//! - `run`, `report`, `system`: run and summary, the report, the registry;
 //! - `timing`: how preprocess renders are timed (time stamps or a CPU clock
 //!   around a synchronising finish, §6.1-6.2);
 //! - `view_cells`: view-cell sampling (vcs) and per-view-cell estimation
-//!   (pvc), §5.1-5.2, compared in `experiments/view-cells.toml` (§7.3).
+//!   (pvc), §5.1-5.2, compared in `experiments/view-cells.toml` (§7.3);
+//! - `lod`: the level-of-detail policies (reactive, predictive) and
+//!   paper 001's benefit;
+//! - `branch`: paper 000 §6.4's conditional branch in the frame's GPU work;
+//! - `perceived`: perceived speed per displayed refresh (Figure 6);
+//! - `run`, `summary`, `report`, `system`: the run, the summary's structs,
+//!   the report, the registry.
 
+pub mod branch;
 pub mod camera;
 pub mod config;
 pub mod culling;
 pub mod estimators;
+pub mod lod;
+pub mod perceived;
 pub mod pos;
 pub mod render;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod summary;
 pub mod system;
 pub mod timing;
 pub mod view_cells;

@@ -90,6 +90,36 @@ pub fn write_report(s: &Value, w: &mut dyn Write) -> io::Result<()> {
             t["readings"]
         )?;
     }
+    let l = &m["lod"];
+    writeln!(
+        w,
+        "lod: policy {} (target {} ms); {} frame skips ({} per minute of {} s displayed); benefit {} per frame ({} of all finest); {} level switches per second; mean level {}, {} dropped per frame",
+        l["policy"].as_str().unwrap_or(""),
+        fixed(f(&l["target_ms"]), 3),
+        m["frame_skips"],
+        fixed(f(&m["frame_skips_per_minute"]), 2),
+        fixed(f(&m["displayed_seconds"]), 2),
+        fixed(f(&m["benefit_mean"]), 0),
+        fixed(f(&m["benefit_fraction"]), 3),
+        fixed(f(&m["lod_switches_per_second"]), 1),
+        fixed(f(&l["mean_level"]), 2),
+        fixed(f(&l["dropped_per_frame"]), 2)
+    )?;
+    if let Some(b) = l.get("branch") {
+        writeln!(
+            w,
+            "  conditional branch: {} tokens per frame, {} objects switched in {} frames ({} prefix runs)",
+            fixed(f(&b["tokens_per_frame"]), 2),
+            b["switched_objects"],
+            b["frames_with_switch"],
+            b["prefix_runs"]
+        )?;
+    }
+    if let Some(notes) = l["notes"].as_array() {
+        for n in notes {
+            writeln!(w, "  note: {}", n.as_str().unwrap_or(""))?;
+        }
+    }
     writeln!(
         w,
         "{} events in {} frame-pipeline runs, {} s wall ({} s preprocess, {} s frames)",

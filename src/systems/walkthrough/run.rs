@@ -12,7 +12,6 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use rand::Rng;
-use serde::Serialize;
 use serde_json::Value;
 
 use crate::engine::{PS_PER_MS, RngStreams};
@@ -20,18 +19,23 @@ use crate::output::trace::TraceWriter;
 use crate::systems::error::{SystemError, invalid};
 use crate::systems::summary::{Dist, EventCounts, to_json};
 
+use super::branch::{BranchStats, Switchable, evaluate};
 use super::camera::{self, Pose};
 use super::config::WalkthroughConfig;
 use super::culling::{Projection, Pvs, View, project, sample_projection};
 use super::estimators::{Constants, ESTIMATORS, Features, Score, fit};
+use super::lod::{BenefitTerms, Offer, Policy, Reactive, select};
 use super::pos::{PosTable, build as build_table};
 use super::render::{Draw, Renderer, frame_seeds, next_seed};
-use super::scene::{Scene, SceneTotals, build_scene};
+use super::scene::{Scene, build_scene};
 use super::timing::{Clock, TimingMode, TimingSummary};
 use super::view_cells::{PVC, VCS, ViewCellSummary, ViewCellTables};
 
-/// LOD policies known by name; only `none` is built so far.
-pub const LOD_POLICIES: [&str; 4] = ["none", "reactive", "predictive", "predictive+branch"];
+pub use super::lod::LOD_POLICIES;
+pub use super::summary::{
+    BASE_COLUMNS, BranchSummary, CameraSummary, EstimationSummary, LOD_COLUMNS, LodSummary, PosTables, WalkMetrics,
+    WalkthroughSummary,
+};
 
 /// Most frames and fit samples a run may ask for.
 pub const MAX_FRAMES: u64 = 10_000_000;
@@ -58,21 +62,6 @@ pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
             "system",
             format!("expected \"walkthrough\", got {:?}", cfg.system),
         ));
-    }
-    match cfg.lod.policy.as_str() {
-        "none" => {}
-        p if LOD_POLICIES.contains(&p) => {
-            return Err(invalid(
-                "lod.policy",
-                format!("{p:?} is not built yet (issue 11 item 5); only \"none\" runs so far"),
-            ));
-        }
-        p => {
-            return Err(invalid(
-                "lod.policy",
-                format!("unknown policy {p:?} (known: {})", LOD_POLICIES.join(", ")),
-            ));
-        }
     }
     for (i, e) in cfg.estimation.estimators.iter().enumerate() {
         if !ESTIMATORS.contains(&e.as_str()) {
@@ -161,17 +150,18 @@ pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
         ));
     }
     super::timing::validate(cfg.estimation.clock_overhead, cfg.estimation.clock_noise)?;
+    super::lod::validate(&cfg.lod, &cfg.estimation.estimators)?;
     check_memory(cfg)
 }
 
 fn check_memory(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
     use crate::limits::{DEFAULT_MAX_MEMORY, add_bytes, over_memory_message, show_bytes};
     let mut total = 0u64;
-    add_bytes(&mut total, cfg.run.frames, 16 * 8 + 64);
+    add_bytes(&mut total, cfg.run.frames, 512);
     let mut fit = 0u64;
     add_bytes(&mut fit, cfg.estimation.fit_samples, 48);
     let parts = format!(
-        "{} frames x 192 bytes = {}, {} fit samples x 48 bytes = {}",
+        "{} frames x 512 bytes = {}, {} fit samples x 48 bytes = {}",
         cfg.run.frames,
         show_bytes(total),
         cfg.estimation.fit_samples,
@@ -185,146 +175,17 @@ fn check_memory(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
     Ok(())
 }
 
+/// A candidate for a branch token: its estimated cost at the chosen level
+/// (ps), its index among the visible objects, its alternatives.
+type BranchCandidate = (f64, usize, Vec<(u32, f64)>);
+
+fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
 fn ms(ps: f64) -> f64 {
     ps / PS_PER_MS as f64
 }
-
-/// The pos tables of the run: the built ones and the renders they took.
-#[derive(Debug, Clone, Serialize)]
-pub struct PosTables {
-    /// Tables built (one per prototype drawn, finest level).
-    pub tables: u64,
-    /// Sample renders made.
-    pub renders: u64,
-    /// Renders the full grids would have taken.
-    pub full_renders: u64,
-    /// Share of the full grids' renders saved by pruning.
-    pub pruned_fraction: f64,
-}
-
-/// `metrics.estimation` of a walkthrough summary.
-#[derive(Debug, Clone, Serialize)]
-pub struct EstimationSummary {
-    /// Time of an empty frame (the frame's own terms, added to every
-    /// estimate), ms.
-    pub empty_frame_ms: f64,
-    /// Single-object renders the constants were fitted to.
-    pub fit_samples: u64,
-    /// The fitted constants (absent without h1-h4).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub constants: Option<Constants>,
-    /// The pos tables (absent without pos).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub pos_tables: Option<PosTables>,
-    /// Triangles (h1).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub h1: Option<Score>,
-    /// Transformed vertices (h2).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub h2: Option<Score>,
-    /// Funkhouser's max (h3).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub h3: Option<Score>,
-    /// Transformed vertices plus pixels (h4).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub h4: Option<Score>,
-    /// Per-object sampling.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub pos: Option<Score>,
-    /// View-cell sampling.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub vcs: Option<Score>,
-    /// Per-view-cell estimation.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub pvc: Option<Score>,
-    /// The view-cell preprocess (absent without vcs and pvc).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub view_cells: Option<ViewCellSummary>,
-    /// The CPU clock the preprocess was timed with (absent with time stamps).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub timing: Option<TimingSummary>,
-}
-
-/// `metrics` of a walkthrough summary.
-#[derive(Debug, Clone, Serialize)]
-pub struct WalkMetrics {
-    /// The frames' rendering time RT (CPU start to the GPU's last work), ms.
-    pub frame_time_ms: Dist,
-    /// GPU time per frame, ms.
-    pub gpu_time_ms: Dist,
-    /// The frame budget: one display refresh, ms.
-    pub budget_ms: f64,
-    /// Frames whose rendering time exceeds the budget.
-    pub frames_over_budget: u64,
-    /// Their share of the frames.
-    pub over_budget_fraction: f64,
-    /// Objects drawn per frame (in the PVS and the frustum).
-    pub visible_objects: Dist,
-    /// Triangles drawn per frame.
-    pub triangles: Dist,
-    /// Pixels covered per frame (overdraw included).
-    pub pixels_covered: Dist,
-    /// Frames with the camera inside an object's bounding sphere.
-    pub frames_inside_an_object: u64,
-    /// The estimators.
-    pub estimation: EstimationSummary,
-}
-
-/// The camera path as run.
-#[derive(Debug, Clone, Serialize)]
-pub struct CameraSummary {
-    /// The path kind (`street`, `forest`, `flight`, `keyframes`).
-    pub path: String,
-    /// Path length, metres.
-    pub length_m: f64,
-    /// View cells visited (their PVS computed); 0 without view cells.
-    pub view_cells_visited: u64,
-}
-
-/// The summary of a walkthrough (`summary.json`).
-#[derive(Debug, Clone, Serialize)]
-pub struct WalkthroughSummary {
-    /// `"walkthrough"`.
-    pub system: &'static str,
-    /// The model's description.
-    pub description: String,
-    /// How the frames were drawn.
-    pub fidelity: crate::systems::frame_pipeline::Fidelity,
-    /// Master seed.
-    pub seed: u64,
-    /// Frames.
-    pub frames: u64,
-    /// Kernel events of every frame-pipeline run (preprocess and frames).
-    pub events: EventCounts,
-    /// Frame-pipeline runs made (preprocess renders and frames).
-    pub pipeline_runs: u64,
-    /// Wall time of the whole run, seconds.
-    pub wall_seconds: f64,
-    /// Wall time of the scene, path and preprocess, seconds.
-    pub build_seconds: f64,
-    /// Wall time of the frames, seconds.
-    pub simulate_seconds: f64,
-    /// The scene preset (null: listed objects only).
-    pub preset: Option<String>,
-    /// The scene's totals.
-    pub scene: SceneTotals,
-    /// The camera path.
-    pub camera: CameraSummary,
-    /// The results.
-    pub metrics: WalkMetrics,
-}
-
-/// Columns of the per-frame table before the estimates.
-pub const BASE_COLUMNS: [&str; 8] = [
-    "Frame",
-    "TimeInSeconds",
-    "Objects",
-    "Triangles",
-    "PixelsCovered",
-    "ActualMs",
-    "GpuMs",
-    "BudgetMs",
-];
 
 struct Counter {
     events: u64,
@@ -445,8 +306,13 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
         None
     };
 
-    // The pos tables, one per prototype in use, finest level (lod.policy = "none").
-    let mut tables: Vec<Option<PosTable>> = vec![None; scene.protos.len()];
+    // The pos tables, one per prototype in use, at its finest level (every
+    // level when a policy other than "none" draws coarser ones).
+    let (policy, lod_est, algorithm) = super::lod::validate(&cfg.lod, &cfg.estimation.estimators)?;
+    let table_levels = |p: &super::scene::Prototype| {
+        if policy == Policy::None { 1 } else { p.levels.len() }
+    };
+    let mut tables: Vec<Vec<Option<PosTable>>> = scene.protos.iter().map(|p| vec![None; table_levels(p)]).collect();
     let mut pos_tables = None;
     if wants[4] || wants[PVC] {
         let mut used = vec![false; scene.protos.len()];
@@ -463,19 +329,21 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 .iter()
                 .find(|o| o.proto as usize == i)
                 .map_or((0, 0, 0), |o| o.state);
-            let (table, r) = build_table(&cfg.estimation.pos, proto, 0, (focal, w, h), |_, covered| {
-                let d = Draw {
-                    proto: i as u32,
-                    level: 0,
-                    pixels: covered,
-                    state,
-                };
-                object_time(d, &mut count, &mut pos_clock)
-            })?;
-            renders += r;
-            full += table.full_size();
-            n += 1;
-            tables[i] = Some(table);
+            for (level, slot) in tables[i].iter_mut().enumerate() {
+                let (table, r) = build_table(&cfg.estimation.pos, proto, level, (focal, w, h), |_, covered| {
+                    let d = Draw {
+                        proto: i as u32,
+                        level: level as u32,
+                        pixels: covered,
+                        state,
+                    };
+                    object_time(d, &mut count, &mut pos_clock)
+                })?;
+                renders += r;
+                full += table.full_size();
+                n += 1;
+                *slot = Some(table);
+            }
         }
         pos_tables = Some(PosTables {
             tables: n,
@@ -553,6 +421,31 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
     let mut visible: Vec<(u32, Projection)> = Vec::new();
     let mut feats: Vec<Features> = Vec::new();
     let mut draws: Vec<Draw> = Vec::new();
+    // Level of detail: the policy's state across frames.
+    let lod = &cfg.lod;
+    let target = refresh as f64 * (1.0 - lod.margin);
+    let knapsack_budget = (target - empty).max(0.0);
+    let mut reactive = Reactive::new(lod, target);
+    let c = constants.unwrap_or_default();
+    let n_objects = scene.objects.len();
+    let mut prev_level: Vec<Option<u32>> = vec![None; n_objects];
+    let mut prev_seen: Vec<bool> = vec![false; n_objects];
+    let mut prev_list: Vec<u32> = Vec::new();
+    let mut prev_view: Option<View> = None;
+    let mut prev_eye: Option<[f64; 3]> = None;
+    let max_levels = scene.protos.iter().map(|p| p.levels.len()).max().unwrap_or(1);
+    let mut terms: Vec<BenefitTerms> = Vec::new();
+    let mut chosen: Vec<Option<u32>> = Vec::new();
+    let mut order: Vec<usize> = Vec::new();
+    let mut lod_reads = 0u64;
+    let (mut skips, mut refreshes, mut switches) = (0u64, 0u64, 0u64);
+    let (mut benefit_sum, mut finest_sum) = (0.0f64, 0.0f64);
+    let mut level_counts = vec![0u64; max_levels];
+    let (mut dropped_total, mut unaffordable_total) = (0u64, 0u64);
+    let mut k_series: Vec<f64> = Vec::new();
+    let mut branch_total = BranchStats::default();
+    let mut branch_frames = 0u64;
+    let gpu_swap = cfg.gpu.swap.0 as f64;
     for (f, pose) in poses.iter().enumerate() {
         let view = View::new(pose, &cfg.camera);
         let candidates: &[u32] = match scene.view_cell {
@@ -560,24 +453,187 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
             None => &all,
         };
         visible.clear();
-        feats.clear();
-        draws.clear();
         for &i in candidates {
             let o = &scene.objects[i as usize];
             if view.sees_sphere(o.center, o.radius) {
                 let p = project(&view, o, &scene.protos[o.proto as usize]);
                 visible.push((i, p));
-                feats.push(features(&scene, o.proto, 0, &p));
-                draws.push(Draw {
-                    proto: o.proto,
-                    level: 0,
-                    pixels: p.covered_pixels,
-                    state: o.state,
-                });
             }
         }
         if visible.iter().any(|(_, p)| p.inside) {
             inside_frames += 1;
+        }
+        // The benefit's view-dependent terms.
+        terms.clear();
+        for (i, p) in &visible {
+            let o = &scene.objects[*i as usize];
+            let v = view.to_view(o.center);
+            terms.push(BenefitTerms::of(
+                lod,
+                p.disk_pixels,
+                v,
+                prev_view.map(|pv| pv.to_view(o.center)),
+                dt,
+            ));
+        }
+        // The cost of object `vi` at `level` under the policy's estimator (ps).
+        let cost_of = |vi: usize, level: usize, reads: &mut u64| -> f64 {
+            let (i, p) = &visible[vi];
+            let o = &scene.objects[*i as usize];
+            if lod_est < 4 {
+                c.object(lod_est, &features(&scene, o.proto, level, p))
+            } else {
+                tables[o.proto as usize]
+                    .get(level)
+                    .and_then(|t| t.as_ref())
+                    .map_or(0.0, |t| t.lookup(p.alpha, p.gamma, p.phi, reads))
+                    .max(0.0)
+            }
+        };
+        // The levels chosen (None: not drawn), per visible object.
+        chosen.clear();
+        let mut plan_cost = f64::NAN;
+        let mut dropped = 0u64;
+        match policy {
+            Policy::None => chosen.extend(visible.iter().map(|_| Some(0))),
+            Policy::Reactive => {
+                for (i, p) in &visible {
+                    let proto = &scene.protos[scene.objects[*i as usize].proto as usize];
+                    chosen.push(Some(
+                        reactive.level(proto.levels.iter().map(|l| l.triangles), p.disk_pixels),
+                    ));
+                }
+            }
+            Policy::Predictive | Policy::PredictiveBranch => {
+                let mut offers = Vec::with_capacity(visible.len());
+                let mut previous = Vec::with_capacity(visible.len());
+                for (vi, (i, _)) in visible.iter().enumerate() {
+                    let proto = &scene.protos[scene.objects[*i as usize].proto as usize];
+                    let before = prev_level[*i as usize];
+                    offers.push(Offer {
+                        levels: proto
+                            .levels
+                            .iter()
+                            .enumerate()
+                            .map(|(l, lv)| {
+                                (
+                                    cost_of(vi, l, &mut lod_reads),
+                                    terms[vi].selection(lod, lv.triangles, l as u32, before),
+                                )
+                            })
+                            .collect(),
+                    });
+                    previous.push(before);
+                }
+                let (sel, unaffordable) = select(&offers, knapsack_budget as u64, algorithm, &previous)?;
+                unaffordable_total += unaffordable as u64;
+                plan_cost = sel.total_cost as f64;
+                chosen.extend(sel.levels.iter().copied());
+                // Dropped: on screen (positive size) and not drawn; an
+                // object whose disk is clipped away has no benefit and is
+                // never drawn by the knapsack (not counted).
+                dropped = chosen
+                    .iter()
+                    .zip(&terms)
+                    .filter(|(l, t)| l.is_none() && t.size > 0.0)
+                    .count() as u64;
+            }
+        }
+        // The draw order: the visible objects in scene order; with the
+        // branch, its switchable objects last, nearest first (branch.rs).
+        order.clear();
+        order.extend((0..visible.len()).filter(|&vi| chosen[vi].is_some()));
+        let mut switchable: Vec<Switchable> = Vec::new();
+        let mut draw_cost: Vec<f64> = Vec::new();
+        if policy == Policy::PredictiveBranch && lod.branch_objects > 0 {
+            let dist = |vi: usize| {
+                let o = &scene.objects[visible[vi].0 as usize];
+                let d = sub3(o.center, pose.eye);
+                (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+            };
+            // Candidates: (cost at the chosen level, vi, alternatives).
+            let mut cands: Vec<BranchCandidate> = Vec::new();
+            for &vi in &order {
+                let l = chosen[vi].unwrap_or(0) as usize;
+                let levels = scene.protos[scene.objects[visible[vi].0 as usize].proto as usize]
+                    .levels
+                    .len();
+                if dist(vi) < lod.branch_min_distance || l + 1 >= levels {
+                    continue;
+                }
+                let c0 = cost_of(vi, l, &mut lod_reads);
+                let mut alts = vec![(l as u32, c0)];
+                let mut last = c0;
+                for m in l + 1..levels {
+                    if alts.len() > lod.branch_levels as usize {
+                        break;
+                    }
+                    let cm = cost_of(vi, m, &mut lod_reads);
+                    if cm < last {
+                        alts.push((m as u32, cm));
+                        last = cm;
+                    }
+                }
+                if alts.len() > 1 {
+                    cands.push((c0, vi, alts));
+                }
+            }
+            cands.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            cands.truncate(lod.branch_objects as usize);
+            cands.sort_by(|a, b| dist(a.1).total_cmp(&dist(b.1)).then(a.1.cmp(&b.1)));
+            let marked: Vec<usize> = cands.iter().map(|c| c.1).collect();
+            order.retain(|vi| !marked.contains(vi));
+            let first = order.len();
+            for (k, (_, vi, alts)) in cands.into_iter().enumerate() {
+                order.push(vi);
+                switchable.push(Switchable {
+                    draw: first + k,
+                    alternatives: alts,
+                });
+            }
+            for &vi in &order {
+                draw_cost.push(cost_of(vi, chosen[vi].unwrap_or(0) as usize, &mut lod_reads));
+            }
+        }
+        draws.clear();
+        for &vi in &order {
+            let (i, p) = &visible[vi];
+            let o = &scene.objects[*i as usize];
+            draws.push(Draw {
+                proto: o.proto,
+                level: chosen[vi].unwrap_or(0),
+                pixels: p.covered_pixels,
+                state: o.state,
+            });
+        }
+        let seed = next_seed(&mut seeds);
+        let mut bstats = BranchStats::default();
+        if !switchable.is_empty() {
+            bstats = evaluate(
+                &mut draws,
+                &switchable,
+                &mut draw_cost,
+                refresh as f64,
+                gpu_swap,
+                |prefix| {
+                    let (t, by_kind, names) = actual.render_counted(prefix, seed, start)?;
+                    count.add(t.events, &by_kind, names);
+                    Ok((t.rt as f64 - gpu_swap).max(0.0))
+                },
+            )?;
+            for (d, &vi) in draws.iter().zip(&order) {
+                chosen[vi] = Some(d.level);
+            }
+            branch_total.switched += bstats.switched;
+            branch_total.tokens += bstats.tokens;
+            branch_total.prefix_runs += bstats.prefix_runs;
+            if bstats.switched > 0 {
+                branch_frames += 1;
+            }
+        }
+        feats.clear();
+        for (d, &vi) in draws.iter().zip(&order) {
+            feats.push(features(&scene, d.proto, d.level as usize, &visible[vi].1));
         }
         let mut sums = [0.0f64; ESTIMATORS.len()];
         for k in 0..4 {
@@ -595,9 +651,9 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
             let t = Instant::now();
             let mut reads = 0u64;
             let mut sum = 0.0;
-            for (i, p) in &visible {
-                let o = &scene.objects[*i as usize];
-                if let Some(tb) = &tables[o.proto as usize] {
+            for (d, &vi) in draws.iter().zip(&order) {
+                let p = &visible[vi].1;
+                if let Some(Some(tb)) = tables[d.proto as usize].get(d.level as usize) {
                     sum += tb.lookup(p.alpha, p.gamma, p.phi, &mut reads);
                 }
             }
@@ -615,7 +671,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 }
             }
         }
-        let (timing, by_kind, names) = actual.render_counted(&draws, next_seed(&mut seeds), start)?;
+        let (timing, by_kind, names) = actual.render_counted(&draws, seed, start)?;
         count.add(timing.events, &by_kind, names);
         // RT = the frame's own terms + max(ET_cpu, ET_gpu) (paper 000 §4.1):
         // the empty frame, the CPU's submission work (known), the estimate.
@@ -629,15 +685,66 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 });
             }
         }
+        // The display: the frame started at a vertical blank and is shown at
+        // the first one after its rendering time; the refreshes in between
+        // show the frame before again (skips).
+        let shown = timing.rt.div_ceil(refresh).max(1);
+        skips += shown - 1;
+        refreshes += shown;
         let interval = if cfg.display.vsync {
-            timing.rt.div_ceil(refresh).max(1) * refresh
+            shown * refresh
         } else {
             timing.rt.max(1)
         };
+        if policy == Policy::Reactive {
+            k_series.push(reactive.k);
+            reactive.record(timing.rt as f64);
+        }
         let rt = ms(timing.rt as f64);
         if timing.rt > refresh {
             over += 1;
         }
+        // Benefit, levels, popping.
+        let (mut frame_benefit, mut frame_finest, mut level_sum) = (0.0f64, 0.0f64, 0u64);
+        let mut frame_switches = 0u64;
+        let mut at_level = vec![0u64; max_levels];
+        for (vi, (i, _)) in visible.iter().enumerate() {
+            let proto = &scene.protos[scene.objects[*i as usize].proto as usize];
+            frame_finest += terms[vi].image(lod, proto.levels[0].triangles);
+            if let Some(l) = chosen[vi] {
+                frame_benefit += terms[vi].image(lod, proto.levels[l as usize].triangles);
+                level_sum += l as u64;
+                at_level[l as usize] += 1;
+            }
+            // Popping: a level change of an object on screen in both frames
+            // (an object whose disk is clipped away entirely is not seen).
+            if terms[vi].size > 0.0 && prev_seen[*i as usize] && prev_level[*i as usize] != chosen[vi] {
+                frame_switches += 1;
+            }
+        }
+        for &j in &prev_list {
+            prev_seen[j as usize] = false;
+            prev_level[j as usize] = None;
+        }
+        prev_list.clear();
+        for (vi, (i, _)) in visible.iter().enumerate() {
+            prev_seen[*i as usize] = terms[vi].size > 0.0;
+            prev_level[*i as usize] = chosen[vi];
+            prev_list.push(*i);
+        }
+        prev_view = Some(view);
+        switches += frame_switches;
+        benefit_sum += frame_benefit;
+        finest_sum += frame_finest;
+        dropped_total += dropped;
+        for (a, b) in level_counts.iter_mut().zip(&at_level) {
+            *a += b;
+        }
+        let moved = prev_eye.map_or(0.0, |e| {
+            let d = sub3(pose.eye, e);
+            (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+        });
+        prev_eye = Some(pose.eye);
         let tris: u64 = draws
             .iter()
             .map(|d| scene.protos[d.proto as usize].levels[d.level as usize].triangles)
@@ -658,6 +765,30 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 row.push(est[k][f]);
             }
         }
+        row.extend([
+            (shown - 1) as f64,
+            refreshes as f64,
+            moved,
+            frame_benefit,
+            frame_finest,
+            if draws.is_empty() {
+                0.0
+            } else {
+                level_sum as f64 / draws.len() as f64
+            },
+            draws.len() as f64,
+            dropped as f64,
+            frame_switches as f64,
+            ms(empty + plan_cost),
+            if policy == Policy::Reactive {
+                *k_series.last().unwrap_or(&f64::NAN)
+            } else {
+                f64::NAN
+            },
+            bstats.tokens as f64,
+            bstats.switched as f64,
+        ]);
+        row.extend(at_level.iter().map(|&n| n as f64));
         rows.push(row);
         actual_ms.push(rt);
         gpu_ms.push(ms(timing.gpu as f64));
@@ -669,6 +800,51 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
     let simulate_seconds = t1.elapsed().as_secs_f64();
     let score = |k: usize| wants[k].then(|| Score::of(&est[k], &actual_ms, wall[k], ops[k]));
     let frames = poses.len() as u64;
+    let per_frame = |x: f64| if frames > 0 { x / frames as f64 } else { 0.0 };
+    let displayed_seconds = refreshes as f64 * refresh as f64 * 1e-12;
+    let drawn_total: u64 = level_counts.iter().sum();
+    let mut notes = Vec::new();
+    if policy.predictive() && knapsack_budget <= 0.0 && !visible_n.iter().all(|v| *v == 0.0) {
+        notes.push(format!(
+            "the target {:.3} ms (refresh x (1 - lod.margin)) is not above the empty frame's {:.3} ms: no object fits the knapsack, nothing is drawn",
+            ms(target),
+            ms(empty)
+        ));
+    } else if unaffordable_total > 0 {
+        notes.push(format!(
+            "{unaffordable_total} visible (object, frame) pairs had no level within the knapsack budget of {:.3} ms and were not drawn",
+            ms(knapsack_budget)
+        ));
+    }
+    let lod_summary = LodSummary {
+        policy: cfg.lod.policy.clone(),
+        estimator: cfg.lod.estimator.clone(),
+        algorithm: cfg.lod.algorithm.clone(),
+        target_ms: ms(target),
+        knapsack_budget_ms: ms(knapsack_budget),
+        mean_level: if drawn_total > 0 {
+            level_counts
+                .iter()
+                .enumerate()
+                .map(|(l, n)| l as f64 * *n as f64)
+                .sum::<f64>()
+                / drawn_total as f64
+        } else {
+            0.0
+        },
+        objects_per_level: level_counts.iter().map(|n| per_frame(*n as f64)).collect(),
+        dropped_per_frame: per_frame(dropped_total as f64),
+        unaffordable_object_frames: unaffordable_total,
+        switches,
+        reactive_k: (policy == Policy::Reactive).then(|| Dist::of(&k_series)),
+        branch: (policy == Policy::PredictiveBranch).then_some(BranchSummary {
+            tokens_per_frame: per_frame(branch_total.tokens as f64),
+            switched_objects: branch_total.switched as u64,
+            frames_with_switch: branch_frames,
+            prefix_runs: branch_total.prefix_runs as u64,
+        }),
+        notes,
+    };
     let length: f64 = poses
         .windows(2)
         .map(|p: &[Pose]| (0..3).map(|a| (p[1].eye[a] - p[0].eye[a]).powi(2)).sum::<f64>().sqrt())
@@ -734,6 +910,25 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                     per_object_bias_ms: ms(cfg.estimation.clock_overhead.0 as f64) / cfg.estimation.repeats as f64,
                 }),
             },
+            frame_skips: skips,
+            frame_skips_per_minute: if displayed_seconds > 0.0 {
+                skips as f64 / (displayed_seconds / 60.0)
+            } else {
+                0.0
+            },
+            displayed_seconds,
+            benefit_mean: per_frame(benefit_sum),
+            benefit_fraction: if finest_sum > 0.0 {
+                benefit_sum / finest_sum
+            } else {
+                1.0
+            },
+            lod_switches_per_second: if displayed_seconds > 0.0 {
+                switches as f64 / displayed_seconds
+            } else {
+                0.0
+            },
+            lod: lod_summary,
         },
     };
     let mut columns: Vec<String> = BASE_COLUMNS.iter().map(|s| s.to_string()).collect();
@@ -742,6 +937,8 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
             columns.push(format!("Est{}Ms", e.to_uppercase()));
         }
     }
+    columns.extend(LOD_COLUMNS.iter().map(|s| s.to_string()));
+    columns.extend((0..max_levels).map(|l| format!("AtLevel{l}")));
     Ok(WalkthroughRun {
         config: cfg,
         summary: to_json(&summary),

@@ -378,8 +378,8 @@ pub struct Inputs<'a> {
     pub cell: f64,
     /// The path.
     pub poses: &'a [Pose],
-    /// The pos tables by prototype (`pvc`).
-    pub tables: &'a [Option<PosTable>],
+    /// The pos tables by prototype and level (`pvc` reads the finest, level 0).
+    pub tables: &'a [Vec<Option<PosTable>>],
     /// Build `vcs`, `pvc`.
     pub want: (bool, bool),
     /// Master seed.
@@ -442,7 +442,7 @@ pub fn build(
             for (bin, total) in row.iter_mut().enumerate() {
                 for &i in &set {
                     let o = &scene.objects[i as usize];
-                    let Some(tb) = &inp.tables[o.proto as usize] else {
+                    let Some(Some(tb)) = inp.tables[o.proto as usize].first() else {
                         continue;
                     };
                     sum.pvc_bounds += 1;
