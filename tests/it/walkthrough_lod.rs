@@ -290,7 +290,11 @@ fn bad_lod_keys_name_the_key() {
         ("lod.policy=\"fastest\"", "lod.policy", "unknown policy"),
         ("lod.margin=1.0", "lod.margin", "between 0 and 1"),
         ("lod.margin=-0.1", "lod.margin", "between 0 and 1"),
-        ("lod.estimator=\"h9\"", "lod.estimator", "unknown or whole-frame estimator"),
+        (
+            "lod.estimator=\"h9\"",
+            "lod.estimator",
+            "unknown or whole-frame estimator",
+        ),
         ("lod.estimator=\"vcs\"", "lod.estimator", "needs a per-object one"),
         ("lod.algorithm=\"optimal\"", "lod.algorithm", "greedy, incremental"),
         ("lod.history=0", "lod.history", "between 1"),
