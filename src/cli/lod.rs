@@ -2,21 +2,16 @@
 //! on one knapsack instance and its state-sorting buffer on one sequence
 //! (the library's `components::lod_select` and `components::sorting_buffer`).
 
-use std::collections::HashMap;
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Result, anyhow, bail};
 
 use rendersim::components::lod_select::{
     Algorithm, MAX_OPTIMAL_OBJECTS, SelectionSummary, file::read_instance, optimal,
 };
-use rendersim::components::sorting_buffer::{
-    SortbufSummary, SortbufSweep, StateId, Strategy, sequence::sequence_from_spec,
-};
-use rendersim::config::{Overrides, load_model};
+use rendersim::components::sorting_buffer::{SortbufSummary, SortbufSweep, Strategy, sequence::sequence_from_spec};
 use rendersim::output::text::fixed;
-use rendersim::scene::config::SceneWorkload;
-use rendersim::scene::states::state_sequence;
+use rendersim::scene::states::scene_state_ids;
 
 use super::args::{LodSelectArgs, SortbufArgs};
 
@@ -111,49 +106,10 @@ pub fn lod_select(args: &LodSelectArgs) -> Result<()> {
     Ok(())
 }
 
-/// `scene:MODEL.toml[:state|shader|texture|material]`: the state ids of a
-/// model's scene in submission order (`scene::states`), numbered by first
-/// appearance; `state` (the default) is the whole (shader, texture,
-/// material) triple, the others one attribute.
-fn scene_sequence(spec: &str) -> Result<Vec<StateId>> {
-    let rest = &spec["scene:".len()..];
-    let (path, attr) = match rest.rsplit_once(':') {
-        Some((p, a)) if ["state", "shader", "texture", "material"].contains(&a) => (p, a),
-        _ => (rest, "state"),
-    };
-    let model = load_model(Some(Path::new(path)), &Overrides::default())?;
-    let Some(w) = model.table.get("workload").and_then(|v| v.as_table()) else {
-        bail!("{path}: the model has no [workload] table, so no scene to take states from");
-    };
-    if w.get("kind").and_then(|k| k.as_str()) != Some("scene") {
-        bail!("{path}: workload.kind is not \"scene\", so there is no scene to take states from");
-    }
-    let mut w = w.clone();
-    w.remove("kind");
-    let scene: SceneWorkload = toml::Value::Table(w)
-        .try_into()
-        .with_context(|| format!("{path}: reading [workload]"))?;
-    let states = state_sequence(&scene).map_err(|e| anyhow!("{path}: {e}"))?;
-    let mut ids: HashMap<(u64, u64, u64), StateId> = HashMap::new();
-    Ok(states
-        .into_iter()
-        .map(|(sh, tx, mt)| {
-            let key = match attr {
-                "shader" => (sh, 0, 0),
-                "texture" => (0, tx, 0),
-                "material" => (0, 0, mt),
-                _ => (sh, tx, mt),
-            };
-            let n = ids.len() as StateId;
-            *ids.entry(key).or_insert(n)
-        })
-        .collect())
-}
-
 /// `rendersim sortbuf`.
 pub fn sortbuf(args: &SortbufArgs) -> Result<()> {
     let seq = if args.sequence.starts_with("scene:") {
-        scene_sequence(&args.sequence)?
+        scene_state_ids(&args.sequence["scene:".len()..], Path::new(".")).map_err(|e| anyhow!(e))?
     } else {
         sequence_from_spec(&args.sequence, Path::new("."))?
     };

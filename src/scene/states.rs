@@ -96,3 +96,49 @@ pub fn state_sequence(scene: &SceneWorkload) -> Result<Vec<ObjectState>, String>
     }
     Ok(out)
 }
+
+/// The state ids of a model file's scene in submission order, numbered by
+/// first appearance: `spec` is `MODEL.toml[:state|shader|texture|material]`
+/// (relative paths from `base`); `state` (the default) numbers the whole
+/// (shader, texture, material) triple, the others one attribute. This is
+/// `rendersim sortbuf scene:...`'s sequence and the `sorting_buffer`
+/// system's. Errors name the file and what is missing.
+pub fn scene_state_ids(spec: &str, base: &std::path::Path) -> Result<Vec<u64>, String> {
+    use crate::config::{Overrides, load_model};
+    let (path, attr) = match spec.rsplit_once(':') {
+        Some((p, a)) if ["state", "shader", "texture", "material"].contains(&a) => (p, a),
+        _ => (spec, "state"),
+    };
+    let full = base.join(path);
+    let model = load_model(Some(&full), &Overrides::default()).map_err(|e| e.to_string())?;
+    let Some(w) = model.table.get("workload").and_then(|v| v.as_table()) else {
+        return Err(format!(
+            "{path}: the model has no [workload] table, so no scene to take states from"
+        ));
+    };
+    if w.get("kind").and_then(|k| k.as_str()) != Some("scene") {
+        return Err(format!(
+            "{path}: workload.kind is not \"scene\", so there is no scene to take states from"
+        ));
+    }
+    let mut w = w.clone();
+    w.remove("kind");
+    let scene: SceneWorkload = toml::Value::Table(w)
+        .try_into()
+        .map_err(|e| format!("{path}: reading [workload]: {e}"))?;
+    let states = state_sequence(&scene).map_err(|e| format!("{path}: {e}"))?;
+    let mut ids: std::collections::HashMap<ObjectState, u64> = std::collections::HashMap::new();
+    Ok(states
+        .into_iter()
+        .map(|(sh, tx, mt)| {
+            let key = match attr {
+                "shader" => (sh, 0, 0),
+                "texture" => (0, tx, 0),
+                "material" => (0, 0, mt),
+                _ => (sh, tx, mt),
+            };
+            let n = ids.len() as u64;
+            *ids.entry(key).or_insert(n)
+        })
+        .collect())
+}

@@ -8,6 +8,7 @@ pub mod error;
 pub mod frame_pipeline;
 pub mod multi_rate;
 pub mod pixelflow;
+pub mod state_sorting;
 pub mod summary;
 pub mod tracked_input;
 pub mod vr;
@@ -175,6 +176,7 @@ pub const SYSTEMS: &[&dyn System] = &[
     &pixelflow::system::PixelFlowSystem,
     &walkthrough::system::WalkthroughSystem,
     &device_predictions::system::DevicePredictionsSystem,
+    &state_sorting::system::StateSortingSystem,
 ];
 
 /// A resolved model's TOML with the header every system writes.

@@ -29,6 +29,7 @@ mod pipeline_oracles;
 mod pixelflow;
 mod shards;
 mod sortbuf;
+mod state_sorting;
 mod timeline;
 mod unified;
 mod view_cells;

@@ -1,0 +1,236 @@
+//! The `state_sorting` run, its summary (`metrics.state_changes.<strategy>`,
+//! `metrics.lower_bound`, `metrics.over_bound.<strategy>`, ...), its table
+//! (one row per strategy) and the registry entry
+//! ([`crate::systems::SYSTEMS`]).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+use serde::Serialize;
+use serde_json::Value;
+
+use crate::components::sorting_buffer::{
+    MAX_OFFLINE_LEN, StateId, Strategy, check_buffer, distinct_states, input_runs, lower_bound, offline_optimum,
+    sequence::sequence_from_spec, simulate,
+};
+use crate::config::{ModelSource, deserialize};
+use crate::output::trace::TraceWriter;
+use crate::scene::states::scene_state_ids;
+use crate::systems::{Outcome, SimError, System, SystemError, outcome_basics, resolved_toml};
+
+use super::config::StateSortingConfig;
+
+/// `system = "state_sorting"`.
+pub struct StateSortingSystem;
+
+/// The summary's numbers.
+#[derive(Debug, Serialize)]
+struct Metrics {
+    sequence_length: usize,
+    distinct_states: usize,
+    /// State changes without a buffer (runs of the input).
+    input_runs: u64,
+    buffer: usize,
+    /// A lower bound of the offline optimum.
+    lower_bound: u64,
+    /// The exact offline optimum (sequences of at most `MAX_OFFLINE_LEN`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    offline_optimum: Option<u64>,
+    /// State changes per strategy.
+    state_changes: BTreeMap<&'static str, u64>,
+    /// State changes over the lower bound, per strategy.
+    over_bound: BTreeMap<&'static str, f64>,
+    /// State changes over the changes without a buffer, per strategy.
+    over_input: BTreeMap<&'static str, f64>,
+    /// Overflows (the strategy's choices), per strategy.
+    overflows: BTreeMap<&'static str, u64>,
+}
+
+/// The summary.
+#[derive(Debug, Serialize)]
+struct Summary {
+    system: &'static str,
+    description: String,
+    sequence: String,
+    seed: u64,
+    wall_seconds: f64,
+    simulate_seconds: f64,
+    metrics: Metrics,
+}
+
+/// A finished run.
+#[derive(Debug)]
+pub struct StateSortingRun {
+    summary: Value,
+    config: StateSortingConfig,
+    /// (strategy, state changes, overflows), in the model's order.
+    rows: Vec<(Strategy, u64, u64)>,
+    lower_bound: u64,
+    trace: Option<TraceWriter>,
+}
+
+/// Columns of the per-strategy table.
+const COLUMNS: [&str; 5] = ["Strategy", "Buffer", "StateChanges", "LowerBound", "Overflows"];
+
+fn strategy_of(name: &str) -> Option<Strategy> {
+    Strategy::ALL.into_iter().find(|s| s.name() == name)
+}
+
+/// The sequence a spec names (relative paths from `base`).
+pub fn resolve_sequence(spec: &str, base: &Path) -> Result<Vec<StateId>, String> {
+    match spec.strip_prefix("scene:") {
+        Some(rest) => scene_state_ids(rest, base),
+        None => sequence_from_spec(spec, base).map_err(|e| e.to_string()),
+    }
+}
+
+/// Reads the sequence and runs every strategy.
+pub fn run_state_sorting(cfg: StateSortingConfig, base_dir: &Path) -> Result<StateSortingRun, SystemError> {
+    let bad = |key: &str, m: String| SystemError::Invalid {
+        key: key.into(),
+        message: m,
+    };
+    let start = Instant::now();
+    if cfg.system != "state_sorting" {
+        return Err(bad(
+            "system",
+            format!("expected \"state_sorting\", got {:?}", cfg.system),
+        ));
+    }
+    check_buffer(cfg.buffer).map_err(|e| bad("buffer", e.to_string()))?;
+    if cfg.strategies.is_empty() {
+        return Err(bad("strategies", "names no strategy".into()));
+    }
+    let mut strategies = Vec::new();
+    for (i, name) in cfg.strategies.iter().enumerate() {
+        let s = strategy_of(name).ok_or_else(|| {
+            bad(
+                &format!("strategies[{i}]"),
+                format!("unknown strategy {name:?} (known: lru, bounded-waste, random, round-robin)"),
+            )
+        })?;
+        if strategies.contains(&s) {
+            return Err(bad(&format!("strategies[{i}]"), format!("{name:?} is listed twice")));
+        }
+        strategies.push(s);
+    }
+    let seq = resolve_sequence(&cfg.sequence, base_dir).map_err(|e| bad("sequence", e))?;
+    let sim_start = Instant::now();
+    let mut rows = Vec::new();
+    let mut metrics = Metrics {
+        sequence_length: seq.len(),
+        distinct_states: distinct_states(&seq),
+        input_runs: input_runs(&seq),
+        buffer: cfg.buffer,
+        lower_bound: lower_bound(&seq, cfg.buffer),
+        offline_optimum: None,
+        state_changes: BTreeMap::new(),
+        over_bound: BTreeMap::new(),
+        over_input: BTreeMap::new(),
+        overflows: BTreeMap::new(),
+    };
+    if seq.len() <= MAX_OFFLINE_LEN {
+        metrics.offline_optimum = Some(offline_optimum(&seq, cfg.buffer).map_err(|e| bad("sequence", e.to_string()))?);
+    }
+    let ratio = |a: u64, b: u64| {
+        if b == 0 {
+            if a == 0 { 1.0 } else { f64::INFINITY }
+        } else {
+            a as f64 / b as f64
+        }
+    };
+    for &s in &strategies {
+        let r = simulate(&seq, cfg.buffer, s, cfg.run.seed, false).map_err(|e| bad("sequence", e.to_string()))?;
+        metrics.state_changes.insert(s.name(), r.state_changes);
+        metrics
+            .over_bound
+            .insert(s.name(), ratio(r.state_changes, metrics.lower_bound));
+        metrics
+            .over_input
+            .insert(s.name(), ratio(r.state_changes, metrics.input_runs));
+        metrics.overflows.insert(s.name(), r.overflows);
+        rows.push((s, r.state_changes, r.overflows));
+    }
+    let simulate_seconds = sim_start.elapsed().as_secs_f64();
+    let lower = metrics.lower_bound;
+    let summary = Summary {
+        system: "state_sorting",
+        description: cfg.description.clone(),
+        sequence: cfg.sequence.clone(),
+        seed: cfg.run.seed,
+        wall_seconds: start.elapsed().as_secs_f64(),
+        simulate_seconds,
+        metrics,
+    };
+    let summary = serde_json::to_value(&summary).map_err(|e| bad("sequence", e.to_string()))?;
+    Ok(StateSortingRun {
+        summary,
+        config: cfg,
+        rows,
+        lower_bound: lower,
+        trace: None,
+    })
+}
+
+impl System for StateSortingSystem {
+    fn name(&self) -> &'static str {
+        "state_sorting"
+    }
+
+    fn run(
+        &self,
+        src: &ModelSource,
+        table: &toml::Table,
+        trace: Option<TraceWriter>,
+    ) -> Result<Box<dyn Outcome>, SimError> {
+        let cfg: StateSortingConfig = deserialize(table, src)?;
+        let mut run = run_state_sorting(cfg, &src.base_dir).map_err(|e| SimError::of(src, e))?;
+        // No events of its own: a requested trace file is closed empty.
+        run.trace = trace;
+        Ok(Box::new(run))
+    }
+}
+
+impl Outcome for StateSortingRun {
+    outcome_basics!();
+
+    fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
+        let rows = self
+            .rows
+            .iter()
+            .map(|&(s, changes, overflows)| {
+                let index = Strategy::ALL.iter().position(|&x| x == s).unwrap_or(0);
+                vec![
+                    index as f64,
+                    self.config.buffer as f64,
+                    changes as f64,
+                    self.lower_bound as f64,
+                    overflows as f64,
+                ]
+            })
+            .collect();
+        (COLUMNS.iter().map(|c| c.to_string()).collect(), rows)
+    }
+
+    fn write_table(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {
+        use crate::output::table::{number, write_table};
+        let (columns, rows) = self.table();
+        let rows = rows.iter().map(|r| r.iter().map(|&v| number(v)).collect());
+        write_table(std::io::BufWriter::new(w), &columns, rows)
+    }
+
+    fn resolved_model(&self, base_dir: &Path) -> String {
+        let mut cfg = self.config.clone();
+        // A file or a scene's model, made absolute so the resolved model runs anywhere.
+        let spec = &cfg.sequence;
+        if !spec.starts_with("lru-worst:") {
+            let (prefix, rest) = match spec.strip_prefix("scene:") {
+                Some(r) => ("scene:", r),
+                None => ("", spec.as_str()),
+            };
+            cfg.sequence = format!("{prefix}{}", base_dir.join(rest).display());
+        }
+        resolved_toml(&cfg)
+    }
+}
