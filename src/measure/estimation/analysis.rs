@@ -9,7 +9,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::measure::fit::median;
-use crate::systems::walkthrough::estimators::{Constants, ESTIMATORS, Features, Score, fit};
+use crate::systems::walkthrough::estimators::{Constants, Features, PER_OBJECT_ESTIMATORS, Score, fit};
 
 use super::{
     EstimationError, EstimationSetup, ObjectDraw, PassKind, PassMeasurement, Plan, PlannedPass, PosEntry, Prototype,
@@ -340,7 +340,7 @@ pub fn analyze(
         let actual: Vec<f64> = set.iter().map(|(_, m)| m.time_ns / 1e6).collect();
         let estimates: Vec<[f64; 5]> = passes.iter().map(|p| study.pass_ms(plan, p)).collect();
         let mut scores = BTreeMap::new();
-        for (k, est_name) in ESTIMATORS.iter().enumerate() {
+        for (k, est_name) in PER_OBJECT_ESTIMATORS.iter().enumerate() {
             let est: Vec<f64> = estimates.iter().map(|e| e[k]).collect();
             let (secs, ops) = time_estimator(&study, plan, &passes, k);
             scores.insert(est_name.to_string(), Score::of(&est, &actual, secs, ops));

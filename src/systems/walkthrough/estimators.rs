@@ -25,6 +25,11 @@ use serde::Serialize;
 /// per-view-cell estimation.
 pub const ESTIMATORS: [&str; 7] = ["h1", "h2", "h3", "h4", "pos", "vcs", "pvc"];
 
+/// The estimators that price one object in one view (h1-h4, pos): the
+/// first five of [`ESTIMATORS`]. vcs and pvc estimate whole frames per view
+/// cell, so the LOD policies and the measured estimation study use these.
+pub const PER_OBJECT_ESTIMATORS: [&str; 5] = ["h1", "h2", "h3", "h4", "pos"];
+
 /// What the heuristics read of an object in a view.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Features {

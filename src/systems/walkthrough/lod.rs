@@ -37,7 +37,7 @@ use crate::engine::Duration;
 use crate::systems::error::{SystemError, invalid};
 
 use super::config::LodConfig;
-use super::estimators::ESTIMATORS;
+use super::estimators::PER_OBJECT_ESTIMATORS;
 
 /// The policies by name.
 pub const LOD_POLICIES: [&str; 4] = ["none", "reactive", "predictive", "predictive+branch"];
@@ -70,7 +70,7 @@ impl Policy {
 }
 
 /// Checks the `[lod]` keys; returns the policy, the estimator index (into
-/// [`ESTIMATORS`]) and the knapsack algorithm.
+/// [`PER_OBJECT_ESTIMATORS`]) and the knapsack algorithm.
 pub fn validate(cfg: &LodConfig, estimators: &[String]) -> Result<(Policy, usize, Algorithm), SystemError> {
     let policy = match cfg.policy.as_str() {
         "none" => Policy::None,
@@ -86,7 +86,7 @@ pub fn validate(cfg: &LodConfig, estimators: &[String]) -> Result<(Policy, usize
     };
     // The per-object estimators (h1-h4, pos) price an (object, level);
     // vcs and pvc estimate whole frames per view cell and cannot.
-    let per_object = &ESTIMATORS[..5];
+    let per_object = &PER_OBJECT_ESTIMATORS;
     let est = per_object.iter().position(|e| *e == cfg.estimator).ok_or_else(|| {
         invalid(
             "lod.estimator",
