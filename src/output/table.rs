@@ -37,6 +37,12 @@ pub fn write_table<W: Write, S: AsRef<str>>(
     csv.flush()
 }
 
+/// Writes a table of numbers (cells through [`number`]): the per-row
+/// tables of the systems whose rows are all numeric.
+pub fn write_number_table<W: Write, S: AsRef<str>>(w: W, header: &[S], rows: &[Vec<f64>]) -> std::io::Result<()> {
+    write_table(w, header, rows.iter().map(|r| r.iter().map(|&v| number(v)).collect()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

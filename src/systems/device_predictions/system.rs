@@ -209,10 +209,8 @@ impl Outcome for DevicePredictionsRun {
     }
 
     fn write_table(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        use crate::output::table::{number, write_table};
         let (columns, rows) = self.table();
-        let rows = rows.iter().map(|r| r.iter().map(|&v| number(v)).collect());
-        write_table(std::io::BufWriter::new(w), &columns, rows)
+        crate::output::table::write_number_table(std::io::BufWriter::new(w), &columns, &rows)
     }
 
     fn resolved_model(&self, base_dir: &Path) -> String {

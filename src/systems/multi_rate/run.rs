@@ -417,11 +417,11 @@ fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &A
 
 /// Writes the per-event table as CSV.
 pub fn write_events_csv(events: &[EventRecord], w: &mut dyn Write) -> std::io::Result<()> {
-    use crate::output::table::{number, write_table};
-    let rows = event_rows(events)
-        .into_iter()
-        .map(|r| r.iter().map(|&v| number(v)).collect());
-    write_table(std::io::BufWriter::new(w), &super::latency::COLUMNS, rows)
+    crate::output::table::write_number_table(
+        std::io::BufWriter::new(w),
+        &super::latency::COLUMNS,
+        &event_rows(events),
+    )
 }
 
 /// Refuses, before simulating, a run whose expected span (the input events

@@ -668,11 +668,7 @@ pub fn region_rows(run: &PixelFlowRun) -> Vec<Vec<f64>> {
 
 /// Writes the per-region table as CSV.
 pub fn write_regions_csv(run: &PixelFlowRun, w: &mut dyn std::io::Write) -> std::io::Result<()> {
-    use crate::output::table::{number, write_table};
-    let rows = region_rows(run)
-        .into_iter()
-        .map(|r| r.iter().map(|&v| number(v)).collect());
-    write_table(std::io::BufWriter::new(w), &COLUMNS, rows)
+    crate::output::table::write_number_table(std::io::BufWriter::new(w), &COLUMNS, &region_rows(run))
 }
 
 /// Writes a Chrome/Perfetto trace: one process per node role, one thread

@@ -255,11 +255,7 @@ pub fn motion_rows(motions: &[MotionRecord]) -> Vec<Vec<f64>> {
 
 /// Writes the per-motion table as CSV.
 pub fn write_motions_csv(motions: &[MotionRecord], w: &mut dyn Write) -> std::io::Result<()> {
-    use crate::output::table::{number, write_table};
-    let rows = motion_rows(motions)
-        .into_iter()
-        .map(|r| r.iter().map(|&v| number(v)).collect());
-    write_table(std::io::BufWriter::new(w), &COLUMNS, rows)
+    crate::output::table::write_number_table(std::io::BufWriter::new(w), &COLUMNS, &motion_rows(motions))
 }
 
 /// Refuses, before simulating, a run whose expected span (the motions and

@@ -40,9 +40,7 @@ impl Outcome for WalkthroughRun {
     }
 
     fn write_table(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        use crate::output::table::{number, write_table};
-        let rows = self.rows.iter().map(|r| r.iter().map(|&v| number(v)).collect());
-        write_table(std::io::BufWriter::new(w), &self.columns, rows)
+        crate::output::table::write_number_table(std::io::BufWriter::new(w), &self.columns, &self.rows)
     }
 
     fn resolved_model(&self, _base_dir: &Path) -> String {
