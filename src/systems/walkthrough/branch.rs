@@ -31,6 +31,7 @@
 
 use crate::systems::error::SystemError;
 
+use super::config::LodConfig;
 use super::render::Draw;
 
 /// One switchable object: its position in the draw list and its
@@ -42,6 +43,68 @@ pub struct Switchable {
     pub draw: usize,
     /// Alternatives, the designated level first.
     pub alternatives: Vec<(u32, f64)>,
+}
+
+/// A candidate for a branch token: its estimated cost at the chosen level
+/// (ps), its index among the visible objects, its alternatives.
+type Candidate = (f64, usize, Vec<(u32, f64)>);
+
+/// Marks a frame's switchable objects and moves them to the end of the
+/// draw order. `order` holds the indices of the objects to draw (scene
+/// order); `level(vi)` is an object's chosen level, `levels(vi)` its
+/// number of levels, `dist(vi)` its distance from the eye (m), and
+/// `cost(vi, l)` its estimated cost at level `l` (ps). An object at least
+/// `lod.branch_min_distance` away with a coarser level is a candidate; its
+/// alternatives are its chosen level and up to `lod.branch_levels` coarser
+/// levels, each cheaper than the one before. The `lod.branch_objects`
+/// costliest candidates are marked and drawn last, nearest first.
+pub fn mark_switchable(
+    order: &mut Vec<usize>,
+    lod: &LodConfig,
+    level: impl Fn(usize) -> usize,
+    levels: impl Fn(usize) -> usize,
+    dist: impl Fn(usize) -> f64,
+    mut cost: impl FnMut(usize, usize) -> f64,
+) -> Vec<Switchable> {
+    let mut cands: Vec<Candidate> = Vec::new();
+    for &vi in order.iter() {
+        let l = level(vi);
+        let n = levels(vi);
+        if dist(vi) < lod.branch_min_distance || l + 1 >= n {
+            continue;
+        }
+        let c0 = cost(vi, l);
+        let mut alts = vec![(l as u32, c0)];
+        let mut last = c0;
+        for m in l + 1..n {
+            if alts.len() > lod.branch_levels as usize {
+                break;
+            }
+            let cm = cost(vi, m);
+            if cm < last {
+                alts.push((m as u32, cm));
+                last = cm;
+            }
+        }
+        if alts.len() > 1 {
+            cands.push((c0, vi, alts));
+        }
+    }
+    cands.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    cands.truncate(lod.branch_objects as usize);
+    cands.sort_by(|a, b| dist(a.1).total_cmp(&dist(b.1)).then(a.1.cmp(&b.1)));
+    let marked: Vec<usize> = cands.iter().map(|c| c.1).collect();
+    order.retain(|vi| !marked.contains(vi));
+    let first = order.len();
+    let mut switchable = Vec::with_capacity(cands.len());
+    for (k, (_, vi, alts)) in cands.into_iter().enumerate() {
+        order.push(vi);
+        switchable.push(Switchable {
+            draw: first + k,
+            alternatives: alts,
+        });
+    }
+    switchable
 }
 
 /// What the branches of one frame did.

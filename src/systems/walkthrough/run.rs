@@ -19,7 +19,7 @@ use crate::output::trace::TraceWriter;
 use crate::systems::error::{SystemError, invalid};
 use crate::systems::summary::{Dist, EventCounts, to_json};
 
-use super::branch::{BranchStats, Switchable, evaluate};
+use super::branch::{BranchStats, Switchable, evaluate, mark_switchable};
 use super::camera::{self, Pose};
 use super::config::WalkthroughConfig;
 use super::culling::{Projection, Pvs, View, project, sample_projection};
@@ -174,10 +174,6 @@ fn check_memory(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
     }
     Ok(())
 }
-
-/// A candidate for a branch token: its estimated cost at the chosen level
-/// (ps), its index among the visible objects, its alternatives.
-type BranchCandidate = (f64, usize, Vec<(u32, f64)>);
 
 fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
@@ -551,46 +547,18 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                 let d = sub3(o.center, pose.eye);
                 (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
             };
-            // Candidates: (cost at the chosen level, vi, alternatives).
-            let mut cands: Vec<BranchCandidate> = Vec::new();
-            for &vi in &order {
-                let l = chosen[vi].unwrap_or(0) as usize;
-                let levels = scene.protos[scene.objects[visible[vi].0 as usize].proto as usize]
-                    .levels
-                    .len();
-                if dist(vi) < lod.branch_min_distance || l + 1 >= levels {
-                    continue;
-                }
-                let c0 = cost_of(vi, l, &mut lod_reads);
-                let mut alts = vec![(l as u32, c0)];
-                let mut last = c0;
-                for m in l + 1..levels {
-                    if alts.len() > lod.branch_levels as usize {
-                        break;
-                    }
-                    let cm = cost_of(vi, m, &mut lod_reads);
-                    if cm < last {
-                        alts.push((m as u32, cm));
-                        last = cm;
-                    }
-                }
-                if alts.len() > 1 {
-                    cands.push((c0, vi, alts));
-                }
-            }
-            cands.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-            cands.truncate(lod.branch_objects as usize);
-            cands.sort_by(|a, b| dist(a.1).total_cmp(&dist(b.1)).then(a.1.cmp(&b.1)));
-            let marked: Vec<usize> = cands.iter().map(|c| c.1).collect();
-            order.retain(|vi| !marked.contains(vi));
-            let first = order.len();
-            for (k, (_, vi, alts)) in cands.into_iter().enumerate() {
-                order.push(vi);
-                switchable.push(Switchable {
-                    draw: first + k,
-                    alternatives: alts,
-                });
-            }
+            switchable = mark_switchable(
+                &mut order,
+                lod,
+                |vi| chosen[vi].unwrap_or(0) as usize,
+                |vi| {
+                    scene.protos[scene.objects[visible[vi].0 as usize].proto as usize]
+                        .levels
+                        .len()
+                },
+                dist,
+                |vi, l| cost_of(vi, l, &mut lod_reads),
+            );
             for &vi in &order {
                 draw_cost.push(cost_of(vi, chosen[vi].unwrap_or(0) as usize, &mut lod_reads));
             }
