@@ -117,11 +117,63 @@ pub struct Measurement {
     pub wall_seconds: f64,
 }
 
-fn stats_types() -> wgpu::PipelineStatisticsTypes {
+pub(crate) fn stats_types() -> wgpu::PipelineStatisticsTypes {
     wgpu::PipelineStatisticsTypes::VERTEX_SHADER_INVOCATIONS
         | wgpu::PipelineStatisticsTypes::CLIPPER_INVOCATIONS
         | wgpu::PipelineStatisticsTypes::CLIPPER_PRIMITIVES_OUT
         | wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS
+}
+
+/// The colour format the measurement pipelines render to.
+pub(crate) const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// A render pipeline of the measurement shaders: 2-D float positions (one
+/// vertex buffer, stride 8) through `vs_main`, `fs_main` into one
+/// [`TARGET_FORMAT`] attachment without blending, no culling, the given
+/// depth state (`rendersim measure`'s passes and `study estimation`'s).
+pub(crate) fn position_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    shader: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    depth_stencil: Option<wgpu::DepthStencilState>,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module: shader,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: 8,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &[wgpu::VertexAttribute {
+                    format: wgpu::VertexFormat::Float32x2,
+                    offset: 0,
+                    shader_location: 0,
+                }],
+            })],
+        },
+        primitive: wgpu::PrimitiveState {
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: shader,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format: TARGET_FORMAT,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 /// An opened adapter and device, reused across measurements (a study opens
@@ -329,29 +381,13 @@ impl Gpu {
             bind_group_layouts: &[Some(&bgl)],
             ..Default::default()
         });
-        let format = wgpu::TextureFormat::Rgba8Unorm;
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("measure"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: 8,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &[wgpu::VertexAttribute {
-                        format: wgpu::VertexFormat::Float32x2,
-                        offset: 0,
-                        shader_location: 0,
-                    }],
-                })],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
+        let format = TARGET_FORMAT;
+        let pipeline = position_pipeline(
+            device,
+            "measure",
+            &shader,
+            &layout,
+            Some(wgpu::DepthStencilState {
                 format: wgpu::TextureFormat::Depth32Float,
                 depth_write_enabled: Some(opts.depth_test),
                 depth_compare: Some(if opts.depth_test {
@@ -362,20 +398,7 @@ impl Gpu {
                 stencil: Default::default(),
                 bias: Default::default(),
             }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        );
         let extent = wgpu::Extent3d {
             width: opts.size.0,
             height: opts.size.1,

@@ -11,7 +11,7 @@ use std::time::Instant;
 
 use wgpu::util::DeviceExt;
 
-use super::device::{Gpu, MeasureError};
+use super::device::{Gpu, MeasureError, TARGET_FORMAT, position_pipeline, stats_types};
 use super::estimation::{EstimationStudy, PassMeasurement, Plan, PlannedPass, analyze};
 use super::fit::median;
 use super::geometry::mesh_positions;
@@ -147,43 +147,8 @@ impl<'a> Renderer<'a> {
             bind_group_layouts: &[Some(&bgl)],
             ..Default::default()
         });
-        let format = wgpu::TextureFormat::Rgba8Unorm;
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("estimation"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: 8,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &[wgpu::VertexAttribute {
-                        format: wgpu::VertexFormat::Float32x2,
-                        offset: 0,
-                        shader_location: 0,
-                    }],
-                })],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let format = TARGET_FORMAT;
+        let pipeline = position_pipeline(device, "estimation", &shader, &layout, None);
         let target = plan.setup.target;
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("target"),
@@ -201,12 +166,7 @@ impl<'a> Renderer<'a> {
         });
         let stats = device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some("stats"),
-            ty: wgpu::QueryType::PipelineStatistics(
-                wgpu::PipelineStatisticsTypes::VERTEX_SHADER_INVOCATIONS
-                    | wgpu::PipelineStatisticsTypes::CLIPPER_INVOCATIONS
-                    | wgpu::PipelineStatisticsTypes::CLIPPER_PRIMITIVES_OUT
-                    | wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS,
-            ),
+            ty: wgpu::QueryType::PipelineStatistics(stats_types()),
             count: CHUNK as u32,
         });
         let times = device.create_query_set(&wgpu::QuerySetDescriptor {
