@@ -110,54 +110,11 @@ if [ "$state" != idle ]; then
 fi
 echo "Slurm $(sinfo -V | awk '{print $2}') up on $host ($cpus CPUs)"
 
-# A small noisy experiment: 3 x 2 points x 2 seeds = 12 runs, with
-# per-frame data (histogram, derived spread), line and scatter plots.
-cat > "$work/m.toml" <<'TOML'
-[run]
-frames = 60
-warmup_frames = 5
-[noise]
-enabled = true
-[workload]
-kind = "fixed"
-cpu = "2ms"
-gpu = "9ms"
-TOML
-cat > "$work/e.toml" <<'TOML'
-name = "slurm-test"
-model = "m.toml"
-replications = 2
-[[sweep]]
-key = "workload.gpu"
-values = ["9ms", "17ms", "25ms"]
-[[sweep]]
-key = "display.buffers"
-values = [2, 3]
-[[metric]]
-path = "metrics.display_interval_ms.mean"
-[[metric]]
-path = "metrics.display_latency_ms.mean"
-[[plot]]
-file = "interval"
-kind = "line"
-x = "workload.gpu"
-y = ["metrics.display_interval_ms.mean"]
-[[plot]]
-file = "frames"
-kind = "histogram"
-column = "FrameTime"
-bins = 20
-[[plot]]
-file = "scatter"
-kind = "scatter"
-x = "metrics.display_interval_ms.mean"
-y = "metrics.display_latency_ms.mean"
-[[derived]]
-name = "c99"
-kind = "quantile_width_from_min"
-column = "FrameTime"
-level = 0.99
-TOML
+# The shared small noisy experiment (tests/fixtures/sharded/, also run by
+# tests/it/shards.rs with a stand-in sbatch): 3 x 2 points x 2 seeds = 12
+# runs, with per-frame data (histogram, derived spread), line and scatter
+# plots and a check.
+cp "$root/tests/fixtures/sharded/m.toml" "$root/tests/fixtures/sharded/e.toml" "$work/"
 
 said=$("$bin" experiment "$work/e.toml" --out "$work/sharded" --slurm --shards 4 --submit)
 echo "$said"

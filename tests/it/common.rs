@@ -113,3 +113,35 @@ pub fn list(indices: Vec<u32>) -> rendersim::scene::mesh::Mesh {
         vertex_count,
     }
 }
+
+/// A simulated latency distribution (`{dist}.min/mean/max`) lies inside its
+/// closed-form bounds over all start phases (`{bounds}.phase_min/phase_max`),
+/// its extremes come within `touch` of the bounds' width of them, and its
+/// mean is within `mean_tol` (relative) of the closed-form mean over
+/// independent uniform phases (`{bounds}.phase_mean`). Returns the mean.
+pub fn check_within_phase_bounds(s: &Value, dist: &str, bounds: &str, touch: f64, mean_tol: f64) -> f64 {
+    let (min, mean, max) = (
+        num(s, &format!("{dist}.min")),
+        num(s, &format!("{dist}.mean")),
+        num(s, &format!("{dist}.max")),
+    );
+    let (lo, hi, mu) = (
+        num(s, &format!("{bounds}.phase_min")),
+        num(s, &format!("{bounds}.phase_max")),
+        num(s, &format!("{bounds}.phase_mean")),
+    );
+    assert!(
+        min >= lo - 1e-6 && max <= hi + 1e-6,
+        "{dist}: [{min}, {max}] outside [{lo}, {hi}]"
+    );
+    let width = hi - lo;
+    assert!(
+        min - lo <= touch * width && hi - max <= touch * width,
+        "{dist}: [{min}, {max}] vs [{lo}, {hi}]"
+    );
+    assert!(
+        (mean - mu).abs() <= mean_tol * mu,
+        "{dist}: mean {mean} vs closed form {mu}"
+    );
+    mean
+}

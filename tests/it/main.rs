@@ -36,3 +36,4 @@ mod view_cells;
 mod vr;
 mod walkthrough;
 mod walkthrough_lod;
+mod walkthrough_scenes;

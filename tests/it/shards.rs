@@ -31,61 +31,16 @@ fn err(args: &[&str]) -> String {
     e
 }
 
-/// A small noisy experiment (so seeds matter) with per-frame data (a
-/// histogram and a derived spread), a line plot, a scatter plot and checks:
-/// 3 x 2 points x 2 seeds = 12 runs.
+/// The small noisy experiment of `tests/fixtures/sharded/` (so seeds
+/// matter; also run by scripts/slurm-test.sh on a real Slurm), copied into
+/// `dir`: per-frame data (a histogram and a derived spread), a line plot, a
+/// scatter plot and a check; 3 x 2 points x 2 seeds = 12 runs.
 fn experiment(dir: &Path) -> PathBuf {
-    std::fs::write(
-        dir.join("m.toml"),
-        "[run]\nframes = 60\nwarmup_frames = 5\n[noise]\nenabled = true\n\
-         [workload]\nkind = \"fixed\"\ncpu = \"2ms\"\ngpu = \"9ms\"\n",
-    )
-    .unwrap();
-    let p = dir.join("e.toml");
-    std::fs::write(
-        &p,
-        r#"name = "sharded"
-model = "m.toml"
-replications = 2
-[[sweep]]
-key = "workload.gpu"
-values = ["9ms", "17ms", "25ms"]
-[[sweep]]
-key = "display.buffers"
-values = [2, 3]
-[[metric]]
-path = "metrics.display_interval_ms.mean"
-[[metric]]
-path = "metrics.display_latency_ms.mean"
-[[plot]]
-file = "interval"
-kind = "line"
-x = "workload.gpu"
-y = ["metrics.display_interval_ms.mean"]
-[[plot]]
-file = "frames"
-kind = "histogram"
-column = "FrameTime"
-bins = 20
-[[plot]]
-file = "scatter"
-kind = "scatter"
-x = "metrics.display_interval_ms.mean"
-y = "metrics.display_latency_ms.mean"
-[[derived]]
-name = "c99"
-kind = "quantile_width_from_min"
-column = "FrameTime"
-level = 0.99
-[[check]]
-path = "metrics.display_interval_ms.mean"
-where = { "workload.gpu" = "25ms", "display.buffers" = 2 }
-at_least = 25.0
-tolerance = 0
-"#,
-    )
-    .unwrap();
-    p
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/sharded");
+    for name in ["m.toml", "e.toml"] {
+        std::fs::copy(fixtures.join(name), dir.join(name)).unwrap();
+    }
+    dir.join("e.toml")
 }
 
 /// `text` with the cells of the columns whose header starts with

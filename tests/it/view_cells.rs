@@ -9,6 +9,7 @@ use std::process::Command;
 use serde_json::Value;
 
 use crate::common::{num, try_run_any};
+use crate::walkthrough_scenes::{coarse_pos, free_running_display, linear_gpu};
 
 const CITY: &str = include_str!("../../models/walkthrough-city.toml");
 
@@ -17,27 +18,13 @@ const CITY: &str = include_str!("../../models/walkthrough-city.toml");
 /// along +y towards object "a" (always ahead); object "b" lies behind the
 /// walk. A frame's time is the empty frame's plus 10 ns per triangle of
 /// "a" (pos tables are exact: the time does not depend on the view).
-const AHEAD: &str = r#"
-system = "walkthrough"
-[run]
-frames = 40
-seed = 3
-[gpu]
-architecture = "split"
-[gpu.geometry]
-triangle_setup = "10ns"
-[display]
-vsync = false
-present_mode = "immediate"
-[noise]
-enabled = false
-[estimation]
-estimators = ["h1", "pos", "vcs", "pvc"]
-fit_samples = 200
-[estimation.pos]
-alpha_steps = 4
-gamma_steps = 2
-phi_steps = 1
+const AHEAD: &str = concat!(
+    "system = \"walkthrough\"\n[run]\nframes = 40\nseed = 3\n",
+    linear_gpu!(),
+    free_running_display!(),
+    "[estimation]\nestimators = [\"h1\", \"pos\", \"vcs\", \"pvc\"]\nfit_samples = 200\n",
+    coarse_pos!(),
+    r#"
 [estimation.view_cells]
 directions = 8
 samples = 6
@@ -62,7 +49,8 @@ position = [3.0, -200.0, 0.0]
 size = [10.0, 6.0, 20.0]
 levels = [{ triangles = 50000, acmr = 1.2 }]
 texture = 1
-"#;
+"#,
+);
 
 const SMALL_CITY: [&str; 5] = [
     "scene.scale=0.05",

@@ -10,6 +10,7 @@ use rendersim::systems::walkthrough::culling::{View, disk_in_rect};
 use serde_json::Value;
 
 use crate::common::{num, summary_of, try_run_any};
+use crate::walkthrough_scenes::{coarse_pos, free_running_display, linear_gpu, three_objects_walk};
 
 const CITY: &str = include_str!("../../models/walkthrough-city.toml");
 const FOREST: &str = include_str!("../../models/walkthrough-forest.toml");
@@ -17,51 +18,14 @@ const FOREST: &str = include_str!("../../models/walkthrough-forest.toml");
 /// A small scene of listed objects on a GPU whose only cost is triangle
 /// setup (split architecture, no CPU costs, no noise, no vsync): a frame's
 /// time is linear in its triangles by construction.
-const LINEAR: &str = r#"
-system = "walkthrough"
-[run]
-frames = 40
-seed = 3
-[gpu]
-architecture = "split"
-[gpu.geometry]
-triangle_setup = "10ns"
-[display]
-vsync = false
-present_mode = "immediate"
-[noise]
-enabled = false
-[estimation]
-fit_samples = 200
-[estimation.pos]
-alpha_steps = 4
-gamma_steps = 2
-phi_steps = 1
-[camera]
-speed = 150.0
-[[camera.keyframes]]
-position = [0.0, -60.0, 1.7]
-yaw = 90
-[[camera.keyframes]]
-position = [0.0, 60.0, 1.7]
-yaw = 90
-[[scene.objects]]
-name = "a"
-position = [15.0, 0.0, 0.0]
-size = [8.0, 8.0, 12.0]
-levels = [{ triangles = 3000, acmr = 1.2 }, { triangles = 700, acmr = 1.2 }]
-[[scene.objects]]
-name = "b"
-position = [-20.0, 30.0, 0.0]
-size = [10.0, 6.0, 20.0]
-levels = [{ triangles = 1200, acmr = 1.2 }]
-texture = 1
-[[scene.objects]]
-name = "c"
-position = [12.0, 80.0, 0.0]
-size = [4.0, 4.0, 4.0]
-levels = [{ triangles = 50000, acmr = 1.2 }]
-"#;
+const LINEAR: &str = concat!(
+    "system = \"walkthrough\"\n[run]\nframes = 40\nseed = 3\n",
+    linear_gpu!(),
+    free_running_display!(),
+    "[estimation]\nfit_samples = 200\n",
+    coarse_pos!(),
+    three_objects_walk!(),
+);
 
 fn without_wall(mut v: Value) -> Value {
     fn strip(v: &mut Value) {

@@ -9,6 +9,7 @@ use std::process::Command;
 use serde_json::Value;
 
 use crate::common::{num, summary_of, try_run_any};
+use crate::walkthrough_scenes::{linear_gpu, three_objects_walk};
 
 const CITY: &str = include_str!("../../models/walkthrough-city.toml");
 const FOREST: &str = include_str!("../../models/walkthrough-forest.toml");
@@ -16,47 +17,12 @@ const FOREST: &str = include_str!("../../models/walkthrough-forest.toml");
 /// Listed objects on a GPU whose only cost is triangle setup (10 ns), no
 /// CPU costs worth speaking of, no noise: an object's time is its
 /// triangles x 10 ns, what h1 fits exactly.
-const LINEAR: &str = r#"
-system = "walkthrough"
-[run]
-frames = 30
-seed = 3
-[gpu]
-architecture = "split"
-[gpu.geometry]
-triangle_setup = "10ns"
-[noise]
-enabled = false
-[estimation]
-estimators = ["h1", "h4"]
-fit_samples = 200
-[lod]
-estimator = "h1"
-[camera]
-speed = 150.0
-[[camera.keyframes]]
-position = [0.0, -60.0, 1.7]
-yaw = 90
-[[camera.keyframes]]
-position = [0.0, 60.0, 1.7]
-yaw = 90
-[[scene.objects]]
-name = "a"
-position = [15.0, 0.0, 0.0]
-size = [8.0, 8.0, 12.0]
-levels = [{ triangles = 3000, acmr = 1.2 }, { triangles = 700, acmr = 1.2 }]
-[[scene.objects]]
-name = "b"
-position = [-20.0, 30.0, 0.0]
-size = [10.0, 6.0, 20.0]
-levels = [{ triangles = 1200, acmr = 1.2 }]
-texture = 1
-[[scene.objects]]
-name = "c"
-position = [12.0, 80.0, 0.0]
-size = [4.0, 4.0, 4.0]
-levels = [{ triangles = 50000, acmr = 1.2 }]
-"#;
+const LINEAR: &str = concat!(
+    "system = \"walkthrough\"\n[run]\nframes = 30\nseed = 3\n",
+    linear_gpu!(),
+    "[estimation]\nestimators = [\"h1\", \"h4\"]\nfit_samples = 200\n[lod]\nestimator = \"h1\"\n",
+    three_objects_walk!(),
+);
 
 const POLICIES: [&str; 4] = ["none", "reactive", "predictive", "predictive+branch"];
 
