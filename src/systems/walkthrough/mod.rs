@@ -21,8 +21,11 @@
 //!   paper 001's benefit;
 //! - `branch`: paper 000 §6.4's conditional branch in the frame's GPU work;
 //! - `perceived`: perceived speed per displayed refresh (Figure 6);
-//! - `run`, `summary`, `report`, `system`: the run, the summary's structs,
-//!   the report, the registry.
+//! - `validate`: the model's checks serde cannot make;
+//! - `preprocess`: the empty frame, the fit renders, the pos tables and the
+//!   view-cell estimators, before the first frame;
+//! - `run`, `summary`, `report`, `system`: the frames and the summary, the
+//!   summary's structs, the report, the registry.
 
 pub mod branch;
 pub mod camera;
@@ -32,6 +35,7 @@ pub mod estimators;
 pub mod lod;
 pub mod perceived;
 pub mod pos;
+mod preprocess;
 pub mod render;
 pub mod report;
 pub mod run;
@@ -39,6 +43,7 @@ pub mod scene;
 pub mod summary;
 pub mod system;
 pub mod timing;
+mod validate;
 pub mod view_cells;
 
 pub use config::WalkthroughConfig;

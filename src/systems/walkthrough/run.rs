@@ -1,35 +1,36 @@
-//! Validating, preparing and running a walkthrough, and its summary.
+//! Running a walkthrough and its summary.
 //!
-//! Order of work: the scene, the camera path, then the preprocess (an
-//! empty frame, the single-object renders the heuristics are fitted to,
-//! the pos tables), all timed exactly (system tasks off: ideal timing, the
-//! time-stamp reading of paper 000 §6.2); then per frame: the view cell's
-//! PVS, frustum culling, each visible object's projection, every
-//! estimator's estimate (each timed on its own), and the frame drawn by
-//! the frame pipeline with the model's noise (the actual time).
+//! Order of work: the model's checks (`validate.rs`), the scene, the camera
+//! path, then the preprocess (`preprocess.rs`: an empty frame, the
+//! single-object renders the heuristics are fitted to, the pos tables, the
+//! view-cell estimators), all timed exactly (system tasks off); then per
+//! frame: the view cell's PVS, frustum culling, each visible object's
+//! projection, the LOD policy's levels, every estimator's estimate (each
+//! timed on its own), and the frame drawn by the frame pipeline with the
+//! model's noise (the actual time).
 
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use rand::Rng;
 use serde_json::Value;
 
-use crate::engine::{PS_PER_MS, RngStreams};
+use crate::engine::PS_PER_MS;
 use crate::output::trace::TraceWriter;
-use crate::systems::error::{SystemError, invalid};
+use crate::systems::error::SystemError;
 use crate::systems::summary::{Dist, EventCounts, to_json};
 
 use super::branch::{BranchStats, Switchable, evaluate, mark_switchable};
 use super::camera::{self, Pose};
 use super::config::WalkthroughConfig;
-use super::culling::{Projection, Pvs, View, project, sample_projection};
-use super::estimators::{Constants, ESTIMATORS, Features, Score, fit};
+use super::culling::{Projection, View, project};
+use super::estimators::{ESTIMATORS, Features, Score};
 use super::lod::{BenefitTerms, Offer, Policy, Reactive, select};
-use super::pos::{PosTable, build as build_table};
+use super::preprocess::{Preprocess, preprocess};
 use super::render::{Draw, Renderer, frame_seeds, next_seed};
 use super::scene::{Scene, build_scene};
-use super::timing::{Clock, TimingMode, TimingSummary};
-use super::view_cells::{PVC, VCS, ViewCellSummary, ViewCellTables};
+use super::timing::{TimingMode, TimingSummary};
+use super::validate::validate;
+use super::view_cells::{PVC, VCS};
 
 pub use super::lod::LOD_POLICIES;
 pub use super::summary::{
@@ -55,126 +56,6 @@ pub struct WalkthroughRun {
     pub trace: Option<TraceWriter>,
 }
 
-/// Checks the keys serde cannot.
-pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
-    if cfg.system != "walkthrough" {
-        return Err(invalid(
-            "system",
-            format!("expected \"walkthrough\", got {:?}", cfg.system),
-        ));
-    }
-    for (i, e) in cfg.estimation.estimators.iter().enumerate() {
-        if !ESTIMATORS.contains(&e.as_str()) {
-            return Err(invalid(
-                &format!("estimation.estimators.{i}"),
-                format!("unknown estimator {e:?} (known: {})", ESTIMATORS.join(", ")),
-            ));
-        }
-        if cfg.estimation.estimators[..i].contains(e) {
-            return Err(invalid(
-                &format!("estimation.estimators.{i}"),
-                format!("{e:?} is listed twice"),
-            ));
-        }
-    }
-    if cfg.run.frames > MAX_FRAMES {
-        return Err(invalid(
-            "run.frames",
-            format!("{} frames is more than the limit of {MAX_FRAMES}", cfg.run.frames),
-        ));
-    }
-    let heuristics = cfg
-        .estimation
-        .estimators
-        .iter()
-        .any(|e| ESTIMATORS[..4].contains(&e.as_str()));
-    if cfg.estimation.fit_samples > MAX_FRAMES {
-        return Err(invalid(
-            "estimation.fit_samples",
-            format!("{} is more than the limit of {MAX_FRAMES}", cfg.estimation.fit_samples),
-        ));
-    }
-    if heuristics && cfg.estimation.fit_samples == 0 {
-        return Err(invalid(
-            "estimation.fit_samples",
-            "must be at least 1 when h1-h4 are estimated (their constants are fitted to these renders)",
-        ));
-    }
-    if !(1..=1024).contains(&cfg.estimation.repeats) {
-        return Err(invalid(
-            "estimation.repeats",
-            format!("must be between 1 and 1024, got {}", cfg.estimation.repeats),
-        ));
-    }
-    let p = &cfg.estimation.pos;
-    for (key, v, lo) in [
-        ("estimation.pos.alpha_steps", p.alpha_steps, 2),
-        ("estimation.pos.gamma_steps", p.gamma_steps, 1),
-        ("estimation.pos.phi_steps", p.phi_steps, 1),
-    ] {
-        if !(lo..=256).contains(&v) {
-            return Err(invalid(key, format!("must be between {lo} and 256, got {v}")));
-        }
-    }
-    if !(p.phi_min.is_finite()
-        && p.phi_max.is_finite()
-        && -90.0 <= p.phi_min
-        && p.phi_min <= p.phi_max
-        && p.phi_max <= 90.0)
-    {
-        return Err(invalid(
-            "estimation.pos.phi_min|estimation.pos.phi_max",
-            format!(
-                "need -90 <= phi_min <= phi_max <= 90 degrees, got {} and {}",
-                p.phi_min, p.phi_max
-            ),
-        ));
-    }
-    if !(p.prune_tolerance.is_finite() && (0.0..=1.0).contains(&p.prune_tolerance)) {
-        return Err(invalid(
-            "estimation.pos.prune_tolerance",
-            format!("must be between 0 and 1, got {}", p.prune_tolerance),
-        ));
-    }
-    let v = &cfg.estimation.view_cells;
-    if !(1..=360).contains(&v.directions) {
-        return Err(invalid(
-            "estimation.view_cells.directions",
-            format!("must be between 1 and 360, got {}", v.directions),
-        ));
-    }
-    if !(1..=4096).contains(&v.samples) {
-        return Err(invalid(
-            "estimation.view_cells.samples",
-            format!("must be between 1 and 4096, got {}", v.samples),
-        ));
-    }
-    super::timing::validate(cfg.estimation.clock_overhead, cfg.estimation.clock_noise)?;
-    super::lod::validate(&cfg.lod, &cfg.estimation.estimators)?;
-    check_memory(cfg)
-}
-
-fn check_memory(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
-    use crate::limits::{DEFAULT_MAX_MEMORY, add_bytes, over_memory_message, show_bytes};
-    let mut total = 0u64;
-    add_bytes(&mut total, cfg.run.frames, 512);
-    let mut fit = 0u64;
-    add_bytes(&mut fit, cfg.estimation.fit_samples, 48);
-    let parts = format!(
-        "{} frames x 512 bytes = {}, {} fit samples x 48 bytes = {}",
-        cfg.run.frames,
-        show_bytes(total),
-        cfg.estimation.fit_samples,
-        show_bytes(fit)
-    );
-    total = total.saturating_add(fit);
-    let limit = cfg.run.max_memory.map_or(DEFAULT_MAX_MEMORY, |b| b.0);
-    if total > limit {
-        return Err(invalid("run.max_memory", over_memory_message(total, &parts, limit)));
-    }
-    Ok(())
-}
-
 fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
@@ -183,7 +64,7 @@ fn ms(ps: f64) -> f64 {
     ps / PS_PER_MS as f64
 }
 
-struct Counter {
+pub(super) struct Counter {
     events: u64,
     by_kind: Vec<u64>,
     names: &'static [&'static str],
@@ -191,7 +72,7 @@ struct Counter {
 }
 
 impl Counter {
-    fn add(&mut self, events: u64, by_kind: &[u64], names: &'static [&'static str]) {
+    pub(super) fn add(&mut self, events: u64, by_kind: &[u64], names: &'static [&'static str]) {
         self.events += events;
         if self.by_kind.len() < by_kind.len() {
             self.by_kind.resize(by_kind.len(), 0);
@@ -205,7 +86,7 @@ impl Counter {
 }
 
 /// One object's features at `level` in projection `p`.
-fn features(scene: &Scene, proto: u32, level: usize, p: &Projection) -> Features {
+pub(super) fn features(scene: &Scene, proto: u32, level: usize, p: &Projection) -> Features {
     let l = scene.protos[proto as usize].levels[level];
     Features {
         triangles: l.triangles as f64,
@@ -232,174 +113,20 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
         names: &[],
         runs: 0,
     };
-    let render_exact = |draws: &[Draw], count: &mut Counter| -> Result<(f64, f64), SystemError> {
-        let (t, by_kind, names) = exact.render_counted(draws, 0, 0)?;
-        count.add(t.events, &by_kind, names);
-        Ok((t.rt as f64, t.gpu as f64))
-    };
-    let (empty, empty_gpu) = render_exact(&[], &mut count)?;
-    // The clocks the preprocess's renders are read with (timing.rs).
-    let est_cfg = &cfg.estimation;
-    let clock = |stream: &str| {
-        Clock::new(
-            est_cfg.timing,
-            est_cfg.clock_overhead,
-            est_cfg.clock_noise,
-            cfg.run.seed,
-            stream,
-        )
-    };
-    let (mut fit_clock, mut pos_clock, mut vcs_clock) = (
-        clock("estimation.clock.fit"),
-        clock("estimation.clock.pos"),
-        clock("estimation.clock.vcs"),
-    );
-    // One object's GPU time: `repeats` copies drawn (state set once), the
-    // GPU time beyond the empty frame's divided among them.
-    let repeats = cfg.estimation.repeats as usize;
-    let mut copies: Vec<Draw> = Vec::with_capacity(repeats);
-    let mut object_time = |d: Draw, count: &mut Counter, clock: &mut Clock| -> Result<f64, SystemError> {
-        copies.clear();
-        copies.resize(repeats, d);
-        let (_, gpu) = render_exact(&copies, count)?;
-        Ok((clock.read(gpu) - empty_gpu) / repeats as f64)
-    };
     let wants: Vec<bool> = ESTIMATORS
         .iter()
         .map(|e| cfg.estimation.estimators.iter().any(|x| x == e))
         .collect();
-    let (w, h) = (cfg.camera.width as f64, cfg.camera.height as f64);
-    let focal = 0.5 * w / (0.5 * cfg.camera.fov.to_radians()).tan();
-    let alpha_range = super::pos::alphas(&cfg.estimation.pos, focal, w, h);
-    let (alpha_lo, alpha_hi) = (alpha_range[0].ln(), alpha_range[alpha_range.len() - 1].ln());
-
-    // The heuristics' constants, fitted to single-object renders.
-    let constants = if wants[..4].iter().any(|w| *w) && !scene.objects.is_empty() {
-        let mut rng = RngStreams::new(cfg.run.seed).stream("estimation.fit");
-        let p = &cfg.estimation.pos;
-        let mut samples = Vec::with_capacity(cfg.estimation.fit_samples as usize);
-        for _ in 0..cfg.estimation.fit_samples {
-            let o = &scene.objects[rng.random_range(0..scene.objects.len())];
-            let proto = &scene.protos[o.proto as usize];
-            let level = rng.random_range(0..proto.levels.len());
-            let alpha = rng.random_range(alpha_lo..=alpha_hi).exp();
-            let gamma = rng.random_range(0.0..std::f64::consts::TAU);
-            let phi = rng.random_range(p.phi_min..=p.phi_max).to_radians();
-            let pr = sample_projection(proto, alpha, gamma, phi, focal, w, h);
-            let d = Draw {
-                proto: o.proto,
-                level: level as u32,
-                pixels: pr.covered_pixels,
-                state: o.state,
-            };
-            let y = object_time(d, &mut count, &mut fit_clock)?;
-            samples.push((features(&scene, o.proto, level, &pr), y));
-        }
-        Some(fit(&samples))
-    } else if wants[..4].iter().any(|w| *w) {
-        Some(Constants::default())
-    } else {
-        None
-    };
-
-    // The pos tables, one per prototype in use, at its finest level (every
-    // level when a policy other than "none" draws coarser ones).
     let (policy, lod_est, algorithm) = super::lod::validate(&cfg.lod, &cfg.estimation.estimators)?;
-    let table_levels = |p: &super::scene::Prototype| {
-        if policy == Policy::None { 1 } else { p.levels.len() }
-    };
-    let mut tables: Vec<Vec<Option<PosTable>>> = scene.protos.iter().map(|p| vec![None; table_levels(p)]).collect();
-    let mut pos_tables = None;
-    if wants[4] || wants[PVC] {
-        let mut used = vec![false; scene.protos.len()];
-        for o in &scene.objects {
-            used[o.proto as usize] = true;
-        }
-        let (mut renders, mut full, mut n) = (0u64, 0u64, 0u64);
-        for (i, proto) in scene.protos.iter().enumerate() {
-            if !used[i] {
-                continue;
-            }
-            let state = scene
-                .objects
-                .iter()
-                .find(|o| o.proto as usize == i)
-                .map_or((0, 0, 0), |o| o.state);
-            for (level, slot) in tables[i].iter_mut().enumerate() {
-                let (table, r) = build_table(&cfg.estimation.pos, proto, level, (focal, w, h), |_, covered| {
-                    let d = Draw {
-                        proto: i as u32,
-                        level: level as u32,
-                        pixels: covered,
-                        state,
-                    };
-                    object_time(d, &mut count, &mut pos_clock)
-                })?;
-                renders += r;
-                full += table.full_size();
-                n += 1;
-                *slot = Some(table);
-            }
-        }
-        pos_tables = Some(PosTables {
-            tables: n,
-            renders,
-            full_renders: full,
-            pruned_fraction: if full > 0 {
-                1.0 - renders as f64 / full as f64
-            } else {
-                0.0
-            },
-        });
-    }
-    // The view-cell estimators, for the cells the path visits.
-    let mut pvs = Pvs::default();
-    let mut view_cells: Option<(ViewCellTables, ViewCellSummary)> = None;
-    if wants[VCS] || wants[PVC] {
-        let Some(cell) = scene.view_cell else {
-            let i = cfg
-                .estimation
-                .estimators
-                .iter()
-                .position(|e| e == "vcs" || e == "pvc")
-                .unwrap_or(0);
-            return Err(invalid(
-                &format!("estimation.estimators.{i}"),
-                format!(
-                    "{:?} needs view cells (the city preset, or scene.view_cell > 0 with listed objects)",
-                    cfg.estimation.estimators[i]
-                ),
-            ));
-        };
-        let cells = super::view_cells::visited(&poses, cell).len() as u64;
-        let v = &cfg.estimation.view_cells;
-        let renders = cells * v.directions as u64 * v.samples as u64;
-        if wants[VCS] && renders > MAX_FRAMES {
-            return Err(invalid(
-                "estimation.view_cells.samples",
-                format!(
-                    "{cells} cells x {} directions x {} samples = {renders} sample views is more than the limit of {MAX_FRAMES}",
-                    v.directions, v.samples
-                ),
-            ));
-        }
-        let inputs = super::view_cells::Inputs {
-            cfg: v,
-            cam: &cfg.camera,
-            cell,
-            poses: &poses,
-            tables: &tables,
-            want: (wants[VCS], wants[PVC]),
-            seed: cfg.run.seed,
-        };
-        view_cells = Some(super::view_cells::build(
-            &inputs,
-            &scene,
-            &mut pvs,
-            &mut vcs_clock,
-            |draws| render_exact(draws, &mut count).map(|(rt, _)| rt),
-        )?);
-    }
+    let Preprocess {
+        empty,
+        constants,
+        tables,
+        pos_tables,
+        mut pvs,
+        view_cells,
+        clock_readings,
+    } = preprocess(&cfg, &scene, &poses, &exact, &wants, policy, &mut count)?;
     let build_seconds = t0.elapsed().as_secs_f64();
 
     // The frames.
@@ -874,7 +601,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
                     mode: TimingMode::CpuClock.name(),
                     overhead_ms: ms(cfg.estimation.clock_overhead.0 as f64),
                     noise_ms: ms(cfg.estimation.clock_noise.0 as f64),
-                    readings: fit_clock.readings() + pos_clock.readings() + vcs_clock.readings(),
+                    readings: clock_readings,
                     per_object_bias_ms: ms(cfg.estimation.clock_overhead.0 as f64) / cfg.estimation.repeats as f64,
                 }),
             },
