@@ -6,7 +6,7 @@ use crate::plot::{Histogram, LinePlot, PlotError, Scatter, ScatterPoint, Series,
 
 use super::run::PointResult;
 use super::spec::{Experiment, PlotKind, PlotSpec};
-use super::sweep::{Point, value_text};
+use super::sweep::Point;
 
 /// Draw one plot into `out_dir`; returns caption lines for the report (for
 /// histograms with a `range`: the values left outside it).
@@ -53,7 +53,7 @@ pub(crate) fn draw(
                         .iter()
                         .enumerate()
                         .filter(|&(i, (k, _))| i != xi && !filter.iter().any(|(f, _)| f == k))
-                        .map(|(_, (k, v))| format!("{k}={}", value_text(v)))
+                        .map(|(i, _)| points[members[0]].plot_assignment(&exp.sweeps, i))
                         .collect::<Vec<_>>()
                         .join(", ");
                     let name = match (group_label.is_empty(), y.len() > 1) {
@@ -122,7 +122,7 @@ pub(crate) fn draw(
                 .filter(|p| p.matches(filter))
                 .map(|p| {
                     let v = c.and_then(|c| pooled.get(p.index)?.get(c).cloned()).unwrap_or_default();
-                    (p.label(), v)
+                    (p.plot_label(&exp.sweeps), v)
                 })
                 .collect();
             let h = Histogram {
@@ -139,9 +139,10 @@ pub(crate) fn draw(
         PlotKind::Scatter { x, y, log_x, log_y } => {
             let pts = results
                 .iter()
-                .filter_map(|r| {
+                .zip(points)
+                .filter_map(|(r, p)| {
                     Some(ScatterPoint {
-                        label: r.label.clone(),
+                        label: p.plot_label(&exp.sweeps),
                         x: r.value(x)?,
                         y: r.value(y)?,
                     })

@@ -210,6 +210,30 @@ impl Point {
             .join(", ")
     }
 
+    /// The text plots show for assignment `i`: `key=label`, with the
+    /// sweep's `labels` when the file gave them (`model=city` rather than
+    /// `model=../models/city.toml`), else `key=value` as in [`Point::label`].
+    pub fn plot_assignment(&self, sweeps: &[Sweep], i: usize) -> String {
+        let (k, v) = &self.assignments[i];
+        let text = match (sweeps.get(i), self.value_indices.get(i)) {
+            (Some(s), Some(&vi)) if s.key == *k => s.labels.get(vi).cloned().unwrap_or_else(|| value_text(v)),
+            _ => value_text(v),
+        };
+        format!("{k}={text}")
+    }
+
+    /// [`Point::label`] as plots show it: every assignment through
+    /// [`Point::plot_assignment`].
+    pub fn plot_label(&self, sweeps: &[Sweep]) -> String {
+        if self.assignments.is_empty() {
+            return self.label();
+        }
+        (0..self.assignments.len())
+            .map(|i| self.plot_assignment(sweeps, i))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
     /// Whether the point satisfies every `key = value` of `filter`.
     pub fn matches(&self, filter: &[(String, toml::Value)]) -> bool {
         filter

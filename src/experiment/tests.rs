@@ -149,6 +149,38 @@ fn expansion_order_and_counts() {
 }
 
 #[test]
+fn plots_name_points_by_the_sweeps_labels() {
+    let exp = parse(
+        r#"
+name = "labels"
+[[sweep]]
+key = "display.buffers"
+values = [2, 3]
+labels = ["double buffering", "triple buffering"]
+[[sweep]]
+key = "workload.gpu"
+values = ["10ms", "20ms"]
+"#,
+    );
+    let pts = expand_points(&exp);
+    // The CSV's and the report's label keeps the values ...
+    assert_eq!(pts[3].label(), "display.buffers=3, workload.gpu=20ms");
+    // ... plots show the labels where the file gave them, values elsewhere.
+    assert_eq!(
+        pts[3].plot_label(&exp.sweeps),
+        "display.buffers=triple buffering, workload.gpu=20ms"
+    );
+    assert_eq!(
+        pts[0].plot_assignment(&exp.sweeps, 0),
+        "display.buffers=double buffering"
+    );
+    assert_eq!(
+        expand_points(&parse("name = \"x\"\n"))[0].plot_label(&[]),
+        "(single point)"
+    );
+}
+
+#[test]
 fn range_formatting() {
     let exp = parse(BASIC);
     let vals: Vec<String> = exp.sweeps[0].values.iter().map(value_text).collect();

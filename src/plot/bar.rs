@@ -10,7 +10,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::PlotError;
 use super::axis::widen;
-use super::font::FAMILY;
+use super::font::{AXIS_PX, FAMILY, TICK_PX, TITLE_PX};
 use super::output::{draw_notes, render_both};
 use super::palette::color;
 
@@ -68,7 +68,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &BarChart) -> Resu
     };
     let mut chart = ChartBuilder::on(root)
         .margin(20)
-        .caption(&c.title, (FAMILY, 24))
+        .caption(&c.title, (FAMILY, TITLE_PX))
         .x_label_area_size(50)
         .y_label_area_size(60)
         .build_cartesian_2d(-0.5..(n as f64 - 0.5), lo..hi)
@@ -78,8 +78,8 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &BarChart) -> Resu
         .disable_x_mesh()
         .x_labels(0)
         .y_desc(c.y_label.as_str())
-        .label_style((FAMILY, 14))
-        .axis_desc_style((FAMILY, 16))
+        .label_style((FAMILY, TICK_PX))
+        .axis_desc_style((FAMILY, AXIS_PX))
         .draw()
         .map_err(e)?;
     let k = c.series.len().max(1) as f64;
@@ -119,7 +119,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &BarChart) -> Resu
         }
     }
     // Category names under the groups.
-    let font = TextStyle::from((FAMILY, 15).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
+    let font = TextStyle::from((FAMILY, TICK_PX).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
     for (i, name) in c.categories.iter().enumerate() {
         let (x, y) = chart.backend_coord(&(i as f64, lo));
         root.draw_text(
@@ -132,7 +132,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &BarChart) -> Resu
     if !c.series.is_empty() {
         chart
             .configure_series_labels()
-            .label_font((FAMILY, 14))
+            .label_font((FAMILY, TICK_PX))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .position(SeriesLabelPosition::UpperRight)

@@ -7,7 +7,7 @@ use plotters::prelude::*;
 
 use super::PlotError;
 use super::axis::{coord, format_number, omitted_note, ticks, widen};
-use super::font::FAMILY;
+use super::font::{AXIS_PX, FAMILY, LABEL_PX, TICK_PX, TITLE_PX};
 use super::legend::{self, Occupied};
 use super::output::{draw_notes, render_both};
 use super::palette::color;
@@ -268,7 +268,7 @@ fn draw<DB: DrawingBackend>(
     let xt = ticks(l.x.0, l.x.1, false, false);
     let yt = ticks(0.0, ymax, false, false);
     let mut chart = ChartBuilder::on(root)
-        .caption(&h.title, (FAMILY, 24))
+        .caption(&h.title, (FAMILY, TITLE_PX))
         .margin(20)
         .margin_bottom(20 + 16 * notes.len() as u32)
         .x_label_area_size(55)
@@ -281,8 +281,8 @@ fn draw<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc(h.x_label.as_str())
         .y_desc(density_label(&h.x_label))
-        .label_style((FAMILY, 14))
-        .axis_desc_style((FAMILY, 16))
+        .label_style((FAMILY, TICK_PX))
+        .axis_desc_style((FAMILY, AXIS_PX))
         .x_label_formatter(&fx)
         .y_label_formatter(&fy)
         .draw()
@@ -329,14 +329,14 @@ fn draw<DB: DrawingBackend>(
             .draw_series(std::iter::once(Text::new(
                 format!(" {}", m.label),
                 (m.at, y),
-                (FAMILY, 13).into_font().color(&BLACK),
+                (FAMILY, LABEL_PX).into_font().color(&BLACK),
             )))
             .map_err(e)?;
     }
     if any_legend {
         chart
             .configure_series_labels()
-            .label_font((FAMILY, 14))
+            .label_font((FAMILY, TICK_PX))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .position(l.legend)

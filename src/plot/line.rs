@@ -7,7 +7,7 @@ use plotters::prelude::*;
 
 use super::PlotError;
 use super::axis::{Ticks, all_integers, coord, omitted_note, padded_range, ticks, to_axis};
-use super::font::FAMILY;
+use super::font::{AXIS_PX, FAMILY, TICK_PX, TITLE_PX};
 use super::legend::{self, Occupied};
 use super::output::{draw_notes, render_both};
 use super::palette::color;
@@ -207,7 +207,7 @@ fn draw<DB: DrawingBackend>(
     }
     let yt = ticks(yr.0, yr.1, plot.log_y, false);
     let mut chart = ChartBuilder::on(root)
-        .caption(&plot.title, (FAMILY, 24))
+        .caption(&plot.title, (FAMILY, TITLE_PX))
         .margin(20)
         .margin_bottom(20 + 16 * notes.len() as u32)
         .x_label_area_size(55)
@@ -220,8 +220,8 @@ fn draw<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc(plot.x_label.as_str())
         .y_desc(plot.y_label.as_str())
-        .label_style((FAMILY, 14))
-        .axis_desc_style((FAMILY, 16))
+        .label_style((FAMILY, TICK_PX))
+        .axis_desc_style((FAMILY, AXIS_PX))
         .x_label_formatter(&fx)
         .y_label_formatter(&fy)
         .draw()
@@ -270,7 +270,7 @@ fn draw<DB: DrawingBackend>(
     if any_legend {
         chart
             .configure_series_labels()
-            .label_font((FAMILY, 14))
+            .label_font((FAMILY, TICK_PX))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .position(legend)

@@ -64,7 +64,9 @@ pub(crate) fn draw_notes<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, note
         root.draw(&Text::new(
             note.clone(),
             (8, y),
-            (super::font::FAMILY, 13).into_font().color(&RGBColor(150, 40, 40)),
+            (super::font::FAMILY, super::font::LABEL_PX)
+                .into_font()
+                .color(&RGBColor(150, 40, 40)),
         ))
         .map_err(|e| e.to_string())?;
     }

@@ -8,7 +8,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::PlotError;
 use super::axis::{all_integers, coord, omitted_note, padded_range, ticks, to_axis};
-use super::font::FAMILY;
+use super::font::{AXIS_PX, FAMILY, LABEL_PX, TICK_PX, TITLE_PX};
 use super::output::{draw_notes, render_both};
 use super::palette::color;
 
@@ -158,7 +158,7 @@ pub(crate) fn place_labels(
 
 /// Font of point labels.
 fn label_font() -> TextStyle<'static> {
-    (FAMILY, 13).into_font().into()
+    (FAMILY, LABEL_PX).into_font().into()
 }
 
 /// Width of the side panel listing labels that found no free spot.
@@ -236,8 +236,8 @@ fn chart_into<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc(s.x_label.as_str())
         .y_desc(s.y_label.as_str())
-        .label_style((FAMILY, 14))
-        .axis_desc_style((FAMILY, 16))
+        .label_style((FAMILY, TICK_PX))
+        .axis_desc_style((FAMILY, AXIS_PX))
         .x_label_formatter(&fx)
         .y_label_formatter(&fy)
         .draw()
@@ -280,7 +280,10 @@ fn draw<DB: DrawingBackend>(
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let xr = padded_range(pts.iter().map(|p| p.1));
     let yr = padded_range(pts.iter().map(|p| p.2));
-    let body = root.margin(20, 20, 20, 20).titled(&s.title, (FAMILY, 24)).map_err(e)?;
+    let body = root
+        .margin(20, 20, 20, 20)
+        .titled(&s.title, (FAMILY, TITLE_PX))
+        .map_err(e)?;
     // Labels that do not fit next to their points are listed in a panel on
     // the right instead, numbered, with the number next to the point.
     let mut dropped = chart_into(&body, s, pts, (xr, yr), true)?;

@@ -16,7 +16,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::PlotError;
 use super::axis::{Ticks, coord, ticks};
-use super::font::{FAMILY, ensure_font};
+use super::font::{AXIS_PX, FAMILY, TICK_PX, TITLE_PX, ensure_font};
 use super::output::draw_notes;
 use super::palette::color;
 use super::{HEIGHT, WIDTH};
@@ -130,7 +130,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline) -> Resu
         minor: Vec::new(),
     };
     let mut chart = ChartBuilder::on(root)
-        .caption(&t.title, (FAMILY, 24))
+        .caption(&t.title, (FAMILY, TITLE_PX))
         .margin(20)
         .margin_bottom(44 + 16 * t.notes.len() as u32)
         .x_label_area_size(55)
@@ -142,8 +142,8 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline) -> Resu
     chart
         .configure_mesh()
         .x_desc(t.x_label.as_str())
-        .label_style((FAMILY, 15))
-        .axis_desc_style((FAMILY, 16))
+        .label_style((FAMILY, TICK_PX))
+        .axis_desc_style((FAMILY, AXIS_PX))
         .x_label_formatter(&fx)
         .y_label_formatter(&fy)
         .disable_y_mesh()
@@ -205,7 +205,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline) -> Resu
                             .draw_series(std::iter::once(Text::new(
                                 label,
                                 ((s + end) / 2.0, base + 0.5),
-                                (FAMILY, 14)
+                                (FAMILY, TICK_PX)
                                     .into_font()
                                     .color(&WHITE)
                                     .pos(Pos::new(HPos::Center, VPos::Center)),
@@ -230,7 +230,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline) -> Resu
     // A key under the x axis: what greys and dashes mean.
     let key_y = root.dim_in_pixel().1 as i32 - 26 - 16 * t.notes.len() as i32;
     let mut x = 20;
-    let font = (FAMILY, 14).into_font().color(&BLACK);
+    let font = (FAMILY, TICK_PX).into_font().color(&BLACK);
     let key = |x: &mut i32, swatch: &dyn Fn(i32) -> Result<(), String>, text: &str| -> Result<(), String> {
         swatch(*x)?;
         root.draw(&Text::new(
