@@ -127,6 +127,53 @@ pub(crate) fn stats_types() -> wgpu::PipelineStatisticsTypes {
 /// The colour format the measurement pipelines render to.
 pub(crate) const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
+/// The bind group of whole `buffers` at bindings 0, 1, ... (each with its
+/// binding type and the stages that read it) and the pipeline layout over
+/// it: the resources of `rendersim measure`'s passes and `study
+/// estimation`'s.
+pub(crate) fn buffer_bindings(
+    device: &wgpu::Device,
+    buffers: &[(&wgpu::Buffer, wgpu::BufferBindingType, wgpu::ShaderStages)],
+) -> (wgpu::BindGroup, wgpu::PipelineLayout) {
+    let entries: Vec<wgpu::BindGroupLayoutEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, &(_, ty, visibility))| wgpu::BindGroupLayoutEntry {
+            binding: i as u32,
+            visibility,
+            ty: wgpu::BindingType::Buffer {
+                ty,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        })
+        .collect();
+    let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: None,
+        entries: &entries,
+    });
+    let resources: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, (buffer, _, _))| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: buffer.as_entire_binding(),
+        })
+        .collect();
+    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &bgl,
+        entries: &resources,
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: None,
+        bind_group_layouts: &[Some(&bgl)],
+        ..Default::default()
+    });
+    (bind, layout)
+}
+
 /// A render pipeline of the measurement shaders: 2-D float positions (one
 /// vertex buffer, stride 8) through `vs_main`, `fs_main` into one
 /// [`TARGET_FORMAT`] attachment without blending, no culling, the given
@@ -337,50 +384,21 @@ impl Gpu {
             label: Some("measure"),
             source: wgpu::ShaderSource::Wgsl(include_str!("shader.wgsl").into()),
         });
-        let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: None,
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::VERTEX,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+        let (bind, layout) = buffer_bindings(
+            device,
+            &[
+                (
+                    &ubuf,
+                    wgpu::BufferBindingType::Uniform,
+                    wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ),
+                (
+                    &obuf,
+                    wgpu::BufferBindingType::Storage { read_only: true },
+                    wgpu::ShaderStages::VERTEX,
+                ),
             ],
-        });
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout: &bgl,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: ubuf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: obuf.as_entire_binding(),
-                },
-            ],
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: None,
-            bind_group_layouts: &[Some(&bgl)],
-            ..Default::default()
-        });
+        );
         let format = TARGET_FORMAT;
         let pipeline = position_pipeline(
             device,

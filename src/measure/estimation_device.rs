@@ -11,7 +11,7 @@ use std::time::Instant;
 
 use wgpu::util::DeviceExt;
 
-use super::device::{Gpu, MeasureError, TARGET_FORMAT, position_pipeline, stats_types};
+use super::device::{Gpu, MeasureError, TARGET_FORMAT, buffer_bindings, position_pipeline, stats_types};
 use super::estimation::{EstimationStudy, PassMeasurement, Plan, PlannedPass, analyze};
 use super::fit::median;
 use super::geometry::mesh_positions;
@@ -121,32 +121,14 @@ impl<'a> Renderer<'a> {
             label: Some("estimation"),
             source: wgpu::ShaderSource::Wgsl(include_str!("estimation.wgsl").into()),
         });
-        let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: None,
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
-        });
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout: &bgl,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: objects.as_entire_binding(),
-            }],
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: None,
-            bind_group_layouts: &[Some(&bgl)],
-            ..Default::default()
-        });
+        let (bind, layout) = buffer_bindings(
+            device,
+            &[(
+                &objects,
+                wgpu::BufferBindingType::Storage { read_only: true },
+                wgpu::ShaderStages::VERTEX,
+            )],
+        );
         let format = TARGET_FORMAT;
         let pipeline = position_pipeline(device, "estimation", &shader, &layout, None);
         let target = plan.setup.target;
