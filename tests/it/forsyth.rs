@@ -117,3 +117,42 @@ proptest! {
         prop_assert_eq!(optimize_vertex_cache(&idx, verts), optimize_vertex_cache_reference(&idx, verts));
     }
 }
+
+#[test]
+fn the_build_benchmark_checks_both_forms_and_times_every_model() {
+    // At a small scale: one repetition each; the benchmark fails if the two
+    // forms ever return different buffers.
+    let b = rendersim::bench::build::build_bench(0.01).expect("the build benchmark");
+    let specs: Vec<&str> = b.reorders.iter().map(|r| r.spec.as_str()).collect();
+    assert_eq!(specs, ["grid:96x96", "grid:96x96:shuffled:1", "grid:30x30"]);
+    assert!(
+        b.reorders
+            .iter()
+            .all(|r| r.triangles > 0 && r.reference_s > 0.0 && r.fast_s > 0.0)
+    );
+    let models: Vec<&str> = b.models.iter().map(|m| m.model.as_str()).collect();
+    assert_eq!(models, ["default", "one-mesh", "single-view", "h2-pass"]);
+    for m in &b.models {
+        // One repetition, so the medians are that run's: the whole run is
+        // its build plus its event loop.
+        assert_eq!(m.reps, 1);
+        for run in [&m.triangle, &m.draw] {
+            assert!(run.build_s > 0.0 && run.simulate_s > 0.0, "{}: {run:?}", m.model);
+            assert!((run.wall_s - (run.build_s + run.simulate_s)).abs() <= 1e-9 * run.wall_s.max(1.0));
+        }
+    }
+}
+
+#[test]
+fn an_unknown_benchmark_names_build_among_the_choices() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+        .args(["bench", "nosuch"])
+        .output()
+        .expect("rendersim runs");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("unknown benchmark \"nosuch\"") && err.contains("build"),
+        "{err}"
+    );
+}
