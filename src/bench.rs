@@ -12,6 +12,9 @@
 //!   fidelity.
 //! - `pixelflow`: Figures 3 and 4 of paper 002 at event fidelity against
 //!   the closed forms and a target.
+//! - `build`: the vertex-cache reordering against its direct form, and the
+//!   scene build against the simulation of the models that build a mesh
+//!   ([`build`]).
 //!
 //! The functions return the measurements; `rendersim bench` prints them.
 
@@ -26,6 +29,8 @@ use crate::engine::{
     Control, Duration, EngineError, EventKind, Limits, Model, QueueKind, RngStreams, Scheduler, StreamRng, Time, run,
 };
 use crate::systems::{SimError, run_model};
+
+pub mod build;
 
 /// Hold-model event.
 #[derive(Debug, Clone, Copy)]
@@ -249,6 +254,9 @@ pub enum BenchError {
     /// A benchmark's run failed.
     #[error(transparent)]
     Sim(#[from] SimError),
+    /// The reordering benchmark's mesh or its check failed.
+    #[error("reordering benchmark: {0}")]
+    Reorder(String),
 }
 
 /// One of the benchmarks of `rendersim bench`.
@@ -262,11 +270,19 @@ pub enum Bench {
     Hour,
     /// PixelFlow's Figures 3 and 4 ([`pixelflow_bench`]).
     Pixelflow,
+    /// Scene building against simulation ([`build::build_bench`]).
+    Build,
 }
 
 impl Bench {
     /// Every benchmark, in the order `rendersim bench all` runs them.
-    pub const ALL: [Bench; 4] = [Bench::Pixelflow, Bench::Kernel, Bench::Pipeline, Bench::Hour];
+    pub const ALL: [Bench; 5] = [
+        Bench::Pixelflow,
+        Bench::Kernel,
+        Bench::Pipeline,
+        Bench::Hour,
+        Bench::Build,
+    ];
 }
 
 /// Checks that `scale` (the fraction of the full work) is in (0, 1].

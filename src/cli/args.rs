@@ -317,7 +317,7 @@ pub struct StudyArgs {
 /// `rendersim bench`.
 #[derive(Args)]
 pub struct BenchArgs {
-    /// Which: kernel, pipeline, hour, pixelflow, all.
+    /// Which: kernel, pipeline, hour, pixelflow, build, all.
     #[arg(default_value = "all", value_parser = Choice::<BenchTarget>::new(unknown_bench))]
     pub which: BenchTarget,
     /// Scale the work down (0.01 .. 1) for a quick check.
@@ -400,6 +400,8 @@ pub enum BenchTarget {
     Hour,
     /// PixelFlow's Figures 3 and 4.
     Pixelflow,
+    /// Scene building (the vertex-cache reordering) against simulation.
+    Build,
     /// All of them.
     All,
 }
@@ -411,13 +413,14 @@ impl From<BenchTarget> for Vec<Bench> {
             BenchTarget::Pipeline => vec![Bench::Pipeline],
             BenchTarget::Hour => vec![Bench::Hour],
             BenchTarget::Pixelflow => vec![Bench::Pixelflow],
+            BenchTarget::Build => vec![Bench::Build],
             BenchTarget::All => Bench::ALL.to_vec(),
         }
     }
 }
 
 fn unknown_bench(s: &str) -> String {
-    format!("unknown benchmark {s:?} (kernel, pipeline, hour, pixelflow, all)")
+    format!("unknown benchmark {s:?} (kernel, pipeline, hour, pixelflow, build, all)")
 }
 
 /// A render target size, `WxH`.

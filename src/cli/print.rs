@@ -62,6 +62,41 @@ pub fn hour_bench(h: &HourBench) -> String {
     )
 }
 
+/// The build benchmark's lines: the reordering, fast against direct, then
+/// each model's build, event loop and whole run at both fidelities.
+pub fn build_bench(b: &rendersim::bench::build::BuildBench) -> String {
+    let ms = |s: f64| format!("{:.3} ms", s * 1e3);
+    let mut lines = Vec::new();
+    for r in &b.reorders {
+        lines.push(format!(
+            "build: vertex-cache reordering of {} ({} triangles), median of {}: direct form {}, fast form {}, {:.1}x faster, same index buffer",
+            r.spec,
+            r.triangles,
+            r.reps,
+            ms(r.reference_s),
+            ms(r.fast_s),
+            r.reference_s / r.fast_s
+        ));
+    }
+    for m in &b.models {
+        let (t, d) = (&m.triangle, &m.draw);
+        lines.push(format!(
+            "build: model {} (10 frames after 2 warm-up, no noise), median of {}: triangle fidelity build {} + event loop {} = {}; draw fidelity build {} + event loop {} = {}; whole run {:.1}x faster at draw fidelity (event loop {:.0}x)",
+            m.model,
+            m.reps,
+            ms(t.build_s),
+            ms(t.simulate_s),
+            ms(t.wall_s),
+            ms(d.build_s),
+            ms(d.simulate_s),
+            ms(d.wall_s),
+            t.wall_s / d.wall_s,
+            t.simulate_s / d.simulate_s
+        ));
+    }
+    lines.join("\n")
+}
+
 /// A measurement's line.
 #[cfg(feature = "wgpu")]
 pub fn measurement(mesh: &str, r: &rendersim::measure::Measurement) -> String {

@@ -14,6 +14,7 @@ mod devices;
 mod display_oracles;
 mod estimation;
 mod extreme;
+mod forsyth;
 mod fuzz;
 mod golden;
 mod lavapipe_policy;
