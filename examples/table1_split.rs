@@ -53,7 +53,19 @@ fn main() {
     );
     println!(
         "{:<10} {:>4} {:>5} {:>5} | {:>6} {:>6} {:>6} {:>6} | {:>6} {:>6} | {:>7} {:>7} {:>5}",
-        "sizes", "fifo", "sigma", "share", "vs ns", "vs' ns", "fs ns", "fs' ns", "G ms", "F ms", "4th ms", "error", "ratio"
+        "sizes",
+        "fifo",
+        "sigma",
+        "share",
+        "vs ns",
+        "vs' ns",
+        "fs ns",
+        "fs' ns",
+        "G ms",
+        "F ms",
+        "4th ms",
+        "error",
+        "ratio"
     );
     let error = |ms: f64| 100.0 * (ms / PAPER.complex_complex - 1.0);
     let mut worst_calibration: f64 = 0.0;
@@ -69,6 +81,11 @@ fn main() {
             let c = model.calibrate(share, &PAPER).expect("the cells calibrate");
             worst_calibration = worst_calibration.max(c.max_calibration_error(&PAPER));
             let (k, d, ratio) = (c.costs, c.cells.complex_complex, c.cells.ratio());
+            // The prediction lies between the max and the sum of the cells.
+            assert!(
+                d >= c.cells.max_prediction() && d <= c.cells.sum_prediction() + 1e-3,
+                "{c:?}"
+            );
             println!(
                 "{:<10} {:>4} {:>5.1} {:>5.1} | {:>6.2} {:>6.2} {:>6.3} {:>6.3} | {:>6.3} {:>6.3} | {:>7.3} {:>+6.1}% {:>5.2}",
                 order_name(s.order),
@@ -112,6 +129,7 @@ fn main() {
         "{runs} runs; every calibrated cell within {worst_calibration:.4} ms of the paper (each search stops within \
          {TOLERANCE_MS} ms or at one picosecond of cost)"
     );
+    assert!(worst_calibration <= 1e-3, "a cell {worst_calibration} ms off");
     for line in summaries {
         println!("{line}");
     }
@@ -127,7 +145,9 @@ fn main() {
             let s = setup(random, depth, 0.8);
             let src = s.source();
             let table = s.table(&src, Fidelity::Triangle).expect("the terrain model patches");
-            let c = CellModel::new(&src, table).calibrate(0.5, &PAPER).expect("the cells calibrate");
+            let c = CellModel::new(&src, table)
+                .calibrate(0.5, &PAPER)
+                .expect("the cells calibrate");
             println!(
                 "triangle fidelity, {}, geometry share 0.5: 4th cell {:.3} ms ({:+.1}%), ratio {:.2}",
                 s.label(),

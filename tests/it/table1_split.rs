@@ -12,7 +12,7 @@ use crate::common::{metric, run};
 use rendersim::scene::config::SizeOrder;
 use rendersim::systems::frame_pipeline::Fidelity;
 use rendersim::systems::frame_pipeline::table1::{
-    Calibration, CalibrationError, Cells, CellModel, PAPER, SplitTerrain, TERRAIN, terrain_variant,
+    Calibration, CalibrationError, CellModel, Cells, PAPER, SplitTerrain, TERRAIN, terrain_variant,
 };
 
 /// One picosecond more per fragment moves a cell by 0.00095 ms on the
@@ -97,13 +97,29 @@ fn a_shallower_fifo_moves_the_prediction_towards_the_sum() {
     // which sorted sizes give at any depth.
     let by_depth: Vec<f64> = [16, 4, 1, 0]
         .iter()
-        .map(|&depth| predictions(&calibrate(setup(SizeOrder::Random, depth, 0.8), Fidelity::Triangle, &[0.5]))[0])
+        .map(|&depth| {
+            predictions(&calibrate(
+                setup(SizeOrder::Random, depth, 0.8),
+                Fidelity::Triangle,
+                &[0.5],
+            ))[0]
+        })
         .collect();
-    assert!(by_depth.windows(2).all(|w| w[1] > w[0]), "FIFO 16, 4, 1, 0: {by_depth:?}");
+    assert!(
+        by_depth.windows(2).all(|w| w[1] > w[0]),
+        "FIFO 16, 4, 1, 0: {by_depth:?}"
+    );
     assert!(by_depth[3] - by_depth[0] > 0.5, "FIFO 16, 4, 1, 0: {by_depth:?}");
     let fifo_zero = by_depth[3];
-    let sorted = predictions(&calibrate(setup(SizeOrder::Ascending, 16, 0.8), Fidelity::Triangle, &[0.5]))[0];
-    assert!(relative(fifo_zero, sorted) < 0.005, "FIFO 0 {fifo_zero} vs sorted {sorted}");
+    let sorted = predictions(&calibrate(
+        setup(SizeOrder::Ascending, 16, 0.8),
+        Fidelity::Triangle,
+        &[0.5],
+    ))[0];
+    assert!(
+        relative(fifo_zero, sorted) < 0.005,
+        "FIFO 0 {fifo_zero} vs sorted {sorted}"
+    );
     // At a direct hand-off `draw` fidelity is exact in expectation.
     let draw = predictions(&calibrate(setup(SizeOrder::Random, 0, 0.8), Fidelity::Draw, &[0.5]))[0];
     assert!(relative(draw, fifo_zero) < 0.005, "draw {draw} vs triangle {fifo_zero}");
@@ -114,13 +130,23 @@ fn sorted_sizes_make_the_fifo_depth_irrelevant() {
     // Smallest first: the bottleneck moves once, from geometry to
     // fragments, over tens of thousands of triangles, which no FIFO of a
     // few triangles can smooth.
-    let at = |depth| predictions(&calibrate(setup(SizeOrder::Ascending, depth, 0.8), Fidelity::Draw, &[0.5]))[0];
+    let at = |depth| {
+        predictions(&calibrate(
+            setup(SizeOrder::Ascending, depth, 0.8),
+            Fidelity::Draw,
+            &[0.5],
+        ))[0]
+    };
     let deep = at(64);
     for depth in [16, 4, 0] {
         let d = at(depth);
         assert!(relative(d, deep) < 0.001, "FIFO {depth}: {d} vs FIFO 64: {deep}");
     }
-    let tri = predictions(&calibrate(setup(SizeOrder::Ascending, 16, 0.8), Fidelity::Triangle, &[0.5]))[0];
+    let tri = predictions(&calibrate(
+        setup(SizeOrder::Ascending, 16, 0.8),
+        Fidelity::Triangle,
+        &[0.5],
+    ))[0];
     assert!(relative(tri, deep) < 0.01, "triangle {tri} vs draw {deep}");
 }
 
@@ -128,10 +154,17 @@ fn sorted_sizes_make_the_fifo_depth_irrelevant() {
 fn the_preset_spread_comes_within_ten_percent_but_not_to_the_ratio() {
     // The per-triangle max with the preset's sizes (sigma 0.8): 8% short
     // of the paper's 11.856 ms at every share, ratio under 0.5 (paper 0.84).
-    let cs = calibrate(setup(SizeOrder::Ascending, 16, 0.8), Fidelity::Draw, &[0.1, 0.3, 0.5, 0.7, 0.9]);
+    let cs = calibrate(
+        setup(SizeOrder::Ascending, 16, 0.8),
+        Fidelity::Draw,
+        &[0.1, 0.3, 0.5, 0.7, 0.9],
+    );
     for c in &cs {
         let (d, r) = (c.cells.complex_complex, c.cells.ratio());
-        assert!(d > 0.9 * PAPER.complex_complex && d < 0.95 * PAPER.complex_complex, "{d}");
+        assert!(
+            d > 0.9 * PAPER.complex_complex && d < 0.95 * PAPER.complex_complex,
+            "{d}"
+        );
         assert!(r > 0.35 && r < 0.5, "ratio {r}");
     }
 }
@@ -150,7 +183,11 @@ fn the_papers_ratio_needs_sizes_spread_far_wider() {
         .collect();
     for i in 0..shares.len() {
         let r: Vec<f64> = by_spread.iter().map(|cs| cs[i].cells.ratio()).collect();
-        assert!(r[0] + 0.1 < r[1] && r[1] + 0.05 < r[2], "share {}: ratios {r:?}", shares[i]);
+        assert!(
+            r[0] + 0.1 < r[1] && r[1] + 0.05 < r[2],
+            "share {}: ratios {r:?}",
+            shares[i]
+        );
     }
     for c in &by_spread[2] {
         assert!(c.cells.ratio() >= 0.84, "{c:?}");

@@ -116,7 +116,12 @@ impl SplitTerrain {
 
     /// `order, FIFO depth, sigma` for tables.
     pub fn label(&self) -> String {
-        format!("{} sizes, FIFO {}, sigma {}", order_name(self.order), self.fifo_depth, self.sigma)
+        format!(
+            "{} sizes, FIFO {}, sigma {}",
+            order_name(self.order),
+            self.fifo_depth,
+            self.sigma
+        )
     }
 }
 
@@ -340,26 +345,44 @@ impl<'a> CellModel<'a> {
         // least the fixed time plus the longer stage, the pool at least the
         // fixed time plus both.
         let room = |target: f64| (target - zero.gpu).max(0.0);
-        let guess = |ms: f64, per_ps: f64| if per_ps > 0.0 { (ms / per_ps).ceil() as u64 } else { PROBE };
+        let guess = |ms: f64, per_ps: f64| {
+            if per_ps > 0.0 {
+                (ms / per_ps).ceil() as u64
+            } else {
+                PROBE
+            }
+        };
         let s_guess = (2.0 * room(targets.simple_simple) * 1e9).ceil() as u64;
-        let (s, _) = self.solve("simple/simple", targets.simple_simple, (0, zero.gpu), s_guess, |m, s| {
-            let (v, f) = split(s);
-            m.gpu_ms(v, f)
-        })?;
+        let (s, _) = self.solve(
+            "simple/simple",
+            targets.simple_simple,
+            (0, zero.gpu),
+            s_guess,
+            |m, s| {
+                let (v, f) = split(s);
+                m.gpu_ms(v, f)
+            },
+        )?;
         let (v0, f0) = split(s);
         let base = self.times(v0, f0)?;
         // 2. The complex fragment shader.
         let f_guess = guess(room(targets.simple_complex), per_fragment_ps);
-        let (f1, simple_complex) =
-            self.solve("simple/complex", targets.simple_complex, (f0, base.gpu), f_guess, |m, f| {
-                m.gpu_ms(v0, f)
-            })?;
+        let (f1, simple_complex) = self.solve(
+            "simple/complex",
+            targets.simple_complex,
+            (f0, base.gpu),
+            f_guess,
+            |m, f| m.gpu_ms(v0, f),
+        )?;
         // 3. The complex vertex shader.
         let v_guess = guess(room(targets.complex_simple), per_vertex_ps);
-        let (v1, complex_simple) =
-            self.solve("complex/simple", targets.complex_simple, (v0, base.gpu), v_guess, |m, v| {
-                m.gpu_ms(v, f0)
-            })?;
+        let (v1, complex_simple) = self.solve(
+            "complex/simple",
+            targets.complex_simple,
+            (v0, base.gpu),
+            v_guess,
+            |m, v| m.gpu_ms(v, f0),
+        )?;
         // 4. The prediction.
         let complex_complex = self.gpu_ms(v1, f1)?;
         Ok(Calibration {
