@@ -457,7 +457,7 @@ impl<'a> CellModel<'a> {
         let mut iteration = 0u32;
         while hi - lo > 1 {
             iteration += 1;
-            let x = if iteration % 3 == 0 || w_hi <= w_lo {
+            let x = if iteration.is_multiple_of(3) || w_hi <= w_lo {
                 lo + (hi - lo) / 2
             } else {
                 let x = lo as f64 + (-w_lo / (w_hi - w_lo)) * (hi - lo) as f64;
@@ -534,7 +534,7 @@ triangle_pixels = 10.0
     fn equal_triangles_on_a_deep_fifo_calibrate_to_the_max() {
         // Every triangle alike and a FIFO as long as the draw: the split
         // pipeline is max(G, F) (plus one triangle), so the fourth cell is
-        // the max bound whatever the share that is not balanced.
+        // the max bound (here at a share of 0.2, away from balance).
         let src = ModelSource::from_text("t.toml", FIXED);
         let mut table = src.table().unwrap();
         apply_set(&mut table, "gpu.fragment.fifo_depth=10000").unwrap();
