@@ -31,6 +31,7 @@ mod pixelflow;
 mod shards;
 mod sortbuf;
 mod state_sorting;
+mod table1_split;
 mod timeline;
 mod unified;
 mod view_cells;

@@ -12,7 +12,9 @@
 //! - `records`: per-frame records and the PresentMon-style table;
 //! - `report`: the human-readable report of a run;
 //! - `timeline`: the picture of paper 000 Figure 4, from the run's trace;
-//! - `run`: validate, build, run, summarize.
+//! - `run`: validate, build, run, summarize;
+//! - `table1`: paper 000 Table 1's four cells, three calibrated and one
+//!   predicted, for a geometry share of the first cell (§4.5.1).
 
 pub mod accounting;
 pub mod closed_form;
@@ -27,6 +29,7 @@ pub mod records;
 pub mod report;
 pub mod run;
 pub mod system;
+pub mod table1;
 pub mod timeline;
 pub mod workload;
 
