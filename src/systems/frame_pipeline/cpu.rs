@@ -6,7 +6,7 @@
 
 use crate::engine::{Duration, Scheduler, Time};
 
-use super::model::{Command, CpuPhase, Ev, FramePipeline, Program};
+use super::model::{Command, CpuPhase, Ev, FramePipeline, FrontPhase, Program};
 use super::records::FrameRecord;
 use crate::systems::error::SystemError;
 
@@ -116,6 +116,26 @@ impl FramePipeline {
     pub(super) fn cpu_op_done(&mut self, now: Time) {
         debug_assert_eq!(self.cpu_phase, CpuPhase::Running);
         self.cpu_phase = self.cpu_after_work(now);
+    }
+
+    /// After an operation's work, when nothing but the CPU thread moves:
+    /// takes the CPU's step (push the command, start the next operation)
+    /// and returns true when that was all the event did, so `settle` and
+    /// `account` can be skipped. That holds when the front end is not
+    /// waiting for commands (a push wakes only an idle front end; no other
+    /// GPU step depends on the CPU), no trace is written (it records the
+    /// FIFO's level at every event), and the CPU ends up working on the
+    /// same frame (its clock, its frame and its critical-path mode are what
+    /// the last event left; a blocked push or a new frame needs the full
+    /// accounting). Returns false otherwise, with at most the CPU's step
+    /// taken, which `settle` then repeats as a no-op before the front end's.
+    pub(super) fn cpu_step_alone(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
+        if self.front_phase == FrontPhase::Idle || self.acct.trace.is_some() {
+            return Ok(false);
+        }
+        let frame = self.cpu_frame;
+        self.cpu_step(now, s)?;
+        Ok(self.cpu_phase == CpuPhase::Running && self.cpu_frame == frame)
     }
 
     /// Advances the CPU thread as far as it can go now. Returns whether
