@@ -140,7 +140,24 @@ impl FramePipeline {
 
     /// Advances the CPU thread as far as it can go now. Returns whether
     /// anything changed.
+    #[inline]
     pub(super) fn cpu_step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
+        // At rest while an operation runs or too many frames are in flight
+        // (most events find it so), and for good once finished or waiting
+        // for its zero-time frame: no step, and no call.
+        match self.cpu_phase {
+            CpuPhase::Running | CpuPhase::ZeroTimeWait | CpuPhase::Finished => return Ok(false),
+            CpuPhase::WaitFrames if self.cpu_frame - self.gpu_completed >= self.cfg.cpu.max_frames_ahead as u64 => {
+                return Ok(false);
+            }
+            _ => {}
+        }
+        self.cpu_step_from_rest(now, s)
+    }
+
+    /// [`FramePipeline::cpu_step`] from a phase that may move.
+    #[inline(never)]
+    fn cpu_step_from_rest(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         let mut progressed = false;
         loop {
             match self.cpu_phase {

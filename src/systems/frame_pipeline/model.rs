@@ -550,6 +550,7 @@ impl FramePipeline {
         }
     }
 
+    #[inline]
     pub(super) fn schedule_wake(s: &mut Scheduler<Ev>, w: Wake, cpu: bool) {
         if let Wake::JobAt(t, tag) = w {
             s.at(
