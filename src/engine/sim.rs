@@ -117,13 +117,13 @@ impl<E> Scheduler<E> {
 
     /// Schedules `event` at the absolute time `t` (must not be in the past;
     /// the loop reports it as an error if it is).
-    #[inline]
+    #[inline(always)]
     pub fn at(&mut self, t: Time, event: E) {
         self.queue.push(t, event);
     }
 
     /// Schedules `event` after `d`, or fails on time overflow naming `context`.
-    #[inline]
+    #[inline(always)]
     pub fn after(&mut self, d: Duration, event: E, context: &str) -> Result<Time, TimeError> {
         let t = self.now.add(d, context)?;
         self.queue.push(t, event);

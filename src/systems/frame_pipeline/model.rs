@@ -550,7 +550,7 @@ impl FramePipeline {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     pub(super) fn schedule_wake(s: &mut Scheduler<Ev>, w: Wake, cpu: bool) {
         if let Wake::JobAt(t, tag) = w {
             s.at(
