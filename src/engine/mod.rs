@@ -10,5 +10,5 @@ pub mod time;
 
 pub use queue::{EventQueue, QueueKind};
 pub use rng::{RngStreams, StreamRng};
-pub use sim::{Control, EngineError, EventKind, Limits, Model, RunStats, Scheduler, StopReason, run};
+pub use sim::{Control, EngineError, EventKind, Limits, Model, RunStats, Scheduler, Slot, StopReason, run};
 pub use time::{Duration, PS_PER_MS, PS_PER_NS, PS_PER_S, PS_PER_US, Time, TimeError};

@@ -128,6 +128,16 @@ impl<E> EventQueue<E> {
         }
     }
 
+    /// Takes the next sequence number without scheduling an event (see
+    /// [`super::sim::Scheduler::reserve`]): events scheduled later still
+    /// come after it at the same time.
+    #[inline]
+    pub fn reserve_seq(&mut self) -> u64 {
+        let seq = self.next_seq;
+        self.next_seq += 1;
+        seq
+    }
+
     /// Puts back an event just popped, keeping its place among events due
     /// at the same time (the run loop uses it when a time limit stops it).
     pub fn restore(&mut self, s: Scheduled<E>) {

@@ -66,6 +66,25 @@ pub trait Model {
 pub struct Scheduler<E> {
     queue: EventQueue<E>,
     now: Time,
+    /// The sequence number of the event being handled (`u64::MAX` once a
+    /// run stopped at its time limit: every slot up to the limit passed).
+    seq: u64,
+}
+
+/// A place in the `(time, seq)` order of events taken without an event
+/// ([`Scheduler::reserve`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub struct Slot {
+    time: Time,
+    seq: u64,
+}
+
+impl Slot {
+    /// When the event that was not scheduled would have been due.
+    #[inline]
+    pub fn time(&self) -> Time {
+        self.time
+    }
 }
 
 impl<E> Default for Scheduler<E> {
@@ -86,6 +105,7 @@ impl<E> Scheduler<E> {
         Scheduler {
             queue: EventQueue::of_kind(kind),
             now: Time::ZERO,
+            seq: 0,
         }
     }
 
@@ -97,13 +117,13 @@ impl<E> Scheduler<E> {
 
     /// Schedules `event` at the absolute time `t` (must not be in the past;
     /// the loop reports it as an error if it is).
-    #[inline]
+    #[inline(always)]
     pub fn at(&mut self, t: Time, event: E) {
         self.queue.push(t, event);
     }
 
     /// Schedules `event` after `d`, or fails on time overflow naming `context`.
-    #[inline]
+    #[inline(always)]
     pub fn after(&mut self, d: Duration, event: E, context: &str) -> Result<Time, TimeError> {
         let t = self.now.add(d, context)?;
         self.queue.push(t, event);
@@ -113,6 +133,29 @@ impl<E> Scheduler<E> {
     /// Number of pending events.
     pub fn pending(&self) -> usize {
         self.queue.len()
+    }
+
+    /// Takes the place in the `(time, seq)` order that an event scheduled
+    /// now at `t` would have, without scheduling one. For an event whose
+    /// handling would change nothing but the model's own bookkeeping (no
+    /// other event, no other unit's step): the model keeps the slot and does
+    /// that bookkeeping itself at the first event handled after the slot
+    /// ([`Scheduler::passed`]), exactly where the event would have run, and
+    /// the run has one event fewer to queue, pop and dispatch.
+    #[inline]
+    pub fn reserve(&mut self, t: Time) -> Slot {
+        Slot {
+            time: t,
+            seq: self.queue.reserve_seq(),
+        }
+    }
+
+    /// Whether `slot` comes before the event being handled in `(time, seq)`
+    /// order (after a run that stopped at its time limit: whether it is due
+    /// by the limit).
+    #[inline]
+    pub fn passed(&self, slot: Slot) -> bool {
+        (slot.time, slot.seq) < (self.now, self.seq)
     }
 }
 
@@ -175,6 +218,7 @@ pub fn run<M: Model>(model: &mut M, sched: &mut Scheduler<M::Event>, limits: Lim
             // Put it back (in its place) so the caller could resume.
             sched.queue.restore(next);
             sched.now = until;
+            sched.seq = u64::MAX;
             break StopReason::TimeLimit;
         }
         let kind = next.event.kind();
@@ -187,6 +231,7 @@ pub fn run<M: Model>(model: &mut M, sched: &mut Scheduler<M::Event>, limits: Lim
             .into());
         }
         sched.now = next.time;
+        sched.seq = next.seq;
         by_kind[kind] += 1;
         events += 1;
         if model.handle(next.time, next.event, sched)? == Control::Stop {
@@ -287,6 +332,69 @@ mod tests {
         )
         .unwrap();
         assert_eq!((st.events, st.stopped_by), (5, StopReason::EventLimit));
+    }
+
+    /// A model that keeps some events as slots: it must see each one
+    /// passed exactly where the event would have run.
+    struct Keeper {
+        /// (time, label) of each event and each passed slot, in order.
+        seen: Vec<(Time, char)>,
+        slots: Vec<(Slot, char)>,
+    }
+    impl Keeper {
+        fn catch_up(&mut self, s: &Scheduler<Ev>) {
+            while let Some(i) = self.slots.iter().position(|(slot, _)| s.passed(*slot)) {
+                let (slot, c) = self.slots.remove(i);
+                self.seen.push((slot.time(), c));
+            }
+        }
+    }
+    impl Model for Keeper {
+        type Event = Ev;
+        type Error = EngineError;
+        fn handle(&mut self, now: Time, e: Ev, s: &mut Scheduler<Ev>) -> Result<Control, EngineError> {
+            self.catch_up(s);
+            self.seen.push((now, if let Ev::Tick = e { 'T' } else { 't' }));
+            if self.seen.len() == 1 {
+                // Slots between, before and after events due at 10 and 20.
+                let slot = s.reserve(Time(10));
+                self.slots.push((slot, 'a'));
+                s.at(Time(10), Ev::Tock);
+                self.slots.push((s.reserve(Time(10)), 'b'));
+                self.slots.push((s.reserve(Time(15)), 'c'));
+                s.at(Time(20), Ev::Tock);
+                self.slots.push((s.reserve(Time(20)), 'd'));
+                self.slots.push((s.reserve(Time(25)), 'e'));
+            }
+            Ok(Control::Continue)
+        }
+    }
+
+    #[test]
+    fn reserved_slots_pass_in_time_and_scheduling_order() {
+        let limits = Limits {
+            until: Some(Time(24)),
+            max_events: None,
+        };
+        let go = |last: Option<Time>| {
+            let mut m = Keeper {
+                seen: vec![],
+                slots: vec![],
+            };
+            let mut s = Scheduler::new();
+            s.at(Time(0), Ev::Tick);
+            if let Some(t) = last {
+                s.at(t, Ev::Tick);
+            }
+            let st = run(&mut m, &mut s, limits).unwrap();
+            m.catch_up(&s);
+            assert!(m.seen.windows(2).all(|w| w[0].0 <= w[1].0));
+            (st.stopped_by, m.seen.iter().map(|e| e.1).collect::<String>())
+        };
+        // Out of events after the one at 20: the slots after it stay.
+        assert_eq!(go(None), (StopReason::Exhausted, "Tatbct".to_string()));
+        // Stopped by the time limit: the slots due by the limit pass.
+        assert_eq!(go(Some(Time(30))), (StopReason::TimeLimit, "Tatbctd".to_string()));
     }
 
     #[test]

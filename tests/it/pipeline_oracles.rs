@@ -218,18 +218,37 @@ fn vertex_cache_changes_geometry_time_by_actually_transformed_vertices() {
     assert!((geo(&optimized) - tv(&optimized) * 1e-6).abs() < 1e-9);
 }
 
+/// A traced run accounts every instant in full; an untraced one takes the
+/// short cuts (a quiet front-end completion's accounting, a CPU step that
+/// skips `settle` and `account`): both must give the same results, also
+/// with system tasks preempting the front end (stale quiet completions) and
+/// a command FIFO small enough to block the CPU.
 #[test]
 fn tracing_does_not_change_results_at_either_fidelity() {
     use rendersim::config::ModelSource;
     use rendersim::systems::run_model;
-    for fid in ["triangle", "draw"] {
+    let stressed: &[&str] = &[
+        "noise.periodic.0.target=\"gpu\"",
+        "noise.random.0.target=\"gpu\"",
+        "noise.random.0.rate=\"300Hz\"",
+        "command_fifo.capacity=8",
+    ];
+    for (fid, extra) in [
+        ("triangle", &[][..]),
+        ("draw", &[][..]),
+        ("draw", stressed),
+        ("triangle", &stressed[3..]),
+    ] {
         let src = ModelSource::from_text("d.toml", DEFAULT);
         let mut t = src.table().unwrap();
         for s in [
             format!("fidelity=\"{fid}\""),
             "run.frames=8".into(),
             "run.warmup_frames=0".into(),
-        ] {
+        ]
+        .into_iter()
+        .chain(extra.iter().map(|s| s.to_string()))
+        {
             rendersim::config::apply_set(&mut t, &s).unwrap();
         }
         let get = |trace: bool| {
@@ -244,11 +263,14 @@ fn tracing_does_not_change_results_at_either_fidelity() {
         };
         let (a, b) = (get(false), get(true));
         assert!(a.trace.is_none() && b.trace.is_some());
-        assert_eq!(csv(&a), csv(&b), "{fid}");
+        assert_eq!(csv(&a), csv(&b), "{fid} {extra:?}");
         assert_eq!(a.clocks.geometry, b.clocks.geometry, "{fid}");
         assert_eq!(a.clocks.fragment, b.clocks.fragment, "{fid}");
         assert_eq!(a.clocks.bottleneck, b.clocks.bottleneck, "{fid}");
         assert_eq!(a.summary["metrics"], b.summary["metrics"], "{fid}");
+        assert_eq!(a.clocks.cpu, b.clocks.cpu, "{fid}");
+        assert_eq!(a.clocks.front, b.clocks.front, "{fid}");
+        assert_eq!(a.clocks.gpu, b.clocks.gpu, "{fid}");
     }
 }
 

@@ -34,6 +34,9 @@ pub const FRONT_STATES: [&str; 6] = [
     "wait: geometry",
     "system task",
 ];
+/// The front end's state (index into [`FRONT_STATES`]) while a draw waits
+/// for the geometry stage.
+pub const FRONT_WAIT_GEOMETRY: usize = 4;
 /// Geometry-stage states.
 pub const GEOM_STATES: [&str; 3] = ["busy", "blocked: triangle FIFO full", "idle"];
 /// Fragment-stage states.
@@ -237,7 +240,7 @@ fn front_state_of(p: FrontPhase) -> usize {
         of[FrontPhase::Idle as usize] = 1;
         of[FrontPhase::WaitImage as usize] = 2;
         of[FrontPhase::WaitDrain as usize] = 3;
-        of[FrontPhase::Handoff as usize] = 4;
+        of[FrontPhase::Handoff as usize] = FRONT_WAIT_GEOMETRY as u8;
         of
     };
     OF[p as usize] as usize

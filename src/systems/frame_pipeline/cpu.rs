@@ -6,7 +6,7 @@
 
 use crate::engine::{Duration, Scheduler, Time};
 
-use super::model::{Command, CpuPhase, Ev, FramePipeline, Program};
+use super::model::{Command, CpuPhase, Ev, FramePipeline, FrontPhase, Program};
 use super::records::FrameRecord;
 use crate::systems::error::SystemError;
 
@@ -118,9 +118,46 @@ impl FramePipeline {
         self.cpu_phase = self.cpu_after_work(now);
     }
 
+    /// After an operation's work, when nothing but the CPU thread moves:
+    /// takes the CPU's step (push the command, start the next operation)
+    /// and returns true when that was all the event did, so `settle` and
+    /// `account` can be skipped. That holds when the front end is not
+    /// waiting for commands (a push wakes only an idle front end; no other
+    /// GPU step depends on the CPU), no trace is written (it records the
+    /// FIFO's level at every event), and the CPU ends up working on the
+    /// same frame (its clock, its frame and its critical-path mode are what
+    /// the last event left; a blocked push or a new frame needs the full
+    /// accounting). Returns false otherwise, with at most the CPU's step
+    /// taken, which `settle` then repeats as a no-op before the front end's.
+    pub(super) fn cpu_step_alone(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
+        if self.front_phase == FrontPhase::Idle || self.acct.trace.is_some() {
+            return Ok(false);
+        }
+        let frame = self.cpu_frame;
+        self.cpu_step(now, s)?;
+        Ok(self.cpu_phase == CpuPhase::Running && self.cpu_frame == frame)
+    }
+
     /// Advances the CPU thread as far as it can go now. Returns whether
     /// anything changed.
+    #[inline]
     pub(super) fn cpu_step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
+        // At rest while an operation runs or too many frames are in flight
+        // (most events find it so), and for good once finished or waiting
+        // for its zero-time frame: no step, and no call.
+        match self.cpu_phase {
+            CpuPhase::Running | CpuPhase::ZeroTimeWait | CpuPhase::Finished => return Ok(false),
+            CpuPhase::WaitFrames if self.cpu_frame - self.gpu_completed >= self.cfg.cpu.max_frames_ahead as u64 => {
+                return Ok(false);
+            }
+            _ => {}
+        }
+        self.cpu_step_from_rest(now, s)
+    }
+
+    /// [`FramePipeline::cpu_step`] from a phase that may move.
+    #[inline(never)]
+    fn cpu_step_from_rest(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         let mut progressed = false;
         loop {
             match self.cpu_phase {

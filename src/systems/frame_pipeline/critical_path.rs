@@ -218,6 +218,19 @@ impl CriticalPath {
         self.modes = modes;
     }
 
+    /// [`CriticalPath::update`] when only `unit` (one of the four of
+    /// [`Modes`]) may have changed its mode and no frame was presented or
+    /// shown at this instant: the same result without comparing the others.
+    #[inline]
+    pub fn set_mode(&mut self, unit: Unit, mode: Mode, now: Time) {
+        debug_assert!(!self.pending);
+        let i = unit as usize;
+        if self.modes[i] != mode {
+            self.materialize(i, now);
+            self.modes[i] = mode;
+        }
+    }
+
     /// Records the front end's path with the frames presented now, and
     /// moves the display's path to the frame shown now.
     #[cold]

@@ -8,6 +8,7 @@
 //! becomes sort-middle bins: a draw's fragments start after its last
 //! triangle's geometry, and the next draw waits for the bins to drain.
 
+use crate::components::preemptible::Wake;
 use crate::engine::{Duration, Scheduler, Time};
 
 use super::config::Fidelity;
@@ -135,8 +136,12 @@ impl FramePipeline {
         s: &mut Scheduler<Ev>,
     ) -> Result<FrontPhase, SystemError> {
         if work.0 > 0 || self.front.in_system() {
-            let w = self.front.start_job(now, work)?;
-            Self::schedule_wake(s, w, false);
+            match self.front.start_job(now, work)? {
+                Wake::JobAt(end, tag) if self.quiet_completion(c, end) => {
+                    self.front_quiet = Some((s.reserve(end), tag));
+                }
+                w => Self::schedule_wake(s, w, false),
+            }
             return Ok(FrontPhase::Running);
         }
         self.front_after(now, c)
@@ -196,7 +201,7 @@ impl FramePipeline {
                     self.geom_busy = true;
                     self.frag_busy = true;
                     self.draw_split = Some((t.geometry, t.fragment, t.total));
-                    s.after(t.total, Ev::DrawDone, "draw")?;
+                    self.draw_done_at = Some(s.after(t.total, Ev::DrawDone, "draw")?);
                     return Ok(());
                 }
                 if t.geometry.0 > 0 {
@@ -209,7 +214,7 @@ impl FramePipeline {
                 } else {
                     self.frag_busy = true;
                 }
-                s.after(t.total, Ev::DrawDone, "draw")?;
+                self.draw_done_at = Some(s.after(t.total, Ev::DrawDone, "draw")?);
                 Ok(())
             }
         }
@@ -229,6 +234,7 @@ impl FramePipeline {
         self.frag_busy = false;
         self.geom_draw = None;
         self.draw_fragment_limited = None;
+        self.draw_done_at = None;
     }
 
     /// Starts the next triangle of the current draw, or finishes the draw.

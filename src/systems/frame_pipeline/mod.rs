@@ -7,6 +7,8 @@
 //! - `model`: the kernel model (state and event dispatch);
 //! - `cpu`, `gpu`, `display`: the units' event handlers;
 //! - `closed_form`: the `draw`-fidelity formula;
+//! - `quiet`: front-end completions kept out of the event queue at `draw`
+//!   fidelity (they only start a hand-off);
 //! - `accounting`: state clocks, trace timeline, each unit's mode;
 //! - `critical_path`: bottleneck attribution along the critical path;
 //! - `records`: per-frame records and the PresentMon-style table;
@@ -25,6 +27,7 @@ mod display;
 mod gpu;
 pub mod isolate;
 pub mod model;
+mod quiet;
 pub mod records;
 pub mod report;
 pub mod run;

@@ -14,7 +14,7 @@ use crate::components::noise::{Arrivals, NoiseSource, NoiseTarget};
 use crate::components::preemptible::{Preemptible, Wake};
 use crate::components::shader_pool::{ShaderPool, Stream};
 use crate::components::swap_chain::{PresentMode, SwapChain};
-use crate::engine::{Control, Duration, EventKind, Model, RngStreams, Scheduler, StreamRng, Time};
+use crate::engine::{Control, Duration, EventKind, Model, RngStreams, Scheduler, Slot, StreamRng, Time};
 use crate::systems::error::SystemError;
 
 use super::accounting::Accounting;
@@ -234,6 +234,11 @@ pub struct FramePipeline {
     /// `draw` fidelity: whether the running draw is fragment-limited (F >= G);
     /// the bottleneck of the whole draw goes to that stage.
     pub(super) draw_fragment_limited: Option<bool>,
+    /// `draw` fidelity: when the running draw ends (its [`Ev::DrawDone`]).
+    pub(super) draw_done_at: Option<Time>,
+    /// The front end's draw command completing quietly: its slot in the
+    /// event order and the job's tag ([`super::quiet`]).
+    pub(super) front_quiet: Option<(Slot, u32)>,
     /// A finished triangle's fragment work (shader, fixed-function) that
     /// found the triangle FIFO full.
     pub(super) geom_held: Option<FragWork>,
@@ -392,6 +397,8 @@ impl FramePipeline {
             geom_busy: false,
             draw_split: None,
             draw_fragment_limited: None,
+            draw_done_at: None,
+            front_quiet: None,
             geom_held: None,
             draw_sizes: Vec::new(),
             pool: match cfg.fidelity {
@@ -543,6 +550,7 @@ impl FramePipeline {
         }
     }
 
+    #[inline(always)]
     pub(super) fn schedule_wake(s: &mut Scheduler<Ev>, w: Wake, cpu: bool) {
         if let Wake::JobAt(t, tag) = w {
             s.at(
@@ -591,10 +599,14 @@ impl Model for FramePipeline {
     type Error = SystemError;
 
     fn handle(&mut self, now: Time, ev: Ev, s: &mut Scheduler<Ev>) -> Result<Control, SystemError> {
+        self.catch_up(s)?;
         match ev {
             Ev::CpuDone { tag } => {
                 if self.cpu.complete(tag) {
                     self.cpu_op_done(now);
+                    if self.cpu_step_alone(now, s)? {
+                        return Ok(Control::Continue);
+                    }
                 }
             }
             Ev::FrontDone { tag } => {

@@ -291,6 +291,7 @@ pub fn run_pipeline(
         max_events: model.cfg.run.max_events,
     };
     let stats = run(&mut model, &mut sched, limits)?;
+    model.catch_up(&sched)?;
     if stats.stopped_by == StopReason::Exhausted && !model.done() {
         return Err(SystemError::Unfinished {
             at: stats.end_time,
@@ -740,6 +741,7 @@ pub fn simulate_program(
     let mut sched = Scheduler::new();
     model.start(&mut sched)?;
     let stats = run(&mut model, &mut sched, Limits::default())?;
+    model.catch_up(&sched)?;
     if !model.done() {
         return Err(SystemError::Unfinished {
             at: stats.end_time,

@@ -1,0 +1,81 @@
+//! Quiet completions at `draw` fidelity: a front-end completion that would
+//! change nothing but the accounting is not queued as an event.
+//!
+//! Paper 000 §4.5: the GPU's front end processes a draw command (its state
+//! changes) and hands the draw to the geometry stage, which takes it once
+//! the previous draw is through (at `draw` fidelity, when that draw's closed
+//! form ends, [`super::closed_form`]). When the front end finishes a draw
+//! command while the geometry stage still holds an earlier draw, all that
+//! happens is that the front end starts waiting for geometry: no FIFO space
+//! is freed, no frame completes, and no unit can take a step it could not
+//! take before. In a GPU-bound stretch that is almost every draw.
+//!
+//! Such a completion keeps its place in the event order without an event
+//! ([`Scheduler::reserve`]); the hand-off and the accounting of that instant
+//! are done at the first event handled after it (or after the run), exactly
+//! where the event would have run ([`Scheduler::passed`]), so every clock,
+//! record and critical-path share is the same to the picosecond. The run
+//! counts only the front-end completions that do something
+//! (`events.by_kind.gpu_front_end`), and has one event fewer to queue, pop
+//! and settle per quiet draw. At `triangle` fidelity the geometry stage's
+//! end is not known in advance, so every completion is an event.
+
+use crate::engine::{Scheduler, Time};
+use crate::systems::error::SystemError;
+
+use super::accounting::FRONT_WAIT_GEOMETRY;
+use super::critical_path::{Mode, Unit};
+use super::model::{Command, Ev, FramePipeline, FrontPhase};
+
+impl FramePipeline {
+    /// Whether the front end's job for `c`, ending at `end`, would only
+    /// start a hand-off: a draw command finished while the geometry stage's
+    /// draw ends later (one ending at the same instant runs first, since it
+    /// was scheduled first, and frees the stage).
+    #[inline]
+    pub(super) fn quiet_completion(&self, c: Command, end: Time) -> bool {
+        matches!(c, Command::Draw { .. }) && self.draw_done_at.is_some_and(|d| d > end)
+    }
+
+    /// Does the quiet completion whose turn came before the event being
+    /// handled (after a run: before its end). Called first in every event.
+    #[inline]
+    pub(super) fn catch_up(&mut self, s: &Scheduler<Ev>) -> Result<(), SystemError> {
+        if let Some((slot, tag)) = self.front_quiet
+            && s.passed(slot)
+        {
+            self.front_quiet = None;
+            self.quiet_front_done(slot.time(), tag)?;
+        }
+        Ok(())
+    }
+
+    /// The front end's draw command finished at `at` (job `tag`): the
+    /// hand-off begins, and the instant is accounted as an event's would be.
+    /// (`settle` would find nothing to do: the geometry stage holds a draw
+    /// until after `at`, so the hand-off waits, and the CPU waits on
+    /// nothing a hand-off changes.)
+    #[inline(never)]
+    fn quiet_front_done(&mut self, at: Time, tag: u32) -> Result<(), SystemError> {
+        // A system task that preempted the job made the tag stale; the
+        // resumed job's completion is an event of its own.
+        if !self.front.complete(tag) {
+            return Ok(());
+        }
+        debug_assert!(self.draw_done_at.is_some_and(|d| d > at));
+        self.front_command_done(at)?;
+        debug_assert_eq!(self.front_phase, FrontPhase::Handoff);
+        if self.acct.trace.is_some() {
+            self.account(at);
+            return Ok(());
+        }
+        // Without a trace, `account` would find only the front end moved
+        // (busy -> waiting for geometry, for the critical path too): the
+        // geometry and fragment stages are busy with the draw throughout
+        // (so the GPU stays busy), the CPU and the frames are as the last
+        // event left them.
+        self.acct.front.set(at, FRONT_WAIT_GEOMETRY);
+        self.acct.path.set_mode(Unit::Front, Mode::wait(Unit::Geometry), at);
+        Ok(())
+    }
+}
