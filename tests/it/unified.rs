@@ -47,7 +47,10 @@ fn the_default_model_reproduces_table_1s_direction() {
     // sizes vary, so the bottleneck moves inside draws, paper 000 §4.5.1):
     // about 0.8 (0.794 measured), as docs/models.md says.
     let split = table1_ratio("split");
-    assert!(split < unified - 0.05 && (0.7..0.9).contains(&split), "split ratio {split}");
+    assert!(
+        split < unified - 0.05 && (0.7..0.9).contains(&split),
+        "split ratio {split}"
+    );
 }
 
 /// A scene on the unified pool without fixed-function costs.
