@@ -76,9 +76,9 @@ const MODELS: [(&str, &str); 4] = [
     ("h2-pass", include_str!("../../models/h2-pass.toml")),
 ];
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
+/// The upper middle of `v` ([`crate::measure::fit::median`]), NaN for none.
+fn median(v: Vec<f64>) -> f64 {
+    crate::measure::fit::median(&v).unwrap_or(f64::NAN)
 }
 
 /// Reorders `spec`'s index buffer `reps` times with each form, alternating;

@@ -127,6 +127,33 @@ pub(crate) fn stats_types() -> wgpu::PipelineStatisticsTypes {
 /// The colour format the measurement pipelines render to.
 pub(crate) const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
+/// Maps `read` (a `MAP_READ` buffer whose copies were submitted), waits for
+/// the device, and returns its contents as little-endian `u64` words (query
+/// results), unmapping it again.
+pub(crate) fn read_words(device: &wgpu::Device, read: &wgpu::Buffer) -> Result<Vec<u64>, MeasureError> {
+    let slice = read.slice(..);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| MeasureError::Readback(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| MeasureError::Readback(e.to_string()))?
+        .map_err(|e| MeasureError::Readback(e.to_string()))?;
+    let data = slice
+        .get_mapped_range()
+        .map_err(|e| MeasureError::Readback(e.to_string()))?;
+    let words = data
+        .chunks_exact(8)
+        .map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
+        .collect();
+    drop(data);
+    read.unmap();
+    Ok(words)
+}
+
 /// The bind group of whole `buffers` at bindings 0, 1, ... (each with its
 /// binding type and the stages that read it) and the pipeline layout over
 /// it: the resources of `rendersim measure`'s passes and `study
@@ -512,26 +539,7 @@ impl Gpu {
             });
             enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, 512);
             queue.submit([enc.finish()]);
-            let slice = read.slice(..);
-            let (tx, rx) = std::sync::mpsc::channel();
-            slice.map_async(wgpu::MapMode::Read, move |r| {
-                let _ = tx.send(r);
-            });
-            device
-                .poll(wgpu::PollType::wait_indefinitely())
-                .map_err(|e| MeasureError::Readback(e.to_string()))?;
-            rx.recv()
-                .map_err(|e| MeasureError::Readback(e.to_string()))?
-                .map_err(|e| MeasureError::Readback(e.to_string()))?;
-            let data = slice
-                .get_mapped_range()
-                .map_err(|e| MeasureError::Readback(e.to_string()))?;
-            let words: Vec<u64> = data
-                .chunks_exact(8)
-                .map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
-                .collect();
-            drop(data);
-            read.unmap();
+            let words = read_words(device, &read)?;
             if round >= opts.warmup {
                 counters.push([words[0], words[1], words[2], words[3]]);
                 let (t0, t1) = (words[32], words[33]);

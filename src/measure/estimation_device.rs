@@ -11,7 +11,7 @@ use std::time::Instant;
 
 use wgpu::util::DeviceExt;
 
-use super::device::{Gpu, MeasureError, TARGET_FORMAT, buffer_bindings, position_pipeline, stats_types};
+use super::device::{Gpu, MeasureError, TARGET_FORMAT, buffer_bindings, position_pipeline, read_words, stats_types};
 use super::estimation::{EstimationStudy, PassMeasurement, Plan, PlannedPass, analyze};
 use super::fit::median;
 use super::geometry::mesh_positions;
@@ -256,26 +256,7 @@ impl<'a> Renderer<'a> {
         enc.resolve_query_set(&self.times, 0..2 * n, &self.resolve, self.time_offset);
         enc.copy_buffer_to_buffer(&self.resolve, 0, &self.read, 0, self.read.size());
         self.queue.submit([enc.finish()]);
-        let slice = self.read.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| MeasureError::Readback(e.to_string()))?;
-        rx.recv()
-            .map_err(|e| MeasureError::Readback(e.to_string()))?
-            .map_err(|e| MeasureError::Readback(e.to_string()))?;
-        let data = slice
-            .get_mapped_range()
-            .map_err(|e| MeasureError::Readback(e.to_string()))?;
-        let words: Vec<u64> = data
-            .chunks_exact(8)
-            .map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
-            .collect();
-        drop(data);
-        self.read.unmap();
+        let words = read_words(self.device, &self.read)?;
         let t = (self.time_offset / 8) as usize;
         let out = (0..passes.len())
             .map(|i| {

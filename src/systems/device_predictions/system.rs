@@ -16,6 +16,7 @@ use crate::config::{ModelSource, deserialize};
 use crate::measure::calibrate::read_rows;
 use crate::measure::predictions::{DevicePredictions, ErrorStats, calibrate_rows, predict_rows};
 use crate::output::trace::TraceWriter;
+use crate::systems::error::invalid;
 use crate::systems::{Outcome, SimError, System, SystemError, resolved_toml};
 
 use super::config::DevicePredictionsConfig;
@@ -81,35 +82,32 @@ pub fn run_device_predictions(
     cfg: DevicePredictionsConfig,
     base_dir: &Path,
 ) -> Result<DevicePredictionsRun, SystemError> {
-    let bad = |key: &str, m: String| SystemError::Invalid {
-        key: key.into(),
-        message: m,
-    };
     let start = Instant::now();
     if cfg.system != "device_predictions" {
-        return Err(bad(
+        return Err(invalid(
             "system",
             format!("expected \"device_predictions\", got {:?}", cfg.system),
         ));
     }
     if cfg.files.is_empty() {
-        return Err(bad("files", "names no pass CSV".into()));
+        return Err(invalid("files", "names no pass CSV"));
     }
     if cfg.shader_cores == 0 {
-        return Err(bad("shader_cores", "must be at least 1".into()));
+        return Err(invalid("shader_cores", "must be at least 1"));
     }
     let policy: CachePolicy = cfg
         .vertex_cache
         .parse()
-        .map_err(|e| bad("vertex_cache", format!("{e}")))?;
+        .map_err(|e| invalid("vertex_cache", format!("{e}")))?;
     let mut rows = Vec::new();
     for (i, f) in cfg.files.iter().enumerate() {
         let path = base_dir.join(f);
-        rows.extend(read_rows(&path).map_err(|e| bad(&format!("files[{i}]"), e.to_string()))?);
+        rows.extend(read_rows(&path).map_err(|e| invalid(&format!("files[{i}]"), e.to_string()))?);
     }
-    let cal = calibrate_rows(&rows, &cfg.device, &policy, cfg.shader_cores).map_err(|e| bad("files", e.to_string()))?;
-    let predictions =
-        predict_rows(&cal.profile, &rows, &cal.loo_ns, &cal.linear_loo_pct).map_err(|e| bad("files", e.to_string()))?;
+    let cal =
+        calibrate_rows(&rows, &cfg.device, &policy, cfg.shader_cores).map_err(|e| invalid("files", e.to_string()))?;
+    let predictions = predict_rows(&cal.profile, &rows, &cal.loo_ns, &cal.linear_loo_pct)
+        .map_err(|e| invalid("files", e.to_string()))?;
     let fit = &cal.profile.fit;
     let metrics = Metrics {
         rows: rows.len(),
@@ -136,7 +134,7 @@ pub fn run_device_predictions(
         simulate_seconds: predictions.simulating_seconds,
         metrics,
     };
-    let summary = serde_json::to_value(&summary).map_err(|e| bad("device", e.to_string()))?;
+    let summary = serde_json::to_value(&summary).map_err(|e| invalid("device", e.to_string()))?;
     Ok(DevicePredictionsRun {
         summary,
         config: cfg,

@@ -147,12 +147,19 @@ impl FramePipeline {
         // for its zero-time frame: no step, and no call.
         match self.cpu_phase {
             CpuPhase::Running | CpuPhase::ZeroTimeWait | CpuPhase::Finished => return Ok(false),
-            CpuPhase::WaitFrames if self.cpu_frame - self.gpu_completed >= self.cfg.cpu.max_frames_ahead as u64 => {
+            CpuPhase::WaitFrames if self.frames_ahead_full() => {
                 return Ok(false);
             }
             _ => {}
         }
         self.cpu_step_from_rest(now, s)
+    }
+
+    /// Whether `cpu.max_frames_ahead` frames are in flight (submitted by the
+    /// CPU, not yet completed by the GPU): the CPU may not start another.
+    #[inline(always)]
+    fn frames_ahead_full(&self) -> bool {
+        self.cpu_frame - self.gpu_completed >= u64::from(self.cfg.cpu.max_frames_ahead)
     }
 
     /// [`FramePipeline::cpu_step`] from a phase that may move.
@@ -169,7 +176,7 @@ impl FramePipeline {
                     if self.records.len() as u64 == self.cpu_frame {
                         self.records.push(FrameRecord::new(self.cpu_frame, now));
                     }
-                    if self.cpu_frame - self.gpu_completed >= self.cfg.cpu.max_frames_ahead as u64 {
+                    if self.frames_ahead_full() {
                         let changed = self.cpu_phase != CpuPhase::WaitFrames;
                         self.cpu_phase = CpuPhase::WaitFrames;
                         return Ok(progressed || changed);

@@ -65,13 +65,18 @@ pub const METRIC: &str = "metrics.gpu_time_ms.mean";
 /// A search stops once its cell is this close to the target (ms).
 pub const TOLERANCE_MS: f64 = 1e-4;
 
+/// The name a model file gives an enum value: its serde form
+/// (`"ascending"`, `"draw"`).
+fn key_name<T: Serialize>(value: T) -> String {
+    serde_json::to_value(value)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default()
+}
+
 /// The `size_order` value of `order`.
-pub fn order_name(order: SizeOrder) -> &'static str {
-    match order {
-        SizeOrder::Random => "random",
-        SizeOrder::Ascending => "ascending",
-        SizeOrder::Descending => "descending",
-    }
+pub fn order_name(order: SizeOrder) -> String {
+    key_name(order)
 }
 
 /// The terrain of Table 1 on the split architecture, one frame: the order
@@ -98,10 +103,7 @@ impl SplitTerrain {
     /// frame.
     pub fn table(&self, src: &ModelSource, fidelity: Fidelity) -> Result<toml::Table, ConfigError> {
         let mut t = src.table()?;
-        let fidelity = match fidelity {
-            Fidelity::Triangle => "triangle",
-            Fidelity::Draw => "draw",
-        };
+        let fidelity = key_name(fidelity);
         for set in [
             "gpu.architecture=\"split\"".to_string(),
             format!("fidelity=\"{fidelity}\""),

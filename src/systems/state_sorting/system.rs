@@ -17,6 +17,7 @@ use crate::components::sorting_buffer::{
 use crate::config::{ModelSource, deserialize};
 use crate::output::trace::TraceWriter;
 use crate::scene::states::scene_state_ids;
+use crate::systems::error::invalid;
 use crate::systems::{Outcome, SimError, System, SystemError, outcome_basics, resolved_toml};
 
 use super::config::StateSortingConfig;
@@ -87,35 +88,34 @@ pub fn resolve_sequence(spec: &str, base: &Path) -> Result<Vec<StateId>, String>
 
 /// Reads the sequence and runs every strategy.
 pub fn run_state_sorting(cfg: StateSortingConfig, base_dir: &Path) -> Result<StateSortingRun, SystemError> {
-    let bad = |key: &str, m: String| SystemError::Invalid {
-        key: key.into(),
-        message: m,
-    };
     let start = Instant::now();
     if cfg.system != "state_sorting" {
-        return Err(bad(
+        return Err(invalid(
             "system",
             format!("expected \"state_sorting\", got {:?}", cfg.system),
         ));
     }
-    check_buffer(cfg.buffer).map_err(|e| bad("buffer", e.to_string()))?;
+    check_buffer(cfg.buffer).map_err(|e| invalid("buffer", e.to_string()))?;
     if cfg.strategies.is_empty() {
-        return Err(bad("strategies", "names no strategy".into()));
+        return Err(invalid("strategies", "names no strategy"));
     }
     let mut strategies = Vec::new();
     for (i, name) in cfg.strategies.iter().enumerate() {
         let s = strategy_of(name).ok_or_else(|| {
-            bad(
+            invalid(
                 &format!("strategies[{i}]"),
                 format!("unknown strategy {name:?} (known: lru, bounded-waste, random, round-robin)"),
             )
         })?;
         if strategies.contains(&s) {
-            return Err(bad(&format!("strategies[{i}]"), format!("{name:?} is listed twice")));
+            return Err(invalid(
+                &format!("strategies[{i}]"),
+                format!("{name:?} is listed twice"),
+            ));
         }
         strategies.push(s);
     }
-    let seq = resolve_sequence(&cfg.sequence, base_dir).map_err(|e| bad("sequence", e))?;
+    let seq = resolve_sequence(&cfg.sequence, base_dir).map_err(|e| invalid("sequence", e))?;
     let sim_start = Instant::now();
     let mut rows = Vec::new();
     let mut metrics = Metrics {
@@ -131,7 +131,8 @@ pub fn run_state_sorting(cfg: StateSortingConfig, base_dir: &Path) -> Result<Sta
         overflows: BTreeMap::new(),
     };
     if seq.len() <= MAX_OFFLINE_LEN {
-        metrics.offline_optimum = Some(offline_optimum(&seq, cfg.buffer).map_err(|e| bad("sequence", e.to_string()))?);
+        metrics.offline_optimum =
+            Some(offline_optimum(&seq, cfg.buffer).map_err(|e| invalid("sequence", e.to_string()))?);
     }
     let ratio = |a: u64, b: u64| {
         if b == 0 {
@@ -141,7 +142,7 @@ pub fn run_state_sorting(cfg: StateSortingConfig, base_dir: &Path) -> Result<Sta
         }
     };
     for &s in &strategies {
-        let r = simulate(&seq, cfg.buffer, s, cfg.run.seed, false).map_err(|e| bad("sequence", e.to_string()))?;
+        let r = simulate(&seq, cfg.buffer, s, cfg.run.seed, false).map_err(|e| invalid("sequence", e.to_string()))?;
         metrics.state_changes.insert(s.name(), r.state_changes);
         metrics
             .over_bound
@@ -163,7 +164,7 @@ pub fn run_state_sorting(cfg: StateSortingConfig, base_dir: &Path) -> Result<Sta
         simulate_seconds,
         metrics,
     };
-    let summary = serde_json::to_value(&summary).map_err(|e| bad("sequence", e.to_string()))?;
+    let summary = serde_json::to_value(&summary).map_err(|e| invalid("sequence", e.to_string()))?;
     Ok(StateSortingRun {
         summary,
         config: cfg,
