@@ -149,38 +149,6 @@ fn expansion_order_and_counts() {
 }
 
 #[test]
-fn plots_name_points_by_the_sweeps_labels() {
-    let exp = parse(
-        r#"
-name = "labels"
-[[sweep]]
-key = "display.buffers"
-values = [2, 3]
-labels = ["double buffering", "triple buffering"]
-[[sweep]]
-key = "workload.gpu"
-values = ["10ms", "20ms"]
-"#,
-    );
-    let pts = expand_points(&exp);
-    // The CSV's and the report's label keeps the values ...
-    assert_eq!(pts[3].label(), "display.buffers=3, workload.gpu=20ms");
-    // ... plots show the labels where the file gave them, values elsewhere.
-    assert_eq!(
-        pts[3].plot_label(&exp.sweeps),
-        "display.buffers=triple buffering, workload.gpu=20ms"
-    );
-    assert_eq!(
-        pts[0].plot_assignment(&exp.sweeps, 0),
-        "display.buffers=double buffering"
-    );
-    assert_eq!(
-        expand_points(&parse("name = \"x\"\n"))[0].plot_label(&[]),
-        "(single point)"
-    );
-}
-
-#[test]
 fn range_formatting() {
     let exp = parse(BASIC);
     let vals: Vec<String> = exp.sweeps[0].values.iter().map(value_text).collect();
@@ -623,139 +591,6 @@ rel_tolerance = 0.01
 }
 
 #[test]
-fn line_plot_where_selects_points() {
-    let text = format!(
-        "{BASIC}\n[[plot]]\nfile = \"two\"\nkind = \"line\"\nx = \"workload.gpu\"\n\
-         y = \"metrics.display_interval_ms.mean\"\nwhere = {{ \"display.buffers\" = 3 }}\n"
-    );
-    let exp = parse(&text);
-    let PlotKind::Line { filter, .. } = &exp.plots[1].kind else {
-        panic!("not a line plot")
-    };
-    assert_eq!(filter.len(), 1);
-    let dir = tempfile::tempdir().unwrap();
-    run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap();
-    let svg = read(dir.path(), "two.svg");
-    // One series (buffers = 3), named after the metric, not the filtered key.
-    assert!(!svg.contains("display.buffers=2"), "{svg}");
-    assert!(read(dir.path(), "interval.svg").contains("display.buffers=2"));
-    assert!(dir.path().join("two.png").exists());
-
-    let bad = format!(
-        "{BASIC}\n[[plot]]\nfile = \"bad\"\nkind = \"line\"\nx = \"workload.gpu\"\n\
-         y = \"metrics.display_interval_ms.mean\"\nwhere = {{ \"workload.gpu\" = \"10ms\" }}\n"
-    );
-    assert!(parse_err(&bad).contains("must not fix the x axis key"));
-    let bad = format!(
-        "{BASIC}\n[[plot]]\nfile = \"bad\"\nkind = \"line\"\nx = \"workload.gpu\"\n\
-         y = \"metrics.display_interval_ms.mean\"\nwhere = {{ \"display.buffers\" = 4 }}\n"
-    );
-    assert!(parse_err(&bad).contains("not one of the swept values"));
-}
-
-#[test]
-fn histogram_marks_are_parsed_and_validated() {
-    let plot = |kind: &str, extra: &str| {
-        format!(
-            "name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"{kind}\"\ncolumn = \"FrameTime\"\nx = \"a\"\ny = \"b\"\n{extra}"
-        )
-    };
-    let exp = parse(&plot(
-        "histogram",
-        "marks = [{ at = 337, label = \"paper: best\" }, { at = 390.5, label = \"worst\" }]\n",
-    ));
-    let PlotKind::Histogram { marks, .. } = &exp.plots[0].kind else {
-        panic!("a histogram")
-    };
-    assert_eq!(
-        marks.iter().map(|m| (m.at, m.label.as_str())).collect::<Vec<_>>(),
-        [(337.0, "paper: best"), (390.5, "worst")]
-    );
-    for (kind, bad, want) in [
-        ("histogram", "marks = [{ at = nan, label = \"x\" }]\n", "marks.0.at"),
-        ("histogram", "marks = [{ at = 1, label = \"\" }]\n", "marks.0.label"),
-        ("histogram", "marks = [{ at = 1 }]\n", "label"),
-        (
-            "histogram",
-            "marks = [{ at = 1, label = \"x\", colour = 1 }]\n",
-            "colour",
-        ),
-    ] {
-        let e = parse_err(&plot(kind, bad));
-        assert!(e.contains(want), "{bad}: {e}");
-    }
-    let e = parse_err(
-        "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[plot]]\nfile = \"l\"\nkind = \"line\"\nx = \"a\"\ny = \"metrics.frame_time_ms.mean\"\nmarks = [{ at = 1, label = \"x\" }]\n",
-    );
-    assert!(e.contains("only histogram plots take `marks`"), "{e}");
-}
-
-#[test]
-fn histogram_range_is_parsed_and_validated() {
-    let hist = |extra: &str| {
-        format!("name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"FrameTime\"\n{extra}")
-    };
-    // Integers are fine; no range means the bins span the data.
-    let exp = parse(&hist("range = [11, 14.5]\n"));
-    assert!(matches!(
-        exp.plots[0].kind,
-        PlotKind::Histogram {
-            range: Some((11.0, 14.5)),
-            ..
-        }
-    ));
-    let exp = parse(&hist(""));
-    assert!(matches!(exp.plots[0].kind, PlotKind::Histogram { range: None, .. }));
-    for (bad, want) in [
-        ("range = [3, 3]\n", "needs lo < hi, got [3, 3]"),
-        ("range = [5.0, 1.0]\n", "needs lo < hi"),
-        ("range = [1.0]\n", "must be [lo, hi] (two numbers), got 1 value(s)"),
-        ("range = [1, 2, 3]\n", "got 3 value(s)"),
-        ("range = [nan, 2.0]\n", "bounds must be finite"),
-        ("range = [0.0, inf]\n", "bounds must be finite"),
-    ] {
-        let e = parse_err(&hist(bad));
-        assert!(
-            e.contains("experiments/bad.toml") && e.contains("plot[0] (h).range") && e.contains(want),
-            "{bad}: {e}"
-        );
-    }
-    let e = parse_err(&hist("range = [\"a\", \"b\"]\n"));
-    assert!(e.contains("experiments/bad.toml") && e.contains("range"), "{e}");
-    let e = parse_err(
-        "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[plot]]\nfile = \"p\"\nkind = \"line\"\nx = \"a\"\ny = \"m\"\nrange = [0, 1]\n",
-    );
-    assert!(
-        e.contains("plot[0] (p).range") && e.contains("only histogram plots take `range`"),
-        "{e}"
-    );
-}
-
-#[test]
-fn histogram_range_counts_values_outside_in_the_report() {
-    let text = FIDELITY.replace("bins = 20\n", "bins = 20\nrange = [12, 25]\n");
-    let exp = parse(&text);
-    let dir = tempfile::tempdir().unwrap();
-    let res = run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap();
-    // Frames are gpu + (i % 10) for 100 frames and 2 seeds: at 10ms, 10 and 11
-    // fall below 12 (40 values); at 20ms, 26..29 lie above 25 (80 values).
-    let captions: Vec<&str> = res.plot_captions.iter().map(|c| c.1.as_str()).collect();
-    assert_eq!(captions.len(), 2, "{captions:?}");
-    assert!(res.plot_captions.iter().all(|c| c.0 == "frames"));
-    assert!(
-        captions[0].starts_with("x range [12, 25]: 40 value(s) below and 0 above of 200 not shown (")
-            && captions[0].contains("10ms"),
-        "{captions:?}"
-    );
-    assert!(captions[1].contains("0 value(s) below and 80 above") && captions[1].contains("20ms"));
-    let report = read(dir.path(), "report.md");
-    assert!(report.contains(&format!("Note: {}.", captions[0])), "{report}");
-    // Without a range there are no captions.
-    let res = run_experiment(&parse(FIDELITY), &base_model(), &Fake::default(), dir.path(), false).unwrap();
-    assert!(res.plot_captions.is_empty());
-}
-
-#[test]
 fn claims_are_verdicts_not_failures() {
     let exp = parse(
         r#"
@@ -847,31 +682,6 @@ tolerance = 0
 }
 
 #[test]
-fn array_sweep_values_label_the_x_axis() {
-    let exp = parse(
-        r#"
-name = "arrays"
-[[sweep]]
-key = "resolution"
-values = [[1024, 768], [1280, 1024]]
-[[metric]]
-path = "metrics.display_interval_ms.mean"
-[[plot]]
-file = "res"
-kind = "line"
-x = "resolution"
-y = "metrics.display_interval_ms.mean"
-"#,
-    );
-    assert!(exp.sweeps[0].categorical);
-    assert_eq!(exp.sweeps[0].coords, vec![0.0, 1.0]);
-    let dir = tempfile::tempdir().unwrap();
-    run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap();
-    let svg = read(dir.path(), "res.svg");
-    assert!(svg.contains("[1024, 768]") && svg.contains("[1280, 1024]"), "{svg}");
-}
-
-#[test]
 fn bad_labels_bounds_and_claims() {
     let e = parse_err("name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\nlabels = [\"one\"]\n");
     assert!(
@@ -891,4 +701,5 @@ fn bad_labels_bounds_and_claims() {
 }
 
 // Sampled experiments ([sample]): tests/sample.rs.
+mod plots;
 mod sample;
