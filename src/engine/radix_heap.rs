@@ -237,11 +237,11 @@ impl<E> RadixHeap<E> {
     #[inline(never)]
     fn grow_bucket(&mut self, i: usize) {
         let b = &mut self.buckets[i];
-        if b.capacity() == 0 {
-            if let Some(v) = self.spare.pop() {
-                *b = v;
-                return;
-            }
+        if b.capacity() == 0
+            && let Some(v) = self.spare.pop()
+        {
+            *b = v;
+            return;
         }
         b.reserve(b.capacity().max(4));
     }
