@@ -22,6 +22,7 @@ enum Op {
 }
 
 impl FramePipeline {
+    #[inline]
     fn op_at(&self, op: u32) -> Op {
         match op {
             0 => Op::Input,
@@ -29,13 +30,9 @@ impl FramePipeline {
             2 => Op::Clear,
             _ => {
                 let k = op - 3;
-                let body = match &self.program {
-                    Program::Fixed { .. } => 1,
-                    Program::Scene(s) => s.draws.len() as u32,
-                };
-                match (&self.program, k < body) {
-                    (Program::Fixed { .. }, true) => Op::Fixed,
-                    (Program::Scene(_), true) => Op::Draw(k),
+                match (self.scene_body, k < self.body_ops) {
+                    (false, true) => Op::Fixed,
+                    (true, true) => Op::Draw(k),
                     (_, false) => Op::Swap,
                 }
             }
@@ -95,6 +92,7 @@ impl FramePipeline {
     #[inline]
     fn push_phase(&mut self, c: Command) -> CpuPhase {
         self.cpu_cmd = c;
+        self.cpu_cmd_weight = self.command_weight(&c);
         CpuPhase::Push
     }
 
@@ -150,6 +148,9 @@ impl FramePipeline {
             CpuPhase::WaitFrames if self.frames_ahead_full() => {
                 return Ok(false);
             }
+            // Blocked on a full FIFO (or a rendezvous not yet taken).
+            CpuPhase::Push if !self.fifo.can_push(self.cpu_cmd_weight) => return Ok(false),
+            CpuPhase::Rendezvous if self.fifo.over_capacity() => return Ok(false),
             _ => {}
         }
         self.cpu_step_from_rest(now, s)
@@ -209,7 +210,7 @@ impl FramePipeline {
                 }
                 CpuPhase::Push => {
                     let c = self.cpu_cmd;
-                    let w = self.command_weight(&c);
+                    let w = self.cpu_cmd_weight;
                     if !self.fifo.can_push(w) {
                         return Ok(progressed);
                     }

@@ -202,6 +202,14 @@ pub struct FramePipeline {
     pub(super) cpu_phase: CpuPhase,
     /// The command of [`CpuPhase::Push`].
     pub(super) cpu_cmd: Command,
+    /// Its weight in the FIFO's unit (so a push blocked on a full FIFO is
+    /// found without a call).
+    pub(super) cpu_cmd_weight: u64,
+    /// Operations between the clear and the swap: the scene's draws, or the
+    /// one fixed GPU command.
+    pub(super) body_ops: u32,
+    /// Whether those are a scene's draws (else the fixed command).
+    pub(super) scene_body: bool,
     pub(super) cpu_frame: u64,
     pub(super) cpu_op: u32,
     pub(super) non_render_rng: StreamRng,
@@ -357,6 +365,10 @@ impl FramePipeline {
         };
         let fifo_cap = cfg.command_fifo.capacity;
         let frames_total = cfg.run.frames;
+        let (body_ops, scene_body) = match &program {
+            Program::Fixed { .. } => (1, false),
+            Program::Scene(s) => (s.draws.len() as u32, true),
+        };
         Ok(FramePipeline {
             refresh: cfg.display.refresh.period,
             chain: SwapChain::new(cfg.display.buffers, mode),
@@ -383,6 +395,9 @@ impl FramePipeline {
             cpu: Preemptible::new(),
             cpu_phase: CpuPhase::NextFrame,
             cpu_cmd: Command::Clear { frame: 0 },
+            cpu_cmd_weight: 1,
+            body_ops,
+            scene_body,
             cpu_frame: 0,
             cpu_op: 0,
             fifo: BoundedFifo::new(fifo_cap),
