@@ -220,9 +220,11 @@ fn vertex_cache_changes_geometry_time_by_actually_transformed_vertices() {
 
 /// A traced run accounts every instant in full; an untraced one takes the
 /// short cuts (a quiet front-end completion's accounting, a CPU step that
-/// skips `settle` and `account`): both must give the same results, also
-/// with system tasks preempting the front end (stale quiet completions) and
-/// a command FIFO small enough to block the CPU.
+/// skips `settle` and `account`, a draw's end that accounts only the units
+/// that can have moved): both must give the same results, also with system
+/// tasks preempting the front end (stale quiet completions), a command FIFO
+/// small enough to block the CPU (or a rendezvous), one frame in flight,
+/// vsync off and mailbox presentation.
 #[test]
 fn tracing_does_not_change_results_at_either_fidelity() {
     use rendersim::config::ModelSource;
@@ -233,12 +235,21 @@ fn tracing_does_not_change_results_at_either_fidelity() {
         "noise.random.0.rate=\"300Hz\"",
         "command_fifo.capacity=8",
     ];
+    let draw_variants: &[&[&str]] = &[
+        &["cpu.max_frames_ahead=1"],
+        &["command_fifo.capacity=0"],
+        &["command_fifo.capacity=1", "display.vsync=false"],
+        &["display.present_mode=\"mailbox\"", "display.buffers=3"],
+    ];
     for (fid, extra) in [
         ("triangle", &[][..]),
         ("draw", &[][..]),
         ("draw", stressed),
         ("triangle", &stressed[3..]),
-    ] {
+    ]
+    .into_iter()
+    .chain(draw_variants.iter().map(|v| ("draw", *v)))
+    {
         let src = ModelSource::from_text("d.toml", DEFAULT);
         let mut t = src.table().unwrap();
         for s in [

@@ -169,6 +169,12 @@ pub struct Accounting {
 }
 
 impl Accounting {
+    /// The CPU's frame as of the last accounted instant.
+    #[inline]
+    pub fn cpu_frame(&self) -> u64 {
+        self.cpu_frame
+    }
+
     /// Fresh clocks (everything idle at time zero); `pacing`: the refresh
     /// period when frames are shown at vertical blanks.
     pub fn new(trace: Option<TraceWriter>, pacing: Option<Duration>) -> Self {
@@ -208,6 +214,19 @@ fn set_traced<const N: usize>(
         t.state(track, old, since, now, frame);
     }
     (old, spent.0)
+}
+
+/// Adds `spent` picoseconds in CPU state `old` to frame `frame`'s busy or
+/// waiting time.
+#[inline]
+fn attribute_cpu(records: &mut [FrameRecord], old: usize, spent: u64, frame: u64) {
+    if let Some(r) = records.get_mut(frame as usize) {
+        match old {
+            0 | 1 => r.cpu_busy += spent,
+            2 | 3 => r.cpu_wait += spent,
+            _ => {}
+        }
+    }
 }
 
 /// The CPU state (index into [`CPU_STATES`]) of a phase outside system tasks.
@@ -360,15 +379,6 @@ impl FramePipeline {
         let [cpu_state, front_state, geom_state, frag_state, gpu_state] = states;
         let a = &mut self.acct;
         let records = &mut self.records;
-        let attribute_cpu = |records: &mut Vec<FrameRecord>, old: usize, spent: u64, frame: u64| {
-            if let Some(r) = records.get_mut(frame as usize) {
-                match old {
-                    0 | 1 => r.cpu_busy += spent,
-                    2 | 3 => r.cpu_wait += spent,
-                    _ => {}
-                }
-            }
-        };
         // CPU: attribute the closing interval to the frame it belonged to.
         let old = a.cpu.state();
         let spent = a.cpu.set(now, cpu_state).0;
@@ -403,15 +413,10 @@ impl FramePipeline {
         }
     }
 
-    /// Each unit's mode for the critical path (see [`super::critical_path`]).
-    fn path_modes(&self) -> Modes {
-        let cpu = match self.cpu_phase {
-            CpuPhase::WaitFrames | CpuPhase::Push | CpuPhase::Rendezvous => Mode::wait(Unit::Front),
-            CpuPhase::Finished => Mode::wait(Unit::Display),
-            _ if self.cpu.in_system() => Mode::work(Blame::System),
-            _ => Mode::work(Blame::Cpu),
-        };
-        let front = match self.front_phase {
+    /// The front end's mode for the critical path.
+    #[inline]
+    fn front_mode(&self) -> Mode {
+        match self.front_phase {
             FrontPhase::Running if self.front.in_system() => Mode::work(Blame::System),
             FrontPhase::Running => Mode::work(Blame::FrontEnd),
             FrontPhase::Idle => Mode::wait(Unit::Cpu),
@@ -420,7 +425,66 @@ impl FramePipeline {
             // Binning: no draw in geometry, the bins still being shaded.
             FrontPhase::Handoff if self.geom_draw.is_none() => Mode::wait(Unit::Fragment),
             FrontPhase::Handoff => Mode::wait(Unit::Geometry),
+        }
+    }
+
+    /// [`FramePipeline::account`] after a draw ended, the next began and
+    /// `settle` ran ([`FramePipeline::draw_done_alone`]), when neither the
+    /// CPU's frame nor the GPU's changed: the geometry and fragment stages
+    /// and the GPU are busy as they were (with the draw that ended, now with
+    /// the one that began), so of `account`'s clock moves only the CPU's and
+    /// the front end's can do anything, and of the critical path only the
+    /// CPU's and the front end's modes and the two stages' (the new draw's
+    /// limiting stage) can change. Their old modes make carrying them to
+    /// `now` one at a time, in this order, give what carrying them all under
+    /// the old modes gives: the front end waited for geometry (it held a
+    /// draw), and the stages worked, charged to themselves.
+    pub(super) fn account_draw_handoff(&mut self, now: Time) {
+        debug_assert!(self.acct.trace.is_none() && !self.front.in_system());
+        debug_assert_eq!(self.acct.geom.state(), 0);
+        debug_assert_eq!(self.acct.frag.state(), 0);
+        debug_assert_eq!(self.acct.gpu.state(), 0);
+        debug_assert_eq!(self.acct.cpu_frame, self.cpu_frame);
+        debug_assert!(self.draw_fragment_limited.is_some() && self.geom_busy && self.frag_busy);
+        let cpu_state = if self.cpu.in_system() {
+            1
+        } else {
+            cpu_state_of(self.cpu_phase)
         };
+        let front_state = front_state_of(self.front_phase);
+        let stages = match self.draw_fragment_limited {
+            Some(true) => Mode::work(Blame::Fragment),
+            _ => Mode::work(Blame::Geometry),
+        };
+        let (cpu_mode, front_mode) = (self.cpu_mode(), self.front_mode());
+        let a = &mut self.acct;
+        let old = a.cpu.state();
+        let spent = a.cpu.set(now, cpu_state).0;
+        if spent > 0 {
+            attribute_cpu(&mut self.records, old, spent, a.cpu_frame);
+        }
+        a.front.set(now, front_state);
+        a.path.set_mode(Unit::Cpu, cpu_mode, now);
+        a.path.set_mode(Unit::Front, front_mode, now);
+        a.path.set_mode(Unit::Geometry, stages, now);
+        a.path.set_mode(Unit::Fragment, stages, now);
+    }
+
+    /// The CPU's mode for the critical path.
+    #[inline]
+    fn cpu_mode(&self) -> Mode {
+        match self.cpu_phase {
+            CpuPhase::WaitFrames | CpuPhase::Push | CpuPhase::Rendezvous => Mode::wait(Unit::Front),
+            CpuPhase::Finished => Mode::wait(Unit::Display),
+            _ if self.cpu.in_system() => Mode::work(Blame::System),
+            _ => Mode::work(Blame::Cpu),
+        }
+    }
+
+    /// Each unit's mode for the critical path (see [`super::critical_path`]).
+    fn path_modes(&self) -> Modes {
+        let cpu = self.cpu_mode();
+        let front = self.front_mode();
         let (geometry, fragment) = match self.draw_fragment_limited {
             // `draw` fidelity: the running draw is the limiting stage's.
             Some(true) => (Mode::work(Blame::Fragment), Mode::work(Blame::Fragment)),

@@ -556,7 +556,7 @@ impl FramePipeline {
     /// the front end changes (FIFO space, completed frames). So once the front
     /// end made no progress after a CPU step, another round would change
     /// nothing: the loop ends there.
-    fn settle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+    pub(super) fn settle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         loop {
             self.cpu_step(now, s)?;
             if !self.front_step(now, s)? {
@@ -641,7 +641,12 @@ impl Model for FramePipeline {
             }
             Ev::DrawGeometry => self.geom_busy = false,
             Ev::DrawFragmentStart => self.frag_busy = true,
-            Ev::DrawDone => self.draw_done(now),
+            Ev::DrawDone => {
+                self.draw_done(now);
+                if self.draw_done_alone(now, s)? {
+                    return Ok(if self.done() { Control::Stop } else { Control::Continue });
+                }
+            }
             Ev::Vblank => self.vblank(now, s)?,
             Ev::NoiseArrive { source } => self.noise_arrive(now, source, s)?,
             Ev::NoiseEnd { target } => self.noise_end(now, target, s)?,

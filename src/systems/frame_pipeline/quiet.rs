@@ -78,4 +78,35 @@ impl FramePipeline {
         self.acct.path.set_mode(Unit::Front, Mode::wait(Unit::Geometry), at);
         Ok(())
     }
+
+    /// `draw` fidelity without a trace, called when a draw ended (after
+    /// [`FramePipeline::draw_done`]) while the front end holds the next draw
+    /// (a hand-off): `settle` takes every step as for any event, and when
+    /// neither the CPU's frame nor the GPU's changed, the instant's
+    /// accounting is [`FramePipeline::account_draw_handoff`] (the units
+    /// that can have moved), else `account` in full. Returns false, having
+    /// changed nothing, when the front end holds no draw, a system task
+    /// holds it, the draw's fragments are binned, or a trace is written.
+    #[inline]
+    pub(super) fn draw_done_alone(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
+        if self.front_phase != FrontPhase::Handoff
+            || self.acct.trace.is_some()
+            || self.front.in_system()
+            || self.cfg.gpu.fragment.binned()
+        {
+            return Ok(false);
+        }
+        let gpu_frame = self.gpu_frame;
+        self.settle(now, s)?;
+        if self.gpu_frame == gpu_frame
+            && self.geom_busy
+            && self.cpu_frame == self.acct.cpu_frame()
+            && !self.front.in_system()
+        {
+            self.account_draw_handoff(now);
+        } else {
+            self.account(now);
+        }
+        Ok(true)
+    }
 }
