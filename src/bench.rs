@@ -146,7 +146,23 @@ pub fn kernel_case(work: KernelWork, population: usize, events: u64) -> KernelBe
     let population = population.max(1);
     let engine = engine_rate(work, population, events, QueueKind::Radix);
     let engine_binary = engine_rate(work, population, events, QueueKind::Binary);
-    // Bare loop: the same work on a BinaryHeap of (time, seq).
+    let bare = bare_rate(work, population, events);
+    KernelBench {
+        work,
+        population,
+        events,
+        engine_events_per_s: engine,
+        engine_binary_events_per_s: engine_binary,
+        bare_events_per_s: bare,
+        ratio: engine / bare,
+    }
+}
+
+/// Events per second of the bare loop: `work` on a `BinaryHeap` of
+/// `(time, seq)` with `population` pending, `events` handled (the kernel
+/// benchmark's baseline, and the hour's yardstick of the machine's speed).
+pub fn bare_rate(work: KernelWork, population: usize, events: u64) -> f64 {
+    let population = population.max(1);
     let streams = RngStreams::new(7);
     let mut heap: BinaryHeap<Reverse<(u64, u64)>> = BinaryHeap::with_capacity(64);
     let mut init = streams.stream("init");
@@ -167,16 +183,7 @@ pub fn kernel_case(work: KernelWork, population: usize, events: u64) -> KernelBe
     }
     let bare_s = t.elapsed().as_secs_f64();
     std::hint::black_box(last);
-    let bare = events as f64 / bare_s;
-    KernelBench {
-        work,
-        population,
-        events,
-        engine_events_per_s: engine,
-        engine_binary_events_per_s: engine_binary,
-        bare_events_per_s: bare,
-        ratio: engine / bare,
-    }
+    events as f64 / bare_s
 }
 
 /// The hold model with `population` pending events (see [`kernel_case`]).
@@ -465,19 +472,35 @@ pub struct HourBench {
     pub events: u64,
     /// The run's own events per second (its event loop).
     pub events_per_second: f64,
+    /// The machine's speed beside it: the bare `BinaryHeap` hold loop at
+    /// 1,000 pending ([`bare_rate`]), events per second, the mean of one
+    /// measurement just before the run and one just after (the speed of
+    /// this build machine moves by half within minutes as other work
+    /// shares its host).
+    pub yardstick_events_per_s: f64,
+    /// The run's wall time in yardstick events (millions): wall seconds
+    /// times the yardstick's rate, which stays put when the whole machine
+    /// is slower or faster.
+    pub yardstick_m_events: f64,
 }
 
 /// The hour benchmark at `scale`: 216,000 frames (an hour at 60 Hz) at 1.
 pub fn hour_bench(scale: f64) -> Result<HourBench, BenchError> {
     let frames = (216_000.0 * scale) as u64;
     let f = format!("run.frames={frames}");
+    let yardstick_events = ((5_000_000.0 * scale) as u64).max(200_000);
+    let before = bare_rate(KernelWork::Hold, 1_000, yardstick_events);
     let (s, wall_s) = run_default_with(&["fidelity=\"draw\"", f.as_str()])?;
+    let after = bare_rate(KernelWork::Hold, 1_000, yardstick_events);
+    let yardstick = 0.5 * (before + after);
     Ok(HourBench {
         frames,
         simulated_seconds: s["simulated_seconds"].as_f64().unwrap_or(0.0),
         wall_s,
         events: s["events"]["total"].as_u64().unwrap_or(0),
         events_per_second: s["events_per_second"].as_f64().unwrap_or(0.0),
+        yardstick_events_per_s: yardstick,
+        yardstick_m_events: wall_s * yardstick / 1e6,
     })
 }
 

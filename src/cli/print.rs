@@ -53,12 +53,14 @@ pub fn pipeline_bench(p: &PipelineBench) -> String {
 /// The hour benchmark's line.
 pub fn hour_bench(h: &HourBench) -> String {
     format!(
-        "one {:.0}-second run of the default model at draw fidelity ({} frames, noise on): {:.3} s wall, {} events ({:.2} M events/s)",
+        "one {:.0}-second run of the default model at draw fidelity ({} frames, noise on): {:.3} s wall, {} events ({:.2} M events/s); yardstick beside it (bare BinaryHeap hold loop, 1,000 pending): {:.2} M events/s, so the run took as long as {:.1} M yardstick events",
         h.simulated_seconds,
         h.frames,
         h.wall_s,
         h.events,
-        h.events_per_second / 1e6
+        h.events_per_second / 1e6,
+        h.yardstick_events_per_s / 1e6,
+        h.yardstick_m_events
     )
 }
 

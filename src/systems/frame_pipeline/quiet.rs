@@ -19,6 +19,14 @@
 //! (`events.by_kind.gpu_front_end`), and has one event fewer to queue, pop
 //! and settle per quiet draw. At `triangle` fidelity the geometry stage's
 //! end is not known in advance, so every completion is an event.
+//!
+//! The same stretch's other common instant, a draw's end while the front
+//! end holds the next draw, is an event as always, but its accounting
+//! touches only the units that can have moved
+//! ([`FramePipeline::draw_done_alone`]): the geometry and fragment stages go
+//! from one draw to the next without a change of state, so only the CPU's
+//! and the front end's clocks and the critical-path modes of the CPU, the
+//! front end and the two stages are carried forward.
 
 use crate::engine::{Scheduler, Time};
 use crate::systems::error::SystemError;
