@@ -470,6 +470,28 @@ impl FramePipeline {
         a.path.set_mode(Unit::Fragment, stages, now);
     }
 
+    /// [`FramePipeline::account`] when only the CPU moved at this instant
+    /// and stayed on its frame ([`FramePipeline::cpu_step_alone`]): its
+    /// clock (the closing interval credited to the frame) and its
+    /// critical-path mode are all that can change.
+    pub(super) fn account_cpu_alone(&mut self, now: Time) {
+        debug_assert!(self.acct.trace.is_none());
+        debug_assert_eq!(self.acct.cpu_frame, self.cpu_frame);
+        let cpu_state = if self.cpu.in_system() {
+            1
+        } else {
+            cpu_state_of(self.cpu_phase)
+        };
+        let mode = self.cpu_mode();
+        let a = &mut self.acct;
+        let old = a.cpu.state();
+        let spent = a.cpu.set(now, cpu_state).0;
+        if spent > 0 {
+            attribute_cpu(&mut self.records, old, spent, a.cpu_frame);
+        }
+        a.path.set_mode(Unit::Cpu, mode, now);
+    }
+
     /// The CPU's mode for the critical path.
     #[inline]
     fn cpu_mode(&self) -> Mode {

@@ -122,18 +122,31 @@ impl FramePipeline {
     /// `account` can be skipped. That holds when the front end is not
     /// waiting for commands (a push wakes only an idle front end; no other
     /// GPU step depends on the CPU), no trace is written (it records the
-    /// FIFO's level at every event), and the CPU ends up working on the
-    /// same frame (its clock, its frame and its critical-path mode are what
-    /// the last event left; a blocked push or a new frame needs the full
-    /// accounting). Returns false otherwise, with at most the CPU's step
-    /// taken, which `settle` then repeats as a no-op before the front end's.
+    /// FIFO's level at every event), and the CPU ends up on the same frame
+    /// either working (its clock, frame and critical-path mode are what the
+    /// last event left) or blocked on a full command FIFO (then only its
+    /// own clock and mode move, [`FramePipeline::account_cpu_alone`]; in a
+    /// GPU-bound stretch that is about a quarter of the operations). A new
+    /// frame or a rendezvous needs the full accounting. Returns false
+    /// otherwise, with at most the CPU's step taken, which `settle` then
+    /// repeats as a no-op before the front end's.
     pub(super) fn cpu_step_alone(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         if self.front_phase == FrontPhase::Idle || self.acct.trace.is_some() {
             return Ok(false);
         }
         let frame = self.cpu_frame;
         self.cpu_step(now, s)?;
-        Ok(self.cpu_phase == CpuPhase::Running && self.cpu_frame == frame)
+        if self.cpu_frame != frame {
+            return Ok(false);
+        }
+        match self.cpu_phase {
+            CpuPhase::Running => Ok(true),
+            CpuPhase::Push => {
+                self.account_cpu_alone(now);
+                Ok(true)
+            }
+            _ => Ok(false),
+        }
     }
 
     /// Advances the CPU thread as far as it can go now. Returns whether
