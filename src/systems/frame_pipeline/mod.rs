@@ -14,7 +14,9 @@
 //! - `records`: per-frame records and the PresentMon-style table;
 //! - `report`: the human-readable report of a run;
 //! - `timeline`: the picture of paper 000 Figure 4, from the run's trace;
-//! - `run`: validate, build, run, summarize;
+//! - `run`: build and run a model;
+//! - `validate`: what a model is refused for before it runs;
+//! - `summary`: the run's summary (`summary.json`);
 //! - `table1`: paper 000 Table 1's four cells, three calibrated and one
 //!   predicted, for a geometry share of the first cell (§4.5.1).
 
@@ -31,11 +33,14 @@ mod quiet;
 pub mod records;
 pub mod report;
 pub mod run;
+pub mod summary;
 pub mod system;
 pub mod table1;
 pub mod timeline;
+pub mod validate;
 pub mod workload;
 
 pub use config::{Fidelity, FramePipelineConfig};
 pub use model::FramePipeline;
-pub use run::{PipelineRun, run_pipeline, validate};
+pub use run::{PipelineRun, run_pipeline};
+pub use validate::validate;

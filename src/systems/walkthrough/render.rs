@@ -19,7 +19,8 @@ use crate::engine::{Duration, RngStreams, StreamRng};
 use crate::scene::config::{SceneWorkload, StateOrder, View};
 use crate::systems::error::SystemError;
 use crate::systems::frame_pipeline::config::{FramePipelineConfig, RunConfig, WorkloadConfig};
-use crate::systems::frame_pipeline::run::{simulate_program, validate};
+use crate::systems::frame_pipeline::run::simulate_program;
+use crate::systems::frame_pipeline::validate::validate;
 use crate::systems::frame_pipeline::workload::{
     GroupInfo, Instance, MeshInfo, Misses, WorkloadError, build_program, early_z_pass, fragment_costs, timed_mesh,
 };

@@ -1,0 +1,312 @@
+//! The frame pipeline's summary (`summary.json`): the expected per-frame
+//! terms of paper 000 §4.1 beside the simulated metrics, each unit's time
+//! per state, the commands, the bottleneck shares along the critical path.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+use serde_json::Value;
+
+use crate::engine::{PS_PER_MS, RunStats, StopReason};
+
+use super::accounting::{BOTTLENECKS, CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES};
+use super::config::{FramePipelineConfig, WorkloadConfig};
+use super::model::FramePipeline;
+use super::records::frame_rows;
+use super::workload::SceneProgram;
+use crate::systems::summary::{Dist, EventCounts, events_per_second};
+
+/// Replaces every -0.0 in `v` by 0.0 (an empty sum of floats is -0.0, and
+/// "-0" in an output reads like a negative time).
+pub(super) fn positive_zeros(v: &mut Value) {
+    match v {
+        Value::Number(n) if n.as_f64() == Some(0.0) && n.as_f64().is_some_and(|x| x.is_sign_negative()) => {
+            *v = Value::from(0.0);
+        }
+        Value::Object(m) => m.values_mut().for_each(positive_zeros),
+        Value::Array(a) => a.iter_mut().for_each(positive_zeros),
+        _ => {}
+    }
+}
+
+pub(super) fn ms(ps: u64) -> f64 {
+    ps as f64 / PS_PER_MS as f64
+}
+
+/// Expected per-frame terms of paper 000 §4.1: ET_cpu, and ET_gpu split into
+/// front end, geometry and fragment. `gpu_max_ms` = max of the three (the
+/// front end overlaps the stages: it prepares the next draw while they work),
+/// a lower bound of the GPU time when the GPU never starves; `gpu_sum_ms` =
+/// their sum, the time with no overlap at all (§4.5.1's "sum" estimate).
+pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProgram>) -> AnalyticTerms {
+    let c = &cfg.cpu;
+    // In f64: sums of huge costs must not wrap before the range check.
+    let base_cpu = c.input_sampling.0 as f64 + c.clear.0 as f64 + c.swap.0 as f64 + c.non_render.mean();
+    let base_front = cfg.gpu.clear.0 as f64 + cfg.gpu.swap.0 as f64 + 2.0 * cfg.gpu.command.0 as f64;
+    let (cpu, front, geo, frag) = match (&cfg.workload, scene) {
+        (WorkloadConfig::Fixed(f), _) => (
+            base_cpu + f.cpu.mean(),
+            base_front + f.gpu.mean() + cfg.gpu.command.0 as f64,
+            0.0,
+            0.0,
+        ),
+        (WorkloadConfig::Scene(_), Some(s)) => {
+            let cpu: f64 = s.draws.iter().map(|d| d.cpu.0 as f64).sum();
+            let front: f64 = s.draws.iter().map(|d| d.front.0 as f64).sum();
+            let geo: f64 = s
+                .draws
+                .iter()
+                .map(|d| s.meshes[d.mesh as usize].geometry_time.0 as f64)
+                .sum();
+            let frag: f64 = s
+                .draws
+                .iter()
+                .map(|d| {
+                    let g = &s.groups[d.group as usize];
+                    s.meshes[d.mesh as usize].triangles as f64 * g.pixels.mean() * g.cost_per_pixel()
+                })
+                .sum();
+            (base_cpu + cpu, base_front + front, geo, frag)
+        }
+        _ => (base_cpu, base_front, 0.0, 0.0),
+    };
+    let p = PS_PER_MS as f64;
+    AnalyticTerms {
+        cpu_ms: cpu / p,
+        gpu_front_end_ms: front / p,
+        geometry_ms: geo / p,
+        fragment_ms: frag / p,
+        gpu_max_ms: front.max(geo).max(frag) / p,
+        gpu_sum_ms: (front + geo + frag) / p,
+        frame_max_ms: cpu.max(front.max(geo).max(frag)) / p,
+        frame_sum_ms: cpu.max(front + geo + frag) / p,
+    }
+}
+
+/// The closed-form frame terms from the expected costs (no queueing),
+/// milliseconds: what a frame costs each unit, and the two classic readings
+/// of the frame time (the slowest unit; the GPU's units in series).
+#[derive(Debug, Clone, Serialize)]
+pub struct AnalyticTerms {
+    /// CPU work per frame.
+    pub cpu_ms: f64,
+    /// GPU front end per frame.
+    pub gpu_front_end_ms: f64,
+    /// Geometry per frame.
+    pub geometry_ms: f64,
+    /// Fragment per frame.
+    pub fragment_ms: f64,
+    /// The slowest GPU unit.
+    pub gpu_max_ms: f64,
+    /// The GPU's units added up.
+    pub gpu_sum_ms: f64,
+    /// The slowest unit, CPU included.
+    pub frame_max_ms: f64,
+    /// The CPU or the GPU's sum, whichever is larger.
+    pub frame_sum_ms: f64,
+}
+
+/// Time per state of each unit, milliseconds (state names as in the trace).
+#[derive(Debug, Clone, Serialize)]
+pub struct StatesMs {
+    /// The CPU.
+    pub cpu: BTreeMap<String, f64>,
+    /// The GPU front end.
+    pub gpu_front_end: BTreeMap<String, f64>,
+    /// Geometry.
+    pub geometry: BTreeMap<String, f64>,
+    /// Fragment.
+    pub fragment: BTreeMap<String, f64>,
+    /// The GPU as a whole: busy when any unit is.
+    pub gpu: BTreeMap<String, f64>,
+}
+
+/// Commands through the CPU -> GPU FIFO.
+#[derive(Debug, Clone, Serialize)]
+pub struct CommandCounts {
+    /// Put into the FIFO by the CPU.
+    pub issued: u64,
+    /// Finished by the GPU front end.
+    pub executed: u64,
+    /// Most FIFO entries in use at once.
+    pub fifo_max_used: u64,
+}
+
+/// `metrics` of a frame-pipeline summary (frames after the warm-up).
+#[derive(Debug, Clone, Serialize)]
+pub struct PipelineMetrics {
+    /// Time between a frame's CPU start and the next frame's.
+    pub frame_time_ms: Dist,
+    /// Time between displayed frames (PresentMon's MsBetweenDisplayChange).
+    pub display_interval_ms: Dist,
+    /// Present to display.
+    pub display_latency_ms: Dist,
+    /// CPU start to display.
+    pub until_displayed_ms: Dist,
+    /// GPU time per frame (first to last GPU work).
+    pub gpu_time_ms: Dist,
+    /// CPU busy per frame.
+    pub cpu_busy_ms: Dist,
+    /// GPU busy per frame.
+    pub gpu_busy_ms: Dist,
+    /// Share of the run the CPU worked (its own work and system tasks).
+    pub cpu_busy_fraction: f64,
+    /// Share of the run the CPU waited (FIFO full, frames ahead).
+    pub cpu_wait_fraction: f64,
+    /// Share of the run any GPU unit was busy.
+    pub gpu_busy_fraction: f64,
+    /// Share of the run the GPU was idle.
+    pub gpu_idle_fraction: f64,
+    /// Display refreshes after the warm-up.
+    pub refreshes: u64,
+    /// Refreshes that showed the same image again.
+    pub repeated_refreshes: u64,
+    /// `repeated_refreshes / refreshes` (0 without refreshes).
+    pub repeated_refresh_fraction: f64,
+    /// Frames shown.
+    pub displayed_frames: usize,
+    /// Frames replaced before they were shown.
+    pub dropped_frames: usize,
+    /// Share of the run each unit was on the critical path (the time
+    /// shortening its work would save; see `critical_path.rs`).
+    pub bottleneck: BTreeMap<String, f64>,
+    /// Time per state of each unit.
+    pub states_ms: StatesMs,
+    /// Commands through the FIFO.
+    pub commands: CommandCounts,
+    /// The closed-form terms beside the simulation.
+    pub analytic: AnalyticTerms,
+}
+
+/// The summary of a frame-pipeline run (`summary.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct PipelineSummary {
+    /// `"frame_pipeline"`.
+    pub system: &'static str,
+    /// The model's description.
+    pub description: String,
+    /// `triangle`, `draw` or `frame`.
+    pub fidelity: super::config::Fidelity,
+    /// Master seed.
+    pub seed: u64,
+    /// Frames completed (in the per-frame table).
+    pub frames: usize,
+    /// The same as `frames`.
+    pub frames_simulated: usize,
+    /// `run.frames`.
+    pub frames_requested: u64,
+    /// Frames left out of the statistics.
+    pub warmup_frames: u64,
+    /// Kernel events.
+    pub events: EventCounts,
+    /// Wall time: building the scene plus simulating.
+    pub wall_seconds: f64,
+    /// Wall time building the scene.
+    pub build_seconds: f64,
+    /// Wall time simulating.
+    pub simulate_seconds: f64,
+    /// Kernel events per wall second of simulation.
+    pub events_per_second: f64,
+    /// Simulated time at the end.
+    pub simulated_seconds: f64,
+    /// Why the run stopped (`model`: every frame done; `time_limit`,
+    /// `event_limit`, `exhausted`).
+    pub stopped_by: StopReason,
+    /// The results.
+    pub metrics: PipelineMetrics,
+    /// Scene statistics per frame (absent for a fixed workload).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scene: Option<super::workload::SceneStats>,
+}
+
+fn states(names: &[&str], totals: &[u64]) -> BTreeMap<String, f64> {
+    names.iter().zip(totals).map(|(n, t)| (n.to_string(), ms(*t))).collect()
+}
+
+pub(super) fn summarize(
+    m: &FramePipeline,
+    stats: &RunStats,
+    analytic: AnalyticTerms,
+    scene: Option<super::workload::SceneStats>,
+    build_seconds: f64,
+) -> PipelineSummary {
+    let end = stats.end_time;
+    let elapsed = end.0.max(1) as f64;
+    let warm = m.cfg.run.warmup_frames as usize;
+    let rows = frame_rows(&m.records);
+    let col = |i: usize| -> Dist { Dist::of_finite(&rows.iter().skip(warm).map(|r| r[i]).collect::<Vec<f64>>()) };
+    let cpu = m.acct.cpu.totals_at(end);
+    let front = m.acct.front.totals_at(end);
+    let geom = m.acct.geom.totals_at(end);
+    let frag = m.acct.frag.totals_at(end);
+    let gpu = m.acct.gpu.totals_at(end);
+    let bott = m.acct.path.totals_at(end, m.done());
+    let displayed = m.records.iter().skip(warm).filter(|r| r.displayed.is_some()).count();
+    let dropped = m.records.iter().skip(warm).filter(|r| r.dropped).count();
+    let (mark_vblanks, mark_repeated, mark_time) = m.refresh_mark.unwrap_or((0, 0, crate::engine::Time::ZERO));
+    let refreshes = if m.chain.mode() == crate::components::swap_chain::PresentMode::Immediate {
+        end.0 / m.refresh.0 - mark_time.0 / m.refresh.0
+    } else {
+        m.vblanks - mark_vblanks
+    };
+    let repeated = m.repeated_refreshes - mark_repeated;
+    let (issued, executed) = m.command_counts();
+    PipelineSummary {
+        system: "frame_pipeline",
+        description: m.cfg.description.clone(),
+        fidelity: m.cfg.fidelity,
+        seed: m.cfg.run.seed,
+        frames: m.records.len(),
+        frames_simulated: m.records.len(),
+        frames_requested: m.cfg.run.frames,
+        warmup_frames: m.cfg.run.warmup_frames,
+        events: EventCounts::of(stats),
+        wall_seconds: build_seconds + stats.wall_seconds,
+        build_seconds,
+        simulate_seconds: stats.wall_seconds,
+        events_per_second: events_per_second(stats),
+        simulated_seconds: end.0 as f64 / 1e12,
+        stopped_by: stats.stopped_by,
+        metrics: PipelineMetrics {
+            frame_time_ms: col(2),
+            display_interval_ms: col(11),
+            display_latency_ms: col(10),
+            until_displayed_ms: col(9),
+            gpu_time_ms: col(6),
+            cpu_busy_ms: col(3),
+            gpu_busy_ms: col(7),
+            cpu_busy_fraction: (cpu[0] + cpu[1]) as f64 / elapsed,
+            cpu_wait_fraction: (cpu[2] + cpu[3]) as f64 / elapsed,
+            gpu_busy_fraction: gpu[0] as f64 / elapsed,
+            gpu_idle_fraction: gpu[1] as f64 / elapsed,
+            refreshes,
+            repeated_refreshes: repeated,
+            repeated_refresh_fraction: if refreshes > 0 {
+                repeated as f64 / refreshes as f64
+            } else {
+                0.0
+            },
+            displayed_frames: displayed,
+            dropped_frames: dropped,
+            bottleneck: BOTTLENECKS
+                .iter()
+                .zip(bott)
+                .map(|(n, t)| (n.to_string(), t as f64 / elapsed))
+                .collect(),
+            states_ms: StatesMs {
+                cpu: states(&CPU_STATES, &cpu),
+                gpu_front_end: states(&FRONT_STATES, &front),
+                geometry: states(&GEOM_STATES, &geom),
+                fragment: states(&FRAG_STATES, &frag),
+                gpu: states(&["busy", "idle"], &gpu),
+            },
+            commands: CommandCounts {
+                issued,
+                executed,
+                fifo_max_used: m.fifo.max_used(),
+            },
+            analytic,
+        },
+        scene,
+    }
+}
