@@ -268,11 +268,7 @@ fn front_state_of(p: FrontPhase) -> usize {
 impl FramePipeline {
     /// Derives every unit's state at `now` and advances the clocks.
     pub(super) fn account(&mut self, now: Time) {
-        let cpu_state = if self.cpu.in_system() {
-            1
-        } else {
-            cpu_state_of(self.cpu_phase)
-        };
+        let cpu_state = self.cpu_state();
         let front_state = if self.front.in_system() {
             5
         } else {
@@ -446,25 +442,16 @@ impl FramePipeline {
         debug_assert_eq!(self.acct.gpu.state(), 0);
         debug_assert_eq!(self.acct.cpu_frame, self.cpu_frame);
         debug_assert!(self.draw_fragment_limited.is_some() && self.geom_busy && self.frag_busy);
-        let cpu_state = if self.cpu.in_system() {
-            1
-        } else {
-            cpu_state_of(self.cpu_phase)
-        };
+        // The CPU first: its old mode is carried under everyone's old mode.
+        self.account_cpu_alone(now);
         let front_state = front_state_of(self.front_phase);
         let stages = match self.draw_fragment_limited {
             Some(true) => Mode::work(Blame::Fragment),
             _ => Mode::work(Blame::Geometry),
         };
-        let (cpu_mode, front_mode) = (self.cpu_mode(), self.front_mode());
+        let front_mode = self.front_mode();
         let a = &mut self.acct;
-        let old = a.cpu.state();
-        let spent = a.cpu.set(now, cpu_state).0;
-        if spent > 0 {
-            attribute_cpu(&mut self.records, old, spent, a.cpu_frame);
-        }
         a.front.set(now, front_state);
-        a.path.set_mode(Unit::Cpu, cpu_mode, now);
         a.path.set_mode(Unit::Front, front_mode, now);
         a.path.set_mode(Unit::Geometry, stages, now);
         a.path.set_mode(Unit::Fragment, stages, now);
@@ -477,11 +464,7 @@ impl FramePipeline {
     pub(super) fn account_cpu_alone(&mut self, now: Time) {
         debug_assert!(self.acct.trace.is_none());
         debug_assert_eq!(self.acct.cpu_frame, self.cpu_frame);
-        let cpu_state = if self.cpu.in_system() {
-            1
-        } else {
-            cpu_state_of(self.cpu_phase)
-        };
+        let cpu_state = self.cpu_state();
         let mode = self.cpu_mode();
         let a = &mut self.acct;
         let old = a.cpu.state();
@@ -490,6 +473,16 @@ impl FramePipeline {
             attribute_cpu(&mut self.records, old, spent, a.cpu_frame);
         }
         a.path.set_mode(Unit::Cpu, mode, now);
+    }
+
+    /// The CPU's state (index into [`CPU_STATES`]).
+    #[inline]
+    fn cpu_state(&self) -> usize {
+        if self.cpu.in_system() {
+            1
+        } else {
+            cpu_state_of(self.cpu_phase)
+        }
     }
 
     /// The CPU's mode for the critical path.

@@ -106,11 +106,7 @@ impl FramePipeline {
         }
         let gpu_frame = self.gpu_frame;
         self.settle(now, s)?;
-        if self.gpu_frame == gpu_frame
-            && self.geom_busy
-            && self.cpu_frame == self.acct.cpu_frame()
-            && !self.front.in_system()
-        {
+        if self.gpu_frame == gpu_frame && self.geom_busy && self.cpu_frame == self.acct.cpu_frame() {
             self.account_draw_handoff(now);
         } else {
             self.account(now);

@@ -311,6 +311,32 @@ impl PixelFlow {
         Ok(end)
     }
 
+    /// Node `r`'s rasterizer takes `work`: marks it busy, adds the work to
+    /// its busy total and returns how long the step lasts. While the
+    /// geometry processor still writes the instructions (`streaming`, §6:
+    /// "completely pipelined") it ends no earlier than one primitive
+    /// (`per_prim`) after the geometry.
+    fn begin_rasterize(
+        &mut self,
+        r: usize,
+        work: Duration,
+        per_prim: Duration,
+        now: Time,
+        streaming: bool,
+    ) -> Duration {
+        let mut d = work;
+        if streaming {
+            let tail = self.gen_end[r]
+                .since(now)
+                .checked_add(per_prim)
+                .unwrap_or(Duration(u64::MAX));
+            d = d.max(tail);
+        }
+        self.rast_busy[r] = true;
+        self.busy.rasterize[r] = self.busy.rasterize[r].checked_add(work).unwrap_or(Duration(u64::MAX));
+        d
+    }
+
     /// Schedules the frame's first events.
     pub fn start(&mut self, sched: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         if self.cfg.architecture != Architecture::Nontex {

@@ -85,16 +85,7 @@ impl PixelFlow {
                     self.layout.bin(r, j as usize % self.regions),
                     "rasterization",
                 )?;
-                let mut d = work;
-                if streaming {
-                    let tail = self.gen_end[r]
-                        .since(now)
-                        .checked_add(c.t_rast_per_prim)
-                        .unwrap_or(Duration(u64::MAX));
-                    d = d.max(tail);
-                }
-                self.rast_busy[r] = true;
-                self.busy.rasterize[r] = self.busy.rasterize[r].checked_add(work).unwrap_or(Duration(u64::MAX));
+                let d = self.begin_rasterize(r, work, c.t_rast_per_prim, now, streaming);
                 self.work(sched, d, Ev::RastDone(r as u32), 1, r as u32, "rasterize", j)?;
                 moved = true;
             }

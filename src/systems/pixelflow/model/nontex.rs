@@ -33,16 +33,7 @@ impl PixelFlow {
                 if !self.rast_busy[r] && (self.rast_batches[r] < self.geom_batches[r] || streaming) {
                     let k = self.rast_batches[r];
                     let work = mul(c.t_rast_per_prim, self.batch_entries(r, k), "rasterization")?;
-                    let mut d = work;
-                    if streaming {
-                        let tail = self.gen_end[r]
-                            .since(now)
-                            .checked_add(c.t_rast_per_prim)
-                            .unwrap_or(Duration(u64::MAX));
-                        d = d.max(tail);
-                    }
-                    self.rast_busy[r] = true;
-                    self.busy.rasterize[r] = self.busy.rasterize[r].checked_add(work).unwrap_or(Duration(u64::MAX));
+                    let d = self.begin_rasterize(r, work, c.t_rast_per_prim, now, streaming);
                     self.work(
                         sched,
                         d,
