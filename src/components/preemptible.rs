@@ -59,7 +59,7 @@ impl Preemptible {
     }
 
     /// Starts a job of `work` at `now`.
-    #[inline]
+    #[inline(always)]
     pub fn start_job(&mut self, now: Time, work: Duration) -> Result<Wake, TimeError> {
         debug_assert!(!self.has_job());
         if self.in_system() {

@@ -59,11 +59,22 @@ impl Time {
     /// `self + d`, or an overflow error naming `context`.
     #[inline]
     pub fn add(self, d: Duration, context: &str) -> Result<Time, TimeError> {
-        self.0.checked_add(d.0).map(Time).ok_or_else(|| TimeError::Overflow {
+        match self.0.checked_add(d.0) {
+            Some(t) => Ok(Time(t)),
+            None => Err(Self::overflow(self, d, context)),
+        }
+    }
+
+    /// The error of [`Time::add`], out of line: every event's scheduling
+    /// inlines the addition, not the error's construction.
+    #[cold]
+    #[inline(never)]
+    fn overflow(at: Time, by: Duration, context: &str) -> TimeError {
+        TimeError::Overflow {
             context: context.to_string(),
-            at: self,
-            by: d,
-        })
+            at,
+            by,
+        }
     }
 
     /// The span from `earlier` to `self` (zero if `earlier` is later).

@@ -4,6 +4,7 @@
 //! driver cost per draw and per state change, uploads over the bus) and the
 //! swap, pushing each into the command FIFO. A full FIFO blocks it.
 
+use crate::components::fifo::FifoUnit;
 use crate::engine::{Duration, Scheduler, Time};
 
 use super::model::{Command, CpuPhase, Ev, FramePipeline, FrontPhase, Program};
@@ -149,6 +150,89 @@ impl FramePipeline {
         }
     }
 
+    /// A draw batch's CPU work finished (`cpu_op` is a draw of the scene's
+    /// body), in the case that is most of a long run's CPU events: the
+    /// front end is not waiting for commands, no trace is written, and the
+    /// batch either fits in the FIFO (pushed, and the next operation
+    /// starts, [`FramePipeline::push_draw_start_next`]) or finds it full
+    /// (the CPU waits). That is what [`FramePipeline::cpu_op_done`]
+    /// followed by [`FramePipeline::cpu_step_alone`] does then, taken
+    /// without the general steps' dispatch on the operation and the phase.
+    /// Returns false, having changed nothing, in every other case (the
+    /// general path runs): the front end idle, a trace, a fixed workload,
+    /// the next operation without work, a FIFO the batch would overfill.
+    #[inline]
+    pub(super) fn cpu_draw_done_fast(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
+        let k = self.cpu_op.wrapping_sub(3);
+        if k >= self.body_ops || !self.scene_body || self.front_phase == FrontPhase::Idle || self.acct.trace.is_some() {
+            return Ok(false);
+        }
+        let Program::Scene(sc) = &self.program else {
+            return Ok(false);
+        };
+        let d = &sc.draws[k as usize];
+        let weight = match self.cfg.command_fifo.unit {
+            FifoUnit::Entries => u64::from(d.commands),
+            FifoUnit::Bytes => d.bytes,
+        };
+        let cmd = Command::Draw {
+            frame: self.cpu_frame,
+            draw: k,
+        };
+        if !self.fifo.can_push(weight) {
+            // Blocked on a full FIFO: only the CPU's clock and mode move.
+            self.cpu_cmd = cmd;
+            self.cpu_cmd_weight = weight;
+            self.cpu_phase = CpuPhase::Push;
+            self.account_cpu_alone(now);
+            return Ok(true);
+        }
+        if !self.push_draw_start_next(now, s, cmd, weight)? {
+            return Ok(false);
+        }
+        Ok(true)
+    }
+
+    /// Pushes the draw batch `cmd` of the current frame (weight `weight`,
+    /// which fits in the FIFO) and starts the CPU's next operation, a draw
+    /// or the swap, as [`FramePipeline::cpu_step_from_rest`] does from
+    /// [`CpuPhase::Push`]; the CPU is then [`CpuPhase::Running`]. Returns
+    /// false, having changed nothing, when that is not all the step would
+    /// do: the batch would fill the FIFO past its capacity (a rendezvous),
+    /// or the next operation has no work (it ends at once).
+    #[inline(always)]
+    fn push_draw_start_next(
+        &mut self,
+        now: Time,
+        s: &mut Scheduler<Ev>,
+        cmd: Command,
+        weight: u64,
+    ) -> Result<bool, SystemError> {
+        let (Command::Draw { draw: k, .. }, Program::Scene(sc)) = (cmd, &self.program) else {
+            return Ok(false);
+        };
+        let Some(d) = sc.draws.get(k as usize) else {
+            return Ok(false);
+        };
+        let next = match sc.draws.get(k as usize + 1) {
+            Some(n) => n.cpu,
+            None => self.cfg.cpu.swap,
+        };
+        if next.0 == 0 || self.fifo.used().saturating_add(weight) > self.fifo.capacity() {
+            return Ok(false);
+        }
+        let count = u64::from(d.commands);
+        self.fifo.push(cmd, weight);
+        self.commands_issued += count;
+        self.cpu_cmd = cmd;
+        self.cpu_cmd_weight = weight;
+        self.cpu_op += 1;
+        let w = self.cpu.start_job(now, next)?;
+        Self::schedule_wake(s, w, true);
+        self.cpu_phase = CpuPhase::Running;
+        Ok(true)
+    }
+
     /// Advances the CPU thread as far as it can go now. Returns whether
     /// anything changed.
     #[inline]
@@ -179,6 +263,14 @@ impl FramePipeline {
     /// [`FramePipeline::cpu_step`] from a phase that may move.
     #[inline(never)]
     fn cpu_step_from_rest(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
+        // Released from a full FIFO with a draw batch (at a draw's end, in a
+        // GPU-bound stretch): push it and start the next operation.
+        if self.cpu_phase == CpuPhase::Push
+            && self.fifo.can_push(self.cpu_cmd_weight)
+            && self.push_draw_start_next(now, s, self.cpu_cmd, self.cpu_cmd_weight)?
+        {
+            return Ok(true);
+        }
         let mut progressed = false;
         loop {
             match self.cpu_phase {

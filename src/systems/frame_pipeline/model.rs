@@ -618,6 +618,9 @@ impl Model for FramePipeline {
         match ev {
             Ev::CpuDone { tag } => {
                 if self.cpu.complete(tag) {
+                    if self.cpu_draw_done_fast(now, s)? {
+                        return Ok(Control::Continue);
+                    }
                     self.cpu_op_done(now);
                     if self.cpu_step_alone(now, s)? {
                         return Ok(Control::Continue);

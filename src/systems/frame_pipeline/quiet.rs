@@ -33,7 +33,8 @@ use crate::systems::error::SystemError;
 
 use super::accounting::FRONT_WAIT_GEOMETRY;
 use super::critical_path::{Mode, Unit};
-use super::model::{Command, Ev, FramePipeline, FrontPhase};
+use super::model::{ActiveDraw, Command, Ev, FramePipeline, FrontPhase, Program};
+use crate::components::preemptible::Wake;
 
 impl FramePipeline {
     /// Whether the front end's job for `c`, ending at `end`, would only
@@ -71,7 +72,11 @@ impl FramePipeline {
             return Ok(());
         }
         debug_assert!(self.draw_done_at.is_some_and(|d| d > at));
-        self.front_command_done(at)?;
+        debug_assert!(matches!(self.front_cmd, Command::Draw { .. }));
+        // `front_command_done` for a draw command: the hand-off begins.
+        if self.front_phase == FrontPhase::Running {
+            self.front_phase = FrontPhase::Handoff;
+        }
         debug_assert_eq!(self.front_phase, FrontPhase::Handoff);
         if self.acct.trace.is_some() {
             self.account(at);
@@ -85,6 +90,74 @@ impl FramePipeline {
         self.acct.front.set(at, FRONT_WAIT_GEOMETRY);
         self.acct.path.set_mode(Unit::Front, Mode::wait(Unit::Geometry), at);
         Ok(())
+    }
+
+    /// The front end's first steps of `settle` at a draw's end
+    /// ([`FramePipeline::draw_done_alone`]) in their common case, taken
+    /// without the general step's dispatch: the held draw goes to the
+    /// geometry stage (its closed form, its [`Ev::DrawDone`]), and the front
+    /// end takes the next command when it is a draw with front-end work
+    /// (its job, quiet when it ends before the new draw, as in
+    /// `front_job`), or starts waiting for commands when the FIFO is empty.
+    /// Any other next command, and a draw without its closed form, leave
+    /// everything to `settle`. The CPU's step that `settle` takes first
+    /// does nothing at this instant (a draw's end frees no FIFO space and
+    /// completes no frame), so taking the front end's steps before it
+    /// changes no order; `settle` runs next and takes every step left.
+    /// Returns whether the front end is running the next command's job.
+    #[inline]
+    fn handoff_fast(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
+        let Command::Draw { draw, .. } = self.front_cmd else {
+            return Ok(false);
+        };
+        let Program::Scene(sc) = &self.program else {
+            return Ok(false);
+        };
+        let d = &sc.draws[draw as usize];
+        let Some(t) = d.closed else {
+            return Ok(false);
+        };
+        let triangles = sc.meshes[d.mesh as usize].triangles;
+        let next = match self.fifo.front() {
+            None => None,
+            Some(&Command::Draw { draw: n, .. }) => {
+                let n = &sc.draws[n as usize];
+                if n.front.0 == 0 {
+                    return Ok(false);
+                }
+                Some((n.front, u64::from(n.commands)))
+            }
+            Some(_) => return Ok(false),
+        };
+        // The geometry stage takes the held draw (`geom_start_draw`).
+        self.geom_draw = Some(ActiveDraw {
+            draw,
+            next: 0,
+            triangles,
+        });
+        self.draw_fragment_limited = Some(t.fragment >= t.geometry);
+        self.geom_busy = true;
+        self.frag_busy = true;
+        self.draw_split = Some((t.geometry, t.fragment, t.total));
+        let done_at = s.after(t.total, Ev::DrawDone, "draw")?;
+        self.draw_done_at = Some(done_at);
+        self.front_phase = FrontPhase::Idle;
+        // The front end takes the next draw command (`front_begin`, `front_job`).
+        if let Some((work, commands)) = next
+            && let Some(c) = self.fifo.pop()
+        {
+            self.commands_executed += commands;
+            self.front_cmd = c;
+            match self.front.start_job(now, work)? {
+                Wake::JobAt(end, tag) if done_at > end => {
+                    self.front_quiet = Some((s.reserve(end), tag));
+                }
+                w => Self::schedule_wake(s, w, false),
+            }
+            self.front_phase = FrontPhase::Running;
+            return Ok(true);
+        }
+        Ok(false)
     }
 
     /// `draw` fidelity without a trace, called when a draw ended (after
@@ -105,7 +178,14 @@ impl FramePipeline {
             return Ok(false);
         }
         let gpu_frame = self.gpu_frame;
-        self.settle(now, s)?;
+        if self.handoff_fast(now, s)? {
+            // The front end runs the next draw command's job: of `settle`'s
+            // steps only the CPU's can do anything (a push does not reach a
+            // running front end), and it does not change the front end.
+            self.cpu_step(now, s)?;
+        } else {
+            self.settle(now, s)?;
+        }
         if self.gpu_frame == gpu_frame && self.geom_busy && self.cpu_frame == self.acct.cpu_frame() {
             self.account_draw_handoff(now);
         } else {
