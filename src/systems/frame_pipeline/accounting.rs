@@ -435,7 +435,11 @@ impl FramePipeline {
     /// `now` one at a time, in this order, give what carrying them all under
     /// the old modes gives: the front end waited for geometry (it held a
     /// draw), and the stages worked, charged to themselves.
-    pub(super) fn account_draw_handoff(&mut self, now: Time) {
+    ///
+    /// `cpu_moved`: whether the CPU may have taken a step at this instant;
+    /// when it did not, its state and mode are what the last accounted
+    /// instant left, and its part is skipped.
+    pub(super) fn account_draw_handoff(&mut self, now: Time, cpu_moved: bool) {
         debug_assert!(self.acct.trace.is_none() && !self.front.in_system());
         debug_assert_eq!(self.acct.geom.state(), 0);
         debug_assert_eq!(self.acct.frag.state(), 0);
@@ -443,7 +447,9 @@ impl FramePipeline {
         debug_assert_eq!(self.acct.cpu_frame, self.cpu_frame);
         debug_assert!(self.draw_fragment_limited.is_some() && self.geom_busy && self.frag_busy);
         // The CPU first: its old mode is carried under everyone's old mode.
-        self.account_cpu_alone(now);
+        if cpu_moved {
+            self.account_cpu_alone(now);
+        }
         let front_state = front_state_of(self.front_phase);
         let stages = match self.draw_fragment_limited {
             Some(true) => Mode::work(Blame::Fragment),

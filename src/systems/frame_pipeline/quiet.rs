@@ -178,16 +178,17 @@ impl FramePipeline {
             return Ok(false);
         }
         let gpu_frame = self.gpu_frame;
-        if self.handoff_fast(now, s)? {
+        let cpu_moved = if self.handoff_fast(now, s)? {
             // The front end runs the next draw command's job: of `settle`'s
             // steps only the CPU's can do anything (a push does not reach a
             // running front end), and it does not change the front end.
-            self.cpu_step(now, s)?;
+            self.cpu_step(now, s)?
         } else {
             self.settle(now, s)?;
-        }
+            true
+        };
         if self.gpu_frame == gpu_frame && self.geom_busy && self.cpu_frame == self.acct.cpu_frame() {
-            self.account_draw_handoff(now);
+            self.account_draw_handoff(now, cpu_moved);
         } else {
             self.account(now);
         }
