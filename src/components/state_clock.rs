@@ -11,6 +11,9 @@ pub struct StateClock<const N: usize> {
     state: usize,
     since: Time,
     totals: [u64; N],
+    /// Time moved between states by [`StateClock::transfer`] (two's
+    /// complement: a state's total read is `totals + moved`).
+    moved: [u64; N],
 }
 
 impl<const N: usize> StateClock<N> {
@@ -21,6 +24,7 @@ impl<const N: usize> StateClock<N> {
             state,
             since: Time::ZERO,
             totals: [0; N],
+            moved: [0; N],
         }
     }
 
@@ -60,18 +64,29 @@ impl<const N: usize> StateClock<N> {
         spent
     }
 
-    /// Moves `amount` already accounted from state `from` to state `to`
-    /// (for units whose split inside an interval is known only at its end).
+    /// Moves `amount` from state `from` to state `to` (for units whose
+    /// split inside an interval is known only at its end). The amount must
+    /// have been spent in `from` already, in the current interval or
+    /// before: only totals read after the move see it, so it costs two
+    /// additions, with no interval closed (a unit's draw at a time, at
+    /// every draw's end, in a long run).
+    #[inline]
     pub fn transfer(&mut self, from: usize, to: usize, amount: u64) {
-        let a = amount.min(self.totals[from]);
-        self.totals[from] -= a;
-        self.totals[to] += a;
+        self.moved[from] = self.moved[from].wrapping_sub(amount);
+        self.moved[to] = self.moved[to].wrapping_add(amount);
     }
 
     /// Totals per state as of `now` (the current state counted up to `now`).
     pub fn totals_at(&self, now: Time) -> [u64; N] {
         let mut t = self.totals;
         t[self.state] += now.since(self.since).0;
+        for (t, m) in t.iter_mut().zip(self.moved) {
+            debug_assert!(
+                i128::from(*t) + i128::from(m as i64) >= 0,
+                "more time moved out of a state than it had"
+            );
+            *t = t.wrapping_add(m);
+        }
         t
     }
 }
@@ -90,5 +105,19 @@ mod tests {
         let t = c.totals_at(Time(100));
         assert_eq!(t, [10 + 60, 15, 15]);
         assert_eq!(t.iter().sum::<u64>(), 100);
+    }
+
+    #[test]
+    fn transfers_move_time_between_states_and_keep_the_sum() {
+        let mut c = StateClock::<3>::new(0);
+        c.set(Time(40), 1);
+        // 15 of state 0's 40 were idle, learned later; state 1 still runs.
+        c.transfer(0, 2, 15);
+        assert_eq!(c.totals_at(Time(50)), [25, 10, 15]);
+        c.set(Time(60), 0);
+        // Moved out of the running interval before it closed.
+        c.transfer(0, 1, 5);
+        assert_eq!(c.totals_at(Time(100)), [25 + 40 - 5, 20 + 5, 15]);
+        assert_eq!(c.totals_at(Time(100)).iter().sum::<u64>(), 100);
     }
 }

@@ -221,13 +221,11 @@ impl FramePipeline {
     }
 
     /// `draw` fidelity: the draw's last fragment is done.
-    pub(super) fn draw_done(&mut self, now: Time) {
+    pub(super) fn draw_done(&mut self) {
         if let Some((g, f, t)) = self.draw_split.take() {
             // Both stage clocks have been "busy" since the draw began: keep G
             // (resp. F) of it busy and move the rest to idle.
-            self.acct.geom.split(now);
             self.acct.geom.transfer(0, 2, t.0 - g.0.min(t.0));
-            self.acct.frag.split(now);
             self.acct.frag.transfer(0, 1, t.0 - f.0.min(t.0));
         }
         self.geom_busy = false;

@@ -645,7 +645,7 @@ impl Model for FramePipeline {
             Ev::DrawGeometry => self.geom_busy = false,
             Ev::DrawFragmentStart => self.frag_busy = true,
             Ev::DrawDone => {
-                self.draw_done(now);
+                self.draw_done();
                 if self.draw_done_alone(now, s)? {
                     return Ok(if self.done() { Control::Stop } else { Control::Continue });
                 }
