@@ -26,7 +26,14 @@
 //! ([`FramePipeline::draw_done_alone`]): the geometry and fragment stages go
 //! from one draw to the next without a change of state, so only the CPU's
 //! and the front end's clocks and the critical-path modes of the CPU, the
-//! front end and the two stages are carried forward.
+//! front end and the two stages are carried forward. Its steps are taken
+//! directly in their common case (`handoff_fast`: the held draw goes to
+//! geometry, the next draw command's front-end job starts), and the CPU's
+//! accounting is skipped when the CPU took no step. The CPU's own common
+//! instants have the same kind of direct path in `cpu.rs`
+//! (`cpu_draw_done_fast`, `push_draw_start_next`). A traced run takes none
+//! of these short cuts, which is what the trace-equivalence test compares
+//! against.
 
 use crate::engine::{Scheduler, Time};
 use crate::systems::error::SystemError;
