@@ -88,7 +88,7 @@ pub struct RadixHeap<E> {
     /// the run or `stale`).
     is_small: bool,
     /// Small form: pending events sorted by `(time, seq)`, latest first.
-    small: Small<E>,
+    small: Vec<Scheduled<E>>,
     /// The counting sort's destinations (kept for its allocation).
     scratch: Vec<u32>,
     /// Allocations of spread buckets, handed to the next empty bucket that
@@ -114,102 +114,6 @@ fn slot(time: u64, last: u64) -> (usize, usize) {
     (level, ((time >> (8 * level)) & 0xff) as usize)
 }
 
-/// The small form's events, sorted by `(time, seq)` latest first, with
-/// each field in an array of its own. The next event due is usually the
-/// one the last handler scheduled, popped a few dozen instructions after
-/// it was written: each field is read back as it was written (one 8-byte
-/// store, one 8-byte load), where one array of whole events had its time
-/// and sequence number written by two stores and read by one wider load,
-/// which the processor cannot forward from the stores (a stall on most
-/// pops of a rendering pipeline's run).
-#[derive(Debug)]
-struct Small<E> {
-    time: Vec<super::time::Time>,
-    seq: Vec<u64>,
-    event: Vec<E>,
-}
-
-impl<E> Small<E> {
-    /// Room for [`SMALL_MAX`] events, allocated once.
-    fn new() -> Self {
-        Small {
-            time: Vec::with_capacity(SMALL_MAX),
-            seq: Vec::with_capacity(SMALL_MAX),
-            event: Vec::with_capacity(SMALL_MAX),
-        }
-    }
-
-    /// No allocation (a placeholder while the arrays are moved out).
-    fn empty() -> Self {
-        Small {
-            time: Vec::new(),
-            seq: Vec::new(),
-            event: Vec::new(),
-        }
-    }
-
-    fn is_empty(&self) -> bool {
-        self.time.is_empty()
-    }
-
-    /// Whether another event fits without growing (the arrays are made
-    /// with room for [`SMALL_MAX`]; testing each capacity lets the compiler
-    /// drop `Vec::push`'s growing path).
-    #[inline(always)]
-    fn has_room(&self) -> bool {
-        self.time.len() < SMALL_MAX
-            && self.time.len() < self.time.capacity()
-            && self.seq.len() < self.seq.capacity()
-            && self.event.len() < self.event.capacity()
-    }
-
-    /// Appends `s` as the next due (first in pop order).
-    #[inline(always)]
-    fn push_first(&mut self, s: Scheduled<E>) {
-        self.time.push(s.time);
-        self.seq.push(s.seq);
-        self.event.push(s.event);
-    }
-
-    /// Inserts `s` after (in pop order) every event due at or before its
-    /// time (it has the largest sequence number so far): appended, then
-    /// moved down past the earlier ones (usually few: a new event tends to
-    /// be among the next due); no memmove call.
-    #[inline(always)]
-    fn insert(&mut self, s: Scheduled<E>) {
-        self.push_first(s);
-        let mut i = self.time.len() - 1;
-        while i > 0 && self.time[i - 1] <= self.time[i] {
-            self.time.swap(i - 1, i);
-            self.seq.swap(i - 1, i);
-            self.event.swap(i - 1, i);
-            i -= 1;
-        }
-    }
-
-    /// Removes the next due.
-    #[inline(always)]
-    fn pop(&mut self) -> Option<Scheduled<E>> {
-        let event = self.event.pop()?;
-        match (self.time.pop(), self.seq.pop()) {
-            (Some(time), Some(seq)) => Some(Scheduled { time, seq, event }),
-            _ => unreachable!("the small form's arrays have one length"),
-        }
-    }
-
-    fn next_time(&self) -> Option<super::time::Time> {
-        self.time.last().copied()
-    }
-
-    /// Reverses the pop order (events appended earliest first become
-    /// latest first).
-    fn reverse(&mut self) {
-        self.time.reverse();
-        self.seq.reverse();
-        self.event.reverse();
-    }
-}
-
 impl<E> RadixHeap<E> {
     /// An empty heap at time zero.
     pub fn new() -> Self {
@@ -228,7 +132,7 @@ impl<E> RadixHeap<E> {
             stale: Vec::new(),
             len: 0,
             is_small: true,
-            small: Small::new(),
+            small: Vec::with_capacity(SMALL_MAX),
             scratch: Vec::new(),
             spare: Vec::new(),
         }
@@ -238,7 +142,15 @@ impl<E> RadixHeap<E> {
     /// before its time (it has the largest sequence number so far).
     #[inline(always)]
     fn small_insert(&mut self, s: Scheduled<E>) {
-        self.small.insert(s);
+        // Appended, then moved down past the earlier ones (usually few: a
+        // new event tends to be among the next due); no memmove call.
+        let v = &mut self.small;
+        v.push(s);
+        let mut i = v.len() - 1;
+        while i > 0 && v[i - 1].time <= v[i].time {
+            v.swap(i - 1, i);
+            i -= 1;
+        }
     }
 
     /// Leaves the small form: files its events into the run and the buckets
@@ -247,7 +159,7 @@ impl<E> RadixHeap<E> {
     fn spill_to_buckets(&mut self) {
         self.is_small = false;
         self.run_hi = self.last;
-        let mut small = std::mem::replace(&mut self.small, Small::empty());
+        let mut small = std::mem::take(&mut self.small);
         while let Some(s) = small.pop() {
             self.place(s);
         }
@@ -257,11 +169,11 @@ impl<E> RadixHeap<E> {
     /// Back to the small form (few events left): pops them in order.
     #[cold]
     fn gather_to_small(&mut self) {
-        let mut out = std::mem::replace(&mut self.small, Small::empty());
+        let mut out = std::mem::take(&mut self.small);
         debug_assert!(out.is_empty());
         let n = self.len;
         while let Some(s) = self.pop_buckets() {
-            out.push_first(s);
+            out.push(s);
         }
         out.reverse();
         self.len = n;
@@ -343,7 +255,7 @@ impl<E> RadixHeap<E> {
         // The array is made with room for SMALL_MAX, so the second test
         // always holds with the first; it lets the compiler drop Vec::push's
         // growing path.
-        if self.is_small && self.small.has_room() {
+        if self.is_small && self.small.len() < SMALL_MAX && self.small.len() < self.small.capacity() {
             self.len += 1;
             self.small_insert(s);
             return;
@@ -371,7 +283,7 @@ impl<E> RadixHeap<E> {
         self.len += 1;
         if self.is_small {
             // It was the earliest: it goes back to the end.
-            self.small.push_first(s);
+            self.small.push(s);
             return;
         }
         if s.time.0 < self.last {
@@ -573,7 +485,7 @@ impl<E> RadixHeap<E> {
     /// The earliest due time, without removing anything.
     pub fn peek_time(&self) -> Option<super::time::Time> {
         if self.is_small {
-            return self.small.next_time();
+            return self.small.last().map(|s| s.time);
         }
         if let Some(s) = self.stale.iter().min_by_key(|s| (s.time, s.seq)) {
             return Some(s.time);
