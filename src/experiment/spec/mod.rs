@@ -13,6 +13,7 @@ use std::path::PathBuf;
 use super::ExperimentError;
 use super::sweep::Sweep;
 
+mod outputs;
 mod raw;
 mod validate;
 
