@@ -116,6 +116,13 @@ impl Duration {
         self.0.checked_add(o.0).map(Duration)
     }
 
+    /// Saturating sum: the longest span instead of an overflow (for
+    /// totals and waits that only need to stay ordered).
+    #[inline]
+    pub fn saturating_add(self, o: Duration) -> Duration {
+        Duration(self.0.saturating_add(o.0))
+    }
+
     /// `self * n`, checked.
     #[inline]
     pub fn checked_mul(self, n: u64) -> Option<Duration> {
@@ -339,6 +346,18 @@ impl crate::components::distribution::Quantity for Duration {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn saturating_sums_stop_at_the_longest_span() {
+        assert_eq!(Duration(3).saturating_add(Duration(4)), Duration(7));
+        assert_eq!(Duration(u64::MAX - 1).saturating_add(Duration(5)), Duration(u64::MAX));
+        assert_eq!(
+            Duration(u64::MAX - 1).saturating_add(Duration(5)),
+            Duration(u64::MAX - 1)
+                .checked_add(Duration(5))
+                .unwrap_or(Duration(u64::MAX))
+        );
+    }
 
     #[test]
     fn parses_units_exactly() {

@@ -48,9 +48,7 @@ impl FramePipeline {
                 let work = Duration::from_ps_f64(c.non_render.sample(&mut self.non_render_rng));
                 // Per-frame variation (config `variation.cpu`), drawn only when given.
                 match &self.cfg.variation.cpu() {
-                    Some(v) => work
-                        .checked_add(Duration::from_ps_f64(v.sample(&mut self.variation_rng[0])))
-                        .unwrap_or(Duration(u64::MAX)),
+                    Some(v) => work.saturating_add(Duration::from_ps_f64(v.sample(&mut self.variation_rng[0]))),
                     None => work,
                 }
             }

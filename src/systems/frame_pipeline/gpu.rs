@@ -52,12 +52,7 @@ impl FramePipeline {
                     if !self.pipeline_drained() {
                         return Ok(progressed);
                     }
-                    let work = self
-                        .cfg
-                        .gpu
-                        .swap
-                        .checked_add(self.cfg.gpu.command)
-                        .unwrap_or(Duration(u64::MAX));
+                    let work = self.cfg.gpu.swap.saturating_add(self.cfg.gpu.command);
                     self.front_phase = self.front_job(now, self.front_cmd, work, s)?;
                 }
                 FrontPhase::Handoff => {
@@ -88,7 +83,7 @@ impl FramePipeline {
                 }
             }
             Command::Fixed { gpu, .. } => {
-                let work = gpu.checked_add(cmd_cost).unwrap_or(Duration(u64::MAX));
+                let work = gpu.saturating_add(cmd_cost);
                 self.front_job(now, c, work, s)
             }
             Command::Draw { draw, .. } => {
@@ -111,17 +106,10 @@ impl FramePipeline {
             }
             self.records[frame as usize].gpu_start = Some(now);
         }
-        let mut work = self
-            .cfg
-            .gpu
-            .clear
-            .checked_add(self.cfg.gpu.command)
-            .unwrap_or(Duration(u64::MAX));
+        let mut work = self.cfg.gpu.clear.saturating_add(self.cfg.gpu.command);
         // Per-frame variation (config `variation.gpu`), drawn only when given.
         if let (Command::Clear { .. }, Some(v)) = (c, self.cfg.variation.gpu()) {
-            work = work
-                .checked_add(Duration::from_ps_f64(v.sample(&mut self.variation_rng[1])))
-                .unwrap_or(Duration(u64::MAX));
+            work = work.saturating_add(Duration::from_ps_f64(v.sample(&mut self.variation_rng[1])));
         }
         self.front_job(now, c, work, s)
     }

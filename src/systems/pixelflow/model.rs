@@ -326,14 +326,11 @@ impl PixelFlow {
     ) -> Duration {
         let mut d = work;
         if streaming {
-            let tail = self.gen_end[r]
-                .since(now)
-                .checked_add(per_prim)
-                .unwrap_or(Duration(u64::MAX));
+            let tail = self.gen_end[r].since(now).saturating_add(per_prim);
             d = d.max(tail);
         }
         self.rast_busy[r] = true;
-        self.busy.rasterize[r] = self.busy.rasterize[r].checked_add(work).unwrap_or(Duration(u64::MAX));
+        self.busy.rasterize[r] = self.busy.rasterize[r].saturating_add(work);
         d
     }
 
@@ -447,7 +444,7 @@ impl PixelFlow {
                 Architecture::Nontex => self.cfg.nontex.t_load,
                 _ => self.cfg.deferred.t_load,
             };
-            self.busy.load = self.busy.load.checked_add(d).unwrap_or(Duration(u64::MAX));
+            self.busy.load = self.busy.load.saturating_add(d);
             self.work(sched, d, Ev::LoadDone(j), 4, 0, "load frame buffer", j)?;
             return Ok(true);
         }
@@ -551,7 +548,7 @@ impl Model for PixelFlow {
                 for r in 0..self.nodes {
                     let d = mul(t, self.layout.node_entries(r), "rasterization")?;
                     self.rast_busy[r] = true;
-                    self.busy.rasterize[r] = self.busy.rasterize[r].checked_add(d).unwrap_or(Duration(u64::MAX));
+                    self.busy.rasterize[r] = self.busy.rasterize[r].saturating_add(d);
                     let pass = self.pass;
                     self.work(
                         sched,

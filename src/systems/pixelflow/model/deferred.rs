@@ -27,12 +27,9 @@ impl PixelFlow {
                     Architecture::Standard => (c.t_trans, "geometry + bucket sort"),
                     _ => (c.t_first_pass, "sorting pass"),
                 };
-                let d = c
-                    .t_overhead
-                    .checked_add(mul(per, p, name)?)
-                    .unwrap_or(Duration(u64::MAX));
+                let d = c.t_overhead.saturating_add(mul(per, p, name)?);
                 self.geom_busy[r] = true;
-                self.busy.geometry[r] = self.busy.geometry[r].checked_add(d).unwrap_or(Duration(u64::MAX));
+                self.busy.geometry[r] = self.busy.geometry[r].saturating_add(d);
                 let ft = &mut self.frame_times[f].0;
                 *ft = Some(ft.map_or(now, |t| t.min(now)));
                 self.work(sched, d, Ev::GeomDone(r as u32), 0, r as u32, name, f as u32)?;
@@ -57,7 +54,7 @@ impl PixelFlow {
                 let t1 = (ps * (before + entries) as u128 / total as u128) as u64;
                 let d = Duration(t1 - t0);
                 self.gen_busy[r] = true;
-                self.busy.generate[r] = self.busy.generate[r].checked_add(d).unwrap_or(Duration(u64::MAX));
+                self.busy.generate[r] = self.busy.generate[r].saturating_add(d);
                 self.gen_end[r] = self.work(
                     sched,
                     d,
@@ -98,7 +95,7 @@ impl PixelFlow {
                 self.net_busy = true;
                 self.comp_next += 1;
                 let d = mul(c.t_comp_byte, c.appearance_bytes as u64, "composition")?;
-                self.busy.composite = self.busy.composite.checked_add(d).unwrap_or(Duration(u64::MAX));
+                self.busy.composite = self.busy.composite.saturating_add(d);
                 self.records[j].comp_start = Some(now);
                 self.work(sched, d, Ev::CompDone(j as u32), 3, 0, "composite appearance", j as u32)?;
                 moved = true;
@@ -110,11 +107,8 @@ impl PixelFlow {
             {
                 self.shader_reserved[s] = false;
                 self.shader_busy[s] = Some(j);
-                let d = c
-                    .t_shade_address
-                    .checked_add(c.t_shade_texture)
-                    .unwrap_or(Duration(u64::MAX));
-                self.busy.shade[s] = self.busy.shade[s].checked_add(d).unwrap_or(Duration(u64::MAX));
+                let d = c.t_shade_address.saturating_add(c.t_shade_texture);
+                self.busy.shade[s] = self.busy.shade[s].saturating_add(d);
                 self.records[j as usize].shade_start = Some(now);
                 self.work(sched, d, Ev::ShadeDone(s as u32), 2, s as u32, "shade", j)?;
                 moved = true;
@@ -125,7 +119,7 @@ impl PixelFlow {
         {
             self.color_busy = Some(j);
             let d = mul(c.t_comp_byte, c.color_bytes as u64, "color transfer")?;
-            self.busy.color = self.busy.color.checked_add(d).unwrap_or(Duration(u64::MAX));
+            self.busy.color = self.busy.color.saturating_add(d);
             self.work(sched, d, Ev::ColorDone(j), 3, 1, "send color", j)?;
             moved = true;
         }

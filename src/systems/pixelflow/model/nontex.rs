@@ -4,7 +4,7 @@
 //! rasterized again after the previous sample's whole-screen composition;
 //! the last composition runs region by region, pipelined with the loads.
 
-use crate::engine::{Duration, Scheduler};
+use crate::engine::Scheduler;
 use crate::systems::error::SystemError;
 
 use super::{Ev, PixelFlow, mul};
@@ -20,7 +20,7 @@ impl PixelFlow {
                     let k = self.geom_batches[r];
                     let d = mul(c.t_trans, self.batch_prims(r, k), "geometry")?;
                     self.geom_busy[r] = true;
-                    self.busy.geometry[r] = self.busy.geometry[r].checked_add(d).unwrap_or(Duration(u64::MAX));
+                    self.busy.geometry[r] = self.busy.geometry[r].saturating_add(d);
                     self.gen_end[r] =
                         self.work(sched, d, Ev::BatchGeomDone(r as u32), 0, r as u32, "geometry", k as u32)?;
                     moved = true;
@@ -53,7 +53,7 @@ impl PixelFlow {
             self.comp_next += 1;
             self.net_busy = true;
             let d = mul(c.t_comp_byte, c.composite_bytes as u64, "composition")?;
-            self.busy.composite = self.busy.composite.checked_add(d).unwrap_or(Duration(u64::MAX));
+            self.busy.composite = self.busy.composite.saturating_add(d);
             self.records[j].comp_start = Some(now);
             self.work(sched, d, Ev::CompDone(j as u32), 3, 0, "composite colors", j as u32)?;
             moved = true;
@@ -79,7 +79,7 @@ impl PixelFlow {
         let c = &self.cfg.nontex;
         let per_region = mul(c.t_comp_byte, c.composite_bytes as u64, "composition")?;
         let d = mul(per_region, self.regions as u64, "composition")?;
-        self.busy.composite = self.busy.composite.checked_add(d).unwrap_or(Duration(u64::MAX));
+        self.busy.composite = self.busy.composite.saturating_add(d);
         self.work(sched, d, Ev::PassCompDone, 3, 0, "composite sample", self.pass)?;
         Ok(())
     }
