@@ -71,6 +71,11 @@ impl Validator<'_> {
                     .clone()
                     .ok_or_else(|| self.err(&key, format!("kind `{}` needs `column`", d.kind)))
             };
+            let need_path = || {
+                d.path
+                    .clone()
+                    .ok_or_else(|| self.err(&key, format!("kind `{}` needs `path`", d.kind)))
+            };
             let need_ref = || -> Result<Vec<(String, toml::Value)>, ExperimentError> {
                 let r = d
                     .reference
@@ -104,17 +109,11 @@ impl Validator<'_> {
                     }
                 }
                 "relative_error" => DerivedKind::RelativeError {
-                    path: d
-                        .path
-                        .clone()
-                        .ok_or_else(|| self.err(&key, "kind `relative_error` needs `path`"))?,
+                    path: need_path()?,
                     reference: need_ref()?,
                 },
                 "ratio" => DerivedKind::Ratio {
-                    path: d
-                        .path
-                        .clone()
-                        .ok_or_else(|| self.err(&key, "kind `ratio` needs `path`"))?,
+                    path: need_path()?,
                     reference: need_ref()?,
                 },
                 "speedup" => DerivedKind::Speedup {

@@ -4,10 +4,9 @@
 //! driver cost per draw and per state change, uploads over the bus) and the
 //! swap, pushing each into the command FIFO. A full FIFO blocks it.
 
-use crate::components::fifo::FifoUnit;
 use crate::engine::{Duration, Scheduler, Time};
 
-use super::model::{Command, CpuPhase, Ev, FramePipeline, FrontPhase, Program};
+use super::model::{Command, CpuPhase, Ev, FramePipeline, FrontPhase, Program, draw_batch_weight};
 use super::records::FrameRecord;
 use crate::systems::error::SystemError;
 
@@ -169,10 +168,7 @@ impl FramePipeline {
             return Ok(false);
         };
         let d = &sc.draws[k as usize];
-        let weight = match self.cfg.command_fifo.unit {
-            FifoUnit::Entries => u64::from(d.commands),
-            FifoUnit::Bytes => d.bytes,
-        };
+        let weight = draw_batch_weight(self.cfg.command_fifo.unit, d);
         let cmd = Command::Draw {
             frame: self.cpu_frame,
             draw: k,

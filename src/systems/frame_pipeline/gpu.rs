@@ -11,6 +11,7 @@
 use crate::components::preemptible::Wake;
 use crate::engine::{Duration, Scheduler, Time};
 
+use super::closed_form::DrawTimes;
 use super::config::Fidelity;
 use super::model::{ActiveDraw, Command, Ev, FragWork, FramePipeline, FrontPhase, Program};
 use super::workload::{closed_times, ordered_sizes};
@@ -124,15 +125,29 @@ impl FramePipeline {
         s: &mut Scheduler<Ev>,
     ) -> Result<FrontPhase, SystemError> {
         if work.0 > 0 || self.front.in_system() {
-            match self.front.start_job(now, work)? {
-                Wake::JobAt(end, tag) if self.quiet_completion(c, end) => {
-                    self.front_quiet = Some((s.reserve(end), tag));
-                }
-                w => Self::schedule_wake(s, w, false),
-            }
+            self.start_front_job(now, c, work, s)?;
             return Ok(FrontPhase::Running);
         }
         self.front_after(now, c)
+    }
+
+    /// Starts the front end's job of `work` for `c`; its completion is an
+    /// event, or quiet when it only starts a hand-off ([`super::quiet`]).
+    #[inline(always)]
+    pub(super) fn start_front_job(
+        &mut self,
+        now: Time,
+        c: Command,
+        work: Duration,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
+        match self.front.start_job(now, work)? {
+            Wake::JobAt(end, tag) if self.quiet_completion(c, end) => {
+                self.front_quiet = Some((s.reserve(end), tag));
+            }
+            w => Self::schedule_wake(s, w, false),
+        }
+        Ok(())
     }
 
     /// The running command's work finished.
@@ -161,11 +176,6 @@ impl FramePipeline {
         let d = &sc.draws[draw as usize];
         let mesh = &sc.meshes[d.mesh as usize];
         let triangles = mesh.triangles;
-        self.geom_draw = Some(ActiveDraw {
-            draw,
-            next: 0,
-            triangles,
-        });
         match self.cfg.fidelity {
             Fidelity::Triangle => {
                 let g = &sc.groups[d.group as usize];
@@ -174,6 +184,11 @@ impl FramePipeline {
                 } else {
                     ordered_sizes(g, triangles, &mut self.pixel_rng, &mut self.draw_sizes);
                 }
+                self.geom_draw = Some(ActiveDraw {
+                    draw,
+                    next: 0,
+                    triangles,
+                });
                 self.geom_next_triangle(now, s)
             }
             Fidelity::Draw => {
@@ -181,31 +196,57 @@ impl FramePipeline {
                     Some(t) => t,
                     None => closed_times(&self.cfg, mesh, &sc.groups[d.group as usize]),
                 };
-                self.draw_fragment_limited = Some(t.fragment >= t.geometry);
-                if self.acct.trace.is_none() {
-                    // Geometry runs [0, G] and fragments [T - F, T] of the
-                    // draw; T <= G + F, so the GPU is busy throughout. Without
-                    // a trace the split is credited at the end (one event).
-                    self.geom_busy = true;
-                    self.frag_busy = true;
-                    self.draw_split = Some((t.geometry, t.fragment, t.total));
-                    self.draw_done_at = Some(s.after(t.total, Ev::DrawDone, "draw")?);
-                    return Ok(());
-                }
-                if t.geometry.0 > 0 {
-                    self.geom_busy = true;
-                    s.after(t.geometry, Ev::DrawGeometry, "draw geometry")?;
-                }
-                let frag_start = t.total.saturating_sub(t.fragment);
-                if frag_start.0 > 0 {
-                    s.after(frag_start, Ev::DrawFragmentStart, "draw fragment start")?;
-                } else {
-                    self.frag_busy = true;
-                }
-                self.draw_done_at = Some(s.after(t.total, Ev::DrawDone, "draw")?);
-                Ok(())
+                self.start_closed_draw(draw, triangles, t, s)
             }
         }
+    }
+
+    /// `draw` fidelity: the geometry stage takes `draw` (`triangles`
+    /// triangles), whose closed form is `t`.
+    #[inline(always)]
+    pub(super) fn start_closed_draw(
+        &mut self,
+        draw: u32,
+        triangles: u64,
+        t: DrawTimes,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
+        self.geom_draw = Some(ActiveDraw {
+            draw,
+            next: 0,
+            triangles,
+        });
+        self.draw_fragment_limited = Some(t.fragment >= t.geometry);
+        if self.acct.trace.is_none() {
+            // Geometry runs [0, G] and fragments [T - F, T] of the draw;
+            // T <= G + F, so the GPU is busy throughout. Without a trace the
+            // split is credited at the end (one event).
+            self.geom_busy = true;
+            self.frag_busy = true;
+            self.draw_split = Some((t.geometry, t.fragment, t.total));
+            self.draw_done_at = Some(s.after(t.total, Ev::DrawDone, "draw")?);
+            return Ok(());
+        }
+        self.closed_draw_traced(t, s)
+    }
+
+    /// [`FramePipeline::start_closed_draw`] with a trace: the geometry
+    /// part's end and the fragment part's start are events of their own, so
+    /// the trace shows each stage's span.
+    #[inline(never)]
+    fn closed_draw_traced(&mut self, t: DrawTimes, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+        if t.geometry.0 > 0 {
+            self.geom_busy = true;
+            s.after(t.geometry, Ev::DrawGeometry, "draw geometry")?;
+        }
+        let frag_start = t.total.saturating_sub(t.fragment);
+        if frag_start.0 > 0 {
+            s.after(frag_start, Ev::DrawFragmentStart, "draw fragment start")?;
+        } else {
+            self.frag_busy = true;
+        }
+        self.draw_done_at = Some(s.after(t.total, Ev::DrawDone, "draw")?);
+        Ok(())
     }
 
     /// `draw` fidelity: the draw's last fragment is done.

@@ -20,7 +20,7 @@ use crate::systems::error::SystemError;
 use super::accounting::Accounting;
 use super::config::{Fidelity, FramePipelineConfig, WorkloadConfig};
 use super::records::FrameRecord;
-use super::workload::SceneProgram;
+use super::workload::{DrawItem, SceneProgram};
 
 /// Events of the frame pipeline.
 #[derive(Debug, Clone, Copy)]
@@ -277,6 +277,16 @@ pub struct FramePipeline {
     pub(super) acct: Accounting,
 }
 
+/// A draw batch's weight in the command FIFO's unit: its commands (state
+/// changes, upload, draw) or its bytes.
+#[inline]
+pub(super) fn draw_batch_weight(unit: FifoUnit, d: &DrawItem) -> u64 {
+    match unit {
+        FifoUnit::Entries => u64::from(d.commands),
+        FifoUnit::Bytes => d.bytes,
+    }
+}
+
 /// A triangle's fragment work: shader time (on the pool when unified; all
 /// of it when split) and fixed-function time beside it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -456,21 +466,16 @@ impl FramePipeline {
 
     /// The weight of a command in the FIFO's unit.
     pub(super) fn command_weight(&self, c: &Command) -> u64 {
+        let unit = self.cfg.command_fifo.unit;
         let b = &self.cfg.command_fifo.bytes;
-        match self.cfg.command_fifo.unit {
-            FifoUnit::Entries => match c {
-                Command::Draw { draw, .. } => self
-                    .scene()
-                    .map(|s| s.draws[*draw as usize].commands as u64)
-                    .unwrap_or(1),
-                _ => 1,
-            },
-            FifoUnit::Bytes => match c {
-                Command::Clear { .. } => b.clear.0,
-                Command::Swap { .. } => b.swap.0,
-                Command::Fixed { .. } => b.draw.0,
-                Command::Draw { draw, .. } => self.scene().map(|s| s.draws[*draw as usize].bytes).unwrap_or(b.draw.0),
-            },
+        match (unit, c) {
+            (_, Command::Draw { draw, .. }) if let Some(s) = self.scene() => {
+                draw_batch_weight(unit, &s.draws[*draw as usize])
+            }
+            (FifoUnit::Entries, _) => 1,
+            (FifoUnit::Bytes, Command::Clear { .. }) => b.clear.0,
+            (FifoUnit::Bytes, Command::Swap { .. }) => b.swap.0,
+            (FifoUnit::Bytes, Command::Fixed { .. } | Command::Draw { .. }) => b.draw.0,
         }
     }
 
