@@ -33,6 +33,8 @@ pub fn experiment(
     let ours = move |name: &str| legacy(name) || name.ends_with(".sbatch");
     let runner = SimRunner::for_experiment(exp);
     if let Some(id) = args.shard {
+        // Refused before the folder is claimed (run_shard checks it too).
+        id.check_runs(expand_points(exp).len() * exp.seeds().len())?;
         let dir = claim_folder(out, ours)?;
         match run_shard(exp, base, &runner, &dir, id, !args.quiet)? {
             ShardOutcome::Complete { path, runs } => {

@@ -48,16 +48,12 @@ pub fn run(args: RunArgs) -> Result<()> {
         None => None,
     };
     // The trace is written while the simulation runs (memory stays flat).
-    // A trace inside the --out folder belongs to the result set.
-    let trace = args.trace.map(|path| match &set {
-        Some(set)
-            if path.file_name().is_some()
-                && path.parent().and_then(|p| std::path::absolute(p).ok()).as_deref() == Some(set.target()) =>
-        {
-            set.dir().join(path.file_name().unwrap_or_default())
-        }
-        _ => path,
-    });
+    // A trace inside the --out folder belongs to the result set and goes
+    // through its commit; one that names a file of the set is refused.
+    let trace = match (args.trace, &set) {
+        (Some(path), Some(set)) => Some(set.place(&path, &RUN_FILES)?.unwrap_or(path)),
+        (trace, _) => trace,
+    };
     // With the trace on standard output, the report goes to standard error.
     let trace_on_stdout = trace.as_deref().is_some_and(is_stdout);
     let (trace_file, writer) = match &trace {

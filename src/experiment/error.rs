@@ -74,6 +74,9 @@ pub enum ExperimentError {
         /// What is wrong with it.
         message: String,
     },
+    /// A `--shard K/N` that does not fit the experiment.
+    #[error(transparent)]
+    ShardId(#[from] super::shard::ShardIdError),
     /// The shard files of an experiment do not make a whole (`--merge`).
     #[error("{}: {message}", dir.display())]
     Shards {

@@ -16,14 +16,20 @@
 //! experiment, the shard's runs with their numbers (floats in Rust's
 //! shortest round-trip text, so a merge reads back the very bits a single
 //! process would have used), its CPU time and its start and end on the
-//! wall clock. Running a shard whose file is complete and made from the
-//! same experiment and version does nothing (a preempted array can be
-//! resubmitted whole); any other file is redone.
+//! wall clock, and the SHA-256 of its runs' text (`runs_sha256`). Running a
+//! shard whose file is complete, made from the same experiment and version
+//! and whose runs still match their checksum does nothing (a preempted array
+//! can be resubmitted whole); any other file is redone.
 //!
-//! [`merge_shards`] reads every shard file, refuses when one is missing,
-//! duplicated, incomplete, or made from another experiment or rendersim
-//! version (naming the file and what differs), and hands the runs in
-//! output order to the same code a single process ends with.
+//! A shard file is read back like user input: [`merge_shards`] reads every
+//! shard file, refuses when one is missing, duplicated, incomplete, edited
+//! (its runs no longer match their checksum), holds a value that is not a
+//! finite number, counts more shards than the experiment has runs, or was
+//! made from another experiment or rendersim version (naming the file and
+//! what differs), before it allocates anything sized by what the files
+//! say; then it hands the runs in output order to the same code a single
+//! process ends with. `--shard K/N` with more shards than runs is refused
+//! before anything runs.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -66,6 +72,17 @@ pub enum ShardIdError {
     /// `K` or `N` out of range.
     #[error("`{0}`: needs 1 <= K <= N (K counts from 1)")]
     Range(String),
+    /// More shards than the experiment has runs.
+    #[error(
+        "`--shard {id}`: {} shards for an experiment of {runs} runs; N can be at most {runs} (one run per shard)",
+        id.n
+    )]
+    MoreShardsThanRuns {
+        /// The shard asked for.
+        id: ShardId,
+        /// Runs of the experiment.
+        runs: usize,
+    },
 }
 
 impl FromStr for ShardId {
@@ -98,6 +115,16 @@ impl ShardId {
     pub fn runs(&self, total: usize) -> impl Iterator<Item = usize> + use<> {
         (self.k - 1..total).step_by(self.n)
     }
+
+    /// Refuses a split of `total` runs into more shards than runs (a shard
+    /// with no run, and a merge that would look for files that can never
+    /// hold anything).
+    pub fn check_runs(&self, total: usize) -> Result<(), ShardIdError> {
+        if self.n > total {
+            return Err(ShardIdError::MoreShardsThanRuns { id: *self, runs: total });
+        }
+        Ok(())
+    }
 }
 
 /// One shard file.
@@ -117,7 +144,17 @@ struct ShardFile {
     finished_unix: f64,
     /// CPU time of the shard's process (user + system), seconds.
     cpu_seconds: f64,
+    /// SHA-256 of `runs` as JSON text ([`runs_checksum`]): a file whose runs
+    /// were edited after it was written is not taken as complete.
+    runs_sha256: String,
     runs: Vec<ShardRun>,
+}
+
+/// The checksum stored with a shard's runs: SHA-256 of their JSON text.
+fn runs_checksum(runs: &[ShardRun]) -> String {
+    // Serializing strings and integers cannot fail.
+    let text = serde_json::to_vec(runs).unwrap_or_default();
+    super::fingerprint::sha256_hex(&text)
 }
 
 /// One run in a shard file. Floats are text (see the module documentation).
@@ -149,8 +186,22 @@ fn floats_text(v: &[f64]) -> String {
     s
 }
 
+/// A tracked value or a time read back: a finite number.
 fn parse_float(t: &str) -> Result<f64, String> {
-    t.parse::<f64>().map_err(|_| format!("`{t}` is not a number"))
+    match t.parse::<f64>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        Ok(_) => Err(format!("`{t}` is not a finite number")),
+        Err(_) => Err(format!("`{t}` is not a number")),
+    }
+}
+
+/// A per-frame value read back: a finite number, or `NaN`, which the
+/// systems' tables use for a value a frame does not have.
+fn parse_frame_value(t: &str) -> Result<f64, String> {
+    if t == "NaN" {
+        return Ok(f64::NAN);
+    }
+    parse_float(t)
 }
 
 impl ShardRun {
@@ -195,14 +246,27 @@ impl ShardRun {
         let frames = self
             .frames
             .iter()
-            .map(|c| c.split_ascii_whitespace().map(parse_float).collect())
+            .map(|c| c.split_ascii_whitespace().map(parse_frame_value).collect())
             .collect::<Result<Vec<Vec<f64>>, _>>()?;
+        if let Some(first) = frames.first()
+            && let Some(other) = frames.iter().find(|c| c.len() != first.len())
+        {
+            return Err(format!(
+                "frame columns of {} and {} values: every column has one value per frame",
+                first.len(),
+                other.len()
+            ));
+        }
+        let wall_seconds = parse_float(&self.wall_seconds)?;
+        if wall_seconds < 0.0 {
+            return Err(format!("wall_seconds `{}` is negative", self.wall_seconds));
+        }
         Ok(JobOutput {
             record: RunRecord {
                 point: self.point,
                 seed: self.seed,
                 values,
-                wall_seconds: parse_float(&self.wall_seconds)?,
+                wall_seconds,
             },
             frames,
         })
@@ -254,6 +318,18 @@ fn read_shard(path: &Path) -> Result<ShardFile, ExperimentError> {
             format!("format `{}`, expected `{SHARD_FORMAT}`", file.format),
         ));
     }
+    for (key, x) in [
+        ("started_unix", file.started_unix),
+        ("finished_unix", file.finished_unix),
+        ("cpu_seconds", file.cpu_seconds),
+    ] {
+        if !x.is_finite() || x < 0.0 {
+            return Err(shard_error(path, format!("`{key}` is {x}: not a finite time")));
+        }
+    }
+    if file.finished_unix < file.started_unix {
+        return Err(shard_error(path, "`finished_unix` is before `started_unix`"));
+    }
     Ok(file)
 }
 
@@ -279,6 +355,13 @@ fn mismatch(file: &ShardFile, hash: &str, id: Option<ShardId>, expected: Option<
     {
         return Some(format!("holds shard {}/{}, not {id}", file.shard, file.shards));
     }
+    if runs_checksum(&file.runs) != file.runs_sha256 {
+        return Some(
+            "its runs do not match the checksum stored with them (`runs_sha256`): the file was edited or damaged \
+             after it was written; rerun the shard"
+                .into(),
+        );
+    }
     if let Some(expected) = expected {
         let got: Vec<(usize, u64)> = file.runs.iter().map(|r| (r.point, r.seed)).collect();
         if got != expected {
@@ -292,21 +375,6 @@ fn mismatch(file: &ShardFile, hash: &str, id: Option<ShardId>, expected: Option<
         }
     }
     None
-}
-
-/// Removes temporary files a killed writer of `name` left in `dir`.
-fn remove_partial(dir: &Path, name: &str) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    let prefix = format!(".{name}.tmp-");
-    let mine = format!("{prefix}{}", std::process::id());
-    for e in entries.flatten() {
-        let n = e.file_name().to_string_lossy().to_string();
-        if n.starts_with(&prefix) && n != mine {
-            let _ = std::fs::remove_file(e.path());
-        }
-    }
 }
 
 /// Runs shard `id` of `exp` and writes `out_dir/shards/shard-K-of-N.json`,
@@ -323,12 +391,12 @@ pub fn run_shard(
     let t0 = Instant::now();
     let started_unix = unix_seconds();
     let plan = Plan::new(exp, base_model)?;
-    let hash = experiment_fingerprint(exp, base_model)?;
     let all = plan.jobs(exp);
+    id.check_runs(all.len())?;
+    let hash = experiment_fingerprint(exp, base_model)?;
     let mine: Vec<(usize, u64)> = id.runs(all.len()).map(|i| all[i]).collect();
     let dir = out_dir.join(SHARDS_DIR);
     let path = dir.join(id.file_name());
-    remove_partial(&dir, &id.file_name());
     let redone = if path.exists() {
         let why = match read_shard(&path) {
             Ok(f) => mismatch(&f, &hash, Some(id), Some(&mine)),
@@ -359,7 +427,12 @@ pub fn run_shard(
         started_unix,
         finished_unix: unix_seconds(),
         cpu_seconds: cpu.unwrap_or(0.0),
+        runs_sha256: String::new(),
         runs: outputs.iter().map(ShardRun::from_output).collect(),
+    };
+    let file = ShardFile {
+        runs_sha256: runs_checksum(&file.runs),
+        ..file
     };
     crate::output::files::write_output(&path, |w| {
         serde_json::to_writer(&mut *w, &file).map_err(std::io::Error::other)?;
@@ -425,6 +498,31 @@ pub fn merge_shards(
     }
     let (first_path, first) = &files[0];
     let n = first.shards;
+    // What the files say is bounded by the experiment before anything is
+    // sized by it.
+    for (p, f) in &files {
+        if f.total_runs != all.len() {
+            return Err(shard_error(
+                p,
+                format!(
+                    "says the experiment has {} runs; it has {}: damaged, or from another split; rerun the shard",
+                    f.total_runs,
+                    all.len()
+                ),
+            ));
+        }
+        if f.shards == 0 || f.shards > all.len() {
+            return Err(shard_error(
+                p,
+                format!(
+                    "says it is one of {} shards; an experiment of {} runs has 1 to {} shards: damaged; rerun the shard",
+                    f.shards,
+                    all.len(),
+                    all.len()
+                ),
+            ));
+        }
+    }
     for (p, f) in &files {
         if f.shards != n || f.total_runs != all.len() {
             return Err(shards_error(format!(
@@ -496,4 +594,66 @@ pub fn merge_shards(
     };
     drop(files);
     finish(exp, base_model, runner, &plan, outputs, write_dir, Timing::Shards(cost))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(values: &str, wall: &str, frames: &[&str]) -> ShardRun {
+        ShardRun {
+            point: 0,
+            seed: 1,
+            values: values.into(),
+            wall_seconds: wall.into(),
+            frames: frames.iter().map(|c| c.to_string()).collect(),
+        }
+    }
+
+    #[test]
+    fn values_read_back_are_finite_numbers() {
+        let ok = run("1e0 null 2.5e1", "1e-3", &["1e0 NaN", "2e0 3e0"]);
+        let o = ok.to_output(3, 2).unwrap();
+        assert_eq!(o.record.values, vec![Some(1.0), None, Some(25.0)]);
+        assert!(o.frames[0][1].is_nan(), "a frame's missing value stays missing");
+        for bad in ["NaN", "inf", "-inf", "1e400", "infinity"] {
+            let e = run(&format!("1e0 {bad} 2e0"), "1e-3", &[]).to_output(3, 0).unwrap_err();
+            assert!(e.contains("not a finite number"), "{bad}: {e}");
+            let e = run("1e0", bad, &[]).to_output(1, 0).unwrap_err();
+            assert!(e.contains("not a finite number"), "{bad}: {e}");
+            if bad != "NaN" {
+                let e = run("1e0", "1e-3", &[&format!("1e0 {bad}")])
+                    .to_output(1, 1)
+                    .unwrap_err();
+                assert!(e.contains("not a finite number"), "{bad}: {e}");
+            }
+        }
+        let e = run("1e0", "-1e0", &[]).to_output(1, 0).unwrap_err();
+        assert!(e.contains("negative"), "{e}");
+        let e = run("1e0", "1e0", &["1e0 2e0", "1e0"]).to_output(1, 2).unwrap_err();
+        assert!(e.contains("frame columns of 2 and 1 values"), "{e}");
+        let e = run("x", "1e0", &[]).to_output(1, 0).unwrap_err();
+        assert!(e.contains("`x` is not a number"), "{e}");
+    }
+
+    #[test]
+    fn the_checksum_changes_with_any_run() {
+        let a = vec![run("1e0", "1e-3", &["1e0"])];
+        let mut b = a.clone();
+        assert_eq!(runs_checksum(&a), runs_checksum(&b));
+        b[0].values = "1.0000000000000002e0".into();
+        assert_ne!(runs_checksum(&a), runs_checksum(&b));
+        let mut c = a.clone();
+        c[0].seed = 2;
+        assert_ne!(runs_checksum(&a), runs_checksum(&c));
+    }
+
+    #[test]
+    fn more_shards_than_runs_is_refused() {
+        let id: ShardId = "1/4294967296".parse().unwrap();
+        let e = id.check_runs(12).unwrap_err();
+        assert!(e.to_string().contains("N can be at most 12"), "{e}");
+        let id: ShardId = "12/12".parse().unwrap();
+        id.check_runs(12).unwrap();
+    }
 }

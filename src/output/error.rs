@@ -42,6 +42,31 @@ pub enum OutputError {
         /// A few of the entries that are not rendersim's.
         examples: String,
     },
+    /// A result-set output names a folder (or a folder inside it) that
+    /// cannot be written: replacing it would leave the old set behind,
+    /// unremovable.
+    #[error(
+        "output folder {path} is read-only; rendersim replaces its output folder as a whole and could not \
+         remove the old one: make it writable (chmod u+w) or give another folder"
+    )]
+    ReadOnlyFolder {
+        /// The read-only folder.
+        path: PathBuf,
+    },
+    /// A single-file output (such as `--trace`) names a file of the result
+    /// set written to `--out`, which the set would overwrite or lose.
+    #[error(
+        "{path} is the result set's own `{name}` in {set}; give the file another name (a trace may go inside \
+         the --out folder under any name the set does not use)"
+    )]
+    PartOfSet {
+        /// The path given.
+        path: PathBuf,
+        /// The set's folder.
+        set: PathBuf,
+        /// The set's file it names.
+        name: String,
+    },
     /// A symbolic link chain that does not end.
     #[error("{path}: too many levels of symbolic links")]
     LinkLoop {

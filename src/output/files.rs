@@ -11,7 +11,9 @@
 //! - a regular file, a symbolic link to one (the link is followed and kept),
 //!   or nothing yet (missing folders above it are made): written next to the final file under a temporary name
 //!   and renamed over it, so a reader never sees half a file and a failure or
-//!   an interrupt leaves the old file as it was.
+//!   an interrupt leaves the old file as it was. The temporary name,
+//!   `.NAME.tmp-PID`, names the writing process: one that was killed
+//!   outright leaves it, and the next writer of the same file removes it.
 //!
 //! ```
 //! use std::io::Write;
@@ -26,7 +28,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use super::cleanup::Registered;
+use super::cleanup::{Registered, create_registered};
 use super::error::OutputError;
 
 /// How an output path is written.
@@ -156,9 +158,12 @@ pub fn open_output(path: &Path) -> Result<(OutputFile, Box<dyn Write + Send>), O
                 .map(|n| n.to_string_lossy().to_string())
                 .unwrap_or_else(|| "out".into());
             std::fs::create_dir_all(dir).map_err(OutputError::io("creating folder", dir))?;
+            // What a killed writer of this file left (`kill -9` leaves its
+            // temporary file; an interrupt removes it itself).
+            super::cleanup::remove_stale_temps(dir, &name, &["tmp"]);
             let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-            let registered = Registered::new(&tmp);
-            let f = std::fs::File::create(&tmp).map_err(OutputError::io("creating", &tmp))?;
+            let (registered, f) =
+                create_registered(&tmp, |p| std::fs::File::create(p)).map_err(OutputError::io("creating", &tmp))?;
             Ok((
                 OutputFile {
                     replace: Some((tmp, p)),

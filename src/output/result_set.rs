@@ -41,7 +41,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::cleanup::{Registered, while_locked};
+use super::cleanup::{Registered, create_registered, remove_stale_temps, while_locked};
 use super::error::OutputError;
 use super::files::resolve_links;
 
@@ -69,24 +69,6 @@ fn parent_of(p: &Path) -> PathBuf {
         .unwrap_or_else(|| PathBuf::from("."))
 }
 
-/// Whether process `pid` still runs (unknown: assume it does).
-fn process_alive(pid: u32) -> bool {
-    #[cfg(unix)]
-    {
-        let Ok(pid) = libc::pid_t::try_from(pid) else {
-            return true;
-        };
-        // SAFETY: signal 0 only checks that the process exists.
-        let r = unsafe { libc::kill(pid, 0) };
-        r == 0 || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = pid;
-        true
-    }
-}
-
 /// Checks that `target` may be replaced by a result set: absent, empty,
 /// marked as rendersim's, or holding only regular files for which `legacy`
 /// says rendersim wrote them (sets written before the marker existed).
@@ -102,7 +84,7 @@ fn check_replaceable(target: &Path, legacy: &dyn Fn(&str) -> bool) -> Result<(),
         });
     }
     if target.join(MARKER).is_file() {
-        return Ok(());
+        return check_writable(target);
     }
     let mut foreign = Vec::new();
     for entry in std::fs::read_dir(target).map_err(OutputError::io("reading folder", target))? {
@@ -115,7 +97,7 @@ fn check_replaceable(target: &Path, legacy: &dyn Fn(&str) -> bool) -> Result<(),
         }
     }
     if foreign.is_empty() {
-        return Ok(());
+        return check_writable(target);
     }
     foreign.sort();
     let more = foreign.len().saturating_sub(3);
@@ -134,6 +116,63 @@ fn check_replaceable(target: &Path, legacy: &dyn Fn(&str) -> bool) -> Result<(),
     })
 }
 
+/// Refuses a set folder that could not be removed once replaced: the folder
+/// or a folder inside it without write permission (a removal would fail and
+/// leave the old set beside the new one). Checked before any work is done.
+fn check_writable(target: &Path) -> Result<(), OutputError> {
+    let mut folders = vec![(target.to_path_buf(), 0)];
+    while let Some((dir, depth)) = folders.pop() {
+        let meta = std::fs::symlink_metadata(&dir).map_err(OutputError::io("looking at", &dir))?;
+        if meta.permissions().readonly() {
+            return Err(OutputError::ReadOnlyFolder { path: dir });
+        }
+        // A set is a handful of folders deep (plots, shards, logs).
+        if depth >= 8 {
+            continue;
+        }
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            return Err(OutputError::ReadOnlyFolder { path: dir });
+        };
+        for e in entries.flatten() {
+            if e.file_type().is_ok_and(|t| t.is_dir()) {
+                folders.push((e.path(), depth + 1));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `p` with every part that exists resolved to its real path (links, `.`
+/// and `..`) and the rest normalized as written: so two spellings of one
+/// place compare equal even before the place exists.
+fn real_path(p: &Path) -> PathBuf {
+    use std::path::Component;
+    let Ok(abs) = std::path::absolute(p) else {
+        return p.to_path_buf();
+    };
+    let mut cur = PathBuf::new();
+    for c in abs.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                if let Ok(real) = cur.canonicalize() {
+                    cur = real;
+                }
+                cur.pop();
+            }
+            other => {
+                cur.push(other.as_os_str());
+                if std::fs::symlink_metadata(&cur).is_ok()
+                    && let Ok(real) = cur.canonicalize()
+                {
+                    cur = real;
+                }
+            }
+        }
+    }
+    cur
+}
+
 /// `p` as an absolute path that ends in a name (so it has a parent to stage
 /// beside): `.` and `..` are resolved.
 fn absolute_folder(p: &Path) -> Result<PathBuf, OutputError> {
@@ -142,31 +181,6 @@ fn absolute_folder(p: &Path) -> Result<PathBuf, OutputError> {
         return Ok(abs);
     }
     abs.canonicalize().map_err(OutputError::io("looking at", p))
-}
-
-/// Removes staging and swapped-out folders of `name` left beside it by
-/// processes that no longer run.
-fn remove_stale(parent: &Path, name: &str) {
-    let Ok(entries) = std::fs::read_dir(parent) else {
-        return;
-    };
-    for e in entries.flatten() {
-        let n = e.file_name().to_string_lossy().to_string();
-        let Some(rest) = n.strip_prefix(&format!(".{name}.")) else {
-            continue;
-        };
-        let pid = rest
-            .strip_prefix("partial-")
-            .or_else(|| rest.strip_prefix("old-"))
-            .and_then(|p| p.parse::<u32>().ok());
-        if let Some(pid) = pid
-            && pid != std::process::id()
-            && !process_alive(pid)
-            && e.path().is_dir()
-        {
-            let _ = std::fs::remove_dir_all(e.path());
-        }
-    }
 }
 
 /// Exchanges two existing folders in one step where the system can.
@@ -233,13 +247,13 @@ impl ResultSet {
         let parent = parent_of(&target);
         std::fs::create_dir_all(&parent).map_err(OutputError::io("creating folder", &parent))?;
         let name = file_name(&target);
-        remove_stale(&parent, &name);
+        remove_stale_temps(&parent, &name, &["partial", "old"]);
         let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
         if staging.exists() {
             let _ = std::fs::remove_dir_all(&staging);
         }
-        let registered = Registered::new(&staging);
-        std::fs::create_dir(&staging).map_err(OutputError::io("creating folder", &staging))?;
+        let (registered, ()) = create_registered(&staging, |p| std::fs::create_dir(p))
+            .map_err(OutputError::io("creating folder", &staging))?;
         Ok(ResultSet {
             target,
             staging,
@@ -255,6 +269,39 @@ impl ResultSet {
     /// The folder the set will replace.
     pub fn target(&self) -> &Path {
         &self.target
+    }
+
+    /// Where a single-file output given as `path` (a trace) is written so
+    /// that it goes through the same commit as the set: `None` when `path`
+    /// lies outside the set's folder (write it where it is), else its place
+    /// in the staging folder. A path that names one of the set's own files
+    /// (`reserved`, or the marker) or the folder itself is refused: the set
+    /// would overwrite it, or it the set.
+    pub fn place(&self, path: &Path, reserved: &[&str]) -> Result<Option<PathBuf>, OutputError> {
+        if path.as_os_str() == "-" {
+            return Ok(None);
+        }
+        let Ok(rel) = real_path(path)
+            .strip_prefix(real_path(&self.target))
+            .map(Path::to_path_buf)
+        else {
+            return Ok(None);
+        };
+        let first = rel
+            .components()
+            .next()
+            .map(|c| c.as_os_str().to_string_lossy().to_string());
+        match first {
+            None => Err(OutputError::IsAFolder {
+                path: path.to_path_buf(),
+            }),
+            Some(name) if name == MARKER || reserved.contains(&name.as_str()) => Err(OutputError::PartOfSet {
+                path: path.to_path_buf(),
+                set: self.target.clone(),
+                name,
+            }),
+            Some(_) => Ok(Some(self.staging.join(rel))),
+        }
     }
 
     /// Puts the finished set in place of the target folder; returns it.
@@ -284,20 +331,32 @@ impl ResultSet {
         .map_err(OutputError::io("writing", &marker))?;
         hold_for_tests();
         let staging = self.staging.clone();
+        // Where the old set goes when the two folders cannot be exchanged in
+        // one step; registered so that an interrupt removes it too.
+        let name = file_name(&target);
+        let old = parent_of(&target).join(format!(".{name}.old-{}", std::process::id()));
+        let _old_registered = Registered::new(&old);
         let swapped = while_locked(|| -> Result<Option<PathBuf>, OutputError> {
             if !target.exists() {
-                std::fs::rename(&staging, &target).map_err(OutputError::io("moving the results to", &target))?;
-                return Ok(None);
+                match std::fs::rename(&staging, &target) {
+                    Ok(()) => return Ok(None),
+                    // Another run put its set there since: exchange with it
+                    // (each set stays whole; the last to commit is kept).
+                    Err(e)
+                        if matches!(
+                            e.kind(),
+                            std::io::ErrorKind::DirectoryNotEmpty | std::io::ErrorKind::AlreadyExists
+                        ) && target.join(MARKER).is_file() => {}
+                    Err(e) => return Err(OutputError::io("moving the results to", &target)(e)),
+                }
             }
             if exchange(&staging, &target).map_err(OutputError::io("moving the results to", &target))? {
                 // The staging path now holds the old set.
                 return Ok(Some(staging.clone()));
             }
-            let name = file_name(&target);
-            let old = parent_of(&target).join(format!(".{name}.old-{}", std::process::id()));
             std::fs::rename(&target, &old).map_err(OutputError::io("moving the old results from", &target))?;
             std::fs::rename(&staging, &target).map_err(OutputError::io("moving the results to", &target))?;
-            Ok(Some(old))
+            Ok(Some(old.clone()))
         })?;
         if let Some(old) = swapped {
             let _ = std::fs::remove_dir_all(&old);
@@ -520,5 +579,56 @@ mod tests {
         s.commit_to(&failed).unwrap();
         assert_eq!(std::fs::read_to_string(out.join("a.csv")).unwrap(), "good");
         assert_eq!(std::fs::read_to_string(failed.join("a.csv")).unwrap(), "partial");
+    }
+
+    #[test]
+    fn a_single_file_inside_the_set_is_placed_in_the_staging_folder() {
+        let d = tempfile::tempdir().unwrap();
+        let out = d.path().join("out");
+        let s = ResultSet::begin(&out, |_| false).unwrap();
+        let reserved = ["summary.json"];
+        assert_eq!(s.place(&d.path().join("trace.json"), &reserved).unwrap(), None);
+        assert_eq!(s.place(Path::new("-"), &reserved).unwrap(), None);
+        assert_eq!(
+            s.place(&out.join("trace.json"), &reserved).unwrap(),
+            Some(s.dir().join("trace.json"))
+        );
+        assert_eq!(
+            s.place(&out.join("a/../b/t.json"), &reserved).unwrap(),
+            Some(s.dir().join("b/t.json"))
+        );
+        for bad in ["summary.json", "./summary.json", "x/../summary.json", MARKER] {
+            let e = s.place(&out.join(bad), &reserved).unwrap_err();
+            assert!(matches!(e, OutputError::PartOfSet { .. }), "{bad}: {e}");
+        }
+        let e = s.place(&out.join("."), &reserved).unwrap_err();
+        assert!(matches!(e, OutputError::IsAFolder { .. }), "{e}");
+        // Another spelling of the same folder, through a link.
+        #[cfg(unix)]
+        {
+            let link = d.path().join("link");
+            std::os::unix::fs::symlink(d.path(), &link).unwrap();
+            let e = s.place(&link.join("out/summary.json"), &reserved).unwrap_err();
+            assert!(matches!(e, OutputError::PartOfSet { .. }), "{e}");
+        }
+    }
+
+    #[test]
+    fn temporary_paths_of_dead_processes_are_removed_and_live_ones_kept() {
+        let d = tempfile::tempdir().unwrap();
+        // PIDs are below 2^22 on Linux; this one does not run.
+        let dead = d.path().join(".out.partial-4194999");
+        let dead_file = d.path().join(".t.json.tmp-4194998");
+        let live = d.path().join(format!(".out.partial-{}", std::process::id()));
+        let other = d.path().join(".other.partial-4194999");
+        for p in [&dead, &live, &other] {
+            std::fs::create_dir(p).unwrap();
+        }
+        std::fs::write(&dead_file, "x").unwrap();
+        crate::output::cleanup::remove_stale_temps(d.path(), "out", &["partial", "old"]);
+        crate::output::cleanup::remove_stale_temps(d.path(), "t.json", &["tmp"]);
+        assert!(!dead.exists() && !dead_file.exists());
+        assert!(live.exists(), "this process's own");
+        assert!(other.exists(), "another output's");
     }
 }

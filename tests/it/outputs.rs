@@ -393,3 +393,262 @@ fn a_trace_through_a_link_to_standard_output_is_written_in_place() {
     names.sort();
     assert_eq!(names, ["m.toml", "redirected.json", "stdout-link"]);
 }
+
+// --- A set is one thing; nothing is left behind (issue 29) ---
+
+/// Every name under `dir`, folders included, relative to it (sorted).
+fn tree(dir: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(p) = stack.pop() {
+        for e in std::fs::read_dir(&p).unwrap() {
+            let e = e.unwrap();
+            out.push(e.path().strip_prefix(dir).unwrap().display().to_string());
+            if e.file_type().unwrap().is_dir() {
+                stack.push(e.path());
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn a_trace_that_names_a_file_of_the_set_is_refused_before_simulating() {
+    let d = tempfile::tempdir().unwrap();
+    let m = model(d.path());
+    let out = d.path().join("out");
+    let o = out.to_str().unwrap();
+    ok(bin().args(["run", &m, "--seed", "1", "--out", o]));
+    let old = snapshot(&out);
+    for name in [
+        "summary.json",
+        "frames.csv",
+        "model.toml",
+        ".rendersim-set",
+        "./summary.json",
+        "../out/frames.csv",
+        "sub/../model.toml",
+    ] {
+        let trace = format!("{o}/{name}");
+        let e = err(bin().args(["run", &m, "--frames", "10000000", "--out", o, "--trace", &trace]));
+        assert!(
+            e.contains("is the result set's own") && e.contains(&trace),
+            "{name}: {e}"
+        );
+        assert_eq!(snapshot(&out), old, "{name}: the old set is untouched");
+        assert!(leftovers(d.path(), "out").is_empty(), "{name}");
+    }
+    // The folder itself is not a file.
+    let e = err(bin().args(["run", &m, "--out", o, "--trace", o]));
+    assert!(e.contains("is a folder"), "{e}");
+    // Any other name inside the set goes through the set's commit, in a
+    // subfolder too, and the set's own files are all there beside it.
+    ok(bin().args([
+        "run",
+        &m,
+        "--seed",
+        "2",
+        "--out",
+        o,
+        "--trace",
+        &format!("{o}/trace.json"),
+    ]));
+    ok(bin().args([
+        "run",
+        &m,
+        "--seed",
+        "3",
+        "--out",
+        o,
+        "--trace",
+        &format!("{o}/t/run.json"),
+    ]));
+    assert_eq!(
+        tree(&out),
+        [
+            ".rendersim-set",
+            "frames.csv",
+            "model.toml",
+            "summary.json",
+            "t",
+            "t/run.json"
+        ],
+        "the earlier set (with trace.json) was replaced whole"
+    );
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("t/run.json")).unwrap()).unwrap();
+    assert!(v["traceEvents"].as_array().unwrap().len() > 20);
+    assert!(leftovers(d.path(), "out").is_empty());
+}
+
+#[cfg(unix)]
+#[test]
+fn a_read_only_set_folder_is_refused_before_simulating() {
+    use std::os::unix::fs::PermissionsExt;
+    let d = tempfile::tempdir().unwrap();
+    let m = model(d.path());
+    let out = d.path().join("out");
+    let o = out.to_str().unwrap();
+    ok(bin().args(["run", &m, "--seed", "1", "--out", o]));
+    let old = snapshot(&out);
+    let set_mode = |mode| std::fs::set_permissions(&out, std::fs::Permissions::from_mode(mode)).unwrap();
+    set_mode(0o555);
+    let e = err(bin().args(["run", &m, "--frames", "10000000", "--out", o]));
+    assert!(e.contains("is read-only") && e.contains(o), "{e}");
+    set_mode(0o755);
+    assert_eq!(snapshot(&out), old);
+    assert!(leftovers(d.path(), "out").is_empty());
+    // A read-only folder inside a set (an experiment's plots, say) too.
+    let sub = out.join("plots");
+    std::fs::create_dir(&sub).unwrap();
+    std::fs::set_permissions(&sub, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let e = err(bin().args(["run", &m, "--out", o]));
+    assert!(e.contains("is read-only") && e.contains("plots"), "{e}");
+    std::fs::set_permissions(&sub, std::fs::Permissions::from_mode(0o755)).unwrap();
+    ok(bin().args(["run", &m, "--out", o]));
+    assert!(leftovers(d.path(), "out").is_empty());
+}
+
+/// `.NAME.tmp-PID` and `.NAME.partial-PID` names in `dir`.
+fn temps(dir: &Path) -> Vec<String> {
+    tree(dir)
+        .into_iter()
+        .filter(|n| n.contains(".tmp-") || n.contains(".partial-") || n.contains(".old-"))
+        .collect()
+}
+
+#[cfg(unix)]
+#[test]
+fn a_killed_trace_writer_leaves_a_temp_file_that_the_next_run_removes() {
+    let d = tempfile::tempdir().unwrap();
+    let m = model(d.path());
+    let trace = d.path().join("trace.json");
+    let t = trace.to_str().unwrap();
+    let mut child = bin()
+        .args(["run", &m, "--frames", "10000000", "--trace", t])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let tmp = d.path().join(format!(".trace.json.tmp-{}", child.id()));
+    wait_for("the trace's temporary file", || tmp.exists());
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(tmp.exists(), "SIGKILL cannot be caught");
+    // A temporary file of a process that still runs is not touched (this
+    // test's own process stands for one).
+    let live = d.path().join(format!(".trace.json.tmp-{}", std::process::id()));
+    std::fs::write(&live, "another writer's").unwrap();
+    ok(bin().args(["run", &m, "--trace", t]));
+    assert!(!tmp.exists(), "the dead writer's temporary file is removed");
+    assert!(live.exists());
+    std::fs::remove_file(&live).unwrap();
+    assert!(temps(d.path()).is_empty(), "{:?}", temps(d.path()));
+}
+
+/// SIGTERM at spread moments of runs that write a set and a trace (the
+/// commit window included): nothing temporary is ever left, and the set is
+/// the old one or the new one, whole.
+#[cfg(unix)]
+#[test]
+fn sigterm_at_any_moment_leaves_no_temporary_file() {
+    use rand::{Rng, SeedableRng};
+    let d = tempfile::tempdir().unwrap();
+    let m = model(d.path());
+    let out = d.path().join("out");
+    let o = out.to_str().unwrap();
+    let trace = d.path().join("trace.json");
+    ok(bin().args(["run", &m, "--out", o, "--trace", trace.to_str().unwrap()]));
+    let names = [".rendersim-set", "frames.csv", "model.toml", "summary.json"];
+    // How long one run takes here, to spread the signals over it.
+    let t0 = std::time::Instant::now();
+    ok(bin().args([
+        "run",
+        &m,
+        "--frames",
+        "3000",
+        "--out",
+        o,
+        "--trace",
+        trace.to_str().unwrap(),
+    ]));
+    let span = t0.elapsed().as_micros().max(1000) as u64;
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(29);
+    let mut ended_by_signal = 0;
+    for i in 0..40 {
+        let inside = i % 2 == 0;
+        let trace_path = if inside {
+            format!("{o}/trace.json")
+        } else {
+            trace.to_str().unwrap().to_string()
+        };
+        let mut child = bin()
+            .args(["run", &m, "--frames", "3000", "--out", o, "--trace", &trace_path])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_micros(rng.random_range(0..span + span / 4)));
+        signal(&child, libc::SIGTERM);
+        let status = child.wait().unwrap();
+        use std::os::unix::process::ExitStatusExt;
+        if status.code() == Some(128 + libc::SIGTERM) {
+            ended_by_signal += 1;
+        } else if status.signal() == Some(libc::SIGTERM) {
+            // Ended before its handler was in place: it had written nothing.
+        } else {
+            assert!(status.success(), "trial {i}: {status:?}");
+        }
+        assert!(temps(d.path()).is_empty(), "trial {i}: {:?}", temps(d.path()));
+        let files: Vec<String> = snapshot(&out).into_iter().map(|(n, _)| n).collect();
+        let mut want: Vec<&str> = names.to_vec();
+        if files.iter().any(|n| n == "trace.json") {
+            want.push("trace.json");
+            want.sort();
+        }
+        assert_eq!(files, want, "trial {i}: a whole set");
+    }
+    assert!(ended_by_signal > 0, "no run was interrupted: the spread is off");
+}
+
+/// Runs started at once into one absent folder all succeed, and leave one
+/// whole set and nothing else.
+#[test]
+fn concurrent_runs_into_an_absent_folder_all_succeed() {
+    let d = tempfile::tempdir().unwrap();
+    let m = model(d.path());
+    for trial in 0..8 {
+        let parent = d.path().join(format!("t{trial}"));
+        let out = parent.join("new/out");
+        let children: Vec<Child> = (0..6)
+            .map(|seed| {
+                bin()
+                    .args(["run", &m, "--seed", &seed.to_string(), "--out", out.to_str().unwrap()])
+                    .stdout(Stdio::null())
+                    .stderr(Stdio::piped())
+                    .spawn()
+                    .unwrap()
+            })
+            .collect();
+        for c in children {
+            let o = c.wait_with_output().unwrap();
+            assert!(
+                o.status.success(),
+                "trial {trial}: {}",
+                String::from_utf8_lossy(&o.stderr)
+            );
+        }
+        let files: Vec<String> = snapshot(&out).into_iter().map(|(n, _)| n).collect();
+        assert_eq!(files, [".rendersim-set", "frames.csv", "model.toml", "summary.json"]);
+        assert_eq!(
+            tree(&parent.join("new")),
+            [
+                "out",
+                "out/.rendersim-set",
+                "out/frames.csv",
+                "out/model.toml",
+                "out/summary.json"
+            ]
+        );
+    }
+}

@@ -232,6 +232,16 @@ fn shard_options_are_checked() {
         let e = err(&["experiment", s(&exp), "--out", s(&out), "--shard", bad]);
         assert!(e.contains(says), "{bad}: {e}");
     }
+    // More shards than runs: refused before the folder is made (a merge
+    // would otherwise size its bookkeeping by N).
+    for bad in ["1/13", "1/4294967296"] {
+        let e = err(&["experiment", s(&exp), "--out", s(&out), "--shard", bad]);
+        assert!(
+            e.contains("for an experiment of 12 runs; N can be at most 12"),
+            "{bad}: {e}"
+        );
+        assert!(!out.exists(), "{bad}");
+    }
     let e = err(&["experiment", s(&exp), "--out", s(&out), "--shard", "1/2", "--merge"]);
     assert!(e.contains("cannot be used with"), "{e}");
     let e = err(&["experiment", s(&exp), "--out", s(&out), "--shards", "4"]);
@@ -350,4 +360,102 @@ fn slurm_writes_an_array_and_a_merge_and_submit_chains_them() {
     let e = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{e}");
     assert!(e.contains("invalid partition") && e.contains("job.sbatch"), "{e}");
+}
+
+/// Shard files are read back like user input: counts bounded by the
+/// experiment before anything is sized by them, every run checked against
+/// the checksum written with it, so an edited file is neither merged nor
+/// taken as complete on a rerun.
+#[test]
+fn edited_shard_files_are_refused_and_redone() {
+    let d = tempfile::tempdir().unwrap();
+    let exp = experiment(d.path());
+    let out = d.path().join("out");
+    for k in 1..=3 {
+        ok(&[
+            "experiment",
+            s(&exp),
+            "--quiet",
+            "--out",
+            s(&out),
+            "--shard",
+            &format!("{k}/3"),
+        ]);
+    }
+    let merge = || err(&["experiment", s(&exp), "--quiet", "--out", s(&out), "--merge"]);
+    let shards = out.join("shards");
+    let names: Vec<PathBuf> = (1..=3).map(|k| shards.join(format!("shard-{k}-of-3.json"))).collect();
+    let texts: Vec<String> = names.iter().map(|p| std::fs::read_to_string(p).unwrap()).collect();
+    let restore = || {
+        for (p, t) in names.iter().zip(&texts) {
+            std::fs::write(p, t).unwrap();
+        }
+    };
+    // A shard count far beyond the runs, in every file (no allocation by it).
+    for (p, t) in names.iter().zip(&texts) {
+        std::fs::write(p, t.replace("\"shards\":3", "\"shards\":1000000000")).unwrap();
+    }
+    let e = merge();
+    assert!(
+        e.contains("shard-1-of-3.json") && e.contains("one of 1000000000 shards") && e.contains("1 to 12"),
+        "{e}"
+    );
+    restore();
+    // The whole experiment's run count edited.
+    std::fs::write(
+        &names[1],
+        texts[1].replace("\"total_runs\":12", "\"total_runs\":4000000000"),
+    )
+    .unwrap();
+    let e = merge();
+    assert!(e.contains("shard-2-of-3.json") && e.contains("4000000000 runs"), "{e}");
+    restore();
+    // A time that is not a number of seconds.
+    let t = &texts[2];
+    let start = t.find("\"cpu_seconds\":").unwrap();
+    let end = start + t[start..].find(',').unwrap();
+    std::fs::write(&names[2], format!("{}\"cpu_seconds\":-1{}", &t[..start], &t[end..])).unwrap();
+    let e = merge();
+    assert!(
+        e.contains("shard-3-of-3.json") && e.contains("`cpu_seconds` is -1"),
+        "{e}"
+    );
+    restore();
+    // A tracked value edited to NaN, inf, an overflow, or just another
+    // number: the runs no longer match their checksum.
+    let first_value = |t: &str| {
+        let at = t.find("\"values\":\"").unwrap() + "\"values\":\"".len();
+        let len = t[at..].find([' ', '"']).unwrap();
+        (at, len)
+    };
+    for edit in ["NaN", "inf", "1e400", "2.5e1"] {
+        let (at, len) = first_value(&texts[1]);
+        let edited = format!("{}{edit}{}", &texts[1][..at], &texts[1][at + len..]);
+        std::fs::write(&names[1], &edited).unwrap();
+        let e = merge();
+        assert!(
+            e.contains("shard-2-of-3.json") && e.contains("checksum") && e.contains("edited"),
+            "{edit}: {e}"
+        );
+        // A rerun of the edited shard redoes it instead of calling it complete.
+        let o = run(&["experiment", s(&exp), "--quiet", "--out", s(&out), "--shard", "2/3"]);
+        assert!(o.status.success(), "{edit}");
+        let (stdout, stderr) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+        assert!(!stdout.contains("already complete"), "{edit}: {stdout}");
+        assert!(
+            stderr.contains("redone") && stderr.contains("checksum"),
+            "{edit}: {stderr}"
+        );
+        ok(&["experiment", s(&exp), "--quiet", "--out", s(&out), "--merge"]);
+    }
+    // The rerun wrote the same values (same seeds, same bits) as the first time.
+    let now = std::fs::read_to_string(&names[1]).unwrap();
+    let values = |t: &str| {
+        t.split("\"values\":\"")
+            .skip(1)
+            .map(|v| v[..v.find('"').unwrap()].to_string())
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(values(&now), values(&texts[1]));
+    assert_eq!(values(&now).len(), 4);
 }
