@@ -1,5 +1,7 @@
 //! A seeded fuzz test of every input a user gives: model files, `--set`
-//! values, mesh specs with cache policies, and experiment files.
+//! values, mesh specs with cache policies, and experiment files (leaf values
+//! changed, here), and text-level damage to every kind of file rendersim
+//! reads, shard files and measurement CSVs included ([`text`]).
 //!
 //! Each case runs the real binary under a memory cap (RLIMIT_AS) and a hang
 //! guard, and must end in one of two ways:
@@ -11,9 +13,10 @@
 //! Anything else (a panic, an abort such as "memory allocation failed", a
 //! signal, a hang, a null number) fails the test, and the case is printed
 //! as a command line to paste into `tests/fuzz-regressions.txt`, whose cases
-//! run first on every run. `RENDERSIM_FUZZ_CASES` (default 2,000) and
+//! run first on every run. `RENDERSIM_FUZZ_CASES` (default 2,000 leaf-value
+//! cases), `RENDERSIM_FUZZ_TEXT_CASES` (default 1,000 text cases) and
 //! `RENDERSIM_FUZZ_SEED` (default 1) choose the cases; the counts are
-//! printed. The hang guard (60 s, against runs that normally take well under
+//! printed, by command and by verdict. The hang guard (60 s, against runs that normally take well under
 //! a second) only catches hangs; it is not a speed check.
 
 use std::io::Read;
@@ -25,6 +28,8 @@ use std::time::{Duration, Instant};
 use rand::{Rng, SeedableRng, seq::IndexedRandom};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
+
+mod text;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 /// Address-space cap per case.
@@ -41,6 +46,14 @@ struct Case {
     args: Vec<String>,
     files: Vec<(String, String)>,
     blame: Vec<String>,
+    /// Whether success must print a complete JSON summary.
+    json: bool,
+    /// Keys whose value may be `null` in that summary (an option not asked for).
+    allow_null: Vec<&'static str>,
+    /// Folders copied into the case's folder first (from, to).
+    copy: Vec<(PathBuf, String)>,
+    /// Files removed after the case (written outside the case's folder).
+    cleanup: Vec<PathBuf>,
 }
 
 impl Case {
@@ -281,6 +294,10 @@ fn model_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
         args,
         files,
         blame,
+        json: true,
+        allow_null: vec![],
+        copy: vec![],
+        cleanup: vec![],
     }
 }
 
@@ -345,6 +362,10 @@ fn mesh_case(rng: &mut Xoshiro256PlusPlus) -> Case {
         args: vec!["vcache".into(), mesh, "--policy".into(), policy, "--json".into()],
         files: vec![],
         blame,
+        json: true,
+        allow_null: vec![],
+        copy: vec![],
+        cleanup: vec![],
     }
 }
 
@@ -420,11 +441,18 @@ fn experiment_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
         ],
         files: vec![(name, body)],
         blame,
+        json: false,
+        allow_null: vec![],
+        copy: vec![],
+        cleanup: vec![],
     }
 }
 
 /// How a case ended, when it ended wrongly.
 fn judge(case: &Case, dir: &Path) -> Result<&'static str, String> {
+    for (from, to) in &case.copy {
+        copy_dir(from, &dir.join(to));
+    }
     for (name, text) in &case.files {
         std::fs::write(dir.join(name), text).unwrap();
     }
@@ -492,12 +520,12 @@ fn judge(case: &Case, dir: &Path) -> Result<&'static str, String> {
     }
     match status.code() {
         Some(0) => {
-            if case.args[0] == "experiment" {
+            if !case.json {
                 return Ok("ok");
             }
             let v: serde_json::Value =
                 serde_json::from_str(&stdout).map_err(|e| format!("success without a JSON summary ({e})"))?;
-            if let Some(path) = null_number(&v, "") {
+            if let Some(path) = null_number(&v, "", &case.allow_null) {
                 return Err(format!("null where a number belongs: `{path}`"));
             }
             Ok("ok")
@@ -526,25 +554,37 @@ fn judge(case: &Case, dir: &Path) -> Result<&'static str, String> {
 }
 
 /// The path of a `null` that is not an empty statistic (an object with
-/// `count: 0`), if any.
-fn null_number(v: &serde_json::Value, path: &str) -> Option<String> {
+/// `count: 0`) nor under a key of `allow`, if any.
+fn null_number(v: &serde_json::Value, path: &str, allow: &[&str]) -> Option<String> {
     match v {
         serde_json::Value::Null => Some(path.to_string()),
         serde_json::Value::Object(m) => {
             let empty_stat = m.get("count").and_then(|c| c.as_u64()) == Some(0);
             m.iter().find_map(|(k, x)| {
-                if empty_stat && x.is_null() {
+                if (empty_stat && x.is_null()) || allow.contains(&k.as_str()) {
                     None
                 } else {
-                    null_number(x, &format!("{path}.{k}"))
+                    null_number(x, &format!("{path}.{k}"), allow)
                 }
             })
         }
         serde_json::Value::Array(a) => a
             .iter()
             .enumerate()
-            .find_map(|(i, x)| null_number(x, &format!("{path}.{i}"))),
+            .find_map(|(i, x)| null_number(x, &format!("{path}.{i}"), allow)),
         _ => None,
+    }
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        if e.file_type().unwrap().is_dir() {
+            copy_dir(&e.path(), &to.join(e.file_name()));
+        } else {
+            std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+        }
     }
 }
 
@@ -588,9 +628,13 @@ fn regressions() -> Vec<Case> {
                 .collect();
             Case {
                 what: String::new(),
+                json: args.iter().any(|a| a == "--json"),
                 args,
                 files: vec![],
                 blame,
+                allow_null: vec![],
+                copy: vec![],
+                cleanup: vec![],
             }
         })
         .collect()
@@ -606,6 +650,12 @@ fn every_input_ends_in_a_result_or_a_clean_error() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(2000);
+    let text_count: usize = std::env::var("RENDERSIM_FUZZ_TEXT_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1000);
+    let dir = tempfile::tempdir().unwrap();
+    let tree = text::prepare(dir.path(), Path::new(env!("CARGO_BIN_EXE_rendersim")));
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let mut cases = regressions();
     let fixed = cases.len();
@@ -616,7 +666,9 @@ fn every_input_ends_in_a_result_or_a_clean_error() {
             _ => experiment_case(&mut rng, n),
         });
     }
-    let dir = tempfile::tempdir().unwrap();
+    for n in 0..text_count {
+        cases.push(text::case(&mut rng, n, &tree));
+    }
     let counts: Mutex<std::collections::BTreeMap<String, usize>> = Mutex::default();
     let failures: Mutex<Vec<(String, String)>> = Mutex::default();
     let slowest: Mutex<Vec<(f64, String)>> = Mutex::default();
@@ -625,7 +677,11 @@ fn every_input_ends_in_a_result_or_a_clean_error() {
         // Each case in a folder of its own (experiments write there).
         let d: PathBuf = dir.path().join(format!("c{i}"));
         std::fs::create_dir(&d).unwrap();
-        let kind = format!("{} ", case.args[0]);
+        let kind = format!(
+            "{}{} ",
+            case.args[0],
+            if case.what.starts_with("text:") { " (text)" } else { "" }
+        );
         let t0 = Instant::now();
         let verdict = judge(case, &d);
         slowest
@@ -649,11 +705,14 @@ fn every_input_ends_in_a_result_or_a_clean_error() {
             }
         }
         let _ = std::fs::remove_dir_all(&d);
+        for p in &case.cleanup {
+            let _ = std::fs::remove_file(p);
+        }
     });
     let counts = counts.into_inner().unwrap();
     let failures = failures.into_inner().unwrap();
     println!(
-        "fuzz: {} cases ({fixed} regression cases, {count} generated with seed {seed}) in {:.1} s",
+        "fuzz: {} cases ({fixed} regression cases, {count} leaf-value and {text_count} text cases generated with seed {seed}) in {:.1} s",
         cases.len(),
         started.elapsed().as_secs_f64()
     );
