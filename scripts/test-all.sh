@@ -56,7 +56,7 @@ step "Rust tests (unit, property, integration, doc; wgpu measurements on lavapip
 cargo test --release --locked --no-fail-fast --features wgpu -- --skip every_input_ends_in_a_result_or_a_clean_error 2>&1 | tee "$ci_out/test-output.txt"
 grep -q "test result:" "$ci_out/test-output.txt"
 
-step "Fuzz: 2,000 seeded cases of mutated models, --set values, meshes and experiments, plus the regression cases"
+step "Fuzz: 2,000 seeded leaf-value cases (models, --set values, meshes, experiments), 1,000 text-damage cases of every file kind read (models, devices, experiments, CSVs, instances, meshes, shard files), plus the regression cases"
 cargo test --release --locked --features wgpu --test it fuzz:: -- --nocapture
 
 step "Examples (each asserts what it shows)"
