@@ -379,6 +379,8 @@ pub fn case(rng: &mut Xoshiro256PlusPlus, n: usize, tree: &Tree) -> Case {
                 blame.push(b.split_once('=').unwrap().0.to_string());
             }
             blame.extend(["max_events".into(), "max_memory".into()]);
+            // A walkthrough scene without view cells has no view-cell size.
+            allow_null.push("view_cell_m");
             a.push("--json".into());
             a
         }
