@@ -8,7 +8,7 @@ use anyhow::{Context, Result, bail};
 use serde_json::json;
 
 use rendersim::config::{ModelSource, load_model};
-use rendersim::output::files::open_output;
+use rendersim::output::files::{check_distinct, open_output};
 use rendersim::output::result_set::ResultSet;
 use rendersim::output::text::fixed;
 use rendersim::output::trace::TraceWriter;
@@ -36,6 +36,9 @@ const RUN_FILES: [&str; 3] = ["summary.json", "frames.csv", "model.toml"];
 
 /// `rendersim run`.
 pub fn run(args: RunArgs) -> Result<()> {
+    if let (Some(m), Some(t)) = (&args.model, &args.trace) {
+        check_distinct(&[("MODEL", m), ("--trace", t)])?;
+    }
     let model = load_model(args.model.as_deref(), &(&args).into())?;
     for note in &model.notes {
         eprintln!("note: {note}");
@@ -260,6 +263,12 @@ pub fn vcache(args: VcacheArgs) -> Result<()> {
 
 /// `rendersim calibrate`.
 pub fn calibrate(args: CalibrateArgs) -> Result<()> {
+    let mut files: Vec<(&str, &Path)> = args.files.iter().map(|f| ("FILES", f.as_path())).collect();
+    files.push(("--out", &args.out));
+    if let Some(r) = &args.report {
+        files.push(("--report", r));
+    }
+    check_distinct(&files)?;
     device::calibrate(&args)
 }
 
@@ -312,6 +321,9 @@ pub fn measure(_args: MeasureArgs) -> Result<()> {
 pub fn study(args: StudyArgs) -> Result<()> {
     use rendersim::measure::passes::{append_passes, check_appendable};
     use rendersim::measure::{Gpu, studies};
+    if let (Some(m), Some(c)) = (&args.markdown, &args.csv) {
+        check_distinct(&[("--markdown", m), ("--csv", c)])?;
+    }
     if args.name == super::args::Study::Estimation {
         return study_estimation(args);
     }

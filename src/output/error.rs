@@ -67,6 +67,16 @@ pub enum OutputError {
         /// The set's file it names.
         name: String,
     },
+    /// Two files of one command name the same place.
+    #[error("{second} {path} names the same file as {first}; give each its own file")]
+    SameFile {
+        /// The option (or argument) given first.
+        first: String,
+        /// The option naming the same place again.
+        second: String,
+        /// The path as given to `second`.
+        path: PathBuf,
+    },
     /// A symbolic link chain that does not end.
     #[error("{path}: too many levels of symbolic links")]
     LinkLoop {

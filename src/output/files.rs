@@ -64,6 +64,60 @@ pub fn resolve_links(path: &Path) -> Result<PathBuf, OutputError> {
     })
 }
 
+/// `p` with every part that exists resolved to its real path (links, `.`
+/// and `..`) and the rest normalized as written: so two spellings of one
+/// place compare equal even before the place exists.
+pub fn real_path(p: &Path) -> PathBuf {
+    use std::path::Component;
+    let Ok(abs) = std::path::absolute(p) else {
+        return p.to_path_buf();
+    };
+    let mut cur = PathBuf::new();
+    for c in abs.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                if let Ok(real) = cur.canonicalize() {
+                    cur = real;
+                }
+                cur.pop();
+            }
+            other => {
+                cur.push(other.as_os_str());
+                if std::fs::symlink_metadata(&cur).is_ok()
+                    && let Ok(real) = cur.canonicalize()
+                {
+                    cur = real;
+                }
+            }
+        }
+    }
+    cur
+}
+
+/// Refuses two of a command's files, `(option, path)`, that name one place
+/// (an output that would overwrite an input or another output). Standard
+/// output (`-`) and paths under `/dev` or `/proc` are not compared: they
+/// are streams, written in place.
+pub fn check_distinct(files: &[(&str, &Path)]) -> Result<(), OutputError> {
+    let places: Vec<Option<PathBuf>> = files
+        .iter()
+        .map(|(_, p)| (p.as_os_str() != "-" && !is_system_path(p)).then(|| real_path(p)))
+        .collect();
+    for (j, b) in places.iter().enumerate() {
+        for (i, a) in places[..j].iter().enumerate() {
+            if a.is_some() && a == b {
+                return Err(OutputError::SameFile {
+                    first: files[i].0.to_string(),
+                    second: files[j].0.to_string(),
+                    path: files[j].1.to_path_buf(),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Whether `p` lies under `/dev` or `/proc`, whose links (`/dev/stdout` ->
 /// `/proc/self/fd/1` -> `pipe:[...]` or the file a shell opened) name open
 /// files of a process rather than places to put a file.
@@ -294,6 +348,21 @@ mod tests {
         use std::os::unix::fs::FileTypeExt;
         assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
         assert!(matches!(destination(d.path()), Err(OutputError::IsAFolder { .. })));
+    }
+
+    #[test]
+    fn two_files_of_one_command_naming_one_place_are_refused() {
+        let d = tempfile::tempdir().unwrap();
+        let a = d.path().join("a.csv");
+        std::fs::write(&a, "x").unwrap();
+        let same = d.path().join("sub/../a.csv");
+        let e = check_distinct(&[("FILES", &a), ("--out", &d.path().join("p.toml")), ("--report", &same)]).unwrap_err();
+        assert!(
+            e.to_string().contains("--report") && e.to_string().contains("FILES"),
+            "{e}"
+        );
+        check_distinct(&[("FILES", &a), ("--out", &d.path().join("p.toml"))]).unwrap();
+        check_distinct(&[("--markdown", Path::new("-")), ("--csv", Path::new("-"))]).unwrap();
     }
 
     #[cfg(unix)]

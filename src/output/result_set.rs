@@ -43,7 +43,7 @@ use std::path::{Path, PathBuf};
 
 use super::cleanup::{Registered, create_registered, remove_stale_temps, while_locked};
 use super::error::OutputError;
-use super::files::resolve_links;
+use super::files::{real_path, resolve_links};
 
 /// The marker file in every result set.
 pub const MARKER: &str = ".rendersim-set";
@@ -140,37 +140,6 @@ fn check_writable(target: &Path) -> Result<(), OutputError> {
         }
     }
     Ok(())
-}
-
-/// `p` with every part that exists resolved to its real path (links, `.`
-/// and `..`) and the rest normalized as written: so two spellings of one
-/// place compare equal even before the place exists.
-fn real_path(p: &Path) -> PathBuf {
-    use std::path::Component;
-    let Ok(abs) = std::path::absolute(p) else {
-        return p.to_path_buf();
-    };
-    let mut cur = PathBuf::new();
-    for c in abs.components() {
-        match c {
-            Component::CurDir => {}
-            Component::ParentDir => {
-                if let Ok(real) = cur.canonicalize() {
-                    cur = real;
-                }
-                cur.pop();
-            }
-            other => {
-                cur.push(other.as_os_str());
-                if std::fs::symlink_metadata(&cur).is_ok()
-                    && let Ok(real) = cur.canonicalize()
-                {
-                    cur = real;
-                }
-            }
-        }
-    }
-    cur
 }
 
 /// `p` as an absolute path that ends in a name (so it has a parent to stage

@@ -652,3 +652,49 @@ fn concurrent_runs_into_an_absent_folder_all_succeed() {
         );
     }
 }
+
+#[test]
+fn an_output_that_names_an_input_or_another_output_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let m = model(d.path());
+    let before = std::fs::read(&m).unwrap();
+    let e = err(bin().args(["run", &m, "--trace", &m]));
+    assert!(
+        e.contains("--trace") && e.contains("names the same file as MODEL"),
+        "{e}"
+    );
+    let e = err(bin().args([
+        "run",
+        &m,
+        "--trace",
+        &format!("{m}/../../{}/m.toml", d.path().file_name().unwrap().to_str().unwrap()),
+    ]));
+    assert!(e.contains("names the same file as MODEL"), "{e}");
+    assert_eq!(std::fs::read(&m).unwrap(), before, "the model file is as it was");
+    let csv = d.path().join("passes.csv");
+    std::fs::write(
+        &csv,
+        "mesh,size,vs_loops,fs_loops,geometry_only,vs_invocations,fs_invocations,pass_time_ns\n",
+    )
+    .unwrap();
+    let c = csv.to_str().unwrap();
+    let e = err(bin().args(["calibrate", c, "--out", c]));
+    assert!(e.contains("--out") && e.contains("names the same file as FILES"), "{e}");
+    let p = d.path().join("p.toml");
+    let e = err(bin().args([
+        "calibrate",
+        c,
+        "--out",
+        p.to_str().unwrap(),
+        "--report",
+        p.to_str().unwrap(),
+    ]));
+    assert!(
+        e.contains("--report") && e.contains("names the same file as --out"),
+        "{e}"
+    );
+    assert!(
+        std::fs::read_to_string(&csv).unwrap().starts_with("mesh,size"),
+        "the input is as it was"
+    );
+}
