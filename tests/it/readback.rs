@@ -199,7 +199,7 @@ fn lod_instances_name_file_line_and_key() {
 }
 
 #[test]
-fn mesh_files_naming_billions_of_vertices_are_refused() {
+fn mesh_files_with_billions_of_vertices_or_nan_positions_are_refused() {
     let d = tempfile::tempdir().unwrap();
     let f = fixture("huge-index.idx");
     let dev = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/devices/llvmpipe.toml");
@@ -218,4 +218,11 @@ fn mesh_files_naming_billions_of_vertices_are_refused() {
     );
     let e = refused(d.path(), &["vcache", f.to_str().unwrap(), "--policy", "fifo:24"]);
     assert!(e.contains("huge-index.idx"), "{e}");
+    // An OBJ position that is not a number.
+    let f = fixture("nan-position.obj");
+    let e = refused(d.path(), &["vcache", f.to_str().unwrap(), "--policy", "fifo:8"]);
+    assert!(
+        e.contains("nan-position.obj` at line 3") && e.contains("`nan` is not a finite number"),
+        "{e}"
+    );
 }
