@@ -193,7 +193,9 @@ fn lod_instances_name_file_line_and_key() {
     let f = fixture("huge-benefits.toml");
     let e = refused(d.path(), &["lod-select", f.to_str().unwrap(), "--json"]);
     assert!(
-        e.contains(&format!("{}:7: key `objects.1.levels.0.benefit`: ", f.display())) && e.contains("infinite"),
+        e.contains(&format!("{}:7: key `objects.1.levels.0.benefit`: ", f.display()))
+            && e.contains("benefit 1.2e308 makes the sum")
+            && e.contains("infinite"),
         "{e}"
     );
 }

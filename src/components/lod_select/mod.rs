@@ -104,7 +104,7 @@ impl Algorithm {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LodSelectError {
     /// A benefit is negative, NaN or infinite.
-    #[error("object {object:?} (objects[{index}]) level {level}: benefit {value} {why}")]
+    #[error("object {object:?} (objects[{index}]) level {level}: benefit {value:?} {why}")]
     Benefit {
         /// Object name.
         object: String,
