@@ -18,6 +18,12 @@ pub const DEFAULT_MAX_MEMORY: u64 = 8 << 30;
 /// `random:T:V:SEED`): 2^28, a 1 GiB index buffer (a 6689 x 6689 grid).
 pub const MAX_MESH_INDICES: u64 = 1 << 28;
 
+/// Most vertices of a mesh (`random:T:V:SEED`'s V, an `.idx` file's
+/// largest index + 1, an `.obj` file's vertices): 2^28. Coverage counting
+/// and the caches keep a few bytes per vertex, so a file of three indices
+/// naming vertex 4,000,000,000 would otherwise ask for 32 GiB.
+pub const MAX_MESH_VERTICES: u64 = 1 << 28;
+
 /// Most objects in a frame-pipeline scene (the sum of every group's
 /// `count`, a preset's objects times `workload.scale` included): draws are
 /// indexed with 32 bits, and each costs about 100 bytes to compile.

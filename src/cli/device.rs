@@ -9,11 +9,11 @@ use anyhow::{Context, Result};
 use serde_json::json;
 
 use rendersim::measure::calibrate::{
-    Invocations, LoadCache, error_summary, fit, held_out_half, leave_one_out, leave_one_out_ns, linear_baseline_loo,
-    read_rows, row_load,
+    CalibrateError, Invocations, LoadCache, error_summary, fit, held_out_half, leave_one_out, leave_one_out_ns,
+    linear_baseline_loo, read_rows_with_origins, row_load,
 };
 use rendersim::measure::device_predict::{DevicePass, predict_on_device};
-use rendersim::measure::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy};
+use rendersim::measure::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy, ProfileError};
 use rendersim::measure::fit::rel_error_pct;
 use rendersim::measure::predictions::predict_rows;
 
@@ -40,13 +40,18 @@ fn today() -> String {
 
 /// `rendersim calibrate`.
 pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
-    let mut rows = Vec::new();
+    let (mut rows, mut origins) = (Vec::new(), Vec::new());
     for f in &args.files {
-        rows.extend(read_rows(f)?);
+        let (r, o) = read_rows_with_origins(f)?;
+        rows.extend(r);
+        origins.extend(o);
     }
     let start = Instant::now();
     let mut cache = LoadCache::default();
-    cache.prefetch(&rows, &args.vertex_cache)?;
+    // A mesh that cannot be built is reported at the first row naming it.
+    cache
+        .prefetch(&rows, &args.vertex_cache)
+        .map_err(|e| e.at_row(&rows, &origins))?;
     let mut fit_loads = Vec::with_capacity(rows.len());
     let mut predict_loads = Vec::with_capacity(rows.len());
     for r in &rows {
@@ -97,6 +102,11 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
             loo_p90_pct: loo_summary.map(|s| s.0.1),
         },
     };
+    // What is written must read back: the checks `predict` applies to a
+    // profile file, before anything is written.
+    if let Err(ProfileError::Invalid { key, value, why }) = profile.validate() {
+        return Err(CalibrateError::Profile { key, value, why }.into());
+    }
     let files: Vec<String> = args.files.iter().map(|p| p.display().to_string()).collect();
     let mut header = vec![
         format!(

@@ -39,14 +39,81 @@ pub enum CalibrateError {
         message: String,
     },
     /// Not enough rows to fit the costs.
-    #[error("{0} rows are too few to fit a device profile (at least 12)")]
+    #[error("{0} rows are too few to fit a device profile (at least {MIN_ROWS})")]
     TooFewRows(usize),
+    /// The fit gave a number that is not finite (no profile is made of it).
+    #[error("the fit of {rows} rows gives {what} = {value}, not a finite number; no profile is written")]
+    NotFinite {
+        /// Rows fitted.
+        rows: usize,
+        /// What is not finite (`costs.vertex_ns`, `uncertainty.vertex_ns`, `objective`).
+        what: String,
+        /// Its value.
+        value: f64,
+    },
+    /// A pass time given to the fit that is not a finite number of
+    /// nanoseconds above 0.
+    #[error("row {row} (0-based) has the pass time {value} ns; a fit needs finite times above 0")]
+    BadTime {
+        /// The row, 0-based.
+        row: usize,
+        /// Its time.
+        value: f64,
+    },
+    /// The profile made of the fit breaks a rule a profile file must keep
+    /// ([`super::device_profile::DeviceProfile::validate`]).
+    #[error("the fitted profile has {key} = {value}: {why}; no profile is written")]
+    Profile {
+        /// The profile key.
+        key: String,
+        /// Its value.
+        value: String,
+        /// What it must be.
+        why: String,
+    },
 }
+
+/// The fewest rows [`fit`] fits a profile to.
+pub const MIN_ROWS: usize = 12;
 
 /// Reads the rows of one CSV file (the one pass-CSV reader,
 /// [`super::passes::read_passes`]).
 pub fn read_rows(path: &Path) -> Result<Vec<PassRow>, CalibrateError> {
     Ok(super::passes::read_passes(path)?)
+}
+
+/// Where a row was read: its file and 1-based line.
+pub type RowOrigin = (std::path::PathBuf, u64);
+
+/// [`read_rows`], each row's file and line beside it, so that an error
+/// found later (a mesh that cannot be built) names the row
+/// ([`CalibrateError::at_row`]).
+pub fn read_rows_with_origins(path: &Path) -> Result<(Vec<PassRow>, Vec<RowOrigin>), CalibrateError> {
+    Ok(super::passes::read_passes_with_lines(path)?
+        .into_iter()
+        .map(|(r, line)| (r, (path.to_path_buf(), line)))
+        .unzip())
+}
+
+impl CalibrateError {
+    /// A mesh error as the CSV error of the first row that names the mesh
+    /// (file, line, column 1 `mesh`); other errors unchanged. `origins` is
+    /// parallel to `rows`.
+    pub fn at_row(self, rows: &[PassRow], origins: &[RowOrigin]) -> CalibrateError {
+        match self {
+            CalibrateError::Mesh { spec, message } => match rows.iter().zip(origins).find(|(r, _)| r.mesh == spec) {
+                Some((_, (path, line))) => CalibrateError::Csv(super::passes::PassCsvError::Row {
+                    path: path.clone(),
+                    line: *line,
+                    column: 1,
+                    name: "mesh".into(),
+                    message,
+                }),
+                None => CalibrateError::Mesh { spec, message },
+            },
+            other => other,
+        }
+    }
 }
 
 /// The vertex work of one draw of a mesh under a cache policy.
@@ -348,8 +415,11 @@ fn nnls(rows: &[[f64; P]], y: &[f64]) -> ([f64; P], [f64; P], f64) {
 /// `max(clear, geometry)` each row is on is iterated to a fixed point
 /// (starting from both terms summed), keeping the best fit visited.
 pub fn fit(loads: &[PassLoad], y: &[f64]) -> Result<Fit, CalibrateError> {
-    if loads.len() < 12 {
+    if loads.len() < MIN_ROWS {
         return Err(CalibrateError::TooFewRows(loads.len()));
+    }
+    if let Some((row, &value)) = y.iter().enumerate().find(|(_, t)| !t.is_finite() || **t <= 0.0) {
+        return Err(CalibrateError::BadTime { row, value });
     }
     let mut side = vec![0u8; loads.len()];
     let mut best: Option<([f64; P], [f64; P], f64)> = None;
@@ -375,6 +445,7 @@ pub fn fit(loads: &[PassLoad], y: &[f64]) -> Result<Fit, CalibrateError> {
     }
     let (b, se, objective) = best.unwrap_or(([0.0; P], [0.0; P], f64::INFINITY));
     let costs = DeviceCosts::from_array(&b);
+    check_finite(&costs, &se, objective, loads.len())?;
     Ok(Fit {
         costs,
         std_errors: costs
@@ -385,6 +456,24 @@ pub fn fit(loads: &[PassLoad], y: &[f64]) -> Result<Fit, CalibrateError> {
             .collect(),
         objective,
     })
+}
+
+/// A fit whose numbers are not finite (a load or time beyond what f64
+/// sums) is an error, never a profile.
+fn check_finite(costs: &DeviceCosts, se: &[f64; P], objective: f64, rows: usize) -> Result<(), CalibrateError> {
+    let not_finite = |what: String, value: f64| CalibrateError::NotFinite { rows, what, value };
+    for ((key, v), s) in costs.entries().iter().zip(se) {
+        if !v.is_finite() {
+            return Err(not_finite(format!("costs.{key}"), *v));
+        }
+        if !s.is_finite() {
+            return Err(not_finite(format!("uncertainty.{key}"), *s));
+        }
+    }
+    if !objective.is_finite() {
+        return Err(not_finite("objective".into(), objective));
+    }
+    Ok(())
 }
 
 /// Median, 90th percentile and worst of |errors|.
@@ -514,6 +603,69 @@ mod tests {
             (b[0] - 5.0).abs() < 1e-9 && (b[2] - 2.0).abs() < 1e-9 && obj < 1e-20,
             "{b:?}"
         );
+    }
+
+    fn synthetic() -> (Vec<PassLoad>, Vec<f64>) {
+        let loads: Vec<PassLoad> = (1..=20)
+            .map(|i| PassLoad {
+                pixels: 4096.0 * f64::from(i),
+                vertices: 81.0 * f64::from(i % 5 + 1),
+                vertex_batches: 3.0,
+                triangles: 128.0,
+                vs_loops: f64::from(i % 3),
+                fs_loops: f64::from(i % 4),
+                coverage: Coverage {
+                    fragments: 4096,
+                    quads: 1024,
+                    warps: 128,
+                    triangles: 128,
+                    drawn_triangles: 128,
+                },
+            })
+            .collect();
+        let y = loads.iter().map(|l| 1000.0 + l.pixels * 0.5 + l.vertices).collect();
+        (loads, y)
+    }
+
+    #[test]
+    fn a_fit_refuses_bad_times_and_never_returns_non_finite_costs() {
+        let (loads, y) = synthetic();
+        let f = fit(&loads, &y).unwrap();
+        assert!(f.costs.to_array().iter().all(|c| c.is_finite()) && f.objective.is_finite());
+        for bad in [f64::NAN, f64::INFINITY, -1.0, 0.0] {
+            let mut t = y.clone();
+            t[3] = bad;
+            let e = fit(&loads, &t).unwrap_err();
+            assert!(matches!(e, CalibrateError::BadTime { row: 3, .. }), "{bad}: {e}");
+        }
+        // Loads beyond what f64 sums give an error or finite costs, never
+        // a profile of NaN.
+        for (i, big) in [f64::INFINITY, f64::MAX, 1e300].into_iter().enumerate() {
+            let mut huge = loads.clone();
+            huge[i].pixels = big;
+            huge[i + 1].vertices = big;
+            huge[i + 2].fs_loops = big;
+            if let Ok(f) = fit(&huge, &y) {
+                assert!(f.costs.to_array().iter().all(|c| c.is_finite()), "{f:?}");
+                assert!(f.objective.is_finite(), "{f:?}");
+            }
+        }
+        // The guard itself.
+        let ok = DeviceCosts::from_array(&[1.0; P]);
+        assert!(check_finite(&ok, &[0.5; P], 1.0, 20).is_ok());
+        let mut b = [1.0; P];
+        b[2] = f64::NAN;
+        let e = check_finite(&DeviceCosts::from_array(&b), &[0.5; P], 1.0, 20).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "the fit of 20 rows gives costs.vertex_ns = NaN, not a finite number; no profile is written"
+        );
+        let mut se = [0.5; P];
+        se[13] = f64::INFINITY;
+        let e = check_finite(&ok, &se, 1.0, 20).unwrap_err().to_string();
+        assert!(e.contains("uncertainty.fragment_loop_latency_ns = inf"), "{e}");
+        let e = check_finite(&ok, &[0.5; P], f64::NAN, 20).unwrap_err().to_string();
+        assert!(e.contains("objective = NaN"), "{e}");
     }
 
     #[test]

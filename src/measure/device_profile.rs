@@ -135,27 +135,24 @@ pub enum ProfileError {
         /// Why.
         source: std::io::Error,
     },
-    /// Not TOML of this shape.
-    #[error("device profile {path}: {message}")]
-    Parse {
-        /// The file.
-        path: PathBuf,
-        /// The parser's message (names the key).
-        message: String,
-    },
-    /// A value out of range.
-    #[error("device profile {path}: {key} = {value}: {why}")]
+    /// Not TOML of this shape, or a value out of range: names the file,
+    /// the line and the key (the model files' machinery, `config::load`).
+    #[error(transparent)]
+    Config(#[from] crate::config::ConfigError),
+    /// A profile value out of range (a profile not read from a file).
+    #[error("device profile: {key} = {value}: {why}")]
     Invalid {
-        /// The file.
-        path: PathBuf,
         /// The key.
         key: String,
         /// Its value.
         value: String,
         /// What it must be.
-        why: &'static str,
+        why: String,
     },
 }
+
+/// Most shader cores a profile may give (as `gpu.shader_cores`).
+pub const MAX_SHADER_CORES: u32 = 1 << 20;
 
 /// What a pass is made of, for the cost formula.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
@@ -324,50 +321,319 @@ impl DeviceProfile {
         Self::parse(&text, path)
     }
 
-    /// Parses and validates profile text (`path` names it in errors).
+    /// Parses and validates profile text (`path` names it in errors): every
+    /// error names the file, the line and the key.
     pub fn parse(text: &str, path: &Path) -> Result<DeviceProfile, ProfileError> {
-        let p: DeviceProfile = toml::from_str(text).map_err(|e| ProfileError::Parse {
-            path: path.to_path_buf(),
-            message: e.to_string().trim_end().to_string(),
-        })?;
-        let bad = |key: &str, value: String, why| ProfileError::Invalid {
-            path: path.to_path_buf(),
-            key: key.to_string(),
-            value,
-            why,
-        };
-        for (key, v) in p.costs.entries() {
-            if !v.is_finite() || v < 0.0 {
-                return Err(bad(
-                    &format!("costs.{key}"),
-                    v.to_string(),
-                    "must be a finite number >= 0",
-                ));
-            }
-        }
-        if p.device.shader_cores == 0 {
-            return Err(bad("device.shader_cores", "0".into(), "must be at least 1"));
-        }
-        if let Err(e) = p
-            .device
-            .vertex_cache
-            .parse::<crate::components::vertex_cache::CachePolicy>()
-        {
-            return Err(ProfileError::Invalid {
-                path: path.to_path_buf(),
-                key: "device.vertex_cache".into(),
-                value: format!("{:?} ({e})", p.device.vertex_cache),
-                why: "must be a vertex-cache policy",
-            });
+        let src = crate::config::ModelSource::from_text(&path.display().to_string(), text);
+        let table = src.table()?;
+        let p: DeviceProfile = crate::config::deserialize(&table, &src)?;
+        if let Err(ProfileError::Invalid { key, value, why }) = p.validate() {
+            return Err(crate::config::invalid(&src, &key, format!("{value}: {why}"), None).into());
         }
         Ok(p)
     }
 
+    /// The checks every profile keeps, read ([`DeviceProfile::parse`]) or
+    /// about to be written (`rendersim calibrate`): a known vertex-cache
+    /// policy; 1 to [`MAX_SHADER_CORES`] shader cores; every cost finite and
+    /// non-negative, and not all zero (such a profile predicts 0 ns for
+    /// every pass); standard errors only of costs, finite and non-negative;
+    /// at least [`super::calibrate::MIN_ROWS`] rows; the error statistics
+    /// finite, non-negative and ordered (median <= 90th percentile <=
+    /// worst). The error is [`ProfileError::Invalid`] naming the key.
+    pub fn validate(&self) -> Result<(), ProfileError> {
+        let bad = |key: &str, value: String, why: &str| {
+            Err(ProfileError::Invalid {
+                key: key.to_string(),
+                value,
+                why: why.to_string(),
+            })
+        };
+        if let Err(e) = self
+            .device
+            .vertex_cache
+            .parse::<crate::components::vertex_cache::CachePolicy>()
+        {
+            return bad(
+                "device.vertex_cache",
+                format!("{:?}", self.device.vertex_cache),
+                &format!("must be a vertex-cache policy ({e})"),
+            );
+        }
+        let cores = self.device.shader_cores;
+        if !(1..=MAX_SHADER_CORES).contains(&cores) {
+            return bad(
+                "device.shader_cores",
+                cores.to_string(),
+                &format!("must be between 1 and {MAX_SHADER_CORES}"),
+            );
+        }
+        for (key, v) in self.costs.entries() {
+            if !v.is_finite() || v < 0.0 {
+                return bad(&format!("costs.{key}"), v.to_string(), "must be a finite number >= 0");
+            }
+        }
+        if self.costs.entries().iter().all(|(_, v)| *v == 0.0) {
+            return bad(
+                "costs",
+                "0 for every cost".into(),
+                "such a profile predicts 0 ns for every pass; at least one cost must be above 0",
+            );
+        }
+        let keys = self.costs.entries().map(|(k, _)| k);
+        for (key, v) in &self.uncertainty {
+            if !keys.contains(&key.as_str()) {
+                return bad(
+                    &format!("uncertainty.{key}"),
+                    v.to_string(),
+                    "is no cost key; standard errors are given per cost (the keys of [costs])",
+                );
+            }
+            if !v.is_finite() || *v < 0.0 {
+                return bad(
+                    &format!("uncertainty.{key}"),
+                    v.to_string(),
+                    "must be a finite number >= 0",
+                );
+            }
+        }
+        let f = &self.fit;
+        let min_rows = super::calibrate::MIN_ROWS;
+        if f.rows < min_rows {
+            return bad(
+                "fit.rows",
+                f.rows.to_string(),
+                &format!("a profile is fitted to at least {min_rows} rows"),
+            );
+        }
+        let stats = [
+            ("fit.median_pct", Some(f.median_pct)),
+            ("fit.p90_pct", Some(f.p90_pct)),
+            ("fit.worst_pct", Some(f.worst_pct)),
+            ("fit.loo_median_pct", f.loo_median_pct),
+            ("fit.loo_p90_pct", f.loo_p90_pct),
+        ];
+        for (key, v) in stats {
+            if let Some(v) = v
+                && (!v.is_finite() || v < 0.0)
+            {
+                return bad(key, v.to_string(), "must be a finite percentage >= 0");
+            }
+        }
+        if f.p90_pct < f.median_pct {
+            return bad(
+                "fit.p90_pct",
+                f.p90_pct.to_string(),
+                "must not be below fit.median_pct (a 90th percentile is at least the median)",
+            );
+        }
+        if f.worst_pct < f.p90_pct {
+            return bad(
+                "fit.worst_pct",
+                f.worst_pct.to_string(),
+                "must not be below fit.p90_pct (the worst error is at least the 90th percentile)",
+            );
+        }
+        if let (Some(m), Some(p)) = (f.loo_median_pct, f.loo_p90_pct)
+            && p < m
+        {
+            return bad("fit.loo_p90_pct", p.to_string(), "must not be below fit.loo_median_pct");
+        }
+        Ok(())
+    }
+
     /// The file text: `header` (comment lines, `# ` added) then the TOML.
+    /// Control characters in `header` (a newline in a `--name`) are
+    /// written escaped (`\n`), so each header line stays one comment line;
+    /// the values are TOML-escaped, so [`DeviceProfile::parse`] reads back
+    /// what was written.
     pub fn to_toml(&self, header: &[String]) -> String {
-        let mut s: String = header.iter().map(|l| format!("# {l}\n")).collect();
+        let comment = |l: &String| -> String {
+            l.chars()
+                .map(|c| {
+                    if c.is_control() {
+                        c.escape_default().collect()
+                    } else {
+                        c.to_string()
+                    }
+                })
+                .collect()
+        };
+        let mut s: String = header.iter().map(|l| format!("# {}\n", comment(l))).collect();
         s.push('\n');
         s.push_str(&toml::to_string_pretty(self).unwrap_or_default());
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn shipped(name: &str) -> (String, PathBuf) {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/devices").join(name);
+        (std::fs::read_to_string(&path).unwrap(), path)
+    }
+
+    /// The text with the first line starting `key = ` replaced by `line`.
+    fn edit(text: &str, key: &str, line: &str) -> String {
+        let mut done = false;
+        text.lines()
+            .map(|l| {
+                if !done && l.starts_with(&format!("{key} = ")) {
+                    done = true;
+                    format!("{line}\n")
+                } else {
+                    format!("{l}\n")
+                }
+            })
+            .collect()
+    }
+
+    fn line_of(text: &str, key: &str) -> usize {
+        text.lines().position(|l| l.starts_with(&format!("{key} = "))).unwrap() + 1
+    }
+
+    #[test]
+    fn the_shipped_profiles_read_and_validate() {
+        for name in ["nvidia-h200.toml", "llvmpipe.toml"] {
+            let (text, path) = shipped(name);
+            let p = DeviceProfile::parse(&text, &path).unwrap();
+            p.validate().unwrap();
+            // Written again, read back the same.
+            let again = DeviceProfile::parse(&p.to_toml(&["x".into()]), &path).unwrap();
+            assert_eq!(again, p, "{name}");
+        }
+    }
+
+    #[test]
+    fn bad_values_name_file_line_and_key() {
+        let (text, _) = shipped("nvidia-h200.toml");
+        let path = Path::new("dev.toml");
+        for (key, value, want) in [
+            ("worst_pct", "nan", "key `fit.worst_pct`: NaN"),
+            ("worst_pct", "inf", "key `fit.worst_pct`: inf"),
+            ("median_pct", "-1.0", "key `fit.median_pct`: -1"),
+            (
+                "p90_pct",
+                "0.5",
+                "key `fit.p90_pct`: 0.5: must not be below fit.median_pct",
+            ),
+            ("loo_median_pct", "nan", "key `fit.loo_median_pct`"),
+            ("loo_p90_pct", "-inf", "key `fit.loo_p90_pct`"),
+            ("rows", "0", "key `fit.rows`: 0"),
+            ("rows", "-3", "fit.rows"),
+            ("vertex_ns", "nan", "key `costs.vertex_ns`: NaN"),
+            ("vertex_ns", "-inf", "key `costs.vertex_ns`"),
+            ("fragment_ns", "-1e-9", "key `costs.fragment_ns`"),
+            ("shader_cores", "0", "key `device.shader_cores`: 0"),
+            ("shader_cores", "4294967295", "key `device.shader_cores`: 4294967295"),
+            ("vertex_cache", "\"bogus\"", "key `device.vertex_cache`"),
+        ] {
+            let bad = edit(&text, key, &format!("{key} = {value}"));
+            let line = line_of(&bad, key);
+            let e = DeviceProfile::parse(&bad, path).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("dev.toml:{line}: ")), "{key} = {value}: {e}");
+            assert!(e.contains(want), "{key} = {value}: {want:?} not in {e}");
+        }
+        // A standard error of no cost, or a bad one.
+        let bad = text.replace("[uncertainty]\n", "[uncertainty]\nwarp_ns = 1.0\n");
+        let e = DeviceProfile::parse(&bad, path).unwrap_err().to_string();
+        assert!(
+            e.contains("key `uncertainty.warp_ns`") && e.contains("no cost key"),
+            "{e}"
+        );
+        let (head, tail) = text.split_at(text.find("[uncertainty]").unwrap());
+        let bad = format!("{head}{}", edit(tail, "vertex_ns", "vertex_ns = nan"));
+        let e = DeviceProfile::parse(&bad, path).unwrap_err().to_string();
+        assert!(e.contains("uncertainty.vertex_ns") && e.contains("NaN"), "{e}");
+        // Every cost zero: predicts nothing.
+        let mut zero = text.clone();
+        for (k, _) in DeviceCosts::default().entries() {
+            zero = edit(&zero, k, &format!("{k} = 0.0"));
+        }
+        let e = DeviceProfile::parse(&zero, path).unwrap_err().to_string();
+        assert!(e.contains("key `costs`") && e.contains("0 ns for every pass"), "{e}");
+        // Syntax and unknown keys: the file and line too.
+        let e = DeviceProfile::parse("[device]\nname = \"x\"\n[device]: y\n", path)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("dev.toml: malformed TOML") && e.contains("line 3"), "{e}");
+        let e = DeviceProfile::parse(
+            &text.replace("vertex_loop_latency_ns", "vertex_loop_latency_nanos"),
+            path,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("dev.toml:") && e.contains("costs.vertex_loop_latency_nanos"),
+            "{e}"
+        );
+    }
+
+    fn profile(name: String, costs: [f64; COSTS], stats: [f64; 3], loo: Option<(f64, f64)>) -> DeviceProfile {
+        let mut s = stats;
+        s.sort_by(f64::total_cmp);
+        let mut costs = costs;
+        costs[0] = costs[0].max(1e-3);
+        DeviceProfile {
+            device: DeviceInfo {
+                name,
+                vertex_cache: "fifo:32".into(),
+                shader_cores: 132,
+            },
+            costs: DeviceCosts::from_array(&costs),
+            uncertainty: DeviceCosts::from_array(&costs)
+                .entries()
+                .iter()
+                .map(|(k, v)| (k.to_string(), v / 3.0))
+                .collect(),
+            fit: FitAccuracy {
+                rows: 95,
+                median_pct: s[0],
+                p90_pct: s[1],
+                worst_pct: s[2],
+                loo_median_pct: loo.map(|(a, b)| a.min(b)),
+                loo_p90_pct: loo.map(|(a, b)| a.max(b)),
+            },
+        }
+    }
+
+    fn names() -> impl Strategy<Value = String> {
+        prop_oneof![
+            any::<String>(),
+            "[ -~]{0,20}",
+            Just("x\n[device]".to_string()),
+            Just("quote \" and ' and ''' and \"\"\" and \\ back\\slash".to_string()),
+            Just("trailing newline\n".to_string()),
+            Just("\r\n\t\u{0}\u{7f}\u{85}\u{2028}\u{feff}".to_string()),
+            Just("ünïcødé 🎮 日本語".to_string()),
+            Just("\n".to_string()),
+            Just(String::new()),
+        ]
+    }
+
+    proptest! {
+        /// Whatever calibrate writes, `parse` reads back to the same values
+        /// (names with newlines, quotes, backslashes, unicode; any finite
+        /// non-negative numbers).
+        #[test]
+        fn what_calibrate_writes_reads_back(
+            name in names(),
+            costs in proptest::array::uniform14(prop_oneof![Just(0.0), 0.0f64..1e6, 0.0f64..f64::MAX]),
+            stats in proptest::array::uniform3(0.0f64..1e6),
+            loo in proptest::option::of((0.0f64..1e6, 0.0f64..1e6)),
+        ) {
+            let p = profile(name.clone(), costs, stats, loo);
+            p.validate().unwrap();
+            let header = vec![format!("Device profile {name}: fitted by a test."), "Files: a.csv.".to_string()];
+            let text = p.to_toml(&header);
+            let back = DeviceProfile::parse(&text, Path::new("p.toml"));
+            prop_assert!(back.is_ok(), "{:?}\n{}", back.err().map(|e| e.to_string()), text);
+            prop_assert_eq!(back.unwrap(), p);
+            // The header stays comment lines.
+            prop_assert_eq!(text.lines().take_while(|l| !l.is_empty()).count(), 2, "{}", text);
+        }
     }
 }

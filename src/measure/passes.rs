@@ -292,17 +292,116 @@ fn csv_io(e: csv::Error, action: &'static str, path: &Path) -> PassCsvError {
     }
 }
 
+/// Largest target side a row may give (as `rendersim predict --size`).
+pub const MAX_TARGET_SIDE: u32 = 16384;
+
+/// Longest pass time a row may give: one hour, in nanoseconds (a render
+/// pass of a measurement takes milliseconds; drivers end one that runs for
+/// seconds).
+pub const MAX_PASS_TIME_NS: f64 = 3.6e12;
+
 /// Reads every row of a pass CSV. The header must be [`PASS_HEADER`]; a
-/// field that does not parse is reported with its file, line and column.
+/// field that does not parse, or a value no measurement gives (a time that
+/// is not a finite number of nanoseconds above 0, a zero target side, a
+/// mesh no spec rebuilds, no vertex-shader invocations), is reported with
+/// its file, line and column.
 pub fn read_passes(path: &Path) -> Result<Vec<PassRow>, PassCsvError> {
+    Ok(read_passes_with_lines(path)?.into_iter().map(|(r, _)| r).collect())
+}
+
+/// [`read_passes`], each row with its 1-based line in the file (for errors
+/// found later, such as a mesh file that cannot be built).
+pub fn read_passes_with_lines(path: &Path) -> Result<Vec<(PassRow, u64)>, PassCsvError> {
     let file = std::fs::File::open(path).map_err(io("reading", path))?;
-    read_passes_from(file, path)
+    read_passes_lines_from(file, path)
 }
 
 /// [`read_passes`] from any reader; `path` names it in errors.
 pub fn read_passes_from(reader: impl std::io::Read, path: &Path) -> Result<Vec<PassRow>, PassCsvError> {
-    let mut r = csv::ReaderBuilder::new().has_headers(true).from_reader(reader);
-    let header = r.headers().map_err(|e| row_error(e, path))?.clone();
+    Ok(read_passes_lines_from(reader, path)?
+        .into_iter()
+        .map(|(r, _)| r)
+        .collect())
+}
+
+/// Checks the values of a row that parsed: `(column, message)` of the first
+/// value no measurement gives.
+fn check_row(row: &PassRow) -> Result<(), (usize, String)> {
+    let mesh = row.mesh.trim();
+    if mesh.is_empty() {
+        return Err((
+            1,
+            "is empty; give the mesh spec the pass drew (grid:96x96, a .idx file, ...)".into(),
+        ));
+    }
+    if mesh.chars().any(char::is_control) {
+        return Err((1, format!("{mesh:?} holds a control character")));
+    }
+    if !is_mesh_spec(mesh) {
+        return Err((
+            1,
+            format!("{mesh:?} is no mesh spec (grid:WxH, strip:WxH, random:T:V:SEED, or a .obj or .idx file)"),
+        ));
+    }
+    let TargetSize { width, height } = row.size;
+    if width == 0 || height == 0 || width > MAX_TARGET_SIDE || height > MAX_TARGET_SIDE {
+        return Err((
+            2,
+            format!("{width}x{height}: width and height must be 1..{MAX_TARGET_SIDE}"),
+        ));
+    }
+    if row.vs_invocations == 0 {
+        return Err((
+            6,
+            "0: a pass that draws a triangle runs the vertex shader at least once".into(),
+        ));
+    }
+    let t = row.pass_time_ns;
+    if !t.is_finite() || t <= 0.0 {
+        return Err((8, format!("{t}: must be a finite number of nanoseconds above 0")));
+    }
+    if t > MAX_PASS_TIME_NS {
+        return Err((
+            8,
+            format!("{t}: more than {MAX_PASS_TIME_NS:e} ns (one hour); no render pass takes that long"),
+        ));
+    }
+    Ok(())
+}
+
+fn read_passes_lines_from(mut reader: impl std::io::Read, path: &Path) -> Result<Vec<(PassRow, u64)>, PassCsvError> {
+    // Lines are counted here from the bytes: the csv reader counts a CRLF
+    // file's lines one short after its first record (the shared H200 files
+    // are CRLF).
+    let mut bytes = Vec::new();
+    reader.read_to_end(&mut bytes).map_err(io("reading", path))?;
+    let newlines: Vec<u64> = bytes
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| **b == b'\n')
+        .map(|(i, _)| i as u64)
+        .collect();
+    // A record's position may point at the line ending before it (after a
+    // CRLF) or at blank lines the reader skips: its line is that of its
+    // first byte that ends no line.
+    let line_at = |p: Option<&csv::Position>| {
+        p.map_or(0, |p| {
+            let start = bytes
+                .iter()
+                .skip(p.byte() as usize)
+                .position(|b| *b != b'\r' && *b != b'\n')
+                .map_or(bytes.len() as u64, |i| p.byte() + i as u64);
+            newlines.partition_point(|&n| n < start) as u64 + 1
+        })
+    };
+    let row_error = |e: csv::Error| {
+        let line = line_at(e.position());
+        row_error(e, path, line)
+    };
+    let mut r = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .from_reader(bytes.as_slice());
+    let header = r.headers().map_err(row_error)?.clone();
     if header.iter().ne(COLUMNS) {
         return Err(PassCsvError::NotPasses {
             path: path.to_path_buf(),
@@ -311,10 +410,22 @@ pub fn read_passes_from(reader: impl std::io::Read, path: &Path) -> Result<Vec<P
     }
     let mut rows = Vec::new();
     for record in r.records() {
-        let record = record.map_err(|e| row_error(e, path))?;
-        let line = record.position().map_or(0, |p| p.line());
-        let raw: RawRow = record.deserialize(Some(&header)).map_err(|e| row_error(e, path))?;
-        rows.push(raw.row(path, line)?);
+        let record = record.map_err(row_error)?;
+        let line = line_at(record.position());
+        let raw: RawRow = record.deserialize(Some(&header)).map_err(|e| {
+            // A deserialize error carries no position: the record's.
+            let l = e.position().map_or(line, |p| line_at(Some(p)));
+            self::row_error(e, path, l)
+        })?;
+        let row = raw.row(path, line)?;
+        check_row(&row).map_err(|(column, message)| PassCsvError::Row {
+            path: path.to_path_buf(),
+            line,
+            column: column as u64,
+            name: COLUMNS[column - 1].to_string(),
+            message,
+        })?;
+        rows.push((row, line));
     }
     Ok(rows)
 }
@@ -355,10 +466,9 @@ impl RawRow {
     }
 }
 
-/// A csv error as a [`PassCsvError`] naming line and column.
-fn row_error(e: csv::Error, path: &Path) -> PassCsvError {
+/// A csv error as a [`PassCsvError`] naming `line` and the column.
+fn row_error(e: csv::Error, path: &Path, line: u64) -> PassCsvError {
     let path = path.to_path_buf();
-    let line = e.position().map_or(0, |p| p.line());
     match e.into_kind() {
         csv::ErrorKind::Io(source) => PassCsvError::Io {
             action: "reading",
@@ -534,6 +644,96 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(missing.starts_with("reading /nonexistent/passes.csv: "), "{missing}");
+    }
+
+    #[test]
+    fn values_no_measurement_gives_name_file_line_and_column() {
+        let bad = |cells: &str| {
+            read_passes_from(
+                format!("{PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,1.0\n{cells}\n").as_bytes(),
+                Path::new("x.csv"),
+            )
+            .unwrap_err()
+            .to_string()
+        };
+        for (cells, want) in [
+            ("grid:8x8,64x64,0,0,false,81,4096,nan", "column 8 (pass_time_ns): NaN"),
+            ("grid:8x8,64x64,0,0,false,81,4096,NaN", "column 8 (pass_time_ns): NaN"),
+            ("grid:8x8,64x64,0,0,false,81,4096,inf", "column 8 (pass_time_ns): inf"),
+            ("grid:8x8,64x64,0,0,false,81,4096,-inf", "column 8 (pass_time_ns): -inf"),
+            ("grid:8x8,64x64,0,0,false,81,4096,-5", "column 8 (pass_time_ns): -5"),
+            ("grid:8x8,64x64,0,0,false,81,4096,0", "column 8 (pass_time_ns): 0"),
+            ("grid:8x8,64x64,0,0,false,81,4096,-0.0", "column 8 (pass_time_ns)"),
+            ("grid:8x8,64x64,0,0,false,81,4096,1e400", "column 8 (pass_time_ns): inf"),
+            ("grid:8x8,64x64,0,0,false,81,4096,1e13", "one hour"),
+            (
+                "grid:axb,64x64,0,0,false,81,4096,1.0",
+                "column 1 (mesh): \"grid:axb\" is no mesh spec",
+            ),
+            ("probe,64x64,0,0,false,81,4096,1.0", "column 1 (mesh)"),
+            (",64x64,0,0,false,81,4096,1.0", "column 1 (mesh): is empty"),
+            ("grid:8x8,0x64,0,0,false,81,4096,1.0", "column 2 (size): 0x64"),
+            ("grid:8x8,64x99999,0,0,false,81,4096,1.0", "column 2 (size): 64x99999"),
+            ("grid:8x8,64x64,0,0,false,0,4096,1.0", "column 6 (vs_invocations): 0"),
+            ("grid:8x8,64x64,0,0,false,-1,4096,1.0", "column 6 (vs_invocations)"),
+            ("grid:8x8,64x64,0,0,false,81,-1,1.0", "column 7 (fs_invocations)"),
+            ("grid:8x8,64x64,0,4294967296,false,81,1,1.0", "column 4 (fs_loops)"),
+        ] {
+            let e = bad(cells);
+            assert!(e.starts_with("x.csv: line 3, column "), "{cells}: {e}");
+            assert!(e.contains(want), "{cells}: {want:?} not in {e}");
+        }
+        // The largest values a measurement can give still read.
+        let ok = read_passes_from(
+            format!("{PASS_HEADER}\ngrid:8x8,16384x16384,4294967295,4294967295,true,1,0,3.6e12\n").as_bytes(),
+            Path::new("x.csv"),
+        )
+        .unwrap();
+        assert_eq!(ok[0].pass_time_ns, 3.6e12);
+    }
+
+    #[test]
+    fn rows_carry_their_lines() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.csv");
+        std::fs::write(
+            &path,
+            format!("{PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,1.0\n\"grid:8x8\",64x64,0,0,false,81,4096,2.0\n"),
+        )
+        .unwrap();
+        let rows = read_passes_with_lines(&path).unwrap();
+        assert_eq!(rows.iter().map(|(_, l)| *l).collect::<Vec<_>>(), [2, 3]);
+        // CRLF line endings (the shared H200 files): the file's own line
+        // numbers, for rows and for every kind of error.
+        let crlf = format!(
+            "{PASS_HEADER}\r\ngrid:8x8,64x64,0,0,false,81,4096,1.0\r\ngrid:8x8,64x64,0,0,false,81,4096,2.0\r\ngrid:8x8,64x64,0,0,false,81,4096,nan\r\n"
+        );
+        let e = read_passes_from(crlf.as_bytes(), Path::new("c.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("c.csv: line 4, column 8 (pass_time_ns)"), "{e}");
+        let e = read_passes_from(crlf.replace("nan", "fast").as_bytes(), Path::new("c.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("c.csv: line 4, column 8 (pass_time_ns)"), "{e}");
+        let e = read_passes_from(crlf.replace(",nan", "").as_bytes(), Path::new("c.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("c.csv: line 4, column 0 (row)"), "{e}");
+        let rows = read_passes_lines_from(crlf.replace("nan", "3.0").as_bytes(), Path::new("c.csv")).unwrap();
+        assert_eq!(rows.iter().map(|(_, l)| *l).collect::<Vec<_>>(), [2, 3, 4]);
+        // A quoted cell holding a line break: the line the record starts on.
+        let multi = crlf.replace(
+            "grid:8x8,64x64,0,0,false,81,4096,2.0",
+            "\"grid:\n8x8\",64x64,0,0,false,81,4096,2.0",
+        );
+        let e = read_passes_from(multi.as_bytes(), Path::new("c.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("c.csv: line 3, column 1 (mesh)") && e.contains("control"),
+            "{e}"
+        );
     }
 
     #[test]

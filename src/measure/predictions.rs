@@ -153,6 +153,9 @@ pub fn calibrate_rows(
             loo_p90_pct: Some(lp),
         },
     };
+    if let Err(super::device_profile::ProfileError::Invalid { key, value, why }) = profile.validate() {
+        return Err(CalibrateError::Profile { key, value, why });
+    }
     Ok(Calibration {
         profile,
         loo_ns,

@@ -88,6 +88,7 @@ pub fn mesh_from_spec(spec: &str, base_dir: &Path) -> Result<Mesh, MeshError> {
             nonzero(t, "triangle count", spec)?;
             nonzero(u64::from(v), "vertex count", spec)?;
             check_indices(t.checked_mul(3), spec)?;
+            check_vertices(u64::from(v), spec, "")?;
             Ok(random(t, v, seed, spec))
         }
         _ => Err(unknown()),
@@ -139,6 +140,17 @@ fn check_indices(count: Option<u64>, spec: &str) -> Result<(), MeshError> {
             indices: count.map_or_else(|| "more than 2^64".to_string(), |n| n.to_string()),
         }),
     }
+}
+
+fn check_vertices(vertices: u64, name: &str, what: &'static str) -> Result<(), MeshError> {
+    if vertices > crate::limits::MAX_MESH_VERTICES {
+        return Err(MeshError::TooManyVertices {
+            name: name.to_string(),
+            vertices,
+            what,
+        });
+    }
+    Ok(())
 }
 
 /// Parses `WxH` and checks that a grid of that size fits the index limit
@@ -261,7 +273,15 @@ fn load_idx(path: &Path, name: &str) -> Result<Mesh, MeshError> {
         let content = line.split('#').next().unwrap_or("");
         for token in content.split_whitespace() {
             match token.parse::<u32>() {
-                Ok(i) if i != RESTART => indices.push(i),
+                Ok(i) if i != RESTART => {
+                    if indices.len() as u64 >= MAX_INDICES {
+                        return Err(MeshError::TooLarge {
+                            spec: format!("{} (at line {})", path.display(), n + 1),
+                            indices: format!("at least {}", MAX_INDICES + 1),
+                        });
+                    }
+                    indices.push(i)
+                }
                 _ => {
                     return Err(MeshError::IdxToken {
                         path: path.to_path_buf(),
@@ -286,6 +306,13 @@ fn finish_file(path: &Path, name: &str, indices: Vec<u32>, vertex_count: u32) ->
     if indices.len() < 3 {
         return Err(MeshError::Empty(path.display().to_string()));
     }
+    check_indices(Some(indices.len() as u64), &path.display().to_string())?;
+    let what = if name.to_ascii_lowercase().ends_with(".idx") {
+        " (its largest index + 1)"
+    } else {
+        " (its `v` lines, or distinct corners)"
+    };
+    check_vertices(u64::from(vertex_count), &path.display().to_string(), what)?;
     let mesh = Mesh {
         name: name.to_string(),
         topology: Topology::TriangleList,

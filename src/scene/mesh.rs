@@ -84,6 +84,19 @@ pub enum MeshError {
         /// The indices it would have (or "more than 2^64").
         indices: String,
     },
+    /// The mesh would have too many vertices.
+    #[error(
+        "mesh `{name}` has {vertices} vertices{what}, more than the limit of {}",
+        crate::limits::MAX_MESH_VERTICES
+    )]
+    TooManyVertices {
+        /// The spec or file.
+        name: String,
+        /// Its vertex count.
+        vertices: u64,
+        /// Where the count comes from (` (its largest index + 1)`), or empty.
+        what: &'static str,
+    },
     /// A mesh file does not exist.
     #[error("mesh file `{}` not found", .0.display())]
     FileNotFound(PathBuf),

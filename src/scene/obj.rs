@@ -67,6 +67,9 @@ pub enum ObjError {
         /// Elements of that kind defined before the face.
         count: u64,
     },
+    /// A `v`, `vt` or `vn` number that is NaN or infinite (`nan`, `inf`, `1e400`).
+    #[error("`{0}` is not a finite number (positions, texcoords and normals must be finite)")]
+    NotFinite(String),
     /// More vertices than 32-bit indices (below the restart marker) can address.
     #[error("more vertices than 32-bit indices can address")]
     TooManyVertices,
@@ -194,8 +197,10 @@ fn count_numbers<'a>(
 ) -> Result<(), ObjError> {
     let mut n = 0;
     for w in words {
-        if w.parse::<f64>().is_err() {
-            return Err(error);
+        match w.parse::<f64>() {
+            Err(_) => return Err(error),
+            Ok(v) if !v.is_finite() => return Err(ObjError::NotFinite(w.to_string())),
+            Ok(_) => {}
         }
         n += 1;
     }

@@ -28,6 +28,7 @@ mod obj_files;
 mod outputs;
 mod pipeline_oracles;
 mod pixelflow;
+mod readback;
 mod shards;
 mod sortbuf;
 mod state_sorting;

@@ -10,7 +10,9 @@
 //! Durations are read by the project's unit parser ([`Duration::parse`]: a
 //! unit is required, `0` alone is allowed). Unknown keys, a missing budget,
 //! an object without levels, duplicate names, negative or non-finite
-//! benefits and costs that do not parse are errors naming the object (by
+//! benefits, benefits whose sum is not finite, and costs that do not parse
+//! are errors naming the file, the line and dotted key of the value
+//! (`objects.2.levels.0.benefit`, as model files do), and the object (by
 //! name and index) and the level. An instance without `[[objects]]` is
 //! valid and empty.
 //!
@@ -71,32 +73,60 @@ fn duration(v: &toml::Value) -> Result<Duration, String> {
     }
 }
 
-/// Parses an instance file's text.
+/// Parses an instance file's text. Errors name the key and its line
+/// (`instance:4: key `objects.0.levels.1.benefit`: ...`); [`read_instance`]
+/// names the file instead of `instance`.
 pub fn parse_instance(text: &str) -> Result<Instance, LodSelectError> {
-    let raw: RawInstance =
-        toml::from_str(text).map_err(|e| LodSelectError::File(e.to_string().trim_end().to_string()))?;
-    build(raw)
+    parse_toml(text, "instance")
+}
+
+/// [`parse_instance`] with `file` naming the text in errors.
+fn parse_toml(text: &str, file: &str) -> Result<Instance, LodSelectError> {
+    let src = crate::config::ModelSource::from_text(file, text);
+    let table = src.table().map_err(|e| LodSelectError::File(e.to_string()))?;
+    let raw: RawInstance = crate::config::deserialize(&table, &src).map_err(|e| LodSelectError::File(e.to_string()))?;
+    build(raw).map_err(|(key, e)| LodSelectError::At {
+        file: file.to_string(),
+        line: src.line_of(&key),
+        key,
+        source: Box::new(e),
+    })
 }
 
 /// Parses the same instance written as JSON (`{"budget": "10ms", "objects":
 /// [{"name": ..., "levels": [{"cost": "0.4ms", "benefit": 1.0}]}]}`), for
 /// large generated instances: the toml crate reads about 6 MB/s, so a
-/// 10,000-object TOML file takes longer to read than to select.
+/// 10,000-object TOML file takes longer to read than to select. Errors
+/// name the key (and, for text that does not parse, line and column).
 pub fn parse_instance_json(text: &str) -> Result<Instance, LodSelectError> {
-    let raw: RawInstance = serde_json::from_str(text).map_err(|e| LodSelectError::File(e.to_string()))?;
-    build(raw)
+    parse_json(text, "instance")
 }
 
-fn build(raw: RawInstance) -> Result<Instance, LodSelectError> {
-    let budget = duration(&raw.budget).map_err(|r| LodSelectError::File(format!("budget: {r}")))?;
+fn parse_json(text: &str, file: &str) -> Result<Instance, LodSelectError> {
+    let raw: RawInstance = serde_json::from_str(text).map_err(|e| LodSelectError::File(format!("{file}: {e}")))?;
+    build(raw).map_err(|(key, e)| LodSelectError::At {
+        file: file.to_string(),
+        line: None,
+        key,
+        source: Box::new(e),
+    })
+}
+
+/// The instance, or the dotted key of the value that is wrong and why.
+fn build(raw: RawInstance) -> Result<Instance, (String, LodSelectError)> {
+    let budget =
+        duration(&raw.budget).map_err(|r| ("budget".to_string(), LodSelectError::File(format!("budget {r}"))))?;
     let mut seen: HashMap<&str, usize> = HashMap::new();
     for (i, o) in raw.objects.iter().enumerate() {
         if let Some(&first) = seen.get(o.name.as_str()) {
-            return Err(LodSelectError::DuplicateName {
-                name: o.name.clone(),
-                first,
-                second: i,
-            });
+            return Err((
+                format!("objects.{i}.name"),
+                LodSelectError::DuplicateName {
+                    name: o.name.clone(),
+                    first,
+                    second: i,
+                },
+            ));
         }
         seen.insert(&o.name, i);
     }
@@ -104,11 +134,16 @@ fn build(raw: RawInstance) -> Result<Instance, LodSelectError> {
     for (index, o) in raw.objects.iter().enumerate() {
         let mut levels = Vec::with_capacity(o.levels.len());
         for (level, l) in o.levels.iter().enumerate() {
-            let cost = duration(&l.cost).map_err(|reason| LodSelectError::Cost {
-                object: o.name.clone(),
-                index,
-                level,
-                reason,
+            let cost = duration(&l.cost).map_err(|reason| {
+                (
+                    format!("objects.{index}.levels.{level}.cost"),
+                    LodSelectError::Cost {
+                        object: o.name.clone(),
+                        index,
+                        level,
+                        reason,
+                    },
+                )
             })?;
             levels.push(Level {
                 cost,
@@ -120,21 +155,25 @@ fn build(raw: RawInstance) -> Result<Instance, LodSelectError> {
             levels,
         });
     }
-    Instance::new(budget, objects)
+    Instance::new(budget, objects).map_err(|e| {
+        let key = match &e {
+            LodSelectError::Benefit { index, level, .. } => format!("objects.{index}.levels.{level}.benefit"),
+            LodSelectError::NoLevels { index, .. } => format!("objects.{index}.levels"),
+            _ => "objects".to_string(),
+        };
+        (key, e)
+    })
 }
 
 /// Reads and parses an instance file: JSON when its name ends in `.json`,
-/// TOML otherwise.
+/// TOML otherwise. Errors name the file, the key and (TOML) its line.
 pub fn read_instance(path: &std::path::Path) -> Result<Instance, LodSelectError> {
     let text =
         std::fs::read_to_string(path).map_err(|e| LodSelectError::File(format!("reading {}: {e}", path.display())))?;
-    let parsed = if path.extension().is_some_and(|e| e == "json") {
-        parse_instance_json(&text)
+    let file = path.display().to_string();
+    if path.extension().is_some_and(|e| e == "json") {
+        parse_json(&text, &file)
     } else {
-        parse_instance(&text)
-    };
-    parsed.map_err(|e| match e {
-        LodSelectError::File(m) => LodSelectError::File(format!("{}: {m}", path.display())),
-        other => other,
-    })
+        parse_toml(&text, &file)
+    }
 }

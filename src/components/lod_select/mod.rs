@@ -104,7 +104,7 @@ impl Algorithm {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LodSelectError {
     /// A benefit is negative, NaN or infinite.
-    #[error("object {object:?} (objects[{index}]) level {level}: benefit {value} {why}")]
+    #[error("object {object:?} (objects[{index}]) level {level}: benefit {value:?} {why}")]
     Benefit {
         /// Object name.
         object: String,
@@ -192,12 +192,28 @@ pub enum LodSelectError {
     /// An instance file could not be read or parsed.
     #[error("{0}")]
     File(String),
+    /// A value of an instance file is wrong: the file, the line (TOML) and
+    /// the dotted key (`objects.2.levels.0.benefit`) of the value, and why.
+    #[error("{file}{}: key `{key}`: {source}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    At {
+        /// The file (`instance` for text given without one).
+        file: String,
+        /// 1-based line of the key, where it stands in the file.
+        line: Option<usize>,
+        /// Dotted key of the wrong value.
+        key: String,
+        /// What is wrong.
+        source: Box<LodSelectError>,
+    },
 }
 
 impl Instance {
     /// Validates and builds an instance: every benefit finite and
-    /// non-negative, every object with at least one level.
+    /// non-negative, every object with at least one level, and the sum of
+    /// every object's largest benefit finite (so no total or gap of a
+    /// selection is infinite or NaN).
     pub fn new(budget: Duration, objects: Vec<LodObject>) -> Result<Instance, LodSelectError> {
+        let mut best_sum = 0.0f64;
         for (index, o) in objects.iter().enumerate() {
             if o.levels.is_empty() {
                 return Err(LodSelectError::NoLevels {
@@ -227,6 +243,23 @@ impl Instance {
                         why,
                     });
                 }
+            }
+            let (level, best) = o
+                .levels
+                .iter()
+                .enumerate()
+                .map(|(i, l)| (i, l.benefit))
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap_or((0, 0.0));
+            best_sum += best;
+            if !best_sum.is_finite() {
+                return Err(LodSelectError::Benefit {
+                    object: o.name.clone(),
+                    index,
+                    level,
+                    value: best,
+                    why: "makes the sum of the objects' largest benefits infinite; benefits must add up to a finite number",
+                });
             }
         }
         Ok(Instance { budget, objects })

@@ -222,3 +222,68 @@ fn json_instances_read_like_toml() {
         "{e}"
     );
 }
+
+#[test]
+fn instance_errors_name_the_line_and_key() {
+    let text = "budget = \"1ms\"\n[[objects]]\nname = \"a\"\nlevels = [{ cost = \"1ms\", benefit = 1.0 }]\n[[objects]]\nname = \"b\"\nlevels = [\n  { cost = \"1ms\", benefit = 1.0 },\n  { cost = \"2ms\", benefit = nan },\n]\n";
+    let e = parse_instance(text).unwrap_err().to_string();
+    assert!(
+        e.starts_with("instance:9: key `objects.1.levels.1.benefit`: object \"b\" (objects[1]) level 1: benefit NaN"),
+        "{e}"
+    );
+    let e = parse_instance(&text.replace("nan", "-inf")).unwrap_err().to_string();
+    assert!(
+        e.contains("key `objects.1.levels.1.benefit`") && e.contains("infinite"),
+        "{e}"
+    );
+    let e = parse_instance(&text.replace("\"2ms\"", "\"-2ms\"").replace("nan", "1"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("instance:9: key `objects.1.levels.1.cost`: "), "{e}");
+    let e = parse_instance("budget = \"1e30s\"\n").unwrap_err().to_string();
+    assert!(e.starts_with("instance:1: key `budget`: "), "{e}");
+    let e = parse_instance("budget = \"1ms\"\n[[objects]]\nname = \"a\"\nlevels = []\n")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("instance:4: key `objects.0.levels`: ") && e.contains("no levels"),
+        "{e}"
+    );
+    let e = parse_instance("budget = \"1ms\"\n[[objects]]\nname = \"a\"\nlevels = [{ cost = 0, benefit = 1 }]\n[[objects]]\nname = \"a\"\nlevels = [{ cost = 0, benefit = 1 }]\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("instance:6: key `objects.1.name`: "), "{e}");
+    // Serde's errors through the model files' machinery: key and line.
+    let e = parse_instance(
+        "budget = \"1ms\"\n[[objects]]\nname = \"a\"\nlevels = [{ cost = 0, benefit = 1, colour = 2 }]\n",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("instance:4") && e.contains("colour"), "{e}");
+    let e = parse_instance("budget = \"1ms\"\n[[objects]]\nname = 3\nlevels = []\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("instance:3") && e.contains("objects.0.name"), "{e}");
+    // JSON: the key (no line).
+    let e = parse_instance_json(
+        r#"{"budget": "1ms", "objects": [{"name": "t", "levels": [{"cost": "1ms", "benefit": -1}]}]}"#,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.starts_with("instance: key `objects.0.levels.0.benefit`: "), "{e}");
+}
+
+#[test]
+fn benefits_must_add_up_to_a_finite_sum() {
+    let big = f64::MAX / 1.5;
+    let objects = vec![obj("a", vec![lv(1, big)]), obj("b", vec![lv(1, 1.0), lv(2, big)])];
+    let e = Instance::new(Duration::ms(10), objects).unwrap_err();
+    assert!(matches!(&e, LodSelectError::Benefit { index: 1, level: 1, .. }), "{e}");
+    assert!(e.to_string().contains("infinite"), "{e}");
+    // Large but summable benefits stay valid and give finite totals.
+    let objects = vec![obj("a", vec![lv(1, big / 2.0)]), obj("b", vec![lv(1, big / 2.0)])];
+    let inst = Instance::new(Duration::ms(10), objects).unwrap();
+    for s in [greedy(&inst), optimal(&inst).unwrap()] {
+        assert!(s.total_benefit.is_finite(), "{s:?}");
+    }
+}

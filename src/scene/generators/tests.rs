@@ -281,3 +281,26 @@ fn local_shuffle_keeps_windows_and_interpolates_reuse() {
         Err(MeshError::ZeroSize { .. })
     ));
 }
+
+#[test]
+fn vertex_counts_beyond_the_limit_are_refused_before_allocating() {
+    let max = crate::limits::MAX_MESH_VERTICES;
+    let e = err(&format!("random:1:{}:1", max + 1));
+    assert!(
+        e.contains("random:1:268435457:1") && e.contains("268435457 vertices") && e.contains("limit"),
+        "{e}"
+    );
+    let e = err("random:1:4294967295:1");
+    assert!(e.contains("4294967295 vertices"), "{e}");
+    assert_eq!(build(&format!("random:1:{max}:1")).vertex_count as u64, max);
+    let dir = tempfile::tempdir().unwrap();
+    let big = dir.path().join("big.idx");
+    std::fs::write(&big, "0 1 4294967294\n").unwrap();
+    let e = err(big.to_str().unwrap());
+    assert!(
+        e.contains("big.idx") && e.contains("4294967295 vertices (its largest index + 1)"),
+        "{e}"
+    );
+    std::fs::write(&big, format!("0 1 {}\n", max - 1)).unwrap();
+    assert_eq!(build(big.to_str().unwrap()).vertex_count as u64, max);
+}

@@ -77,6 +77,22 @@ fn errors_name_their_line() {
     assert!(matches!(f.error, ObjError::Normal));
     let f = fail(&format!("{QUAD}vt x\n"));
     assert!(matches!(f.error, ObjError::Texcoord));
+    // Numbers that are not finite.
+    for (bad, word) in [
+        ("v nan 0 0", "nan"),
+        ("v 0 inf 0", "inf"),
+        ("vt 1e400", "1e400"),
+        ("vn 0 0 -inf", "-inf"),
+    ] {
+        let f = fail(&format!("{QUAD}{bad}\n"));
+        assert_eq!(f.line, Some(5), "{bad}");
+        assert!(
+            matches!(&f.error, ObjError::NotFinite(w) if w == word),
+            "{bad}: {}",
+            f.error
+        );
+        assert!(f.error.to_string().contains("not a finite number"), "{}", f.error);
+    }
     for bad in ["f 1 2 0", "f 1 2 x", "f 1/2/3/4 2 3", "f /1 2 3"] {
         let f = fail(&format!("{QUAD}{bad}\n"));
         assert_eq!(f.line, Some(5), "{bad}");
