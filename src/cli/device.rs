@@ -59,21 +59,29 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         predict_loads.push(row_load(r, &mut cache, &args.vertex_cache, Invocations::Predicted)?);
     }
     let y: Vec<f64> = rows.iter().map(|r| r.pass_time_ns).collect();
-    let f = fit(&fit_loads, &y)?;
+    // What the fit refuses is the data of every file together: named so.
+    let inputs = args
+        .files
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let of_inputs = |e: CalibrateError| anyhow::Error::new(e).context(format!("the passes of {inputs}"));
+    let f = fit(&fit_loads, &y).map_err(of_inputs)?;
     let fit_seconds = start.elapsed().as_secs_f64();
     let fitted: Vec<f64> = fit_loads.iter().map(|l| f.costs.cost(l).pass_ns).collect();
     let errors: Vec<f64> = fitted.iter().zip(&y).map(|(p, m)| rel_error_pct(*p, *m)).collect();
     let (median, p90, worst) = error_summary(&errors);
     let loo = if args.loo {
         let t = Instant::now();
-        let e = leave_one_out(&fit_loads, &predict_loads, &y)?;
+        let e = leave_one_out(&fit_loads, &predict_loads, &y).map_err(of_inputs)?;
         let b = linear_baseline_loo(&predict_loads, &y);
         Some((e, b, t.elapsed().as_secs_f64()))
     } else {
         None
     };
     let half = if args.holdout {
-        let e = held_out_half(&fit_loads, &predict_loads, &y)?;
+        let e = held_out_half(&fit_loads, &predict_loads, &y).map_err(of_inputs)?;
         Some((error_summary(&e), e.len()))
     } else {
         None
@@ -105,7 +113,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     // What is written must read back: the checks `predict` applies to a
     // profile file, before anything is written.
     if let Err(ProfileError::Invalid { key, value, why }) = profile.validate() {
-        return Err(CalibrateError::Profile { key, value, why }.into());
+        return Err(of_inputs(CalibrateError::Profile { key, value, why }));
     }
     let files: Vec<String> = args.files.iter().map(|p| p.display().to_string()).collect();
     let mut header = vec![

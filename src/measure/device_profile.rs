@@ -41,6 +41,12 @@ use serde::{Deserialize, Serialize};
 
 use super::coverage::{Coverage, WARP_QUADS};
 
+/// Largest cost a profile may give one unit of work (a pass, a draw, a
+/// vertex, a pixel): one second. Fitted costs are nanoseconds to
+/// microseconds; the bound keeps a prediction (costs times counts of up to
+/// 2^28 vertices and 2^28 pixels) finite.
+pub const MAX_COST_NS: f64 = 1e9;
+
 /// Fitted costs, nanoseconds.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -372,6 +378,14 @@ impl DeviceProfile {
             if !v.is_finite() || v < 0.0 {
                 return bad(&format!("costs.{key}"), v.to_string(), "must be a finite number >= 0");
             }
+            if v > MAX_COST_NS {
+                return bad(
+                    &format!("costs.{key}"),
+                    format!("{v:e}"),
+                    "is more than a second (1e9 ns) per unit of work; no device is that slow, and a \
+                     prediction with it would overflow",
+                );
+            }
         }
         if self.costs.entries().iter().all(|(_, v)| *v == 0.0) {
             return bad(
@@ -621,7 +635,7 @@ mod tests {
         #[test]
         fn what_calibrate_writes_reads_back(
             name in names(),
-            costs in proptest::array::uniform14(prop_oneof![Just(0.0), 0.0f64..1e6, 0.0f64..f64::MAX]),
+            costs in proptest::array::uniform14(prop_oneof![Just(0.0), 0.0f64..1e6, 0.0f64..=MAX_COST_NS]),
             stats in proptest::array::uniform3(0.0f64..1e6),
             loo in proptest::option::of((0.0f64..1e6, 0.0f64..1e6)),
         ) {

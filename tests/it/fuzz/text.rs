@@ -416,7 +416,11 @@ pub fn case(rng: &mut Xoshiro256PlusPlus, n: usize, tree: &Tree) -> Case {
                 "--json".into(),
             ]
         }
-        Kind::Instance => vec!["lod-select".into(), p.clone(), "--json".into()],
+        Kind::Instance => {
+            // An object left out of the selection has no level.
+            allow_null.push("selection");
+            vec!["lod-select".into(), p.clone(), "--json".into()]
+        }
         Kind::Mesh => vec![
             "vcache".into(),
             p.clone(),
