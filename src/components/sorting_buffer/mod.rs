@@ -360,8 +360,8 @@ pub fn simulate(
     let mut pointer = 0usize;
     let mut overflows = 0u64;
     let mut filled = 0usize;
-    let mut waste = Waste::new(if strategy == Strategy::BoundedWaste { d } else { 0 });
     let bounded_waste = strategy == Strategy::BoundedWaste;
+    let mut waste = Waste::new(if bounded_waste { d } else { 0 });
     for (t, &c) in dense.iter().enumerate() {
         if bounded_waste {
             waste.leave(&mut b, c, overflows);
