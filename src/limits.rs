@@ -41,6 +41,29 @@ pub const MIN_REFRESH_PERIOD_PS: u64 = 1_000_000;
 /// Most input events (`run.events`) a multi-frame-rate or VR model may follow.
 pub const MAX_INPUT_EVENTS: u64 = 100_000_000;
 
+/// Least share of a unit (the CPU thread, or the GPU front end) that the
+/// system tasks preempting it (`noise.periodic` and `noise.random`, their
+/// mean durations over their mean gaps, added up per target) must leave
+/// free: 5%. At a share `s` left, every frame's work on that unit stretches
+/// at least `1/s` times (20 times at 5%), and near saturation the waiting
+/// tasks' backlog makes it far worse: 34.99 ms every 35 ms beside the
+/// default model's 2 Hz background task is more than the whole CPU, and
+/// gave 1 frame per 7,148 simulated seconds. No operating system's noise
+/// (the paper's is about 0.5 ms every 35 ms, 1.4%) comes near it.
+pub const MIN_FREE_SHARE: f64 = 0.05;
+
+/// Most events a run may be estimated to need before it simulates, when it
+/// sets no `run.max_events` (and, for the frame pipeline, no `run.until`):
+/// 10^11, one to several hours at the kernel's ten to fifty million events
+/// a second. The estimate is a lower bound from the inputs (frames, display
+/// refreshes and system tasks over the least simulated span the frames
+/// take, triangles at `triangle` fidelity; the loops of a latency system
+/// over the span until the last input arrives), so a run refused by it
+/// could not have finished in a working day. Setting `run.max_events`
+/// raises the bound (a latency system's run needs its events to be under
+/// it; a frame-pipeline run stops there with the frames it completed).
+pub const DEFAULT_MAX_EVENTS: u64 = 100_000_000_000;
+
 /// Most slots of a `direct:SLOTS,SEGMENT` vertex cache (one 4-byte stamp per slot).
 pub const MAX_DIRECT_CACHE_SLOTS: u32 = 1 << 20;
 
@@ -67,6 +90,19 @@ pub const MAX_SORT_BUFFER: usize = 1 << 24;
 /// Largest m of the sorting buffer's `lru-worst:M` sequence (m (m + m² + 1)
 /// elements: about 16.8 million at 256).
 pub const MAX_LRU_WORST_M: u64 = 256;
+
+/// Most layers of `rendersim predict --layers`: each layer is one more copy
+/// of the mesh, simulated triangle by triangle, so a prediction's time grows
+/// linearly with them (about a second per thousand layers of a 64x64 grid;
+/// u32::MAX was accepted and would take weeks). The studies draw at most 8
+/// layers; no screen pass has a depth complexity of a thousand.
+pub const MAX_PASS_LAYERS: u32 = 1024;
+
+/// Most triangles a `rendersim predict` pass simulates (the mesh's
+/// triangles times `--layers`): 2^27, about 134 million, at least the
+/// largest generated mesh ([`MAX_MESH_INDICES`] / 3) drawn once, and about
+/// a quarter of a minute at the kernel's speed (two events per triangle).
+pub const MAX_PASS_TRIANGLES: u64 = 1 << 27;
 
 /// Formats a byte count for messages: `8 GiB`, `1.5 MiB`, `512 bytes`.
 pub fn show_bytes(b: u64) -> String {
@@ -184,6 +220,45 @@ pub fn span_check(terms: &[(&str, f64)]) -> Option<(String, String)> {
     ))
 }
 
+/// One part of a run's event estimate: the key to blame (`a|b` for several),
+/// what the events are, and how many (at least).
+pub type EventPart = (String, String, f64);
+
+/// Refuses, before simulating, a run whose estimated events (`parts`, each a
+/// lower bound) exceed `max_events` (the model's `run.max_events`), or
+/// [`DEFAULT_MAX_EVENTS`] without one. Returns the key of the largest part
+/// and the message, or `None` when the run fits. `advice` ends the message
+/// (what to lower, or how to run anyway).
+pub fn events_check(parts: &[EventPart], max_events: Option<u64>, advice: &str) -> Option<(String, String)> {
+    let total: f64 = parts.iter().map(|p| p.2).sum();
+    let limit = max_events.unwrap_or(DEFAULT_MAX_EVENTS);
+    // Written so that a NaN total is refused too.
+    if total <= limit as f64 {
+        return None;
+    }
+    let mut sorted: Vec<&EventPart> = parts.iter().filter(|p| p.2 > 0.0 || p.2.is_nan()).collect();
+    sorted.sort_by(|a, b| b.2.total_cmp(&a.2));
+    let list = sorted
+        .iter()
+        .take(3)
+        .map(|(k, what, n)| format!("{what} ({k}): {n:.3e}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let bound = match max_events {
+        Some(m) => format!("run.max_events = {m}"),
+        None => format!(
+            "the limit of {:.0e} events for a run without run.max_events \
+             (hours at the kernel's tens of millions of events a second)",
+            DEFAULT_MAX_EVENTS as f64
+        ),
+    };
+    let key = sorted.first().map_or("run.max_events", |p| p.0.as_str()).to_string();
+    Some((
+        key,
+        format!("the run needs at least about {total:.3e} events (largest parts: {list}), more than {bound}; {advice}"),
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -198,6 +273,26 @@ mod tests {
             m.contains("9 GiB") && m.contains("run.max_memory = 8 GiB") && m.contains("16GiB"),
             "{m}"
         );
+    }
+
+    #[test]
+    fn an_event_estimate_past_the_bound_blames_its_largest_part() {
+        let parts = [
+            ("a".to_string(), "frames".to_string(), 10.0),
+            ("b|run.frames".to_string(), "refreshes".to_string(), 2e11),
+        ];
+        assert_eq!(events_check(&parts[..1], None, "x"), None);
+        let (key, m) = events_check(&parts, None, "lower b").unwrap();
+        assert_eq!(key, "b|run.frames");
+        assert!(
+            m.contains("2.000e11 events") && m.contains("refreshes (b|run.frames): 2.000e11") && m.ends_with("lower b"),
+            "{m}"
+        );
+        // An explicit run.max_events is the bound, either way.
+        assert_eq!(events_check(&parts, Some(300_000_000_000), "x"), None);
+        let (_, m) = events_check(&parts[..1], Some(5), "x").unwrap();
+        assert!(m.contains("run.max_events = 5"), "{m}");
+        assert!(events_check(&[("n".into(), "nan".into(), f64::NAN)], None, "x").is_some());
     }
 
     #[test]

@@ -204,7 +204,7 @@ pub struct CalibrateArgs {
     #[arg(long)]
     pub name: Option<String>,
     /// Vertex-cache policy predicting the device's vertex-shader invocations.
-    #[arg(long, value_parser = Plain::new(parse_policy), default_value = "meshopt:32,32,32")]
+    #[arg(long, value_parser = Plain::new(parse_vertex_cache), default_value = "meshopt:32,32,32")]
     pub vertex_cache: CachePolicy,
     /// Shader cores of the unified pool (the H200 has 132 SMs).
     #[arg(long, default_value_t = 132)]
@@ -445,6 +445,14 @@ fn parse_size(size: &str) -> anyhow::Result<Size> {
 
 fn parse_policy(policy: &str) -> anyhow::Result<CachePolicy> {
     policy.parse().map_err(|e| anyhow::anyhow!("--policy {policy:?}: {e}"))
+}
+
+/// `calibrate --vertex-cache`: the same policies as `--policy`, its errors
+/// naming the option they came from.
+fn parse_vertex_cache(policy: &str) -> anyhow::Result<CachePolicy> {
+    policy
+        .parse()
+        .map_err(|e| anyhow::anyhow!("--vertex-cache {policy:?}: {e}"))
 }
 
 /// A usage error with `message` as its whole text (`error: ` before it),

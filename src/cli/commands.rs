@@ -44,6 +44,17 @@ pub fn run(args: RunArgs) -> Result<()> {
         eprintln!("note: {note}");
     }
     let src = &model.source;
+    // A system that writes no trace events would leave an empty trace file
+    // that looks like a broken one: refused before anything is written.
+    if args.trace.is_some()
+        && let Some(system) = rendersim::systems::traceless_system(&model.table)
+    {
+        anyhow::bail!(
+            "--trace: {}: system {system:?} writes no trace events (traces come from {}); leave out --trace",
+            src.name,
+            rendersim::systems::tracing_systems()
+        );
+    }
     // Outputs are checked before simulating: a folder that cannot take the
     // results, or a trace path that is a folder, is reported at once.
     let set = match &args.out {

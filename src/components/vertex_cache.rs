@@ -110,6 +110,12 @@ pub struct VertexCache {
 #[derive(Clone, Debug, Default)]
 struct TriangleState {
     stamps: Vec<u32>,
+    /// Direct-mapped: the slots written since the last flush (at most as
+    /// many as there are slots; past that, `dirty_all`), so a flush costs
+    /// what the segment wrote, not every slot: `direct:1048576,1` flushed a
+    /// million slots per triangle.
+    dirty: Vec<u32>,
+    dirty_all: bool,
     sparse: HashMap<u32, u32>,
     timestamp: u32,
     warp_offset: u32,
@@ -316,7 +322,16 @@ impl VertexCache {
     }
 
     fn flush_direct(&mut self) {
-        self.tri.stamps.iter_mut().for_each(|s| *s = u32::MAX);
+        let t = &mut self.tri;
+        if t.dirty_all {
+            t.stamps.iter_mut().for_each(|s| *s = u32::MAX);
+        } else {
+            for &i in &t.dirty {
+                t.stamps[i as usize] = u32::MAX;
+            }
+        }
+        t.dirty.clear();
+        t.dirty_all = false;
         self.tri.warps += u64::from(self.tri.prim_offset > 0);
         self.tri.prim_offset = 0;
         self.tri.warp_offset = 0;
@@ -326,13 +341,20 @@ impl VertexCache {
     /// `u32::MAX` = empty). True on a miss.
     #[inline]
     fn direct_access(&mut self, v: u32) -> bool {
-        let slots = self.tri.stamps.len() as u32;
-        let slot = &mut self.tri.stamps[(v % slots) as usize];
+        let t = &mut self.tri;
+        let slots = t.stamps.len() as u32;
+        let i = v % slots;
+        let slot = &mut t.stamps[i as usize];
         if *slot == v && v != u32::MAX {
             false
         } else {
             *slot = v;
-            self.tri.warp_offset += 1;
+            t.warp_offset += 1;
+            if t.dirty.len() < t.stamps.len() {
+                t.dirty.push(i);
+            } else {
+                t.dirty_all = true;
+            }
             true
         }
     }

@@ -104,10 +104,29 @@ pub fn predict_on_device(profile: &DeviceProfile, pass: &DevicePass) -> Result<D
     if pass.layers == 0 {
         return Err(DevicePredictError::Option("layers must be at least 1".into()));
     }
+    use crate::limits::{MAX_PASS_LAYERS, MAX_PASS_TRIANGLES};
+    if pass.layers > MAX_PASS_LAYERS {
+        return Err(DevicePredictError::Option(format!(
+            "--layers {}: more than the limit of {MAX_PASS_LAYERS} layers (each layer is a copy of the mesh \
+             simulated triangle by triangle, so the prediction's time grows with the layers; \
+             a screen pass of depth complexity beyond {MAX_PASS_LAYERS} is not one the studies measure)",
+            pass.layers
+        )));
+    }
     let mesh = mesh_from_spec(&pass.mesh, Path::new(".")).map_err(|e| CalibrateError::Mesh {
         spec: pass.mesh.clone(),
         message: e.to_string(),
     })?;
+    let drawn = mesh.triangles().saturating_mul(u64::from(pass.layers));
+    if drawn > MAX_PASS_TRIANGLES {
+        return Err(DevicePredictError::Option(format!(
+            "--layers {} of {} ({} triangles each) make {drawn} triangles, more than the limit of {MAX_PASS_TRIANGLES} \
+             a prediction simulates (about two events each: beyond it a prediction takes minutes); use fewer layers or a smaller mesh",
+            pass.layers,
+            pass.mesh,
+            mesh.triangles()
+        )));
+    }
     let policy: CachePolicy = profile
         .device
         .vertex_cache

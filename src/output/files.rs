@@ -199,7 +199,8 @@ pub fn open_output(path: &Path) -> Result<(OutputFile, Box<dyn Write + Send>), O
                     replace: None,
                     registered: None,
                 },
-                Box::new(std::io::BufWriter::new(f)),
+                // A FIFO whose reader closes it: an error, not SIGPIPE.
+                super::pipe::in_place_writer(f),
             ))
         }
         Destination::Replace(p) => {

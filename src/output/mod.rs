@@ -6,6 +6,8 @@
 //! - [`result_set`]: a folder of results that belong together, staged beside
 //!   its target and swapped in whole, so a kill leaves the old set or the
 //!   new one, never a mix.
+//! - [`pipe`]: a FIFO or socket written in place whose reader closes it
+//!   gives a write error, not a SIGPIPE death.
 //! - [`cleanup`]: temporary paths removed on SIGINT, SIGTERM and SIGHUP.
 //! - [`table`]: per-row tables as CSV through the `csv` crate.
 //! - [`text`]: numbers in human-readable reports.
@@ -16,6 +18,7 @@
 pub mod cleanup;
 pub mod error;
 pub mod files;
+pub mod pipe;
 pub mod result_set;
 pub mod table;
 pub mod text;

@@ -109,7 +109,18 @@ pub fn scene_state_ids(spec: &str, base: &std::path::Path) -> Result<Vec<u64>, S
         Some((p, a)) if ["state", "shader", "texture", "material"].contains(&a) => (p, a),
         _ => (spec, "state"),
     };
+    let expected = "expected scene:MODEL.toml[:state|shader|texture|material]";
+    if path.is_empty() {
+        return Err(format!(
+            "scene:{spec}: names no model file before the attribute; {expected}"
+        ));
+    }
     let full = base.join(path);
+    if full.is_dir() {
+        return Err(format!(
+            "scene:{spec}: {path} is a folder, not a model file; {expected}"
+        ));
+    }
     let model = load_model(Some(&full), &Overrides::default()).map_err(|e| e.to_string())?;
     let Some(w) = model.table.get("workload").and_then(|v| v.as_table()) else {
         return Err(format!(

@@ -100,6 +100,13 @@ pub trait System: Sync {
         table: &toml::Table,
         trace: Option<TraceWriter>,
     ) -> Result<Box<dyn Outcome>, SimError>;
+
+    /// Whether a run writes trace events (`rendersim run --trace`); the
+    /// systems that do not are refused a trace before they run, rather than
+    /// writing an empty one.
+    fn writes_trace(&self) -> bool {
+        true
+    }
 }
 
 /// What a finished run of any system offers: its summary, its per-row
@@ -191,6 +198,31 @@ pub struct SystemRun(Box<dyn Outcome>);
 
 fn known_systems() -> String {
     SYSTEMS.iter().map(|s| s.name()).collect::<Vec<_>>().join(", ")
+}
+
+/// The name of the model's system when that system writes no trace events
+/// (`walkthrough`, `state_sorting`, `device_predictions`); `None` for the
+/// others and for a `system` key that names none (run_model reports it).
+pub fn traceless_system(table: &toml::Table) -> Option<&'static str> {
+    let name = match table.get("system") {
+        None => "frame_pipeline",
+        Some(toml::Value::String(s)) => s.as_str(),
+        Some(_) => return None,
+    };
+    SYSTEMS
+        .iter()
+        .find(|s| s.name() == name && !s.writes_trace())
+        .map(|s| s.name())
+}
+
+/// The systems whose runs write trace events, comma separated.
+pub fn tracing_systems() -> String {
+    SYSTEMS
+        .iter()
+        .filter(|s| s.writes_trace())
+        .map(|s| s.name())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Builds and runs the system a model describes (its `system` key, default

@@ -146,6 +146,77 @@ impl<D: Defaults> RunConfig<D> {
     }
 }
 
+/// One periodic loop of a latency system, for its event estimate: the key
+/// that sets its interval (`a|b` for several), a name, the longest its
+/// iterations can take (picoseconds) and the kernel events of each.
+#[derive(Debug, Clone)]
+pub struct Loop {
+    /// The key to blame.
+    pub key: String,
+    /// What it is ("the warping renderer's frames").
+    pub what: &'static str,
+    /// The longest an iteration takes, picoseconds.
+    pub interval_ps: f64,
+    /// Kernel events per iteration.
+    pub events: f64,
+}
+
+/// When the last of `events` inputs arrives, picoseconds: `warmup` and the
+/// same exponential gaps of mean `mean_interval` the models draw (the
+/// `input.arrivals` stream of `seed`), added up.
+pub fn last_arrival_ps(seed: u64, events: u64, warmup: Duration, mean_interval: Duration) -> f64 {
+    use rand::Rng;
+    let mut rng = crate::engine::RngStreams::new(seed).stream("input.arrivals");
+    let mean = mean_interval.0 as f64;
+    let mut t = warmup.0 as f64;
+    for _ in 0..events {
+        t += Duration::from_ps_f64(-mean * (1.0 - rng.random::<f64>()).ln()).0 as f64;
+    }
+    t
+}
+
+impl<D: Defaults> RunConfig<D> {
+    /// Refuses, before simulating, a run whose loops certainly need more
+    /// events than `run.max_events` (or [`crate::limits::DEFAULT_MAX_EVENTS`]
+    /// without one): the run lasts at least until its last input arrives,
+    /// and over that span each loop iterates at least once per its longest
+    /// interval (less its first two, for the phase). A render step of 1 ps
+    /// would otherwise run for ever. The exact arrival of the last input is
+    /// computed (the models' own draws, O(run.events)) only when the
+    /// expected span already comes near the bound.
+    pub fn check_events(&self, input: &InputConfig, noun: &str, loops: &[Loop]) -> Result<(), SystemError> {
+        let limit = self.max_events.unwrap_or(crate::limits::DEFAULT_MAX_EVENTS) as f64;
+        let parts = |span: f64| {
+            let mut p: Vec<crate::limits::EventPart> =
+                vec![("run.events".into(), format!("{noun}s"), self.events as f64)];
+            for l in loops {
+                let n = (span / l.interval_ps.max(1.0) - 2.0).max(0.0) * l.events;
+                p.push((l.key.clone(), l.what.to_string(), n));
+            }
+            p
+        };
+        let total = |p: &[crate::limits::EventPart]| p.iter().map(|x| x.2).sum::<f64>();
+        let expected = self.warmup.0 as f64 + self.events as f64 * input.mean_interval.0 as f64;
+        if total(&parts(expected)) <= limit / 4.0 {
+            return Ok(());
+        }
+        let span = last_arrival_ps(self.seed, self.events, self.warmup, input.mean_interval);
+        let advice = format!(
+            "the last {noun} arrives only after {:.3e} s of simulated time; lengthen that step or lower run.events, or {}",
+            span / 1e12,
+            if self.max_events.is_some() {
+                "raise run.max_events"
+            } else {
+                "set run.max_events above the estimate to run anyway"
+            }
+        );
+        match crate::limits::events_check(&parts(span), self.max_events, &advice) {
+            Some((key, message)) => Err(invalid(&key, message)),
+            None => Ok(()),
+        }
+    }
+}
+
 /// Fails, naming `run.max_memory`, once the input records (`used` bytes,
 /// `what` describes them) outgrow `max` while the run goes.
 pub fn check_records(used: u64, max: u64, what: impl FnOnce() -> String) -> Result<(), SystemError> {

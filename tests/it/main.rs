@@ -6,6 +6,7 @@
 mod architecture;
 mod binning;
 mod bottleneck;
+mod cannot_finish;
 mod cli;
 mod common;
 mod conservation;

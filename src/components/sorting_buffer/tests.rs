@@ -116,3 +116,85 @@ fn parsing() {
         Err(SortBufferError::Empty { .. })
     ));
 }
+
+/// Bounded waste in its direct form (every buffered state's counter grown
+/// on each overflow, the largest chosen, ties by more elements, then the
+/// older stamp), written apart from the library's grouped counters: the
+/// runs it sends.
+fn bounded_waste_direct(seq: &[StateId], k: usize) -> Vec<(StateId, u64)> {
+    let mut count: HashMap<StateId, u64> = HashMap::new();
+    let mut stamp: HashMap<StateId, u64> = HashMap::new();
+    let mut waste: HashMap<StateId, u64> = HashMap::new();
+    let mut out: Vec<(StateId, u64)> = Vec::new();
+    let send = |c: StateId, n: u64, out: &mut Vec<(StateId, u64)>| match out.last_mut() {
+        Some(l) if l.0 == c => l.1 += n,
+        _ => out.push((c, n)),
+    };
+    let mut filled = 0;
+    for (t, &c) in seq.iter().enumerate() {
+        *count.entry(c).or_insert(0) += 1;
+        stamp.insert(c, t as u64);
+        filled += 1;
+        if filled < k {
+            continue;
+        }
+        for (s, n) in &count {
+            *waste.entry(*s).or_insert(0) += n;
+        }
+        let best = *count
+            .keys()
+            .max_by_key(|s| (waste[*s], count[*s], std::cmp::Reverse(stamp[*s])))
+            .unwrap();
+        waste.insert(best, 0);
+        let n = count.remove(&best).unwrap();
+        filled -= n as usize;
+        send(best, n, &mut out);
+    }
+    if let Some(&(l, _)) = out.last()
+        && let Some(n) = count.remove(&l)
+    {
+        send(l, n, &mut out);
+    }
+    let mut rest: Vec<(u64, StateId, u64)> = count.iter().map(|(s, n)| (stamp[s], *s, *n)).collect();
+    rest.sort();
+    for (_, s, n) in rest {
+        send(s, n, &mut out);
+    }
+    out
+}
+
+#[test]
+fn bounded_waste_chooses_as_its_direct_form() {
+    // Sequences with few and many states, skewed and flat, through buffers
+    // from 1 slot to more than the sequence: the same runs sent.
+    let mut x = 12345u64;
+    let mut next = || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    for case in 0..300 {
+        let len = 1 + (next() % 400) as usize;
+        let states = 1 + next() % [3, 10, 60, 400][case % 4];
+        let seq: Vec<StateId> = (0..len)
+            .map(|_| {
+                let r = next();
+                // Skewed: low ids more often.
+                if case % 3 == 0 {
+                    (r % states) * (r % states) % states
+                } else {
+                    r % states
+                }
+            })
+            .collect();
+        for k in [1, 2, 3, 5, 8, 17, 64, 500] {
+            let r = simulate(&seq, k, Strategy::BoundedWaste, 1, true).unwrap();
+            assert_eq!(
+                r.output.unwrap(),
+                bounded_waste_direct(&seq, k),
+                "case {case}, k = {k}, {seq:?}"
+            );
+        }
+    }
+}

@@ -266,4 +266,39 @@ proptest! {
         let after: Vec<bool> = b.iter().map(|&i| c.access(i)).collect();
         prop_assert_eq!(after, fifo_ref(n as usize, &b));
     }
+
+    /// `direct:SLOTS,SEGMENT` against its plain form (every slot emptied at
+    /// each segment's start and at a reset), with resets between runs of
+    /// triangles and ids up to the empty marker.
+    #[test]
+    fn direct_matches_naive(slots in 1u32..20, segment in 1u32..12,
+                            runs in prop::collection::vec(
+                                prop::collection::vec((0u32..50, 0u32..50, 0u32..50), 0..60), 1..4),
+                            huge in any::<bool>()) {
+        let p = CachePolicy::Direct { slots, segment };
+        let mut c = VertexCache::new(&p, 0);
+        for run in &runs {
+            c.reset();
+            let mut table = vec![u32::MAX; slots as usize];
+            let mut prim = 0u32;
+            for &(a, b, d) in run {
+                let t = if huge { [a, u32::MAX - b, d] } else { [a, b, d] };
+                if prim == segment {
+                    table.iter_mut().for_each(|s| *s = u32::MAX);
+                    prim = 0;
+                }
+                prim += 1;
+                let mut want = 0u8;
+                for v in t {
+                    let s = &mut table[(v % slots) as usize];
+                    if *s == v && v != u32::MAX {
+                        continue;
+                    }
+                    *s = v;
+                    want += 1;
+                }
+                prop_assert_eq!(c.access_triangle(t), want);
+            }
+        }
+    }
 }

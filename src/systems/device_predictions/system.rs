@@ -148,6 +148,10 @@ impl System for DevicePredictionsSystem {
         "device_predictions"
     }
 
+    fn writes_trace(&self) -> bool {
+        false
+    }
+
     fn run(
         &self,
         src: &ModelSource,
@@ -156,7 +160,8 @@ impl System for DevicePredictionsSystem {
     ) -> Result<Box<dyn Outcome>, SimError> {
         let cfg: DevicePredictionsConfig = deserialize(table, src)?;
         let mut run = run_device_predictions(cfg, &src.base_dir).map_err(|e| SimError::of(src, e))?;
-        // No trace of its own: a requested trace file is closed empty.
+        // No trace of its own (`rendersim run --trace` refuses the model): a
+        // trace writer handed in through the library is closed empty.
         run.trace = trace;
         Ok(Box::new(run))
     }

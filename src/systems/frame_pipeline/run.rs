@@ -16,7 +16,7 @@ use crate::systems::error::SystemError;
 use crate::systems::summary::to_json;
 
 use super::summary::{analytic_terms, positive_zeros, summarize};
-use super::validate::{check_memory, check_time_range, validate};
+use super::validate::{check_events, check_memory, check_time_range, validate};
 /// Everything a run produced.
 #[derive(Debug)]
 pub struct PipelineRun {
@@ -75,6 +75,7 @@ pub fn run_pipeline(
     };
     let analytic = analytic_terms(&cfg, scene.as_ref());
     check_time_range(&cfg, &analytic)?;
+    check_events(&cfg, &analytic, scene.as_ref().map(|s| s.stats.triangles))?;
     let scene_stats = scene.as_ref().map(|s| s.stats.clone());
     let mut model = FramePipeline::new(cfg, scene, trace)?;
     let build_seconds = build_start.elapsed().as_secs_f64();

@@ -76,6 +76,7 @@ pub fn validate(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
             .validate()
             .map_err(|e| bad(&format!("noise.random.{i}.duration"), e.to_string()))?;
     }
+    check_noise_share(cfg)?;
     for (key, d) in [
         ("variation.cpu", &cfg.variation.cpu),
         ("variation.gpu", &cfg.variation.gpu),
@@ -86,6 +87,89 @@ pub fn validate(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
     }
     if let WorkloadConfig::Scene(sc) = &cfg.workload {
         check_scene_sizes(sc)?;
+    }
+    Ok(())
+}
+
+/// The system tasks that preempt one unit: their share of its time on
+/// average (mean duration over mean gap, added up), the keys of their
+/// durations and a description of each.
+struct NoiseLoad {
+    share: f64,
+    keys: Vec<String>,
+    tasks: Vec<String>,
+}
+
+/// The enabled system tasks' load on the CPU thread and on the GPU front
+/// end, in that order.
+fn noise_loads(cfg: &FramePipelineConfig) -> [NoiseLoad; 2] {
+    use crate::components::noise::NoiseTarget;
+    let mut loads = [(); 2].map(|()| NoiseLoad {
+        share: 0.0,
+        keys: vec![],
+        tasks: vec![],
+    });
+    if !cfg.noise.enabled {
+        return loads;
+    }
+    let unit = |t: NoiseTarget| usize::from(t == NoiseTarget::Gpu);
+    // Milliseconds to four decimals, trailing zeros dropped.
+    let ms = |ps: f64| {
+        let t = format!("{:.4}", ps / PS_PER_MS as f64);
+        t.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
+    for (i, p) in cfg.noise.periodic.iter().enumerate().filter(|(_, p)| p.enabled) {
+        let l = &mut loads[unit(p.target)];
+        let mean = p.duration.mean();
+        l.share += mean / p.period.0 as f64;
+        l.keys.push(format!("noise.periodic.{i}.duration"));
+        l.tasks.push(format!(
+            "noise.periodic.{i} {:?}: {} ms every {} ms",
+            p.name,
+            ms(mean),
+            ms(p.period.0 as f64)
+        ));
+    }
+    for (i, r) in cfg.noise.random.iter().enumerate().filter(|(_, r)| r.enabled) {
+        let l = &mut loads[unit(r.target)];
+        let mean = r.duration.mean();
+        l.share += mean / r.rate.period.0 as f64;
+        l.keys.push(format!("noise.random.{i}.duration"));
+        l.tasks.push(format!(
+            "noise.random.{i} {:?}: mean {} ms at {}",
+            r.name,
+            ms(mean),
+            r.rate.text
+        ));
+    }
+    loads
+}
+
+/// Refuses system tasks that leave a unit less than
+/// [`crate::limits::MIN_FREE_SHARE`] of its time (a task whose mean duration
+/// is not less than its own gap is refused by its source, naming it).
+fn check_noise_share(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
+    use crate::limits::MIN_FREE_SHARE;
+    for (l, unit) in noise_loads(cfg).iter().zip(["CPU thread", "GPU front end"]) {
+        if l.keys.is_empty() || l.share <= 1.0 - MIN_FREE_SHARE {
+            continue;
+        }
+        // A single task over its own gap gets its source's own error.
+        if l.keys.len() == 1 && (l.share >= 1.0 || l.share.is_nan()) {
+            continue;
+        }
+        return Err(bad(
+            &l.keys.join("|"),
+            format!(
+                "the system tasks on the {unit} ({}) take {:.2}% of it on average, leaving less than the {}% \
+                 a unit must keep free: each frame's work there would take more than {} times as long, and \
+                 far longer as the waiting tasks pile up; shorten the tasks or make them rarer",
+                l.tasks.join("; "),
+                100.0 * l.share,
+                100.0 * MIN_FREE_SHARE,
+                (1.0 / MIN_FREE_SHARE).round()
+            ),
+        ));
     }
     Ok(())
 }
@@ -307,4 +391,205 @@ pub(super) fn check_time_range(cfg: &FramePipelineConfig, a: &AnalyticTerms) -> 
             total / PS_PER_MS as f64 / 1000.0,
         ),
     ))
+}
+
+/// A lower bound of the events a run needs, from its inputs, in parts (the
+/// key to blame, what, how many): one event per frame; over the least span
+/// the frames take (each at least its slowest unit's expected work, the
+/// CPU's and the front end's divided by the share the system tasks leave
+/// them, and a refresh with a vsynced FIFO swap chain), one event per
+/// display refresh (none in immediate mode) and one per system task; at
+/// `triangle` fidelity one per triangle drawn (`triangles`: the scene's
+/// per frame). (Over a few frames the tasks' phase can make the span a
+/// task period shorter than its long-run bound.)
+pub fn estimate_events(
+    cfg: &FramePipelineConfig,
+    a: &AnalyticTerms,
+    triangles: Option<u64>,
+) -> Vec<crate::limits::EventPart> {
+    let frames = cfg.run.frames as f64;
+    let [cpu, gpu] = noise_loads(cfg);
+    let free = |l: &NoiseLoad| (1.0 - l.share).max(crate::limits::MIN_FREE_SHARE);
+    let ps = |ms: f64| ms * PS_PER_MS as f64;
+    let mode = if cfg.display.vsync {
+        cfg.display.present_mode
+    } else {
+        PresentMode::Immediate
+    };
+    let refresh = cfg.display.refresh.period.0 as f64;
+    let mut per_frame = [
+        ps(a.cpu_ms) / free(&cpu),
+        ps(a.gpu_front_end_ms) / free(&gpu),
+        ps(a.geometry_ms),
+        ps(a.fragment_ms),
+    ]
+    .into_iter()
+    .filter(|v| v.is_finite())
+    .fold(0.0, f64::max);
+    if mode == PresentMode::Fifo {
+        per_frame = per_frame.max(refresh);
+    }
+    let span = frames * per_frame;
+    let mut parts: Vec<crate::limits::EventPart> = vec![("run.frames".into(), "frames".into(), frames)];
+    if mode != PresentMode::Immediate {
+        parts.push((
+            "display.refresh|run.frames".into(),
+            "display refreshes".into(),
+            span / refresh,
+        ));
+    }
+    if cfg.noise.enabled {
+        for (i, p) in cfg.noise.periodic.iter().enumerate().filter(|(_, p)| p.enabled) {
+            parts.push((
+                format!("noise.periodic.{i}.period|run.frames"),
+                format!("system task {:?}", p.name),
+                span / p.period.0.max(1) as f64,
+            ));
+        }
+        for (i, r) in cfg.noise.random.iter().enumerate().filter(|(_, r)| r.enabled) {
+            parts.push((
+                format!("noise.random.{i}.rate|run.frames"),
+                format!("system task {:?}", r.name),
+                span / r.rate.period.0.max(1) as f64,
+            ));
+        }
+    }
+    if cfg.fidelity == super::config::Fidelity::Triangle
+        && let Some(t) = triangles
+    {
+        parts.push((
+            "workload|run.frames".into(),
+            "triangles at triangle fidelity".into(),
+            frames * t as f64,
+        ));
+    }
+    parts
+}
+
+/// Refuses, before simulating, a run whose [`estimate_events`] exceeds
+/// [`crate::limits::DEFAULT_MAX_EVENTS`]; runs with `run.max_events` or
+/// `run.until` are bounded by them (they stop there, reporting the frames
+/// they completed) and are left alone.
+pub(super) fn check_events(
+    cfg: &FramePipelineConfig,
+    a: &AnalyticTerms,
+    triangles: Option<u64>,
+) -> Result<(), SystemError> {
+    if cfg.run.until.is_some() || cfg.run.max_events.is_some() {
+        return Ok(());
+    }
+    let parts = estimate_events(cfg, a, triangles);
+    match crate::limits::events_check(
+        &parts,
+        None,
+        "lower that key or run.frames, use fidelity = \"draw\" for big scenes, or set run.max_events or run.until \
+         to stop the run early (it reports the frames it completed)",
+    ) {
+        Some((key, message)) => Err(bad(&key, message)),
+        None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::summary::analytic_terms;
+    use super::super::workload::compile_scene;
+    use super::*;
+    use crate::config::{Overrides, deserialize, load_model};
+
+    /// The estimate against the events of real runs: every shipped
+    /// frame-pipeline model (a few frames), and the default model with
+    /// heavy system tasks on either unit, at draw fidelity, without vsync,
+    /// binned and unified.
+    #[test]
+    fn the_event_estimate_is_a_lower_bound_of_real_runs() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut cases: Vec<(std::path::PathBuf, Vec<&str>)> = Vec::new();
+        let mut models: Vec<_> = std::fs::read_dir(root.join("models"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .collect();
+        models.sort();
+        for m in models {
+            cases.push((m, vec![]));
+        }
+        let default = root.join("models/default.toml");
+        for sets in [
+            vec!["noise.periodic.0.duration=\"28ms\"", "noise.periodic.0.jitter=\"0ms\""],
+            vec!["noise.periodic.0.target=\"gpu\"", "noise.periodic.0.duration=\"25ms\""],
+            vec!["fidelity=\"draw\""],
+            vec!["display.vsync=false"],
+            vec!["gpu.fragment.binning=\"draw\""],
+            vec!["gpu.architecture=\"unified\""],
+        ] {
+            cases.push((default.clone(), sets));
+        }
+        let mut checked = 0;
+        for (path, sets) in cases {
+            let o = Overrides {
+                sets: sets.iter().map(|s| s.to_string()).collect(),
+                frames: Some(12),
+                ..Overrides::default()
+            };
+            let m = load_model(Some(&path), &o).unwrap();
+            if m.table
+                .get("system")
+                .and_then(|s| s.as_str())
+                .unwrap_or("frame_pipeline")
+                != "frame_pipeline"
+            {
+                continue;
+            }
+            let cfg: FramePipelineConfig = deserialize(&m.table, &m.source).unwrap();
+            let scene = match &cfg.workload {
+                WorkloadConfig::Scene(sc) => Some(compile_scene(&cfg, sc, &m.source.base_dir).unwrap()),
+                WorkloadConfig::Fixed(_) => None,
+            };
+            let a = analytic_terms(&cfg, scene.as_ref());
+            let parts = estimate_events(&cfg, &a, scene.as_ref().map(|s| s.stats.triangles));
+            let estimate: f64 = parts.iter().map(|p| p.2).sum();
+            let run = super::super::run::run_pipeline(cfg, &m.source.base_dir, None).unwrap();
+            let events = run.stats.events as f64;
+            assert!(
+                estimate <= events && estimate > 0.0,
+                "{} {sets:?}: estimate {estimate} ({parts:?}) > {events} events",
+                path.display()
+            );
+            checked += 1;
+        }
+        assert!(checked >= 13, "{checked}");
+    }
+
+    #[test]
+    fn system_tasks_must_leave_a_share_of_their_unit() {
+        let m = load_model(
+            None,
+            &Overrides {
+                sets: vec!["noise.periodic.0.duration=\"34.99ms\"".into()],
+                ..Overrides::default()
+            },
+        )
+        .unwrap();
+        let cfg: FramePipelineConfig = deserialize(&m.table, &m.source).unwrap();
+        let e = validate(&cfg).unwrap_err().to_string();
+        assert!(
+            e.contains("noise.periodic.0.duration|noise.random.0.duration")
+                && e.contains("CPU thread")
+                && e.contains("5%")
+                && e.contains("34.99 ms every 35 ms"),
+            "{e}"
+        );
+        // At 90% of the CPU the model runs.
+        let m = load_model(
+            None,
+            &Overrides {
+                sets: vec!["noise.periodic.0.duration=\"31ms\"".into()],
+                ..Overrides::default()
+            },
+        )
+        .unwrap();
+        let cfg: FramePipelineConfig = deserialize(&m.table, &m.source).unwrap();
+        validate(&cfg).unwrap();
+    }
 }

@@ -75,6 +75,30 @@ pub fn validate(cfg: &MultiRateConfig) -> Result<(), SystemError> {
             "FC's frame (upload + render) must take some time",
         ));
     }
+    if t.transfer.0 == 0 {
+        // Its rate (metrics.rates_hz.transfer) would be infinite, written
+        // as null where a number is expected.
+        let (key, fix) = match cfg.transfer.path {
+            super::config::TransferPath::ZeroCopy => {
+                ("zero_copy.lock".to_string(), "give the lock at least 1ps".to_string())
+            }
+            p => (
+                format!("{}.bandwidth", p.name()),
+                format!(
+                    "lower it so that an image ({} bytes) takes at least 1ps",
+                    cfg.frame_bytes()
+                ),
+            ),
+        };
+        return Err(bad(
+            &key,
+            format!(
+                "an image over the {} path would take no time, so the link's rate (metrics.rates_hz.transfer) \
+                 would be infinite; {fix}",
+                cfg.transfer.path.name()
+            ),
+        ));
+    }
     for (key, rate) in [
         ("slow_client.rate", &cfg.slow_client.rate),
         ("fast_client.rate", &cfg.fast_client.rate),
@@ -244,7 +268,8 @@ pub struct RatesHz {
     pub slow_client: f64,
     /// FC's frames.
     pub fast_client: f64,
-    /// Images the link can carry (null for a zero-time path).
+    /// Images the link can carry (a zero-time path is refused by
+    /// [`validate`]).
     pub transfer: f64,
 }
 
@@ -392,11 +417,8 @@ fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &A
             rates_hz: RatesHz {
                 slow_client: 1e3 / t.sc_interval().as_ms_f64(),
                 fast_client: 1e3 / t.fc_interval().as_ms_f64(),
-                transfer: if t.transfer.0 > 0 {
-                    1e3 / t.transfer.as_ms_f64()
-                } else {
-                    f64::INFINITY
-                },
+                // Positive: a zero-time path is refused by `validate`.
+                transfer: 1e3 / t.transfer.as_ms_f64(),
             },
             frames: FrameCounts {
                 slow_client: m.sc_frames,
@@ -427,7 +449,8 @@ pub fn write_events_csv(events: &[EventRecord], w: &mut dyn Write) -> std::io::R
 /// Refuses, before simulating, a run whose expected span (the input events
 /// and what follows the last one until every path shows it) reaches past
 /// the clock's range ([`crate::limits::span_check`]), blaming the largest
-/// part's key.
+/// part's key; then one whose clients' frames certainly need more events
+/// than `run.max_events` or its default (`RunConfig::check_events`).
 fn check_span(cfg: &MultiRateConfig) -> Result<(), SystemError> {
     let t = Terms::of(cfg);
     let f = |d: Duration| d.0 as f64;
@@ -477,8 +500,34 @@ fn check_span(cfg: &MultiRateConfig) -> Result<(), SystemError> {
     if cfg.conventional.enabled {
         terms.push((conv_key, 2.0 * f(t.conventional_frame)));
     }
-    match crate::limits::span_check(&terms) {
-        Some((key, message)) => Err(bad(&key, message)),
-        None => Ok(()),
+    if let Some((key, message)) = crate::limits::span_check(&terms) {
+        return Err(bad(&key, message));
     }
+    // The loops for the event estimate (the tracker is no event): SC
+    // (start, render end, read-back end), FC (start, upload end, end) and
+    // the conventional client (start, end), each at its frame interval.
+    use crate::systems::tracked_input::Loop;
+    let mut loops = vec![
+        Loop {
+            key: sc_key.into(),
+            what: "slow-client frames",
+            interval_ps: f(t.sc_interval()),
+            events: 3.0,
+        },
+        Loop {
+            key: fc_key.into(),
+            what: "fast-client frames",
+            interval_ps: f(t.fc_interval()),
+            events: 3.0,
+        },
+    ];
+    if cfg.conventional.enabled {
+        loops.push(Loop {
+            key: conv_key.into(),
+            what: "conventional-client frames",
+            interval_ps: f(t.conventional_frame),
+            events: 2.0,
+        });
+    }
+    cfg.run.check_events(&cfg.input, "input event", &loops)
 }

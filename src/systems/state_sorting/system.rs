@@ -179,6 +179,10 @@ impl System for StateSortingSystem {
         "state_sorting"
     }
 
+    fn writes_trace(&self) -> bool {
+        false
+    }
+
     fn run(
         &self,
         src: &ModelSource,
@@ -187,7 +191,8 @@ impl System for StateSortingSystem {
     ) -> Result<Box<dyn Outcome>, SimError> {
         let cfg: StateSortingConfig = deserialize(table, src)?;
         let mut run = run_state_sorting(cfg, &src.base_dir).map_err(|e| SimError::of(src, e))?;
-        // No events of its own: a requested trace file is closed empty.
+        // No events of its own (`rendersim run --trace` refuses the model): a
+        // trace writer handed in through the library is closed empty.
         run.trace = trace;
         Ok(Box::new(run))
     }

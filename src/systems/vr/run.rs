@@ -65,7 +65,46 @@ pub fn validate(cfg: &VrConfig) -> Result<(), SystemError> {
     }
     cfg.run.validate(&cfg.input, "motion event")?;
     check_span(cfg)?;
+    cfg.run.check_events(&cfg.input, "motion event", &loops(cfg))?;
     Ok(())
+}
+
+/// The model's loops for the event estimate (the tracker is no event): the
+/// naive loop (start, simulation end, render end, swap) at most a step, a
+/// render and a stereo pair apart; or the simulation (start, end), the
+/// application renderer (start, end) and the warping renderer (start, end,
+/// swap, once per stereo pair).
+fn loops(cfg: &VrConfig) -> Vec<crate::systems::tracked_input::Loop> {
+    use crate::systems::tracked_input::Loop;
+    let f = |d: Duration| d.0 as f64;
+    match cfg.scheme {
+        Scheme::Naive => vec![Loop {
+            key: "simulation.step|renderer.render|display.field_rate".into(),
+            what: "naive loop frames",
+            interval_ps: f(cfg.simulation.step) + f(cfg.renderer.render) + f(cfg.pair()),
+            events: 4.0,
+        }],
+        Scheme::Warp => vec![
+            Loop {
+                key: "simulation.step".into(),
+                what: "simulation steps",
+                interval_ps: f(cfg.simulation.step),
+                events: 2.0,
+            },
+            Loop {
+                key: "renderer.render".into(),
+                what: "application frames",
+                interval_ps: f(cfg.renderer.render),
+                events: 2.0,
+            },
+            Loop {
+                key: "display.field_rate".into(),
+                what: "warped frames",
+                interval_ps: f(cfg.pair()),
+                events: 3.0,
+            },
+        ],
+    }
 }
 
 /// Bytes per motion event: its record with the stages of two paths, and its

@@ -18,6 +18,10 @@ impl System for WalkthroughSystem {
         "walkthrough"
     }
 
+    fn writes_trace(&self) -> bool {
+        false
+    }
+
     fn run(
         &self,
         src: &ModelSource,
@@ -26,7 +30,8 @@ impl System for WalkthroughSystem {
     ) -> Result<Box<dyn Outcome>, SimError> {
         let cfg: WalkthroughConfig = deserialize(table, src)?;
         let mut run = run_walkthrough(cfg).map_err(|e| SimError::of(src, e))?;
-        // No trace of its own: a requested trace file is closed empty.
+        // No trace of its own (`rendersim run --trace` refuses the model): a
+        // trace writer handed in through the library is closed empty.
         run.trace = trace;
         Ok(Box::new(run))
     }
