@@ -283,7 +283,7 @@ fn mutate_once(rng: &mut Xoshiro256PlusPlus, text: &str) -> (String, String) {
             let at = floor(text, rng.random_range(0..=text.len()));
             (text[..at].to_string(), format!("cut at byte {at}"))
         }
-        4 | 5 => {
+        4..=5 => {
             let at = floor(text, rng.random_range(0..=text.len()));
             let c = *CHARS.choose(rng).unwrap();
             (
@@ -291,7 +291,7 @@ fn mutate_once(rng: &mut Xoshiro256PlusPlus, text: &str) -> (String, String) {
                 format!("{c:?} put in at byte {at}"),
             )
         }
-        6 | 7 | 8 => {
+        6..=8 => {
             let spots = numbers(text);
             let Some(&(a, b)) = spots.choose(rng) else {
                 return mutate_once(rng, text);
