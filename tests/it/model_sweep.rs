@@ -124,6 +124,17 @@ fn a_bad_model_sweep_is_an_error_naming_the_entry() {
 }
 
 #[test]
+fn a_missing_model_file_is_an_error_naming_the_experiment_and_its_line() {
+    let exp = "name = \"bad\"\nmodel = \"models/none.toml\"\n[[metric]]\npath = \"metrics.gpu_time_ms.mean\"\n";
+    let (ok, out, err, _d) = experiment(&[("exp.toml", exp)]);
+    assert!(!ok, "ran: {out}");
+    assert!(
+        err.contains("exp.toml:2: `model`: model file \"models/none.toml\" not found"),
+        "{err}"
+    );
+}
+
+#[test]
 fn device_predictions_report_the_leave_one_out_errors_of_the_calibration() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let model = root.join("experiments/device-predictions/nvidia-h200.toml");

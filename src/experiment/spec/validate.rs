@@ -93,7 +93,18 @@ impl Validator<'_> {
             return Err(self.err("model", "must be \"default\" or a file path"));
         } else {
             let dir = self.file.parent().unwrap_or(Path::new(""));
-            ModelSource::File(dir.join(&raw.model))
+            let path = dir.join(&raw.model);
+            if !path.is_file() {
+                return Err(self.err(
+                    "model",
+                    format!(
+                        "model file {:?} not found (looked for {}; paths are relative to the experiment file)",
+                        raw.model,
+                        path.display()
+                    ),
+                ));
+            }
+            ModelSource::File(path)
         };
         let mut set = Vec::new();
         flatten("", &raw.set, &mut set);
