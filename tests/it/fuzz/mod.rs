@@ -689,8 +689,14 @@ fn every_input_ends_in_a_result_or_a_clean_error() {
         // Each case in a folder of its own (experiments write there).
         let d: PathBuf = dir.path().join(format!("c{i}"));
         std::fs::create_dir(&d).unwrap();
+        // Counted by command (an experiment's mode apart) and input kind.
+        let mode = ["--merge", "--slurm", "--shard"]
+            .iter()
+            .find(|m| case.args.iter().any(|a| a == *m))
+            .map(|m| format!(" {m}"))
+            .unwrap_or_default();
         let kind = format!(
-            "{}{} ",
+            "{}{mode}{} ",
             case.args[0],
             if case.what.starts_with("text:") { " (text)" } else { "" }
         );
