@@ -13,7 +13,10 @@ bin=${1:-target/release/rendersim}
 bin=$(realpath "$bin")
 trials=${2:-100}
 work=$(mktemp -d "${TMPDIR:-/tmp}/rendersim-stress.XXXXXX")
-trap 'rm -rf "$work"' EXIT
+# Removed by this shell only (a subshell that ran the trap would take the
+# folder from under the rounds still running).
+main_pid=$$
+trap '[ "$BASHPID" = "$main_pid" ] && rm -rf "$work"' EXIT
 cd "$work"
 printf '[run]\nframes = 3000\n[noise]\nenabled = false\n[workload]\nkind = "fixed"\ncpu = "2ms"\ngpu = "9ms"\n' > m.toml
 printf 'name = "e"\nmodel = "m.toml"\nreplications = 6\n[set]\n"run.frames" = 300\n[[metric]]\npath = "metrics.frame_time_ms.mean"\n' > e.toml
