@@ -9,12 +9,13 @@ use anyhow::{Context, Result};
 use serde_json::json;
 
 use rendersim::measure::calibrate::{
-    CalibrateError, Invocations, LoadCache, error_summary, fit, held_out_half, leave_one_out, leave_one_out_ns,
+    CalibrateError, Fit, Invocations, LoadCache, error_summary, fit, held_out_half, leave_one_out, leave_one_out_ns,
     linear_baseline_loo, read_rows_with_origins, row_load,
 };
 use rendersim::measure::device_predict::{DevicePass, predict_on_device};
 use rendersim::measure::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy, ProfileError};
 use rendersim::measure::fit::rel_error_pct;
+use rendersim::measure::passes::PassRow;
 use rendersim::measure::predictions::predict_rows;
 
 use super::args::{CalibrateArgs, PredictArgs};
@@ -169,17 +170,59 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&v)?);
         return check_holdout(args, half.map(|h| h.0.0));
     }
+    let calibration = Calibration {
+        rows: &rows,
+        files: &files,
+        fit: &f,
+        fit_seconds,
+        fitted: &fitted,
+        errors: &errors,
+        summary: (median, p90, worst),
+        loo: loo.as_ref(),
+        loo_summary,
+        half,
+    };
+    print!("{}", calibration_text(&calibration, &args.out)?);
+    check_holdout(args, half.map(|h| h.0.0))
+}
+
+/// Median, 90th percentile and worst |error|, percent.
+type ErrorSummary = (f64, f64, f64);
+
+/// What `calibrate` fitted, for its text report.
+struct Calibration<'a> {
+    rows: &'a [PassRow],
+    files: &'a [String],
+    fit: &'a Fit,
+    fit_seconds: f64,
+    fitted: &'a [f64],
+    errors: &'a [f64],
+    /// The fit's errors.
+    summary: ErrorSummary,
+    /// Leave-one-out errors, the linear baseline's, and the seconds taken.
+    loo: Option<&'a (Vec<f64>, Vec<f64>, f64)>,
+    /// Leave-one-out's errors and the linear baseline's.
+    loo_summary: Option<(ErrorSummary, ErrorSummary)>,
+    /// The held-out half's summary and its row count.
+    half: Option<(ErrorSummary, usize)>,
+}
+
+/// `calibrate`'s text report: the constants, every row fitted, the error
+/// summaries, and where the profile went.
+fn calibration_text(c: &Calibration, out: &std::path::Path) -> Result<String, std::fmt::Error> {
+    let (median, p90, worst) = c.summary;
     let mut s = String::new();
     writeln!(
         s,
         "{} rows from {}; fit in {:.3} s",
-        rows.len(),
-        files.join(", "),
-        fit_seconds
+        c.rows.len(),
+        c.files.join(", "),
+        c.fit_seconds
     )?;
     writeln!(s, "{:<28} {:>14} {:>12}", "constant", "value", "std error")?;
-    for (k, v) in f.costs.entries() {
-        let se = f
+    for (k, v) in c.fit.costs.entries() {
+        let se = c
+            .fit
             .std_errors
             .iter()
             .find(|(n, _)| n == k)
@@ -198,10 +241,10 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         "measured ns",
         "fitted ns",
         "err %",
-        if loo.is_some() { "   loo %" } else { "" }
+        if c.loo.is_some() { "   loo %" } else { "" }
     )?;
-    for (i, ((r, p), e)) in rows.iter().zip(&fitted).zip(&errors).enumerate() {
-        let l = loo.as_ref().map(|l| format!(" {:>7.1}", l.0[i])).unwrap_or_default();
+    for (i, ((r, p), e)) in c.rows.iter().zip(c.fitted).zip(c.errors).enumerate() {
+        let l = c.loo.map(|l| format!(" {:>7.1}", l.0[i])).unwrap_or_default();
         writeln!(
             s,
             "{:<24} {:>9} {:>6} {:>6} {:>4} {:>14.0} {:>14.0} {:>8.1}{l}",
@@ -219,7 +262,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         s,
         "\nfit |error|: median {median:.1}%, p90 {p90:.1}%, worst {worst:.1}%"
     )?;
-    if let (Some(((m, p, w), (bm, bp, bw))), Some(l)) = (loo_summary, loo.as_ref()) {
+    if let (Some(((m, p, w), (bm, bp, bw))), Some(l)) = (c.loo_summary, c.loo) {
         writeln!(
             s,
             "leave-one-out |error|: median {m:.1}%, p90 {p:.1}%, worst {w:.1}% ({:.2} s)",
@@ -230,15 +273,14 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
             "linear baseline leave-one-out: median {bm:.1}%, p90 {bp:.1}%, worst {bw:.1}%"
         )?;
     }
-    if let Some(((m, p, w), n)) = half {
+    if let Some(((m, p, w), n)) = c.half {
         writeln!(
             s,
             "held-out half (fit on a fixed pseudo-random half, the other {n} rows predicted) |error|: median {m:.1}%, p90 {p:.1}%, worst {w:.1}%"
         )?;
     }
-    writeln!(s, "wrote {}", args.out.display())?;
-    print!("{s}");
-    check_holdout(args, half.map(|h| h.0.0))
+    writeln!(s, "wrote {}", out.display())?;
+    Ok(s)
 }
 
 /// `--holdout-max-median`: the held-out half's median against the bound.

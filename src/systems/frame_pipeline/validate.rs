@@ -563,15 +563,19 @@ mod tests {
 
     #[test]
     fn system_tasks_must_leave_a_share_of_their_unit() {
-        let m = load_model(
-            None,
-            &Overrides {
-                sets: vec!["noise.periodic.0.duration=\"34.99ms\"".into()],
-                ..Overrides::default()
-            },
-        )
-        .unwrap();
-        let cfg: FramePipelineConfig = deserialize(&m.table, &m.source).unwrap();
+        // The default model with one `--set`.
+        let with = |set: &str| -> FramePipelineConfig {
+            let m = load_model(
+                None,
+                &Overrides {
+                    sets: vec![set.into()],
+                    ..Overrides::default()
+                },
+            )
+            .unwrap();
+            deserialize(&m.table, &m.source).unwrap()
+        };
+        let cfg = with("noise.periodic.0.duration=\"34.99ms\"");
         let e = validate(&cfg).unwrap_err().to_string();
         assert!(
             e.contains("noise.periodic.0.duration|noise.random.0.duration")
@@ -581,15 +585,6 @@ mod tests {
             "{e}"
         );
         // At 90% of the CPU the model runs.
-        let m = load_model(
-            None,
-            &Overrides {
-                sets: vec!["noise.periodic.0.duration=\"31ms\"".into()],
-                ..Overrides::default()
-            },
-        )
-        .unwrap();
-        let cfg: FramePipelineConfig = deserialize(&m.table, &m.source).unwrap();
-        validate(&cfg).unwrap();
+        validate(&with("noise.periodic.0.duration=\"31ms\"")).unwrap();
     }
 }
