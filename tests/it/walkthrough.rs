@@ -283,3 +283,20 @@ fn cli_reports_a_bad_key_with_its_line() {
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("scene.lod_ratio") && e.contains("bad.toml:80"), "{e}");
 }
+
+/// `immediate` never waits for a vertical blank, whatever `vsync` says: the
+/// walkthrough follows the same present-mode rule as the frame pipeline
+/// (it used to wait whenever `vsync` was on).
+#[test]
+fn immediate_with_vsync_on_does_not_wait_for_the_vertical_blank() {
+    let frames = |sets: &[&str]| {
+        let mut csv = Vec::new();
+        try_run_any(LINEAR, sets).unwrap().write_frames_csv(&mut csv).unwrap();
+        String::from_utf8(csv).unwrap()
+    };
+    let free = frames(&["display.vsync=false"]);
+    let immediate = frames(&["display.vsync=true", "display.present_mode=\"immediate\""]);
+    let fifo = frames(&["display.vsync=true", "display.present_mode=\"fifo\""]);
+    assert!(free == immediate, "vsync on with immediate differs from vsync off");
+    assert!(immediate != fifo, "a vsynced fifo display waits for the vertical blank");
+}

@@ -459,6 +459,21 @@ pub struct DisplayConfig {
     pub present_mode: PresentMode,
 }
 
+impl DisplayConfig {
+    /// The present mode the run follows: `present_mode`, or `immediate` when
+    /// `vsync` is off. The one place this rule is written: every system and
+    /// study that reads a `[display]` asks here.
+    pub fn effective_mode(&self) -> PresentMode {
+        if self.vsync { self.present_mode } else { PresentMode::Immediate }
+    }
+
+    /// Whether presented frames wait for a vertical blank (`fifo` or
+    /// `mailbox` with vsync on).
+    pub fn waits_for_vblank(&self) -> bool {
+        self.effective_mode() != PresentMode::Immediate
+    }
+}
+
 impl Default for DisplayConfig {
     fn default() -> Self {
         DisplayConfig {

@@ -368,11 +368,7 @@ impl FramePipeline {
                 noise.push(src);
             }
         }
-        let mode = if cfg.display.vsync {
-            cfg.display.present_mode
-        } else {
-            PresentMode::Immediate
-        };
+        let mode = cfg.display.effective_mode();
         let fifo_cap = cfg.command_fifo.capacity;
         let frames_total = cfg.run.frames;
         let (body_ops, scene_body) = match &program {

@@ -11,7 +11,6 @@
 //! it. Spans of one unit less than [`MERGE_GAP_US`] apart are merged (a
 //! frame's per-triangle work becomes a few bars a picture can show).
 
-use crate::components::swap_chain::PresentMode;
 use crate::config::{ModelSource, deserialize};
 use crate::engine::PS_PER_MS;
 use crate::output::trace::TraceWriter;
@@ -171,7 +170,7 @@ pub fn timeline_of(
     let mut cfg: FramePipelineConfig = deserialize(table, src).map_err(SimError::from)?;
     cfg.run.frames = opts.first + opts.frames;
     cfg.run.warmup_frames = 0;
-    let vsync = cfg.display.vsync && cfg.display.present_mode != PresentMode::Immediate;
+    let vsync = cfg.display.waits_for_vblank();
     let capacity = cfg.command_fifo.capacity;
     let unit = format!("{:?}", cfg.command_fifo.unit).to_lowercase();
     let collector = SpanCollector::new(MERGE_GAP_US, &["command FIFO"]);

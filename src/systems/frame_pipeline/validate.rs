@@ -369,7 +369,7 @@ pub(super) fn check_time_range(cfg: &FramePipelineConfig, a: &AnalyticTerms) -> 
         ("fragment work", gpu_key, term(a.fragment_ms)),
     ];
     // A vsynced FIFO swap chain shows every frame for at least one refresh.
-    if cfg.display.vsync && cfg.display.present_mode == PresentMode::Fifo {
+    if cfg.display.effective_mode() == PresentMode::Fifo {
         terms.push((
             "display refresh",
             "display.refresh",
@@ -411,11 +411,7 @@ pub fn estimate_events(
     let [cpu, gpu] = noise_loads(cfg);
     let free = |l: &NoiseLoad| (1.0 - l.share).max(crate::limits::MIN_FREE_SHARE);
     let ps = |ms: f64| ms * PS_PER_MS as f64;
-    let mode = if cfg.display.vsync {
-        cfg.display.present_mode
-    } else {
-        PresentMode::Immediate
-    };
+    let mode = cfg.display.effective_mode();
     let refresh = cfg.display.refresh.period.0 as f64;
     let mut per_frame = [
         ps(a.cpu_ms) / free(&cpu),

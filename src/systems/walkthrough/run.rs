@@ -386,7 +386,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
         let shown = timing.rt.div_ceil(refresh).max(1);
         skips += shown - 1;
         refreshes += shown;
-        let interval = if cfg.display.vsync {
+        let interval = if cfg.display.waits_for_vblank() {
             shown * refresh
         } else {
             timing.rt.max(1)
