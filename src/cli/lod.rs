@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Result, bail};
 
 use rendersim::components::lod_select::{
     Algorithm, MAX_OPTIMAL_OBJECTS, SelectionSummary, file::read_instance, optimal,
@@ -109,7 +109,7 @@ pub fn lod_select(args: &LodSelectArgs) -> Result<()> {
 /// `rendersim sortbuf`.
 pub fn sortbuf(args: &SortbufArgs) -> Result<()> {
     let seq = if args.sequence.starts_with("scene:") {
-        scene_state_ids(&args.sequence["scene:".len()..], Path::new(".")).map_err(|e| anyhow!(e))?
+        scene_state_ids(&args.sequence["scene:".len()..], Path::new("."))?
     } else {
         sequence_from_spec(&args.sequence, Path::new("."))?
     };

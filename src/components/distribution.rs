@@ -45,6 +45,17 @@ impl Quantity for f64 {
     }
 }
 
+/// Picoseconds: the kernel's [`Duration`](crate::engine::Duration) knows
+/// nothing of distributions, so the component layer implements this here.
+impl Quantity for crate::engine::Duration {
+    fn to_f64(self) -> f64 {
+        self.0 as f64
+    }
+    fn from_f64(x: f64) -> Self {
+        crate::engine::Duration::from_ps_f64(x)
+    }
+}
+
 /// One weighted component of a [`Dist::Mixture`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, bound = "V: Quantity")]
@@ -313,6 +324,49 @@ impl<V: Quantity> Dist<V> {
                 let second = weighted(parts, |d| d.variance() + d.mean().powi(2));
                 (second - mean * mean).max(0.0)
             }
+        }
+    }
+
+    /// `P(X > x)` in closed form (`x` in the base unit): the survival
+    /// function, 1 below the support and 0 above it.
+    pub fn survival(&self, x: f64) -> f64 {
+        match self {
+            Dist::Const { value } => f64::from(u8::from(x < value.to_f64())),
+            Dist::Uniform { min, max } => {
+                let (lo, hi) = (min.to_f64(), max.to_f64());
+                if x < lo {
+                    1.0
+                } else if x >= hi {
+                    0.0
+                } else {
+                    (hi - x) / (hi - lo)
+                }
+            }
+            Dist::Exponential { mean } => {
+                let m = mean.to_f64();
+                if x < 0.0 {
+                    1.0
+                } else if m <= 0.0 {
+                    0.0
+                } else {
+                    (-x / m).exp()
+                }
+            }
+            Dist::Lognormal { median, sigma } => {
+                let m = median.to_f64();
+                if x <= 0.0 {
+                    1.0
+                } else if *sigma == 0.0 {
+                    f64::from(u8::from(x < m))
+                } else {
+                    1.0 - phi((x.ln() - m.ln()) / sigma)
+                }
+            }
+            Dist::Pareto { scale, shape } => {
+                let xm = scale.to_f64();
+                if x < xm { 1.0 } else { (xm / x).powf(*shape) }
+            }
+            Dist::Mixture { parts } => weighted(parts, |d| d.survival(x)),
         }
     }
 

@@ -14,6 +14,10 @@
 
 use std::collections::VecDeque;
 
+use serde::{Deserialize, Serialize};
+
+use crate::config::Rate;
+
 /// How presented frames reach the screen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -24,6 +28,73 @@ pub enum PresentMode {
     Mailbox,
     /// Shown at once, no waiting for vertical blank.
     Immediate,
+}
+
+/// A model file's `[display]`: the swap chain and the display it feeds
+/// (paper 004 §4.2), shared by every system that has one.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DisplayConfig {
+    /// Refresh rate.
+    pub refresh: Rate,
+    /// Wait for vertical blank (false = `immediate`, whatever `present_mode` says).
+    pub vsync: bool,
+    /// Swap-chain images (2 = double, 3 = triple buffering).
+    pub buffers: u32,
+    /// How presented frames reach the screen.
+    pub present_mode: PresentMode,
+}
+
+impl DisplayConfig {
+    /// The present mode the run follows: `present_mode`, or `immediate` when
+    /// `vsync` is off. The one place this rule is written: every system and
+    /// study that reads a `[display]` asks here.
+    pub fn effective_mode(&self) -> PresentMode {
+        if self.vsync {
+            self.present_mode
+        } else {
+            PresentMode::Immediate
+        }
+    }
+
+    /// Whether presented frames wait for a vertical blank (`fifo` or
+    /// `mailbox` with vsync on).
+    pub fn waits_for_vblank(&self) -> bool {
+        self.effective_mode() != PresentMode::Immediate
+    }
+
+    /// Checks the display every system can run: a refresh period of at
+    /// least [`crate::limits::MIN_REFRESH_PERIOD_PS`] (every refresh is an
+    /// event) and 2 to 16 swap-chain images; the error is (key, message).
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        if self.refresh.period.0 < crate::limits::MIN_REFRESH_PERIOD_PS {
+            return Err((
+                "display.refresh",
+                format!(
+                    "a refresh period of {} is shorter than the limit of 1us (1 MHz): every refresh is an event",
+                    self.refresh.period
+                ),
+            ));
+        }
+        if !(2..=16).contains(&self.buffers) {
+            return Err((
+                "display.buffers",
+                format!("must be between 2 and 16 swap-chain images, got {}", self.buffers),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl Default for DisplayConfig {
+    fn default() -> Self {
+        DisplayConfig {
+            refresh: Rate::parse("60Hz").expect("valid literal"),
+            vsync: true,
+            buffers: 2,
+            present_mode: PresentMode::Fifo,
+        }
+    }
 }
 
 /// A frame identifier (its index).

@@ -309,6 +309,8 @@ impl<'de> Deserialize<'de> for Duration {
             fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Duration, E> {
                 if v == 0 {
                     Ok(Duration(0))
+                } else if v < 0 {
+                    Err(E::custom(format!("{v} is negative; durations must be >= 0")))
                 } else {
                     Err(E::custom(format!(
                         "a duration needs a unit: write \"{v}ms\" (or s, us, ns, ps), not {v}"
@@ -323,6 +325,8 @@ impl<'de> Deserialize<'de> for Duration {
                     Err(E::custom("NaN is not a duration"))
                 } else if v == 0.0 {
                     Ok(Duration(0))
+                } else if v < 0.0 {
+                    Err(E::custom(format!("{v} is negative; durations must be >= 0")))
                 } else {
                     Err(E::custom(format!(
                         "a duration needs a unit: write \"{v}ms\" (or s, us, ns, ps), not {v}"
@@ -331,15 +335,6 @@ impl<'de> Deserialize<'de> for Duration {
             }
         }
         d.deserialize_any(V)
-    }
-}
-
-impl crate::components::distribution::Quantity for Duration {
-    fn to_f64(self) -> f64 {
-        self.0 as f64
-    }
-    fn from_f64(x: f64) -> Self {
-        Duration::from_ps_f64(x)
     }
 }
 

@@ -264,18 +264,30 @@ pub(crate) fn analyse(exp: &super::spec::Experiment, results: &[super::run::Poin
         .collect()
 }
 
-/// `sensitivity.csv`: one row per metric and parameter.
+/// `sensitivity.csv`: one row per metric and parameter, through the one
+/// table writer ([`crate::output::table`]): a metric path or parameter key
+/// holding a comma is quoted, and an index that could not be estimated
+/// (NaN) is an empty cell, as in every other table.
 pub(crate) fn csv(results: &[Sensitivity]) -> String {
-    let mut s = String::from(
-        "metric,parameter,first_order,first_order_ci_low,first_order_ci_high,total,total_ci_low,total_ci_high\n",
-    );
-    for r in results {
-        for (key, i) in r.indices.iter().flatten() {
-            s.push_str(&format!(
-                "{},{},{},{},{},{},{},{}\n",
-                r.path, key, i.first, i.first_ci.0, i.first_ci.1, i.total, i.total_ci.0, i.total_ci.1
-            ));
-        }
-    }
-    s
+    use crate::output::table::{number, write_table};
+    const HEADER: [&str; 8] = [
+        "metric",
+        "parameter",
+        "first_order",
+        "first_order_ci_low",
+        "first_order_ci_high",
+        "total",
+        "total_ci_low",
+        "total_ci_high",
+    ];
+    let rows = results.iter().flat_map(|r| {
+        r.indices.iter().flatten().map(|(key, i)| {
+            let mut row = vec![r.path.clone(), key.clone()];
+            row.extend([i.first, i.first_ci.0, i.first_ci.1, i.total, i.total_ci.0, i.total_ci.1].map(number));
+            row
+        })
+    });
+    let mut out = Vec::new();
+    write_table(&mut out, &HEADER, rows).expect("writing to memory");
+    String::from_utf8(out).expect("the table writer writes UTF-8")
 }

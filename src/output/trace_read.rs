@@ -204,17 +204,28 @@ impl SpanCollector {
 
     /// What was read, once the trace was finished (its closing `]` seen);
     /// an error names what could not be parsed.
-    pub fn take(&self) -> Result<ReadTrace, String> {
+    pub fn take(&self) -> Result<ReadTrace, TraceReadError> {
         let mut s = self.state();
         s.parse();
         if let Some(e) = &s.error {
-            return Err(format!("reading the trace back: {e}"));
+            return Err(TraceReadError::Parse(e.clone()));
         }
         if !s.done {
-            return Err("reading the trace back: the trace was not finished".into());
+            return Err(TraceReadError::Unfinished);
         }
         Ok(std::mem::take(&mut s.out))
     }
+}
+
+/// Why a trace could not be read back.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum TraceReadError {
+    /// Part of the trace did not parse (what the parser said).
+    #[error("reading the trace back: {0}")]
+    Parse(String),
+    /// The trace's closing `]` never came.
+    #[error("reading the trace back: the trace was not finished")]
+    Unfinished,
 }
 
 impl Write for SpanCollector {
@@ -272,9 +283,12 @@ mod tests {
     fn an_unfinished_or_broken_trace_is_an_error() {
         let mut c = SpanCollector::new(0.0, &[]);
         c.write_all(b"{\"traceEvents\":[{\"ph\":\"X\"").unwrap();
-        assert!(c.take().unwrap_err().contains("not finished"));
+        assert_eq!(c.take().unwrap_err(), TraceReadError::Unfinished);
+        assert!(c.take().unwrap_err().to_string().contains("not finished"));
         let mut c = SpanCollector::new(0.0, &[]);
         c.write_all(b"{\"traceEvents\":[{\"ph\":3}]}").unwrap();
-        assert!(c.take().unwrap_err().contains("reading the trace back"));
+        let e = c.take().unwrap_err();
+        assert!(matches!(e, TraceReadError::Parse(_)), "{e:?}");
+        assert!(e.to_string().contains("reading the trace back"));
     }
 }

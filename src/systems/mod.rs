@@ -15,10 +15,11 @@ pub mod vr;
 pub mod walkthrough;
 
 use std::io::Write;
+use std::path::Path;
 
 use serde_json::Value;
 
-use crate::config::{ConfigError, ModelSource, invalid};
+use crate::config::{ConfigError, ModelSource, deserialize, invalid};
 use crate::output::trace::TraceWriter;
 
 pub use crate::config::DEFAULT_MODEL;
@@ -84,9 +85,98 @@ impl SimError {
     }
 }
 
-/// One simulated system. Adding a system means implementing this for a unit
-/// struct in the system's `system.rs` (its run type implements [`Outcome`])
-/// and adding one line to [`SYSTEMS`].
+/// A system as its parts: the config a model file reads into, the run it
+/// produces, and how a config runs. [`Registered`] makes any of them a
+/// [`System`]; adding a system is implementing this (and [`Outcome`] for its
+/// run) and adding one `Registered` line to [`SYSTEMS`]
+/// (`docs/ARCHITECTURE.md`, "Adding a system").
+///
+/// ```
+/// use std::path::Path;
+/// use rendersim::config::ModelSource;
+/// use rendersim::output::trace::TraceWriter;
+/// use rendersim::systems::{Registered, System, SystemError, SystemModel};
+/// use rendersim::systems::frame_pipeline::config::FramePipelineConfig;
+/// use rendersim::systems::frame_pipeline::run::{PipelineRun, run_pipeline};
+///
+/// /// The frame pipeline again, under another name.
+/// struct Again;
+///
+/// impl SystemModel for Again {
+///     const NAME: &'static str = "again";
+///     type Config = FramePipelineConfig;
+///     type Run = PipelineRun;
+///     fn run(cfg: FramePipelineConfig, base: &Path, trace: Option<TraceWriter>) -> Result<PipelineRun, SystemError> {
+///         run_pipeline(cfg, base, trace)
+///     }
+/// }
+///
+/// let system: &dyn System = &Registered::<Again>::new();
+/// // The embedded default model, 30 frames of it.
+/// let text = rendersim::systems::DEFAULT_MODEL.replace("frames = 300", "frames = 30");
+/// let src = ModelSource::from_text("again.toml", &text);
+/// let run = system.run(&src, &src.table().unwrap(), None).unwrap();
+/// assert_eq!(system.name(), "again");
+/// // 30 frames less the model's 20 warm-up frames, each displayed.
+/// assert_eq!(run.summary()["metrics"]["displayed_frames"], 10);
+/// ```
+pub trait SystemModel: 'static {
+    /// The name a model file gives in `system = "..."`.
+    const NAME: &'static str;
+    /// Whether a run writes trace events; a system that does not is refused
+    /// `rendersim run --trace` before it runs (and keeps a writer handed to
+    /// it through the library for the caller to close, empty).
+    const WRITES_TRACE: bool = true;
+    /// The model file's typed form (read with `--set` patches applied).
+    type Config: serde::de::DeserializeOwned;
+    /// A finished run.
+    type Run: Outcome + 'static;
+    /// Validates `cfg` and runs it; relative file paths in it are from
+    /// `base_dir`; with a `trace` writer, the run's trace goes into it.
+    fn run(cfg: Self::Config, base_dir: &Path, trace: Option<TraceWriter>) -> Result<Self::Run, SystemError>;
+}
+
+/// The one [`System`] implementation, over a [`SystemModel`]: reads the
+/// model's config from its table, runs it, and blames a bad value on the
+/// model file's line ([`SimError::of`]).
+pub struct Registered<S>(std::marker::PhantomData<fn() -> S>);
+
+impl<S> Registered<S> {
+    /// The registry entry of system `S`.
+    pub const fn new() -> Self {
+        Registered(std::marker::PhantomData)
+    }
+}
+
+impl<S> Default for Registered<S> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<S: SystemModel> System for Registered<S> {
+    fn name(&self) -> &'static str {
+        S::NAME
+    }
+
+    fn run(
+        &self,
+        src: &ModelSource,
+        table: &toml::Table,
+        trace: Option<TraceWriter>,
+    ) -> Result<Box<dyn Outcome>, SimError> {
+        let cfg: S::Config = deserialize(table, src)?;
+        let run = S::run(cfg, &src.base_dir, trace).map_err(|e| SimError::of(src, e))?;
+        Ok(Box::new(run))
+    }
+
+    fn writes_trace(&self) -> bool {
+        S::WRITES_TRACE
+    }
+}
+
+/// One simulated system, as [`run_model`] sees it (every one is a
+/// [`Registered`] [`SystemModel`]).
 pub trait System: Sync {
     /// The name a model file gives in `system = "..."`.
     fn name(&self) -> &'static str;
@@ -177,13 +267,13 @@ pub(crate) use outcome_basics;
 
 /// Every system, by the name a model file gives.
 pub const SYSTEMS: &[&dyn System] = &[
-    &frame_pipeline::system::FramePipelineSystem,
-    &multi_rate::system::MultiRateSystem,
-    &vr::system::VrSystem,
-    &pixelflow::system::PixelFlowSystem,
-    &walkthrough::system::WalkthroughSystem,
-    &device_predictions::system::DevicePredictionsSystem,
-    &state_sorting::system::StateSortingSystem,
+    &Registered::<frame_pipeline::system::FramePipelineSystem>::new(),
+    &Registered::<multi_rate::system::MultiRateSystem>::new(),
+    &Registered::<vr::system::VrSystem>::new(),
+    &Registered::<pixelflow::system::PixelFlowSystem>::new(),
+    &Registered::<walkthrough::system::WalkthroughSystem>::new(),
+    &Registered::<device_predictions::system::DevicePredictionsSystem>::new(),
+    &Registered::<state_sorting::system::StateSortingSystem>::new(),
 ];
 
 /// A resolved model's TOML with the header every system writes.

@@ -80,8 +80,9 @@ impl Dist {
 }
 
 /// Mean milliseconds per stage over `rows` (each a list of stage gaps in
-/// picoseconds, in the order of `names`); zeros when there are no rows.
-pub fn mean_stages<'a>(names: &[&str], rows: impl Iterator<Item = &'a Vec<u64>>) -> BTreeMap<String, f64> {
+/// picoseconds, in the order of `names`); every stage `null` when there
+/// are no rows, like an empty [`Dist`].
+pub fn mean_stages<'a>(names: &[&str], rows: impl Iterator<Item = &'a Vec<u64>>) -> BTreeMap<String, Option<f64>> {
     let mut sums = vec![0f64; names.len()];
     let mut n = 0usize;
     for r in rows {
@@ -90,8 +91,11 @@ pub fn mean_stages<'a>(names: &[&str], rows: impl Iterator<Item = &'a Vec<u64>>)
         }
         n += 1;
     }
-    let n = n.max(1) as f64;
-    names.iter().zip(sums).map(|(k, s)| (k.to_string(), s / n)).collect()
+    names
+        .iter()
+        .zip(sums)
+        .map(|(k, s)| (k.to_string(), (n > 0).then(|| s / n as f64)))
+        .collect()
 }
 
 /// Events handled per second of wall time (0 when no time was measured).
@@ -127,7 +131,8 @@ mod tests {
     fn stage_means_divide_by_the_rows() {
         let rows = [vec![1_000_000_000u64, 0], vec![3_000_000_000, 2_000_000_000]];
         let m = mean_stages(&["a", "b"], rows.iter());
-        assert_eq!((m["a"], m["b"]), (2.0, 1.0));
-        assert_eq!(mean_stages(&["a"], std::iter::empty())["a"], 0.0);
+        assert_eq!((m["a"], m["b"]), (Some(2.0), Some(1.0)));
+        assert_eq!(mean_stages(&["a"], std::iter::empty())["a"], None);
+        assert!(to_json(&mean_stages(&["a"], std::iter::empty()))["a"].is_null());
     }
 }

@@ -71,6 +71,24 @@ fn expected_max_matches_monte_carlo() {
 }
 
 #[test]
+fn survival_matches_monte_carlo() {
+    let mut r = rng();
+    for d in all_kinds() {
+        let xs: Vec<f64> = (0..200_000).map(|_| d.sample(&mut r)).collect();
+        for x in [0.5, 1.2, 2.0, 3.0, 6.0] {
+            let mc = xs.iter().filter(|&&v| v > x).count() as f64 / xs.len() as f64;
+            let exact = d.survival(x);
+            assert!((0.0..=1.0).contains(&exact), "{d:?} at {x}: {exact}");
+            // Four standard errors of a proportion from 200,000 draws.
+            assert!(
+                (mc - exact).abs() < 4.0 * (0.25f64 / 200_000.0).sqrt() + 1e-12,
+                "{d:?} at {x}: {mc} vs {exact}"
+            );
+        }
+    }
+}
+
+#[test]
 fn expected_max_exact_for_const() {
     let d = Dist::Const { value: 3.0 };
     assert_eq!(d.expected_max_with(1.0), 3.0);

@@ -55,22 +55,11 @@ struct RawLevel {
     benefit: f64,
 }
 
-/// A duration from a TOML value: a string with a unit, or the integer 0.
+/// A duration from a TOML or JSON value, read as every model file's
+/// durations are (the one parser, [`Duration`]'s `Deserialize`): a string
+/// with a unit, or 0.
 fn duration(v: &toml::Value) -> Result<Duration, String> {
-    match v {
-        toml::Value::String(s) => Duration::parse(s).map_err(|e| e.to_string()),
-        toml::Value::Integer(0) => Ok(Duration::ZERO),
-        toml::Value::Float(f) if *f == 0.0 => Ok(Duration::ZERO),
-        toml::Value::Integer(i) if *i < 0 => Err(format!("{i} is negative; costs must be >= 0")),
-        toml::Value::Float(f) if *f < 0.0 => Err(format!("{f} is negative; costs must be >= 0")),
-        toml::Value::Integer(_) | toml::Value::Float(_) => {
-            Err(format!("{v} needs a unit: write \"{v}ms\" (or s, us, ns, ps)"))
-        }
-        other => Err(format!(
-            "expected a duration like \"0.4ms\", got a {}",
-            other.type_str()
-        )),
-    }
+    Duration::deserialize(v.clone()).map_err(|e| e.to_string())
 }
 
 /// Parses an instance file's text. Errors name the key and its line

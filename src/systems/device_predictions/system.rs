@@ -12,12 +12,11 @@ use serde::Serialize;
 use serde_json::Value;
 
 use crate::components::vertex_cache::CachePolicy;
-use crate::config::{ModelSource, deserialize};
 use crate::measure::calibrate::read_rows;
 use crate::measure::predictions::{DevicePredictions, ErrorStats, calibrate_rows, predict_rows};
 use crate::output::trace::TraceWriter;
 use crate::systems::error::invalid;
-use crate::systems::{Outcome, SimError, System, SystemError, resolved_toml};
+use crate::systems::{Outcome, SystemError, SystemModel, resolved_toml};
 
 use super::config::DevicePredictionsConfig;
 
@@ -83,12 +82,6 @@ pub fn run_device_predictions(
     base_dir: &Path,
 ) -> Result<DevicePredictionsRun, SystemError> {
     let start = Instant::now();
-    if cfg.system != "device_predictions" {
-        return Err(invalid(
-            "system",
-            format!("expected \"device_predictions\", got {:?}", cfg.system),
-        ));
-    }
     if cfg.files.is_empty() {
         return Err(invalid("files", "names no pass CSV"));
     }
@@ -143,27 +136,22 @@ pub fn run_device_predictions(
     })
 }
 
-impl System for DevicePredictionsSystem {
-    fn name(&self) -> &'static str {
-        "device_predictions"
-    }
-
-    fn writes_trace(&self) -> bool {
-        false
-    }
+impl SystemModel for DevicePredictionsSystem {
+    const NAME: &'static str = "device_predictions";
+    const WRITES_TRACE: bool = false;
+    type Config = DevicePredictionsConfig;
+    type Run = DevicePredictionsRun;
 
     fn run(
-        &self,
-        src: &ModelSource,
-        table: &toml::Table,
+        cfg: DevicePredictionsConfig,
+        base_dir: &Path,
         trace: Option<TraceWriter>,
-    ) -> Result<Box<dyn Outcome>, SimError> {
-        let cfg: DevicePredictionsConfig = deserialize(table, src)?;
-        let mut run = run_device_predictions(cfg, &src.base_dir).map_err(|e| SimError::of(src, e))?;
+    ) -> Result<DevicePredictionsRun, SystemError> {
+        let mut run = run_device_predictions(cfg, base_dir)?;
         // No trace of its own (`rendersim run --trace` refuses the model): a
         // trace writer handed in through the library is closed empty.
         run.trace = trace;
-        Ok(Box::new(run))
+        Ok(run)
     }
 }
 

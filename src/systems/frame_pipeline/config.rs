@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 use crate::components::distribution::Dist;
 use crate::components::fifo::FifoUnit;
 use crate::components::noise::NoiseTarget;
-use crate::components::swap_chain::PresentMode;
+pub use crate::components::swap_chain::DisplayConfig;
 use crate::components::vertex_cache::CachePolicy;
 use crate::config::{Bandwidth, Bytes, Rate};
 use crate::engine::Duration;
@@ -441,46 +441,6 @@ impl Default for FragmentConfig {
             per_fragment: Duration::ZERO,
             per_rejected_fragment: Duration::ZERO,
             fixed_per_fragment: Duration::ZERO,
-        }
-    }
-}
-
-/// Swap chain and display (paper 004 §4.2).
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct DisplayConfig {
-    /// Refresh rate.
-    pub refresh: Rate,
-    /// Wait for vertical blank (false = `immediate`, whatever `present_mode` says).
-    pub vsync: bool,
-    /// Swap-chain images (2 = double, 3 = triple buffering).
-    pub buffers: u32,
-    /// How presented frames reach the screen.
-    pub present_mode: PresentMode,
-}
-
-impl DisplayConfig {
-    /// The present mode the run follows: `present_mode`, or `immediate` when
-    /// `vsync` is off. The one place this rule is written: every system and
-    /// study that reads a `[display]` asks here.
-    pub fn effective_mode(&self) -> PresentMode {
-        if self.vsync { self.present_mode } else { PresentMode::Immediate }
-    }
-
-    /// Whether presented frames wait for a vertical blank (`fifo` or
-    /// `mailbox` with vsync on).
-    pub fn waits_for_vblank(&self) -> bool {
-        self.effective_mode() != PresentMode::Immediate
-    }
-}
-
-impl Default for DisplayConfig {
-    fn default() -> Self {
-        DisplayConfig {
-            refresh: Rate::parse("60Hz").expect("valid literal"),
-            vsync: true,
-            buffers: 2,
-            present_mode: PresentMode::Fifo,
         }
     }
 }

@@ -3,9 +3,8 @@
 use std::io::Write;
 use std::path::Path;
 
-use crate::config::{ModelSource, deserialize};
 use crate::output::trace::TraceWriter;
-use crate::systems::{Outcome, SimError, System, outcome_basics, resolved_toml};
+use crate::systems::{Outcome, SystemError, SystemModel, outcome_basics, resolved_toml};
 
 use super::config::{FramePipelineConfig, WorkloadConfig};
 use super::records::{COLUMNS, frame_rows, write_frames_csv};
@@ -14,20 +13,13 @@ use super::run::{PipelineRun, run_pipeline};
 /// `system = "frame_pipeline"` (the default).
 pub struct FramePipelineSystem;
 
-impl System for FramePipelineSystem {
-    fn name(&self) -> &'static str {
-        "frame_pipeline"
-    }
+impl SystemModel for FramePipelineSystem {
+    const NAME: &'static str = "frame_pipeline";
+    type Config = FramePipelineConfig;
+    type Run = PipelineRun;
 
-    fn run(
-        &self,
-        src: &ModelSource,
-        table: &toml::Table,
-        trace: Option<TraceWriter>,
-    ) -> Result<Box<dyn Outcome>, SimError> {
-        let cfg: FramePipelineConfig = deserialize(table, src)?;
-        let run = run_pipeline(cfg, &src.base_dir, trace).map_err(|e| SimError::of(src, e))?;
-        Ok(Box::new(run))
+    fn run(cfg: FramePipelineConfig, base_dir: &Path, trace: Option<TraceWriter>) -> Result<PipelineRun, SystemError> {
+        run_pipeline(cfg, base_dir, trace)
     }
 }
 

@@ -180,7 +180,7 @@ pub fn timeline_of(
         w.finish()
             .map_err(|e| TimelineError::Trace(format!("tracing the run: {e}")))?;
     }
-    let read = collector.take().map_err(TimelineError::Trace)?;
+    let read = collector.take().map_err(|e| TimelineError::Trace(e.to_string()))?;
     let to_ms = |t: crate::engine::Time| t.0 as f64 / PS_PER_MS as f64;
     let refresh_ms = run.refresh.0 as f64 / PS_PER_MS as f64;
     let drawn: Vec<_> = run.records.iter().filter(|r| r.index >= opts.first).collect();

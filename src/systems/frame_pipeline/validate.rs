@@ -19,24 +19,7 @@ pub fn validate(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
             format!("expected \"frame_pipeline\", got {:?}", cfg.system),
         ));
     }
-    if cfg.display.refresh.period.0 < crate::limits::MIN_REFRESH_PERIOD_PS {
-        return Err(bad(
-            "display.refresh",
-            format!(
-                "a refresh period of {} is shorter than the limit of 1us (1 MHz): every refresh is an event",
-                cfg.display.refresh.period
-            ),
-        ));
-    }
-    if !(2..=16).contains(&cfg.display.buffers) {
-        return Err(bad(
-            "display.buffers",
-            format!(
-                "must be between 2 and 16 swap-chain images, got {}",
-                cfg.display.buffers
-            ),
-        ));
-    }
+    cfg.display.check().map_err(|(key, message)| bad(key, message))?;
     cfg.gpu
         .check_architecture()
         .map_err(|(key, message)| bad(key, message))?;

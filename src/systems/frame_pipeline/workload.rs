@@ -299,7 +299,7 @@ pub fn compile_scene(
             format!("must be a number > 0, got {}", scene.scale),
         ));
     }
-    let groups_cfg = scene_groups(scene).map_err(|e| invalid("workload.preset", e))?;
+    let groups_cfg = scene_groups(scene).map_err(|e| invalid("workload.preset", e.to_string()))?;
 
     let pass = early_z_pass(scene.depth_order, scene.depth_complexity);
     let (shade_per_pixel, fixed_per_pixel) = fragment_costs(cfg, pass);

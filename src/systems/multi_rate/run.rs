@@ -40,9 +40,6 @@ pub struct MultiRateRun {
 
 /// Checks values serde cannot.
 pub fn validate(cfg: &MultiRateConfig) -> Result<(), SystemError> {
-    if cfg.system != "multi_rate" {
-        return Err(bad("system", format!("expected \"multi_rate\", got {:?}", cfg.system)));
-    }
     let [w, h] = cfg.resolution;
     if w == 0 || h == 0 || w > 65536 || h > 65536 {
         return Err(bad(
@@ -302,8 +299,8 @@ pub struct MultiRateMetrics {
     /// The paper's closed forms and the bounds over all phases, per path.
     pub analytic_latency_ms: Paths<Bounds>,
     /// Mean milliseconds per latency stage, per path (stage names in
-    /// [`crate::systems::LATENCY_STAGES`]).
-    pub latency_breakdown_ms: Paths<BTreeMap<String, f64>>,
+    /// [`crate::systems::LATENCY_STAGES`]); `null` when none was measured.
+    pub latency_breakdown_ms: Paths<BTreeMap<String, Option<f64>>>,
     /// The per-frame terms.
     pub terms_ms: TermsMs,
     /// Frame and link rates.

@@ -4,9 +4,8 @@
 use std::io::Write;
 use std::path::Path;
 
-use crate::config::{ModelSource, deserialize};
 use crate::output::trace::TraceWriter;
-use crate::systems::{Outcome, SimError, System, outcome_basics, resolved_toml};
+use crate::systems::{Outcome, SystemError, SystemModel, outcome_basics, resolved_toml};
 
 use super::config::MultiRateConfig;
 use super::latency::{COLUMNS, event_rows};
@@ -15,20 +14,13 @@ use super::run::{MultiRateRun, run_multi_rate, write_events_csv};
 /// `system = "multi_rate"`.
 pub struct MultiRateSystem;
 
-impl System for MultiRateSystem {
-    fn name(&self) -> &'static str {
-        "multi_rate"
-    }
+impl SystemModel for MultiRateSystem {
+    const NAME: &'static str = "multi_rate";
+    type Config = MultiRateConfig;
+    type Run = MultiRateRun;
 
-    fn run(
-        &self,
-        src: &ModelSource,
-        table: &toml::Table,
-        trace: Option<TraceWriter>,
-    ) -> Result<Box<dyn Outcome>, SimError> {
-        let cfg: MultiRateConfig = deserialize(table, src)?;
-        let run = run_multi_rate(cfg, trace).map_err(|e| SimError::of(src, e))?;
-        Ok(Box::new(run))
+    fn run(cfg: MultiRateConfig, _base_dir: &Path, trace: Option<TraceWriter>) -> Result<MultiRateRun, SystemError> {
+        run_multi_rate(cfg, trace)
     }
 }
 

@@ -400,15 +400,15 @@ pub struct StagesMs {
 }
 
 /// Region entries per screen region (a primitive counts once per region it
-/// touches).
+/// touches); each `null` when there are no regions.
 #[derive(Debug, Clone, Serialize)]
 pub struct EntryCounts {
     /// Fewest.
-    pub min: u64,
+    pub min: Option<u64>,
     /// Most.
-    pub max: u64,
+    pub max: Option<u64>,
     /// Mean.
-    pub mean: f64,
+    pub mean: Option<f64>,
 }
 
 /// A few statistics over frames; `null` with `count: 0` when there are no
@@ -564,9 +564,9 @@ fn summary(
         Some((l, e)) => (
             l.realised_overlap(),
             Some(EntryCounts {
-                min: e.iter().copied().min().unwrap_or(0),
-                max: e.iter().copied().max().unwrap_or(0),
-                mean: e.iter().sum::<u64>() as f64 / e.len().max(1) as f64,
+                min: e.iter().copied().min(),
+                max: e.iter().copied().max(),
+                mean: (!e.is_empty()).then(|| e.iter().sum::<u64>() as f64 / e.len() as f64),
             }),
         ),
         None => (a.overlap, None),

@@ -3,9 +3,8 @@
 use std::io::Write;
 use std::path::Path;
 
-use crate::config::{ModelSource, deserialize};
 use crate::output::trace::TraceWriter;
-use crate::systems::{Outcome, SimError, System, outcome_basics, resolved_toml};
+use crate::systems::{Outcome, SystemError, SystemModel, outcome_basics, resolved_toml};
 
 use super::config::PixelFlowConfig;
 use super::run::{COLUMNS, PixelFlowRun, region_rows, run_pixelflow, write_regions_csv, write_trace};
@@ -13,26 +12,20 @@ use super::run::{COLUMNS, PixelFlowRun, region_rows, run_pixelflow, write_region
 /// `system = "pixelflow"`.
 pub struct PixelFlowSystem;
 
-impl System for PixelFlowSystem {
-    fn name(&self) -> &'static str {
-        "pixelflow"
-    }
+impl SystemModel for PixelFlowSystem {
+    const NAME: &'static str = "pixelflow";
+    type Config = PixelFlowConfig;
+    type Run = PixelFlowRun;
 
     /// One frame's spans are kept while it runs and written to the trace at
     /// the end (the frame pipeline and the latency systems stream theirs).
-    fn run(
-        &self,
-        src: &ModelSource,
-        table: &toml::Table,
-        trace: Option<TraceWriter>,
-    ) -> Result<Box<dyn Outcome>, SimError> {
-        let cfg: PixelFlowConfig = deserialize(table, src)?;
-        let mut run = run_pixelflow(cfg, trace.is_some()).map_err(|e| SimError::of(src, e))?;
+    fn run(cfg: PixelFlowConfig, _base_dir: &Path, trace: Option<TraceWriter>) -> Result<PixelFlowRun, SystemError> {
+        let mut run = run_pixelflow(cfg, trace.is_some())?;
         run.trace = trace.map(|mut t| {
             write_trace(&run, &mut t);
             t
         });
-        Ok(Box::new(run))
+        Ok(run)
     }
 }
 

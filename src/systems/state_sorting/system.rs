@@ -11,14 +11,13 @@ use serde::Serialize;
 use serde_json::Value;
 
 use crate::components::sorting_buffer::{
-    MAX_OFFLINE_LEN, StateId, Strategy, check_buffer, distinct_states, input_runs, lower_bound, offline_optimum,
-    sequence::sequence_from_spec, simulate,
+    MAX_OFFLINE_LEN, SortBufferError, StateId, Strategy, check_buffer, distinct_states, input_runs, lower_bound,
+    offline_optimum, sequence::sequence_from_spec, simulate,
 };
-use crate::config::{ModelSource, deserialize};
 use crate::output::trace::TraceWriter;
-use crate::scene::states::scene_state_ids;
+use crate::scene::states::{StatesError, scene_state_ids};
 use crate::systems::error::invalid;
-use crate::systems::{Outcome, SimError, System, SystemError, outcome_basics, resolved_toml};
+use crate::systems::{Outcome, SystemError, SystemModel, outcome_basics, resolved_toml};
 
 use super::config::StateSortingConfig;
 
@@ -78,23 +77,28 @@ fn strategy_of(name: &str) -> Option<Strategy> {
     Strategy::ALL.into_iter().find(|s| s.name() == name)
 }
 
+/// Why a sequence spec cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum SequenceError {
+    /// A `scene:MODEL.toml` sequence.
+    #[error(transparent)]
+    Scene(#[from] StatesError),
+    /// A file or generator sequence.
+    #[error(transparent)]
+    Spec(#[from] SortBufferError),
+}
+
 /// The sequence a spec names (relative paths from `base`).
-pub fn resolve_sequence(spec: &str, base: &Path) -> Result<Vec<StateId>, String> {
-    match spec.strip_prefix("scene:") {
-        Some(rest) => scene_state_ids(rest, base),
-        None => sequence_from_spec(spec, base).map_err(|e| e.to_string()),
-    }
+pub fn resolve_sequence(spec: &str, base: &Path) -> Result<Vec<StateId>, SequenceError> {
+    Ok(match spec.strip_prefix("scene:") {
+        Some(rest) => scene_state_ids(rest, base)?,
+        None => sequence_from_spec(spec, base)?,
+    })
 }
 
 /// Reads the sequence and runs every strategy.
 pub fn run_state_sorting(cfg: StateSortingConfig, base_dir: &Path) -> Result<StateSortingRun, SystemError> {
     let start = Instant::now();
-    if cfg.system != "state_sorting" {
-        return Err(invalid(
-            "system",
-            format!("expected \"state_sorting\", got {:?}", cfg.system),
-        ));
-    }
     check_buffer(cfg.buffer).map_err(|e| invalid("buffer", e.to_string()))?;
     if cfg.strategies.is_empty() {
         return Err(invalid("strategies", "names no strategy"));
@@ -115,7 +119,7 @@ pub fn run_state_sorting(cfg: StateSortingConfig, base_dir: &Path) -> Result<Sta
         }
         strategies.push(s);
     }
-    let seq = resolve_sequence(&cfg.sequence, base_dir).map_err(|e| invalid("sequence", e))?;
+    let seq = resolve_sequence(&cfg.sequence, base_dir).map_err(|e| invalid("sequence", e.to_string()))?;
     let sim_start = Instant::now();
     let mut rows = Vec::new();
     let mut metrics = Metrics {
@@ -174,27 +178,22 @@ pub fn run_state_sorting(cfg: StateSortingConfig, base_dir: &Path) -> Result<Sta
     })
 }
 
-impl System for StateSortingSystem {
-    fn name(&self) -> &'static str {
-        "state_sorting"
-    }
-
-    fn writes_trace(&self) -> bool {
-        false
-    }
+impl SystemModel for StateSortingSystem {
+    const NAME: &'static str = "state_sorting";
+    const WRITES_TRACE: bool = false;
+    type Config = StateSortingConfig;
+    type Run = StateSortingRun;
 
     fn run(
-        &self,
-        src: &ModelSource,
-        table: &toml::Table,
+        cfg: StateSortingConfig,
+        base_dir: &Path,
         trace: Option<TraceWriter>,
-    ) -> Result<Box<dyn Outcome>, SimError> {
-        let cfg: StateSortingConfig = deserialize(table, src)?;
-        let mut run = run_state_sorting(cfg, &src.base_dir).map_err(|e| SimError::of(src, e))?;
+    ) -> Result<StateSortingRun, SystemError> {
+        let mut run = run_state_sorting(cfg, base_dir)?;
         // No events of its own (`rendersim run --trace` refuses the model): a
         // trace writer handed in through the library is closed empty.
         run.trace = trace;
-        Ok(Box::new(run))
+        Ok(run)
     }
 }
 

@@ -40,9 +40,6 @@ pub struct VrRun {
 
 /// Checks values serde cannot.
 pub fn validate(cfg: &VrConfig) -> Result<(), SystemError> {
-    if cfg.system != "vr" {
-        return Err(bad("system", format!("expected \"vr\", got {:?}", cfg.system)));
-    }
     for (key, d) in [
         ("tracker.period", cfg.tracker.period),
         ("input.mean_interval", cfg.input.mean_interval),
@@ -179,8 +176,8 @@ pub struct VrMetrics {
     /// The closed forms and the bounds over all phases.
     pub analytic_latency_ms: Motions<Bounds>,
     /// Mean milliseconds per latency stage (stage names in
-    /// [`crate::systems::LATENCY_STAGES`]).
-    pub latency_breakdown_ms: Motions<BTreeMap<String, f64>>,
+    /// [`crate::systems::LATENCY_STAGES`]); `null` when none was measured.
+    pub latency_breakdown_ms: Motions<BTreeMap<String, Option<f64>>>,
     /// One stereo pair of the display (the swap period).
     pub display_frame_ms: f64,
     /// Frames that swapped.

@@ -4,9 +4,8 @@
 use std::io::Write;
 use std::path::Path;
 
-use crate::config::{ModelSource, deserialize};
 use crate::output::trace::TraceWriter;
-use crate::systems::{Outcome, SimError, System, outcome_basics, resolved_toml};
+use crate::systems::{Outcome, SystemError, SystemModel, outcome_basics, resolved_toml};
 
 use super::config::VrConfig;
 use super::run::{COLUMNS, motion_rows};
@@ -15,20 +14,13 @@ use super::run::{VrRun, run_vr, write_motions_csv};
 /// `system = "vr"`.
 pub struct VrSystem;
 
-impl System for VrSystem {
-    fn name(&self) -> &'static str {
-        "vr"
-    }
+impl SystemModel for VrSystem {
+    const NAME: &'static str = "vr";
+    type Config = VrConfig;
+    type Run = VrRun;
 
-    fn run(
-        &self,
-        src: &ModelSource,
-        table: &toml::Table,
-        trace: Option<TraceWriter>,
-    ) -> Result<Box<dyn Outcome>, SimError> {
-        let cfg: VrConfig = deserialize(table, src)?;
-        let run = run_vr(cfg, trace).map_err(|e| SimError::of(src, e))?;
-        Ok(Box::new(run))
+    fn run(cfg: VrConfig, _base_dir: &Path, trace: Option<TraceWriter>) -> Result<VrRun, SystemError> {
+        run_vr(cfg, trace)
     }
 }
 

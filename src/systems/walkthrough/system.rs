@@ -3,9 +3,8 @@
 use std::io::Write;
 use std::path::Path;
 
-use crate::config::{ModelSource, deserialize};
 use crate::output::trace::TraceWriter;
-use crate::systems::{Outcome, SimError, System, outcome_basics, resolved_toml};
+use crate::systems::{Outcome, SystemError, SystemModel, outcome_basics, resolved_toml};
 
 use super::config::WalkthroughConfig;
 use super::run::{WalkthroughRun, run_walkthrough};
@@ -13,27 +12,22 @@ use super::run::{WalkthroughRun, run_walkthrough};
 /// `system = "walkthrough"`.
 pub struct WalkthroughSystem;
 
-impl System for WalkthroughSystem {
-    fn name(&self) -> &'static str {
-        "walkthrough"
-    }
-
-    fn writes_trace(&self) -> bool {
-        false
-    }
+impl SystemModel for WalkthroughSystem {
+    const NAME: &'static str = "walkthrough";
+    const WRITES_TRACE: bool = false;
+    type Config = WalkthroughConfig;
+    type Run = WalkthroughRun;
 
     fn run(
-        &self,
-        src: &ModelSource,
-        table: &toml::Table,
+        cfg: WalkthroughConfig,
+        _base_dir: &Path,
         trace: Option<TraceWriter>,
-    ) -> Result<Box<dyn Outcome>, SimError> {
-        let cfg: WalkthroughConfig = deserialize(table, src)?;
-        let mut run = run_walkthrough(cfg).map_err(|e| SimError::of(src, e))?;
+    ) -> Result<WalkthroughRun, SystemError> {
+        let mut run = run_walkthrough(cfg)?;
         // No trace of its own (`rendersim run --trace` refuses the model): a
         // trace writer handed in through the library is closed empty.
         run.trace = trace;
-        Ok(Box::new(run))
+        Ok(run)
     }
 }
 

@@ -11,12 +11,6 @@ use super::run::MAX_FRAMES;
 
 /// Checks the keys serde cannot.
 pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
-    if cfg.system != "walkthrough" {
-        return Err(invalid(
-            "system",
-            format!("expected \"walkthrough\", got {:?}", cfg.system),
-        ));
-    }
     for (i, e) in cfg.estimation.estimators.iter().enumerate() {
         if !ESTIMATORS.contains(&e.as_str()) {
             return Err(invalid(
