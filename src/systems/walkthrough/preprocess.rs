@@ -182,11 +182,11 @@ fn pos_tables(
     image: (f64, f64, f64),
     renders: &mut ExactRenders,
     clock: &mut Clock,
-) -> Result<(Vec<Vec<Option<PosTable>>>, Option<PosTables>), SystemError> {
+) -> Result<(Tables, Option<PosTables>), SystemError> {
     let table_levels = |p: &super::scene::Prototype| {
         if policy == Policy::None { 1 } else { p.levels.len() }
     };
-    let mut tables: Vec<Vec<Option<PosTable>>> = scene.protos.iter().map(|p| vec![None; table_levels(p)]).collect();
+    let mut tables: Tables = scene.protos.iter().map(|p| vec![None; table_levels(p)]).collect();
     if !(wants[4] || wants[PVC]) {
         return Ok((tables, None));
     }
@@ -232,6 +232,9 @@ fn pos_tables(
     };
     Ok((tables, Some(summary)))
 }
+
+/// Per prototype and level, its pos table (none where none was built).
+type Tables = Vec<Vec<Option<PosTable>>>;
 
 /// The view-cell estimators (when vcs or pvc is wanted), for the cells the
 /// path through `poses` visits, with the potentially visible sets built

@@ -650,7 +650,7 @@ impl<'a> Walk<'a> {
                 .push(features(m.scene, d.proto, d.level as usize, &self.visible[vi].1));
         }
         let mut sums = [0.0f64; ESTIMATORS.len()];
-        for k in 0..4 {
+        for (k, sum_k) in sums.iter_mut().enumerate().take(4) {
             if !m.wants[k] {
                 continue;
             }
@@ -659,7 +659,7 @@ impl<'a> Walk<'a> {
             let sum: f64 = self.feats.iter().map(|x| c.object(k, x)).sum();
             self.wall[k] += t.elapsed().as_secs_f64();
             self.ops[k] += self.feats.len() as u64;
-            sums[k] = sum;
+            *sum_k = sum;
         }
         if m.wants[4] {
             let t = Instant::now();
@@ -695,13 +695,13 @@ impl<'a> Walk<'a> {
         self.count.add(timing.events, &by_kind, names);
         // RT = the frame's own terms + max(ET_cpu, ET_gpu) (paper 000 §4.1):
         // the empty frame, the CPU's submission work (known), the estimate.
-        for k in 0..ESTIMATORS.len() {
+        for (k, &sum) in sums.iter().enumerate() {
             if self.m.wants[k] {
                 // vcs measured whole frames: its table holds RT itself.
                 self.est[k].push(if k == VCS {
-                    ms(sums[k])
+                    ms(sum)
                 } else {
-                    ms(self.m.empty + sums[k].max(timing.cpu_submit as f64))
+                    ms(self.m.empty + sum.max(timing.cpu_submit as f64))
                 });
             }
         }
