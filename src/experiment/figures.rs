@@ -6,7 +6,7 @@ use crate::plot::{Histogram, LinePlot, PlotError, Scatter, ScatterPoint, Series,
 
 use super::run::PointResult;
 use super::spec::{Experiment, PlotKind, PlotSpec};
-use super::sweep::Point;
+use super::sweep::{Point, Sweep};
 
 /// Draw one plot into `out_dir`; returns caption lines for the report (for
 /// histograms with a `range`: the values left outside it).
@@ -29,58 +29,14 @@ pub(crate) fn draw(
             filter,
         } => {
             let xi = exp.sweeps.iter().position(|s| &s.key == x).unwrap_or(0);
-            // Group points by the values of the other sweeps, in first-seen order.
-            let mut groups: Vec<(Vec<usize>, Vec<usize>)> = Vec::new();
-            for p in points.iter().filter(|p| p.matches(filter)) {
-                let key: Vec<usize> = p
-                    .value_indices
-                    .iter()
-                    .enumerate()
-                    .filter(|&(i, _)| i != xi)
-                    .map(|(_, &v)| v)
-                    .collect();
-                match groups.iter_mut().find(|g| g.0 == key) {
-                    Some(g) => g.1.push(p.index),
-                    None => groups.push((key, vec![p.index])),
-                }
-            }
+            let groups = line_groups(points, xi, filter);
             let mut series = Vec::new();
             for path in y {
                 let is_derived = exp.derived.iter().any(|d| &d.name == path);
                 for (_, members) in &groups {
-                    let group_label = points[members[0]]
-                        .assignments
-                        .iter()
-                        .enumerate()
-                        .filter(|&(i, (k, _))| i != xi && !filter.iter().any(|(f, _)| f == k))
-                        .map(|(i, _)| points[members[0]].plot_assignment(&exp.sweeps, i))
-                        .collect::<Vec<_>>()
-                        .join(", ");
-                    let name = match (group_label.is_empty(), y.len() > 1) {
-                        (true, _) => exp.label_of(path),
-                        (false, false) => group_label,
-                        (false, true) => format!("{} ({group_label})", exp.label_of(path)),
-                    };
-                    let mut pts = Vec::new();
-                    let mut ci = Vec::new();
-                    for &m in members {
-                        let xv = exp.sweeps[xi].coords[points[m].value_indices[xi]];
-                        let r = &results[m];
-                        match (is_derived, r.stat(path)) {
-                            (false, Some(c)) if c.n > 0 => {
-                                pts.push((xv, c.mean));
-                                ci.push((c.low, c.high));
-                            }
-                            _ => {
-                                if let Some(v) = r.value(path) {
-                                    pts.push((xv, v));
-                                    ci.push((v, v));
-                                }
-                            }
-                        }
-                    }
+                    let (pts, ci) = series_points(exp, points, results, xi, path, members);
                     series.push(Series {
-                        name,
+                        name: series_name(exp, points, xi, filter, path, y.len() > 1, members),
                         points: pts,
                         ci: (!is_derived).then_some(ci),
                     });
@@ -95,16 +51,7 @@ pub(crate) fn draw(
                     series,
                     log_x: *log_x,
                     log_y: *log_y,
-                    x_categories: if exp.sweeps[xi].categorical {
-                        exp.sweeps[xi]
-                            .coords
-                            .iter()
-                            .copied()
-                            .zip(exp.sweeps[xi].labels.iter().cloned())
-                            .collect()
-                    } else {
-                        Vec::new()
-                    },
+                    x_categories: x_categories(&exp.sweeps[xi]),
                 },
             )?;
             Ok(Vec::new())
@@ -161,5 +108,96 @@ pub(crate) fn draw(
             )?;
             Ok(Vec::new())
         }
+    }
+}
+
+/// A line plot's groups of points (indices), one per combination of the
+/// other sweeps' values (all but sweep `xi`), in first-seen order; only
+/// the points `filter` keeps.
+fn line_groups(points: &[Point], xi: usize, filter: &[(String, toml::Value)]) -> Vec<(Vec<usize>, Vec<usize>)> {
+    let mut groups: Vec<(Vec<usize>, Vec<usize>)> = Vec::new();
+    for p in points.iter().filter(|p| p.matches(filter)) {
+        let key: Vec<usize> = p
+            .value_indices
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| i != xi)
+            .map(|(_, &v)| v)
+            .collect();
+        match groups.iter_mut().find(|g| g.0 == key) {
+            Some(g) => g.1.push(p.index),
+            None => groups.push((key, vec![p.index])),
+        }
+    }
+    groups
+}
+
+/// A line series' name: the metric's label, the group's other sweep values
+/// (those neither on the x axis nor fixed by `filter`), or both when the
+/// plot has several metrics (`multi`).
+fn series_name(
+    exp: &Experiment,
+    points: &[Point],
+    xi: usize,
+    filter: &[(String, toml::Value)],
+    path: &str,
+    multi: bool,
+    members: &[usize],
+) -> String {
+    let group_label = points[members[0]]
+        .assignments
+        .iter()
+        .enumerate()
+        .filter(|&(i, (k, _))| i != xi && !filter.iter().any(|(f, _)| f == k))
+        .map(|(i, _)| points[members[0]].plot_assignment(&exp.sweeps, i))
+        .collect::<Vec<_>>()
+        .join(", ");
+    match (group_label.is_empty(), multi) {
+        (true, _) => exp.label_of(path),
+        (false, false) => group_label,
+        (false, true) => format!("{} ({group_label})", exp.label_of(path)),
+    }
+}
+
+/// A line series' points `(x, value)` over the group's `members`, with
+/// each point's interval (a derived value's is the value itself).
+#[allow(clippy::type_complexity)]
+fn series_points(
+    exp: &Experiment,
+    points: &[Point],
+    results: &[PointResult],
+    xi: usize,
+    path: &str,
+    members: &[usize],
+) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+    let is_derived = exp.derived.iter().any(|d| d.name == path);
+    let mut pts = Vec::new();
+    let mut ci = Vec::new();
+    for &m in members {
+        let xv = exp.sweeps[xi].coords[points[m].value_indices[xi]];
+        let r = &results[m];
+        match (is_derived, r.stat(path)) {
+            (false, Some(c)) if c.n > 0 => {
+                pts.push((xv, c.mean));
+                ci.push((c.low, c.high));
+            }
+            _ => {
+                if let Some(v) = r.value(path) {
+                    pts.push((xv, v));
+                    ci.push((v, v));
+                }
+            }
+        }
+    }
+    (pts, ci)
+}
+
+/// The x axis's categories (coordinate, label) of a categorical sweep
+/// (none for a numeric one).
+fn x_categories(sweep: &Sweep) -> Vec<(f64, String)> {
+    if sweep.categorical {
+        sweep.coords.iter().copied().zip(sweep.labels.iter().cloned()).collect()
+    } else {
+        Vec::new()
     }
 }

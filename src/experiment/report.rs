@@ -5,7 +5,8 @@ use std::fmt::Write;
 
 use crate::stats::ci::MeanCi;
 
-use super::run::ExperimentResult;
+use super::run::{ExperimentResult, PointResult};
+use super::sample::Sample;
 use super::spec::{DerivedKind, Experiment, ModelSource, PlotKind};
 use super::sweep::value_text;
 
@@ -78,6 +79,50 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
         let _ = writeln!(s, "{}\n", exp.description.trim());
     }
 
+    setup(&mut s, exp, r);
+    if let Some(sample) = &exp.sample {
+        sampled_parameters(&mut s, sample);
+    }
+    let point_keys = exp.point_keys();
+    let keys: Vec<&str> = point_keys.iter().map(|s| s.as_str()).collect();
+    results(&mut s, exp, r, &keys);
+    derived(&mut s, exp, r, &keys);
+    sensitivity(&mut s, exp, r);
+    claims(&mut s, r);
+    checks(&mut s, r);
+    timing(&mut s, r);
+    plots(&mut s, exp, r);
+    s
+}
+
+/// The header row (and rule) of a per-point table: the point's `keys`,
+/// then the `extra` columns.
+fn head(keys: &[&str], extra: &[String]) -> String {
+    let cols: Vec<String> = keys
+        .iter()
+        .map(|k| format!("`{k}`"))
+        .chain(extra.iter().cloned())
+        .collect();
+    let cols = if cols.is_empty() {
+        vec!["point".to_string()]
+    } else {
+        cols
+    };
+    format!("| {} |\n|{}\n", cols.join(" | "), "---|".repeat(cols.len()))
+}
+
+/// A per-point table row's first cells: the point's assignments (or its label).
+fn key_cells(p: &PointResult) -> Vec<String> {
+    if p.assignments.is_empty() {
+        vec![cell(&p.label)]
+    } else {
+        p.assignments.iter().map(|(_, v)| cell(v)).collect()
+    }
+}
+
+/// `## Setup`: the model, replications, confidence, points, fixed settings
+/// and sweeps.
+fn setup(s: &mut String, exp: &Experiment, r: &ExperimentResult) {
     let _ = writeln!(s, "## Setup\n");
     let model = match &exp.model {
         ModelSource::Default => "the embedded default model".to_string(),
@@ -110,69 +155,50 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
             let _ = writeln!(s, "| `{}` | {} |", sw.key, cell(&vals.join(", ")));
         }
     }
+}
 
-    if let Some(sample) = &exp.sample {
-        use super::sample::{SampleMethod, Scale};
-        let how = match sample.method {
-            SampleMethod::LatinHypercube => format!("Latin hypercube of {} points", sample.n),
-            SampleMethod::Sobol => format!(
-                "Saltelli's design for Sobol' indices: n = {} rows of A and B (one Latin hypercube in {} dimensions) \
-                 and A_B^(i) per parameter, n (k + 2) = {} points; {} bootstrap resamples",
-                sample.n,
-                2 * sample.params.len(),
-                sample.points(),
-                sample.bootstrap
-            ),
+/// The sampled parameters' table (with the sampling design).
+fn sampled_parameters(s: &mut String, sample: &Sample) {
+    use super::sample::{SampleMethod, Scale};
+    let how = match sample.method {
+        SampleMethod::LatinHypercube => format!("Latin hypercube of {} points", sample.n),
+        SampleMethod::Sobol => format!(
+            "Saltelli's design for Sobol' indices: n = {} rows of A and B (one Latin hypercube in {} dimensions) \
+             and A_B^(i) per parameter, n (k + 2) = {} points; {} bootstrap resamples",
+            sample.n,
+            2 * sample.params.len(),
+            sample.points(),
+            sample.bootstrap
+        ),
+    };
+    let _ = writeln!(
+        s,
+        "\nSampled parameters ({how}; seed {}):\n\n| key | from | to | scale | values |\n|---|---|---|---|---|",
+        sample.seed
+    );
+    for p in &sample.params {
+        let scale = match p.scale {
+            Scale::Linear => "linear",
+            Scale::Log => "log",
+        };
+        let kind = match (&p.unit, p.integer) {
+            (Some(u), true) => format!("integers, in {u}"),
+            (Some(u), false) => format!("real, in {u}"),
+            (None, true) => "integers".into(),
+            (None, false) => "real".into(),
         };
         let _ = writeln!(
             s,
-            "\nSampled parameters ({how}; seed {}):\n\n| key | from | to | scale | values |\n|---|---|---|---|---|",
-            sample.seed
+            "| `{}` | {} | {} | {scale} | {kind} |",
+            p.key,
+            fmt_num(p.from),
+            fmt_num(p.to)
         );
-        for p in &sample.params {
-            let scale = match p.scale {
-                Scale::Linear => "linear",
-                Scale::Log => "log",
-            };
-            let kind = match (&p.unit, p.integer) {
-                (Some(u), true) => format!("integers, in {u}"),
-                (Some(u), false) => format!("real, in {u}"),
-                (None, true) => "integers".into(),
-                (None, false) => "real".into(),
-            };
-            let _ = writeln!(
-                s,
-                "| `{}` | {} | {} | {scale} | {kind} |",
-                p.key,
-                fmt_num(p.from),
-                fmt_num(p.to)
-            );
-        }
     }
+}
 
-    let point_keys = exp.point_keys();
-    let keys: Vec<&str> = point_keys.iter().map(|s| s.as_str()).collect();
-    let head = |extra: &[String]| {
-        let cols: Vec<String> = keys
-            .iter()
-            .map(|k| format!("`{k}`"))
-            .chain(extra.iter().cloned())
-            .collect();
-        let cols = if cols.is_empty() {
-            vec!["point".to_string()]
-        } else {
-            cols
-        };
-        format!("| {} |\n|{}\n", cols.join(" | "), "---|".repeat(cols.len()))
-    };
-    let key_cells = |p: &super::run::PointResult| -> Vec<String> {
-        if p.assignments.is_empty() {
-            vec![cell(&p.label)]
-        } else {
-            p.assignments.iter().map(|(_, v)| cell(v)).collect()
-        }
-    };
-
+/// `## Results`: a table per metric (a summary over sampled points).
+fn results(s: &mut String, exp: &Experiment, r: &ExperimentResult, keys: &[&str]) {
     let _ = writeln!(s, "\n## Results\n");
     let level = format!("{}%", exp.confidence * 100.0);
     for m in &exp.metrics {
@@ -199,7 +225,7 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
             }
             continue;
         }
-        s.push_str(&head(&[format!("mean ± {level} CI"), "n".into()]));
+        s.push_str(&head(keys, &[format!("mean ± {level} CI"), "n".into()]));
         for p in &r.points {
             let mut row = key_cells(p);
             match p.stat(&m.path) {
@@ -213,7 +239,10 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
         }
         s.push('\n');
     }
+}
 
+/// `## Derived values`: what each derived value is, and their table.
+fn derived(s: &mut String, exp: &Experiment, r: &ExperimentResult, keys: &[&str]) {
     if !exp.derived.is_empty() {
         let _ = writeln!(s, "## Derived values\n");
         for d in &exp.derived {
@@ -242,7 +271,7 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
         }
         s.push('\n');
         let names: Vec<String> = exp.derived.iter().map(|d| format!("`{}`", d.name)).collect();
-        s.push_str(&head(&names));
+        s.push_str(&head(keys, &names));
         for p in &r.points {
             let mut row = key_cells(p);
             row.extend(p.derived.iter().map(|d| opt(d.1)));
@@ -250,7 +279,10 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
         }
         s.push('\n');
     }
+}
 
+/// `## Sensitivity (Sobol' indices)`: each metric's indices.
+fn sensitivity(s: &mut String, exp: &Experiment, r: &ExperimentResult) {
     if !r.sensitivity.is_empty() {
         let _ = writeln!(
             s,
@@ -289,7 +321,10 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
             let _ = writeln!(s, "\n![Sobol' indices of {}]({f}.svg)\n", sens.label, f = sens.plot);
         }
     }
+}
 
+/// `## Claims`: each claim's verdict and its checks.
+fn claims(s: &mut String, r: &ExperimentResult) {
     let claims = r.claims();
     if !claims.is_empty() {
         let _ = writeln!(
@@ -325,7 +360,10 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
         }
         s.push('\n');
     }
+}
 
+/// `## Checks`: the reference checks that are not claims.
+fn checks(s: &mut String, r: &ExperimentResult) {
     let tests: Vec<_> = r.checks.iter().filter(|c| c.claim.is_none()).collect();
     if !tests.is_empty() {
         let _ = writeln!(
@@ -351,7 +389,10 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
         }
         s.push('\n');
     }
+}
 
+/// `## Timing`: wall and CPU times.
+fn timing(s: &mut String, r: &ExperimentResult) {
     let _ = writeln!(s, "## Timing\n");
     match &r.shards {
         None => {
@@ -385,7 +426,10 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
         r.sim_wall_seconds,
         r.runs.len()
     );
+}
 
+/// `## Plots`: each plot with its links and notes.
+fn plots(s: &mut String, exp: &Experiment, r: &ExperimentResult) {
     if !exp.plots.is_empty() {
         let _ = writeln!(s, "## Plots\n");
         for p in &exp.plots {
@@ -406,5 +450,4 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
             }
         }
     }
-    s
 }

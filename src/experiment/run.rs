@@ -367,12 +367,71 @@ pub(crate) fn finish(
     let runs: Vec<RunRecord> = outputs.iter().map(|o| o.record.clone()).collect();
     tables::write_runs(&out_dir.join("runs.csv"), exp, points, &paths, &runs)?;
 
-    // Aggregate per point (runs are in point, seed order).
-    let n_paths = paths.len();
+    let (point_stats, pooled) = aggregate(exp, plan, &outputs);
+    let means: Vec<Vec<Option<f64>>> = point_stats
+        .iter()
+        .map(|s| s.iter().map(|c| (c.n > 0).then_some(c.mean)).collect())
+        .collect();
+    let derived = compute(
+        exp,
+        &DerivedInputs {
+            points,
+            means: &means,
+            paths: &paths,
+            frames: &pooled,
+            frame_columns: columns,
+        },
+    );
+    let point_results = point_results(exp, points, &paths, &point_stats, &derived);
+    let mut files = vec![PathBuf::from("runs.csv")];
+    tables::write_points(&out_dir.join("points.csv"), exp, points, &point_results)?;
+    files.push(PathBuf::from("points.csv"));
+
+    let checks = run_checks(exp, points, &point_results);
+    // Verdicts on claims are reported, never counted as failures.
+    let checks_failed = checks.iter().filter(|c| !c.passed && c.claim.is_none()).count();
+    let plot_captions = draw_plots(exp, points, &point_results, &pooled, columns, out_dir, &mut files)?;
+    let sensitivity = write_sensitivity(exp, &point_results, out_dir, &mut files)?;
+    let searches = run_searches(exp, base_model, runner, out_dir, &mut files)?;
+
+    let mut result = ExperimentResult {
+        name: exp.name.clone(),
+        paths,
+        points: point_results,
+        sim_wall_seconds: runs.iter().map(|r| r.wall_seconds).sum(),
+        runs,
+        checks,
+        checks_failed,
+        wall_seconds: 0.0,
+        cpu_seconds: None,
+        shards: None,
+        files,
+        plot_captions,
+        searches,
+        sensitivity,
+    };
+    match timing {
+        Timing::Single(started) => result.wall_seconds = started.elapsed().as_secs_f64(),
+        Timing::Shards(cost) => {
+            result.wall_seconds = cost.array_wall_seconds;
+            result.shards = Some(cost);
+        }
+    }
+    result.cpu_seconds = super::cost::process_cpu_seconds();
+    write_report(exp, &mut result, out_dir)?;
+    Ok(result)
+}
+
+/// Aggregation per point (`outputs` in point, seed order): each tracked
+/// path's mean and interval over the point's runs, and each frame column
+/// pooled over them.
+fn aggregate(exp: &Experiment, plan: &Plan, outputs: &[JobOutput]) -> (Vec<Vec<MeanCi>>, Vec<Vec<Vec<f64>>>) {
+    let (points, columns) = (&plan.points, &plan.columns);
+    let n_paths = plan.paths.len();
     let mut point_stats: Vec<Vec<MeanCi>> = Vec::with_capacity(points.len());
     let mut pooled: Vec<Vec<Vec<f64>>> = vec![vec![Vec::new(); columns.len()]; points.len()];
     let mut by_point: Vec<Vec<&JobOutput>> = vec![Vec::new(); points.len()];
-    for o in &outputs {
+    for o in outputs {
         if let Some(v) = by_point.get_mut(o.record.point) {
             v.push(o);
         }
@@ -392,21 +451,19 @@ pub(crate) fn finish(
             }
         }
     }
-    let means: Vec<Vec<Option<f64>>> = point_stats
-        .iter()
-        .map(|s| s.iter().map(|c| (c.n > 0).then_some(c.mean)).collect())
-        .collect();
-    let derived = compute(
-        exp,
-        &DerivedInputs {
-            points,
-            means: &means,
-            paths: &paths,
-            frames: &pooled,
-            frame_columns: columns,
-        },
-    );
-    let point_results: Vec<PointResult> = points
+    (point_stats, pooled)
+}
+
+/// Each point's result: its label and assignments, its paths' statistics
+/// and its derived values.
+fn point_results(
+    exp: &Experiment,
+    points: &[Point],
+    paths: &[String],
+    point_stats: &[Vec<MeanCi>],
+    derived: &[Vec<Option<f64>>],
+) -> Vec<PointResult> {
+    points
         .iter()
         .map(|p| PointResult {
             index: p.index,
@@ -431,11 +488,11 @@ pub(crate) fn finish(
                 .map(|(d, v)| (d.name.clone(), *v))
                 .collect(),
         })
-        .collect();
-    let mut files = vec![PathBuf::from("runs.csv")];
-    tables::write_points(&out_dir.join("points.csv"), exp, points, &point_results)?;
-    files.push(PathBuf::from("points.csv"));
+        .collect()
+}
 
+/// The experiment's checks (and claims), each at every point it filters.
+fn run_checks(exp: &Experiment, points: &[Point], point_results: &[PointResult]) -> Vec<CheckOutcome> {
     let mut checks = Vec::new();
     for c in &exp.checks {
         for p in points.iter().filter(|p| p.matches(&c.filter)) {
@@ -465,24 +522,44 @@ pub(crate) fn finish(
             }
         }
     }
-    // Verdicts on claims are reported, never counted as failures.
-    let checks_failed = checks.iter().filter(|c| !c.passed && c.claim.is_none()).count();
+    checks
+}
 
+/// The experiment's plots into `out_dir` (their files added to `files`);
+/// returns their captions as (plot file, caption).
+fn draw_plots(
+    exp: &Experiment,
+    points: &[Point],
+    point_results: &[PointResult],
+    pooled: &[Vec<Vec<f64>>],
+    columns: &[String],
+    out_dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<Vec<(String, String)>, ExperimentError> {
     let mut plot_captions = Vec::new();
     for plot in &exp.plots {
-        let captions =
-            figures::draw(exp, plot, points, &point_results, &pooled, columns, out_dir).map_err(|source| {
-                ExperimentError::Plot {
-                    file: plot.file.clone(),
-                    source,
-                }
-            })?;
+        let captions = figures::draw(exp, plot, points, point_results, pooled, columns, out_dir).map_err(|source| {
+            ExperimentError::Plot {
+                file: plot.file.clone(),
+                source,
+            }
+        })?;
         plot_captions.extend(captions.into_iter().map(|c| (plot.file.clone(), c)));
         files.push(PathBuf::from(format!("{}.svg", plot.file)));
         files.push(PathBuf::from(format!("{}.png", plot.file)));
     }
+    Ok(plot_captions)
+}
 
-    let sensitivity = super::sobol::analyse(exp, &point_results);
+/// The Sobol' indices of a sampled experiment: `sensitivity.csv` and a
+/// bar chart per metric into `out_dir` (their files added to `files`).
+fn write_sensitivity(
+    exp: &Experiment,
+    point_results: &[PointResult],
+    out_dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<Vec<super::sobol::Sensitivity>, ExperimentError> {
+    let sensitivity = super::sobol::analyse(exp, point_results);
     if !sensitivity.is_empty() {
         let path = out_dir.join("sensitivity.csv");
         std::fs::write(&path, super::sobol::csv(&sensitivity)).map_err(|source| ExperimentError::Io {
@@ -514,7 +591,19 @@ pub(crate) fn finish(
         files.push(PathBuf::from(format!("{}.svg", s.plot)));
         files.push(PathBuf::from(format!("{}.png", s.plot)));
     }
+    Ok(sensitivity)
+}
 
+/// The experiment's searches (in parallel, on the base model with `[set]`
+/// applied, from the first seed), and `searches.csv` into `out_dir` (added
+/// to `files`).
+fn run_searches(
+    exp: &Experiment,
+    base_model: &toml::Table,
+    runner: &dyn Runner,
+    out_dir: &Path,
+    files: &mut Vec<PathBuf>,
+) -> Result<Vec<super::inverse::SearchResult>, ExperimentError> {
     let mut search_base = base_model.clone();
     for (k, v) in &exp.set {
         set_dotted(&mut search_base, k, v.clone())?;
@@ -539,39 +628,20 @@ pub(crate) fn finish(
         })?;
         files.push(PathBuf::from("searches.csv"));
     }
+    Ok(searches)
+}
 
-    let mut result = ExperimentResult {
-        name: exp.name.clone(),
-        paths,
-        points: point_results,
-        sim_wall_seconds: runs.iter().map(|r| r.wall_seconds).sum(),
-        runs,
-        checks,
-        checks_failed,
-        wall_seconds: 0.0,
-        cpu_seconds: None,
-        shards: None,
-        files,
-        plot_captions,
-        searches,
-        sensitivity,
-    };
-    match timing {
-        Timing::Single(started) => result.wall_seconds = started.elapsed().as_secs_f64(),
-        Timing::Shards(cost) => {
-            result.wall_seconds = cost.array_wall_seconds;
-            result.shards = Some(cost);
-        }
-    }
-    result.cpu_seconds = super::cost::process_cpu_seconds();
+/// `report.md` into `out_dir` (the report, then the searches' section),
+/// added to the result's files.
+fn write_report(exp: &Experiment, result: &mut ExperimentResult, out_dir: &Path) -> Result<(), ExperimentError> {
     let report_path = out_dir.join("report.md");
-    let report_text = report::render(exp, &result) + &super::inverse::report_section(&exp.searches, &result.searches);
+    let report_text = report::render(exp, result) + &super::inverse::report_section(&exp.searches, &result.searches);
     std::fs::write(&report_path, report_text).map_err(|source| ExperimentError::Io {
         path: report_path,
         source,
     })?;
     result.files.push(PathBuf::from("report.md"));
-    Ok(result)
+    Ok(())
 }
 
 fn progress_bar(len: u64, show: bool) -> ProgressBar {

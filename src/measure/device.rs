@@ -367,24 +367,86 @@ impl Gpu {
         Ok(r)
     }
 
+    /// Draws `mesh` (`spec` names its generator, for positions) with
+    /// `opts`: the warm-up passes, then the measured ones, each read back.
     fn draw(&self, mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> Result<Measurement, MeasureError> {
-        if opts.layers == 0 || opts.repeats == 0 || opts.size.0 == 0 || opts.size.1 == 0 {
-            return Err(MeasureError::Option(
-                "layers, repeats and size must be at least 1".into(),
-            ));
-        }
-        if opts.size.0 > 8192 || opts.size.1 > 8192 {
-            return Err(MeasureError::Option("render target larger than 8192x8192".into()));
-        }
+        check_options(opts)?;
         let start = Instant::now();
+        let pass = MeasuredPass::new(&self.device, mesh, spec, opts);
+        let period = self.queue.get_timestamp_period() as f64;
+        let mut times = Vec::new();
+        let mut counters: Vec<[u64; 4]> = Vec::new();
+        for round in 0..opts.warmup + opts.repeats {
+            let words = pass.run(&self.device, &self.queue, opts.layers)?;
+            if round >= opts.warmup {
+                counters.push([words[0], words[1], words[2], words[3]]);
+                let (t0, t1) = (words[32], words[33]);
+                times.push(t1.saturating_sub(t0) as f64 * period);
+            }
+        }
+        let stable = counters.windows(2).all(|w| w[0] == w[1]);
+        let last = *counters.last().unwrap_or(&[0; 4]);
+        let median = super::fit::median(&times).unwrap_or(f64::NAN);
+        Ok(Measurement {
+            adapter: self.adapter.clone(),
+            vs_invocations: last[0],
+            clipper_invocations: last[1],
+            clipper_primitives_out: last[2],
+            fs_invocations: last[3],
+            pass_time_ns: median,
+            pass_times_ns: times,
+            stable_counters: stable,
+            options: opts.clone(),
+            wall_seconds: start.elapsed().as_secs_f64(),
+        })
+    }
+}
+
+/// Refuses options no pass can be drawn with: no layers, repeats or pixels,
+/// or a render target over 8192x8192.
+fn check_options(opts: &MeasureOptions) -> Result<(), MeasureError> {
+    if opts.layers == 0 || opts.repeats == 0 || opts.size.0 == 0 || opts.size.1 == 0 {
+        return Err(MeasureError::Option(
+            "layers, repeats and size must be at least 1".into(),
+        ));
+    }
+    if opts.size.0 > 8192 || opts.size.1 > 8192 {
+        return Err(MeasureError::Option("render target larger than 8192x8192".into()));
+    }
+    Ok(())
+}
+
+/// What every measured pass of one mesh draws with: its buffers, the
+/// pipeline and its bindings, the render and depth targets, and the
+/// queries (pipeline statistics, time stamps) with their resolve buffer.
+struct MeasuredPass {
+    vbuf: wgpu::Buffer,
+    ibuf: wgpu::Buffer,
+    index_count: u32,
+    /// The uniform and order buffers the bind group reads (kept alive with it).
+    _buffers: [wgpu::Buffer; 2],
+    bind: wgpu::BindGroup,
+    pipeline: wgpu::RenderPipeline,
+    /// The render and depth targets (kept alive with their views).
+    _targets: [wgpu::Texture; 2],
+    tview: wgpu::TextureView,
+    dview: wgpu::TextureView,
+    stats_q: wgpu::QuerySet,
+    time_q: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+}
+
+impl MeasuredPass {
+    /// Uploads `mesh` (positions from its generator `spec`, or all at the
+    /// centre with `geometry_only`) and builds the pipeline, targets and
+    /// queries for `opts`.
+    fn new(device: &wgpu::Device, mesh: &Mesh, spec: &str, opts: &MeasureOptions) -> MeasuredPass {
         let list = mesh.to_triangle_list();
         let positions = if opts.geometry_only {
             vec![[0.5, 0.5]; mesh.vertex_count as usize]
         } else {
             mesh_positions(mesh, spec)
         };
-        let (device, queue) = (&self.device, &self.queue);
-        let summary = self.adapter.clone();
         let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("positions"),
             contents: &bytes_f32(&positions),
@@ -407,68 +469,8 @@ impl Gpu {
             contents: &bytes_u32(&slots),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("measure"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("shader.wgsl").into()),
-        });
-        let (bind, layout) = buffer_bindings(
-            device,
-            &[
-                (
-                    &ubuf,
-                    wgpu::BufferBindingType::Uniform,
-                    wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ),
-                (
-                    &obuf,
-                    wgpu::BufferBindingType::Storage { read_only: true },
-                    wgpu::ShaderStages::VERTEX,
-                ),
-            ],
-        );
-        let format = TARGET_FORMAT;
-        let pipeline = position_pipeline(
-            device,
-            "measure",
-            &shader,
-            &layout,
-            Some(wgpu::DepthStencilState {
-                format: wgpu::TextureFormat::Depth32Float,
-                depth_write_enabled: Some(opts.depth_test),
-                depth_compare: Some(if opts.depth_test {
-                    wgpu::CompareFunction::Less
-                } else {
-                    wgpu::CompareFunction::Always
-                }),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-        );
-        let extent = wgpu::Extent3d {
-            width: opts.size.0,
-            height: opts.size.1,
-            depth_or_array_layers: 1,
-        };
-        let target = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("target"),
-            size: extent,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        });
-        let depth = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("depth"),
-            size: extent,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Depth32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        });
+        let (bind, pipeline) = measure_pipeline(device, &ubuf, &obuf, opts.depth_test);
+        let (target, depth) = targets(device, opts.size);
         let tview = target.create_view(&Default::default());
         let dview = depth.create_view(&Default::default());
         let stats_q = device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -487,81 +489,146 @@ impl Gpu {
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let period = queue.get_timestamp_period() as f64;
-        let mut times = Vec::new();
-        let mut counters: Vec<[u64; 4]> = Vec::new();
-        let index_count = list.indices.len() as u32;
-        for round in 0..opts.warmup + opts.repeats {
-            let mut enc = device.create_command_encoder(&Default::default());
-            {
-                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("measured pass"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &tview,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &dview,
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
-                            store: wgpu::StoreOp::Store,
-                        }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: Some(wgpu::RenderPassTimestampWrites {
-                        query_set: &time_q,
-                        beginning_of_pass_write_index: Some(0),
-                        end_of_pass_write_index: Some(1),
-                    }),
-                    occlusion_query_set: None,
-                    ..Default::default()
-                });
-                pass.set_pipeline(&pipeline);
-                pass.set_bind_group(0, &bind, &[]);
-                pass.set_vertex_buffer(0, vbuf.slice(..));
-                pass.set_index_buffer(ibuf.slice(..), wgpu::IndexFormat::Uint32);
-                pass.begin_pipeline_statistics_query(&stats_q, 0);
-                pass.draw_indexed(0..index_count, 0, 0..opts.layers);
-                pass.end_pipeline_statistics_query();
-            }
-            enc.resolve_query_set(&stats_q, 0..1, &resolve, 0);
-            enc.resolve_query_set(&time_q, 0..2, &resolve, 256);
-            let read = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("read"),
-                size: 512,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, 512);
-            queue.submit([enc.finish()]);
-            let words = read_words(device, &read)?;
-            if round >= opts.warmup {
-                counters.push([words[0], words[1], words[2], words[3]]);
-                let (t0, t1) = (words[32], words[33]);
-                times.push(t1.saturating_sub(t0) as f64 * period);
-            }
+        MeasuredPass {
+            vbuf,
+            ibuf,
+            index_count: list.indices.len() as u32,
+            _buffers: [ubuf, obuf],
+            bind,
+            pipeline,
+            _targets: [target, depth],
+            tview,
+            dview,
+            stats_q,
+            time_q,
+            resolve,
         }
-        let stable = counters.windows(2).all(|w| w[0] == w[1]);
-        let last = *counters.last().unwrap_or(&[0; 4]);
-        let median = super::fit::median(&times).unwrap_or(f64::NAN);
-        Ok(Measurement {
-            adapter: summary,
-            vs_invocations: last[0],
-            clipper_invocations: last[1],
-            clipper_primitives_out: last[2],
-            fs_invocations: last[3],
-            pass_time_ns: median,
-            pass_times_ns: times,
-            stable_counters: stable,
-            options: opts.clone(),
-            wall_seconds: start.elapsed().as_secs_f64(),
-        })
     }
+
+    /// Draws one pass of `layers` instances and reads its queries back:
+    /// words 0-3 the pipeline statistics, 32 and 33 the time stamps.
+    fn run(&self, device: &wgpu::Device, queue: &wgpu::Queue, layers: u32) -> Result<Vec<u64>, MeasureError> {
+        let mut enc = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("measured pass"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &self.tview,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &self.dview,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: Some(wgpu::RenderPassTimestampWrites {
+                    query_set: &self.time_q,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                }),
+                occlusion_query_set: None,
+                ..Default::default()
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.bind, &[]);
+            pass.set_vertex_buffer(0, self.vbuf.slice(..));
+            pass.set_index_buffer(self.ibuf.slice(..), wgpu::IndexFormat::Uint32);
+            pass.begin_pipeline_statistics_query(&self.stats_q, 0);
+            pass.draw_indexed(0..self.index_count, 0, 0..layers);
+            pass.end_pipeline_statistics_query();
+        }
+        enc.resolve_query_set(&self.stats_q, 0..1, &self.resolve, 0);
+        enc.resolve_query_set(&self.time_q, 0..2, &self.resolve, 256);
+        let read = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("read"),
+            size: 512,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        enc.copy_buffer_to_buffer(&self.resolve, 0, &read, 0, 512);
+        queue.submit([enc.finish()]);
+        read_words(device, &read)
+    }
+}
+
+/// The measuring shader's pipeline (depth test on or off) and its bind
+/// group over the uniform `ubuf` and the order buffer `obuf`.
+fn measure_pipeline(
+    device: &wgpu::Device,
+    ubuf: &wgpu::Buffer,
+    obuf: &wgpu::Buffer,
+    depth_test: bool,
+) -> (wgpu::BindGroup, wgpu::RenderPipeline) {
+    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("measure"),
+        source: wgpu::ShaderSource::Wgsl(include_str!("shader.wgsl").into()),
+    });
+    let (bind, layout) = buffer_bindings(
+        device,
+        &[
+            (
+                ubuf,
+                wgpu::BufferBindingType::Uniform,
+                wgpu::ShaderStages::VERTEX_FRAGMENT,
+            ),
+            (
+                obuf,
+                wgpu::BufferBindingType::Storage { read_only: true },
+                wgpu::ShaderStages::VERTEX,
+            ),
+        ],
+    );
+    let pipeline = position_pipeline(
+        device,
+        "measure",
+        &shader,
+        &layout,
+        Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(depth_test),
+            depth_compare: Some(if depth_test {
+                wgpu::CompareFunction::Less
+            } else {
+                wgpu::CompareFunction::Always
+            }),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+    );
+    (bind, pipeline)
+}
+
+/// The render target (`TARGET_FORMAT`) and depth target of `size` pixels.
+fn targets(device: &wgpu::Device, size: (u32, u32)) -> (wgpu::Texture, wgpu::Texture) {
+    let extent = wgpu::Extent3d {
+        width: size.0,
+        height: size.1,
+        depth_or_array_layers: 1,
+    };
+    let texture = |label: &str, format: wgpu::TextureFormat| {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: extent,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+    };
+    (
+        texture("target", TARGET_FORMAT),
+        texture("depth", wgpu::TextureFormat::Depth32Float),
+    )
 }
 
 fn bytes_f32(v: &[[f32; 2]]) -> Vec<u8> {

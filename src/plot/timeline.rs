@@ -15,7 +15,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::PlotError;
-use super::axis::{Ticks, coord, ticks};
+use super::axis::{TickedAxis, Ticks, coord, ticks};
 use super::font::{AXIS_PX, FAMILY, TICK_PX, TITLE_PX, ensure_font};
 use super::output::draw_notes;
 use super::palette::color;
@@ -154,67 +154,12 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline) -> Resu
         let b = chart.backend_coord(&(x1, 0.0));
         (b.0 - a.0) as f64 / (x1 - x0)
     };
-    let clip = |v: f64| v.clamp(x0, x1);
     for (i, lane) in t.lanes.iter().enumerate() {
         let base = n - 1.0 - i as f64;
         if let Some(level) = &lane.level {
-            let max = if level.max > 0.0 { level.max } else { 1.0 };
-            let y = |v: f64| base + 0.1 + 0.8 * (v / max).clamp(0.0, 1.0);
-            let mut pts = vec![(x0, base + 0.1)];
-            let mut last = 0.0;
-            for &(x, v) in &level.steps {
-                if x > x1 {
-                    break;
-                }
-                pts.push((clip(x), y(last)));
-                pts.push((clip(x), y(v)));
-                last = v;
-            }
-            pts.push((x1, y(last)));
-            pts.push((x1, base + 0.1));
-            let c = color(0);
-            chart
-                .draw_series(std::iter::once(Polygon::new(pts.clone(), c.mix(0.35).filled())))
-                .map_err(e)?;
-            chart
-                .draw_series(std::iter::once(PathElement::new(pts, c.stroke_width(1))))
-                .map_err(e)?;
+            draw_level(&mut chart, level, base, (x0, x1))?;
         }
-        for pass in [Fill::Wait, Fill::System, Fill::Frame(0)] {
-            let bars = lane.bars.iter().filter(|b| {
-                std::mem::discriminant(&b.fill) == std::mem::discriminant(&pass) && b.end > x0 && b.start < x1
-            });
-            for b in bars {
-                let (lo, hi) = match b.fill {
-                    Fill::Wait => (base + 0.4, base + 0.6),
-                    _ => (base + 0.15, base + 0.85),
-                };
-                let style = match b.fill {
-                    Fill::Frame(f) => color(f as usize).filled(),
-                    Fill::System => SYSTEM.filled(),
-                    Fill::Wait => WAIT.filled(),
-                };
-                let (s, end) = (clip(b.start), clip(b.end));
-                chart
-                    .draw_series(std::iter::once(Rectangle::new([(s, lo), (end, hi)], style)))
-                    .map_err(e)?;
-                if let Fill::Frame(f) = b.fill {
-                    let label = f.to_string();
-                    if (end - s) * px_per_x >= 9.0 * label.len() as f64 + 4.0 {
-                        chart
-                            .draw_series(std::iter::once(Text::new(
-                                label,
-                                ((s + end) / 2.0, base + 0.5),
-                                (FAMILY, TICK_PX)
-                                    .into_font()
-                                    .color(&WHITE)
-                                    .pos(Pos::new(HPos::Center, VPos::Center)),
-                            )))
-                            .map_err(e)?;
-                    }
-                }
-            }
-        }
+        draw_bars(&mut chart, &lane.bars, base, (x0, x1), px_per_x)?;
     }
     let marks: Vec<f64> = t.marks.iter().copied().filter(|m| *m >= x0 && *m <= x1).collect();
     for &m in &marks {
@@ -227,7 +172,98 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline) -> Resu
             ))
             .map_err(e)?;
     }
-    // A key under the x axis: what greys and dashes mean.
+    draw_key(root, t, !marks.is_empty())?;
+    draw_notes(root, &t.notes)
+}
+
+/// A timeline's chart: both axes ticked.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<TickedAxis, TickedAxis>>;
+
+/// Draws `level` as a filled step line inside the lane whose bottom is at
+/// `base`, over the x range `(x0, x1)`.
+fn draw_level<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    level: &Level,
+    base: f64,
+    (x0, x1): (f64, f64),
+) -> Result<(), String> {
+    let clip = |v: f64| v.clamp(x0, x1);
+    let max = if level.max > 0.0 { level.max } else { 1.0 };
+    let y = |v: f64| base + 0.1 + 0.8 * (v / max).clamp(0.0, 1.0);
+    let mut pts = vec![(x0, base + 0.1)];
+    let mut last = 0.0;
+    for &(x, v) in &level.steps {
+        if x > x1 {
+            break;
+        }
+        pts.push((clip(x), y(last)));
+        pts.push((clip(x), y(v)));
+        last = v;
+    }
+    pts.push((x1, y(last)));
+    pts.push((x1, base + 0.1));
+    let c = color(0);
+    chart
+        .draw_series(std::iter::once(Polygon::new(pts.clone(), c.mix(0.35).filled())))
+        .map_err(|e| e.to_string())?;
+    chart
+        .draw_series(std::iter::once(PathElement::new(pts, c.stroke_width(1))))
+        .map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+/// Draws a lane's `bars` (waits, then system tasks, then frames, each
+/// frame's number on it when wide enough) in the lane whose bottom is at
+/// `base`, clipped to the x range `(x0, x1)`; `px_per_x` is pixels per x unit.
+fn draw_bars<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    bars: &[Bar],
+    base: f64,
+    (x0, x1): (f64, f64),
+    px_per_x: f64,
+) -> Result<(), String> {
+    let clip = |v: f64| v.clamp(x0, x1);
+    for pass in [Fill::Wait, Fill::System, Fill::Frame(0)] {
+        let bars = bars
+            .iter()
+            .filter(|b| std::mem::discriminant(&b.fill) == std::mem::discriminant(&pass) && b.end > x0 && b.start < x1);
+        for b in bars {
+            let (lo, hi) = match b.fill {
+                Fill::Wait => (base + 0.4, base + 0.6),
+                _ => (base + 0.15, base + 0.85),
+            };
+            let style = match b.fill {
+                Fill::Frame(f) => color(f as usize).filled(),
+                Fill::System => SYSTEM.filled(),
+                Fill::Wait => WAIT.filled(),
+            };
+            let (s, end) = (clip(b.start), clip(b.end));
+            chart
+                .draw_series(std::iter::once(Rectangle::new([(s, lo), (end, hi)], style)))
+                .map_err(|e| e.to_string())?;
+            if let Fill::Frame(f) = b.fill {
+                let label = f.to_string();
+                if (end - s) * px_per_x >= 9.0 * label.len() as f64 + 4.0 {
+                    chart
+                        .draw_series(std::iter::once(Text::new(
+                            label,
+                            ((s + end) / 2.0, base + 0.5),
+                            (FAMILY, TICK_PX)
+                                .into_font()
+                                .color(&WHITE)
+                                .pos(Pos::new(HPos::Center, VPos::Center)),
+                        )))
+                        .map_err(|e| e.to_string())?;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Draws the key under the x axis: what colours, greys and (with
+/// `has_marks` and a mark label) dashes mean.
+fn draw_key<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline, has_marks: bool) -> Result<(), String> {
     let key_y = root.dim_in_pixel().1 as i32 - 26 - 16 * t.notes.len() as i32;
     let mut x = 20;
     let font = (FAMILY, TICK_PX).into_font().color(&BLACK);
@@ -238,7 +274,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline) -> Resu
             (*x + 26, key_y),
             font.clone().pos(Pos::new(HPos::Left, VPos::Center)),
         ))
-        .map_err(e)?;
+        .map_err(|e| e.to_string())?;
         *x += 26 + 9 * text.len() as i32 + 24;
         Ok(())
     };
@@ -249,7 +285,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline) -> Resu
                 [(x, key_y - 7), (x + 20, key_y + 7)],
                 color(1).filled(),
             ))
-            .map_err(e)
+            .map_err(|e| e.to_string())
         },
         "work on frame n (colour and number)",
     )?;
@@ -257,7 +293,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline) -> Resu
         &mut x,
         &|x| {
             root.draw(&Rectangle::new([(x, key_y - 7), (x + 20, key_y + 7)], SYSTEM.filled()))
-                .map_err(e)
+                .map_err(|e| e.to_string())
         },
         "system task",
     )?;
@@ -265,11 +301,11 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline) -> Resu
         &mut x,
         &|x| {
             root.draw(&Rectangle::new([(x, key_y - 2), (x + 20, key_y + 2)], WAIT.filled()))
-                .map_err(e)
+                .map_err(|e| e.to_string())
         },
         "waiting / blocked",
     )?;
-    if !marks.is_empty() && !t.mark_label.is_empty() {
+    if has_marks && !t.mark_label.is_empty() {
         key(
             &mut x,
             &|x| {
@@ -277,12 +313,12 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline) -> Resu
                     vec![(x + 10, key_y - 8), (x + 10, key_y + 8)],
                     BLACK.mix(0.6).stroke_width(2),
                 ))
-                .map_err(e)
+                .map_err(|e| e.to_string())
             },
             &t.mark_label,
         )?;
     }
-    draw_notes(root, &t.notes)
+    Ok(())
 }
 
 /// Writes `t` to `path` as SVG or PNG, by the path's extension (see

@@ -143,9 +143,8 @@ impl Validator<'_> {
         metrics: &[Metric],
         name: &str,
     ) -> Result<Vec<PlotSpec>, ExperimentError> {
-        let find_sweep = |k: &str| sweeps.iter().find(|s| s.key == k);
         let mut plots: Vec<PlotSpec> = Vec::new();
-        for (i, p) in raw.into_iter().enumerate() {
+        for (i, mut p) in raw.into_iter().enumerate() {
             let key = format!("plot[{i}] ({})", p.file);
             if p.file.is_empty() || p.file.contains(['/', '\\']) || p.file == "." || p.file == ".." {
                 return Err(self.err(
@@ -156,110 +155,10 @@ impl Validator<'_> {
             if plots.iter().any(|o| o.file == p.file) {
                 return Err(self.err(format!("{key}.file"), "is used by two plots"));
             }
-            let kind = match p.kind.as_str() {
-                "line" => {
-                    let x =
-                        p.x.clone()
-                            .ok_or_else(|| self.err(&key, "kind `line` needs `x` (a sweep key)"))?;
-                    if find_sweep(&x).is_none() {
-                        return Err(self.err(format!("{key}.x"), format!("`{x}` is not a sweep key")));
-                    }
-                    let y = p.y.map(OneOrMany::into_vec).unwrap_or_default();
-                    if y.is_empty() || y.iter().any(|s| s.trim().is_empty()) {
-                        return Err(self.err(format!("{key}.y"), "needs one or more metric paths"));
-                    }
-                    let f = match &p.filter {
-                        Some(t) => self.filter(sweeps, &format!("{key}.where"), t)?,
-                        None => Vec::new(),
-                    };
-                    if f.iter().any(|(k, _)| *k == x) {
-                        return Err(self.err(format!("{key}.where"), format!("must not fix the x axis key `{x}`")));
-                    }
-                    PlotKind::Line {
-                        x,
-                        y,
-                        log_x: p.log_x,
-                        log_y: p.log_y,
-                        filter: f,
-                    }
-                }
-                "histogram" => {
-                    let column = p
-                        .column
-                        .clone()
-                        .ok_or_else(|| self.err(&key, "kind `histogram` needs `column`"))?;
-                    let bins = p.bins.unwrap_or(50);
-                    if !(1..=100_000).contains(&bins) {
-                        return Err(self.err(format!("{key}.bins"), "must be between 1 and 100000"));
-                    }
-                    let f = match &p.filter {
-                        Some(t) => self.filter(sweeps, &format!("{key}.where"), t)?,
-                        None => Vec::new(),
-                    };
-                    let range = match &p.range {
-                        None => None,
-                        Some(r) => match r[..] {
-                            [lo, hi] if lo.is_finite() && hi.is_finite() && lo < hi => Some((lo, hi)),
-                            [lo, hi] if lo.is_finite() && hi.is_finite() => {
-                                return Err(
-                                    self.err(format!("{key}.range"), format!("needs lo < hi, got [{lo}, {hi}]"))
-                                );
-                            }
-                            [_, _] => {
-                                return Err(self.err(format!("{key}.range"), "bounds must be finite numbers"));
-                            }
-                            _ => {
-                                return Err(self.err(
-                                    format!("{key}.range"),
-                                    format!("must be [lo, hi] (two numbers), got {} value(s)", r.len()),
-                                ));
-                            }
-                        },
-                    };
-                    let mut marks = Vec::new();
-                    for (i, m) in p.marks.iter().flatten().enumerate() {
-                        let mkey = format!("{key}.marks.{i}");
-                        if !m.at.is_finite() {
-                            return Err(self.err(format!("{mkey}.at"), "must be a finite number"));
-                        }
-                        if m.label.trim().is_empty() || m.label.chars().count() > 80 {
-                            return Err(self.err(format!("{mkey}.label"), "must be 1 to 80 characters"));
-                        }
-                        if i >= 16 {
-                            return Err(self.err(format!("{key}.marks"), "at most 16 marks"));
-                        }
-                        marks.push(crate::plot::Mark {
-                            at: m.at,
-                            label: m.label.clone(),
-                        });
-                    }
-                    PlotKind::Histogram {
-                        column,
-                        bins: bins as usize,
-                        range,
-                        filter: f,
-                        marks,
-                    }
-                }
-                "scatter" => {
-                    let x =
-                        p.x.clone()
-                            .ok_or_else(|| self.err(&key, "kind `scatter` needs `x` (a metric path)"))?;
-                    let y = match p.y.map(OneOrMany::into_vec) {
-                        Some(v) if v.len() == 1 => v.into_iter().next().unwrap_or_default(),
-                        _ => {
-                            return Err(
-                                self.err(format!("{key}.y"), "kind `scatter` needs exactly one `y` metric path")
-                            );
-                        }
-                    };
-                    PlotKind::Scatter {
-                        x,
-                        y,
-                        log_x: p.log_x,
-                        log_y: p.log_y,
-                    }
-                }
+            let kind = match p.kind.clone().as_str() {
+                "line" => self.line_plot(&mut p, &key, sweeps)?,
+                "histogram" => self.histogram_plot(&p, &key, sweeps)?,
+                "scatter" => self.scatter_plot(&mut p, &key)?,
                 other => {
                     return Err(self.err(
                         format!("{key}.kind"),
@@ -297,6 +196,127 @@ impl Validator<'_> {
             });
         }
         Ok(plots)
+    }
+
+    /// A line plot's x (a sweep key), y (metric paths), scales and filter.
+    fn line_plot(&self, p: &mut RawPlot, key: &str, sweeps: &[Sweep]) -> Result<PlotKind, ExperimentError> {
+        let find_sweep = |k: &str| sweeps.iter().find(|s| s.key == k);
+        let x =
+            p.x.clone()
+                .ok_or_else(|| self.err(key, "kind `line` needs `x` (a sweep key)"))?;
+        if find_sweep(&x).is_none() {
+            return Err(self.err(format!("{key}.x"), format!("`{x}` is not a sweep key")));
+        }
+        let y = p.y.take().map(OneOrMany::into_vec).unwrap_or_default();
+        if y.is_empty() || y.iter().any(|s| s.trim().is_empty()) {
+            return Err(self.err(format!("{key}.y"), "needs one or more metric paths"));
+        }
+        let f = match &p.filter {
+            Some(t) => self.filter(sweeps, &format!("{key}.where"), t)?,
+            None => Vec::new(),
+        };
+        if f.iter().any(|(k, _)| *k == x) {
+            return Err(self.err(format!("{key}.where"), format!("must not fix the x axis key `{x}`")));
+        }
+        Ok(PlotKind::Line {
+            x,
+            y,
+            log_x: p.log_x,
+            log_y: p.log_y,
+            filter: f,
+        })
+    }
+
+    /// A histogram's column, bins, filter, range and marks.
+    fn histogram_plot(&self, p: &RawPlot, key: &str, sweeps: &[Sweep]) -> Result<PlotKind, ExperimentError> {
+        let column = p
+            .column
+            .clone()
+            .ok_or_else(|| self.err(key, "kind `histogram` needs `column`"))?;
+        let bins = p.bins.unwrap_or(50);
+        if !(1..=100_000).contains(&bins) {
+            return Err(self.err(format!("{key}.bins"), "must be between 1 and 100000"));
+        }
+        let f = match &p.filter {
+            Some(t) => self.filter(sweeps, &format!("{key}.where"), t)?,
+            None => Vec::new(),
+        };
+        let range = self.histogram_range(key, &p.range)?;
+        let marks = self.histogram_marks(key, &p.marks)?;
+        Ok(PlotKind::Histogram {
+            column,
+            bins: bins as usize,
+            range,
+            filter: f,
+            marks,
+        })
+    }
+
+    /// A histogram's `range`: none, or finite [lo, hi] with lo < hi.
+    fn histogram_range(&self, key: &str, range: &Option<Vec<f64>>) -> Result<Option<(f64, f64)>, ExperimentError> {
+        Ok(match range {
+            None => None,
+            Some(r) => match r[..] {
+                [lo, hi] if lo.is_finite() && hi.is_finite() && lo < hi => Some((lo, hi)),
+                [lo, hi] if lo.is_finite() && hi.is_finite() => {
+                    return Err(self.err(format!("{key}.range"), format!("needs lo < hi, got [{lo}, {hi}]")));
+                }
+                [_, _] => {
+                    return Err(self.err(format!("{key}.range"), "bounds must be finite numbers"));
+                }
+                _ => {
+                    return Err(self.err(
+                        format!("{key}.range"),
+                        format!("must be [lo, hi] (two numbers), got {} value(s)", r.len()),
+                    ));
+                }
+            },
+        })
+    }
+
+    /// A histogram's `marks`: at most 16, each at a finite x with a label of 1 to 80 characters.
+    fn histogram_marks(
+        &self,
+        key: &str,
+        raw: &Option<Vec<RawMark>>,
+    ) -> Result<Vec<crate::plot::Mark>, ExperimentError> {
+        let mut marks = Vec::new();
+        for (i, m) in raw.iter().flatten().enumerate() {
+            let mkey = format!("{key}.marks.{i}");
+            if !m.at.is_finite() {
+                return Err(self.err(format!("{mkey}.at"), "must be a finite number"));
+            }
+            if m.label.trim().is_empty() || m.label.chars().count() > 80 {
+                return Err(self.err(format!("{mkey}.label"), "must be 1 to 80 characters"));
+            }
+            if i >= 16 {
+                return Err(self.err(format!("{key}.marks"), "at most 16 marks"));
+            }
+            marks.push(crate::plot::Mark {
+                at: m.at,
+                label: m.label.clone(),
+            });
+        }
+        Ok(marks)
+    }
+
+    /// A scatter plot's x and y (one metric path each) and scales.
+    fn scatter_plot(&self, p: &mut RawPlot, key: &str) -> Result<PlotKind, ExperimentError> {
+        let x =
+            p.x.clone()
+                .ok_or_else(|| self.err(key, "kind `scatter` needs `x` (a metric path)"))?;
+        let y = match p.y.take().map(OneOrMany::into_vec) {
+            Some(v) if v.len() == 1 => v.into_iter().next().unwrap_or_default(),
+            _ => {
+                return Err(self.err(format!("{key}.y"), "kind `scatter` needs exactly one `y` metric path"));
+            }
+        };
+        Ok(PlotKind::Scatter {
+            x,
+            y,
+            log_x: p.log_x,
+            log_y: p.log_y,
+        })
     }
 
     /// The `[[check]]`s: a path, a tolerance, and an expected value or

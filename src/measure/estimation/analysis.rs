@@ -240,7 +240,6 @@ pub fn analyze(
         )));
     }
     let setup = &plan.setup;
-    let target = setup.target;
     let of_kind = |k: PassKind| -> Vec<(&PlannedPass, &PassMeasurement)> {
         plan.passes.iter().zip(measured).filter(|(p, _)| p.kind == k).collect()
     };
@@ -251,50 +250,10 @@ pub fn analyze(
         unstable_counters: measured.iter().filter(|m| !m.stable).count(),
         ..EstimationChecks::default()
     };
-    // Tables and transformed vertices per prototype.
-    let mut prototypes: Vec<PrototypeResult> = plan
-        .prototypes
-        .iter()
-        .map(|p| PrototypeResult {
-            prototype: p.clone(),
-            transformed: 0,
-            pos_table: Vec::new(),
-        })
-        .collect();
-    let mut seen = vec![false; prototypes.len()];
-    for (p, m) in of_kind(PassKind::Pos) {
-        let o = &p.objects[0];
-        let r = &mut prototypes[o.prototype];
-        if !seen[o.prototype] {
-            seen[o.prototype] = true;
-            r.transformed = m.vs_invocations;
-        } else if r.transformed != m.vs_invocations {
-            checks.transformed_table_mismatches += 1;
-        }
-        r.pos_table.push(PosEntry {
-            pixels: o.pixels(target),
-            ms: (m.time_ns - overhead_ns) / 1e6,
-        });
-    }
-    for r in &mut prototypes {
-        r.pos_table.sort_by(|a, b| a.pixels.total_cmp(&b.pixels));
-    }
+    let prototypes = prototype_tables(plan, &of_kind(PassKind::Pos), overhead_ns, &mut checks);
     // The fit on the single-object passes (picoseconds).
     let single = of_kind(PassKind::Single);
-    let samples: Vec<(Features, f64)> = single
-        .iter()
-        .map(|(p, m)| {
-            let o = &p.objects[0];
-            let proto = &plan.prototypes[o.prototype];
-            let f = Features {
-                triangles: proto.triangles as f64,
-                transformed: m.vs_invocations as f64,
-                vertices: proto.vertices as f64,
-                pixels: o.pixels(target),
-            };
-            (f, (m.time_ns - overhead_ns) * 1e3)
-        })
-        .collect();
+    let samples = fit_samples(plan, &single, overhead_ns);
     let t = Instant::now();
     let constants = fit(&samples);
     let fit_wall_ms = t.elapsed().as_secs_f64() * 1e3;
@@ -335,29 +294,7 @@ pub fn analyze(
         prototypes,
         notes: String::new(),
     };
-    for (name, set) in [("single", &single), ("multi", &multi)] {
-        let passes: Vec<&PlannedPass> = set.iter().map(|(p, _)| *p).collect();
-        let actual: Vec<f64> = set.iter().map(|(_, m)| m.time_ns / 1e6).collect();
-        let estimates: Vec<[f64; 5]> = passes.iter().map(|p| study.pass_ms(plan, p)).collect();
-        let mut scores = BTreeMap::new();
-        for (k, est_name) in PER_OBJECT_ESTIMATORS.iter().enumerate() {
-            let est: Vec<f64> = estimates.iter().map(|e| e[k]).collect();
-            let (secs, ops) = time_estimator(&study, plan, &passes, k);
-            scores.insert(est_name.to_string(), Score::of(&est, &actual, secs, ops));
-        }
-        if name == "single" {
-            study.fit = scores;
-        } else {
-            study.scores = scores;
-        }
-    }
-    study.best = study
-        .scores
-        .iter()
-        .filter_map(|(n, s)| Some((n, s.mse_ms2?)))
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(n, _)| n.clone())
-        .unwrap_or_default();
+    score_estimators(&mut study, plan, &single, &multi);
     for kind in [PassKind::Overhead, PassKind::Pos, PassKind::Single, PassKind::Multi] {
         let wall = of_kind(kind).iter().map(|(_, m)| m.wall_s).sum();
         study.timing.wall_s_by_kind.insert(kind.name().to_string(), wall);
@@ -375,4 +312,95 @@ pub fn analyze(
     }
     study.timing.measure_once_mse_ms2 = se / count.max(1) as f64;
     Ok(study)
+}
+
+/// Measured passes with what was planned for each.
+type Measured<'a> = [(&'a PlannedPass, &'a PassMeasurement)];
+
+/// Each prototype's pos table (milliseconds beyond the empty pass's
+/// `overhead_ns`, by pixels) and transformed vertices, from its `pos`
+/// passes; counts in `checks` the passes whose transformed vertices differ
+/// from the prototype's first.
+fn prototype_tables(
+    plan: &Plan,
+    pos: &Measured,
+    overhead_ns: f64,
+    checks: &mut EstimationChecks,
+) -> Vec<PrototypeResult> {
+    let mut prototypes: Vec<PrototypeResult> = plan
+        .prototypes
+        .iter()
+        .map(|p| PrototypeResult {
+            prototype: p.clone(),
+            transformed: 0,
+            pos_table: Vec::new(),
+        })
+        .collect();
+    let mut seen = vec![false; prototypes.len()];
+    for &(p, m) in pos {
+        let o = &p.objects[0];
+        let r = &mut prototypes[o.prototype];
+        if !seen[o.prototype] {
+            seen[o.prototype] = true;
+            r.transformed = m.vs_invocations;
+        } else if r.transformed != m.vs_invocations {
+            checks.transformed_table_mismatches += 1;
+        }
+        r.pos_table.push(PosEntry {
+            pixels: o.pixels(plan.setup.target),
+            ms: (m.time_ns - overhead_ns) / 1e6,
+        });
+    }
+    for r in &mut prototypes {
+        r.pos_table.sort_by(|a, b| a.pixels.total_cmp(&b.pixels));
+    }
+    prototypes
+}
+
+/// The fit's samples from the `single`-object passes: each object's
+/// features and its time (picoseconds) beyond the empty pass's `overhead_ns`.
+fn fit_samples(plan: &Plan, single: &Measured, overhead_ns: f64) -> Vec<(Features, f64)> {
+    single
+        .iter()
+        .map(|(p, m)| {
+            let o = &p.objects[0];
+            let proto = &plan.prototypes[o.prototype];
+            let f = Features {
+                triangles: proto.triangles as f64,
+                transformed: m.vs_invocations as f64,
+                vertices: proto.vertices as f64,
+                pixels: o.pixels(plan.setup.target),
+            };
+            (f, (m.time_ns - overhead_ns) * 1e3)
+        })
+        .collect()
+}
+
+/// Scores every per-object estimator on the `single` passes (the fit, in
+/// `study.fit`) and the `multi` passes (`study.scores`), and names the
+/// best on the latter (least mse).
+fn score_estimators(study: &mut EstimationStudy, plan: &Plan, single: &Measured, multi: &Measured) {
+    for (name, set) in [("single", single), ("multi", multi)] {
+        let passes: Vec<&PlannedPass> = set.iter().map(|(p, _)| *p).collect();
+        let actual: Vec<f64> = set.iter().map(|(_, m)| m.time_ns / 1e6).collect();
+        let estimates: Vec<[f64; 5]> = passes.iter().map(|p| study.pass_ms(plan, p)).collect();
+        let mut scores = BTreeMap::new();
+        for (k, est_name) in PER_OBJECT_ESTIMATORS.iter().enumerate() {
+            let est: Vec<f64> = estimates.iter().map(|e| e[k]).collect();
+            let (secs, ops) = time_estimator(study, plan, &passes, k);
+            scores.insert(est_name.to_string(), Score::of(&est, &actual, secs, ops));
+        }
+        if name == "single" {
+            study.fit = scores;
+        } else {
+            study.scores = scores;
+        }
+    }
+    study.best = study
+        .scores
+        .iter()
+        .filter_map(|(n, s)| Some((n, s.mse_ms2?)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(n, _)| n.clone())
+        .unwrap_or_default();
 }

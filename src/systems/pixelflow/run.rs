@@ -51,6 +51,15 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), SystemError> {
     if cfg.system != "pixelflow" {
         return Err(bad("system", format!("expected \"pixelflow\", got {:?}", cfg.system)));
     }
+    check_counts(cfg)?;
+    check_sizes(cfg)?;
+    check_regions(cfg)?;
+    check_options(cfg)
+}
+
+/// The node, frame and sample counts, and the nodes' roles: a frame
+/// buffer, at least one rasterizer and (texturing) at least one shader.
+fn check_counts(cfg: &PixelFlowConfig) -> Result<(), SystemError> {
     if cfg.nodes > crate::limits::MAX_PIXELFLOW_NODES {
         return Err(bad(
             "nodes",
@@ -101,6 +110,12 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), SystemError> {
             "the texturing architectures need at least one shading node",
         ));
     }
+    Ok(())
+}
+
+/// The display, primitive and region sizes: finite, at least a pixel
+/// where needed, with finite areas and a finite overlap factor.
+fn check_sizes(cfg: &PixelFlowConfig) -> Result<(), SystemError> {
     check_size("display", &cfg.display)?;
     check_size("primitive", &cfg.primitive)?;
     check_size("aa_primitive", &cfg.aa_primitive)?;
@@ -142,6 +157,11 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), SystemError> {
             ),
         ));
     }
+    Ok(())
+}
+
+/// The regions, and the bins and region records they make, within limits.
+fn check_regions(cfg: &PixelFlowConfig) -> Result<(), SystemError> {
     if cfg.regions() > 1_000_000 {
         return Err(bad(
             "region",
@@ -171,6 +191,11 @@ pub fn validate(cfg: &PixelFlowConfig) -> Result<(), SystemError> {
             ),
         ));
     }
+    Ok(())
+}
+
+/// The non-texturing batch, the node skew and the clustered placement's table.
+fn check_options(cfg: &PixelFlowConfig) -> Result<(), SystemError> {
     if cfg.nontex.batch_primitives == 0 {
         return Err(bad("nontex.batch_primitives", "must be at least 1"));
     }

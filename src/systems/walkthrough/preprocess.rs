@@ -55,169 +55,25 @@ pub(super) fn preprocess(
     policy: Policy,
     count: &mut Counter,
 ) -> Result<Preprocess, SystemError> {
-    let render_exact = |draws: &[Draw], count: &mut Counter| -> Result<(f64, f64), SystemError> {
-        let (t, by_kind, names) = exact.render_counted(draws, 0, 0)?;
-        count.add(t.events, &by_kind, names);
-        Ok((t.rt as f64, t.gpu as f64))
+    let mut renders = ExactRenders {
+        renderer: exact,
+        count,
+        empty_gpu: 0.0,
+        repeats: cfg.estimation.repeats as usize,
+        copies: Vec::with_capacity(cfg.estimation.repeats as usize),
     };
-    let (empty, empty_gpu) = render_exact(&[], count)?;
+    let (empty, empty_gpu) = renders.render(&[])?;
+    renders.empty_gpu = empty_gpu;
     // The clocks the preprocess's renders are read with (timing.rs).
-    let est_cfg = &cfg.estimation;
-    let clock = |stream: &str| {
-        Clock::new(
-            est_cfg.timing,
-            est_cfg.clock_overhead,
-            est_cfg.clock_noise,
-            cfg.run.seed,
-            stream,
-        )
-    };
     let (mut fit_clock, mut pos_clock, mut vcs_clock) = (
-        clock("estimation.clock.fit"),
-        clock("estimation.clock.pos"),
-        clock("estimation.clock.vcs"),
+        clock(cfg, "estimation.clock.fit"),
+        clock(cfg, "estimation.clock.pos"),
+        clock(cfg, "estimation.clock.vcs"),
     );
-    // One object's GPU time: `repeats` copies drawn (state set once), the
-    // GPU time beyond the empty frame's divided among them.
-    let repeats = cfg.estimation.repeats as usize;
-    let mut copies: Vec<Draw> = Vec::with_capacity(repeats);
-    let mut object_time = |d: Draw, count: &mut Counter, clock: &mut Clock| -> Result<f64, SystemError> {
-        copies.clear();
-        copies.resize(repeats, d);
-        let (_, gpu) = render_exact(&copies, count)?;
-        Ok((clock.read(gpu) - empty_gpu) / repeats as f64)
-    };
-    let (w, h) = (cfg.camera.width as f64, cfg.camera.height as f64);
-    let focal = 0.5 * w / (0.5 * cfg.camera.fov.to_radians()).tan();
-    let alpha_range = super::pos::alphas(&cfg.estimation.pos, focal, w, h);
-    let (alpha_lo, alpha_hi) = (alpha_range[0].ln(), alpha_range[alpha_range.len() - 1].ln());
-
-    // The heuristics' constants, fitted to single-object renders.
-    let constants = if wants[..4].iter().any(|w| *w) && !scene.objects.is_empty() {
-        let mut rng = RngStreams::new(cfg.run.seed).stream("estimation.fit");
-        let p = &cfg.estimation.pos;
-        let mut samples = Vec::with_capacity(cfg.estimation.fit_samples as usize);
-        for _ in 0..cfg.estimation.fit_samples {
-            let o = &scene.objects[rng.random_range(0..scene.objects.len())];
-            let proto = &scene.protos[o.proto as usize];
-            let level = rng.random_range(0..proto.levels.len());
-            let alpha = rng.random_range(alpha_lo..=alpha_hi).exp();
-            let gamma = rng.random_range(0.0..std::f64::consts::TAU);
-            let phi = rng.random_range(p.phi_min..=p.phi_max).to_radians();
-            let pr = sample_projection(proto, alpha, gamma, phi, focal, w, h);
-            let d = Draw {
-                proto: o.proto,
-                level: level as u32,
-                pixels: pr.covered_pixels,
-                state: o.state,
-            };
-            let y = object_time(d, count, &mut fit_clock)?;
-            samples.push((features(scene, o.proto, level, &pr), y));
-        }
-        Some(fit(&samples))
-    } else if wants[..4].iter().any(|w| *w) {
-        Some(Constants::default())
-    } else {
-        None
-    };
-
-    // The pos tables, one per prototype in use, at its finest level (every
-    // level when a policy other than "none" draws coarser ones).
-    let table_levels = |p: &super::scene::Prototype| {
-        if policy == Policy::None { 1 } else { p.levels.len() }
-    };
-    let mut tables: Vec<Vec<Option<PosTable>>> = scene.protos.iter().map(|p| vec![None; table_levels(p)]).collect();
-    let mut pos_tables = None;
-    if wants[4] || wants[PVC] {
-        let mut used = vec![false; scene.protos.len()];
-        for o in &scene.objects {
-            used[o.proto as usize] = true;
-        }
-        let (mut renders, mut full, mut n) = (0u64, 0u64, 0u64);
-        for (i, proto) in scene.protos.iter().enumerate() {
-            if !used[i] {
-                continue;
-            }
-            let state = scene
-                .objects
-                .iter()
-                .find(|o| o.proto as usize == i)
-                .map_or((0, 0, 0), |o| o.state);
-            for (level, slot) in tables[i].iter_mut().enumerate() {
-                let (table, r) = build_table(&cfg.estimation.pos, proto, level, (focal, w, h), |_, covered| {
-                    let d = Draw {
-                        proto: i as u32,
-                        level: level as u32,
-                        pixels: covered,
-                        state,
-                    };
-                    object_time(d, count, &mut pos_clock)
-                })?;
-                renders += r;
-                full += table.full_size();
-                n += 1;
-                *slot = Some(table);
-            }
-        }
-        pos_tables = Some(PosTables {
-            tables: n,
-            renders,
-            full_renders: full,
-            pruned_fraction: if full > 0 {
-                1.0 - renders as f64 / full as f64
-            } else {
-                0.0
-            },
-        });
-    }
-    // The view-cell estimators, for the cells the path visits.
-    let mut pvs = Pvs::default();
-    let mut view_cells: Option<(ViewCellTables, ViewCellSummary)> = None;
-    if wants[VCS] || wants[PVC] {
-        let Some(cell) = scene.view_cell else {
-            let i = cfg
-                .estimation
-                .estimators
-                .iter()
-                .position(|e| e == "vcs" || e == "pvc")
-                .unwrap_or(0);
-            return Err(invalid(
-                &format!("estimation.estimators.{i}"),
-                format!(
-                    "{:?} needs view cells (the city preset, or scene.view_cell > 0 with listed objects)",
-                    cfg.estimation.estimators[i]
-                ),
-            ));
-        };
-        let cells = super::view_cells::visited(poses, cell).len() as u64;
-        let v = &cfg.estimation.view_cells;
-        let renders = cells * v.directions as u64 * v.samples as u64;
-        if wants[VCS] && renders > MAX_FRAMES {
-            return Err(invalid(
-                "estimation.view_cells.samples",
-                format!(
-                    "{cells} cells x {} directions x {} samples = {renders} sample views is more than the limit of {MAX_FRAMES}",
-                    v.directions, v.samples
-                ),
-            ));
-        }
-        let inputs = super::view_cells::Inputs {
-            cfg: v,
-            cam: &cfg.camera,
-            cell,
-            poses,
-            tables: &tables,
-            want: (wants[VCS], wants[PVC]),
-            seed: cfg.run.seed,
-        };
-        view_cells = Some(super::view_cells::build(
-            &inputs,
-            scene,
-            &mut pvs,
-            &mut vcs_clock,
-            |draws| render_exact(draws, count).map(|(rt, _)| rt),
-        )?);
-    }
+    let image = image(cfg);
+    let constants = fit_constants(cfg, scene, wants, image, &mut renders, &mut fit_clock)?;
+    let (tables, pos_tables) = pos_tables(cfg, scene, wants, policy, image, &mut renders, &mut pos_clock)?;
+    let (pvs, view_cells) = view_cells(cfg, scene, poses, wants, &tables, &mut renders, &mut vcs_clock)?;
     Ok(Preprocess {
         empty,
         constants,
@@ -227,4 +83,213 @@ pub(super) fn preprocess(
         view_cells,
         clock_readings: fit_clock.readings() + pos_clock.readings() + vcs_clock.readings(),
     })
+}
+
+/// The preprocess's renders: exact (run seed 0, at time 0), their events
+/// counted; one object's time from `repeats` copies of it.
+struct ExactRenders<'a> {
+    renderer: &'a Renderer,
+    count: &'a mut Counter,
+    /// The empty frame's GPU time (ps).
+    empty_gpu: f64,
+    repeats: usize,
+    copies: Vec<Draw>,
+}
+
+impl ExactRenders<'_> {
+    /// Draws `draws`; returns the rendering and GPU times (ps).
+    fn render(&mut self, draws: &[Draw]) -> Result<(f64, f64), SystemError> {
+        let (t, by_kind, names) = self.renderer.render_counted(draws, 0, 0)?;
+        self.count.add(t.events, &by_kind, names);
+        Ok((t.rt as f64, t.gpu as f64))
+    }
+
+    /// One object's GPU time read with `clock`: `repeats` copies of `d`
+    /// drawn (state set once), the GPU time beyond the empty frame's
+    /// divided among them.
+    fn object_time(&mut self, d: Draw, clock: &mut Clock) -> Result<f64, SystemError> {
+        let mut copies = std::mem::take(&mut self.copies);
+        copies.clear();
+        copies.resize(self.repeats, d);
+        let gpu = self.render(&copies).map(|(_, gpu)| gpu);
+        self.copies = copies;
+        Ok((clock.read(gpu?) - self.empty_gpu) / self.repeats as f64)
+    }
+}
+
+/// The estimation's clock for the renders of `stream` (timing.rs).
+fn clock(cfg: &WalkthroughConfig, stream: &str) -> Clock {
+    let e = &cfg.estimation;
+    Clock::new(e.timing, e.clock_overhead, e.clock_noise, cfg.run.seed, stream)
+}
+
+/// The camera's image: focal length (pixels), width and height.
+fn image(cfg: &WalkthroughConfig) -> (f64, f64, f64) {
+    let (w, h) = (cfg.camera.width as f64, cfg.camera.height as f64);
+    let focal = 0.5 * w / (0.5 * cfg.camera.fov.to_radians()).tan();
+    (focal, w, h)
+}
+
+/// The heuristics' constants (when one of h1-h4 is wanted), fitted to
+/// single-object renders of random objects, levels and views.
+fn fit_constants(
+    cfg: &WalkthroughConfig,
+    scene: &Scene,
+    wants: &[bool],
+    (focal, w, h): (f64, f64, f64),
+    renders: &mut ExactRenders,
+    clock: &mut Clock,
+) -> Result<Option<Constants>, SystemError> {
+    if !wants[..4].iter().any(|w| *w) {
+        return Ok(None);
+    }
+    if scene.objects.is_empty() {
+        return Ok(Some(Constants::default()));
+    }
+    let alpha_range = super::pos::alphas(&cfg.estimation.pos, focal, w, h);
+    let (alpha_lo, alpha_hi) = (alpha_range[0].ln(), alpha_range[alpha_range.len() - 1].ln());
+    let mut rng = RngStreams::new(cfg.run.seed).stream("estimation.fit");
+    let p = &cfg.estimation.pos;
+    let mut samples = Vec::with_capacity(cfg.estimation.fit_samples as usize);
+    for _ in 0..cfg.estimation.fit_samples {
+        let o = &scene.objects[rng.random_range(0..scene.objects.len())];
+        let proto = &scene.protos[o.proto as usize];
+        let level = rng.random_range(0..proto.levels.len());
+        let alpha = rng.random_range(alpha_lo..=alpha_hi).exp();
+        let gamma = rng.random_range(0.0..std::f64::consts::TAU);
+        let phi = rng.random_range(p.phi_min..=p.phi_max).to_radians();
+        let pr = sample_projection(proto, alpha, gamma, phi, focal, w, h);
+        let d = Draw {
+            proto: o.proto,
+            level: level as u32,
+            pixels: pr.covered_pixels,
+            state: o.state,
+        };
+        let y = renders.object_time(d, clock)?;
+        samples.push((features(scene, o.proto, level, &pr), y));
+    }
+    Ok(Some(fit(&samples)))
+}
+
+/// The pos tables (when pos or pvc is wanted), one per prototype in use,
+/// at its finest level (every level when a policy other than "none" draws
+/// coarser ones), and what they took.
+fn pos_tables(
+    cfg: &WalkthroughConfig,
+    scene: &Scene,
+    wants: &[bool],
+    policy: Policy,
+    image: (f64, f64, f64),
+    renders: &mut ExactRenders,
+    clock: &mut Clock,
+) -> Result<(Tables, Option<PosTables>), SystemError> {
+    let table_levels = |p: &super::scene::Prototype| {
+        if policy == Policy::None { 1 } else { p.levels.len() }
+    };
+    let mut tables: Tables = scene.protos.iter().map(|p| vec![None; table_levels(p)]).collect();
+    if !(wants[4] || wants[PVC]) {
+        return Ok((tables, None));
+    }
+    let mut used = vec![false; scene.protos.len()];
+    for o in &scene.objects {
+        used[o.proto as usize] = true;
+    }
+    let (mut n_renders, mut full, mut n) = (0u64, 0u64, 0u64);
+    for (i, proto) in scene.protos.iter().enumerate() {
+        if !used[i] {
+            continue;
+        }
+        let state = scene
+            .objects
+            .iter()
+            .find(|o| o.proto as usize == i)
+            .map_or((0, 0, 0), |o| o.state);
+        for (level, slot) in tables[i].iter_mut().enumerate() {
+            let (table, r) = build_table(&cfg.estimation.pos, proto, level, image, |_, covered| {
+                let d = Draw {
+                    proto: i as u32,
+                    level: level as u32,
+                    pixels: covered,
+                    state,
+                };
+                renders.object_time(d, clock)
+            })?;
+            n_renders += r;
+            full += table.full_size();
+            n += 1;
+            *slot = Some(table);
+        }
+    }
+    let summary = PosTables {
+        tables: n,
+        renders: n_renders,
+        full_renders: full,
+        pruned_fraction: if full > 0 {
+            1.0 - n_renders as f64 / full as f64
+        } else {
+            0.0
+        },
+    };
+    Ok((tables, Some(summary)))
+}
+
+/// Per prototype and level, its pos table (none where none was built).
+type Tables = Vec<Vec<Option<PosTable>>>;
+
+/// The view-cell estimators (when vcs or pvc is wanted), for the cells the
+/// path through `poses` visits, with the potentially visible sets built
+/// for them.
+fn view_cells(
+    cfg: &WalkthroughConfig,
+    scene: &Scene,
+    poses: &[Pose],
+    wants: &[bool],
+    tables: &[Vec<Option<PosTable>>],
+    renders: &mut ExactRenders,
+    clock: &mut Clock,
+) -> Result<(Pvs, Option<(ViewCellTables, ViewCellSummary)>), SystemError> {
+    let mut pvs = Pvs::default();
+    if !(wants[VCS] || wants[PVC]) {
+        return Ok((pvs, None));
+    }
+    let Some(cell) = scene.view_cell else {
+        let i = cfg
+            .estimation
+            .estimators
+            .iter()
+            .position(|e| e == "vcs" || e == "pvc")
+            .unwrap_or(0);
+        return Err(invalid(
+            &format!("estimation.estimators.{i}"),
+            format!(
+                "{:?} needs view cells (the city preset, or scene.view_cell > 0 with listed objects)",
+                cfg.estimation.estimators[i]
+            ),
+        ));
+    };
+    let cells = super::view_cells::visited(poses, cell).len() as u64;
+    let v = &cfg.estimation.view_cells;
+    let n_renders = cells * v.directions as u64 * v.samples as u64;
+    if wants[VCS] && n_renders > MAX_FRAMES {
+        return Err(invalid(
+            "estimation.view_cells.samples",
+            format!(
+                "{cells} cells x {} directions x {} samples = {n_renders} sample views is more than the limit of {MAX_FRAMES}",
+                v.directions, v.samples
+            ),
+        ));
+    }
+    let inputs = super::view_cells::Inputs {
+        cfg: v,
+        cam: &cfg.camera,
+        cell,
+        poses,
+        tables,
+        want: (wants[VCS], wants[PVC]),
+        seed: cfg.run.seed,
+    };
+    let built = super::view_cells::build(&inputs, scene, &mut pvs, clock, |draws| {
+        renders.render(draws).map(|(rt, _)| rt)
+    })?;
+    Ok((pvs, Some(built)))
 }
