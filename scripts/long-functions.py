@@ -73,12 +73,18 @@ def functions(path):
     stack = []  # (name, start line, depth at which the body opened)
     depth = 0
     pending = None
+    brackets = 0  # open ( and [ of a signature: a `;` inside is a type's, as in [T; N]
     for no, raw in enumerate(lines, 1):
         code = strip(raw, state)
         m = FN.match(code)
         if m:
             pending = (m.group(7), no)
+            brackets = 0
         for ch in code:
+            if ch in '([':
+                brackets += 1
+            elif ch in ')]':
+                brackets -= 1
             if ch == '{':
                 depth += 1
                 if pending:
@@ -89,7 +95,7 @@ def functions(path):
                     name, start, _ = stack.pop()
                     yield name, start, no - start + 1
                 depth -= 1
-            elif ch == ';' and pending and depth >= 0:
+            elif ch == ';' and pending and brackets <= 0:
                 pending = None  # a declaration without a body
     return
 
