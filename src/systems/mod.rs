@@ -8,6 +8,7 @@ pub mod error;
 pub mod frame_pipeline;
 pub mod multi_rate;
 pub mod pixelflow;
+pub mod present;
 pub mod state_sorting;
 pub mod summary;
 pub mod tracked_input;
@@ -274,6 +275,7 @@ pub const SYSTEMS: &[&dyn System] = &[
     &Registered::<walkthrough::system::WalkthroughSystem>::new(),
     &Registered::<device_predictions::system::DevicePredictionsSystem>::new(),
     &Registered::<state_sorting::system::StateSortingSystem>::new(),
+    &Registered::<present::PresentSystem>::new(),
 ];
 
 /// A resolved model's TOML with the header every system writes.

@@ -29,6 +29,7 @@ mod obj_files;
 mod outputs;
 mod pipeline_oracles;
 mod pixelflow;
+mod present;
 mod readback;
 mod shards;
 mod sortbuf;

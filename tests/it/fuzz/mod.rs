@@ -112,6 +112,7 @@ fn bases() -> Vec<(&'static str, Vec<&'static str>)> {
         ("models/vr-warp.toml", vec!["run.events=40", MEM, EVENTS]),
         ("models/vr-naive.toml", vec!["run.events=40", MEM, EVENTS]),
         ("models/pixelflow-20.toml", vec!["primitives=2000"]),
+        ("models/present.toml", vec!["run.frames=50", EVENTS]),
     ]
 }
 

@@ -1,0 +1,367 @@
+//! Running the present system: validation, the run, its summary, per-frame
+//! table, report, and its entry in the registry ([`PresentSystem`]).
+
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+use serde::Serialize;
+use serde_json::Value;
+
+use crate::components::swap_chain::PresentMode;
+use crate::engine::{Limits, RngStreams, RunStats, Scheduler, StopReason, run};
+use crate::output::table::write_number_table;
+use crate::output::text::fixed;
+use crate::output::trace::TraceWriter;
+use crate::systems::error::invalid;
+use crate::systems::summary::{Dist, EventCounts, to_json};
+use crate::systems::{Outcome, SystemError, SystemModel, resolved_toml};
+
+use super::config::PresentConfig;
+use super::model::{FrameTimes, Present};
+
+/// `system = "present"`.
+pub struct PresentSystem;
+
+impl SystemModel for PresentSystem {
+    const NAME: &'static str = "present";
+    type Config = PresentConfig;
+    type Run = PresentRun;
+
+    fn run(cfg: PresentConfig, _base_dir: &Path, trace: Option<TraceWriter>) -> Result<PresentRun, SystemError> {
+        run_present(cfg, trace)
+    }
+}
+
+/// A finished run.
+#[derive(Debug)]
+pub struct PresentRun {
+    /// The summary (`summary.json`).
+    pub summary: Value,
+    /// The model as run.
+    pub config: PresentConfig,
+    /// Every frame, in order.
+    pub frames: Vec<FrameTimes>,
+    trace: Option<TraceWriter>,
+}
+
+/// The mean interval between displayed frames (ms) for render times drawn
+/// independently from `render` (paper 004 §4.2). With two images and vsync
+/// a frame starts at a vertical blank and is shown at the first one after
+/// it is done, so its interval is its render time `T` rounded up to whole
+/// refreshes `R`: `E[max(1, ceil(T/R))] R = R (1 + sum_k>=1 P(T > kR))`,
+/// exact. With three or more images the renderer goes on while a frame
+/// waits, so in the long run the mean interval is the larger of `E[T]` and
+/// `R` (exact for a constant render time); `immediate` shows each frame
+/// when it is done: `E[T]`.
+pub fn analytic_interval_ms(
+    render: &crate::components::distribution::Dist<crate::engine::Duration>,
+    refresh_ms: f64,
+    buffers: u32,
+    mode: PresentMode,
+) -> f64 {
+    let mean_ms = render.mean() / 1e9;
+    match mode {
+        PresentMode::Immediate => mean_ms,
+        _ if buffers == 2 => {
+            let r = refresh_ms * 1e9;
+            let mut sum = 1.0;
+            // The tail terms fall below 1e-12 for every light-tailed kind;
+            // a heavy tail is cut at a million refreshes.
+            for k in 1..=1_000_000u32 {
+                let p = render.survival(f64::from(k) * r);
+                if p < 1e-12 {
+                    break;
+                }
+                sum += p;
+            }
+            sum * refresh_ms
+        }
+        _ => mean_ms.max(refresh_ms),
+    }
+}
+
+/// Checks what the simulator cannot run: a render-time distribution with
+/// bad parameters, the display ([`crate::components::swap_chain::DisplayConfig::check`]),
+/// warm-up frames that leave none, and work that could not finish.
+pub fn validate(cfg: &PresentConfig) -> Result<(), SystemError> {
+    cfg.render
+        .time
+        .validate()
+        .map_err(|e| invalid("render.time", e.to_string()))?;
+    cfg.display.check().map_err(|(key, message)| invalid(key, message))?;
+    if cfg.run.warmup_frames > cfg.run.frames {
+        return Err(invalid(
+            "run.warmup_frames",
+            format!(
+                "{} warm-up frames of {} leave none to measure",
+                cfg.run.warmup_frames, cfg.run.frames
+            ),
+        ));
+    }
+    // Each frame takes at least its mean render time and, waiting for a
+    // vertical blank, a refresh: the span must fit the clock, and its
+    // vertical blanks the event budget.
+    let render = cfg.render.time.mean();
+    let refresh = cfg.display.refresh.period.0 as f64;
+    let vsync = cfg.display.waits_for_vblank();
+    let per_frame = if vsync { render.max(refresh) } else { render };
+    let span = per_frame * cfg.run.frames as f64;
+    if let Some((key, message)) = crate::limits::span_check(&[("render.time|run.frames", span)]) {
+        return Err(invalid(&key, message));
+    }
+    let parts = [
+        ("run.frames".to_string(), "frames".to_string(), cfg.run.frames as f64),
+        (
+            "display.refresh".to_string(),
+            "vertical blanks".to_string(),
+            if vsync { span / refresh } else { 0.0 },
+        ),
+    ];
+    if let Some((key, message)) = crate::limits::events_check(&parts, cfg.run.max_events, "lower run.frames") {
+        return Err(invalid(&key, message));
+    }
+    Ok(())
+}
+
+/// Validates and runs a model, writing its trace into `trace` if given.
+pub fn run_present(cfg: PresentConfig, trace: Option<TraceWriter>) -> Result<PresentRun, SystemError> {
+    validate(&cfg)?;
+    let streams = RngStreams::new(cfg.run.seed);
+    let mut model = Present::new(
+        cfg.run.frames,
+        cfg.render.time.clone(),
+        streams.stream("render"),
+        cfg.display.buffers,
+        cfg.display.effective_mode(),
+        cfg.display.refresh.period,
+        trace,
+    );
+    let mut sched = Scheduler::new();
+    let start = Instant::now();
+    model.start(&mut sched)?;
+    let limits = Limits {
+        until: None,
+        max_events: cfg.run.max_events,
+    };
+    let stats = run(&mut model, &mut sched, limits)?;
+    if !model.done() {
+        return Err(SystemError::Unfinished {
+            at: stats.end_time,
+            missing: "every frame was shown or dropped".into(),
+            state: model.describe(),
+        });
+    }
+    let mut stats = stats;
+    stats.wall_seconds = start.elapsed().as_secs_f64();
+    let done = model.finish(stats.end_time);
+    let summary = summarize(&cfg, &done, &stats);
+    Ok(PresentRun {
+        summary,
+        config: cfg,
+        frames: done.frames,
+        trace: done.trace,
+    })
+}
+
+/// `metrics` of a present summary (frames after the warm-up).
+#[derive(Debug, Clone, Serialize)]
+pub struct PresentMetrics {
+    /// Frames rendered and measured.
+    pub frames: usize,
+    /// Frames that reached the screen.
+    pub displayed_frames: usize,
+    /// Frames replaced in the mailbox before they were shown.
+    pub dropped_frames: usize,
+    /// Render time per frame.
+    pub render_ms: Dist,
+    /// Time between successive displayed frames.
+    pub display_interval_ms: Dist,
+    /// Render start to screen, per displayed frame.
+    pub latency_ms: Dist,
+    /// Present to screen, per displayed frame (the wait for the vertical
+    /// blank and for the frames queued before it).
+    pub present_to_display_ms: Dist,
+    /// The closed form of the mean display interval,
+    /// [`analytic_interval_ms`].
+    pub analytic_interval_ms: f64,
+    /// Vertical blanks over the whole run.
+    pub vblanks: u64,
+    /// Vertical blanks that showed the frame before again.
+    pub repeated_refreshes: u64,
+    /// Share of the run the renderer waited for a free image.
+    pub renderer_wait_share: f64,
+}
+
+/// The summary of a present run (`summary.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct PresentSummary {
+    /// `"present"`.
+    pub system: &'static str,
+    /// The model's description.
+    pub description: String,
+    /// Master seed.
+    pub seed: u64,
+    /// Kernel events.
+    pub events: EventCounts,
+    /// Wall time of the run.
+    pub wall_seconds: f64,
+    /// Wall time of the simulation (the same: nothing is built first).
+    pub simulate_seconds: f64,
+    /// Simulated time at the end.
+    pub simulated_seconds: f64,
+    /// Why the run stopped (`model`: every frame shown or dropped).
+    pub stopped_by: StopReason,
+    /// The results.
+    pub metrics: PresentMetrics,
+}
+
+fn summarize(cfg: &PresentConfig, done: &super::model::Finished, stats: &RunStats) -> Value {
+    let measured = &done.frames[(cfg.run.warmup_frames as usize).min(done.frames.len())..];
+    let ms = |a: crate::engine::Time, b: crate::engine::Time| b.since(a).as_ms_f64();
+    let shown: Vec<&FrameTimes> = measured.iter().filter(|f| f.shown.is_some()).collect();
+    let shown_at: Vec<crate::engine::Time> = shown.iter().filter_map(|f| f.shown).collect();
+    let render: Vec<f64> = measured.iter().map(|f| ms(f.start, f.present)).collect();
+    let end = stats.end_time.0 as f64;
+    let summary = PresentSummary {
+        system: "present",
+        description: cfg.description.clone(),
+        seed: cfg.run.seed,
+        events: EventCounts::of(stats),
+        wall_seconds: stats.wall_seconds,
+        simulate_seconds: stats.wall_seconds,
+        simulated_seconds: end / 1e12,
+        stopped_by: stats.stopped_by,
+        metrics: PresentMetrics {
+            frames: measured.len(),
+            displayed_frames: shown.len(),
+            dropped_frames: measured.len() - shown.len(),
+            display_interval_ms: Dist::of(&shown_at.windows(2).map(|w| ms(w[0], w[1])).collect::<Vec<_>>()),
+            latency_ms: Dist::of(
+                &shown
+                    .iter()
+                    .map(|f| ms(f.start, f.shown.unwrap_or(f.start)))
+                    .collect::<Vec<_>>(),
+            ),
+            present_to_display_ms: Dist::of(
+                &shown
+                    .iter()
+                    .map(|f| ms(f.present, f.shown.unwrap_or(f.present)))
+                    .collect::<Vec<_>>(),
+            ),
+            analytic_interval_ms: analytic_interval_ms(
+                &cfg.render.time,
+                cfg.display.refresh.period.as_ms_f64(),
+                cfg.display.buffers,
+                cfg.display.effective_mode(),
+            ),
+            render_ms: Dist::of(&render),
+            vblanks: done.vblanks,
+            repeated_refreshes: done.repeated,
+            renderer_wait_share: if end > 0.0 { done.waited.0 as f64 / end } else { 0.0 },
+        },
+    };
+    to_json(&summary)
+}
+
+/// Columns of the per-frame table.
+pub const COLUMNS: [&str; 6] = ["Frame", "StartMs", "RenderMs", "PresentMs", "ShownMs", "LatencyMs"];
+
+/// The per-frame table (NaN where a frame was not shown).
+pub fn frame_rows(frames: &[FrameTimes]) -> Vec<Vec<f64>> {
+    frames
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let shown = f.shown.map_or(f64::NAN, |t| t.as_ms_f64());
+            vec![
+                i as f64,
+                f.start.as_ms_f64(),
+                f.present.since(f.start).as_ms_f64(),
+                f.present.as_ms_f64(),
+                shown,
+                shown - f.start.as_ms_f64(),
+            ]
+        })
+        .collect()
+}
+
+/// Writes the human-readable report of the run whose summary is `s`.
+pub fn write_report(s: &Value, w: &mut dyn Write) -> std::io::Result<()> {
+    let m = &s["metrics"];
+    let n = |v: &Value| v.as_f64().unwrap_or(f64::NAN);
+    writeln!(
+        w,
+        "{} (present), {} frames, seed {}",
+        s["model"].as_str().unwrap_or(""),
+        m["frames"],
+        s["seed"]
+    )?;
+    writeln!(
+        w,
+        "  displayed {} dropped {}   repeated refreshes {} of {}",
+        m["displayed_frames"], m["dropped_frames"], m["repeated_refreshes"], m["vblanks"]
+    )?;
+    for (label, key) in [
+        ("render time     ", "render_ms"),
+        ("display interval", "display_interval_ms"),
+        ("latency         ", "latency_ms"),
+    ] {
+        let d = &m[key];
+        writeln!(
+            w,
+            "  {label} mean {:>8} p99 {:>8} max {:>8} ms",
+            fixed(n(&d["mean"]), 3),
+            fixed(n(&d["p99"]), 3),
+            fixed(n(&d["max"]), 3)
+        )?;
+    }
+    writeln!(
+        w,
+        "  closed form mean interval {} ms (paper 004 §4.2); renderer waited {}% of the run",
+        fixed(n(&m["analytic_interval_ms"]), 3),
+        fixed(100.0 * n(&m["renderer_wait_share"]), 1)
+    )?;
+    crate::output::text::events_line(w, s)
+}
+
+impl Outcome for PresentRun {
+    fn summary(&self) -> &Value {
+        &self.summary
+    }
+
+    fn summary_mut(&mut self) -> &mut Value {
+        &mut self.summary
+    }
+
+    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        write_report(&self.summary, w)
+    }
+
+    fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
+        (
+            COLUMNS.iter().map(|s| s.to_string()).collect(),
+            frame_rows(&self.frames),
+        )
+    }
+
+    fn write_table(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        write_number_table(std::io::BufWriter::new(w), &COLUMNS, &frame_rows(&self.frames))
+    }
+
+    fn resolved_model(&self, _base_dir: &Path) -> String {
+        resolved_toml(&self.config)
+    }
+
+    fn take_trace(&mut self) -> Option<TraceWriter> {
+        self.trace.take()
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    fn into_any(self: Box<Self>) -> Box<dyn std::any::Any> {
+        self
+    }
+}
