@@ -109,7 +109,7 @@ pub fn quantile(sorted: &[f64], q: f64) -> f64 {
 mod tests {
     use super::*;
 
-    fn close(a: f64, b: f64) -> bool {
+    fn nearly_equal(a: f64, b: f64) -> bool {
         (a - b).abs() < 1e-9
     }
 
@@ -117,11 +117,11 @@ mod tests {
     fn quantile_matches_numpy_linear() {
         let s = [1.0, 2.0, 3.0, 4.0];
         // numpy.quantile([1,2,3,4], [0, .25, .5, .9, 1]) = 1, 1.75, 2.5, 3.7, 4
-        assert!(close(quantile(&s, 0.0), 1.0));
-        assert!(close(quantile(&s, 0.25), 1.75));
-        assert!(close(quantile(&s, 0.5), 2.5));
-        assert!(close(quantile(&s, 0.9), 3.7));
-        assert!(close(quantile(&s, 1.0), 4.0));
+        assert!(nearly_equal(quantile(&s, 0.0), 1.0));
+        assert!(nearly_equal(quantile(&s, 0.25), 1.75));
+        assert!(nearly_equal(quantile(&s, 0.5), 2.5));
+        assert!(nearly_equal(quantile(&s, 0.9), 3.7));
+        assert!(nearly_equal(quantile(&s, 1.0), 4.0));
     }
 
     #[test]
@@ -138,13 +138,13 @@ mod tests {
         let v: Vec<f64> = (1..=100).map(f64::from).collect();
         let s = Summary::of(&v);
         assert_eq!(s.count, 100);
-        assert!(close(s.mean, 50.5));
-        assert!(close(s.p50, 50.5));
+        assert!(nearly_equal(s.mean, 50.5));
+        assert!(nearly_equal(s.p50, 50.5));
         // numpy.quantile(range(1,101), .99) = 99.01
-        assert!(close(s.p99, 99.01));
+        assert!(nearly_equal(s.p99, 99.01));
         assert_eq!((s.min, s.max), (1.0, 100.0));
         // sample std of 1..=100 = sqrt(841.666..)
-        assert!(close(s.std, (100.0f64 * 101.0 / 12.0).sqrt()));
+        assert!(nearly_equal(s.std, (100.0f64 * 101.0 / 12.0).sqrt()));
     }
 
     #[test]

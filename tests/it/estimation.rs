@@ -62,7 +62,7 @@ fn study(extra_multi_ns: f64) -> (Plan, EstimationStudy, Vec<u64>) {
     (plan, s, tv)
 }
 
-fn close(a: f64, b: f64, rel: f64) -> bool {
+fn within_rel(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * b.abs().max(1e-12)
 }
 
@@ -73,7 +73,7 @@ fn the_fit_recovers_known_constants_from_synthetic_passes() {
     // h4's formula is the device's: its constants come back (ps per unit).
     let [a, b] = s.constants.h4_ps;
     assert!(
-        close(a, PER_VERTEX_NS * 1e3, 1e-6) && close(b, PER_PIXEL_NS * 1e3, 1e-6),
+        within_rel(a, PER_VERTEX_NS * 1e3, 1e-6) && within_rel(b, PER_PIXEL_NS * 1e3, 1e-6),
         "{:?}",
         s.constants
     );
@@ -91,12 +91,12 @@ fn the_fit_recovers_known_constants_from_synthetic_passes() {
         xx2 += v * v;
     }
     assert!(
-        close(s.constants.h1_per_triangle_ps, xy1 / xx1, 1e-9),
+        within_rel(s.constants.h1_per_triangle_ps, xy1 / xx1, 1e-9),
         "{:?}",
         s.constants
     );
     assert!(
-        close(s.constants.h2_per_transformed_vertex_ps, xy2 / xx2, 1e-9),
+        within_rel(s.constants.h2_per_transformed_vertex_ps, xy2 / xx2, 1e-9),
         "{:?}",
         s.constants
     );
@@ -124,9 +124,15 @@ fn the_scores_of_a_constructed_case_follow_by_hand() {
     let (plan, s, tv) = study(delta_ms * 1e6);
     for name in ["h4", "pos"] {
         let x = &s.scores[name];
-        assert!(close(x.mse_ms2.unwrap(), delta_ms * delta_ms, 1e-9), "{name}: {x:?}");
-        assert!(close(x.mean_error_ms.unwrap(), -delta_ms, 1e-9), "{name}: {x:?}");
-        assert!(close(x.mean_abs_error_ms.unwrap(), delta_ms, 1e-9), "{name}: {x:?}");
+        assert!(
+            within_rel(x.mse_ms2.unwrap(), delta_ms * delta_ms, 1e-9),
+            "{name}: {x:?}"
+        );
+        assert!(within_rel(x.mean_error_ms.unwrap(), -delta_ms, 1e-9), "{name}: {x:?}");
+        assert!(
+            within_rel(x.mean_abs_error_ms.unwrap(), delta_ms, 1e-9),
+            "{name}: {x:?}"
+        );
         assert_eq!(x.underestimated_fraction, Some(1.0), "{name}");
     }
     // h1 by hand: overhead + c1 * triangles summed over each pass's objects.
@@ -147,12 +153,14 @@ fn the_scores_of_a_constructed_case_follow_by_hand() {
     }
     let h1 = &s.scores["h1"];
     assert_eq!(n, 60);
-    assert!(close(h1.mse_ms2.unwrap(), se / n as f64, 1e-9), "{h1:?}");
-    assert!(close(h1.mean_error_ms.unwrap(), e / n as f64, 1e-9), "{h1:?}");
+    assert!(within_rel(h1.mse_ms2.unwrap(), se / n as f64, 1e-9), "{h1:?}");
+    assert!(within_rel(h1.mean_error_ms.unwrap(), e / n as f64, 1e-9), "{h1:?}");
     assert_eq!(h1.underestimated_fraction, Some(under as f64 / n as f64));
     // Operations per pass: one per object for h1-h4, two table reads for pos.
     let objects = s.passes.multi_objects as f64 / n as f64;
-    assert!(close(h1.ops_per_frame, objects, 1e-12) && close(s.scores["pos"].ops_per_frame, 2.0 * objects, 1e-12));
+    assert!(
+        within_rel(h1.ops_per_frame, objects, 1e-12) && within_rel(s.scores["pos"].ops_per_frame, 2.0 * objects, 1e-12)
+    );
     assert!(s.best == "h4" || s.best == "pos", "{}", s.best);
 }
 

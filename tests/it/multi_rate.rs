@@ -12,7 +12,7 @@ use serde_json::Value;
 const CLUSTER: &str = include_str!("../../models/mfr-cluster.toml");
 const MULTIGPU: &str = include_str!("../../models/mfr-multigpu.toml");
 
-fn close(got: f64, want: f64, tol: f64, what: &str) {
+fn assert_within(got: f64, want: f64, tol: f64, what: &str) {
     assert!(
         (got - want).abs() <= tol,
         "{what}: got {got}, paper {want} (tolerance {tol})"
@@ -23,19 +23,19 @@ fn close(got: f64, want: f64, tol: f64, what: &str) {
 fn cluster_reproduces_the_papers_hand_analysis() {
     let s = summary(CLUSTER, &["run.events=200"]);
     let a = "metrics.analytic_latency_ms";
-    close(num(&s, &format!("{a}.conventional.best")), 206.0, 1e-9, "conventional");
-    close(num(&s, &format!("{a}.fast.best")), 73.0, 1e-9, "fast client");
+    assert_within(num(&s, &format!("{a}.conventional.best")), 206.0, 1e-9, "conventional");
+    assert_within(num(&s, &format!("{a}.fast.best")), 73.0, 1e-9, "fast client");
     // 40 + 166 + 20 + 111.1 (10 MiB at 90 MiB/s)
-    close(num(&s, &format!("{a}.slow.best")), 337.0, 0.2, "cluster slow client");
-    close(
+    assert_within(num(&s, &format!("{a}.slow.best")), 337.0, 0.2, "cluster slow client");
+    assert_within(
         num(&s, &format!("{a}.slow.worst")),
         390.0,
         0.2,
         "cluster slow client, at most",
     );
-    close(num(&s, "metrics.terms_ms.transfer"), 111.0, 0.2, "network transfer");
-    close(num(&s, "metrics.rates_hz.fast_client"), 30.0, 0.4, "FC rate");
-    close(
+    assert_within(num(&s, "metrics.terms_ms.transfer"), 111.0, 0.2, "network transfer");
+    assert_within(num(&s, "metrics.rates_hz.fast_client"), 30.0, 0.4, "FC rate");
+    assert_within(
         num(&s, "metrics.rates_hz.slow_client"),
         5.4,
         0.1,
@@ -47,15 +47,15 @@ fn cluster_reproduces_the_papers_hand_analysis() {
 fn multi_gpu_reproduces_the_papers_hand_analysis() {
     let s = summary(MULTIGPU, &["run.events=200"]);
     let a = "metrics.analytic_latency_ms";
-    close(num(&s, &format!("{a}.fast.best")), 73.0, 1e-9, "fast client");
+    assert_within(num(&s, &format!("{a}.fast.best")), 73.0, 1e-9, "fast client");
     // The lock's 0.1 ms is the only transfer term.
-    close(
+    assert_within(
         num(&s, &format!("{a}.slow.best")),
         226.0,
         0.1 + 1e-9,
         "multi-GPU slow client",
     );
-    close(
+    assert_within(
         num(&s, &format!("{a}.slow.worst")),
         279.0,
         0.1 + 1e-9,
@@ -73,7 +73,7 @@ fn table2_network_transfer_times_by_resolution() {
         ("[1600, 1200]", 166.0, 4.0),
     ] {
         let s = summary(CLUSTER, &["run.events=20", &format!("resolution={res}")]);
-        close(num(&s, "metrics.terms_ms.transfer"), paper, tol, res);
+        assert_within(num(&s, "metrics.terms_ms.transfer"), paper, tol, res);
     }
 }
 
@@ -118,14 +118,14 @@ fn stage_breakdown_adds_up_to_the_mean_latency() {
         let sum: f64 = b.as_object().unwrap().values().map(|v| v.as_f64().unwrap()).sum();
         let mean = num(&s, &format!("metrics.event_latency_ms.{path}.mean"));
         assert!((sum - mean).abs() < 1e-6, "{path}: stages {sum} vs mean {mean}");
-        close(num(b, "sensor_transport"), 40.0, 1e-9, "sensor transport");
-        close(num(b, "display"), 5.0, 1e-9, "display");
+        assert_within(num(b, "sensor_transport"), 40.0, 1e-9, "sensor transport");
+        assert_within(num(b, "display"), 5.0, 1e-9, "display");
     }
     let slow = &s["metrics"]["latency_breakdown_ms"]["slow"];
-    close(num(slow, "render"), 166.0, 1e-9, "SC render");
-    close(num(slow, "readback"), 20.0, 1e-9, "SC read-back");
-    close(num(slow, "transfer"), 111.1, 0.1, "network transfer");
-    close(num(slow, "render_submission"), 10.0, 1e-9, "FC upload");
+    assert_within(num(slow, "render"), 166.0, 1e-9, "SC render");
+    assert_within(num(slow, "readback"), 20.0, 1e-9, "SC read-back");
+    assert_within(num(slow, "transfer"), 111.1, 0.1, "network transfer");
+    assert_within(num(slow, "render_submission"), 10.0, 1e-9, "FC upload");
 }
 
 #[test]
@@ -150,7 +150,7 @@ fn a_link_slower_than_the_slow_client_replaces_buffers_and_still_finishes() {
     let s = summary(CLUSTER, &["run.events=300", "resolution=[1600, 1200]", "stereo=true"]);
     assert_eq!(s["metrics"]["link_keeps_up"], Value::Bool(false));
     assert!(s["metrics"]["buffers"]["replaced_before_sending"].as_u64().unwrap() > 0);
-    close(
+    assert_within(
         num(&s, "metrics.terms_ms.transfer"),
         2.0 * 162.76,
         0.1,
@@ -163,7 +163,7 @@ fn a_link_slower_than_the_slow_client_replaces_buffers_and_still_finishes() {
 fn faster_paths_shorten_only_the_slow_path() {
     let net = summary(CLUSTER, &["run.events=2000"]);
     let fast_net = summary(CLUSTER, &["run.events=2000", "network.bandwidth=\"180MiB/s\""]);
-    close(
+    assert_within(
         num(&fast_net, "metrics.terms_ms.transfer"),
         55.56,
         0.01,
@@ -328,11 +328,11 @@ fn issue5_experiments_plot_with_labelled_axes() {
 fn a_rate_cap_makes_the_client_wait_for_its_next_tick() {
     let free = summary(CLUSTER, &["run.events=4000"]);
     let s = summary(CLUSTER, &["run.events=4000", "fast_client.rate=\"20Hz\""]);
-    close(num(&s, "metrics.rates_hz.fast_client"), 20.0, 1e-9, "FC capped rate");
-    close(num(&s, "metrics.analytic_latency_ms.fast.best"), 73.0, 1e-9, "FC best");
+    assert_within(num(&s, "metrics.rates_hz.fast_client"), 20.0, 1e-9, "FC capped rate");
+    assert_within(num(&s, "metrics.analytic_latency_ms.fast.best"), 73.0, 1e-9, "FC best");
     // Waiting for the next 50 ms tick instead of the next 33 ms frame: 8.5 ms more on average.
     let a = "metrics.analytic_latency_ms.fast";
-    close(
+    assert_within(
         num(&s, &format!("{a}.phase_mean")) - num(&free, &format!("{a}.phase_mean")),
         8.5,
         1e-6,
@@ -359,10 +359,10 @@ fn a_rate_cap_makes_the_client_wait_for_its_next_tick() {
     // FC frames: one per 50 ms (the run covers the same simulated time).
     let frames = num(&s, "metrics.frames.fast_client");
     let free_frames = num(&free, "metrics.frames.fast_client");
-    close(frames / free_frames, 33.0 / 50.0, 0.05, "FC frames, capped vs free");
+    assert_within(frames / free_frames, 33.0 / 50.0, 0.05, "FC frames, capped vs free");
     // A slow-client cap: 186 ms frames on a 200 ms grid.
     let sc = summary(CLUSTER, &["run.events=500", "slow_client.rate=\"200ms\""]);
-    close(num(&sc, "metrics.rates_hz.slow_client"), 5.0, 1e-9, "SC capped rate");
+    assert_within(num(&sc, "metrics.rates_hz.slow_client"), 5.0, 1e-9, "SC capped rate");
     within(&sc, "slow");
     // Unset rates keep the paper's numbers (checked above); a bad rate is a clear error.
     let e = try_run(CLUSTER, &["fast_client.rate=\"fast\""]).unwrap_err();
@@ -373,10 +373,10 @@ fn a_rate_cap_makes_the_client_wait_for_its_next_tick() {
 fn network_bandwidth_units_pin_the_papers_mebibytes() {
     // The paper's "90 MB/s" are 2^20-byte MB: 10 MiB in 111 ms is written "90MiB/s".
     let mib = summary(CLUSTER, &["run.events=50", "network.bandwidth=\"90MiB/s\""]);
-    close(num(&mib, "metrics.terms_ms.transfer"), 111.111, 0.001, "90MiB/s");
+    assert_within(num(&mib, "metrics.terms_ms.transfer"), 111.111, 0.001, "90MiB/s");
     // The unit parser is SI: "90MB/s" is 90e6 B/s, and 10 MiB takes 116.5 ms.
     let si = summary(CLUSTER, &["run.events=50", "network.bandwidth=\"90MB/s\""]);
-    close(num(&si, "metrics.terms_ms.transfer"), 116.508, 0.001, "90MB/s");
+    assert_within(num(&si, "metrics.terms_ms.transfer"), 116.508, 0.001, "90MB/s");
 }
 
 #[test]
@@ -385,14 +385,14 @@ fn deferred_shading_moves_bytes_and_shading_to_the_fast_client() {
     let s = summary(CLUSTER, &["run.events=500", "deferred.enabled=true"]);
     // 144 bits instead of 64 per pixel: 2.25 times the bytes on every buffer term.
     assert_eq!(s["frame_bytes"].as_u64().unwrap(), 1280 * 1024 * 18);
-    close(
+    assert_within(
         num(&s, "metrics.terms_ms.transfer"),
         2.25 * num(&plain, "metrics.terms_ms.transfer"),
         0.01,
         "transfer",
     );
     // FC shades 4 lights x 1.31 Mpixel at 0.39 ns.
-    close(
+    assert_within(
         num(&s, "deferred_shading_ms"),
         4.0 * 1280.0 * 1024.0 * 0.39e-6,
         1e-6,
@@ -562,8 +562,8 @@ fn closed_forms_say_where_they_hold_with_stereo_on() {
         if sets.len() == 1 {
             // The issue's numbers: 985.9 ms simulated against 780.2 ms.
             assert!(max > phase_max, "{max} vs {phase_max}: the failing bound fails here");
-            close(phase_max, 780.2, 0.1, "keeps-up bound");
-            close(bound, 1002.4, 0.1, "bound that holds");
+            assert_within(phase_max, 780.2, 0.1, "keeps-up bound");
+            assert_within(bound, 1002.4, 0.1, "bound that holds");
         }
     }
     // Mono: everything holds and no caveat is given.

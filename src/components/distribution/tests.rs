@@ -33,7 +33,7 @@ fn all_kinds() -> Vec<Dist<f64>> {
     ]
 }
 
-fn close(a: f64, b: f64, rel: f64) -> bool {
+fn within_rel(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * b.abs().max(1e-9)
 }
 
@@ -47,9 +47,9 @@ fn sample_means_converge() {
         assert!(xs.iter().all(|x| *x >= 0.0 && x.is_finite()));
         let m = xs.iter().sum::<f64>() / n as f64;
         let v = xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n as f64;
-        assert!(close(m, d.mean(), 0.02), "{d:?}: mean {m} vs {}", d.mean());
+        assert!(within_rel(m, d.mean(), 0.02), "{d:?}: mean {m} vs {}", d.mean());
         if d.variance() > 0.0 {
-            assert!(close(v, d.variance(), 0.1), "{d:?}: var {v} vs {}", d.variance());
+            assert!(within_rel(v, d.variance(), 0.1), "{d:?}: var {v} vs {}", d.variance());
         } else {
             assert_eq!(v, 0.0);
         }
@@ -64,7 +64,7 @@ fn expected_max_matches_monte_carlo() {
         for a in [-1.0, 0.0, 0.5, 1.2, 2.0, 3.0, 6.0] {
             let mc = xs.iter().map(|x| x.max(a)).sum::<f64>() / xs.len() as f64;
             let cf = d.expected_max_with(a);
-            assert!(close(cf, mc, 0.02), "{d:?} a={a}: {cf} vs mc {mc}");
+            assert!(within_rel(cf, mc, 0.02), "{d:?} a={a}: {cf} vs mc {mc}");
             assert!(cf >= a && cf >= d.mean() - 1e-12);
         }
     }
@@ -120,9 +120,13 @@ fn heavy_tails_are_infinite() {
 fn scaled_scales_moments() {
     for d in all_kinds() {
         let s = d.scaled(3.0);
-        assert!(close(s.mean(), 3.0 * d.mean(), 1e-12));
-        assert!(close(s.variance(), 9.0 * d.variance(), 1e-12));
-        assert!(close(s.expected_max_with(6.0), 3.0 * d.expected_max_with(2.0), 1e-12));
+        assert!(within_rel(s.mean(), 3.0 * d.mean(), 1e-12));
+        assert!(within_rel(s.variance(), 9.0 * d.variance(), 1e-12));
+        assert!(within_rel(
+            s.expected_max_with(6.0),
+            3.0 * d.expected_max_with(2.0),
+            1e-12
+        ));
     }
 }
 

@@ -48,9 +48,6 @@ fn check_size(key: &str, s: &Size) -> Result<(), SystemError> {
 
 /// Checks what serde cannot.
 pub fn validate(cfg: &PixelFlowConfig) -> Result<(), SystemError> {
-    if cfg.system != "pixelflow" {
-        return Err(bad("system", format!("expected \"pixelflow\", got {:?}", cfg.system)));
-    }
     check_counts(cfg)?;
     check_sizes(cfg)?;
     check_regions(cfg)?;

@@ -25,7 +25,7 @@ fn analytic(sets: &[&str]) -> serde_json::Value {
     run_with(&all).unwrap().summary()["metrics"]["analytic"].clone()
 }
 
-fn close(a: f64, b: f64, tol: f64) {
+fn assert_within(a: f64, b: f64, tol: f64) {
     assert!((a - b).abs() <= tol, "{a} vs {b} (tolerance {tol})");
 }
 
@@ -34,9 +34,9 @@ fn overlap_factors_are_the_papers() {
     // (10+128)(10+64)/(128 x 64) = 1.2466 ("1.25"); 20 x 20 footprint under
     // 8-sample antialiasing: (148 x 84)/8192 = 1.5176 ("1.52").
     let a1 = analytic(&["samples=1"]);
-    close(a1["overlap"].as_f64().unwrap(), 10212.0 / 8192.0, 1e-12);
+    assert_within(a1["overlap"].as_f64().unwrap(), 10212.0 / 8192.0, 1e-12);
     let a8 = analytic(&["samples=8"]);
-    close(a8["overlap"].as_f64().unwrap(), 12432.0 / 8192.0, 1e-12);
+    assert_within(a8["overlap"].as_f64().unwrap(), 12432.0 / 8192.0, 1e-12);
     assert_eq!(a8["regions"], 40);
 }
 
@@ -54,16 +54,16 @@ fn standard_closed_form_by_hand() {
         "primitives=200000",
     ]);
     let g = |k: &str| a[k].as_f64().unwrap();
-    close(g("t_front_ms"), 24.766_666_7, 1e-6);
-    close(g("t_rast_ms"), 16.794_531_25, 1e-6);
-    close(g("t_comp_ms"), 1.0752, 1e-9);
-    close(g("t_shade_ms"), 1.104, 1e-9);
-    close(g("t_load_ms"), 2.08, 1e-9);
-    close(g("latency_ms"), 41.561_197_9, 1e-6);
+    assert_within(g("t_front_ms"), 24.766_666_7, 1e-6);
+    assert_within(g("t_rast_ms"), 16.794_531_25, 1e-6);
+    assert_within(g("t_comp_ms"), 1.0752, 1e-9);
+    assert_within(g("t_shade_ms"), 1.104, 1e-9);
+    assert_within(g("t_load_ms"), 2.08, 1e-9);
+    assert_within(g("latency_ms"), 41.561_197_9, 1e-6);
     // One shader: 18 rasterizers, shading 40 x 110.4 us = 4.416 ms.
     let a = analytic(&["shading_nodes=1", "primitives=0"]);
-    close(a["t_shade_ms"].as_f64().unwrap(), 4.416, 1e-9);
-    close(a["latency_ms"].as_f64().unwrap(), 0.1 + 4.416, 1e-9);
+    assert_within(a["t_shade_ms"].as_f64().unwrap(), 4.416, 1e-9);
+    assert_within(a["latency_ms"].as_f64().unwrap(), 0.1 + 4.416, 1e-9);
 }
 
 #[test]
@@ -79,10 +79,10 @@ fn presort_closed_form_by_hand() {
         "primitives=100000",
     ]);
     let g = |k: &str| a[k].as_f64().unwrap();
-    close(g("t_front_ms"), 4.211_111_1, 1e-6);
-    close(g("t_gen_ms"), 8.055_555_6, 1e-6);
-    close(g("t_rast_ms"), 0.83e-3 * 1e5 * (10212.0 / 8192.0) / 18.0, 1e-9);
-    close(g("latency_ms"), 12.266_666_7, 1e-6);
+    assert_within(g("t_front_ms"), 4.211_111_1, 1e-6);
+    assert_within(g("t_gen_ms"), 8.055_555_6, 1e-6);
+    assert_within(g("t_rast_ms"), 0.83e-3 * 1e5 * (10212.0 / 8192.0) / 18.0, 1e-9);
+    assert_within(g("latency_ms"), 12.266_666_7, 1e-6);
 }
 
 #[test]
@@ -92,15 +92,15 @@ fn nontex_closed_form_by_hand() {
     // t_comp = 40 x 7 x 1.28 us = 0.3584 ms; latency = 27.573684 + 2.08.
     let a = analytic(&["architecture=\"nontex\"", "samples=1", "primitives=600000"]);
     let g = |k: &str| a[k].as_f64().unwrap();
-    close(g("t_comp_ms"), 0.3584, 1e-9);
-    close(g("t_front_ms"), 27.573_684_2, 1e-6);
-    close(g("latency_ms"), 29.653_684_2, 1e-6);
+    assert_within(g("t_comp_ms"), 0.3584, 1e-9);
+    assert_within(g("t_front_ms"), 27.573_684_2, 1e-6);
+    assert_within(g("latency_ms"), 29.653_684_2, 1e-6);
     assert_eq!(a["rasterizers"], 19);
     // 8 samples, 100,000 primitives: max(4.678947, 4.067) + 7 (4.067 + 0.3584) + 2.08.
     let a = analytic(&["architecture=\"nontex\"", "samples=8", "primitives=100000"]);
     let rast = 0.62e-3 * 1e5 * (10212.0 / 8192.0) / 19.0;
     let front: f64 = 0.1 + 0.87e-3 * 1e5 / 19.0;
-    close(
+    assert_within(
         a["latency_ms"].as_f64().unwrap(),
         front.max(rast) + 7.0 * (rast + 0.3584) + 2.08,
         1e-9,
@@ -148,8 +148,8 @@ fn few_primitives_show_pipeline_fill_and_drain() {
     .unwrap();
     let ev = metric(&r, "latency_ms");
     let cf = metric(&r, "analytic_latency_ms");
-    close(cf, 4.516, 1e-9);
-    close(ev, 0.1 + 0.02688 + 4.416 + 0.00384 + 0.052, 1e-9);
+    assert_within(cf, 4.516, 1e-9);
+    assert_within(ev, 0.1 + 0.02688 + 4.416 + 0.00384 + 0.052, 1e-9);
 }
 
 #[test]
@@ -173,7 +173,7 @@ fn runs_are_deterministic_and_seeded() {
 fn random_placement_realises_the_overlap_factor() {
     let r = run_with(&["placement=\"random\"", "primitives=200000", "samples=1"]).unwrap();
     let realised = metric(&r, "realised_overlap");
-    close(realised, 10212.0 / 8192.0, 0.005);
+    assert_within(realised, 10212.0 / 8192.0, 0.005);
 }
 
 #[test]
@@ -205,7 +205,7 @@ fn node_skew_costs_what_the_busiest_node_would_alone() {
         let lat = metric(&skewed, "latency_ms");
         let want = metric(&heavier, "analytic_latency_ms");
         assert!((lat - want).abs() <= 0.01 * want, "{arch}/{shaders}: {lat} vs {want}");
-        close(
+        assert_within(
             metric(&skewed, "analytic_latency_ms"),
             metric(&balanced, "analytic_latency_ms"),
             1e-9,
@@ -269,10 +269,10 @@ fn standard_pipelines_frames_with_two_instruction_buffers() {
     let m = &r.summary()["metrics"];
     let first = m["frame_latency_ms"]["first"].as_f64().unwrap();
     let last = m["frame_latency_ms"]["last"].as_f64().unwrap();
-    close(first, metric(&r, "latency_ms"), 1e-12);
-    close(last, first, 1e-6);
+    assert_within(first, metric(&r, "latency_ms"), 1e-12);
+    assert_within(last, first, 1e-6);
     // (the slowest node has 13,334 primitives: 0.1 ms + 13334 x 1.85 us)
-    close(
+    assert_within(
         m["frame_interval_ms"]["mean"].as_f64().unwrap(),
         0.1 + 1.85e-3 * 13_334.0,
         1e-6,
@@ -286,7 +286,7 @@ fn standard_pipelines_frames_with_two_instruction_buffers() {
     let last = m["frame_latency_ms"]["last"].as_f64().unwrap();
     assert!(last > first + 1.0, "{first} {last}");
     // Steady state: one frame per back end (40 x 110.4 us of shading).
-    close(m["frame_interval_ms"]["last"].as_f64().unwrap(), 4.416, 0.01);
+    assert_within(m["frame_interval_ms"]["last"].as_f64().unwrap(), 4.416, 0.01);
     let (_, rows) = r.frame_table();
     assert_eq!(rows.len(), 6 * 40);
     // Presort does not pipeline frames: each frame's sorting pass follows the
