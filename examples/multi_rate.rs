@@ -44,7 +44,12 @@ fn check(system: &str, path: &str, r: &MultiRateRun) -> (f64, f64) {
         num(cf, "worst"),
         num(cf, "phase_mean")
     );
-    assert_eq!(cf["holds"], Value::Bool(true), "{system} {path}: {}", m["closed_form_caveats"]);
+    assert_eq!(
+        cf["holds"],
+        Value::Bool(true),
+        "{system} {path}: {}",
+        m["closed_form_caveats"]
+    );
     // Every event within the bounds over all phases (1 us of rounding).
     assert!(min >= num(cf, "phase_min") - 1e-3 && max <= num(cf, "bound_max") + 1e-3);
     // 5000 events at random phases average to the phase mean (the tracker's

@@ -58,7 +58,10 @@ fn main() {
         // closed form leaves out, and drains the pipeline's last regions.
         let colour = e.summary["metrics"]["stages_ms"]["color"].as_f64().unwrap();
         assert!((colour - 0.1536).abs() < 1e-9);
-        assert!(sim > closed && sim - closed < colour + 0.06, "{n} primitives: {sim} vs {closed}");
+        assert!(
+            sim > closed && sim - closed < colour + 0.06,
+            "{n} primitives: {sim} vs {closed}"
+        );
         fronts.push((n, front, bound));
     }
     assert_eq!((fronts[0].2, fronts[3].2), ("load", "rasterize"));
@@ -67,5 +70,8 @@ fn main() {
     let slope = (fronts[3].1 - fronts[0].1) / (fronts[3].0 - fronts[0].0) as f64;
     assert!((slope - 0.00185 / 15.0).abs() < 1e-12);
     assert!((fronts[0].1 - 10_000.0 * slope - 0.1).abs() < 1e-9);
-    println!("front end: 0.1 ms + {:.4} us per primitive (t_trans 1.85 us over 15 rasterizers)", 1000.0 * slope);
+    println!(
+        "front end: 0.1 ms + {:.4} us per primitive (t_trans 1.85 us over 15 rasterizers)",
+        1000.0 * slope
+    );
 }

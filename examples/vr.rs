@@ -40,10 +40,14 @@ fn check(scheme: &str, motion: &str, s: &Value) -> f64 {
         f(cf, "best")
     );
     // Every motion lies within the bounds over all phases (1 us of rounding).
-    assert!(min >= lo - 1e-3 && max <= hi + 1e-3, "{scheme} {motion} outside its bounds");
-    // The mean adds the tracker's sampling delay (up to one 5 ms period) to
-    // the closed form's phase average.
-    assert!(mean >= cf_mean - 0.5 && mean <= cf_mean + 5.0, "{scheme} {motion}: {mean} vs {cf_mean}");
+    assert!(
+        min >= lo - 1e-3 && max <= hi + 1e-3,
+        "{scheme} {motion} outside its bounds"
+    );
+    // The mean of 5000 motions lies within 3 ms of the closed form's
+    // average over phases, which takes every phase as independent and
+    // uniform (0.7 to 2.7 ms above it here); the bounds are the guarantee.
+    assert!((mean - cf_mean).abs() < 3.0, "{scheme} {motion}: {mean} vs {cf_mean}");
     mean
 }
 
@@ -64,5 +68,9 @@ fn main() {
     // motion still waits for a 20 Hz application frame.
     assert!(warp_head * 3.0 < naive_head);
     assert!(warp_head < warp_object && warp_object < naive_object);
-    println!("warping: head motion {:.1}x faster, object motion {:.1}x faster", naive_head / warp_head, naive_object / warp_object);
+    println!(
+        "warping: head motion {:.1}x faster, object motion {:.1}x faster",
+        naive_head / warp_head,
+        naive_object / warp_object
+    );
 }
