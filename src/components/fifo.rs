@@ -21,6 +21,31 @@ pub enum FifoUnit {
 }
 
 /// A bounded FIFO of `T`, each entry with a weight (1 entry or its bytes).
+///
+/// A producer checks [`BoundedFifo::can_push`] before each push and blocks
+/// while it is false; an entry larger than the capacity still enters an
+/// empty FIFO.
+///
+/// ```
+/// use rendersim::components::fifo::BoundedFifo;
+///
+/// // A command buffer of 1000 bytes.
+/// let mut fifo = BoundedFifo::new(1000);
+/// fifo.push("draw 1", 400);
+/// fifo.push("draw 2", 400);
+/// assert_eq!(fifo.used(), 800);
+/// assert!(!fifo.can_push(400)); // 1200 > 1000: the driver blocks
+/// assert_eq!(fifo.pop(), Some("draw 1")); // oldest first
+/// assert!(fifo.can_push(400));
+/// fifo.push("draw 3", 400);
+/// assert_eq!((fifo.len(), fifo.used(), fifo.max_used()), (2, 800, 800));
+///
+/// // A 5000-byte entry enters only an empty FIFO, and holds its producer.
+/// let mut big = BoundedFifo::new(1000);
+/// assert!(big.can_push(5000));
+/// big.push("texture upload", 5000);
+/// assert!(big.over_capacity());
+/// ```
 #[derive(Debug, Clone)]
 pub struct BoundedFifo<T> {
     items: VecDeque<(T, u64)>,

@@ -40,6 +40,33 @@ pub enum Arrivals {
 }
 
 /// One source of system tasks, with its own RNG stream.
+///
+/// The scheduler tick of paper 000 §4.2 as a periodic source: a 0.5 ms task
+/// every 35 ms from 5 ms on (no jitter), so its arrivals are 5, 40, 75 ms.
+///
+/// ```
+/// use rendersim::components::distribution::Dist;
+/// use rendersim::components::noise::{Arrivals, NoiseSource, NoiseTarget};
+/// use rendersim::engine::{Duration, RngStreams, Time};
+///
+/// let arrivals = Arrivals::Periodic { period: Duration::ms(35), phase: Duration::ms(5), jitter: Duration::ZERO };
+/// let duration = Dist::constant(Duration::us(500));
+/// let rng = RngStreams::new(1).stream("scheduler");
+/// let mut tick = NoiseSource::new("scheduler".into(), NoiseTarget::Cpu, arrivals, duration, rng).unwrap();
+/// let mut t = Time::ZERO;
+/// let mut at_ms = Vec::new();
+/// for _ in 0..3 {
+///     t = tick.next_arrival(t).unwrap();
+///     at_ms.push(t.as_ms_f64());
+/// }
+/// assert_eq!(at_ms, [5.0, 40.0, 75.0]);
+/// assert_eq!(tick.draw_duration(), Duration::us(500));
+///
+/// // A task longer than its period would never let the unit run: refused.
+/// let busy = Arrivals::Periodic { period: Duration::ms(1), phase: Duration::ZERO, jitter: Duration::ZERO };
+/// let rng = RngStreams::new(1).stream("busy");
+/// assert!(NoiseSource::new("busy".into(), NoiseTarget::Gpu, busy, Dist::constant(Duration::ms(2)), rng).is_err());
+/// ```
 #[derive(Debug, Clone)]
 pub struct NoiseSource {
     /// Name (also names its RNG stream).

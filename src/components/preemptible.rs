@@ -12,6 +12,31 @@ use std::collections::VecDeque;
 use crate::engine::{Duration, Time, TimeError};
 
 /// A preemptible processor.
+///
+/// A 10 ms job started at 0 is preempted by a 3 ms system task at 4 ms: the
+/// completion event scheduled for 10 ms goes stale, and the job resumes when
+/// the task ends, finishing at 13 ms, 3 ms late.
+///
+/// ```
+/// use rendersim::components::preemptible::{Preemptible, Wake};
+/// use rendersim::engine::{Duration, Time};
+///
+/// let ms = |v| Time(Duration::ms(v).0);
+/// let mut cpu = Preemptible::new();
+/// let Wake::JobAt(end, stale) = cpu.start_job(ms(0), Duration::ms(10)).unwrap() else { panic!() };
+/// assert_eq!(end, ms(10));
+/// // The task starts at once and ends at 7 ms.
+/// assert_eq!(cpu.task_arrives(ms(4), Duration::ms(3)).unwrap(), Some(ms(7)));
+/// assert!(cpu.in_system());
+/// // The job's remaining 6 ms resume at 7 ms, under a new tag.
+/// let (next_task, wake) = cpu.task_ends(ms(7)).unwrap();
+/// assert_eq!(next_task, None);
+/// let Wake::JobAt(end, tag) = wake else { panic!() };
+/// assert_eq!(end, ms(13));
+/// assert!(!cpu.complete(stale)); // the 10 ms completion is ignored
+/// assert!(cpu.complete(tag));
+/// assert!(!cpu.has_job());
+/// ```
 #[derive(Debug, Clone, Default)]
 pub struct Preemptible {
     /// Remaining work of the current job, when suspended or not yet started.

@@ -94,6 +94,35 @@ struct Slot {
 }
 
 /// The pool: `cores` cores, a policy, and the item each stream serves.
+///
+/// A vertex item of 10 us of whole-pool work starts alone at 0; at 4 us a
+/// fragment item of 3 us arrives and the fair policy halves each stream's
+/// speed. The fragment item ends at 10 us (3 us of work at half speed), the
+/// vertex item, alone again, at 13 us: the work adds up, 10 + 3.
+///
+/// ```
+/// use rendersim::components::shader_pool::{Scheduling, ShaderPool, Stream};
+/// use rendersim::engine::{Duration, Time};
+///
+/// let us = |v| Time(Duration::us(v).0);
+/// let mut pool = ShaderPool::new(4, Scheduling::Fair);
+/// pool.begin(us(0), Stream::Vertex, Duration::us(10), Duration::ZERO).unwrap();
+/// let due: Vec<_> = pool.settle(us(0)).unwrap().iter().map(|d| (d.stream, d.at)).collect();
+/// assert_eq!(due, [(Stream::Vertex, us(10))]);
+///
+/// pool.begin(us(4), Stream::Fragment, Duration::us(3), Duration::ZERO).unwrap();
+/// let due: Vec<_> = pool.settle(us(4)).unwrap().iter().map(|d| (d.stream, d.at)).collect();
+/// // Vertex: 6 us of work left at half speed; fragment: 3 us at half speed.
+/// assert_eq!(due, [(Stream::Vertex, us(16)), (Stream::Fragment, us(10))]);
+///
+/// pool.end(us(10), Stream::Fragment);
+/// let moved = pool.settle(us(10)).unwrap();
+/// let vertex = moved.iter().next().unwrap();
+/// assert_eq!((vertex.stream, vertex.at), (Stream::Vertex, us(13)));
+/// assert!(pool.is_current(Stream::Vertex, vertex.tag)); // the 16 us event is stale
+/// pool.end(us(13), Stream::Vertex);
+/// assert_eq!(pool.work_done(), Duration::us(13));
+/// ```
 #[derive(Debug, Clone)]
 pub struct ShaderPool {
     cores: u64,

@@ -6,6 +6,25 @@ use crate::engine::{Duration, Time};
 
 /// Accumulates time per state for one unit. `N` is the number of states;
 /// states are given as indices (`state as usize`).
+///
+/// A GPU idle until 2 ms, busy until 7 ms, idle again: at 10 ms it was busy
+/// 5 ms and idle 5 ms, and the totals add up to the elapsed 10 ms.
+///
+/// ```
+/// use rendersim::components::state_clock::StateClock;
+/// use rendersim::engine::{Duration, Time};
+///
+/// const IDLE: usize = 0;
+/// const BUSY: usize = 1;
+/// let ms = |v| Time(Duration::ms(v).0);
+/// let mut gpu = StateClock::<2>::new(IDLE);
+/// assert_eq!(gpu.set(ms(2), BUSY), Duration::ms(2)); // 2 ms idle ended
+/// assert_eq!(gpu.set(ms(2), BUSY), Duration::ZERO); // no change, nothing happens
+/// assert_eq!(gpu.set(ms(7), IDLE), Duration::ms(5));
+/// let totals = gpu.totals_at(ms(10));
+/// assert_eq!(totals, [Duration::ms(5).0, Duration::ms(5).0]); // picoseconds
+/// assert_eq!(totals.iter().sum::<u64>(), ms(10).0);
+/// ```
 #[derive(Debug, Clone)]
 pub struct StateClock<const N: usize> {
     state: usize,

@@ -101,6 +101,34 @@ impl Default for DisplayConfig {
 pub type FrameId = u64;
 
 /// The images and what is on screen.
+///
+/// The renderer [`acquire`](SwapChain::acquire)s a free image, renders and
+/// [`present`](SwapChain::present)s it; the display shows it at a
+/// [`vblank`](SwapChain::vblank) (or at once in `immediate` mode). With two
+/// buffers and `fifo`, one image is on screen and one is rendered into, so
+/// the renderer waits for every vertical blank:
+///
+/// ```
+/// use rendersim::components::swap_chain::{PresentMode, SwapChain};
+///
+/// let mut chain = SwapChain::new(2, PresentMode::Fifo);
+/// assert!(chain.acquire()); // the back buffer
+/// assert!(!chain.acquire()); // the other image is the (blank) front
+/// chain.present(0);
+/// assert_eq!(chain.queued(), 1);
+/// let flip = chain.vblank();
+/// assert_eq!((flip.shown, flip.freed), (Some(0), true));
+/// assert_eq!(chain.front(), Some(0));
+/// assert!(chain.acquire()); // the old front image is free again
+///
+/// // Mailbox with three images: a newer frame replaces a queued one.
+/// let mut mailbox = SwapChain::new(3, PresentMode::Mailbox);
+/// assert!(mailbox.acquire());
+/// mailbox.present(0);
+/// assert!(mailbox.acquire());
+/// assert_eq!(mailbox.present(1).dropped, Some(0)); // never shown
+/// assert_eq!(mailbox.vblank().shown, Some(1));
+/// ```
 #[derive(Debug, Clone)]
 pub struct SwapChain {
     mode: PresentMode,

@@ -86,6 +86,27 @@ pub fn analyze_triangle_list(
 }
 
 /// A simulated post-transform vertex cache.
+///
+/// Two triangles sharing an edge transform 4 vertices through any cache,
+/// 6 without one. Through a FIFO of 3, a triangle of new vertices pushes the
+/// first one's out: drawing it again transforms all three again; a FIFO of
+/// 6 keeps them.
+///
+/// ```
+/// use rendersim::components::vertex_cache::{CachePolicy, VertexCache};
+///
+/// let transformed = |policy: &str, tris: &[[u32; 3]]| {
+///     let policy: CachePolicy = policy.parse().unwrap();
+///     let mut cache = VertexCache::new(&policy, 8);
+///     tris.iter().map(|&t| u64::from(cache.access_triangle(t))).sum::<u64>()
+/// };
+/// let quad = [[0, 1, 2], [2, 1, 3]];
+/// assert_eq!(transformed("fifo:3", &quad), 4);
+/// assert_eq!(transformed("none", &quad), 6);
+/// let again = [[0, 1, 2], [3, 4, 5], [0, 1, 2]];
+/// assert_eq!(transformed("fifo:3", &again), 9);
+/// assert_eq!(transformed("fifo:6", &again), 6);
+/// ```
 #[derive(Clone, Debug)]
 pub struct VertexCache {
     policy: CachePolicy,

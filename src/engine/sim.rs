@@ -47,6 +47,58 @@ pub enum EngineError {
 }
 
 /// A simulated system driven by the loop.
+///
+/// A model handles its own event enum; [`run`] hands it the events in
+/// `(time, seq)` order: by time, and events due at the same time in the
+/// order they were scheduled.
+///
+/// ```
+/// use rendersim::engine::{run, Control, Duration, EngineError, EventKind, Limits, Model, Scheduler, StopReason, Time};
+///
+/// enum Ev {
+///     Start,
+///     Job(&'static str),
+/// }
+/// impl EventKind for Ev {
+///     const NAMES: &'static [&'static str] = &["start", "job"];
+///     fn kind(&self) -> usize {
+///         match self {
+///             Ev::Start => 0,
+///             Ev::Job(_) => 1,
+///         }
+///     }
+/// }
+///
+/// /// Writes down when each job ran.
+/// struct Log(Vec<(u64, &'static str)>);
+/// impl Model for Log {
+///     type Event = Ev;
+///     type Error = EngineError;
+///     fn handle(&mut self, now: Time, e: Ev, s: &mut Scheduler<Ev>) -> Result<Control, EngineError> {
+///         match e {
+///             Ev::Start => {
+///                 // Three jobs 5 ns from now, scheduled b, a, c; one at 2 ns.
+///                 for name in ["b", "a", "c"] {
+///                     s.after(Duration::ns(5), Ev::Job(name), "a job")?;
+///                 }
+///                 s.after(Duration::ns(2), Ev::Job("early"), "a job")?;
+///             }
+///             Ev::Job(name) => self.0.push((now.0 / 1000, name)),
+///         }
+///         Ok(Control::Continue)
+///     }
+/// }
+///
+/// let mut log = Log(Vec::new());
+/// let mut sched = Scheduler::new();
+/// sched.at(Time::ZERO, Ev::Start);
+/// let stats = run(&mut log, &mut sched, Limits::default()).unwrap();
+/// // Earliest first; the three at 5 ns in the order they were scheduled.
+/// assert_eq!(log.0, [(2, "early"), (5, "b"), (5, "a"), (5, "c")]);
+/// assert_eq!((stats.events, stats.by_kind.clone()), (5, vec![1, 4]));
+/// assert_eq!(stats.stopped_by, StopReason::Exhausted);
+/// assert_eq!(stats.end_time, Time(5_000)); // picoseconds
+/// ```
 pub trait Model {
     /// The system's event type.
     type Event: EventKind;
@@ -62,6 +114,21 @@ pub trait Model {
 }
 
 /// The model's handle on the future: schedule events relative to now.
+///
+/// [`Scheduler::at`] takes an absolute time, [`Scheduler::after`] a delay
+/// from [`Scheduler::now`] and returns when the event is due. Outside a run
+/// the clock stands at zero; [`run`] advances it to each event it pops.
+///
+/// ```
+/// use rendersim::engine::{Duration, Scheduler, Time};
+///
+/// let mut sched: Scheduler<&str> = Scheduler::new();
+/// assert_eq!(sched.now(), Time::ZERO);
+/// let due = sched.after(Duration::us(3), "vblank", "the first vblank").unwrap();
+/// assert_eq!(due, Time(3_000_000)); // 3 us in picoseconds
+/// sched.at(Time(10), "input");
+/// assert_eq!(sched.pending(), 2);
+/// ```
 #[derive(Debug)]
 pub struct Scheduler<E> {
     queue: EventQueue<E>,

@@ -322,6 +322,24 @@ impl Waste {
 /// Runs `strategy` over `seq` with a buffer of `k` slots. `seed` is the
 /// master seed of the random strategy's stream; `record` keeps the runs
 /// sent.
+///
+/// Alternating states `0 1 0 1 0 1`: one slot reorders nothing (6 changes,
+/// the input's runs); six slots hold the whole sequence, and the one
+/// overflow when they are full sends the three 0s (LRU: the older stamp),
+/// the final flush the three 1s: 2 changes, the number of distinct states,
+/// which no buffer beats.
+///
+/// ```
+/// use rendersim::components::sorting_buffer::{input_runs, lower_bound, simulate, Strategy};
+///
+/// let seq = [0, 1, 0, 1, 0, 1];
+/// assert_eq!(input_runs(&seq), 6);
+/// assert_eq!(simulate(&seq, 1, Strategy::Lru, 1, false).unwrap().state_changes, 6);
+/// let all = simulate(&seq, 6, Strategy::Lru, 1, true).unwrap();
+/// assert_eq!((all.state_changes, all.overflows), (2, 1));
+/// assert_eq!(all.output.unwrap(), [(0, 3), (1, 3)]);
+/// assert!(lower_bound(&seq, 6) <= 2);
+/// ```
 pub fn simulate(
     seq: &[StateId],
     k: usize,
