@@ -106,7 +106,7 @@ pub fn run_pipeline(
     }
     let mut summary = to_json(&summarize(&model, &stats, analytic, scene_stats, build_seconds));
     positive_zeros(&mut summary);
-    let refresh = model.refresh;
+    let refresh = model.display.refresh();
     let end = stats.end_time;
     let a = &model.acct;
     let clocks = ClockTotals {

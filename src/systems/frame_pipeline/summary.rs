@@ -243,13 +243,14 @@ pub(super) fn summarize(
     let bott = m.acct.path.totals_at(end, m.done());
     let displayed = m.records.iter().skip(warm).filter(|r| r.displayed.is_some()).count();
     let dropped = m.records.iter().skip(warm).filter(|r| r.dropped).count();
-    let (mark_vblanks, mark_repeated, mark_time) = m.refresh_mark.unwrap_or((0, 0, crate::engine::Time::ZERO));
-    let refreshes = if m.chain.mode() == crate::components::swap_chain::PresentMode::Immediate {
-        end.0 / m.refresh.0 - mark_time.0 / m.refresh.0
+    let (mark_vblanks, mark_repeated, mark_time) =
+        m.display.refresh_mark().unwrap_or((0, 0, crate::engine::Time::ZERO));
+    let refreshes = if m.links.chain.mode() == crate::components::swap_chain::PresentMode::Immediate {
+        end.0 / m.display.refresh().0 - mark_time.0 / m.display.refresh().0
     } else {
-        m.vblanks - mark_vblanks
+        m.display.vblanks() - mark_vblanks
     };
-    let repeated = m.repeated_refreshes - mark_repeated;
+    let repeated = m.display.repeated_refreshes() - mark_repeated;
     let (issued, executed) = m.command_counts();
     PipelineSummary {
         system: "frame_pipeline",
@@ -303,7 +304,7 @@ pub(super) fn summarize(
             commands: CommandCounts {
                 issued,
                 executed,
-                fifo_max_used: m.fifo.max_used(),
+                fifo_max_used: m.links.commands.max_used(),
             },
             analytic,
         },
