@@ -464,11 +464,7 @@ impl DisplayConfig {
     /// `vsync` is off. The one place this rule is written: every system and
     /// study that reads a `[display]` asks here.
     pub fn effective_mode(&self) -> PresentMode {
-        if self.vsync {
-            self.present_mode
-        } else {
-            PresentMode::Immediate
-        }
+        if self.vsync { self.present_mode } else { PresentMode::Immediate }
     }
 
     /// Whether presented frames wait for a vertical blank (`fifo` or
