@@ -428,6 +428,7 @@ impl Accounting {
     /// `cpu_moved`: whether the CPU may have taken a step at this instant;
     /// when it did not, its state and mode are what the last accounted
     /// instant left, and its part is skipped.
+    #[inline(always)]
     pub(super) fn account_draw_handoff(
         &mut self,
         now: Time,

@@ -321,6 +321,7 @@ impl CpuThread {
     /// frame or a rendezvous needs the full accounting. Returns `None`
     /// otherwise, with at most the thread's step taken, which `settle` then
     /// repeats as a no-op before the front end's.
+    #[inline(always)]
     pub(super) fn step_alone(
         &mut self,
         now: Time,
@@ -350,7 +351,7 @@ impl CpuThread {
     /// the phase. Returns `None`, having changed nothing, in every other
     /// case (the general path runs): a fixed workload, the next operation
     /// without work, a FIFO the batch would overfill.
-    #[inline]
+    #[inline(always)]
     pub(super) fn draw_done_fast(
         &mut self,
         now: Time,
@@ -427,7 +428,7 @@ impl CpuThread {
 
     /// Advances the thread as far as it can go now. Returns whether
     /// anything changed.
-    #[inline]
+    #[inline(always)]
     pub(super) fn step(&mut self, now: Time, env: &mut Env<'_>, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         // At rest while an operation runs or too many frames are in flight
         // (most events find it so), and for good once finished or waiting

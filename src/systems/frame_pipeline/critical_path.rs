@@ -284,7 +284,7 @@ impl CriticalPath {
     }
 
     /// Carries `u`'s path to `now` under its current mode.
-    #[inline]
+    #[inline(always)]
     fn materialize(&mut self, u: usize, now: Time) {
         let (w, b) = self.source(u);
         let add = now.since(self.since[w]).0;

@@ -125,7 +125,7 @@ impl Links {
 /// is written (which turns the short cuts off).
 pub(super) struct Env<'a> {
     pub(super) cfg: &'a FramePipelineConfig,
-    pub(super) scene: Option<&'a SceneProgram>,
+    pub(super) scene: &'a Option<SceneProgram>,
     pub(super) links: &'a mut Links,
     pub(super) records: &'a mut Vec<FrameRecord>,
     pub(super) traced: bool,
@@ -142,7 +142,7 @@ pub(super) fn draw_batch_weight(unit: FifoUnit, d: &DrawItem) -> u64 {
 }
 
 /// The weight of a command in the FIFO's unit.
-pub(super) fn command_weight(cfg: &FramePipelineConfig, scene: Option<&SceneProgram>, c: &Command) -> u64 {
+pub(super) fn command_weight(cfg: &FramePipelineConfig, scene: &Option<SceneProgram>, c: &Command) -> u64 {
     let unit = cfg.command_fifo.unit;
     let b = &cfg.command_fifo.bytes;
     match (unit, c) {
@@ -156,9 +156,9 @@ pub(super) fn command_weight(cfg: &FramePipelineConfig, scene: Option<&SceneProg
 
 /// Commands in a FIFO entry (a draw batch holds its state changes and
 /// upload with the draw).
-pub(super) fn command_count(scene: Option<&SceneProgram>, c: &Command) -> u64 {
+pub(super) fn command_count(scene: &Option<SceneProgram>, c: &Command) -> u64 {
     match c {
-        Command::Draw { draw, .. } => scene.map(|s| s.draws[*draw as usize].commands as u64).unwrap_or(1),
+        Command::Draw { draw, .. } => scene.as_ref().map(|s| s.draws[*draw as usize].commands as u64).unwrap_or(1),
         _ => 1,
     }
 }

@@ -137,6 +137,8 @@ pub struct FramePipeline {
     noise: Vec<NoiseSource>,
     pub(super) records: Vec<FrameRecord>,
     pub(super) acct: Accounting,
+    /// Whether a trace is written (which turns the short cuts off).
+    pub(super) traced: bool,
 }
 
 /// What a unit's transition gets of `$p` (a [`FramePipeline`]): an [`Env`].
@@ -144,10 +146,10 @@ macro_rules! pipeline_env {
     ($p:ident) => {
         super::links::Env {
             cfg: &$p.cfg,
-            scene: $p.scene.as_ref(),
+            scene: &$p.scene,
             links: &mut $p.links,
             records: &mut $p.records,
-            traced: $p.acct.trace.is_some(),
+            traced: $p.traced,
         }
     };
 }
@@ -274,6 +276,7 @@ impl FramePipeline {
             frames_total,
             noise,
             records: Vec::with_capacity(frames_total.min(1 << 16) as usize),
+            traced: trace.is_some(),
             acct: Accounting::new(
                 trace,
                 (mode != PresentMode::Immediate).then_some(cfg.display.refresh.period),
@@ -402,7 +405,7 @@ impl FramePipeline {
     /// any other operation's [`CpuThread::step_alone`].
     #[inline(always)]
     fn cpu_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
-        let alone = self.acct.trace.is_none() && self.front.phase() != FrontPhase::Idle;
+        let alone = !self.traced && self.front.phase() != FrontPhase::Idle;
         let mut env = pipeline_env!(self);
         if alone && let Some(a) = self.cpu.draw_done_fast(now, &mut env, s)? {
             self.account_cpu_alone(now, a);

@@ -71,7 +71,7 @@ impl FramePipeline {
             return;
         }
         debug_assert!(self.geom.done_at().is_some_and(|d| d > at));
-        if self.acct.trace.is_some() {
+        if self.traced {
             self.account(at);
             return;
         }
@@ -91,7 +91,7 @@ impl FramePipeline {
     #[inline]
     pub(super) fn draw_done_alone(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         if self.front.phase() != FrontPhase::Handoff
-            || self.acct.trace.is_some()
+            || self.traced
             || self.front.in_system()
             || self.cfg.gpu.fragment.binned()
         {
