@@ -14,8 +14,8 @@ use crate::components::preemptible::{Preemptible, Wake};
 use crate::engine::{Duration, Scheduler, StreamRng, Time};
 use crate::systems::error::SystemError;
 
+use super::events::Ev;
 use super::links::{Command, Env, command_count, command_weight, draw_batch_weight};
-use super::model::Ev;
 use super::records::FrameRecord;
 
 /// What the CPU thread is doing. The phases carry no data (the command
@@ -321,7 +321,6 @@ impl CpuThread {
     /// frame or a rendezvous needs the full accounting. Returns `None`
     /// otherwise, with at most the thread's step taken, which `settle` then
     /// repeats as a no-op before the front end's.
-    #[inline(always)]
     pub(super) fn step_alone(
         &mut self,
         now: Time,

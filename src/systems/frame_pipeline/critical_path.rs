@@ -267,7 +267,7 @@ impl CriticalPath {
     /// work is charged to (as indices): `u`'s path now is that unit's path
     /// carried to now. A cycle is closed by the unit met twice, charged for
     /// itself.
-    #[inline]
+    #[inline(always)]
     fn source(&self, mut u: usize) -> (usize, usize) {
         let mut visiting = 0u8;
         loop {

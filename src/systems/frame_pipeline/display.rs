@@ -13,7 +13,7 @@ use crate::engine::{Duration, Scheduler, Time};
 use crate::systems::error::SystemError;
 
 use super::critical_path::CriticalPath;
-use super::model::Ev;
+use super::events::Ev;
 use super::records::FrameRecord;
 
 /// The display.

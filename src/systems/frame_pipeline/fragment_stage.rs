@@ -14,9 +14,9 @@ use crate::components::shader_pool::{ShaderPool, Stream};
 use crate::engine::{Scheduler, Time};
 use crate::systems::error::SystemError;
 
+use super::events::Ev;
 use super::geometry_stage::GeometryStage;
 use super::links::{Env, FragWork};
-use super::model::Ev;
 
 /// The fragment stage.
 #[derive(Debug, Default)]

@@ -17,10 +17,10 @@ use crate::systems::error::SystemError;
 
 use super::critical_path::CriticalPath;
 use super::display::Display;
+use super::events::Ev;
 use super::fragment_stage::FragmentStage;
 use super::geometry_stage::GeometryStage;
 use super::links::{Command, Env, command_count};
-use super::model::Ev;
 
 /// What the GPU front end is doing (its command is its own, see
 /// [`FrontEnd::describe`]).

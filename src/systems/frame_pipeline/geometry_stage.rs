@@ -22,9 +22,9 @@ use crate::systems::error::SystemError;
 
 use super::closed_form::DrawTimes;
 use super::config::{Fidelity, GeometryConfig};
+use super::events::Ev;
 use super::fragment_stage::FragmentStage;
 use super::links::{Env, FragWork};
-use super::model::Ev;
 use super::workload::{closed_times, ordered_sizes};
 
 /// The geometry stage's time for some work: its vertex-shader part and the

@@ -16,7 +16,7 @@ use crate::engine::{Duration, Scheduler, Time};
 use crate::systems::error::SystemError;
 
 use super::config::FramePipelineConfig;
-use super::model::Ev;
+use super::events::Ev;
 use super::records::FrameRecord;
 use super::workload::{DrawItem, SceneProgram};
 
@@ -158,7 +158,10 @@ pub(super) fn command_weight(cfg: &FramePipelineConfig, scene: &Option<SceneProg
 /// upload with the draw).
 pub(super) fn command_count(scene: &Option<SceneProgram>, c: &Command) -> u64 {
     match c {
-        Command::Draw { draw, .. } => scene.as_ref().map(|s| s.draws[*draw as usize].commands as u64).unwrap_or(1),
+        Command::Draw { draw, .. } => scene
+            .as_ref()
+            .map(|s| s.draws[*draw as usize].commands as u64)
+            .unwrap_or(1),
         _ => 1,
     }
 }

@@ -8,6 +8,7 @@
 //!   the order of the data flow);
 //! - `cpu_thread`, `front_end`, `geometry_stage`, `fragment_stage`,
 //!   `display`: the units, each owning its state and transitions;
+//! - `events`: the event enum the units schedule;
 //! - `links`: what the units share (the command and triangle FIFOs, the
 //!   shader pool, the swap chain), passed to their methods;
 //! - `closed_form`: the `draw`-fidelity formula;
@@ -30,6 +31,7 @@ pub mod config;
 mod cpu_thread;
 pub mod critical_path;
 mod display;
+mod events;
 mod fragment_stage;
 mod front_end;
 mod geometry_stage;

@@ -11,7 +11,8 @@
 //! fragment stages (`geometry_stage.rs`, `fragment_stage.rs`) and the
 //! display (`display.rs`); the FIFOs, the shader pool and the swap chain
 //! between them are the [`Links`] (`links.rs`), passed to the units'
-//! methods. [`FramePipeline`] holds the units, dispatches each event to the
+//! methods; the events they schedule are [`Ev`] (`events.rs`).
+//! [`FramePipeline`] holds the units, dispatches each event to the
 //! unit it concerns, then lets the units take their steps in the order the
 //! data flows ([`FramePipeline::settle`]) and has the instant accounted
 //! (`accounting.rs`, which reads the units through an immutable view).
@@ -20,7 +21,7 @@ use crate::components::fifo::BoundedFifo;
 use crate::components::noise::{Arrivals, NoiseSource, NoiseTarget};
 use crate::components::shader_pool::{ShaderPool, Stream};
 use crate::components::swap_chain::{PresentMode, SwapChain};
-use crate::engine::{Control, EventKind, Model, RngStreams, Scheduler, Time};
+use crate::engine::{Control, Model, RngStreams, Scheduler, Time};
 use crate::systems::error::SystemError;
 
 use super::accounting::{Accounting, Units};
@@ -35,91 +36,10 @@ use super::records::FrameRecord;
 use super::workload::SceneProgram;
 
 pub use super::cpu_thread::CpuPhase;
+pub use super::events::Ev;
 pub use super::front_end::FrontPhase;
 pub use super::geometry_stage::ActiveDraw;
 pub use super::links::{Command, FragWork};
-
-/// Events of the frame pipeline.
-#[derive(Debug, Clone, Copy)]
-pub enum Ev {
-    /// The CPU thread's current work item finished (tag guards preemption).
-    CpuDone {
-        /// Generation tag.
-        tag: u32,
-    },
-    /// The GPU front end's current command finished.
-    FrontDone {
-        /// Generation tag.
-        tag: u32,
-    },
-    /// The geometry stage finished a triangle (`triangle` fidelity; the tag
-    /// guards the unified pool's rescheduling, 0 when split).
-    GeomTriangle {
-        /// Generation tag.
-        tag: u32,
-    },
-    /// The fragment stage finished a triangle (`triangle` fidelity; tagged
-    /// as [`Ev::GeomTriangle`]).
-    FragTriangle {
-        /// Generation tag.
-        tag: u32,
-    },
-    /// The geometry part of a draw ended (`draw` fidelity).
-    DrawGeometry,
-    /// The fragment part of a draw began (`draw` fidelity).
-    DrawFragmentStart,
-    /// A draw ended (`draw` fidelity).
-    DrawDone,
-    /// Vertical blank.
-    Vblank,
-    /// A system task arrives.
-    NoiseArrive {
-        /// Index of the noise source.
-        source: u16,
-    },
-    /// The running system task on a unit ends.
-    NoiseEnd {
-        /// Which unit.
-        target: NoiseTarget,
-    },
-    /// The CPU thread starts a frame at the instant where more frames
-    /// started than could be in flight, so frames take no time: each such
-    /// frame goes through the run loop as an event, and `run.max_events`
-    /// holds for it (scheduled only for zero-time frames).
-    ZeroTimeFrame,
-}
-
-impl EventKind for Ev {
-    const NAMES: &'static [&'static str] = &[
-        "cpu_work",
-        "gpu_front_end",
-        "geometry_triangle",
-        "fragment_triangle",
-        "draw_geometry",
-        "draw_fragment_start",
-        "draw_done",
-        "vblank",
-        "noise_arrival",
-        "noise_end",
-        "zero_time_frame",
-    ];
-    #[inline]
-    fn kind(&self) -> usize {
-        match self {
-            Ev::CpuDone { .. } => 0,
-            Ev::FrontDone { .. } => 1,
-            Ev::GeomTriangle { .. } => 2,
-            Ev::FragTriangle { .. } => 3,
-            Ev::DrawGeometry => 4,
-            Ev::DrawFragmentStart => 5,
-            Ev::DrawDone => 6,
-            Ev::Vblank => 7,
-            Ev::NoiseArrive { .. } => 8,
-            Ev::NoiseEnd { .. } => 9,
-            Ev::ZeroTimeFrame => 10,
-        }
-    }
-}
 
 /// The frame pipeline: its units, the links between them, the noise
 /// sources, the per-frame records and the accounting.

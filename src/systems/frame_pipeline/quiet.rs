@@ -46,8 +46,9 @@ use crate::engine::{Scheduler, Time};
 use crate::systems::error::SystemError;
 
 use super::accounting::Units;
+use super::events::Ev;
 use super::front_end::FrontPhase;
-use super::model::{Ev, FramePipeline, pipeline_env};
+use super::model::{FramePipeline, pipeline_env};
 
 impl FramePipeline {
     /// Does the quiet completion whose turn came before the event being
