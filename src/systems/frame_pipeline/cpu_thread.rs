@@ -232,7 +232,7 @@ impl CpuThread {
         }
     }
 
-    fn op_work(&mut self, op: Op, env: &Env<'_>) -> Duration {
+    fn op_work(&mut self, op: Op, env: &Env) -> Duration {
         let c = &env.cfg.cpu;
         match op {
             Op::Input => c.input_sampling,
@@ -250,7 +250,7 @@ impl CpuThread {
                 Some(f) => Duration::from_ps_f64(f.cpu.sample(&mut f.cpu_rng)),
                 None => Duration::ZERO,
             },
-            Op::Draw(k) => match env.scene {
+            Op::Draw(k) => match &env.scene {
                 Some(sc) => sc.draws[k as usize].cpu,
                 None => Duration::ZERO,
             },
@@ -258,7 +258,7 @@ impl CpuThread {
     }
 
     /// The phase after the current operation's work is done.
-    fn after_work(&mut self, now: Time, env: &mut Env<'_>) -> CpuPhase {
+    fn after_work(&mut self, now: Time, env: &mut Env) -> CpuPhase {
         let frame = self.frame;
         match self.op_at(self.op) {
             Op::Input => {
@@ -281,15 +281,15 @@ impl CpuThread {
 
     /// The phase that pushes `c`.
     #[inline]
-    fn push_phase(&mut self, c: Command, env: &Env<'_>) -> CpuPhase {
+    fn push_phase(&mut self, c: Command, env: &Env) -> CpuPhase {
         self.cmd = c;
-        self.cmd_weight = command_weight(env.cfg, env.scene, &c);
+        self.cmd_weight = command_weight(&env.cfg, &env.scene, &c);
         CpuPhase::Push
     }
 
     /// After a completed push or an operation without command: next
     /// operation, or the end of the frame after the swap.
-    fn advance(&mut self, now: Time, env: &mut Env<'_>) -> CpuPhase {
+    fn advance(&mut self, now: Time, env: &mut Env) -> CpuPhase {
         if let Op::Swap = self.op_at(self.op) {
             env.records[self.frame as usize].present = now;
             self.frame += 1;
@@ -302,7 +302,7 @@ impl CpuThread {
     }
 
     /// The running operation's work finished.
-    pub(super) fn op_done(&mut self, now: Time, env: &mut Env<'_>) {
+    pub(super) fn op_done(&mut self, now: Time, env: &mut Env) {
         debug_assert_eq!(self.phase, CpuPhase::Running);
         self.phase = self.after_work(now, env);
     }
@@ -324,7 +324,7 @@ impl CpuThread {
     pub(super) fn step_alone(
         &mut self,
         now: Time,
-        env: &mut Env<'_>,
+        env: &mut Env,
         s: &mut Scheduler<Ev>,
     ) -> Result<Option<Alone>, SystemError> {
         let frame = self.frame;
@@ -354,14 +354,14 @@ impl CpuThread {
     pub(super) fn draw_done_fast(
         &mut self,
         now: Time,
-        env: &mut Env<'_>,
+        env: &mut Env,
         s: &mut Scheduler<Ev>,
     ) -> Result<Option<Alone>, SystemError> {
         let k = self.op.wrapping_sub(3);
         if k >= self.body_ops || !self.scene_body {
             return Ok(None);
         }
-        let Some(sc) = env.scene else {
+        let Some(sc) = &env.scene else {
             return Ok(None);
         };
         let d = &sc.draws[k as usize];
@@ -394,12 +394,12 @@ impl CpuThread {
     fn push_draw_start_next(
         &mut self,
         now: Time,
-        env: &mut Env<'_>,
+        env: &mut Env,
         s: &mut Scheduler<Ev>,
         cmd: Command,
         weight: u64,
     ) -> Result<bool, SystemError> {
-        let (Command::Draw { draw: k, .. }, Some(sc)) = (cmd, env.scene) else {
+        let (Command::Draw { draw: k, .. }, Some(sc)) = (cmd, &env.scene) else {
             return Ok(false);
         };
         let Some(d) = sc.draws.get(k as usize) else {
@@ -428,7 +428,7 @@ impl CpuThread {
     /// Advances the thread as far as it can go now. Returns whether
     /// anything changed.
     #[inline(always)]
-    pub(super) fn step(&mut self, now: Time, env: &mut Env<'_>, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
+    pub(super) fn step(&mut self, now: Time, env: &mut Env, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         // At rest while an operation runs or too many frames are in flight
         // (most events find it so), and for good once finished or waiting
         // for its zero-time frame: no step, and no call.
@@ -448,13 +448,13 @@ impl CpuThread {
     /// Whether `cpu.max_frames_ahead` frames are in flight (submitted by the
     /// CPU, not yet completed by the GPU): the thread may not start another.
     #[inline(always)]
-    fn frames_ahead_full(&self, env: &Env<'_>) -> bool {
+    fn frames_ahead_full(&self, env: &Env) -> bool {
         self.frame - env.links.frames_completed >= u64::from(env.cfg.cpu.max_frames_ahead)
     }
 
     /// [`CpuThread::step`] from a phase that may move.
     #[inline(never)]
-    fn step_from_rest(&mut self, now: Time, env: &mut Env<'_>, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
+    fn step_from_rest(&mut self, now: Time, env: &mut Env, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         // Released from a full FIFO with a draw batch (at a draw's end, in a
         // GPU-bound stretch): push it and start the next operation.
         if self.phase == CpuPhase::Push
@@ -489,7 +489,7 @@ impl CpuThread {
                         return Ok(progressed);
                     }
                     fifo.push(c, w);
-                    self.issued += command_count(env.scene, &c);
+                    self.issued += command_count(&env.scene, &c);
                     self.phase = if env.links.commands.over_capacity() {
                         CpuPhase::Rendezvous
                     } else {
@@ -513,7 +513,7 @@ impl CpuThread {
     /// returns whether the phase changed when the thread stops here
     /// (finished, too many frames in flight, a zero-time frame's event).
     #[inline(always)]
-    fn start_frame(&mut self, now: Time, env: &mut Env<'_>, s: &mut Scheduler<Ev>) -> Option<bool> {
+    fn start_frame(&mut self, now: Time, env: &mut Env, s: &mut Scheduler<Ev>) -> Option<bool> {
         if self.frame >= self.frames_total {
             self.phase = CpuPhase::Finished;
             return Some(true);

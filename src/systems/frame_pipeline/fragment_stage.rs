@@ -64,12 +64,12 @@ impl FragmentStage {
     pub(super) fn triangle_done(
         &mut self,
         now: Time,
-        env: &mut Env<'_>,
+        env: &mut Env,
         geom: &mut GeometryStage,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
         self.busy = false;
-        let links = &mut *env.links;
+        let links = &mut env.links;
         if let Some(f) = links.triangles.pop() {
             self.start(now, f, &mut links.shaders, s)?;
         }

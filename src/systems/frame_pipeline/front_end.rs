@@ -145,7 +145,7 @@ impl FrontEnd {
     pub(super) fn step(
         &mut self,
         now: Time,
-        env: &mut Env<'_>,
+        env: &mut Env,
         down: &mut Downstream<'_>,
         s: &mut Scheduler<Ev>,
     ) -> Result<bool, SystemError> {
@@ -156,7 +156,7 @@ impl FrontEnd {
                     let Some(c) = env.links.commands.pop() else {
                         return Ok(progressed);
                     };
-                    self.executed += command_count(env.scene, &c);
+                    self.executed += command_count(&env.scene, &c);
                     self.cmd = c;
                     self.phase = self.begin(now, c, env, down, s)?;
                 }
@@ -196,7 +196,7 @@ impl FrontEnd {
         &mut self,
         now: Time,
         c: Command,
-        env: &mut Env<'_>,
+        env: &mut Env,
         down: &mut Downstream<'_>,
         s: &mut Scheduler<Ev>,
     ) -> Result<FrontPhase, SystemError> {
@@ -214,7 +214,7 @@ impl FrontEnd {
                 self.job(now, c, work, env, down, s)
             }
             Command::Draw { draw, .. } => {
-                let work = match env.scene {
+                let work = match &env.scene {
                     Some(sc) => sc.draws[draw as usize].front,
                     None => Duration::ZERO,
                 };
@@ -228,7 +228,7 @@ impl FrontEnd {
         &mut self,
         now: Time,
         c: Command,
-        env: &mut Env<'_>,
+        env: &mut Env,
         down: &mut Downstream<'_>,
         s: &mut Scheduler<Ev>,
     ) -> Result<FrontPhase, SystemError> {
@@ -252,7 +252,7 @@ impl FrontEnd {
         now: Time,
         c: Command,
         work: Duration,
-        env: &mut Env<'_>,
+        env: &mut Env,
         down: &mut Downstream<'_>,
         s: &mut Scheduler<Ev>,
     ) -> Result<FrontPhase, SystemError> {
@@ -288,7 +288,7 @@ impl FrontEnd {
     pub(super) fn command_done(
         &mut self,
         now: Time,
-        env: &mut Env<'_>,
+        env: &mut Env,
         down: &mut Downstream<'_>,
     ) -> Result<(), SystemError> {
         if let FrontPhase::Running = self.phase {
@@ -301,7 +301,7 @@ impl FrontEnd {
         &mut self,
         now: Time,
         c: Command,
-        env: &mut Env<'_>,
+        env: &mut Env,
         down: &mut Downstream<'_>,
     ) -> Result<FrontPhase, SystemError> {
         Ok(match c {
@@ -312,7 +312,7 @@ impl FrontEnd {
                 env.records[frame as usize].gpu_end = Some(now);
                 self.frame = None;
                 down.display
-                    .present(now, frame, &mut env.links.chain, env.records, down.path);
+                    .present(now, frame, &mut env.links.chain, &mut env.records, down.path);
                 FrontPhase::Idle
             }
             Command::Clear { .. } | Command::Fixed { .. } => FrontPhase::Idle,
@@ -369,12 +369,12 @@ impl FrontEnd {
     pub(super) fn handoff_fast(
         &mut self,
         now: Time,
-        env: &mut Env<'_>,
+        env: &mut Env,
         geom: &mut GeometryStage,
         frag: &mut FragmentStage,
         s: &mut Scheduler<Ev>,
     ) -> Result<bool, SystemError> {
-        let (Command::Draw { draw, .. }, Some(sc)) = (self.cmd, env.scene) else {
+        let (Command::Draw { draw, .. }, Some(sc)) = (self.cmd, &env.scene) else {
             return Ok(false);
         };
         let d = &sc.draws[draw as usize];

@@ -185,11 +185,11 @@ impl GeometryStage {
         &mut self,
         now: Time,
         draw: u32,
-        env: &mut Env<'_>,
+        env: &mut Env,
         frag: &mut FragmentStage,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
-        let Some(sc) = env.scene else {
+        let Some(sc) = &env.scene else {
             return Ok(());
         };
         let d = &sc.draws[draw as usize];
@@ -213,7 +213,7 @@ impl GeometryStage {
             Fidelity::Draw => {
                 let t = match d.closed {
                     Some(t) => t,
-                    None => closed_times(env.cfg, mesh, &sc.groups[d.group as usize]),
+                    None => closed_times(&env.cfg, mesh, &sc.groups[d.group as usize]),
                 };
                 self.start_closed_draw(draw, triangles, t, frag, env.traced, s)
             }
@@ -295,12 +295,7 @@ impl GeometryStage {
     }
 
     /// Starts the next triangle of the current draw, or finishes the draw.
-    pub(super) fn next_triangle(
-        &mut self,
-        now: Time,
-        env: &mut Env<'_>,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<(), SystemError> {
+    pub(super) fn next_triangle(&mut self, now: Time, env: &mut Env, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         let Some(a) = self.draw else {
             return Ok(());
         };
@@ -308,7 +303,7 @@ impl GeometryStage {
             self.draw = None;
             return Ok(());
         }
-        let Some(sc) = env.scene else {
+        let Some(sc) = &env.scene else {
             return Ok(());
         };
         let mesh = &sc.meshes[sc.draws[a.draw as usize].mesh as usize];
@@ -340,7 +335,7 @@ impl GeometryStage {
     pub(super) fn triangle_done(
         &mut self,
         now: Time,
-        env: &mut Env<'_>,
+        env: &mut Env,
         frag: &mut FragmentStage,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
@@ -350,7 +345,7 @@ impl GeometryStage {
         };
         a.next += 1;
         let (next, last, draw) = (a.next, a.next >= a.triangles, a.draw);
-        let Some(sc) = env.scene else {
+        let Some(sc) = &env.scene else {
             return Ok(());
         };
         let g = &sc.groups[sc.draws[draw as usize].group as usize];
@@ -358,7 +353,7 @@ impl GeometryStage {
             Some(&px) => px,
             None => g.pixels.sample(&mut self.pixel_rng),
         };
-        let links = &mut *env.links;
+        let links = &mut env.links;
         let f = if links.shaders.is_some() {
             FragWork {
                 shader: Duration::from_ps_f64(px * g.shade_per_pixel),

@@ -122,12 +122,16 @@ impl Links {
 
 /// What a unit's transition reads and writes besides its own state: the
 /// model, the scene, the links, the per-frame records, and whether a trace
-/// is written (which turns the short cuts off).
-pub(super) struct Env<'a> {
-    pub(super) cfg: &'a FramePipelineConfig,
-    pub(super) scene: &'a Option<SceneProgram>,
-    pub(super) links: &'a mut Links,
-    pub(super) records: &'a mut Vec<FrameRecord>,
+/// is written (which turns the short cuts off). The pipeline owns it as one
+/// field, so a transition gets it as one reference and no struct of
+/// references is built per event.
+#[derive(Debug)]
+pub(super) struct Env {
+    pub(super) cfg: FramePipelineConfig,
+    /// The compiled scene (`None`: a fixed workload, which the CPU thread holds).
+    pub(super) scene: Option<SceneProgram>,
+    pub(super) links: Links,
+    pub(super) records: Vec<FrameRecord>,
     pub(super) traced: bool,
 }
 

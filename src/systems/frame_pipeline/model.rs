@@ -31,8 +31,7 @@ use super::display::Display;
 use super::fragment_stage::FragmentStage;
 use super::front_end::{Downstream, FrontEnd};
 use super::geometry_stage::GeometryStage;
-use super::links::Links;
-use super::records::FrameRecord;
+use super::links::{Env, Links};
 use super::workload::SceneProgram;
 
 pub use super::cpu_thread::CpuPhase;
@@ -44,36 +43,18 @@ pub use super::links::{Command, FragWork};
 /// The frame pipeline: its units, the links between them, the noise
 /// sources, the per-frame records and the accounting.
 pub struct FramePipeline {
-    pub(super) cfg: FramePipelineConfig,
-    /// The compiled scene (`None`: a fixed workload, which the CPU thread holds).
-    pub(super) scene: Option<SceneProgram>,
+    /// The model, the scene, the links, the records and the trace flag that
+    /// the units' transitions get.
+    pub(super) env: Env,
     pub(super) frames_total: u64,
     pub(super) cpu: CpuThread,
     pub(super) front: FrontEnd,
     pub(super) geom: GeometryStage,
     pub(super) frag: FragmentStage,
     pub(super) display: Display,
-    pub(super) links: Links,
     noise: Vec<NoiseSource>,
-    pub(super) records: Vec<FrameRecord>,
     pub(super) acct: Accounting,
-    /// Whether a trace is written (which turns the short cuts off).
-    pub(super) traced: bool,
 }
-
-/// What a unit's transition gets of `$p` (a [`FramePipeline`]): an [`Env`].
-macro_rules! pipeline_env {
-    ($p:ident) => {
-        super::links::Env {
-            cfg: &$p.cfg,
-            scene: &$p.scene,
-            links: &mut $p.links,
-            records: &mut $p.records,
-            traced: $p.traced,
-        }
-    };
-}
-pub(super) use pipeline_env;
 
 /// The units downstream of the front end in `$p` (a [`FramePipeline`]).
 macro_rules! downstream {
@@ -157,6 +138,7 @@ impl FramePipeline {
             }
         };
         let noise = noise_sources(&cfg, &streams)?;
+        let traced = trace.is_some();
         let mode = cfg.display.effective_mode();
         let frames_total = cfg.run.frames;
         let body = match &scene {
@@ -171,37 +153,40 @@ impl FramePipeline {
             }
             _ => None,
         };
+        let links = Links {
+            commands: BoundedFifo::new(cfg.command_fifo.capacity),
+            // Binning: the FIFO is the draw's bins and holds all of it.
+            triangles: BoundedFifo::new(if cfg.gpu.fragment.binned() {
+                u64::MAX
+            } else {
+                cfg.gpu.fragment.fifo_depth as u64
+            }),
+            shaders: match cfg.fidelity {
+                Fidelity::Triangle => cfg.gpu.pool().map(|(n, p)| ShaderPool::new(n, p)),
+                Fidelity::Draw => None,
+            },
+            chain: SwapChain::new(cfg.display.buffers, mode),
+            frames_completed: 0,
+        };
         Ok(FramePipeline {
             cpu: CpuThread::new(frames_total, body, cpu_rngs, fixed, zero_time_after),
             front: FrontEnd::new(streams.stream("variation.gpu")),
             geom: GeometryStage::new(streams.stream("fragment.pixels"), pixel_rng_start),
             frag: FragmentStage::default(),
             display: Display::new(cfg.display.refresh.period, frames_total, cfg.run.warmup_frames),
-            links: Links {
-                commands: BoundedFifo::new(cfg.command_fifo.capacity),
-                // Binning: the FIFO is the draw's bins and holds all of it.
-                triangles: BoundedFifo::new(if cfg.gpu.fragment.binned() {
-                    u64::MAX
-                } else {
-                    cfg.gpu.fragment.fifo_depth as u64
-                }),
-                shaders: match cfg.fidelity {
-                    Fidelity::Triangle => cfg.gpu.pool().map(|(n, p)| ShaderPool::new(n, p)),
-                    Fidelity::Draw => None,
-                },
-                chain: SwapChain::new(cfg.display.buffers, mode),
-                frames_completed: 0,
-            },
-            scene,
             frames_total,
             noise,
-            records: Vec::with_capacity(frames_total.min(1 << 16) as usize),
-            traced: trace.is_some(),
             acct: Accounting::new(
                 trace,
                 (mode != PresentMode::Immediate).then_some(cfg.display.refresh.period),
             ),
-            cfg,
+            env: Env {
+                links,
+                scene,
+                records: Vec::with_capacity(frames_total.min(1 << 16) as usize),
+                traced,
+                cfg,
+            },
         })
     }
 
@@ -210,7 +195,7 @@ impl FramePipeline {
         if self.frames_total == 0 {
             return Ok(());
         }
-        if self.links.chain.mode() != PresentMode::Immediate {
+        if self.env.links.chain.mode() != PresentMode::Immediate {
             s.at(Time::ZERO, Ev::Vblank);
         }
         for i in 0..self.noise.len() {
@@ -223,7 +208,7 @@ impl FramePipeline {
 
     /// The fidelity.
     pub fn fidelity(&self) -> Fidelity {
-        self.cfg.fidelity
+        self.env.cfg.fidelity
     }
 
     /// Commands pushed by the CPU and commands executed by the GPU.
@@ -240,11 +225,12 @@ impl FramePipeline {
     /// stopped by a time or event limit): the leading completed frames stay.
     pub fn keep_completed_frames(&mut self) {
         let done = self
+            .env
             .records
             .iter()
             .take_while(|r| r.displayed.is_some() || r.dropped)
             .count();
-        self.records.truncate(done);
+        self.env.records.truncate(done);
     }
 
     /// Whether all asked-for frames are done.
@@ -258,15 +244,15 @@ impl FramePipeline {
         format!(
             "cpu {}, command fifo {}/{}, front end {}, geometry {:?} busy={} held={}, fragment busy={}, frames completed {}, queued for display {}",
             self.cpu.describe(),
-            self.links.commands.used(),
-            self.links.commands.capacity(),
+            self.env.links.commands.used(),
+            self.env.links.commands.capacity(),
             self.front.describe(),
             self.geom.draw(),
             self.geom.busy(),
             self.geom.holds_triangle(),
             self.frag.busy(),
-            self.links.frames_completed,
-            self.links.chain.queued()
+            self.env.links.frames_completed,
+            self.env.links.chain.queued()
         )
     }
 
@@ -277,7 +263,7 @@ impl FramePipeline {
     #[inline]
     fn step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         self.settle(now, s)?;
-        self.links.settle_shaders(now, s)?;
+        self.env.links.settle_shaders(now, s)?;
         self.account(now);
         Ok(())
     }
@@ -294,11 +280,15 @@ impl FramePipeline {
     /// end made no progress after a CPU step, another round would change
     /// nothing: the loop ends there.
     pub(super) fn settle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
-        let mut env = pipeline_env!(self);
-        let mut down = downstream!(self);
         loop {
-            self.cpu.step(now, &mut env, s)?;
-            if !self.front.step(now, &mut env, &mut down, s)? {
+            self.cpu.step(now, &mut self.env, s)?;
+            // A running front end takes no step (most events find it so):
+            // its downstream units are not even gathered.
+            if self.front.phase() == FrontPhase::Running {
+                return Ok(());
+            }
+            let mut down = downstream!(self);
+            if !self.front.step(now, &mut self.env, &mut down, s)? {
                 return Ok(());
             }
         }
@@ -312,9 +302,9 @@ impl FramePipeline {
             front: &self.front,
             geom: &self.geom,
             frag: &self.frag,
-            links: &self.links,
+            links: &self.env.links,
         };
-        self.acct.account(now, &units, &mut self.records);
+        self.acct.account(now, &units, &mut self.env.records);
     }
 
     /// The CPU thread's operation finished (its event, not stale): the
@@ -325,15 +315,13 @@ impl FramePipeline {
     /// any other operation's [`CpuThread::step_alone`].
     #[inline(always)]
     fn cpu_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
-        let alone = !self.traced && self.front.phase() != FrontPhase::Idle;
-        let mut env = pipeline_env!(self);
-        if alone && let Some(a) = self.cpu.draw_done_fast(now, &mut env, s)? {
+        let alone = !self.env.traced && self.front.phase() != FrontPhase::Idle;
+        if alone && let Some(a) = self.cpu.draw_done_fast(now, &mut self.env, s)? {
             self.account_cpu_alone(now, a);
             return Ok(true);
         }
-        let mut env = pipeline_env!(self);
-        self.cpu.op_done(now, &mut env);
-        if alone && let Some(a) = self.cpu.step_alone(now, &mut env, s)? {
+        self.cpu.op_done(now, &mut self.env);
+        if alone && let Some(a) = self.cpu.step_alone(now, &mut self.env, s)? {
             self.account_cpu_alone(now, a);
             return Ok(true);
         }
@@ -344,7 +332,7 @@ impl FramePipeline {
     #[inline(always)]
     fn account_cpu_alone(&mut self, now: Time, a: Alone) {
         if a == Alone::Blocked {
-            self.acct.account_cpu_alone(now, &self.cpu, &mut self.records);
+            self.acct.account_cpu_alone(now, &self.cpu, &mut self.env.records);
         }
     }
 
@@ -394,21 +382,18 @@ impl Model for FramePipeline {
             }
             Ev::FrontDone { tag } => {
                 if self.front.complete(tag) {
-                    let mut env = pipeline_env!(self);
                     let mut down = downstream!(self);
-                    self.front.command_done(now, &mut env, &mut down)?;
+                    self.front.command_done(now, &mut self.env, &mut down)?;
                 }
             }
             Ev::GeomTriangle { tag } => {
-                if self.links.shader_completes(now, Stream::Vertex, tag) {
-                    let mut env = pipeline_env!(self);
-                    self.geom.triangle_done(now, &mut env, &mut self.frag, s)?;
+                if self.env.links.shader_completes(now, Stream::Vertex, tag) {
+                    self.geom.triangle_done(now, &mut self.env, &mut self.frag, s)?;
                 }
             }
             Ev::FragTriangle { tag } => {
-                if self.links.shader_completes(now, Stream::Fragment, tag) {
-                    let mut env = pipeline_env!(self);
-                    self.frag.triangle_done(now, &mut env, &mut self.geom, s)?;
+                if self.env.links.shader_completes(now, Stream::Fragment, tag) {
+                    self.frag.triangle_done(now, &mut self.env, &mut self.geom, s)?;
                 }
             }
             Ev::DrawGeometry => self.geom.closed_geometry_done(),
@@ -424,7 +409,7 @@ impl Model for FramePipeline {
             Ev::Vblank => {
                 let path = &mut self.acct.path;
                 self.display
-                    .vblank(now, &mut self.links.chain, &mut self.records, path, s)?;
+                    .vblank(now, &mut self.env.links.chain, &mut self.env.records, path, s)?;
             }
             Ev::NoiseArrive { source } => self.noise_arrive(now, source, s)?,
             Ev::NoiseEnd { target } => self.noise_end(now, target, s)?,

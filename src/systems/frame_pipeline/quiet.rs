@@ -48,7 +48,7 @@ use crate::systems::error::SystemError;
 use super::accounting::Units;
 use super::events::Ev;
 use super::front_end::FrontPhase;
-use super::model::{FramePipeline, pipeline_env};
+use super::model::FramePipeline;
 
 impl FramePipeline {
     /// Does the quiet completion whose turn came before the event being
@@ -72,7 +72,7 @@ impl FramePipeline {
             return;
         }
         debug_assert!(self.geom.done_at().is_some_and(|d| d > at));
-        if self.traced {
+        if self.env.traced {
             self.account(at);
             return;
         }
@@ -92,22 +92,21 @@ impl FramePipeline {
     #[inline]
     pub(super) fn draw_done_alone(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         if self.front.phase() != FrontPhase::Handoff
-            || self.traced
+            || self.env.traced
             || self.front.in_system()
-            || self.cfg.gpu.fragment.binned()
+            || self.env.cfg.gpu.fragment.binned()
         {
             return Ok(false);
         }
         let gpu_frame = self.front.frame();
-        let mut env = pipeline_env!(self);
         let cpu_moved = if self
             .front
-            .handoff_fast(now, &mut env, &mut self.geom, &mut self.frag, s)?
+            .handoff_fast(now, &mut self.env, &mut self.geom, &mut self.frag, s)?
         {
             // The front end runs the next draw command's job: of `settle`'s
             // steps only the CPU's can do anything (a push does not reach a
             // running front end), and it does not change the front end.
-            self.cpu.step(now, &mut env, s)?
+            self.cpu.step(now, &mut self.env, s)?
         } else {
             self.settle(now, s)?;
             true
@@ -118,10 +117,10 @@ impl FramePipeline {
                 front: &self.front,
                 geom: &self.geom,
                 frag: &self.frag,
-                links: &self.links,
+                links: &self.env.links,
             };
             self.acct
-                .account_draw_handoff(now, cpu_moved, &units, &mut self.records);
+                .account_draw_handoff(now, cpu_moved, &units, &mut self.env.records);
         } else {
             self.account(now);
         }
