@@ -356,7 +356,13 @@ impl<V: Quantity> Dist<V> {
     /// function, 1 below the support and 0 above it.
     pub fn survival(&self, x: f64) -> f64 {
         match self {
-            Dist::Const { value } => f64::from(u8::from(x < value.to_f64())),
+            Dist::Const { value } => {
+                if x < value.to_f64() {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
             Dist::Uniform { min, max } => {
                 let (lo, hi) = (min.to_f64(), max.to_f64());
                 if x < lo {
@@ -382,7 +388,7 @@ impl<V: Quantity> Dist<V> {
                 if x <= 0.0 {
                     1.0
                 } else if *sigma == 0.0 {
-                    f64::from(u8::from(x < m))
+                    if x < m { 1.0 } else { 0.0 }
                 } else {
                     1.0 - phi((x.ln() - m.ln()) / sigma)
                 }

@@ -234,11 +234,15 @@ pub trait Outcome: std::fmt::Debug + Send {
 }
 
 /// The [`Outcome`] methods every run type implements alike, for a run struct
-/// with `summary: Value` and `trace: Option<TraceWriter>` fields and a
-/// `report::write_report(&Value, w)` beside it: used inside
-/// `impl Outcome for ...` in each system's `system.rs`.
+/// with `summary: Value` and `trace: Option<TraceWriter>` fields: used
+/// inside `impl Outcome for ...` in each system. The report is
+/// `super::report::write_report(&Value, w)`, or the function named in
+/// `outcome_basics!(report = PATH)`.
 macro_rules! outcome_basics {
     () => {
+        outcome_basics!(report = super::report::write_report);
+    };
+    (report = $report:path) => {
         fn summary(&self) -> &serde_json::Value {
             &self.summary
         }
@@ -248,7 +252,7 @@ macro_rules! outcome_basics {
         }
 
         fn write_report(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {
-            super::report::write_report(&self.summary, w)
+            $report(&self.summary, w)
         }
 
         fn take_trace(&mut self) -> Option<crate::output::trace::TraceWriter> {

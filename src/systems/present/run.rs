@@ -9,13 +9,13 @@ use serde::Serialize;
 use serde_json::Value;
 
 use crate::components::swap_chain::PresentMode;
-use crate::engine::{Limits, RngStreams, RunStats, Scheduler, StopReason, run};
+use crate::engine::{Limits, RngStreams, RunStats, Scheduler, StopReason, Time, run};
 use crate::output::table::write_number_table;
 use crate::output::text::fixed;
 use crate::output::trace::TraceWriter;
 use crate::systems::error::invalid;
 use crate::systems::summary::{Dist, EventCounts, to_json};
-use crate::systems::{Outcome, SystemError, SystemModel, resolved_toml};
+use crate::systems::{Outcome, SystemError, SystemModel, outcome_basics, resolved_toml};
 
 use super::config::PresentConfig;
 use super::model::{FrameTimes, Present};
@@ -144,7 +144,7 @@ pub fn run_present(cfg: PresentConfig, trace: Option<TraceWriter>) -> Result<Pre
         until: None,
         max_events: cfg.run.max_events,
     };
-    let stats = run(&mut model, &mut sched, limits)?;
+    let mut stats = run(&mut model, &mut sched, limits)?;
     if !model.done() {
         return Err(SystemError::Unfinished {
             at: stats.end_time,
@@ -152,7 +152,6 @@ pub fn run_present(cfg: PresentConfig, trace: Option<TraceWriter>) -> Result<Pre
             state: model.describe(),
         });
     }
-    let mut stats = stats;
     stats.wall_seconds = start.elapsed().as_secs_f64();
     let done = model.finish(stats.end_time);
     let summary = summarize(&cfg, &done, &stats);
@@ -218,10 +217,11 @@ pub struct PresentSummary {
 
 fn summarize(cfg: &PresentConfig, done: &super::model::Finished, stats: &RunStats) -> Value {
     let measured = &done.frames[(cfg.run.warmup_frames as usize).min(done.frames.len())..];
-    let ms = |a: crate::engine::Time, b: crate::engine::Time| b.since(a).as_ms_f64();
-    let shown: Vec<&FrameTimes> = measured.iter().filter(|f| f.shown.is_some()).collect();
-    let shown_at: Vec<crate::engine::Time> = shown.iter().filter_map(|f| f.shown).collect();
-    let render: Vec<f64> = measured.iter().map(|f| ms(f.start, f.present)).collect();
+    let ms = |a: Time, b: Time| b.since(a).as_ms_f64();
+    // The displayed frames, each with the time it reached the screen.
+    let shown: Vec<(&FrameTimes, Time)> = measured.iter().filter_map(|f| f.shown.map(|t| (f, t))).collect();
+    let of_shown =
+        |f: &dyn Fn(&FrameTimes, Time) -> f64| Dist::of(&shown.iter().map(|&(fr, t)| f(fr, t)).collect::<Vec<_>>());
     let end = stats.end_time.0 as f64;
     let summary = PresentSummary {
         system: "present",
@@ -236,26 +236,16 @@ fn summarize(cfg: &PresentConfig, done: &super::model::Finished, stats: &RunStat
             frames: measured.len(),
             displayed_frames: shown.len(),
             dropped_frames: measured.len() - shown.len(),
-            display_interval_ms: Dist::of(&shown_at.windows(2).map(|w| ms(w[0], w[1])).collect::<Vec<_>>()),
-            latency_ms: Dist::of(
-                &shown
-                    .iter()
-                    .map(|f| ms(f.start, f.shown.unwrap_or(f.start)))
-                    .collect::<Vec<_>>(),
-            ),
-            present_to_display_ms: Dist::of(
-                &shown
-                    .iter()
-                    .map(|f| ms(f.present, f.shown.unwrap_or(f.present)))
-                    .collect::<Vec<_>>(),
-            ),
+            display_interval_ms: Dist::of(&shown.windows(2).map(|w| ms(w[0].1, w[1].1)).collect::<Vec<_>>()),
+            latency_ms: of_shown(&|f, t| ms(f.start, t)),
+            present_to_display_ms: of_shown(&|f, t| ms(f.present, t)),
             analytic_interval_ms: analytic_interval_ms(
                 &cfg.render.time,
                 cfg.display.refresh.period.as_ms_f64(),
                 cfg.display.buffers,
                 cfg.display.effective_mode(),
             ),
-            render_ms: Dist::of(&render),
+            render_ms: Dist::of(&measured.iter().map(|f| ms(f.start, f.present)).collect::<Vec<_>>()),
             vblanks: done.vblanks,
             repeated_refreshes: done.repeated,
             renderer_wait_share: if end > 0.0 { done.waited.0 as f64 / end } else { 0.0 },
@@ -326,17 +316,7 @@ pub fn write_report(s: &Value, w: &mut dyn Write) -> std::io::Result<()> {
 }
 
 impl Outcome for PresentRun {
-    fn summary(&self) -> &Value {
-        &self.summary
-    }
-
-    fn summary_mut(&mut self) -> &mut Value {
-        &mut self.summary
-    }
-
-    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        write_report(&self.summary, w)
-    }
+    outcome_basics!(report = write_report);
 
     fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
         (
@@ -351,17 +331,5 @@ impl Outcome for PresentRun {
 
     fn resolved_model(&self, _base_dir: &Path) -> String {
         resolved_toml(&self.config)
-    }
-
-    fn take_trace(&mut self) -> Option<TraceWriter> {
-        self.trace.take()
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
-
-    fn into_any(self: Box<Self>) -> Box<dyn std::any::Any> {
-        self
     }
 }
