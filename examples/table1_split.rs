@@ -9,7 +9,7 @@
 //! 9.859, 7.35 ms) and the fourth is predicted (paper: 11.856 ms; the ratio
 //! of what the complex vertex shader adds under the complex fragment shader
 //! to what it adds under the simple one: 0.84).
-//! `rendersim::systems::frame_pipeline::table1` does the root finding. The
+//! `rendersim::studies::table1` does the root finding. The
 //! runs use `draw` fidelity (`tests/it/table1_split.rs` checks the setups
 //! against `triangle` fidelity).
 //!
@@ -19,8 +19,8 @@
 //! 86,400 triangles).
 
 use rendersim::scene::config::SizeOrder;
+use rendersim::studies::table1::{CellModel, PAPER, SplitTerrain, TOLERANCE_MS, order_name};
 use rendersim::systems::frame_pipeline::Fidelity;
-use rendersim::systems::frame_pipeline::table1::{CellModel, PAPER, SplitTerrain, TOLERANCE_MS, order_name};
 
 const SHARES: [f64; 5] = [0.1, 0.3, 0.5, 0.7, 0.9];
 

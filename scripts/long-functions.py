@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
 """Lists functions in Rust sources longer than a limit (default 150 lines).
 
-Usage: scripts/long-functions.py [LIMIT] [DIR...]   (default DIR: src)
+Usage: scripts/long-functions.py [LIMIT] [DIR...]   (default DIRs: src crates/*/src)
 
 A function runs from its `fn` line to the line of the brace that closes its
 body; braces inside strings, chars and comments are skipped. Exit 1 when any
 function is over the limit.
 """
+import glob
 import os
 import re
 import sys
@@ -105,7 +106,7 @@ def main():
     limit = 150
     if args and args[0].isdigit():
         limit = int(args.pop(0))
-    dirs = args or ['src']
+    dirs = args or ['src'] + sorted(glob.glob('crates/*/src'))
     long = []
     for d in dirs:
         for root, _, files in os.walk(d):

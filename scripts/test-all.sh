@@ -37,30 +37,30 @@ if [ -z "${RENDERSIM_KEEP_CI_OUT:-}" ]; then
 else
   echo "outputs kept in $ci_out"
 fi
-cargo build --release --locked --all-targets --features wgpu
+cargo build --release --locked --workspace --all-targets --features wgpu
 export RENDERSIM_BIN="$root/target/release/rendersim"
 
 step "Formatting and lints (cargo fmt --check; clippy with warnings as errors)"
 for tool in rustfmt clippy; do
   cargo "${tool/rustfmt/fmt}" --version >/dev/null 2>&1 || rustup component add "$tool" || true
 done
-if cargo fmt --version >/dev/null 2>&1; then cargo fmt --check; else echo "rustfmt unavailable: skipped"; fi
+if cargo fmt --version >/dev/null 2>&1; then cargo fmt --all --check; else echo "rustfmt unavailable: skipped"; fi
 if cargo clippy --version >/dev/null 2>&1; then
-  cargo clippy --release --locked --all-targets --features wgpu -- -D warnings
+  cargo clippy --release --locked --workspace --all-targets --features wgpu -- -D warnings
 else
   echo "clippy unavailable: skipped"
 fi
 
 step "Rust tests (unit, property, integration, doc; wgpu measurements on lavapipe)"
 # (The fuzz test runs in its own step below, so that its counts are shown.)
-cargo test --release --locked --no-fail-fast --features wgpu -- --skip every_input_ends_in_a_result_or_a_clean_error 2>&1 | tee "$ci_out/test-output.txt"
+cargo test --release --locked --no-fail-fast --workspace --features wgpu -- --skip every_input_ends_in_a_result_or_a_clean_error 2>&1 | tee "$ci_out/test-output.txt"
 grep -q "test result:" "$ci_out/test-output.txt"
 
 step "Fuzz: 2,000 seeded leaf-value cases (models, --set values, meshes, experiments), 1,000 text-damage cases of every file kind read (models, devices, experiments, CSVs, instances, meshes, shard files), plus the regression cases"
 cargo test --release --locked --features wgpu --test it fuzz:: -- --nocapture
 
 step "Examples (each asserts what it shows)"
-for ex in examples/*.rs; do
+for ex in examples/*.rs crates/*/examples/*.rs; do
   name=$(basename "$ex" .rs)
   echo "-- $name"
   "target/release/examples/$name" | tail -n 2

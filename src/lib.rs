@@ -1,26 +1,29 @@
 //! rendersim: a discrete-event simulator of GPU rendering pipelines and latency.
 //!
-//! Layers, from the bottom up (see `docs/ARCHITECTURE.md`):
-//! - [`engine`]: integer-picosecond time, the event queue, the run loop, RNG
-//!   streams. Knows nothing of GPUs.
-//! - [`components`]: reusable parts (bounded FIFOs, vertex caches, swap chains,
-//!   system-task noise, distributions, state-time accounting).
-//! - [`scene`]: workloads: meshes, generators, OBJ files, synthetic scenes.
-//! - [`systems`]: simulated systems, each composed from components.
-//! - [`config`]: model files, units, `--set` patches, validation.
-//! - [`stats`], [`output`], [`plot`], [`experiment`]: results and studies.
-//! - [`limits`]: the stated limits on sizes read from input.
+//! The workspace's crates are its layers, from the bottom up (see
+//! `docs/ARCHITECTURE.md`); this crate re-exports each under its old name,
+//! so `rendersim::engine`, `rendersim::systems`, ... name the same items
+//! whichever crate holds them:
+//! - [`engine`] (`rendersim-engine`): integer-picosecond time, the event
+//!   queue, the run loop, RNG streams. Knows nothing of GPUs.
+//! - [`output`], [`stats`], [`plot`] (`rendersim-report`): tables, traces,
+//!   result sets, statistics and plots, shared by every system.
+//! - [`config`], [`components`], [`scene`], [`systems`], [`limits`]
+//!   (`rendersim-models`): model files, reusable parts, workloads, the
+//!   simulated systems.
+//! - [`measure`] (`rendersim-measure`): real measurements through wgpu,
+//!   device profiles, calibration and predictions.
+//! - here: [`studies`] that run whole models (isolation, paper 000 Table 1,
+//!   the Figure 4 timeline, device predictions), [`experiment`],
+//!   [`bench`], and the command-line tool (`src/main.rs`, `src/cli`).
 #![warn(missing_docs)]
 
+pub use rendersim_engine as engine;
+pub use rendersim_measure as measure;
+pub use rendersim_models::{components, config, limits, scene};
+pub use rendersim_report::{output, plot, stats};
+
 pub mod bench;
-pub mod components;
-pub mod config;
-pub mod engine;
 pub mod experiment;
-pub mod limits;
-pub mod measure;
-pub mod output;
-pub mod plot;
-pub mod scene;
-pub mod stats;
+pub mod studies;
 pub mod systems;

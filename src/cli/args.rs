@@ -106,7 +106,7 @@ pub struct IsolateArgs {
     #[arg(long)]
     pub keep_vsync: bool,
     /// Reductions of the frame time within this fraction of the best reduction are reported as a tie.
-    #[arg(long, default_value_t = rendersim::systems::frame_pipeline::isolate::DEFAULT_TIE_TOLERANCE)]
+    #[arg(long, default_value_t = rendersim::studies::isolate::DEFAULT_TIE_TOLERANCE)]
     pub tie_tolerance: f64,
     /// Print JSON.
     #[arg(long)]
@@ -637,7 +637,7 @@ pub struct TimelineArgs {
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub sets: Vec<String>,
     /// Frames to draw.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=rendersim::systems::frame_pipeline::timeline::MAX_TIMELINE_FRAMES))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=rendersim::studies::timeline::MAX_TIMELINE_FRAMES))]
     pub frames: u64,
     /// The first frame drawn (the frames before it are simulated, not drawn).
     #[arg(long, value_name = "F", default_value_t = 0)]

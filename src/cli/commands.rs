@@ -12,7 +12,7 @@ use rendersim::output::files::{check_distinct, open_output};
 use rendersim::output::result_set::ResultSet;
 use rendersim::output::text::fixed;
 use rendersim::output::trace::TraceWriter;
-use rendersim::systems::frame_pipeline::isolate::IsolateOptions;
+use rendersim::studies::isolate::IsolateOptions;
 use rendersim::systems::run_model;
 
 use super::args::TimelineArgs;
@@ -213,7 +213,7 @@ pub fn isolate(args: IsolateArgs) -> Result<()> {
         keep_vsync,
         tie_tolerance: args.tie_tolerance,
     };
-    let iso = rendersim::systems::frame_pipeline::isolate::isolate(&cfg, &src.base_dir, options)?;
+    let iso = rendersim::studies::isolate::isolate(&cfg, &src.base_dir, options)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&iso)?);
         return Ok(());
@@ -490,7 +490,7 @@ pub fn bench(args: BenchArgs) -> Result<()> {
 
 /// `rendersim timeline`: the picture of paper 000 Figure 4 for a few frames.
 pub fn timeline(args: TimelineArgs) -> Result<()> {
-    use rendersim::systems::frame_pipeline::timeline::{TimelineOptions, timeline_of};
+    use rendersim::studies::timeline::{TimelineOptions, timeline_of};
     // The extension is checked before simulating.
     rendersim::plot::ImageFormat::of(&args.out)?;
     let model = load_model(

@@ -1,9 +1,20 @@
-//! docs/ARCHITECTURE.md stays true to the code: every file under `src/` is
-//! named in it (a `mod.rs` by its folder, `name/`), so a newcomer reading the
-//! map finds every file, and a file added without a word there fails here;
-//! and no function in `src/` runs over 150 lines (issue 27).
+//! The layers hold, and docs/ARCHITECTURE.md stays true to the code:
+//!
+//! - the crates' dependency graph (`cargo metadata`) has no edge that the
+//!   map's "Layers" table does not allow, and only `rendersim-measure`
+//!   depends on wgpu;
+//! - inside `rendersim-models`, a module's code names only the modules
+//!   listed before it;
+//! - every source file of every crate is named on the map (a `mod.rs` by its
+//!   folder, `name/`);
+//! - no function runs over 150 lines (issue 27).
 
-use std::path::Path;
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
 
 fn files(dir: &Path, out: &mut Vec<String>) {
     for e in std::fs::read_dir(dir).unwrap() {
@@ -11,23 +22,271 @@ fn files(dir: &Path, out: &mut Vec<String>) {
         if p.is_dir() {
             files(&p, out);
         } else {
-            out.push(
-                p.strip_prefix(env!("CARGO_MANIFEST_DIR"))
-                    .unwrap()
-                    .display()
-                    .to_string(),
-            );
+            out.push(p.strip_prefix(root()).unwrap().display().to_string());
+        }
+    }
+}
+
+/// Every source folder of the workspace: `src/` and each crate's `src/`.
+fn source_dirs() -> Vec<PathBuf> {
+    let mut dirs = vec![root().join("src")];
+    let mut crates: Vec<PathBuf> = std::fs::read_dir(root().join("crates"))
+        .unwrap()
+        .map(|e| e.unwrap().path().join("src"))
+        .filter(|p| p.is_dir())
+        .collect();
+    crates.sort();
+    dirs.extend(crates);
+    dirs
+}
+
+fn all_source_files() -> Vec<String> {
+    let mut all = Vec::new();
+    for d in source_dirs() {
+        files(&d, &mut all);
+    }
+    all.sort();
+    all
+}
+
+/// The "Layers" table of docs/ARCHITECTURE.md: each crate and the crates it
+/// may depend on.
+fn documented_layers(doc: &str) -> BTreeMap<String, BTreeSet<String>> {
+    let section = doc
+        .split("\n## Layers\n")
+        .nth(1)
+        .expect("docs/ARCHITECTURE.md has a \"## Layers\" section");
+    let section = section.split("\n## ").next().unwrap();
+    let mut layers = BTreeMap::new();
+    for line in section.lines().filter(|l| l.starts_with("| rendersim")) {
+        let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
+        assert_eq!(cells.len(), 3, "a Layers row has crate, folder, may depend on: {line}");
+        let allowed = cells[2]
+            .split(',')
+            .map(str::trim)
+            .filter(|c| c.starts_with("rendersim"))
+            .map(String::from)
+            .collect();
+        layers.insert(cells[0].to_string(), allowed);
+    }
+    layers
+}
+
+/// Each workspace crate's dependencies (normal, build and dev) as
+/// `cargo metadata` reports them.
+fn actual_dependencies() -> BTreeMap<String, BTreeSet<String>> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = std::process::Command::new(cargo)
+        .args(["metadata", "--format-version", "1", "--no-deps", "--offline"])
+        .current_dir(root())
+        .output()
+        .expect("cargo metadata runs");
+    assert!(
+        out.status.success(),
+        "cargo metadata: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let meta: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    meta["packages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            let deps = p["dependencies"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|d| d["name"].as_str().unwrap().to_string())
+                .collect();
+            (p["name"].as_str().unwrap().to_string(), deps)
+        })
+        .collect()
+}
+
+/// The edges of `actual` between workspace crates that `allowed` does not
+/// list, and the crates that are not in the table at all.
+fn layer_violations(
+    actual: &BTreeMap<String, BTreeSet<String>>,
+    allowed: &BTreeMap<String, BTreeSet<String>>,
+) -> Vec<String> {
+    let mut bad = Vec::new();
+    for (krate, deps) in actual {
+        let Some(ok) = allowed.get(krate) else {
+            bad.push(format!("{krate} is not in the Layers table"));
+            continue;
+        };
+        for d in deps.iter().filter(|d| actual.contains_key(*d)) {
+            if !ok.contains(d) {
+                bad.push(format!("{krate} -> {d}"));
+            }
+        }
+    }
+    bad
+}
+
+#[test]
+fn the_layer_table_itself_only_points_down() {
+    let doc = std::fs::read_to_string(root().join("docs/ARCHITECTURE.md")).unwrap();
+    let layers = documented_layers(&doc);
+    // In the table's order, a crate may name only crates in the rows above it.
+    let section = doc.split("\n## Layers\n").nth(1).unwrap();
+    let order: Vec<String> = section
+        .lines()
+        .filter(|l| l.starts_with("| rendersim"))
+        .map(|l| l.trim_matches('|').split('|').next().unwrap().trim().to_string())
+        .collect();
+    assert_eq!(order.len(), 5, "five crates in the Layers table: {order:?}");
+    assert_eq!(order[0], "rendersim-engine");
+    assert!(
+        layers["rendersim-engine"].is_empty(),
+        "the engine depends on no other crate"
+    );
+    for (i, krate) in order.iter().enumerate() {
+        for d in &layers[krate] {
+            let j = order
+                .iter()
+                .position(|o| o == d)
+                .unwrap_or_else(|| panic!("{krate} may depend on unknown {d}"));
+            assert!(j < i, "the table lets {krate} depend on {d}, which is not below it");
         }
     }
 }
 
 #[test]
+fn the_crates_depend_only_on_the_layers_below_them() {
+    let doc = std::fs::read_to_string(root().join("docs/ARCHITECTURE.md")).unwrap();
+    let allowed = documented_layers(&doc);
+    let actual = actual_dependencies();
+    let bad = layer_violations(&actual, &allowed);
+    assert!(
+        bad.is_empty(),
+        "dependencies that docs/ARCHITECTURE.md's Layers table does not allow:\n{}",
+        bad.join("\n")
+    );
+    let on_wgpu: Vec<&String> = actual
+        .iter()
+        .filter(|(_, d)| d.contains("wgpu"))
+        .map(|(k, _)| k)
+        .collect();
+    assert_eq!(
+        on_wgpu,
+        ["rendersim-measure"],
+        "only the measurement crate depends on wgpu"
+    );
+}
+
+#[test]
+fn an_extra_edge_is_a_violation() {
+    // The check itself can fail: the engine reaching up to the models, and
+    // a crate missing from the table, are both reported.
+    let set = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<BTreeSet<_>>();
+    let allowed = BTreeMap::from([
+        ("rendersim-engine".to_string(), set(&[])),
+        ("rendersim-models".to_string(), set(&["rendersim-engine"])),
+    ]);
+    let mut actual = BTreeMap::from([
+        ("rendersim-engine".to_string(), set(&["rand", "rendersim-models"])),
+        ("rendersim-models".to_string(), set(&["rendersim-engine", "serde"])),
+    ]);
+    assert_eq!(
+        layer_violations(&actual, &allowed),
+        ["rendersim-engine -> rendersim-models"]
+    );
+    actual.insert("rendersim-extra".to_string(), set(&[]));
+    assert_eq!(layer_violations(&actual, &allowed).len(), 2);
+}
+
+/// The modules of `rendersim-models` in their documented order.
+fn model_module_order(doc: &str) -> Vec<String> {
+    let line = doc
+        .lines()
+        .find(|l| l.starts_with("Modules of `rendersim-models`, in order:"))
+        .expect("docs/ARCHITECTURE.md lists the models' module order");
+    line.split(':')
+        .nth(1)
+        .unwrap()
+        .trim()
+        .trim_end_matches('.')
+        .split(',')
+        .map(|m| m.trim().to_string())
+        .collect()
+}
+
+/// The `crate::MODULE` names a file's code uses (comments and strings left out).
+fn crate_paths(text: &str) -> BTreeSet<String> {
+    let mut strip = Strip::default();
+    let mut names = BTreeSet::new();
+    for line in text.lines() {
+        let code = strip.code(line);
+        for (i, _) in code.match_indices("crate::") {
+            if i > 0 && code[..i].ends_with('$') {
+                continue;
+            }
+            let rest = &code[i + "crate::".len()..];
+            let name: String = rest.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+            if !name.is_empty() {
+                names.insert(name);
+            }
+        }
+        // `use crate::{a::.., b::..}`: the names after the brace.
+        for (i, _) in code.match_indices("crate::{") {
+            let rest = &code[i + "crate::{".len()..];
+            for part in rest.split(['}', ';']).next().unwrap().split(',') {
+                let name: String = part
+                    .trim()
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                if !name.is_empty() {
+                    names.insert(name);
+                }
+            }
+        }
+    }
+    names
+}
+
+#[test]
+fn each_model_module_names_only_the_modules_before_it() {
+    let doc = std::fs::read_to_string(root().join("docs/ARCHITECTURE.md")).unwrap();
+    let order = model_module_order(&doc);
+    assert_eq!(order, ["limits", "config", "components", "scene", "systems"]);
+    let src = root().join("crates/models/src");
+    let mut bad = Vec::new();
+    for (i, module) in order.iter().enumerate() {
+        let mut files_of = Vec::new();
+        let (dir, file) = (src.join(module), src.join(format!("{module}.rs")));
+        if dir.is_dir() {
+            files(&dir, &mut files_of);
+        }
+        if file.is_file() {
+            files_of.push(file.strip_prefix(root()).unwrap().display().to_string());
+        }
+        assert!(!files_of.is_empty(), "no source for models module {module}");
+        let later: BTreeSet<&String> = order[i + 1..].iter().collect();
+        for f in files_of.iter().filter(|f| f.ends_with(".rs")) {
+            let text = std::fs::read_to_string(root().join(f)).unwrap();
+            for name in crate_paths(&text) {
+                if later.contains(&name) {
+                    bad.push(format!("{f} names crate::{name}, a module after {module}"));
+                }
+            }
+        }
+    }
+    assert!(bad.is_empty(), "models modules reaching up:\n{}", bad.join("\n"));
+}
+
+#[test]
+fn crate_paths_are_read_from_code_only() {
+    let text = "use crate::config::Rate; // crate::systems\nuse crate::{engine::Time, output::x};\nlet s = \"crate::scene\";\n/// [`crate::plot`]\n";
+    let names: Vec<String> = crate_paths(text).into_iter().collect();
+    assert_eq!(names, ["config", "engine", "output"]);
+}
+
+#[test]
 fn every_source_file_is_on_the_architecture_map() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let doc = std::fs::read_to_string(root.join("docs/ARCHITECTURE.md")).unwrap();
-    let mut all = Vec::new();
-    files(&root.join("src"), &mut all);
-    all.sort();
+    let doc = std::fs::read_to_string(root().join("docs/ARCHITECTURE.md")).unwrap();
+    let all = all_source_files();
     let missing: Vec<&String> = all
         .iter()
         .filter(|f| {
@@ -48,7 +307,7 @@ fn every_source_file_is_on_the_architecture_map() {
         .collect();
     assert!(
         missing.is_empty(),
-        "docs/ARCHITECTURE.md does not name these files under src/ (add a line for each):\n{}",
+        "docs/ARCHITECTURE.md does not name these source files (add a line for each):\n{}",
         missing.iter().map(|s| s.as_str()).collect::<Vec<_>>().join("\n")
     );
 }
@@ -201,14 +460,11 @@ fn function_lengths_are_counted_through_strings_comments_and_array_types() {
 
 #[test]
 fn no_function_in_src_is_longer_than_a_reader_can_hold() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut all = Vec::new();
-    files(&root.join("src"), &mut all);
-    let long: Vec<String> = all
+    let long: Vec<String> = all_source_files()
         .iter()
         .filter(|f| f.ends_with(".rs"))
         .flat_map(|f| {
-            let text = std::fs::read_to_string(root.join(f)).unwrap();
+            let text = std::fs::read_to_string(root().join(f)).unwrap();
             function_lengths(&text)
                 .into_iter()
                 .filter(|(_, _, n)| *n > MAX_FUNCTION_LINES)

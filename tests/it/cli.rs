@@ -584,7 +584,7 @@ fn system_noise_experiment_prints_the_paper_constant_at_the_end() {
     );
     assert!(tail.len() <= 16, "{out}");
 }
-// Sizes read from input are checked against stated limits (src/limits.rs,
+// Sizes read from input are checked against stated limits (crates/models/src/limits.rs,
 // docs/models.md "Limits") before anything is allocated: a clear error that
 // names the key, the value and the limit, exit 2, never an allocation
 // failure or a panic.

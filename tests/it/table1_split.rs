@@ -1,7 +1,7 @@
 //! Paper 000 Table 1 on the split architecture (§4.5.1, "the myth of the
 //! single bottleneck"): three cells calibrated on the terrain, the fourth
 //! predicted, for each share of the simple/simple cell's shader time that
-//! is geometry (`src/systems/frame_pipeline/table1.rs`,
+//! is geometry (`src/studies/table1.rs`,
 //! `examples/table1_split.rs`, docs/models.md). The findings: random sizes
 //! through the 16-triangle FIFO give the max bound; a direct hand-off or
 //! sizes sorted along the draw give the per-triangle max, about 8% short
@@ -10,10 +10,10 @@
 
 use crate::common::{metric, run};
 use rendersim::scene::config::SizeOrder;
-use rendersim::systems::frame_pipeline::Fidelity;
-use rendersim::systems::frame_pipeline::table1::{
+use rendersim::studies::table1::{
     Calibration, CalibrationError, CellModel, Cells, PAPER, SplitTerrain, TERRAIN, terrain_variant,
 };
+use rendersim::systems::frame_pipeline::Fidelity;
 
 /// One picosecond more per fragment moves a cell by 0.00095 ms on the
 /// terrain's 952k pixels; the searches stop within 0.0001 ms or at one

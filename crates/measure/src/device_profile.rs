@@ -1,0 +1,655 @@
+//! A device profile: the costs of one GPU fitted to measured passes by
+//! `rendersim calibrate` (`calibrate.rs`) and run by `rendersim predict`
+//! (`device_predict.rs`). Stored as TOML under `models/devices/`. The cost
+//! of a pass (all times in nanoseconds; V vertex-shader invocations, B the
+//! vertex batches (warps of 32 lanes) the cache policy cuts, T triangles
+//! drawn, Tc triangles covering a pixel centre, Lv and Lf the vertex and
+//! fragment loop counts, P target pixels; from `coverage.rs`: F fragments,
+//! H = 4Q - F helper lanes of the Q quads, E = 32W - 4Q empty lanes of the
+//! W fragment warps):
+//!
+//! ```text
+//! geometry  G = vertex V + triangle T + covered_triangle Tc
+//!             + (vertex_loop_latency + vertex_lane_per_loop 32B) Lv
+//! fragments R = fragment F + helper_lane H + empty_lane E
+//!             + (fragment_per_loop F + helper_lane_per_loop H
+//!                + empty_lane_per_loop E + fragment_loop_latency) Lf
+//! pass      = pass_overhead + max(clear_store_per_pixel P, G) + R
+//! ```
+//!
+//! Why this shape (fitted to the H200 passes of `docs/measurements`): a
+//! loop iteration of a vertex warp costs the same however many of its 32
+//! lanes hold a vertex, so the vertex loop cost follows the batches, not
+//! the invocations (geometry-only passes of six meshes cost 0.48-0.50 ns
+//! per batch lane and loop once there are a few batches per SM, and
+//! 0.0106-0.0224 ns per invocation and loop); every drawn triangle pays
+//! for setup and culling even when it covers no pixel (`grid:256x256` at
+//! 64x64); and a fragment lane's cost at zero loops (rasterization, quad
+//! packing, blending) and per loop iteration (shader issue) weigh helper
+//! and empty lanes differently, so each has its own cost. The loop
+//! latencies are the occupancy floor (an iteration cannot take less than
+//! its dependent-instruction latency however few warps run); clearing and
+//! storing the target overlaps the geometry work (the H200's geometry-only
+//! passes at 2048x2048 cost the same 0.603 ms under any vertex load up to
+//! it). Every cost is linear, so calibration is one non-negative least
+//! squares fit per side of the max.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::coverage::{Coverage, WARP_QUADS};
+
+/// Largest cost a profile may give one unit of work (a pass, a draw, a
+/// vertex, a pixel): one second. Fitted costs are nanoseconds to
+/// microseconds; the bound keeps a prediction (costs times counts of up to
+/// 2^28 vertices and 2^28 pixels) finite.
+pub const MAX_COST_NS: f64 = 1e9;
+
+/// Fitted costs, nanoseconds.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeviceCosts {
+    /// Fixed cost of a render pass.
+    pub pass_overhead_ns: f64,
+    /// Clearing and storing one target pixel (overlaps the geometry work).
+    pub clear_store_per_pixel_ns: f64,
+    /// One vertex-shader invocation with no loop.
+    pub vertex_ns: f64,
+    /// Setup (and culling) of one drawn triangle.
+    pub triangle_ns: f64,
+    /// Rasterization of one triangle that covers a pixel centre.
+    pub covered_triangle_ns: f64,
+    /// One vertex loop iteration of the whole pass (latency floor).
+    pub vertex_loop_latency_ns: f64,
+    /// One loop iteration of one lane of a vertex batch (32 lanes a batch).
+    pub vertex_lane_per_loop_ns: f64,
+    /// One covered fragment with no loop.
+    pub fragment_ns: f64,
+    /// One helper lane (quad pixel not covered) with no loop.
+    pub helper_lane_ns: f64,
+    /// One empty lane of a fragment warp packed below 32 lanes, no loop.
+    pub empty_lane_ns: f64,
+    /// One loop iteration of one covered fragment.
+    pub fragment_per_loop_ns: f64,
+    /// One loop iteration of one helper lane.
+    pub helper_lane_per_loop_ns: f64,
+    /// One loop iteration of one empty warp lane.
+    pub empty_lane_per_loop_ns: f64,
+    /// One fragment loop iteration of the whole pass (latency floor).
+    pub fragment_loop_latency_ns: f64,
+}
+
+/// The structural part of a profile: what is not fitted.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeviceInfo {
+    /// Short name (`nvidia-h200`).
+    pub name: String,
+    /// Vertex-cache policy predicting vertex-shader invocations.
+    pub vertex_cache: String,
+    /// Shader cores of the unified pool (the H200's 132 SMs; the costs are
+    /// for the whole pool, so this only shapes how the pool is shared).
+    pub shader_cores: u32,
+}
+
+/// How well the fit reproduces its rows, relative errors in percent.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitAccuracy {
+    /// Rows fitted.
+    pub rows: usize,
+    /// Median |error| over the fitted rows.
+    pub median_pct: f64,
+    /// 90th percentile |error|.
+    pub p90_pct: f64,
+    /// Worst |error|.
+    pub worst_pct: f64,
+    /// Median |error| of each row predicted by a fit without it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loo_median_pct: Option<f64>,
+    /// 90th percentile of the leave-one-out |error|.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loo_p90_pct: Option<f64>,
+}
+
+/// A device profile file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeviceProfile {
+    /// What is not fitted.
+    pub device: DeviceInfo,
+    /// The fitted costs.
+    pub costs: DeviceCosts,
+    /// Standard error of each fitted cost (same key), from the fit's
+    /// covariance (zero for a cost the fit pinned at zero).
+    #[serde(default)]
+    pub uncertainty: BTreeMap<String, f64>,
+    /// The fit's accuracy.
+    pub fit: FitAccuracy,
+}
+
+/// Errors reading a profile.
+#[derive(Debug, thiserror::Error)]
+pub enum ProfileError {
+    /// The file cannot be read.
+    #[error("cannot read device profile {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// Not TOML of this shape, or a value out of range: names the file,
+    /// the line and the key (the model files' machinery, `config::load`).
+    #[error(transparent)]
+    Config(#[from] crate::config::ConfigError),
+    /// A profile value out of range (a profile not read from a file).
+    #[error("device profile: {key} = {value}: {why}")]
+    Invalid {
+        /// The key.
+        key: String,
+        /// Its value.
+        value: String,
+        /// What it must be.
+        why: String,
+    },
+}
+
+/// Most shader cores a profile may give (as `gpu.shader_cores`).
+pub const MAX_SHADER_CORES: u32 = 1 << 20;
+
+/// What a pass is made of, for the cost formula.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct PassLoad {
+    /// Target pixels.
+    pub pixels: f64,
+    /// Vertex-shader invocations.
+    pub vertices: f64,
+    /// Vertex batches (warps of up to 32 vertices) the cache policy cuts.
+    pub vertex_batches: f64,
+    /// Triangles drawn (geometry-only passes too).
+    pub triangles: f64,
+    /// Vertex loop iterations.
+    pub vs_loops: f64,
+    /// Fragment loop iterations.
+    pub fs_loops: f64,
+    /// What the triangles cover (all zero for geometry-only passes).
+    pub coverage: Coverage,
+}
+
+/// The terms of a pass's cost.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PassCost {
+    /// Geometry work G, ns.
+    pub geometry_ns: f64,
+    /// Clearing and storing the target, ns.
+    pub clear_ns: f64,
+    /// Fragment work R, ns.
+    pub fragment_ns: f64,
+    /// The part of R that does not depend on the loop count, ns.
+    pub fragment_base_ns: f64,
+    /// The pass, ns.
+    pub pass_ns: f64,
+}
+
+/// Lanes of the fragment warps: covered, helper and empty.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FragmentLanes {
+    /// Covered fragments F.
+    pub covered: f64,
+    /// Helper lanes H = 4Q - F.
+    pub helper: f64,
+    /// Empty lanes E = 32W - 4Q.
+    pub empty: f64,
+}
+
+impl PassLoad {
+    /// The fragment lanes of this pass.
+    pub fn lanes(&self) -> FragmentLanes {
+        let c = &self.coverage;
+        let (f, q4, w32) = (
+            c.fragments as f64,
+            4.0 * c.quads as f64,
+            f64::from(WARP_QUADS * 4) * c.warps as f64,
+        );
+        FragmentLanes {
+            covered: f,
+            helper: (q4 - f).max(0.0),
+            empty: (w32 - q4).max(0.0),
+        }
+    }
+
+    /// The regressors of the cost formula, in [`DeviceCosts::entries`]
+    /// order, with the clear term (index 1) and the geometry terms (2..=6)
+    /// as they enter `max(clear, G)`: the cost is
+    /// `x[0] + max(x[1], sum x[2..=6]) + sum x[7..]`, each `x` times its cost.
+    pub fn regressors(&self) -> [f64; COSTS] {
+        let l = self.lanes();
+        let frag = self.coverage.fragments > 0;
+        let f = |v: f64| if frag { v } else { 0.0 };
+        let lf = self.fs_loops;
+        [
+            1.0,
+            self.pixels,
+            self.vertices,
+            self.triangles,
+            self.coverage.triangles as f64,
+            self.vs_loops,
+            32.0 * self.vertex_batches * self.vs_loops,
+            f(l.covered),
+            f(l.helper),
+            f(l.empty),
+            f(l.covered * lf),
+            f(l.helper * lf),
+            f(l.empty * lf),
+            f(lf),
+        ]
+    }
+}
+
+/// Number of fitted costs.
+pub const COSTS: usize = 14;
+
+impl DeviceCosts {
+    /// The costs as an array, in [`DeviceCosts::entries`] order.
+    pub fn to_array(&self) -> [f64; COSTS] {
+        self.entries().map(|(_, v)| v)
+    }
+
+    /// Costs from an array in [`DeviceCosts::entries`] order.
+    pub fn from_array(b: &[f64; COSTS]) -> DeviceCosts {
+        DeviceCosts {
+            pass_overhead_ns: b[0],
+            clear_store_per_pixel_ns: b[1],
+            vertex_ns: b[2],
+            triangle_ns: b[3],
+            covered_triangle_ns: b[4],
+            vertex_loop_latency_ns: b[5],
+            vertex_lane_per_loop_ns: b[6],
+            fragment_ns: b[7],
+            helper_lane_ns: b[8],
+            empty_lane_ns: b[9],
+            fragment_per_loop_ns: b[10],
+            helper_lane_per_loop_ns: b[11],
+            empty_lane_per_loop_ns: b[12],
+            fragment_loop_latency_ns: b[13],
+        }
+    }
+
+    /// The cost of `load`.
+    pub fn cost(&self, load: &PassLoad) -> PassCost {
+        let x = load.regressors();
+        let b = self.to_array();
+        let term = |i: usize| x[i] * b[i];
+        let geometry_ns: f64 = (2..=6).map(term).sum();
+        let fragment_base_ns: f64 = (7..=9).map(term).sum();
+        let fragment_ns = fragment_base_ns + (10..COSTS).map(term).sum::<f64>();
+        let clear_ns = term(1);
+        PassCost {
+            geometry_ns,
+            clear_ns,
+            fragment_ns,
+            fragment_base_ns,
+            pass_ns: self.pass_overhead_ns + clear_ns.max(geometry_ns) + fragment_ns,
+        }
+    }
+
+    /// `(key, value)` of every cost, in file order.
+    pub fn entries(&self) -> [(&'static str, f64); COSTS] {
+        [
+            ("pass_overhead_ns", self.pass_overhead_ns),
+            ("clear_store_per_pixel_ns", self.clear_store_per_pixel_ns),
+            ("vertex_ns", self.vertex_ns),
+            ("triangle_ns", self.triangle_ns),
+            ("covered_triangle_ns", self.covered_triangle_ns),
+            ("vertex_loop_latency_ns", self.vertex_loop_latency_ns),
+            ("vertex_lane_per_loop_ns", self.vertex_lane_per_loop_ns),
+            ("fragment_ns", self.fragment_ns),
+            ("helper_lane_ns", self.helper_lane_ns),
+            ("empty_lane_ns", self.empty_lane_ns),
+            ("fragment_per_loop_ns", self.fragment_per_loop_ns),
+            ("helper_lane_per_loop_ns", self.helper_lane_per_loop_ns),
+            ("empty_lane_per_loop_ns", self.empty_lane_per_loop_ns),
+            ("fragment_loop_latency_ns", self.fragment_loop_latency_ns),
+        ]
+    }
+}
+
+impl DeviceProfile {
+    /// Reads and validates a profile file.
+    pub fn read(path: &Path) -> Result<DeviceProfile, ProfileError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ProfileError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses and validates profile text (`path` names it in errors): every
+    /// error names the file, the line and the key.
+    pub fn parse(text: &str, path: &Path) -> Result<DeviceProfile, ProfileError> {
+        let src = crate::config::ModelSource::from_text(&path.display().to_string(), text);
+        let table = src.table()?;
+        let p: DeviceProfile = crate::config::deserialize(&table, &src)?;
+        if let Err(ProfileError::Invalid { key, value, why }) = p.validate() {
+            return Err(crate::config::invalid(&src, &key, format!("{value}: {why}"), None).into());
+        }
+        Ok(p)
+    }
+
+    /// The checks every profile keeps, read ([`DeviceProfile::parse`]) or
+    /// about to be written (`rendersim calibrate`): a known vertex-cache
+    /// policy; 1 to [`MAX_SHADER_CORES`] shader cores; every cost finite and
+    /// non-negative, and not all zero (such a profile predicts 0 ns for
+    /// every pass); standard errors only of costs, finite and non-negative;
+    /// at least [`super::calibrate::MIN_ROWS`] rows; the error statistics
+    /// finite, non-negative and ordered (median <= 90th percentile <=
+    /// worst). The error is [`ProfileError::Invalid`] naming the key.
+    pub fn validate(&self) -> Result<(), ProfileError> {
+        let bad = |key: &str, value: String, why: &str| {
+            Err(ProfileError::Invalid {
+                key: key.to_string(),
+                value,
+                why: why.to_string(),
+            })
+        };
+        if let Err(e) = self
+            .device
+            .vertex_cache
+            .parse::<crate::components::vertex_cache::CachePolicy>()
+        {
+            return bad(
+                "device.vertex_cache",
+                format!("{:?}", self.device.vertex_cache),
+                &format!("must be a vertex-cache policy ({e})"),
+            );
+        }
+        let cores = self.device.shader_cores;
+        if !(1..=MAX_SHADER_CORES).contains(&cores) {
+            return bad(
+                "device.shader_cores",
+                cores.to_string(),
+                &format!("must be between 1 and {MAX_SHADER_CORES}"),
+            );
+        }
+        for (key, v) in self.costs.entries() {
+            if !v.is_finite() || v < 0.0 {
+                return bad(&format!("costs.{key}"), v.to_string(), "must be a finite number >= 0");
+            }
+            if v > MAX_COST_NS {
+                return bad(
+                    &format!("costs.{key}"),
+                    format!("{v:e}"),
+                    "is more than a second (1e9 ns) per unit of work; no device is that slow, and a \
+                     prediction with it would overflow",
+                );
+            }
+        }
+        if self.costs.entries().iter().all(|(_, v)| *v == 0.0) {
+            return bad(
+                "costs",
+                "0 for every cost".into(),
+                "such a profile predicts 0 ns for every pass; at least one cost must be above 0",
+            );
+        }
+        let keys = self.costs.entries().map(|(k, _)| k);
+        for (key, v) in &self.uncertainty {
+            if !keys.contains(&key.as_str()) {
+                return bad(
+                    &format!("uncertainty.{key}"),
+                    v.to_string(),
+                    "is no cost key; standard errors are given per cost (the keys of [costs])",
+                );
+            }
+            if !v.is_finite() || *v < 0.0 {
+                return bad(
+                    &format!("uncertainty.{key}"),
+                    v.to_string(),
+                    "must be a finite number >= 0",
+                );
+            }
+        }
+        let f = &self.fit;
+        let min_rows = super::calibrate::MIN_ROWS;
+        if f.rows < min_rows {
+            return bad(
+                "fit.rows",
+                f.rows.to_string(),
+                &format!("a profile is fitted to at least {min_rows} rows"),
+            );
+        }
+        let stats = [
+            ("fit.median_pct", Some(f.median_pct)),
+            ("fit.p90_pct", Some(f.p90_pct)),
+            ("fit.worst_pct", Some(f.worst_pct)),
+            ("fit.loo_median_pct", f.loo_median_pct),
+            ("fit.loo_p90_pct", f.loo_p90_pct),
+        ];
+        for (key, v) in stats {
+            if let Some(v) = v
+                && (!v.is_finite() || v < 0.0)
+            {
+                return bad(key, v.to_string(), "must be a finite percentage >= 0");
+            }
+        }
+        if f.p90_pct < f.median_pct {
+            return bad(
+                "fit.p90_pct",
+                f.p90_pct.to_string(),
+                "must not be below fit.median_pct (a 90th percentile is at least the median)",
+            );
+        }
+        if f.worst_pct < f.p90_pct {
+            return bad(
+                "fit.worst_pct",
+                f.worst_pct.to_string(),
+                "must not be below fit.p90_pct (the worst error is at least the 90th percentile)",
+            );
+        }
+        if let (Some(m), Some(p)) = (f.loo_median_pct, f.loo_p90_pct)
+            && p < m
+        {
+            return bad("fit.loo_p90_pct", p.to_string(), "must not be below fit.loo_median_pct");
+        }
+        Ok(())
+    }
+
+    /// The file text: `header` (comment lines, `# ` added) then the TOML.
+    /// Control characters in `header` (a newline in a `--name`) are
+    /// written escaped (`\n`), so each header line stays one comment line;
+    /// the values are TOML-escaped, so [`DeviceProfile::parse`] reads back
+    /// what was written.
+    pub fn to_toml(&self, header: &[String]) -> String {
+        let comment = |l: &String| -> String {
+            l.chars()
+                .map(|c| {
+                    if c.is_control() {
+                        c.escape_default().collect()
+                    } else {
+                        c.to_string()
+                    }
+                })
+                .collect()
+        };
+        let mut s: String = header.iter().map(|l| format!("# {}\n", comment(l))).collect();
+        s.push('\n');
+        s.push_str(&toml::to_string_pretty(self).unwrap_or_default());
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn shipped(name: &str) -> (String, PathBuf) {
+        let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+            .join("models/devices")
+            .join(name);
+        (std::fs::read_to_string(&path).unwrap(), path)
+    }
+
+    /// The text with the first line starting `key = ` replaced by `line`.
+    fn edit(text: &str, key: &str, line: &str) -> String {
+        let mut done = false;
+        text.lines()
+            .map(|l| {
+                if !done && l.starts_with(&format!("{key} = ")) {
+                    done = true;
+                    format!("{line}\n")
+                } else {
+                    format!("{l}\n")
+                }
+            })
+            .collect()
+    }
+
+    fn line_of(text: &str, key: &str) -> usize {
+        text.lines().position(|l| l.starts_with(&format!("{key} = "))).unwrap() + 1
+    }
+
+    #[test]
+    fn the_shipped_profiles_read_and_validate() {
+        for name in ["nvidia-h200.toml", "llvmpipe.toml"] {
+            let (text, path) = shipped(name);
+            let p = DeviceProfile::parse(&text, &path).unwrap();
+            p.validate().unwrap();
+            // Written again, read back the same.
+            let again = DeviceProfile::parse(&p.to_toml(&["x".into()]), &path).unwrap();
+            assert_eq!(again, p, "{name}");
+        }
+    }
+
+    #[test]
+    fn bad_values_name_file_line_and_key() {
+        let (text, _) = shipped("nvidia-h200.toml");
+        let path = Path::new("dev.toml");
+        for (key, value, want) in [
+            ("worst_pct", "nan", "key `fit.worst_pct`: NaN"),
+            ("worst_pct", "inf", "key `fit.worst_pct`: inf"),
+            ("median_pct", "-1.0", "key `fit.median_pct`: -1"),
+            (
+                "p90_pct",
+                "0.5",
+                "key `fit.p90_pct`: 0.5: must not be below fit.median_pct",
+            ),
+            ("loo_median_pct", "nan", "key `fit.loo_median_pct`"),
+            ("loo_p90_pct", "-inf", "key `fit.loo_p90_pct`"),
+            ("rows", "0", "key `fit.rows`: 0"),
+            ("rows", "-3", "fit.rows"),
+            ("vertex_ns", "nan", "key `costs.vertex_ns`: NaN"),
+            ("vertex_ns", "-inf", "key `costs.vertex_ns`"),
+            ("fragment_ns", "-1e-9", "key `costs.fragment_ns`"),
+            ("shader_cores", "0", "key `device.shader_cores`: 0"),
+            ("shader_cores", "4294967295", "key `device.shader_cores`: 4294967295"),
+            ("vertex_cache", "\"bogus\"", "key `device.vertex_cache`"),
+        ] {
+            let bad = edit(&text, key, &format!("{key} = {value}"));
+            let line = line_of(&bad, key);
+            let e = DeviceProfile::parse(&bad, path).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("dev.toml:{line}: ")), "{key} = {value}: {e}");
+            assert!(e.contains(want), "{key} = {value}: {want:?} not in {e}");
+        }
+        // A standard error of no cost, or a bad one.
+        let bad = text.replace("[uncertainty]\n", "[uncertainty]\nwarp_ns = 1.0\n");
+        let e = DeviceProfile::parse(&bad, path).unwrap_err().to_string();
+        assert!(
+            e.contains("key `uncertainty.warp_ns`") && e.contains("no cost key"),
+            "{e}"
+        );
+        let (head, tail) = text.split_at(text.find("[uncertainty]").unwrap());
+        let bad = format!("{head}{}", edit(tail, "vertex_ns", "vertex_ns = nan"));
+        let e = DeviceProfile::parse(&bad, path).unwrap_err().to_string();
+        assert!(e.contains("uncertainty.vertex_ns") && e.contains("NaN"), "{e}");
+        // Every cost zero: predicts nothing.
+        let mut zero = text.clone();
+        for (k, _) in DeviceCosts::default().entries() {
+            zero = edit(&zero, k, &format!("{k} = 0.0"));
+        }
+        let e = DeviceProfile::parse(&zero, path).unwrap_err().to_string();
+        assert!(e.contains("key `costs`") && e.contains("0 ns for every pass"), "{e}");
+        // Syntax and unknown keys: the file and line too.
+        let e = DeviceProfile::parse("[device]\nname = \"x\"\n[device]: y\n", path)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("dev.toml: malformed TOML") && e.contains("line 3"), "{e}");
+        let e = DeviceProfile::parse(
+            &text.replace("vertex_loop_latency_ns", "vertex_loop_latency_nanos"),
+            path,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("dev.toml:") && e.contains("costs.vertex_loop_latency_nanos"),
+            "{e}"
+        );
+    }
+
+    fn profile(name: String, costs: [f64; COSTS], stats: [f64; 3], loo: Option<(f64, f64)>) -> DeviceProfile {
+        let mut s = stats;
+        s.sort_by(f64::total_cmp);
+        let mut costs = costs;
+        costs[0] = costs[0].max(1e-3);
+        DeviceProfile {
+            device: DeviceInfo {
+                name,
+                vertex_cache: "fifo:32".into(),
+                shader_cores: 132,
+            },
+            costs: DeviceCosts::from_array(&costs),
+            uncertainty: DeviceCosts::from_array(&costs)
+                .entries()
+                .iter()
+                .map(|(k, v)| (k.to_string(), v / 3.0))
+                .collect(),
+            fit: FitAccuracy {
+                rows: 95,
+                median_pct: s[0],
+                p90_pct: s[1],
+                worst_pct: s[2],
+                loo_median_pct: loo.map(|(a, b)| a.min(b)),
+                loo_p90_pct: loo.map(|(a, b)| a.max(b)),
+            },
+        }
+    }
+
+    fn names() -> impl Strategy<Value = String> {
+        prop_oneof![
+            any::<String>(),
+            "[ -~]{0,20}",
+            Just("x\n[device]".to_string()),
+            Just("quote \" and ' and ''' and \"\"\" and \\ back\\slash".to_string()),
+            Just("trailing newline\n".to_string()),
+            Just("\r\n\t\u{0}\u{7f}\u{85}\u{2028}\u{feff}".to_string()),
+            Just("ünïcødé 🎮 日本語".to_string()),
+            Just("\n".to_string()),
+            Just(String::new()),
+        ]
+    }
+
+    proptest! {
+        /// Whatever calibrate writes, `parse` reads back to the same values
+        /// (names with newlines, quotes, backslashes, unicode; any finite
+        /// non-negative numbers).
+        #[test]
+        fn what_calibrate_writes_reads_back(
+            name in names(),
+            costs in proptest::array::uniform14(prop_oneof![Just(0.0), 0.0f64..1e6, 0.0f64..=MAX_COST_NS]),
+            stats in proptest::array::uniform3(0.0f64..1e6),
+            loo in proptest::option::of((0.0f64..1e6, 0.0f64..1e6)),
+        ) {
+            let p = profile(name.clone(), costs, stats, loo);
+            p.validate().unwrap();
+            let header = vec![format!("Device profile {name}: fitted by a test."), "Files: a.csv.".to_string()];
+            let text = p.to_toml(&header);
+            let back = DeviceProfile::parse(&text, Path::new("p.toml"));
+            prop_assert!(back.is_ok(), "{:?}\n{}", back.err().map(|e| e.to_string()), text);
+            prop_assert_eq!(back.unwrap(), p);
+            // The header stays comment lines.
+            prop_assert_eq!(text.lines().take_while(|l| !l.is_empty()).count(), 2, "{}", text);
+        }
+    }
+}

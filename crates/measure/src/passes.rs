@@ -1,0 +1,781 @@
+//! Measured passes as CSV rows, one format for every writer and reader:
+//! `rendersim measure --csv`, `rendersim study --csv` and the shared
+//! measurement files (`docs/measurements/nvidia-h200/load-grid.csv`,
+//! `load-sweep.csv`). The header is [`PASS_HEADER`]:
+//!
+//! ```text
+//! mesh,size,vs_loops,fs_loops,geometry_only,vs_invocations,fs_invocations,pass_time_ns
+//! grid:96x96:optimized,384x384,0,500,false,15570,147456,1512832.0
+//! ```
+//!
+//! A row describes a pass of one layer without the depth test (the format
+//! has no column for either); `pass_time_ns` is the median of the recorded
+//! passes. Files are appended to: the header is written only into a new or
+//! empty file, and a file whose first line is another header is refused
+//! untouched. [`read_passes`] reads the format back, naming file, line and
+//! column of anything that does not parse.
+
+use std::fmt;
+use std::io::{BufRead, Write};
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+use super::fit::median;
+
+/// The first line of every pass CSV.
+pub const PASS_HEADER: &str = "mesh,size,vs_loops,fs_loops,geometry_only,vs_invocations,fs_invocations,pass_time_ns";
+
+/// The column names of [`PASS_HEADER`], in order.
+const COLUMNS: [&str; 8] = [
+    "mesh",
+    "size",
+    "vs_loops",
+    "fs_loops",
+    "geometry_only",
+    "vs_invocations",
+    "fs_invocations",
+    "pass_time_ns",
+];
+
+/// A render target size, written `WxH` (`384x384`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct TargetSize {
+    /// Pixels across.
+    pub width: u32,
+    /// Pixels down.
+    pub height: u32,
+}
+
+impl From<(u32, u32)> for TargetSize {
+    fn from((width, height): (u32, u32)) -> Self {
+        TargetSize { width, height }
+    }
+}
+
+impl fmt::Display for TargetSize {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}x{}", self.width, self.height)
+    }
+}
+
+/// A size that is not `WxH` with whole numbers.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("size {0:?}: expected WxH, e.g. 384x384")]
+pub struct BadSize(pub String);
+
+impl FromStr for TargetSize {
+    type Err = BadSize;
+
+    fn from_str(s: &str) -> Result<Self, BadSize> {
+        s.split_once('x')
+            .and_then(|(w, h)| {
+                Some(TargetSize {
+                    width: w.parse().ok()?,
+                    height: h.parse().ok()?,
+                })
+            })
+            .ok_or_else(|| BadSize(s.to_string()))
+    }
+}
+
+impl Serialize for TargetSize {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+impl<'de> Deserialize<'de> for TargetSize {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let text = <std::borrow::Cow<'de, str>>::deserialize(d)?;
+        text.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+/// One measured pass: what was drawn, the counters, the median time.
+/// Serialized in the order of [`PASS_HEADER`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PassRow {
+    /// Mesh spec (`grid:96x96:optimized`, `random:30000:5000:7`, a `.idx` file).
+    pub mesh: String,
+    /// Render target.
+    pub size: TargetSize,
+    /// Extra vertex-shader ALU loop iterations.
+    pub vs_loops: u32,
+    /// Extra fragment-shader ALU loop iterations.
+    pub fs_loops: u32,
+    /// Every vertex at one point: the geometry stage alone.
+    pub geometry_only: bool,
+    /// Vertex-shader invocations of one pass.
+    pub vs_invocations: u64,
+    /// Fragment-shader invocations of one pass.
+    pub fs_invocations: u64,
+    /// Median pass time, nanoseconds.
+    pub pass_time_ns: f64,
+}
+
+/// What identifies a pass: everything but its results.
+type PassKey = (String, TargetSize, u32, u32, bool);
+
+impl PassRow {
+    fn key(&self) -> PassKey {
+        (
+            self.mesh.clone(),
+            self.size,
+            self.vs_loops,
+            self.fs_loops,
+            self.geometry_only,
+        )
+    }
+}
+
+#[cfg(feature = "wgpu")]
+impl PassRow {
+    /// The row of a measurement of the mesh `spec`; `None` for a pass the
+    /// format cannot describe: more than one layer, the depth test on, or a
+    /// mesh that no spec rebuilds (H1's built-in probes).
+    pub fn from_measurement(spec: &str, m: &super::Measurement) -> Option<PassRow> {
+        let o = &m.options;
+        if o.layers != 1 || o.depth_test || !is_mesh_spec(spec) {
+            return None;
+        }
+        Some(PassRow {
+            mesh: spec.to_string(),
+            size: o.size.into(),
+            vs_loops: o.vs_loops,
+            fs_loops: o.fs_loops,
+            geometry_only: o.geometry_only,
+            vs_invocations: m.vs_invocations,
+            fs_invocations: m.fs_invocations,
+            pass_time_ns: m.pass_time_ns,
+        })
+    }
+}
+
+/// Whether `spec` names a mesh that can be built again: a generator spec
+/// (`grid:`, `strip:`, `random:`) or an `.obj` / `.idx` file.
+pub fn is_mesh_spec(spec: &str) -> bool {
+    let lower = spec.trim().to_ascii_lowercase();
+    crate::scene::generators::spec_index_count(spec).is_some() || lower.ends_with(".obj") || lower.ends_with(".idx")
+}
+
+/// Errors of reading or appending a pass CSV.
+#[derive(Debug, thiserror::Error)]
+pub enum PassCsvError {
+    /// The operating system refused a read or write.
+    #[error("{action} {path}: {source}")]
+    Io {
+        /// What was being done ("reading", "appending to").
+        action: &'static str,
+        /// The file.
+        path: PathBuf,
+        /// The operating system's error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file's first line is not [`PASS_HEADER`].
+    #[error(
+        "{path} has the header {found:?}, not the pass CSV header {PASS_HEADER:?}; \
+         give a new file or one with that header ({path} is left as it was)"
+    )]
+    Header {
+        /// The file.
+        path: PathBuf,
+        /// Its first line.
+        found: String,
+    },
+    /// A file read as pass rows does not start with [`PASS_HEADER`].
+    #[error("{path}: line 1 is the header {found:?}, not the pass CSV header {PASS_HEADER:?}")]
+    NotPasses {
+        /// The file.
+        path: PathBuf,
+        /// Its first line.
+        found: String,
+    },
+    /// A row that does not parse.
+    #[error("{path}: line {line}, column {column} ({name}): {message}")]
+    Row {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line of the row.
+        line: u64,
+        /// 1-based column of the bad field (0 when the whole row is wrong).
+        column: u64,
+        /// The column's name (or "row").
+        name: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+fn io(action: &'static str, path: &Path) -> impl FnOnce(std::io::Error) -> PassCsvError {
+    let path = path.to_path_buf();
+    move |source| PassCsvError::Io { action, path, source }
+}
+
+/// The first line of `path` without its line ending; `None` when the file
+/// does not exist or is empty.
+fn first_line(path: &Path) -> Result<Option<String>, PassCsvError> {
+    let file = match std::fs::File::open(path) {
+        Ok(f) => f,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(io("reading", path)(e)),
+    };
+    let mut line = String::new();
+    std::io::BufReader::new(file)
+        .read_line(&mut line)
+        .map_err(io("reading", path))?;
+    if line.is_empty() {
+        return Ok(None);
+    }
+    Ok(Some(line.trim_end_matches(['\n', '\r']).to_string()))
+}
+
+/// Checks that rows can be appended to `path`: it is new, empty, or starts
+/// with [`PASS_HEADER`]. Returns whether the header still has to be
+/// written. Commands call it before measuring, so a wrong file costs no
+/// device time.
+pub fn check_appendable(path: &Path) -> Result<bool, PassCsvError> {
+    match first_line(path)? {
+        None => Ok(true),
+        Some(line) if line == PASS_HEADER => Ok(false),
+        Some(found) => Err(PassCsvError::Header {
+            path: path.to_path_buf(),
+            found,
+        }),
+    }
+}
+
+/// Appends `rows` to `path` (created when missing), with the header first
+/// when the file is new or empty. A file with another header is refused
+/// and left untouched.
+pub fn append_passes(path: &Path, rows: &[PassRow]) -> Result<(), PassCsvError> {
+    let needs_header = check_appendable(path)?;
+    let mut file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .map_err(io("appending to", path))?;
+    // A last row without its line ending is ended first.
+    let len = file.metadata().map_err(io("appending to", path))?.len();
+    if len > 0 && !ends_with_newline(path)? {
+        file.write_all(b"\n").map_err(io("appending to", path))?;
+    }
+    let mut w = csv::WriterBuilder::new()
+        .has_headers(needs_header)
+        .from_writer(std::io::BufWriter::new(file));
+    for row in rows {
+        w.serialize(row).map_err(|e| csv_io(e, "appending to", path))?;
+    }
+    w.flush().map_err(io("appending to", path))
+}
+
+fn ends_with_newline(path: &Path) -> Result<bool, PassCsvError> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut f = std::fs::File::open(path).map_err(io("reading", path))?;
+    f.seek(SeekFrom::End(-1)).map_err(io("reading", path))?;
+    let mut last = [0u8];
+    f.read_exact(&mut last).map_err(io("reading", path))?;
+    Ok(last[0] == b'\n')
+}
+
+fn csv_io(e: csv::Error, action: &'static str, path: &Path) -> PassCsvError {
+    let source = match e.into_kind() {
+        csv::ErrorKind::Io(e) => e,
+        other => std::io::Error::other(format!("{other:?}")),
+    };
+    PassCsvError::Io {
+        action,
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Largest target side a row may give (as `rendersim predict --size`).
+pub const MAX_TARGET_SIDE: u32 = 16384;
+
+/// Longest pass time a row may give: one hour, in nanoseconds (a render
+/// pass of a measurement takes milliseconds; drivers end one that runs for
+/// seconds).
+pub const MAX_PASS_TIME_NS: f64 = 3.6e12;
+
+/// Reads every row of a pass CSV. The header must be [`PASS_HEADER`]; a
+/// field that does not parse, or a value no measurement gives (a time that
+/// is not a finite number of nanoseconds above 0, a zero target side, a
+/// mesh no spec rebuilds, no vertex-shader invocations), is reported with
+/// its file, line and column.
+pub fn read_passes(path: &Path) -> Result<Vec<PassRow>, PassCsvError> {
+    Ok(read_passes_with_lines(path)?.into_iter().map(|(r, _)| r).collect())
+}
+
+/// [`read_passes`], each row with its 1-based line in the file (for errors
+/// found later, such as a mesh file that cannot be built).
+pub fn read_passes_with_lines(path: &Path) -> Result<Vec<(PassRow, u64)>, PassCsvError> {
+    let file = std::fs::File::open(path).map_err(io("reading", path))?;
+    read_passes_lines_from(file, path)
+}
+
+/// [`read_passes`] from any reader; `path` names it in errors.
+pub fn read_passes_from(reader: impl std::io::Read, path: &Path) -> Result<Vec<PassRow>, PassCsvError> {
+    Ok(read_passes_lines_from(reader, path)?
+        .into_iter()
+        .map(|(r, _)| r)
+        .collect())
+}
+
+/// Checks the values of a row that parsed: `(column, message)` of the first
+/// value no measurement gives.
+fn check_row(row: &PassRow) -> Result<(), (usize, String)> {
+    let mesh = row.mesh.trim();
+    if mesh.is_empty() {
+        return Err((
+            1,
+            "is empty; give the mesh spec the pass drew (grid:96x96, a .idx file, ...)".into(),
+        ));
+    }
+    if mesh.chars().any(char::is_control) {
+        return Err((1, format!("{mesh:?} holds a control character")));
+    }
+    if !is_mesh_spec(mesh) {
+        return Err((
+            1,
+            format!("{mesh:?} is no mesh spec (grid:WxH, strip:WxH, random:T:V:SEED, or a .obj or .idx file)"),
+        ));
+    }
+    let TargetSize { width, height } = row.size;
+    if width == 0 || height == 0 || width > MAX_TARGET_SIDE || height > MAX_TARGET_SIDE {
+        return Err((
+            2,
+            format!("{width}x{height}: width and height must be 1..{MAX_TARGET_SIDE}"),
+        ));
+    }
+    if row.vs_invocations == 0 {
+        return Err((
+            6,
+            "0: a pass that draws a triangle runs the vertex shader at least once".into(),
+        ));
+    }
+    let t = row.pass_time_ns;
+    if !t.is_finite() || t <= 0.0 {
+        return Err((8, format!("{t}: must be a finite number of nanoseconds above 0")));
+    }
+    if t > MAX_PASS_TIME_NS {
+        return Err((
+            8,
+            format!("{t}: more than {MAX_PASS_TIME_NS:e} ns (one hour); no render pass takes that long"),
+        ));
+    }
+    Ok(())
+}
+
+fn read_passes_lines_from(mut reader: impl std::io::Read, path: &Path) -> Result<Vec<(PassRow, u64)>, PassCsvError> {
+    // Lines are counted here from the bytes: the csv reader counts a CRLF
+    // file's lines one short after its first record (the shared H200 files
+    // are CRLF).
+    let mut bytes = Vec::new();
+    reader.read_to_end(&mut bytes).map_err(io("reading", path))?;
+    let newlines: Vec<u64> = bytes
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| **b == b'\n')
+        .map(|(i, _)| i as u64)
+        .collect();
+    // A record's position may point at the line ending before it (after a
+    // CRLF) or at blank lines the reader skips: its line is that of its
+    // first byte that ends no line.
+    let line_at = |p: Option<&csv::Position>| {
+        p.map_or(0, |p| {
+            let start = bytes
+                .iter()
+                .skip(p.byte() as usize)
+                .position(|b| *b != b'\r' && *b != b'\n')
+                .map_or(bytes.len() as u64, |i| p.byte() + i as u64);
+            newlines.partition_point(|&n| n < start) as u64 + 1
+        })
+    };
+    let row_error = |e: csv::Error| {
+        let line = line_at(e.position());
+        row_error(e, path, line)
+    };
+    let mut r = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .from_reader(bytes.as_slice());
+    let header = r.headers().map_err(row_error)?.clone();
+    if header.iter().ne(COLUMNS) {
+        return Err(PassCsvError::NotPasses {
+            path: path.to_path_buf(),
+            found: header.iter().collect::<Vec<_>>().join(","),
+        });
+    }
+    let mut rows = Vec::new();
+    for record in r.records() {
+        let record = record.map_err(row_error)?;
+        let line = line_at(record.position());
+        let raw: RawRow = record.deserialize(Some(&header)).map_err(|e| {
+            // A deserialize error carries no position: the record's.
+            let l = e.position().map_or(line, |p| line_at(Some(p)));
+            self::row_error(e, path, l)
+        })?;
+        let row = raw.row(path, line)?;
+        check_row(&row).map_err(|(column, message)| PassCsvError::Row {
+            path: path.to_path_buf(),
+            line,
+            column: column as u64,
+            name: COLUMNS[column - 1].to_string(),
+            message,
+        })?;
+        rows.push((row, line));
+    }
+    Ok(rows)
+}
+
+/// A row as read, before its size is parsed (so that a bad size is
+/// reported with its line and column like any other field).
+#[derive(Deserialize)]
+struct RawRow {
+    mesh: String,
+    size: String,
+    vs_loops: u32,
+    fs_loops: u32,
+    geometry_only: bool,
+    vs_invocations: u64,
+    fs_invocations: u64,
+    pass_time_ns: f64,
+}
+
+impl RawRow {
+    fn row(self, path: &Path, line: u64) -> Result<PassRow, PassCsvError> {
+        let size = self.size.parse().map_err(|e: BadSize| PassCsvError::Row {
+            path: path.to_path_buf(),
+            line,
+            column: 2,
+            name: "size".into(),
+            message: e.to_string(),
+        })?;
+        Ok(PassRow {
+            mesh: self.mesh,
+            size,
+            vs_loops: self.vs_loops,
+            fs_loops: self.fs_loops,
+            geometry_only: self.geometry_only,
+            vs_invocations: self.vs_invocations,
+            fs_invocations: self.fs_invocations,
+            pass_time_ns: self.pass_time_ns,
+        })
+    }
+}
+
+/// A csv error as a [`PassCsvError`] naming `line` and the column.
+fn row_error(e: csv::Error, path: &Path, line: u64) -> PassCsvError {
+    let path = path.to_path_buf();
+    match e.into_kind() {
+        csv::ErrorKind::Io(source) => PassCsvError::Io {
+            action: "reading",
+            path,
+            source,
+        },
+        csv::ErrorKind::Deserialize { err, .. } => {
+            let column = err.field().map_or(0, |f| f + 1);
+            let name = usize::try_from(column)
+                .ok()
+                .and_then(|c| c.checked_sub(1))
+                .and_then(|i| COLUMNS.get(i))
+                .map_or("row", |n| n)
+                .to_string();
+            PassCsvError::Row {
+                path,
+                line,
+                column,
+                name,
+                message: err.kind().to_string(),
+            }
+        }
+        csv::ErrorKind::UnequalLengths { expected_len, len, .. } => PassCsvError::Row {
+            path,
+            line,
+            column: 0,
+            name: "row".into(),
+            message: format!("{len} fields, expected {expected_len}"),
+        },
+        csv::ErrorKind::Utf8 { err, .. } => PassCsvError::Row {
+            path,
+            line,
+            column: err.field() as u64 + 1,
+            name: COLUMNS.get(err.field()).map_or("row", |n| n).to_string(),
+            message: "not UTF-8".into(),
+        },
+        other => PassCsvError::Row {
+            path,
+            line,
+            column: 0,
+            name: "row".into(),
+            message: format!("{other:?}"),
+        },
+    }
+}
+
+/// Pools repeated measurements of the same pass (same mesh, size, loop
+/// counts and geometry-only flag) into one row each, in the order each
+/// pass was first measured: the recorded pass times of every measurement
+/// are pooled and their median is the row's time; the counters are the
+/// last measurement's.
+pub fn pool(passes: impl IntoIterator<Item = (PassRow, Vec<f64>)>) -> Vec<PassRow> {
+    let mut order: Vec<(PassRow, Vec<f64>)> = Vec::new();
+    let mut index: std::collections::HashMap<PassKey, usize> = std::collections::HashMap::new();
+    for (row, times) in passes {
+        match index.get(&row.key()) {
+            Some(&i) => {
+                let (kept, pooled) = &mut order[i];
+                pooled.extend(times);
+                kept.vs_invocations = row.vs_invocations;
+                kept.fs_invocations = row.fs_invocations;
+            }
+            None => {
+                index.insert(row.key(), order.len());
+                order.push((row, times));
+            }
+        }
+    }
+    order
+        .into_iter()
+        .map(|(mut row, times)| {
+            if let Some(m) = median(&times) {
+                row.pass_time_ns = m;
+            }
+            row
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(mesh: &str, vs: u32, t: f64) -> PassRow {
+        PassRow {
+            mesh: mesh.into(),
+            size: (384, 384).into(),
+            vs_loops: vs,
+            fs_loops: 0,
+            geometry_only: false,
+            vs_invocations: 15570,
+            fs_invocations: 147456,
+            pass_time_ns: t,
+        }
+    }
+
+    fn shared(name: &str) -> PathBuf {
+        Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+            .join("docs/measurements/nvidia-h200")
+            .join(name)
+    }
+
+    #[test]
+    fn the_serialized_header_is_the_pass_header() {
+        assert_eq!(COLUMNS.join(","), PASS_HEADER);
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.serialize(row("grid:96x96:optimized", 0, 55200.0)).unwrap();
+        let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
+        assert_eq!(
+            text,
+            format!("{PASS_HEADER}\ngrid:96x96:optimized,384x384,0,0,false,15570,147456,55200.0\n")
+        );
+    }
+
+    #[test]
+    fn the_shared_h200_files_read_back() {
+        let grid = read_passes(&shared("load-grid.csv")).unwrap();
+        assert_eq!(grid.len(), 19);
+        assert_eq!(grid[3].fs_loops, 7681);
+        assert_eq!(grid[3].pass_time_ns, 22844640.0);
+        assert!(grid[4].geometry_only && grid[4].fs_invocations == 0);
+        let sweep = read_passes(&shared("load-sweep.csv")).unwrap();
+        assert_eq!(sweep.len(), 76);
+        let last = sweep.last().unwrap();
+        assert_eq!(last.mesh, "random:30000:5000:7");
+        assert_eq!(
+            last.size,
+            TargetSize {
+                width: 2048,
+                height: 2048
+            }
+        );
+        // Every row written back reads the same.
+        let dir = tempfile::tempdir().unwrap();
+        let copy = dir.path().join("copy.csv");
+        append_passes(&copy, &sweep).unwrap();
+        assert_eq!(read_passes(&copy).unwrap(), sweep);
+        // Byte for byte, but for the shared file's CRLF line endings.
+        assert_eq!(
+            std::fs::read_to_string(&copy).unwrap(),
+            std::fs::read_to_string(shared("load-sweep.csv"))
+                .unwrap()
+                .replace("\r\n", "\n")
+        );
+    }
+
+    #[test]
+    fn malformed_rows_name_file_line_and_column() {
+        let bad = |text: &str| {
+            read_passes_from(text.as_bytes(), Path::new("x.csv"))
+                .unwrap_err()
+                .to_string()
+        };
+        let e = bad(&format!(
+            "{PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,1.0\ngrid:8x8,64by64,0,0,false,81,4096,1.0\n"
+        ));
+        assert!(e.starts_with("x.csv: line 3, column 2 (size): "), "{e}");
+        assert!(e.contains("expected WxH"), "{e}");
+        let e = bad(&format!("{PASS_HEADER}\ngrid:8x8,64x64,-1,0,false,81,4096,1.0\n"));
+        assert!(e.starts_with("x.csv: line 2, column 3 (vs_loops): "), "{e}");
+        let e = bad(&format!("{PASS_HEADER}\ngrid:8x8,64x64,0,0,yes,81,4096,1.0\n"));
+        assert!(e.starts_with("x.csv: line 2, column 5 (geometry_only): "), "{e}");
+        let e = bad(&format!("{PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,fast\n"));
+        assert!(e.starts_with("x.csv: line 2, column 8 (pass_time_ns): "), "{e}");
+        let e = bad(&format!("{PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81\n"));
+        assert!(
+            e.starts_with("x.csv: line 2, column 0 (row): 6 fields, expected 8"),
+            "{e}"
+        );
+        let e = bad("mesh,size,time\ngrid:8x8,64x64,1.0\n");
+        assert!(e.contains("x.csv: line 1 is the header \"mesh,size,time\""), "{e}");
+        let missing = read_passes(Path::new("/nonexistent/passes.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(missing.starts_with("reading /nonexistent/passes.csv: "), "{missing}");
+    }
+
+    #[test]
+    fn values_no_measurement_gives_name_file_line_and_column() {
+        let bad = |cells: &str| {
+            read_passes_from(
+                format!("{PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,1.0\n{cells}\n").as_bytes(),
+                Path::new("x.csv"),
+            )
+            .unwrap_err()
+            .to_string()
+        };
+        for (cells, want) in [
+            ("grid:8x8,64x64,0,0,false,81,4096,nan", "column 8 (pass_time_ns): NaN"),
+            ("grid:8x8,64x64,0,0,false,81,4096,NaN", "column 8 (pass_time_ns): NaN"),
+            ("grid:8x8,64x64,0,0,false,81,4096,inf", "column 8 (pass_time_ns): inf"),
+            ("grid:8x8,64x64,0,0,false,81,4096,-inf", "column 8 (pass_time_ns): -inf"),
+            ("grid:8x8,64x64,0,0,false,81,4096,-5", "column 8 (pass_time_ns): -5"),
+            ("grid:8x8,64x64,0,0,false,81,4096,0", "column 8 (pass_time_ns): 0"),
+            ("grid:8x8,64x64,0,0,false,81,4096,-0.0", "column 8 (pass_time_ns)"),
+            ("grid:8x8,64x64,0,0,false,81,4096,1e400", "column 8 (pass_time_ns): inf"),
+            ("grid:8x8,64x64,0,0,false,81,4096,1e13", "one hour"),
+            (
+                "grid:axb,64x64,0,0,false,81,4096,1.0",
+                "column 1 (mesh): \"grid:axb\" is no mesh spec",
+            ),
+            ("probe,64x64,0,0,false,81,4096,1.0", "column 1 (mesh)"),
+            (",64x64,0,0,false,81,4096,1.0", "column 1 (mesh): is empty"),
+            ("grid:8x8,0x64,0,0,false,81,4096,1.0", "column 2 (size): 0x64"),
+            ("grid:8x8,64x99999,0,0,false,81,4096,1.0", "column 2 (size): 64x99999"),
+            ("grid:8x8,64x64,0,0,false,0,4096,1.0", "column 6 (vs_invocations): 0"),
+            ("grid:8x8,64x64,0,0,false,-1,4096,1.0", "column 6 (vs_invocations)"),
+            ("grid:8x8,64x64,0,0,false,81,-1,1.0", "column 7 (fs_invocations)"),
+            ("grid:8x8,64x64,0,4294967296,false,81,1,1.0", "column 4 (fs_loops)"),
+        ] {
+            let e = bad(cells);
+            assert!(e.starts_with("x.csv: line 3, column "), "{cells}: {e}");
+            assert!(e.contains(want), "{cells}: {want:?} not in {e}");
+        }
+        // The largest values a measurement can give still read.
+        let ok = read_passes_from(
+            format!("{PASS_HEADER}\ngrid:8x8,16384x16384,4294967295,4294967295,true,1,0,3.6e12\n").as_bytes(),
+            Path::new("x.csv"),
+        )
+        .unwrap();
+        assert_eq!(ok[0].pass_time_ns, 3.6e12);
+    }
+
+    #[test]
+    fn rows_carry_their_lines() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.csv");
+        std::fs::write(
+            &path,
+            format!("{PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,1.0\n\"grid:8x8\",64x64,0,0,false,81,4096,2.0\n"),
+        )
+        .unwrap();
+        let rows = read_passes_with_lines(&path).unwrap();
+        assert_eq!(rows.iter().map(|(_, l)| *l).collect::<Vec<_>>(), [2, 3]);
+        // CRLF line endings (the shared H200 files): the file's own line
+        // numbers, for rows and for every kind of error.
+        let crlf = format!(
+            "{PASS_HEADER}\r\ngrid:8x8,64x64,0,0,false,81,4096,1.0\r\ngrid:8x8,64x64,0,0,false,81,4096,2.0\r\ngrid:8x8,64x64,0,0,false,81,4096,nan\r\n"
+        );
+        let e = read_passes_from(crlf.as_bytes(), Path::new("c.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("c.csv: line 4, column 8 (pass_time_ns)"), "{e}");
+        let e = read_passes_from(crlf.replace("nan", "fast").as_bytes(), Path::new("c.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("c.csv: line 4, column 8 (pass_time_ns)"), "{e}");
+        let e = read_passes_from(crlf.replace(",nan", "").as_bytes(), Path::new("c.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("c.csv: line 4, column 0 (row)"), "{e}");
+        let rows = read_passes_lines_from(crlf.replace("nan", "3.0").as_bytes(), Path::new("c.csv")).unwrap();
+        assert_eq!(rows.iter().map(|(_, l)| *l).collect::<Vec<_>>(), [2, 3, 4]);
+        // A quoted cell holding a line break: the line the record starts on.
+        let multi = crlf.replace(
+            "grid:8x8,64x64,0,0,false,81,4096,2.0",
+            "\"grid:\n8x8\",64x64,0,0,false,81,4096,2.0",
+        );
+        let e = read_passes_from(multi.as_bytes(), Path::new("c.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("c.csv: line 3, column 1 (mesh)") && e.contains("control"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn appending_writes_the_header_once_and_refuses_another_header() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.csv");
+        std::fs::write(&path, "").unwrap();
+        append_passes(&path, &[row("grid:8x8", 0, 1.0)]).unwrap();
+        append_passes(&path, &[row("grid:8x8", 5, 2.5)]).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text.matches("mesh,size").count(), 1, "{text}");
+        assert_eq!(read_passes(&path).unwrap().len(), 2);
+        // A last line without its newline is ended before appending.
+        std::fs::write(&path, text.trim_end()).unwrap();
+        append_passes(&path, &[row("grid:8x8", 6, 3.0)]).unwrap();
+        assert_eq!(read_passes(&path).unwrap().len(), 3);
+
+        let other = dir.path().join("other.csv");
+        std::fs::write(&other, "a,b\n1,2\n").unwrap();
+        let e = append_passes(&other, &[row("grid:8x8", 0, 1.0)])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("other.csv has the header \"a,b\""), "{e}");
+        assert_eq!(std::fs::read_to_string(&other).unwrap(), "a,b\n1,2\n");
+        assert!(check_appendable(&dir.path().join("new.csv")).unwrap());
+    }
+
+    #[test]
+    fn only_rebuildable_meshes_are_specs() {
+        assert!(is_mesh_spec("grid:96x96:optimized") && is_mesh_spec("corpus/fan10.idx"));
+        assert!(!is_mesh_spec("probe") && !is_mesh_spec("grid:axb"));
+    }
+
+    #[test]
+    fn repeated_passes_pool_their_times() {
+        let rows = pool([
+            (row("grid:8x8", 0, 0.0), vec![3.0, 1.0]),
+            (row("grid:8x8", 9, 0.0), vec![7.0]),
+            (row("grid:8x8", 0, 0.0), vec![2.0]),
+        ]);
+        assert_eq!(rows.len(), 2);
+        assert_eq!((rows[0].vs_loops, rows[0].pass_time_ns), (0, 2.0));
+        assert_eq!((rows[1].vs_loops, rows[1].pass_time_ns), (9, 7.0));
+    }
+}

@@ -1,0 +1,278 @@
+//! The swap chain and display: images the GPU renders into, presented with
+//! vsync in one of three modes (paper 004 §4.2: with double buffering and
+//! vsync, a frame that misses a refresh waits for the next one, so the frame
+//! rate snaps to refresh/1, refresh/2, ...).
+//!
+//! - `fifo`: presented frames queue and each vertical blank shows the oldest;
+//!   the GPU waits for a free image (classic double/triple buffering).
+//! - `mailbox`: a newly presented frame replaces a queued one (the replaced
+//!   frame is dropped and its image freed); each vertical blank shows it.
+//! - `immediate` (or vsync off): a presented frame is shown at once (tearing).
+//!
+//! One image is always the front buffer being scanned out; `buffers` counts
+//! all images, so double buffering leaves one image to render into.
+
+use std::collections::VecDeque;
+
+use serde::{Deserialize, Serialize};
+
+use crate::config::Rate;
+
+/// How presented frames reach the screen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PresentMode {
+    /// Queue; one frame per vertical blank; never drops.
+    Fifo,
+    /// Newest replaces the queued frame; shown at the vertical blank.
+    Mailbox,
+    /// Shown at once, no waiting for vertical blank.
+    Immediate,
+}
+
+/// A model file's `[display]`: the swap chain and the display it feeds
+/// (paper 004 §4.2), shared by every system that has one.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DisplayConfig {
+    /// Refresh rate.
+    pub refresh: Rate,
+    /// Wait for vertical blank (false = `immediate`, whatever `present_mode` says).
+    pub vsync: bool,
+    /// Swap-chain images (2 = double, 3 = triple buffering).
+    pub buffers: u32,
+    /// How presented frames reach the screen.
+    pub present_mode: PresentMode,
+}
+
+impl DisplayConfig {
+    /// The present mode the run follows: `present_mode`, or `immediate` when
+    /// `vsync` is off. The one place this rule is written: every system and
+    /// study that reads a `[display]` asks here.
+    pub fn effective_mode(&self) -> PresentMode {
+        if self.vsync {
+            self.present_mode
+        } else {
+            PresentMode::Immediate
+        }
+    }
+
+    /// Whether presented frames wait for a vertical blank (`fifo` or
+    /// `mailbox` with vsync on).
+    pub fn waits_for_vblank(&self) -> bool {
+        self.effective_mode() != PresentMode::Immediate
+    }
+
+    /// Checks the display every system can run: a refresh period of at
+    /// least [`crate::limits::MIN_REFRESH_PERIOD_PS`] (every refresh is an
+    /// event) and 2 to 16 swap-chain images; the error is (key, message).
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        if self.refresh.period.0 < crate::limits::MIN_REFRESH_PERIOD_PS {
+            return Err((
+                "display.refresh",
+                format!(
+                    "a refresh period of {} is shorter than the limit of 1us (1 MHz): every refresh is an event",
+                    self.refresh.period
+                ),
+            ));
+        }
+        if !(2..=16).contains(&self.buffers) {
+            return Err((
+                "display.buffers",
+                format!("must be between 2 and 16 swap-chain images, got {}", self.buffers),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl Default for DisplayConfig {
+    fn default() -> Self {
+        DisplayConfig {
+            refresh: Rate::parse("60Hz").expect("valid literal"),
+            vsync: true,
+            buffers: 2,
+            present_mode: PresentMode::Fifo,
+        }
+    }
+}
+
+/// A frame identifier (its index).
+pub type FrameId = u64;
+
+/// The images and what is on screen.
+///
+/// The renderer [`acquire`](SwapChain::acquire)s a free image, renders and
+/// [`present`](SwapChain::present)s it; the display shows it at a
+/// [`vblank`](SwapChain::vblank) (or at once in `immediate` mode). With two
+/// buffers and `fifo`, one image is on screen and one is rendered into, so
+/// the renderer waits for every vertical blank:
+///
+/// ```
+/// use rendersim_models::components::swap_chain::{PresentMode, SwapChain};
+///
+/// let mut chain = SwapChain::new(2, PresentMode::Fifo);
+/// assert!(chain.acquire()); // the back buffer
+/// assert!(!chain.acquire()); // the other image is the (blank) front
+/// chain.present(0);
+/// assert_eq!(chain.queued(), 1);
+/// let flip = chain.vblank();
+/// assert_eq!((flip.shown, flip.freed), (Some(0), true));
+/// assert_eq!(chain.front(), Some(0));
+/// assert!(chain.acquire()); // the old front image is free again
+///
+/// // Mailbox with three images: a newer frame replaces a queued one.
+/// let mut mailbox = SwapChain::new(3, PresentMode::Mailbox);
+/// assert!(mailbox.acquire());
+/// mailbox.present(0);
+/// assert!(mailbox.acquire());
+/// assert_eq!(mailbox.present(1).dropped, Some(0)); // never shown
+/// assert_eq!(mailbox.vblank().shown, Some(1));
+/// ```
+#[derive(Debug, Clone)]
+pub struct SwapChain {
+    mode: PresentMode,
+    free: u32,
+    queued: VecDeque<FrameId>,
+    front: Option<FrameId>,
+}
+
+/// What a present or a vertical blank did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Flip {
+    /// The frame that became visible now, if any.
+    pub shown: Option<FrameId>,
+    /// A frame discarded without ever being shown (mailbox), if any.
+    pub dropped: Option<FrameId>,
+    /// Whether an image became free (a waiting GPU may acquire it).
+    pub freed: bool,
+}
+
+impl SwapChain {
+    /// A chain of `buffers` images (>= 2) in `mode`.
+    pub fn new(buffers: u32, mode: PresentMode) -> Self {
+        debug_assert!(buffers >= 2);
+        SwapChain {
+            mode,
+            free: buffers - 1,
+            queued: VecDeque::new(),
+            front: None,
+        }
+    }
+
+    /// The present mode.
+    pub fn mode(&self) -> PresentMode {
+        self.mode
+    }
+
+    /// Takes a free image to render into; false if none is free.
+    #[inline]
+    pub fn acquire(&mut self) -> bool {
+        if self.free > 0 {
+            self.free -= 1;
+            true
+        } else {
+            false
+        }
+    }
+
+    /// Frames waiting for a vertical blank.
+    pub fn queued(&self) -> usize {
+        self.queued.len()
+    }
+
+    /// The frame on screen.
+    pub fn front(&self) -> Option<FrameId> {
+        self.front
+    }
+
+    /// The GPU finished rendering `frame` into its image and presents it.
+    pub fn present(&mut self, frame: FrameId) -> Flip {
+        match self.mode {
+            PresentMode::Immediate => {
+                // The old front image (at start-up the blank one) is freed.
+                self.front = Some(frame);
+                self.free += 1;
+                Flip {
+                    shown: Some(frame),
+                    dropped: None,
+                    freed: true,
+                }
+            }
+            PresentMode::Fifo => {
+                self.queued.push_back(frame);
+                Flip::default()
+            }
+            PresentMode::Mailbox => {
+                let dropped = self.queued.pop_front();
+                self.queued.push_back(frame);
+                if dropped.is_some() {
+                    self.free += 1;
+                }
+                Flip {
+                    shown: None,
+                    dropped,
+                    freed: dropped.is_some(),
+                }
+            }
+        }
+    }
+
+    /// A vertical blank: the oldest queued frame (if any) becomes the front
+    /// buffer and the old front image is freed.
+    pub fn vblank(&mut self) -> Flip {
+        if self.mode == PresentMode::Immediate {
+            return Flip::default();
+        }
+        match self.queued.pop_front() {
+            Some(f) => {
+                self.front = Some(f);
+                self.free += 1;
+                Flip {
+                    shown: Some(f),
+                    dropped: None,
+                    freed: true,
+                }
+            }
+            None => Flip::default(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn double_buffered_fifo_blocks_until_vblank() {
+        let mut s = SwapChain::new(2, PresentMode::Fifo);
+        assert!(s.acquire());
+        assert!(!s.acquire());
+        s.present(0);
+        assert!(!s.acquire());
+        let f = s.vblank();
+        assert_eq!(f.shown, Some(0));
+        assert!(s.acquire());
+    }
+
+    #[test]
+    fn mailbox_replaces_and_drops() {
+        let mut s = SwapChain::new(3, PresentMode::Mailbox);
+        assert!(s.acquire());
+        s.present(0);
+        assert!(s.acquire());
+        let f = s.present(1);
+        assert_eq!(f.dropped, Some(0));
+        assert!(s.acquire());
+        assert_eq!(s.vblank().shown, Some(1));
+    }
+
+    #[test]
+    fn immediate_shows_at_once() {
+        let mut s = SwapChain::new(2, PresentMode::Immediate);
+        assert!(s.acquire());
+        assert_eq!(s.present(7).shown, Some(7));
+        assert!(s.acquire());
+        assert_eq!(s.vblank(), Flip::default());
+    }
+}

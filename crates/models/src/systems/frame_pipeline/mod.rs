@@ -1,0 +1,43 @@
+//! The single-GPU frame pipeline (paper 000 §3-4, Figure 4; paper 004 §4):
+//! CPU thread -> command FIFO -> GPU front end -> geometry -> triangle FIFO
+//! -> fragment -> swap chain -> display, with system-task noise.
+//!
+//! - `config`: the model file;
+//! - `workload`: compiling scenes into draws and meshes;
+//! - `model`: the kernel model (state and event dispatch);
+//! - `cpu`, `gpu`, `display`: the units' event handlers;
+//! - `closed_form`: the `draw`-fidelity formula;
+//! - `quiet`: front-end completions kept out of the event queue at `draw`
+//!   fidelity (they only start a hand-off);
+//! - `accounting`: state clocks, trace timeline, each unit's mode;
+//! - `critical_path`: bottleneck attribution along the critical path;
+//! - `records`: per-frame records and the PresentMon-style table;
+//! - `report`: the human-readable report of a run;
+//! - `run`: build and run a model;
+//! - `validate`: what a model is refused for before it runs;
+//! - `summary`: the run's summary (`summary.json`).
+//!
+//! Studies that run this system whole (isolation, Table 1, the Figure 4
+//! timeline) live above it, in the `rendersim` crate's `studies`.
+
+pub mod accounting;
+pub mod closed_form;
+pub mod config;
+mod cpu;
+pub mod critical_path;
+mod display;
+mod gpu;
+pub mod model;
+mod quiet;
+pub mod records;
+pub mod report;
+pub mod run;
+pub mod summary;
+pub mod system;
+pub mod validate;
+pub mod workload;
+
+pub use config::{Fidelity, FramePipelineConfig};
+pub use model::FramePipeline;
+pub use run::{PipelineRun, run_pipeline};
+pub use validate::validate;

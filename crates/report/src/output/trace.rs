@@ -1,0 +1,291 @@
+//! Chrome / Perfetto trace JSON (the "Trace Event Format"), written as the
+//! simulation makes it: memory stays flat however many frames are traced.
+//!
+//! A [`TraceWriter`] knows nothing of the systems: they name their own
+//! processes and tracks and hand it spans (complete `"X"` events), instants
+//! and counters in simulated time. The file opens in ui.perfetto.dev or
+//! chrome://tracing, which sort events by time themselves, so events may be
+//! written in any order.
+//!
+//! Write errors are kept, not raised on the hot path: the first one stops
+//! further writing and is returned by [`TraceWriter::finish`].
+//!
+//! ```
+//! use rendersim_engine::Time;
+//! use rendersim_report::output::trace::TraceWriter;
+//!
+//! let mut t = TraceWriter::new(Box::new(Vec::new()));
+//! t.process(1, "example");
+//! t.thread(1, 1, "CPU");
+//! t.span(1, 1, "work", Time(0), Time(2_000_000), None);
+//! t.counter(1, "queue", "used", Time(1_000_000), 3);
+//! assert_eq!(t.finish().unwrap(), 4); // two names, a span and a counter
+//! ```
+
+use std::io::Write;
+
+use serde::Serialize;
+
+use crate::engine::Time;
+
+/// Microseconds (the format's unit) from picoseconds.
+fn us(t: Time) -> f64 {
+    t.0 as f64 / 1e6
+}
+
+/// One event of the Trace Event Format (only the fields rendersim uses).
+#[derive(Debug, Serialize)]
+struct Event<'a> {
+    /// Phase: `M` metadata, `X` complete span, `i` instant, `C` counter.
+    ph: &'static str,
+    pid: u32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    tid: Option<u32>,
+    name: &'a str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ts: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    dur: Option<f64>,
+    /// Instant scope (`t`: the thread).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    s: Option<&'static str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    args: Option<Args<'a>>,
+}
+
+/// An event's `args`.
+#[derive(Debug, Serialize)]
+#[serde(untagged)]
+enum Args<'a> {
+    Name { name: &'a str },
+    SortIndex { sort_index: u32 },
+    One(std::collections::BTreeMap<&'a str, u64>),
+}
+
+/// A trace being written (see the module documentation).
+pub struct TraceWriter {
+    out: Box<dyn Write + Send>,
+    events: u64,
+    error: Option<std::io::Error>,
+}
+
+impl std::fmt::Debug for TraceWriter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TraceWriter").field("events", &self.events).finish()
+    }
+}
+
+impl TraceWriter {
+    /// Starts a trace on `out` (buffer it: events are written one by one).
+    pub fn new(out: Box<dyn Write + Send>) -> Self {
+        let mut t = TraceWriter {
+            out,
+            events: 0,
+            error: None,
+        };
+        let r = t.out.write_all(b"{\"displayTimeUnit\":\"ms\",\"traceEvents\":[");
+        t.keep(r);
+        t
+    }
+
+    fn keep(&mut self, r: std::io::Result<()>) {
+        if let Err(e) = r
+            && self.error.is_none()
+        {
+            self.error = Some(e);
+        }
+    }
+
+    fn event(&mut self, e: &Event<'_>) {
+        if self.error.is_some() {
+            return;
+        }
+        let r = (|| {
+            if self.events > 0 {
+                self.out.write_all(b",")?;
+            }
+            serde_json::to_writer(&mut self.out, e).map_err(std::io::Error::from)
+        })();
+        self.events += 1;
+        self.keep(r);
+    }
+
+    /// Names process `pid` (a group of tracks) and sorts it by its number.
+    pub fn process(&mut self, pid: u32, name: &str) {
+        self.event(&Event {
+            ph: "M",
+            pid,
+            tid: None,
+            name: "process_name",
+            ts: None,
+            dur: None,
+            s: None,
+            args: Some(Args::Name { name }),
+        });
+    }
+
+    /// Sorts process `pid` by `index` among the processes.
+    pub fn process_order(&mut self, pid: u32, index: u32) {
+        self.event(&Event {
+            ph: "M",
+            pid,
+            tid: None,
+            name: "process_sort_index",
+            ts: None,
+            dur: None,
+            s: None,
+            args: Some(Args::SortIndex { sort_index: index }),
+        });
+    }
+
+    /// Names track `tid` of process `pid`.
+    pub fn thread(&mut self, pid: u32, tid: u32, name: &str) {
+        self.event(&Event {
+            ph: "M",
+            pid,
+            tid: Some(tid),
+            name: "thread_name",
+            ts: None,
+            dur: None,
+            s: None,
+            args: Some(Args::Name { name }),
+        });
+    }
+
+    /// Names track `tid` and sorts it by its number.
+    pub fn track(&mut self, pid: u32, tid: u32, name: &str) {
+        self.thread(pid, tid, name);
+        self.event(&Event {
+            ph: "M",
+            pid,
+            tid: Some(tid),
+            name: "thread_sort_index",
+            ts: None,
+            dur: None,
+            s: None,
+            args: Some(Args::SortIndex { sort_index: tid }),
+        });
+    }
+
+    /// A span from `start` to `end` on a track, with an optional numeric
+    /// argument (`("index", 3)`).
+    pub fn span(&mut self, pid: u32, tid: u32, name: &str, start: Time, end: Time, arg: Option<(&str, u64)>) {
+        self.event(&Event {
+            ph: "X",
+            pid,
+            tid: Some(tid),
+            name,
+            ts: Some(us(start)),
+            dur: Some(us(end) - us(start)),
+            s: None,
+            args: arg.map(|(k, v)| Args::One([(k, v)].into_iter().collect())),
+        });
+    }
+
+    /// A point in time on a track.
+    pub fn instant(&mut self, pid: u32, tid: u32, name: &str, at: Time) {
+        self.event(&Event {
+            ph: "i",
+            pid,
+            tid: Some(tid),
+            name,
+            ts: Some(us(at)),
+            dur: None,
+            s: Some("t"),
+            args: None,
+        });
+    }
+
+    /// A counter track `name` taking `value` (shown as `series`) from `at` on.
+    pub fn counter(&mut self, pid: u32, name: &str, series: &str, at: Time, value: u64) {
+        self.event(&Event {
+            ph: "C",
+            pid,
+            tid: None,
+            name,
+            ts: Some(us(at)),
+            dur: None,
+            s: None,
+            args: Some(Args::One([(series, value)].into_iter().collect())),
+        });
+    }
+
+    /// Events written so far.
+    pub fn events(&self) -> u64 {
+        self.events
+    }
+
+    /// Closes the trace and flushes it; returns the number of events, or the
+    /// first write error.
+    pub fn finish(mut self) -> std::io::Result<u64> {
+        let r = self.out.write_all(b"]}").and_then(|()| self.out.flush());
+        self.keep(r);
+        match self.error.take() {
+            Some(e) => Err(e),
+            None => Ok(self.events),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::{Arc, Mutex};
+
+    /// A `Write` whose bytes can be read after the writer is consumed.
+    #[derive(Clone, Default)]
+    struct Shared(Arc<Mutex<Vec<u8>>>);
+    impl Write for Shared {
+        fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+            self.0.lock().unwrap().extend_from_slice(b);
+            Ok(b.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn events_form_one_valid_document() {
+        let buf = Shared::default();
+        let mut t = TraceWriter::new(Box::new(buf.clone()));
+        t.process(1, "p \"quoted\", with comma");
+        t.track(1, 2, "GPU");
+        t.span(1, 2, "draw", Time(1_000_000), Time(3_500_000), Some(("index", 7)));
+        t.instant(1, 2, "input", Time(0));
+        t.counter(1, "FIFO", "used", Time(2_000_000), 4);
+        assert_eq!(t.finish().unwrap(), 6);
+        let v: serde_json::Value = serde_json::from_slice(&buf.0.lock().unwrap()).unwrap();
+        let ev = v["traceEvents"].as_array().unwrap();
+        assert_eq!(ev.len(), 6);
+        assert_eq!(ev[0]["args"]["name"], "p \"quoted\", with comma");
+        assert_eq!(ev[3]["ts"], 1.0);
+        assert_eq!(ev[3]["dur"], 2.5);
+        assert_eq!(ev[3]["args"]["index"], 7);
+        assert_eq!(ev[4]["s"], "t");
+        assert_eq!(ev[5]["args"]["used"], 4);
+        assert_eq!(v["displayTimeUnit"], "ms");
+    }
+
+    #[test]
+    fn an_empty_trace_is_valid_and_the_first_error_is_kept() {
+        let buf = Shared::default();
+        assert_eq!(TraceWriter::new(Box::new(buf.clone())).finish().unwrap(), 0);
+        let v: serde_json::Value = serde_json::from_slice(&buf.0.lock().unwrap()).unwrap();
+        assert_eq!(v["traceEvents"].as_array().unwrap().len(), 0);
+
+        struct Full;
+        impl Write for Full {
+            fn write(&mut self, _: &[u8]) -> std::io::Result<usize> {
+                Err(std::io::Error::new(std::io::ErrorKind::StorageFull, "disk full"))
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                Ok(())
+            }
+        }
+        let mut t = TraceWriter::new(Box::new(Full));
+        t.span(1, 1, "x", Time(0), Time(1), None);
+        let e = t.finish().unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::StorageFull);
+    }
+}

@@ -1,0 +1,268 @@
+//! Bottleneck isolation as paper 004 §4.1 teaches: reduce one subsystem's
+//! load at a time (CPU work; the GPU front end's command processing: per
+//! command, per state change, clear and swap; geometry work per vertex and
+//! triangle; raster work per fragment) and see which reduction moves the
+//! frame time. Vsync is switched off by default, as §4.2 advises, so refresh
+//! quantization does not hide a change.
+//!
+//! The verdict: a reduction counts when it moves the mean frame time down by
+//! more than [`MIN_CHANGE`] (1%); the one that moves it most is the
+//! bottleneck, unless others come within the tie tolerance of it (by
+//! default [`DEFAULT_TIE_TOLERANCE`]: reductions within 2% of the best
+//! frame-time reduction, relative to it) — then the result is a tie listing
+//! them all, since one run cannot tell them apart (two stages in series,
+//! say, with equal loads).
+
+use std::path::Path;
+
+use crate::components::distribution::Dist;
+use crate::engine::Duration;
+
+use crate::systems::error::SystemError;
+use crate::systems::frame_pipeline::config::{FramePipelineConfig, StateCosts, WorkloadConfig};
+use crate::systems::frame_pipeline::run::run_pipeline;
+
+/// One variant's result.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Variant {
+    /// `baseline`, `cpu`, `front_end`, `geometry`, `raster` (scenes);
+    /// `baseline`, `cpu`, `front_end`, `gpu` (fixed workloads).
+    pub name: String,
+    /// Mean frame time (ms).
+    pub frame_time_ms: f64,
+    /// Mean display interval (ms).
+    pub display_interval_ms: f64,
+    /// Relative change of the frame time against the baseline.
+    pub change: f64,
+}
+
+/// The isolation report.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Isolation {
+    /// Load factor applied to the reduced subsystem.
+    pub factor: f64,
+    /// Whether vsync stayed on.
+    pub vsync: bool,
+    /// Baseline and the reductions.
+    pub variants: Vec<Variant>,
+    /// The subsystem whose reduction moved the frame time most; `tie` when
+    /// several are tied (see `tied`); `none` if no reduction moved it by
+    /// more than 1%.
+    pub bottleneck: String,
+    /// Every subsystem whose reduction came within the tie tolerance of the
+    /// best (the bottleneck alone when there is no tie; empty for `none`).
+    pub tied: Vec<String>,
+    /// Reductions of the frame time within this fraction of the best
+    /// reduction are tied.
+    pub tie_tolerance: f64,
+    /// Wall time of all runs, seconds.
+    pub wall_seconds: f64,
+}
+
+/// A reduction must lower the mean frame time by more than this fraction
+/// to count.
+pub const MIN_CHANGE: f64 = 0.01;
+/// The default tie tolerance: reductions within 2% of the best one are tied.
+pub const DEFAULT_TIE_TOLERANCE: f64 = 0.02;
+
+/// How to isolate.
+#[derive(Debug, Clone, Copy)]
+pub struct IsolateOptions {
+    /// Load factor of the reduced subsystem, in (0, 1).
+    pub factor: f64,
+    /// Keep vsync on.
+    pub keep_vsync: bool,
+    /// Reductions within this fraction of the best reduction are tied, in [0, 1).
+    pub tie_tolerance: f64,
+}
+
+impl Default for IsolateOptions {
+    fn default() -> Self {
+        IsolateOptions {
+            factor: 0.5,
+            keep_vsync: false,
+            tie_tolerance: DEFAULT_TIE_TOLERANCE,
+        }
+    }
+}
+
+fn scale(d: Duration, k: f64) -> Duration {
+    Duration::from_ps_f64(d.0 as f64 * k)
+}
+
+fn scale_states(s: &mut StateCosts, k: f64) {
+    for d in [&mut s.shader, &mut s.texture, &mut s.material, &mut s.matrix] {
+        *d = scale(*d, k);
+    }
+}
+
+fn scale_dist(d: &Dist<Duration>, k: f64) -> Dist<Duration> {
+    d.scaled_as(k)
+}
+
+/// The model with one subsystem's load multiplied by `k`.
+pub fn reduced(cfg: &FramePipelineConfig, which: &str, k: f64) -> FramePipelineConfig {
+    let mut c = cfg.clone();
+    match which {
+        "cpu" => {
+            let p = &mut c.cpu;
+            p.input_sampling = scale(p.input_sampling, k);
+            p.non_render = scale_dist(&p.non_render, k);
+            p.per_object = scale(p.per_object, k);
+            p.per_draw = scale(p.per_draw, k);
+            p.clear = scale(p.clear, k);
+            p.swap = scale(p.swap, k);
+            scale_states(&mut p.state_change, k);
+            if let WorkloadConfig::Fixed(f) = &mut c.workload {
+                f.cpu = scale_dist(&f.cpu, k);
+            }
+        }
+        "front_end" => {
+            // Everything the front end executes itself (the clear and swap
+            // run there in this model, see docs/models.md).
+            let g = &mut c.gpu;
+            g.command = scale(g.command, k);
+            g.clear = scale(g.clear, k);
+            g.swap = scale(g.swap, k);
+            scale_states(&mut g.state_change, k);
+        }
+        "geometry" => {
+            let g = &mut c.gpu.geometry;
+            g.index_fetch = scale(g.index_fetch, k);
+            g.vertex_shader = scale(g.vertex_shader, k);
+            g.triangle_setup = scale(g.triangle_setup, k);
+        }
+        "raster" => {
+            let f = &mut c.gpu.fragment;
+            f.per_fragment = scale(f.per_fragment, k);
+            f.per_rejected_fragment = scale(f.per_rejected_fragment, k);
+        }
+        "gpu" => {
+            if let WorkloadConfig::Fixed(f) = &mut c.workload {
+                f.gpu = scale_dist(&f.gpu, k);
+            }
+        }
+        _ => {}
+    }
+    c
+}
+
+/// The verdict over the reductions (`variants` without the baseline):
+/// (bottleneck, tied subsystems), see the module docs.
+pub fn verdict(reductions: &[Variant], tie_tolerance: f64) -> (String, Vec<String>) {
+    let best = reductions
+        .iter()
+        .map(|v| v.change)
+        .filter(|c| *c < -MIN_CHANGE)
+        .min_by(f64::total_cmp);
+    let Some(best) = best else {
+        return ("none".to_string(), Vec::new());
+    };
+    let tied: Vec<String> = reductions
+        .iter()
+        .filter(|v| v.change < -MIN_CHANGE && v.change - best <= tie_tolerance * best.abs())
+        .map(|v| v.name.clone())
+        .collect();
+    let bottleneck = match tied.as_slice() {
+        [one] => one.clone(),
+        _ => "tie".to_string(),
+    };
+    (bottleneck, tied)
+}
+
+fn check_options(o: &IsolateOptions) -> Result<(), SystemError> {
+    if !(o.factor.is_finite() && o.factor > 0.0 && o.factor < 1.0) {
+        return Err(SystemError::Invalid {
+            key: "--factor".into(),
+            message: format!("must be between 0 and 1 (exclusive), got {}", o.factor),
+        });
+    }
+    if !(o.tie_tolerance.is_finite() && (0.0..1.0).contains(&o.tie_tolerance)) {
+        return Err(SystemError::Invalid {
+            key: "--tie-tolerance".into(),
+            message: format!("must be at least 0 and less than 1, got {}", o.tie_tolerance),
+        });
+    }
+    Ok(())
+}
+
+/// Runs the baseline and each reduction.
+pub fn isolate(cfg: &FramePipelineConfig, base_dir: &Path, options: IsolateOptions) -> Result<Isolation, SystemError> {
+    check_options(&options)?;
+    let IsolateOptions {
+        factor,
+        keep_vsync,
+        tie_tolerance,
+    } = options;
+    let start = std::time::Instant::now();
+    let mut base = cfg.clone();
+    if !keep_vsync {
+        base.display.vsync = false;
+    }
+    let names: &[&str] = match base.workload {
+        WorkloadConfig::Fixed(_) => &["baseline", "cpu", "front_end", "gpu"],
+        WorkloadConfig::Scene(_) => &["baseline", "cpu", "front_end", "geometry", "raster"],
+    };
+    let mut variants = Vec::new();
+    let mut base_ft = 0.0;
+    for name in names {
+        let c = if *name == "baseline" {
+            base.clone()
+        } else {
+            reduced(&base, name, factor)
+        };
+        let r = run_pipeline(c, base_dir, None)?;
+        let m = &r.summary["metrics"];
+        let ft = m["frame_time_ms"]["mean"].as_f64().unwrap_or(0.0);
+        if *name == "baseline" {
+            base_ft = ft;
+        }
+        variants.push(Variant {
+            name: name.to_string(),
+            frame_time_ms: ft,
+            display_interval_ms: m["display_interval_ms"]["mean"].as_f64().unwrap_or(0.0),
+            change: if base_ft > 0.0 { (ft - base_ft) / base_ft } else { 0.0 },
+        });
+    }
+    let (bottleneck, tied) = verdict(&variants[1..], tie_tolerance);
+    Ok(Isolation {
+        factor,
+        vsync: keep_vsync,
+        variants,
+        bottleneck,
+        tied,
+        tie_tolerance,
+        wall_seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn reductions(changes: &[(&str, f64)]) -> Vec<Variant> {
+        changes
+            .iter()
+            .map(|(n, c)| Variant {
+                name: n.to_string(),
+                frame_time_ms: 10.0 * (1.0 + c),
+                display_interval_ms: 0.0,
+                change: *c,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn one_winner_a_tie_or_none() {
+        let v = reductions(&[("cpu", -0.40), ("front_end", 0.0), ("geometry", -0.05)]);
+        assert_eq!(verdict(&v, 0.02), ("cpu".into(), vec!["cpu".into()]));
+        // -0.395 is within 2% of -0.40 (0.008); -0.39 is not.
+        let v = reductions(&[("cpu", -0.40), ("geometry", -0.395), ("raster", -0.39)]);
+        assert_eq!(verdict(&v, 0.02), ("tie".into(), vec!["cpu".into(), "geometry".into()]));
+        assert_eq!(verdict(&v, 0.0).0, "cpu");
+        assert_eq!(verdict(&v, 0.05).1.len(), 3);
+        // Changes of 1% or less do not count, tied or not.
+        let v = reductions(&[("cpu", -0.01), ("raster", -0.005), ("geometry", 0.02)]);
+        assert_eq!(verdict(&v, 0.5), ("none".into(), vec![]));
+    }
+}

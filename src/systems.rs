@@ -1,0 +1,38 @@
+//! Every system the tool runs: the models' systems
+//! ([`rendersim_models::systems`], re-exported here whole) and the studies
+//! registered as systems ([`STUDIES`]). [`systems`], [`run_model`],
+//! [`traceless_system`] and [`tracing_systems`] here know both; the models'
+//! own functions of the same names, and [`SYSTEMS`], know only the models'
+//! systems (a study that runs a system cannot be below it).
+
+pub use rendersim_models::systems::*;
+
+pub use crate::studies::device_predictions;
+
+use crate::config::ModelSource;
+use crate::output::trace::TraceWriter;
+
+/// The studies that are also systems (a model file names them in `system`).
+pub const STUDIES: &[&dyn System] = &[&Registered::<device_predictions::system::DevicePredictionsSystem>::new()];
+
+/// Every system: the models' ([`rendersim_models::systems::SYSTEMS`]) and the studies'.
+pub fn systems() -> impl Iterator<Item = &'static dyn System> {
+    rendersim_models::systems::SYSTEMS.iter().chain(STUDIES).copied()
+}
+
+/// Builds and runs the system a model describes, among every system
+/// ([`systems`]); see [`rendersim_models::systems::run_model`].
+pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWriter>) -> Result<SystemRun, SimError> {
+    run_among(&systems().collect::<Vec<_>>(), src, table, trace)
+}
+
+/// The name of the model's system when that system writes no trace events,
+/// among every system; see [`rendersim_models::systems::traceless_system`].
+pub fn traceless_system(table: &toml::Table) -> Option<&'static str> {
+    traceless_among(&systems().collect::<Vec<_>>(), table)
+}
+
+/// The systems whose runs write trace events, comma separated, among every system.
+pub fn tracing_systems() -> String {
+    tracing_among(&systems().collect::<Vec<_>>())
+}
