@@ -27,7 +27,7 @@ pub enum FifoUnit {
 /// empty FIFO.
 ///
 /// ```
-/// use rendersim::components::fifo::BoundedFifo;
+/// use rendersim_models::components::fifo::BoundedFifo;
 ///
 /// // A command buffer of 1000 bytes.
 /// let mut fifo = BoundedFifo::new(1000);
