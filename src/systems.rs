@@ -15,24 +15,32 @@ use crate::output::trace::TraceWriter;
 /// The studies that are also systems (a model file names them in `system`).
 pub const STUDIES: &[&dyn System] = &[&Registered::<device_predictions::system::DevicePredictionsSystem>::new()];
 
-/// Every system: the models' ([`rendersim_models::systems::SYSTEMS`]) and the studies'.
-pub fn systems() -> impl Iterator<Item = &'static dyn System> {
-    rendersim_models::systems::SYSTEMS.iter().chain(STUDIES).copied()
+/// Every system: the models' ([`rendersim_models::systems::SYSTEMS`]) and
+/// the studies', gathered once.
+pub fn systems() -> &'static [&'static dyn System] {
+    static ALL: std::sync::LazyLock<Vec<&'static dyn System>> = std::sync::LazyLock::new(|| {
+        rendersim_models::systems::SYSTEMS
+            .iter()
+            .chain(STUDIES)
+            .copied()
+            .collect()
+    });
+    &ALL
 }
 
 /// Builds and runs the system a model describes, among every system
 /// ([`systems`]); see [`rendersim_models::systems::run_model`].
 pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWriter>) -> Result<SystemRun, SimError> {
-    run_among(&systems().collect::<Vec<_>>(), src, table, trace)
+    run_among(systems(), src, table, trace)
 }
 
 /// The name of the model's system when that system writes no trace events,
 /// among every system; see [`rendersim_models::systems::traceless_system`].
 pub fn traceless_system(table: &toml::Table) -> Option<&'static str> {
-    traceless_among(&systems().collect::<Vec<_>>(), table)
+    traceless_among(systems(), table)
 }
 
 /// The systems whose runs write trace events, comma separated, among every system.
 pub fn tracing_systems() -> String {
-    tracing_among(&systems().collect::<Vec<_>>())
+    tracing_among(systems())
 }

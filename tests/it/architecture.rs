@@ -49,15 +49,15 @@ fn all_source_files() -> Vec<String> {
     all
 }
 
-/// The "Layers" table of docs/ARCHITECTURE.md: each crate and the crates it
-/// may depend on.
-fn documented_layers(doc: &str) -> BTreeMap<String, BTreeSet<String>> {
+/// The "Layers" table of docs/ARCHITECTURE.md, in its order: each crate
+/// and the crates it may depend on.
+fn documented_layers(doc: &str) -> Vec<(String, BTreeSet<String>)> {
     let section = doc
         .split("\n## Layers\n")
         .nth(1)
         .expect("docs/ARCHITECTURE.md has a \"## Layers\" section");
     let section = section.split("\n## ").next().unwrap();
-    let mut layers = BTreeMap::new();
+    let mut layers = Vec::new();
     for line in section.lines().filter(|l| l.starts_with("| rendersim")) {
         let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
         assert_eq!(cells.len(), 3, "a Layers row has crate, folder, may depend on: {line}");
@@ -67,7 +67,7 @@ fn documented_layers(doc: &str) -> BTreeMap<String, BTreeSet<String>> {
             .filter(|c| c.starts_with("rendersim"))
             .map(String::from)
             .collect();
-        layers.insert(cells[0].to_string(), allowed);
+        layers.push((cells[0].to_string(), allowed));
     }
     layers
 }
@@ -129,23 +129,15 @@ fn the_layer_table_itself_only_points_down() {
     let doc = std::fs::read_to_string(root().join("docs/ARCHITECTURE.md")).unwrap();
     let layers = documented_layers(&doc);
     // In the table's order, a crate may name only crates in the rows above it.
-    let section = doc.split("\n## Layers\n").nth(1).unwrap();
-    let order: Vec<String> = section
-        .lines()
-        .filter(|l| l.starts_with("| rendersim"))
-        .map(|l| l.trim_matches('|').split('|').next().unwrap().trim().to_string())
-        .collect();
+    let order: Vec<&String> = layers.iter().map(|(k, _)| k).collect();
     assert_eq!(order.len(), 5, "five crates in the Layers table: {order:?}");
     assert_eq!(order[0], "rendersim-engine");
-    assert!(
-        layers["rendersim-engine"].is_empty(),
-        "the engine depends on no other crate"
-    );
-    for (i, krate) in order.iter().enumerate() {
-        for d in &layers[krate] {
+    assert!(layers[0].1.is_empty(), "the engine depends on no other crate");
+    for (i, (krate, allowed)) in layers.iter().enumerate() {
+        for d in allowed {
             let j = order
                 .iter()
-                .position(|o| o == d)
+                .position(|o| *o == d)
                 .unwrap_or_else(|| panic!("{krate} may depend on unknown {d}"));
             assert!(j < i, "the table lets {krate} depend on {d}, which is not below it");
         }
@@ -155,7 +147,7 @@ fn the_layer_table_itself_only_points_down() {
 #[test]
 fn the_crates_depend_only_on_the_layers_below_them() {
     let doc = std::fs::read_to_string(root().join("docs/ARCHITECTURE.md")).unwrap();
-    let allowed = documented_layers(&doc);
+    let allowed = documented_layers(&doc).into_iter().collect();
     let actual = actual_dependencies();
     let bad = layer_violations(&actual, &allowed);
     assert!(
