@@ -13,8 +13,12 @@ use crate::components::state_clock::StateClock;
 use crate::engine::{Duration, Time};
 use crate::output::trace::TraceWriter;
 
+use super::cpu_thread::{CpuPhase, CpuThread};
 use super::critical_path::{Blame, CriticalPath, Mode, Modes, Unit};
-use super::model::{CpuPhase, FramePipeline, FrontPhase};
+use super::fragment_stage::FragmentStage;
+use super::front_end::{FrontEnd, FrontPhase};
+use super::geometry_stage::GeometryStage;
+use super::links::Links;
 use super::records::FrameRecord;
 
 /// CPU states.
@@ -265,30 +269,46 @@ fn front_state_of(p: FrontPhase) -> usize {
     OF[p as usize] as usize
 }
 
-impl FramePipeline {
-    /// Derives every unit's state at `now` and advances the clocks.
-    pub(super) fn account(&mut self, now: Time) {
-        let cpu_state = self.cpu_state();
-        let front_state = if self.front.in_system() {
+/// What the accounting reads of the units after an instant: each unit's
+/// state, immutably (the clocks and the critical path are the accounting's
+/// own; the per-frame records get the CPU's and the GPU's time).
+#[derive(Clone, Copy)]
+pub(super) struct Units<'a> {
+    pub(super) cpu: &'a CpuThread,
+    pub(super) front: &'a FrontEnd,
+    pub(super) geom: &'a GeometryStage,
+    pub(super) frag: &'a FragmentStage,
+    pub(super) links: &'a Links,
+}
+
+impl Accounting {
+    /// Derives every unit's state at `now` and advances the clocks. Inlined
+    /// into the step after every event, so the view `u` is never built in
+    /// memory; the traced path is a call of its own.
+    #[inline(always)]
+    pub(super) fn account(&mut self, now: Time, u: Units<'_>, records: &mut [FrameRecord]) {
+        let cpu_state = cpu_state(u.cpu);
+        let front_state = if u.front.in_system() {
             5
         } else {
-            front_state_of(self.front_phase)
+            front_state_of(u.front.phase())
         };
-        let geom_state = if self.geom_busy {
+        let geom_state = if u.geom.busy() {
             0
-        } else if self.geom_held.is_some() {
+        } else if u.geom.holds_triangle() {
             1
         } else {
             2
         };
-        let frag_state = if self.frag_busy { 0 } else { 1 };
+        let frag_state = if u.frag.busy() { 0 } else { 1 };
         let gpu_busy = front_state == 0 || geom_state == 0 || frag_state == 0;
-        let modes = self.path_modes();
-        self.acct.path.update(now, modes);
+        let modes = path_modes(u);
+        self.path.update(now, modes);
 
         let gpu_state = if gpu_busy { 0 } else { 1 };
 
-        let a = &mut self.acct;
+        let (cpu_frame, gpu_frame) = (u.cpu.frame(), u.front.frame());
+        let a = self;
         if a.trace.is_none() {
             // Nothing changed since the last event (no state, no frame):
             // every step would add nothing.
@@ -297,14 +317,41 @@ impl FramePipeline {
                 && geom_state == a.geom.state()
                 && frag_state == a.frag.state()
                 && gpu_state == a.gpu.state()
-                && self.cpu_frame == a.cpu_frame
-                && (self.gpu_frame.is_none() || self.gpu_frame == a.gpu_frame)
+                && cpu_frame == a.cpu_frame
+                && (gpu_frame.is_none() || gpu_frame == a.gpu_frame)
             {
                 return;
             }
-            self.account_untraced(now, [cpu_state, front_state, geom_state, frag_state, gpu_state]);
+            a.account_untraced(
+                now,
+                [cpu_state, front_state, geom_state, frag_state, gpu_state],
+                (cpu_frame, gpu_frame),
+                records,
+            );
             return;
         }
+        a.account_traced(
+            now,
+            [cpu_state, front_state, geom_state, frag_state, gpu_state],
+            (cpu_frame, gpu_frame),
+            u,
+            records,
+        );
+    }
+
+    /// [`Accounting::account`] with a trace: every state change is a span.
+    #[inline(never)]
+    fn account_traced(
+        &mut self,
+        now: Time,
+        states: [usize; 5],
+        frames: (u64, Option<u64>),
+        u: Units<'_>,
+        records: &mut [FrameRecord],
+    ) {
+        let [cpu_state, front_state, geom_state, frag_state, gpu_state] = states;
+        let (cpu_frame, gpu_frame) = frames;
+        let a = self;
         // CPU: attribute the closing interval to the frame it belonged to.
         let (old, spent) = set_traced(
             &mut a.cpu,
@@ -315,21 +362,12 @@ impl FramePipeline {
             4,
             Some(a.cpu_frame),
         );
-        let mut attribute_cpu = |old: usize, spent: u64, frame: u64| {
-            if let Some(r) = self.records.get_mut(frame as usize) {
-                match old {
-                    0 | 1 => r.cpu_busy += spent,
-                    2 | 3 => r.cpu_wait += spent,
-                    _ => {}
-                }
-            }
-        };
-        attribute_cpu(old, spent, a.cpu_frame);
-        if self.cpu_frame != a.cpu_frame {
+        attribute_cpu(records, old, spent, a.cpu_frame);
+        if cpu_frame != a.cpu_frame {
             let st = a.cpu.state();
             let since = a.cpu.since();
             let spent = a.cpu.split(now).0;
-            attribute_cpu(st, spent, a.cpu_frame);
+            attribute_cpu(records, st, spent, a.cpu_frame);
             // The CPU moved to the next frame in the same state: the trace
             // closes the old frame's span here.
             if let Some(t) = &mut a.trace
@@ -338,94 +376,71 @@ impl FramePipeline {
             {
                 t.state(Track::Cpu, st, since, now, Some(a.cpu_frame));
             }
-            a.cpu_frame = self.cpu_frame;
+            a.cpu_frame = cpu_frame;
         }
         set_traced(&mut a.front, now, front_state, Track::Front, &mut a.trace, 1, None);
         set_traced(&mut a.geom, now, geom_state, Track::Geometry, &mut a.trace, 2, None);
         set_traced(&mut a.frag, now, frag_state, Track::Fragment, &mut a.trace, 1, None);
-        // GPU busy per frame (the frame the front end is on).
-        let old = a.gpu.state();
-        let spent = a.gpu.set(now, gpu_state).0;
-        let frame_changed = self.gpu_frame != a.gpu_frame && self.gpu_frame.is_some();
-        let spent = if frame_changed && old == gpu_state {
-            spent + a.gpu.split(now).0
-        } else {
-            spent
-        };
-        if old == 0
-            && let Some(r) = a.gpu_frame.and_then(|f| self.records.get_mut(f as usize))
-        {
-            r.gpu_busy += spent;
-        }
-        if self.gpu_frame.is_some() {
-            a.gpu_frame = self.gpu_frame;
-        }
+        a.gpu_per_frame(now, gpu_state, gpu_frame, records);
         if let Some(t) = &mut a.trace {
-            t.fifo_levels(now, self.fifo.used(), self.tri_fifo.len() as u64);
+            t.fifo_levels(now, u.links.commands.used(), u.links.triangles.len() as u64);
         }
     }
-}
 
-impl FramePipeline {
-    /// [`FramePipeline::account`] without a trace (every long run): the
-    /// same clock moves and per-frame attribution, with no trace checks
-    /// between them. `states`: CPU, front end, geometry, fragment, GPU.
-    #[inline]
-    fn account_untraced(&mut self, now: Time, states: [usize; 5]) {
-        let [cpu_state, front_state, geom_state, frag_state, gpu_state] = states;
-        let a = &mut self.acct;
-        let records = &mut self.records;
-        // CPU: attribute the closing interval to the frame it belonged to.
-        let old = a.cpu.state();
-        let spent = a.cpu.set(now, cpu_state).0;
-        if spent > 0 {
-            attribute_cpu(records, old, spent, a.cpu_frame);
-        }
-        if self.cpu_frame != a.cpu_frame {
-            let st = a.cpu.state();
-            let spent = a.cpu.split(now).0;
-            attribute_cpu(records, st, spent, a.cpu_frame);
-            a.cpu_frame = self.cpu_frame;
-        }
-        a.front.set(now, front_state);
-        a.geom.set(now, geom_state);
-        a.frag.set(now, frag_state);
-        // GPU busy per frame (the frame the front end is on).
-        let old = a.gpu.state();
-        let spent = a.gpu.set(now, gpu_state).0;
-        let frame_changed = self.gpu_frame != a.gpu_frame && self.gpu_frame.is_some();
+    /// GPU busy per frame (the frame the front end is on, `gpu_frame`).
+    #[inline(always)]
+    fn gpu_per_frame(&mut self, now: Time, gpu_state: usize, gpu_frame: Option<u64>, records: &mut [FrameRecord]) {
+        let old = self.gpu.state();
+        let spent = self.gpu.set(now, gpu_state).0;
+        let frame_changed = gpu_frame != self.gpu_frame && gpu_frame.is_some();
         let spent = if frame_changed && old == gpu_state {
-            spent + a.gpu.split(now).0
+            spent + self.gpu.split(now).0
         } else {
             spent
         };
         if old == 0
-            && let Some(r) = a.gpu_frame.and_then(|f| records.get_mut(f as usize))
+            && let Some(r) = self.gpu_frame.and_then(|f| records.get_mut(f as usize))
         {
             r.gpu_busy += spent;
         }
-        if self.gpu_frame.is_some() {
-            a.gpu_frame = self.gpu_frame;
+        if gpu_frame.is_some() {
+            self.gpu_frame = gpu_frame;
         }
     }
 
-    /// The front end's mode for the critical path.
+    /// [`Accounting::account`] without a trace (every long run): the
+    /// same clock moves and per-frame attribution, with no trace checks
+    /// between them. `states`: CPU, front end, geometry, fragment, GPU;
+    /// `frames`: the CPU's and the front end's.
     #[inline]
-    fn front_mode(&self) -> Mode {
-        match self.front_phase {
-            FrontPhase::Running if self.front.in_system() => Mode::work(Blame::System),
-            FrontPhase::Running => Mode::work(Blame::FrontEnd),
-            FrontPhase::Idle => Mode::wait(Unit::Cpu),
-            FrontPhase::WaitImage => Mode::wait(Unit::Display),
-            FrontPhase::WaitDrain => Mode::wait(Unit::Fragment),
-            // Binning: no draw in geometry, the bins still being shaded.
-            FrontPhase::Handoff if self.geom_draw.is_none() => Mode::wait(Unit::Fragment),
-            FrontPhase::Handoff => Mode::wait(Unit::Geometry),
+    fn account_untraced(
+        &mut self,
+        now: Time,
+        states: [usize; 5],
+        (cpu_frame, gpu_frame): (u64, Option<u64>),
+        records: &mut [FrameRecord],
+    ) {
+        let [cpu_state, front_state, geom_state, frag_state, gpu_state] = states;
+        // CPU: attribute the closing interval to the frame it belonged to.
+        let old = self.cpu.state();
+        let spent = self.cpu.set(now, cpu_state).0;
+        if spent > 0 {
+            attribute_cpu(records, old, spent, self.cpu_frame);
         }
+        if cpu_frame != self.cpu_frame {
+            let st = self.cpu.state();
+            let spent = self.cpu.split(now).0;
+            attribute_cpu(records, st, spent, self.cpu_frame);
+            self.cpu_frame = cpu_frame;
+        }
+        self.front.set(now, front_state);
+        self.geom.set(now, geom_state);
+        self.frag.set(now, frag_state);
+        self.gpu_per_frame(now, gpu_state, gpu_frame, records);
     }
 
-    /// [`FramePipeline::account`] after a draw ended, the next began and
-    /// `settle` ran ([`FramePipeline::draw_done_alone`]), when neither the
+    /// [`Accounting::account`] after a draw ended, the next began and
+    /// `settle` ran (`draw_done_alone`, [`super::quiet`]), when neither the
     /// CPU's frame nor the GPU's changed: the geometry and fragment stages
     /// and the GPU are busy as they were (with the draw that ended, now with
     /// the one that began), so of `account`'s clock moves only the CPU's and
@@ -439,92 +454,130 @@ impl FramePipeline {
     /// `cpu_moved`: whether the CPU may have taken a step at this instant;
     /// when it did not, its state and mode are what the last accounted
     /// instant left, and its part is skipped.
-    pub(super) fn account_draw_handoff(&mut self, now: Time, cpu_moved: bool) {
-        debug_assert!(self.acct.trace.is_none() && !self.front.in_system());
-        debug_assert_eq!(self.acct.geom.state(), 0);
-        debug_assert_eq!(self.acct.frag.state(), 0);
-        debug_assert_eq!(self.acct.gpu.state(), 0);
-        debug_assert_eq!(self.acct.cpu_frame, self.cpu_frame);
-        debug_assert!(self.draw_fragment_limited.is_some() && self.geom_busy && self.frag_busy);
+    #[inline(always)]
+    pub(super) fn account_draw_handoff(
+        &mut self,
+        now: Time,
+        cpu_moved: bool,
+        u: Units<'_>,
+        records: &mut [FrameRecord],
+    ) {
+        debug_assert!(self.trace.is_none() && !u.front.in_system());
+        debug_assert_eq!(self.geom.state(), 0);
+        debug_assert_eq!(self.frag.state(), 0);
+        debug_assert_eq!(self.gpu.state(), 0);
+        debug_assert_eq!(self.cpu_frame, u.cpu.frame());
+        debug_assert!(u.geom.fragment_limited().is_some() && u.geom.busy() && u.frag.busy());
         // The CPU first: its old mode is carried under everyone's old mode.
         if cpu_moved {
-            self.account_cpu_alone(now);
+            self.account_cpu_alone(now, u.cpu, records);
         }
-        let front_state = front_state_of(self.front_phase);
-        let stages = match self.draw_fragment_limited {
+        let front_state = front_state_of(u.front.phase());
+        let stages = match u.geom.fragment_limited() {
             Some(true) => Mode::work(Blame::Fragment),
             _ => Mode::work(Blame::Geometry),
         };
-        let front_mode = self.front_mode();
-        let a = &mut self.acct;
-        a.front.set(now, front_state);
-        a.path.set_mode(Unit::Front, front_mode, now);
-        a.path.set_mode(Unit::Geometry, stages, now);
-        a.path.set_mode(Unit::Fragment, stages, now);
+        let front_mode = front_mode(u);
+        self.front.set(now, front_state);
+        self.path.set_mode(Unit::Front, front_mode, now);
+        self.path.set_mode(Unit::Geometry, stages, now);
+        self.path.set_mode(Unit::Fragment, stages, now);
     }
 
-    /// [`FramePipeline::account`] when only the CPU moved at this instant
-    /// and stayed on its frame ([`FramePipeline::cpu_step_alone`]): its
+    /// [`Accounting::account`] when only the CPU moved at this instant and
+    /// stayed on its frame (the CPU thread's short cuts,
+    /// [`Alone`](super::cpu_thread::Alone)): its
     /// clock (the closing interval credited to the frame) and its
     /// critical-path mode are all that can change.
-    pub(super) fn account_cpu_alone(&mut self, now: Time) {
-        debug_assert!(self.acct.trace.is_none());
-        debug_assert_eq!(self.acct.cpu_frame, self.cpu_frame);
-        let cpu_state = self.cpu_state();
-        let mode = self.cpu_mode();
-        let a = &mut self.acct;
-        let old = a.cpu.state();
-        let spent = a.cpu.set(now, cpu_state).0;
+    pub(super) fn account_cpu_alone(&mut self, now: Time, cpu: &CpuThread, records: &mut [FrameRecord]) {
+        debug_assert!(self.trace.is_none());
+        debug_assert_eq!(self.cpu_frame, cpu.frame());
+        let cpu_state = cpu_state(cpu);
+        let mode = cpu_mode(cpu);
+        let old = self.cpu.state();
+        let spent = self.cpu.set(now, cpu_state).0;
         if spent > 0 {
-            attribute_cpu(&mut self.records, old, spent, a.cpu_frame);
+            attribute_cpu(records, old, spent, self.cpu_frame);
         }
-        a.path.set_mode(Unit::Cpu, mode, now);
+        self.path.set_mode(Unit::Cpu, mode, now);
     }
 
-    /// The CPU's state (index into [`CPU_STATES`]).
-    #[inline]
-    fn cpu_state(&self) -> usize {
-        if self.cpu.in_system() {
-            1
-        } else {
-            cpu_state_of(self.cpu_phase)
-        }
+    /// [`Accounting::account`] at a quiet front-end completion without a
+    /// trace ([`super::quiet`]): only the front end moved (busy -> waiting
+    /// for geometry, for the critical path too): the geometry and fragment
+    /// stages are busy with the draw throughout (so the GPU stays busy),
+    /// the CPU and the frames are as the last event left them.
+    #[inline(always)]
+    pub(super) fn front_waits_for_geometry(&mut self, at: Time) {
+        self.front.set(at, FRONT_WAIT_GEOMETRY);
+        self.path.set_mode(Unit::Front, Mode::wait(Unit::Geometry), at);
     }
 
-    /// The CPU's mode for the critical path.
-    #[inline]
-    fn cpu_mode(&self) -> Mode {
-        match self.cpu_phase {
-            CpuPhase::WaitFrames | CpuPhase::Push | CpuPhase::Rendezvous => Mode::wait(Unit::Front),
-            CpuPhase::Finished => Mode::wait(Unit::Display),
-            _ if self.cpu.in_system() => Mode::work(Blame::System),
-            _ => Mode::work(Blame::Cpu),
-        }
+    /// `draw` fidelity without a trace, at a draw's end: both stage clocks
+    /// have been "busy" since the draw began; of its `(geometry, fragment,
+    /// total)` times, keep G (resp. F) of it busy and move the rest to idle.
+    #[inline(always)]
+    pub(super) fn credit_draw_split(&mut self, (g, f, t): (Duration, Duration, Duration)) {
+        self.geom.transfer(0, 2, t.0 - g.0.min(t.0));
+        self.frag.transfer(0, 1, t.0 - f.0.min(t.0));
     }
+}
 
-    /// Each unit's mode for the critical path (see [`super::critical_path`]).
-    fn path_modes(&self) -> Modes {
-        let cpu = self.cpu_mode();
-        let front = self.front_mode();
-        let (geometry, fragment) = match self.draw_fragment_limited {
-            // `draw` fidelity: the running draw is the limiting stage's.
-            Some(true) => (Mode::work(Blame::Fragment), Mode::work(Blame::Fragment)),
-            Some(false) => (Mode::work(Blame::Geometry), Mode::work(Blame::Geometry)),
-            None => (
-                if self.geom_busy {
-                    Mode::work(Blame::Geometry)
-                } else if self.geom_held.is_some() {
-                    Mode::wait(Unit::Fragment)
-                } else {
-                    Mode::wait(Unit::Front)
-                },
-                if self.frag_busy {
-                    Mode::work(Blame::Fragment)
-                } else {
-                    Mode::wait(Unit::Geometry)
-                },
-            ),
-        };
-        [cpu, front, geometry, fragment]
+/// The front end's mode for the critical path.
+#[inline(always)]
+fn front_mode(u: Units<'_>) -> Mode {
+    match u.front.phase() {
+        FrontPhase::Running if u.front.in_system() => Mode::work(Blame::System),
+        FrontPhase::Running => Mode::work(Blame::FrontEnd),
+        FrontPhase::Idle => Mode::wait(Unit::Cpu),
+        FrontPhase::WaitImage => Mode::wait(Unit::Display),
+        FrontPhase::WaitDrain => Mode::wait(Unit::Fragment),
+        // Binning: no draw in geometry, the bins still being shaded.
+        FrontPhase::Handoff if !u.geom.has_draw() => Mode::wait(Unit::Fragment),
+        FrontPhase::Handoff => Mode::wait(Unit::Geometry),
     }
+}
+
+/// The CPU's state (index into [`CPU_STATES`]).
+#[inline]
+fn cpu_state(cpu: &CpuThread) -> usize {
+    if cpu.in_system() { 1 } else { cpu_state_of(cpu.phase()) }
+}
+
+/// The CPU's mode for the critical path.
+#[inline]
+fn cpu_mode(cpu: &CpuThread) -> Mode {
+    match cpu.phase() {
+        CpuPhase::WaitFrames | CpuPhase::Push | CpuPhase::Rendezvous => Mode::wait(Unit::Front),
+        CpuPhase::Finished => Mode::wait(Unit::Display),
+        _ if cpu.in_system() => Mode::work(Blame::System),
+        _ => Mode::work(Blame::Cpu),
+    }
+}
+
+/// Each unit's mode for the critical path (see [`super::critical_path`]).
+#[inline(always)]
+fn path_modes(u: Units<'_>) -> Modes {
+    let cpu = cpu_mode(u.cpu);
+    let front = front_mode(u);
+    let (geometry, fragment) = match u.geom.fragment_limited() {
+        // `draw` fidelity: the running draw is the limiting stage's.
+        Some(true) => (Mode::work(Blame::Fragment), Mode::work(Blame::Fragment)),
+        Some(false) => (Mode::work(Blame::Geometry), Mode::work(Blame::Geometry)),
+        None => (
+            if u.geom.busy() {
+                Mode::work(Blame::Geometry)
+            } else if u.geom.holds_triangle() {
+                Mode::wait(Unit::Fragment)
+            } else {
+                Mode::wait(Unit::Front)
+            },
+            if u.frag.busy() {
+                Mode::work(Blame::Fragment)
+            } else {
+                Mode::wait(Unit::Geometry)
+            },
+        ),
+    };
+    [cpu, front, geometry, fragment]
 }

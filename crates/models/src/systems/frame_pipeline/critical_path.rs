@@ -267,7 +267,7 @@ impl CriticalPath {
     /// work is charged to (as indices): `u`'s path now is that unit's path
     /// carried to now. A cycle is closed by the unit met twice, charged for
     /// itself.
-    #[inline]
+    #[inline(always)]
     fn source(&self, mut u: usize) -> (usize, usize) {
         let mut visiting = 0u8;
         loop {
@@ -284,7 +284,7 @@ impl CriticalPath {
     }
 
     /// Carries `u`'s path to `now` under its current mode.
-    #[inline]
+    #[inline(always)]
     fn materialize(&mut self, u: usize, now: Time) {
         let (w, b) = self.source(u);
         let add = now.since(self.since[w]).0;

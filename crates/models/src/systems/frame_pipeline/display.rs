@@ -1,33 +1,114 @@
-//! Frame completion, presentation and the display's vertical blanks
-//! (paper 004 §4.2). Frames are shown at a vertical blank (`fifo`,
-//! `mailbox`) or at once (`immediate` / vsync off); repeated refreshes and
-//! dropped frames are counted.
+//! The display (paper 004 §4.2): frames the front end presents into the
+//! swap chain are shown at a vertical blank (`fifo`, `mailbox`) or at once
+//! (`immediate` / vsync off); repeated refreshes and dropped frames are
+//! counted.
+//!
+//! [`Display`] owns the display's counters (vertical blanks, repeated
+//! refreshes, the mark where refresh metrics start after warm-up, frames
+//! shown or dropped) and its transitions; the swap chain, the records and
+//! the critical path it reports presents and shows to are arguments.
 
-use crate::components::swap_chain::{Flip, PresentMode};
-use crate::engine::{Scheduler, Time};
-
-use super::model::{Ev, FramePipeline};
+use crate::components::swap_chain::{Flip, PresentMode, SwapChain};
+use crate::engine::{Duration, Scheduler, Time};
 use crate::systems::error::SystemError;
 
-impl FramePipeline {
-    /// The GPU finished frame `frame` (its swap): present it.
-    pub(super) fn frame_completed(&mut self, now: Time, frame: u64) -> Result<(), SystemError> {
-        self.gpu_completed += 1;
-        self.records[frame as usize].gpu_end = Some(now);
-        self.gpu_frame = None;
-        self.acct.path.presented(frame);
-        let flip = self.chain.present(frame);
-        self.apply_flip(now, flip);
-        Ok(())
+use super::critical_path::CriticalPath;
+use super::events::Ev;
+use super::records::FrameRecord;
+
+/// The display.
+#[derive(Debug)]
+pub struct Display {
+    refresh: Duration,
+    frames_total: u64,
+    warmup_frames: u64,
+    vblanks: u64,
+    repeated_refreshes: u64,
+    /// (vertical blanks, repeated refreshes, time) when the first frame after
+    /// warm-up was shown; refresh metrics count from there.
+    refresh_mark: Option<(u64, u64, Time)>,
+    last_display: Option<Time>,
+    /// Frames shown or dropped.
+    resolved: u64,
+}
+
+impl Display {
+    /// A display refreshing every `refresh`, for a run of `frames_total`
+    /// frames whose first `warmup_frames` are warm-up.
+    pub(super) fn new(refresh: Duration, frames_total: u64, warmup_frames: u64) -> Self {
+        Display {
+            refresh,
+            frames_total,
+            warmup_frames,
+            vblanks: 0,
+            repeated_refreshes: 0,
+            refresh_mark: None,
+            last_display: None,
+            resolved: 0,
+        }
     }
 
-    fn apply_flip(&mut self, now: Time, flip: Flip) {
+    /// The refresh period.
+    pub(super) fn refresh(&self) -> Duration {
+        self.refresh
+    }
+
+    /// Vertical blanks so far.
+    pub(super) fn vblanks(&self) -> u64 {
+        self.vblanks
+    }
+
+    /// Refreshes that showed no new frame so far.
+    pub(super) fn repeated_refreshes(&self) -> u64 {
+        self.repeated_refreshes
+    }
+
+    /// (vertical blanks, repeated refreshes, time) when the first frame
+    /// after warm-up was shown.
+    pub(super) fn refresh_mark(&self) -> Option<(u64, u64, Time)> {
+        self.refresh_mark
+    }
+
+    /// Frames shown or dropped so far.
+    #[inline(always)]
+    pub(super) fn resolved(&self) -> u64 {
+        self.resolved
+    }
+
+    /// Whether every frame of the run was shown or dropped.
+    #[inline(always)]
+    pub(super) fn done(&self) -> bool {
+        self.resolved >= self.frames_total
+    }
+
+    /// The front end presents `frame` (the GPU finished its swap).
+    pub(super) fn present(
+        &mut self,
+        now: Time,
+        frame: u64,
+        chain: &mut SwapChain,
+        records: &mut [FrameRecord],
+        path: &mut CriticalPath,
+    ) {
+        path.presented(frame);
+        let flip = chain.present(frame);
+        self.apply_flip(now, flip, chain.mode(), records, path);
+    }
+
+    fn apply_flip(
+        &mut self,
+        now: Time,
+        flip: Flip,
+        mode: PresentMode,
+        records: &mut [FrameRecord],
+        path: &mut CriticalPath,
+    ) {
         if let Some(d) = flip.dropped {
-            self.records[d as usize].dropped = true;
+            records[d as usize].dropped = true;
             self.resolved += 1;
         }
         if let Some(f) = flip.shown {
-            if self.chain.mode() == PresentMode::Immediate
+            if mode == PresentMode::Immediate
                 && let Some(prev) = self.last_display
             {
                 // Refresh boundaries crossed without a new frame.
@@ -35,11 +116,11 @@ impl FramePipeline {
                 let crossed = now.0 / p - prev.0 / p;
                 self.repeated_refreshes += crossed.saturating_sub(1);
             }
-            self.records[f as usize].displayed = Some(now);
-            self.acct.path.shown(f);
+            records[f as usize].displayed = Some(now);
+            path.shown(f);
             self.last_display = Some(now);
             self.resolved += 1;
-            let warm = self.cfg.run.warmup_frames;
+            let warm = self.warmup_frames;
             if warm > 0 && f >= warm && self.refresh_mark.is_none() {
                 // Refresh counts after warm-up start at the first later frame shown.
                 self.refresh_mark = Some((self.vblanks, self.repeated_refreshes, now));
@@ -48,13 +129,20 @@ impl FramePipeline {
     }
 
     /// A vertical blank.
-    pub(super) fn vblank(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+    pub(super) fn vblank(
+        &mut self,
+        now: Time,
+        chain: &mut SwapChain,
+        records: &mut [FrameRecord],
+        path: &mut CriticalPath,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
         self.vblanks += 1;
-        let flip = self.chain.vblank();
+        let flip = chain.vblank();
         if flip.shown.is_none() && self.last_display.is_some() {
             self.repeated_refreshes += 1;
         }
-        self.apply_flip(now, flip);
+        self.apply_flip(now, flip, chain.mode(), records, path);
         if !self.done() {
             s.after(self.refresh, Ev::Vblank, "scheduling the next vertical blank")?;
         }

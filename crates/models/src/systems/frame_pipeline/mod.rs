@@ -4,8 +4,13 @@
 //!
 //! - `config`: the model file;
 //! - `workload`: compiling scenes into draws and meshes;
-//! - `model`: the kernel model (state and event dispatch);
-//! - `cpu`, `gpu`, `display`: the units' event handlers;
+//! - `model`: the kernel model (the units, event dispatch, the step in
+//!   the order of the data flow);
+//! - `cpu_thread`, `front_end`, `geometry_stage`, `fragment_stage`,
+//!   `display`: the units, each owning its state and transitions;
+//! - `events`: the event enum the units schedule;
+//! - `links`: what the units share (the command and triangle FIFOs, the
+//!   shader pool, the swap chain), passed to their methods;
 //! - `closed_form`: the `draw`-fidelity formula;
 //! - `quiet`: front-end completions kept out of the event queue at `draw`
 //!   fidelity (they only start a hand-off);
@@ -23,10 +28,14 @@
 pub mod accounting;
 pub mod closed_form;
 pub mod config;
-mod cpu;
+mod cpu_thread;
 pub mod critical_path;
 mod display;
-mod gpu;
+mod events;
+mod fragment_stage;
+mod front_end;
+mod geometry_stage;
+mod links;
 pub mod model;
 mod quiet;
 pub mod records;

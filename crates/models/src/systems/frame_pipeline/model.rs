@@ -5,307 +5,110 @@
 //!
 //! Follows paper 000 §3-4 and Figure 4 (CPU and GPU working in parallel
 //! through the command buffer; idle time when it is full or empty) and paper
-//! 004 §4.2 (vsync and double buffering). The event handlers live in
-//! `cpu.rs`, `gpu.rs` and `display.rs`; time accounting in `accounting.rs`.
+//! 004 §4.2 (vsync and double buffering). Each unit is a struct of its own
+//! that owns its state and the transitions that change it: the CPU thread
+//! (`cpu_thread.rs`), the front end (`front_end.rs`), the geometry and
+//! fragment stages (`geometry_stage.rs`, `fragment_stage.rs`) and the
+//! display (`display.rs`); the FIFOs, the shader pool and the swap chain
+//! between them are the [`Links`] (`links.rs`), passed to the units'
+//! methods; the events they schedule are [`Ev`] (`events.rs`).
+//! [`FramePipeline`] holds the units, dispatches each event to the
+//! unit it concerns, then lets the units take their steps in the order the
+//! data flows ([`FramePipeline::settle`]) and has the instant accounted
+//! (`accounting.rs`, which reads the units through an immutable view).
 
-use crate::components::distribution::Dist;
-use crate::components::fifo::{BoundedFifo, FifoUnit};
+use crate::components::fifo::BoundedFifo;
 use crate::components::noise::{Arrivals, NoiseSource, NoiseTarget};
-use crate::components::preemptible::{Preemptible, Wake};
 use crate::components::shader_pool::{ShaderPool, Stream};
 use crate::components::swap_chain::{PresentMode, SwapChain};
-use crate::engine::{Control, Duration, EventKind, Model, RngStreams, Scheduler, Slot, StreamRng, Time};
+use crate::engine::{Control, Model, RngStreams, Scheduler, Time};
 use crate::systems::error::SystemError;
 
-use super::accounting::Accounting;
+use super::accounting::{Accounting, Units};
 use super::config::{Fidelity, FramePipelineConfig, WorkloadConfig};
-use super::records::FrameRecord;
-use super::workload::{DrawItem, SceneProgram};
+use super::cpu_thread::{Alone, CpuThread, FixedWork};
+use super::display::Display;
+use super::fragment_stage::FragmentStage;
+use super::front_end::{Downstream, FrontEnd};
+use super::geometry_stage::GeometryStage;
+use super::links::{Env, Links};
+use super::workload::SceneProgram;
 
-/// Events of the frame pipeline.
-#[derive(Debug, Clone, Copy)]
-pub enum Ev {
-    /// The CPU thread's current work item finished (tag guards preemption).
-    CpuDone {
-        /// Generation tag.
-        tag: u32,
-    },
-    /// The GPU front end's current command finished.
-    FrontDone {
-        /// Generation tag.
-        tag: u32,
-    },
-    /// The geometry stage finished a triangle (`triangle` fidelity; the tag
-    /// guards the unified pool's rescheduling, 0 when split).
-    GeomTriangle {
-        /// Generation tag.
-        tag: u32,
-    },
-    /// The fragment stage finished a triangle (`triangle` fidelity; tagged
-    /// as [`Ev::GeomTriangle`]).
-    FragTriangle {
-        /// Generation tag.
-        tag: u32,
-    },
-    /// The geometry part of a draw ended (`draw` fidelity).
-    DrawGeometry,
-    /// The fragment part of a draw began (`draw` fidelity).
-    DrawFragmentStart,
-    /// A draw ended (`draw` fidelity).
-    DrawDone,
-    /// Vertical blank.
-    Vblank,
-    /// A system task arrives.
-    NoiseArrive {
-        /// Index of the noise source.
-        source: u16,
-    },
-    /// The running system task on a unit ends.
-    NoiseEnd {
-        /// Which unit.
-        target: NoiseTarget,
-    },
-    /// The CPU thread starts a frame at the instant where more frames
-    /// started than could be in flight, so frames take no time: each such
-    /// frame goes through the run loop as an event, and `run.max_events`
-    /// holds for it (scheduled only for zero-time frames).
-    ZeroTimeFrame,
-}
+pub use super::cpu_thread::CpuPhase;
+pub use super::events::Ev;
+pub use super::front_end::FrontPhase;
+pub use super::geometry_stage::ActiveDraw;
+pub use super::links::{Command, FragWork};
 
-impl EventKind for Ev {
-    const NAMES: &'static [&'static str] = &[
-        "cpu_work",
-        "gpu_front_end",
-        "geometry_triangle",
-        "fragment_triangle",
-        "draw_geometry",
-        "draw_fragment_start",
-        "draw_done",
-        "vblank",
-        "noise_arrival",
-        "noise_end",
-        "zero_time_frame",
-    ];
-    #[inline]
-    fn kind(&self) -> usize {
-        match self {
-            Ev::CpuDone { .. } => 0,
-            Ev::FrontDone { .. } => 1,
-            Ev::GeomTriangle { .. } => 2,
-            Ev::FragTriangle { .. } => 3,
-            Ev::DrawGeometry => 4,
-            Ev::DrawFragmentStart => 5,
-            Ev::DrawDone => 6,
-            Ev::Vblank => 7,
-            Ev::NoiseArrive { .. } => 8,
-            Ev::NoiseEnd { .. } => 9,
-            Ev::ZeroTimeFrame => 10,
-        }
-    }
-}
-
-/// A command in the CPU -> GPU FIFO.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Command {
-    /// Clear (needs a free swap-chain image).
-    Clear {
-        /// Frame.
-        frame: u64,
-    },
-    /// Fixed GPU work.
-    Fixed {
-        /// Frame.
-        frame: u64,
-        /// GPU time.
-        gpu: Duration,
-    },
-    /// A draw batch (state changes, uploads, draw).
-    Draw {
-        /// Frame.
-        frame: u64,
-        /// Index into the scene's draws.
-        draw: u32,
-    },
-    /// End of frame: drain the pipeline and present.
-    Swap {
-        /// Frame.
-        frame: u64,
-    },
-}
-
-/// The workload as the simulation consumes it.
-#[derive(Debug)]
-pub enum Program {
-    /// Fixed CPU and GPU time per frame.
-    Fixed {
-        /// CPU time.
-        cpu: Dist<Duration>,
-        /// GPU time.
-        gpu: Dist<Duration>,
-        /// Stream for the CPU part.
-        cpu_rng: StreamRng,
-        /// Stream for the GPU part.
-        gpu_rng: StreamRng,
-    },
-    /// A compiled scene.
-    Scene(SceneProgram),
-}
-
-/// What the CPU thread is doing. The phases carry no data (the command
-/// to push is in [`FramePipeline::cpu_cmd`]), so a phase is one byte,
-/// written and read back whole on the hot path.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CpuPhase {
-    /// About to start frame `cpu_frame` (transient).
-    NextFrame,
-    /// Blocked: too many frames in flight.
-    WaitFrames,
-    /// About to run operation `cpu_op` (transient).
-    Ready,
-    /// Running operation `cpu_op` (possibly preempted).
-    Running,
-    /// Must push the command in `cpu_cmd`; at rest this means the FIFO is
-    /// full.
-    Push,
-    /// Pushed into a FIFO beyond its capacity (rendezvous): waits until taken.
-    Rendezvous,
-    /// Waits for its [`Ev::ZeroTimeFrame`] event before starting a frame
-    /// that takes no time.
-    ZeroTimeWait,
-    /// All frames submitted.
-    Finished,
-}
-
-/// What the GPU front end is doing (its command is in
-/// [`FramePipeline::front_cmd`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FrontPhase {
-    /// Waiting for commands (starved when at rest).
-    Idle,
-    /// A clear (in `front_cmd`) waits for a free swap-chain image.
-    WaitImage,
-    /// A swap (in `front_cmd`) waits for the pipeline to drain.
-    WaitDrain,
-    /// Processing the command in `front_cmd` (possibly preempted).
-    Running,
-    /// A draw (in `front_cmd`) waits for the geometry stage to take it.
-    Handoff,
-}
-
-/// The frame pipeline's full state.
+/// The frame pipeline: its units, the links between them, the noise
+/// sources, the per-frame records and the accounting.
 pub struct FramePipeline {
-    pub(super) cfg: FramePipelineConfig,
-    pub(super) program: Program,
+    /// The model, the scene, the links, the records and the trace flag that
+    /// the units' transitions get.
+    pub(super) env: Env,
     pub(super) frames_total: u64,
-    // CPU thread
-    pub(super) cpu: Preemptible,
-    pub(super) cpu_phase: CpuPhase,
-    /// The command of [`CpuPhase::Push`].
-    pub(super) cpu_cmd: Command,
-    /// Its weight in the FIFO's unit (so a push blocked on a full FIFO is
-    /// found without a call).
-    pub(super) cpu_cmd_weight: u64,
-    /// Operations between the clear and the swap: the scene's draws, or the
-    /// one fixed GPU command.
-    pub(super) body_ops: u32,
-    /// Whether those are a scene's draws (else the fixed command).
-    pub(super) scene_body: bool,
-    pub(super) cpu_frame: u64,
-    pub(super) cpu_op: u32,
-    pub(super) non_render_rng: StreamRng,
-    /// Per-frame variation streams: CPU, GPU (`variation.cpu`, `variation.gpu`).
-    pub(super) variation_rng: [StreamRng; 2],
-    /// The instant the CPU thread last started a frame, and how many
-    /// frames it started then.
-    pub(super) frames_at_instant: (Time, u64),
-    /// Frames started at one instant beyond which a frame is known to take
-    /// no time (more than could be in flight); see [`Ev::ZeroTimeFrame`].
-    pub(super) zero_time_after: u64,
-    /// The pending [`Ev::ZeroTimeFrame`] was handled: start the frame.
-    pub(super) zero_time_go: bool,
-    pub(super) fifo: BoundedFifo<Command>,
-    pub(super) commands_issued: u64,
-    pub(super) commands_executed: u64,
-    // GPU
-    pub(super) front: Preemptible,
-    pub(super) front_phase: FrontPhase,
-    /// The command of every [`FrontPhase`] but `Idle`.
-    pub(super) front_cmd: Command,
-    pub(super) gpu_frame: Option<u64>,
-    pub(super) gpu_completed: u64,
-    pub(super) geom_draw: Option<ActiveDraw>,
-    pub(super) geom_busy: bool,
-    /// `draw` fidelity without a trace: the running draw's (geometry,
-    /// fragment, total) times, credited to the stage clocks when it ends
-    /// instead of with two extra events.
-    pub(super) draw_split: Option<(Duration, Duration, Duration)>,
-    /// `draw` fidelity: whether the running draw is fragment-limited (F >= G);
-    /// the bottleneck of the whole draw goes to that stage.
-    pub(super) draw_fragment_limited: Option<bool>,
-    /// `draw` fidelity: when the running draw ends (its [`Ev::DrawDone`]).
-    pub(super) draw_done_at: Option<Time>,
-    /// The front end's draw command completing quietly: its slot in the
-    /// event order and the job's tag ([`super::quiet`]).
-    pub(super) front_quiet: Option<(Slot, u32)>,
-    /// A finished triangle's fragment work (shader, fixed-function) that
-    /// found the triangle FIFO full.
-    pub(super) geom_held: Option<FragWork>,
-    pub(super) tri_fifo: BoundedFifo<FragWork>,
-    /// The unified architecture's shader-core pool (`None`: split).
-    pub(super) pool: Option<ShaderPool>,
-    /// The running draw's triangle sizes when its group sorts them
-    /// (`size_order`), in drawing order; empty otherwise.
-    pub(super) draw_sizes: Vec<f64>,
-    pub(super) frag_busy: bool,
-    pub(super) pixel_rng: StreamRng,
-    /// The size stream's state at the start, restored every frame for a static view.
-    pub(super) pixel_rng_start: Option<StreamRng>,
-    // display
-    pub(super) chain: SwapChain,
-    pub(super) refresh: Duration,
-    pub(super) vblanks: u64,
-    pub(super) repeated_refreshes: u64,
-    /// (vertical blanks, repeated refreshes, time) when the first frame after
-    /// warm-up was shown; refresh metrics count from there.
-    pub(super) refresh_mark: Option<(u64, u64, Time)>,
-    pub(super) last_display: Option<Time>,
-    pub(super) resolved: u64,
-    // noise
-    pub(super) noise: Vec<NoiseSource>,
-    // results
-    pub(super) records: Vec<FrameRecord>,
+    pub(super) cpu: CpuThread,
+    pub(super) front: FrontEnd,
+    pub(super) geom: GeometryStage,
+    pub(super) frag: FragmentStage,
+    pub(super) display: Display,
+    noise: Vec<NoiseSource>,
     pub(super) acct: Accounting,
 }
 
-/// A draw batch's weight in the command FIFO's unit: its commands (state
-/// changes, upload, draw) or its bytes.
-#[inline]
-pub(super) fn draw_batch_weight(unit: FifoUnit, d: &DrawItem) -> u64 {
-    match unit {
-        FifoUnit::Entries => u64::from(d.commands),
-        FifoUnit::Bytes => d.bytes,
+/// The units downstream of the front end in `$p` (a [`FramePipeline`]).
+macro_rules! downstream {
+    ($p:ident) => {
+        Downstream {
+            geom: &mut $p.geom,
+            frag: &mut $p.frag,
+            display: &mut $p.display,
+            path: &mut $p.acct.path,
+        }
+    };
+}
+
+/// The model's noise sources (system tasks), periodic then random.
+fn noise_sources(cfg: &FramePipelineConfig, streams: &RngStreams) -> Result<Vec<NoiseSource>, SystemError> {
+    let mut noise = Vec::new();
+    if !cfg.noise.enabled {
+        return Ok(noise);
     }
-}
-
-/// A triangle's fragment work: shader time (on the pool when unified; all
-/// of it when split) and fixed-function time beside it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct FragWork {
-    /// Shader work (split: the whole fragment-stage time).
-    pub shader: Duration,
-    /// Fixed-function time (unified only; zero when split).
-    pub fixed: Duration,
-}
-
-/// A draw in the geometry stage.
-#[derive(Debug, Clone, Copy)]
-pub struct ActiveDraw {
-    /// Index into the scene's draws.
-    pub draw: u32,
-    /// Next triangle.
-    pub next: u64,
-    /// Triangles.
-    pub triangles: u64,
+    for (i, p) in cfg.noise.periodic.iter().enumerate().filter(|(_, p)| p.enabled) {
+        let src = NoiseSource::new(
+            p.name.clone(),
+            p.target,
+            Arrivals::Periodic {
+                period: p.period,
+                phase: p.phase,
+                jitter: p.jitter,
+            },
+            p.duration.clone(),
+            streams.stream(&format!("noise.{}", p.name)),
+        )
+        .map_err(|e| SystemError::Invalid {
+            key: format!("noise.periodic.{i}"),
+            message: e.to_string(),
+        })?;
+        noise.push(src);
+    }
+    for (i, r) in cfg.noise.random.iter().enumerate().filter(|(_, r)| r.enabled) {
+        let src = NoiseSource::new(
+            r.name.clone(),
+            r.target,
+            Arrivals::Poisson {
+                mean_gap: r.rate.period,
+            },
+            r.duration.clone(),
+            streams.stream(&format!("noise.{}", r.name)),
+        )
+        .map_err(|e| SystemError::Invalid {
+            key: format!("noise.random.{i}"),
+            message: e.to_string(),
+        })?;
+        noise.push(src);
+    }
+    Ok(noise)
 }
 
 impl FramePipeline {
@@ -316,14 +119,17 @@ impl FramePipeline {
         trace: Option<crate::output::trace::TraceWriter>,
     ) -> Result<Self, SystemError> {
         let streams = RngStreams::new(cfg.run.seed);
-        let program = match (&cfg.workload, scene) {
-            (WorkloadConfig::Fixed(f), _) => Program::Fixed {
-                cpu: f.cpu.clone(),
-                gpu: f.gpu.clone(),
-                cpu_rng: streams.stream("workload.cpu"),
-                gpu_rng: streams.stream("workload.gpu"),
-            },
-            (WorkloadConfig::Scene(_), Some(s)) => Program::Scene(s),
+        let (fixed, scene) = match (&cfg.workload, scene) {
+            (WorkloadConfig::Fixed(f), _) => (
+                Some(FixedWork {
+                    cpu: f.cpu.clone(),
+                    gpu: f.gpu.clone(),
+                    cpu_rng: streams.stream("workload.cpu"),
+                    gpu_rng: streams.stream("workload.gpu"),
+                }),
+                None,
+            ),
+            (WorkloadConfig::Scene(_), Some(s)) => (None, Some(s)),
             (WorkloadConfig::Scene(_), None) => {
                 return Err(SystemError::Invalid {
                     key: "workload".into(),
@@ -331,114 +137,56 @@ impl FramePipeline {
                 });
             }
         };
-        let mut noise = Vec::new();
-        if cfg.noise.enabled {
-            for (i, p) in cfg.noise.periodic.iter().enumerate().filter(|(_, p)| p.enabled) {
-                let src = NoiseSource::new(
-                    p.name.clone(),
-                    p.target,
-                    Arrivals::Periodic {
-                        period: p.period,
-                        phase: p.phase,
-                        jitter: p.jitter,
-                    },
-                    p.duration.clone(),
-                    streams.stream(&format!("noise.{}", p.name)),
-                )
-                .map_err(|e| SystemError::Invalid {
-                    key: format!("noise.periodic.{i}"),
-                    message: e.to_string(),
-                })?;
-                noise.push(src);
-            }
-            for (i, r) in cfg.noise.random.iter().enumerate().filter(|(_, r)| r.enabled) {
-                let src = NoiseSource::new(
-                    r.name.clone(),
-                    r.target,
-                    Arrivals::Poisson {
-                        mean_gap: r.rate.period,
-                    },
-                    r.duration.clone(),
-                    streams.stream(&format!("noise.{}", r.name)),
-                )
-                .map_err(|e| SystemError::Invalid {
-                    key: format!("noise.random.{i}"),
-                    message: e.to_string(),
-                })?;
-                noise.push(src);
-            }
-        }
+        let noise = noise_sources(&cfg, &streams)?;
+        let traced = trace.is_some();
         let mode = cfg.display.effective_mode();
-        let fifo_cap = cfg.command_fifo.capacity;
         let frames_total = cfg.run.frames;
-        let (body_ops, scene_body) = match &program {
-            Program::Fixed { .. } => (1, false),
-            Program::Scene(s) => (s.draws.len() as u32, true),
+        let body = match &scene {
+            None => (1, false),
+            Some(s) => (s.draws.len() as u32, true),
         };
-        Ok(FramePipeline {
-            refresh: cfg.display.refresh.period,
-            chain: SwapChain::new(cfg.display.buffers, mode),
+        let zero_time_after = u64::from(cfg.cpu.max_frames_ahead) + u64::from(cfg.display.buffers) + 1;
+        let cpu_rngs = [streams.stream("cpu.non_render"), streams.stream("variation.cpu")];
+        let pixel_rng_start = match &cfg.workload {
+            WorkloadConfig::Scene(sc) if sc.view == crate::scene::config::View::Static => {
+                Some(streams.stream("fragment.pixels"))
+            }
+            _ => None,
+        };
+        let links = Links {
+            commands: BoundedFifo::new(cfg.command_fifo.capacity),
             // Binning: the FIFO is the draw's bins and holds all of it.
-            tri_fifo: BoundedFifo::new(if cfg.gpu.fragment.binned() {
+            triangles: BoundedFifo::new(if cfg.gpu.fragment.binned() {
                 u64::MAX
             } else {
                 cfg.gpu.fragment.fifo_depth as u64
             }),
-            non_render_rng: streams.stream("cpu.non_render"),
-            variation_rng: [streams.stream("variation.cpu"), streams.stream("variation.gpu")],
-            frames_at_instant: (Time::ZERO, 0),
-            zero_time_after: u64::from(cfg.cpu.max_frames_ahead) + u64::from(cfg.display.buffers) + 1,
-            zero_time_go: false,
-            pixel_rng: streams.stream("fragment.pixels"),
-            pixel_rng_start: match &cfg.workload {
-                WorkloadConfig::Scene(sc) if sc.view == crate::scene::config::View::Static => {
-                    Some(streams.stream("fragment.pixels"))
-                }
-                _ => None,
-            },
-            program,
-            frames_total,
-            cpu: Preemptible::new(),
-            cpu_phase: CpuPhase::NextFrame,
-            cpu_cmd: Command::Clear { frame: 0 },
-            cpu_cmd_weight: 1,
-            body_ops,
-            scene_body,
-            cpu_frame: 0,
-            cpu_op: 0,
-            fifo: BoundedFifo::new(fifo_cap),
-            commands_issued: 0,
-            commands_executed: 0,
-            front: Preemptible::new(),
-            front_phase: FrontPhase::Idle,
-            front_cmd: Command::Clear { frame: 0 },
-            gpu_frame: None,
-            gpu_completed: 0,
-            geom_draw: None,
-            geom_busy: false,
-            draw_split: None,
-            draw_fragment_limited: None,
-            draw_done_at: None,
-            front_quiet: None,
-            geom_held: None,
-            draw_sizes: Vec::new(),
-            pool: match cfg.fidelity {
+            shaders: match cfg.fidelity {
                 Fidelity::Triangle => cfg.gpu.pool().map(|(n, p)| ShaderPool::new(n, p)),
                 Fidelity::Draw => None,
             },
-            frag_busy: false,
-            vblanks: 0,
-            repeated_refreshes: 0,
-            refresh_mark: None,
-            last_display: None,
-            resolved: 0,
+            chain: SwapChain::new(cfg.display.buffers, mode),
+            frames_completed: 0,
+        };
+        Ok(FramePipeline {
+            cpu: CpuThread::new(frames_total, body, cpu_rngs, fixed, zero_time_after),
+            front: FrontEnd::new(streams.stream("variation.gpu")),
+            geom: GeometryStage::new(streams.stream("fragment.pixels"), pixel_rng_start),
+            frag: FragmentStage::default(),
+            display: Display::new(cfg.display.refresh.period, frames_total, cfg.run.warmup_frames),
+            frames_total,
             noise,
-            records: Vec::with_capacity(frames_total.min(1 << 16) as usize),
             acct: Accounting::new(
                 trace,
                 (mode != PresentMode::Immediate).then_some(cfg.display.refresh.period),
             ),
-            cfg,
+            env: Env {
+                links,
+                scene,
+                records: Vec::with_capacity(frames_total.min(1 << 16) as usize),
+                traced,
+                cfg,
+            },
         })
     }
 
@@ -447,110 +195,84 @@ impl FramePipeline {
         if self.frames_total == 0 {
             return Ok(());
         }
-        if self.chain.mode() != PresentMode::Immediate {
+        if self.env.links.chain.mode() != PresentMode::Immediate {
             s.at(Time::ZERO, Ev::Vblank);
         }
         for i in 0..self.noise.len() {
             let t = self.noise[i].next_arrival(Time::ZERO)?;
             s.at(t, Ev::NoiseArrive { source: i as u16 });
         }
-        self.settle(Time::ZERO, s)?;
-        self.pool_settle(Time::ZERO, s)?;
-        self.account(Time::ZERO);
+        self.step(Time::ZERO, s)?;
         Ok(())
-    }
-
-    /// The weight of a command in the FIFO's unit.
-    pub(super) fn command_weight(&self, c: &Command) -> u64 {
-        let unit = self.cfg.command_fifo.unit;
-        let b = &self.cfg.command_fifo.bytes;
-        match (unit, c) {
-            (_, Command::Draw { draw, .. }) if let Some(s) = self.scene() => {
-                draw_batch_weight(unit, &s.draws[*draw as usize])
-            }
-            (FifoUnit::Entries, _) => 1,
-            (FifoUnit::Bytes, Command::Clear { .. }) => b.clear.0,
-            (FifoUnit::Bytes, Command::Swap { .. }) => b.swap.0,
-            (FifoUnit::Bytes, Command::Fixed { .. } | Command::Draw { .. }) => b.draw.0,
-        }
-    }
-
-    /// Commands in a FIFO entry (a draw batch holds its state changes and
-    /// upload with the draw).
-    pub(super) fn command_count(&self, c: &Command) -> u64 {
-        match c {
-            Command::Draw { draw, .. } => self
-                .scene()
-                .map(|s| s.draws[*draw as usize].commands as u64)
-                .unwrap_or(1),
-            _ => 1,
-        }
-    }
-
-    pub(super) fn scene(&self) -> Option<&SceneProgram> {
-        match &self.program {
-            Program::Scene(s) => Some(s),
-            Program::Fixed { .. } => None,
-        }
     }
 
     /// The fidelity.
     pub fn fidelity(&self) -> Fidelity {
-        self.cfg.fidelity
+        self.env.cfg.fidelity
     }
 
     /// Commands pushed by the CPU and commands executed by the GPU.
     pub fn command_counts(&self) -> (u64, u64) {
-        (self.commands_issued, self.commands_executed)
+        (self.cpu.issued(), self.front.executed())
     }
 
     /// Frames displayed or dropped so far.
     pub fn resolved(&self) -> u64 {
-        self.resolved
+        self.display.resolved()
     }
 
     /// Drops the records of frames not yet displayed or dropped (after a run
     /// stopped by a time or event limit): the leading completed frames stay.
     pub fn keep_completed_frames(&mut self) {
         let done = self
+            .env
             .records
             .iter()
             .take_while(|r| r.displayed.is_some() || r.dropped)
             .count();
-        self.records.truncate(done);
+        self.env.records.truncate(done);
     }
 
     /// Whether all asked-for frames are done.
+    #[inline]
     pub fn done(&self) -> bool {
-        self.resolved >= self.frames_total
+        self.display.done()
     }
 
     /// A one-line description of the units' states (for stall reports).
     pub fn describe(&self) -> String {
         format!(
-            "cpu {} (frame {}, op {}), command fifo {}/{}, front end {}, geometry {:?} busy={} held={}, fragment busy={}, frames completed {}, queued for display {}",
-            match self.cpu_phase {
-                CpuPhase::Push => format!("Push({:?})", self.cpu_cmd),
-                p => format!("{p:?}"),
-            },
-            self.cpu_frame,
-            self.cpu_op,
-            self.fifo.used(),
-            self.fifo.capacity(),
-            match self.front_phase {
-                FrontPhase::Idle => "Idle".to_string(),
-                p => format!("{p:?}({:?})", self.front_cmd),
-            },
-            self.geom_draw,
-            self.geom_busy,
-            self.geom_held.is_some(),
-            self.frag_busy,
-            self.gpu_completed,
-            self.chain.queued()
+            "cpu {}, command fifo {}/{}, front end {}, geometry {:?} busy={} held={}, fragment busy={}, frames completed {}, queued for display {}",
+            self.cpu.describe(),
+            self.env.links.commands.used(),
+            self.env.links.commands.capacity(),
+            self.front.describe(),
+            self.geom.draw(),
+            self.geom.busy(),
+            self.geom.holds_triangle(),
+            self.frag.busy(),
+            self.env.links.frames_completed,
+            self.env.links.chain.queued()
         )
     }
 
-    /// Lets the CPU thread and the front end make every step they can now.
+    /// What follows every event but those a short cut took whole: the
+    /// units take every step they can now ([`FramePipeline::settle`]), the
+    /// shader pool's completions that moved are scheduled, and the instant
+    /// is accounted.
+    #[inline]
+    fn step(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+        self.settle(now, s)?;
+        self.env.links.settle_shaders(now, s)?;
+        self.account(now);
+        Ok(())
+    }
+
+    /// Lets the units make every step they can now, in the order the data
+    /// of a frame flows: the CPU thread pushes its commands into the command
+    /// FIFO; the front end takes them, waits for swap-chain images, hands
+    /// draws to the geometry stage (which feeds the fragment stage through
+    /// the triangle FIFO), and presents finished frames to the display.
     ///
     /// Each step runs its unit until it cannot go on, and a step that finds
     /// nothing to do changes nothing; the CPU's progress depends only on what
@@ -559,24 +281,58 @@ impl FramePipeline {
     /// nothing: the loop ends there.
     pub(super) fn settle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         loop {
-            self.cpu_step(now, s)?;
-            if !self.front_step(now, s)? {
+            self.cpu.step(now, &mut self.env, s)?;
+            // A running front end takes no step (most events find it so):
+            // its downstream units are not even gathered.
+            if self.front.phase() == FrontPhase::Running {
+                return Ok(());
+            }
+            let mut down = downstream!(self);
+            if !self.front.step(now, &mut self.env, &mut down, s)? {
                 return Ok(());
             }
         }
     }
 
+    /// Accounts the instant `now` in full: every unit's state, read through
+    /// an immutable view.
+    pub(super) fn account(&mut self, now: Time) {
+        let units = Units {
+            cpu: &self.cpu,
+            front: &self.front,
+            geom: &self.geom,
+            frag: &self.frag,
+            links: &self.env.links,
+        };
+        self.acct.account(now, units, &mut self.env.records);
+    }
+
+    /// The CPU thread's operation finished (its event, not stale): the
+    /// thread takes its next steps. Returns true when the thread's short
+    /// cuts took the whole event (the rest of `handle` is skipped): when
+    /// nothing downstream waits for the CPU (the front end is not idle) and
+    /// no trace is written, a draw batch's end is [`CpuThread::draw_done_fast`],
+    /// any other operation's [`CpuThread::step_alone`].
     #[inline(always)]
-    pub(super) fn schedule_wake(s: &mut Scheduler<Ev>, w: Wake, cpu: bool) {
-        if let Wake::JobAt(t, tag) = w {
-            s.at(
-                t,
-                if cpu {
-                    Ev::CpuDone { tag }
-                } else {
-                    Ev::FrontDone { tag }
-                },
-            );
+    fn cpu_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
+        let alone = !self.env.traced && self.front.phase() != FrontPhase::Idle;
+        if alone && let Some(a) = self.cpu.draw_done_fast(now, &mut self.env, s)? {
+            self.account_cpu_alone(now, a);
+            return Ok(true);
+        }
+        self.cpu.op_done(now, &mut self.env);
+        if alone && let Some(a) = self.cpu.step_alone(now, &mut self.env, s)? {
+            self.account_cpu_alone(now, a);
+            return Ok(true);
+        }
+        Ok(false)
+    }
+
+    /// The accounting an instant that only the CPU thread moved leaves.
+    #[inline(always)]
+    fn account_cpu_alone(&mut self, now: Time, a: Alone) {
+        if a == Alone::Blocked {
+            self.acct.account_cpu_alone(now, &self.cpu, &mut self.env.records);
         }
     }
 
@@ -586,26 +342,28 @@ impl FramePipeline {
         let target = src.target;
         let next = src.next_arrival(now)?;
         s.at(next, Ev::NoiseArrive { source });
-        let unit = match target {
-            NoiseTarget::Cpu => &mut self.cpu,
-            NoiseTarget::Gpu => &mut self.front,
+        let end = match target {
+            NoiseTarget::Cpu => self.cpu.task_arrives(now, d)?,
+            NoiseTarget::Gpu => self.front.task_arrives(now, d)?,
         };
-        if let Some(end) = unit.task_arrives(now, d)? {
+        if let Some(end) = end {
             s.at(end, Ev::NoiseEnd { target });
         }
         Ok(())
     }
 
     fn noise_end(&mut self, now: Time, target: NoiseTarget, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
-        let unit = match target {
-            NoiseTarget::Cpu => &mut self.cpu,
-            NoiseTarget::Gpu => &mut self.front,
+        let (next, wake) = match target {
+            NoiseTarget::Cpu => self.cpu.task_ends(now)?,
+            NoiseTarget::Gpu => self.front.task_ends(now)?,
         };
-        let (next, wake) = unit.task_ends(now)?;
         if let Some(end) = next {
             s.at(end, Ev::NoiseEnd { target });
         }
-        Self::schedule_wake(s, wake, target == NoiseTarget::Cpu);
+        match target {
+            NoiseTarget::Cpu => CpuThread::schedule_wake(s, wake),
+            NoiseTarget::Gpu => FrontEnd::schedule_wake(s, wake),
+        }
         Ok(())
     }
 }
@@ -618,50 +376,46 @@ impl Model for FramePipeline {
         self.catch_up(s)?;
         match ev {
             Ev::CpuDone { tag } => {
-                if self.cpu.complete(tag) {
-                    if self.cpu_draw_done_fast(now, s)? {
-                        return Ok(Control::Continue);
-                    }
-                    self.cpu_op_done(now);
-                    if self.cpu_step_alone(now, s)? {
-                        return Ok(Control::Continue);
-                    }
+                if self.cpu.complete(tag) && self.cpu_done(now, s)? {
+                    return Ok(Control::Continue);
                 }
             }
             Ev::FrontDone { tag } => {
                 if self.front.complete(tag) {
-                    self.front_command_done(now)?;
+                    let mut down = downstream!(self);
+                    self.front.command_done(now, &mut self.env, &mut down)?;
                 }
             }
             Ev::GeomTriangle { tag } => {
-                if self.pool_completes(now, Stream::Vertex, tag) {
-                    self.geom_triangle_done(now, s)?;
+                if self.env.links.shader_completes(now, Stream::Vertex, tag) {
+                    self.geom.triangle_done(now, &mut self.env, &mut self.frag, s)?;
                 }
             }
             Ev::FragTriangle { tag } => {
-                if self.pool_completes(now, Stream::Fragment, tag) {
-                    self.frag_triangle_done(now, s)?;
+                if self.env.links.shader_completes(now, Stream::Fragment, tag) {
+                    self.frag.triangle_done(now, &mut self.env, &mut self.geom, s)?;
                 }
             }
-            Ev::DrawGeometry => self.geom_busy = false,
-            Ev::DrawFragmentStart => self.frag_busy = true,
+            Ev::DrawGeometry => self.geom.closed_geometry_done(),
+            Ev::DrawFragmentStart => self.frag.set_closed_busy(true),
             Ev::DrawDone => {
-                self.draw_done();
+                if let Some(split) = self.geom.draw_done(&mut self.frag) {
+                    self.acct.credit_draw_split(split);
+                }
                 if self.draw_done_alone(now, s)? {
                     return Ok(if self.done() { Control::Stop } else { Control::Continue });
                 }
             }
-            Ev::Vblank => self.vblank(now, s)?,
+            Ev::Vblank => {
+                let path = &mut self.acct.path;
+                self.display
+                    .vblank(now, &mut self.env.links.chain, &mut self.env.records, path, s)?;
+            }
             Ev::NoiseArrive { source } => self.noise_arrive(now, source, s)?,
             Ev::NoiseEnd { target } => self.noise_end(now, target, s)?,
-            Ev::ZeroTimeFrame => {
-                self.zero_time_go = true;
-                self.cpu_phase = CpuPhase::NextFrame;
-            }
+            Ev::ZeroTimeFrame => self.cpu.zero_time_frame(),
         }
-        self.settle(now, s)?;
-        self.pool_settle(now, s)?;
-        self.account(now);
+        self.step(now, s)?;
         Ok(if self.done() { Control::Stop } else { Control::Continue })
     }
 }

@@ -82,8 +82,8 @@ pub fn run_pipeline(
     let mut sched = Scheduler::new();
     model.start(&mut sched)?;
     let limits = Limits {
-        until: model.cfg.run.until.map(|d| Time(d.0)),
-        max_events: model.cfg.run.max_events,
+        until: model.env.cfg.run.until.map(|d| Time(d.0)),
+        max_events: model.env.cfg.run.max_events,
     };
     let stats = run(&mut model, &mut sched, limits)?;
     model.catch_up(&sched)?;
@@ -106,7 +106,7 @@ pub fn run_pipeline(
     }
     let mut summary = to_json(&summarize(&model, &stats, analytic, scene_stats, build_seconds));
     positive_zeros(&mut summary);
-    let refresh = model.refresh;
+    let refresh = model.display.refresh();
     let end = stats.end_time;
     let a = &model.acct;
     let clocks = ClockTotals {
@@ -119,7 +119,7 @@ pub fn run_pipeline(
         elapsed: end.0,
     };
     let commands = model.command_counts();
-    let records = std::mem::take(&mut model.records);
+    let records = std::mem::take(&mut model.env.records);
     let trace = model.acct.trace.take().map(|t| t.end(&records, refresh));
     Ok(PipelineRun {
         stats,
@@ -129,7 +129,7 @@ pub fn run_pipeline(
         clocks,
         commands,
         records,
-        config: model.cfg,
+        config: model.env.cfg,
     })
 }
 
@@ -155,5 +155,5 @@ pub fn simulate_program(
             state: model.describe(),
         });
     }
-    Ok((stats, std::mem::take(&mut model.records)))
+    Ok((stats, std::mem::take(&mut model.env.records)))
 }

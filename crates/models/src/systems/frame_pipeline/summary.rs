@@ -232,8 +232,8 @@ pub(super) fn summarize(
 ) -> PipelineSummary {
     let end = stats.end_time;
     let elapsed = end.0.max(1) as f64;
-    let warm = m.cfg.run.warmup_frames as usize;
-    let rows = frame_rows(&m.records);
+    let warm = m.env.cfg.run.warmup_frames as usize;
+    let rows = frame_rows(&m.env.records);
     let col = |i: usize| -> Dist { Dist::of_finite(&rows.iter().skip(warm).map(|r| r[i]).collect::<Vec<f64>>()) };
     let cpu = m.acct.cpu.totals_at(end);
     let front = m.acct.front.totals_at(end);
@@ -241,25 +241,32 @@ pub(super) fn summarize(
     let frag = m.acct.frag.totals_at(end);
     let gpu = m.acct.gpu.totals_at(end);
     let bott = m.acct.path.totals_at(end, m.done());
-    let displayed = m.records.iter().skip(warm).filter(|r| r.displayed.is_some()).count();
-    let dropped = m.records.iter().skip(warm).filter(|r| r.dropped).count();
-    let (mark_vblanks, mark_repeated, mark_time) = m.refresh_mark.unwrap_or((0, 0, crate::engine::Time::ZERO));
-    let refreshes = if m.chain.mode() == crate::components::swap_chain::PresentMode::Immediate {
-        end.0 / m.refresh.0 - mark_time.0 / m.refresh.0
+    let displayed = m
+        .env
+        .records
+        .iter()
+        .skip(warm)
+        .filter(|r| r.displayed.is_some())
+        .count();
+    let dropped = m.env.records.iter().skip(warm).filter(|r| r.dropped).count();
+    let (mark_vblanks, mark_repeated, mark_time) =
+        m.display.refresh_mark().unwrap_or((0, 0, crate::engine::Time::ZERO));
+    let refreshes = if m.env.links.chain.mode() == crate::components::swap_chain::PresentMode::Immediate {
+        end.0 / m.display.refresh().0 - mark_time.0 / m.display.refresh().0
     } else {
-        m.vblanks - mark_vblanks
+        m.display.vblanks() - mark_vblanks
     };
-    let repeated = m.repeated_refreshes - mark_repeated;
+    let repeated = m.display.repeated_refreshes() - mark_repeated;
     let (issued, executed) = m.command_counts();
     PipelineSummary {
         system: "frame_pipeline",
-        description: m.cfg.description.clone(),
-        fidelity: m.cfg.fidelity,
-        seed: m.cfg.run.seed,
-        frames: m.records.len(),
-        frames_simulated: m.records.len(),
-        frames_requested: m.cfg.run.frames,
-        warmup_frames: m.cfg.run.warmup_frames,
+        description: m.env.cfg.description.clone(),
+        fidelity: m.env.cfg.fidelity,
+        seed: m.env.cfg.run.seed,
+        frames: m.env.records.len(),
+        frames_simulated: m.env.records.len(),
+        frames_requested: m.env.cfg.run.frames,
+        warmup_frames: m.env.cfg.run.warmup_frames,
         events: EventCounts::of(stats),
         wall_seconds: build_seconds + stats.wall_seconds,
         build_seconds,
@@ -303,7 +310,7 @@ pub(super) fn summarize(
             commands: CommandCounts {
                 issued,
                 executed,
-                fifo_max_used: m.fifo.max_used(),
+                fifo_max_used: m.env.links.commands.max_used(),
             },
             analytic,
         },

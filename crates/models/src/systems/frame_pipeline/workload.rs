@@ -17,6 +17,7 @@ use crate::scene::states::{StateNumbering, scene_groups};
 
 use super::closed_form::{DrawTimes, draw_times, draw_times_unified, ordered_draw_total};
 use super::config::{Fidelity, FramePipelineConfig};
+use super::geometry_stage::{CostOverflow, geometry_cost};
 
 /// Errors while building the workload.
 #[derive(Debug, thiserror::Error)]
@@ -389,16 +390,14 @@ pub fn fragment_costs(cfg: &FramePipelineConfig, pass: f64) -> (f64, f64) {
 /// fetch, vertex shader per transformed vertex, triangle setup); `key`
 /// names the mesh in errors.
 pub fn timed_mesh(cfg: &FramePipelineConfig, info: MeshInfo, key: &str) -> Result<MeshInfo, WorkloadError> {
-    let geo = &cfg.gpu.geometry;
-    let geometry_shader = mul(geo.vertex_shader, info.transformed, key)?;
-    let geometry_time = add(
-        add(mul(geo.index_fetch, info.indices, key)?, geometry_shader, key)?,
-        mul(geo.triangle_setup, info.triangles, key)?,
-        key,
-    )?;
+    let cost =
+        geometry_cost(&cfg.gpu.geometry, info.transformed, info.indices, info.triangles).map_err(|e| match e {
+            CostOverflow::Product => invalid(key, "cost x count overflows the 64-bit picosecond range"),
+            CostOverflow::Sum => invalid(key, "sum of costs overflows the 64-bit picosecond range"),
+        })?;
     Ok(MeshInfo {
-        geometry_time,
-        geometry_shader,
+        geometry_time: cost.total,
+        geometry_shader: cost.shader,
         ..info
     })
 }

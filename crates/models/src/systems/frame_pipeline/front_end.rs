@@ -1,0 +1,420 @@
+//! The GPU's front end (paper 000 §4.5, with §3-4's command buffer): it
+//! takes the commands from the command FIFO in order and processes each
+//! (command cost, state changes): a clear waits for a free swap-chain image
+//! (paper 004 §4.2), a draw is handed to the geometry stage once that stage
+//! is free, and a swap waits for the pipeline to drain, then presents the
+//! frame to the display. A system task can preempt its command processing.
+//!
+//! [`FrontEnd`] owns the front end's state (its phase, the command it
+//! holds, the frame it is on, its quiet completion, its random stream) and
+//! its transitions; the FIFOs and the swap chain come in an [`Env`], and
+//! the units downstream of it (geometry, fragment, display, and the
+//! critical path the display reports to) in a [`Downstream`].
+
+use crate::components::preemptible::{Preemptible, Wake};
+use crate::engine::{Duration, Scheduler, Slot, StreamRng, Time};
+use crate::systems::error::SystemError;
+
+use super::critical_path::CriticalPath;
+use super::display::Display;
+use super::events::Ev;
+use super::fragment_stage::FragmentStage;
+use super::geometry_stage::GeometryStage;
+use super::links::{Command, Env, command_count};
+
+/// What the GPU front end is doing (its command is its own, see
+/// [`FrontEnd::describe`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrontPhase {
+    /// Waiting for commands (starved when at rest).
+    Idle,
+    /// A clear waits for a free swap-chain image.
+    WaitImage,
+    /// A swap waits for the pipeline to drain.
+    WaitDrain,
+    /// Processing its command (possibly preempted).
+    Running,
+    /// A draw waits for the geometry stage to take it.
+    Handoff,
+}
+
+/// The units a front-end step can reach: the draws it hands on, the drain
+/// it waits for, the frames it presents.
+pub(super) struct Downstream<'a> {
+    pub(super) geom: &'a mut GeometryStage,
+    pub(super) frag: &'a mut FragmentStage,
+    pub(super) display: &'a mut Display,
+    pub(super) path: &'a mut CriticalPath,
+}
+
+/// The GPU front end.
+#[derive(Debug)]
+pub struct FrontEnd {
+    work: Preemptible,
+    phase: FrontPhase,
+    /// The command of every [`FrontPhase`] but `Idle`.
+    cmd: Command,
+    /// The frame it is on (from its clear to its swap).
+    frame: Option<u64>,
+    /// Its draw command completing quietly: its slot in the event order and
+    /// the job's tag ([`super::quiet`]).
+    quiet: Option<(Slot, u32)>,
+    /// The per-frame variation stream (`variation.gpu`).
+    variation_rng: StreamRng,
+    /// Commands executed.
+    executed: u64,
+}
+
+#[inline(always)]
+fn schedule(s: &mut Scheduler<Ev>, w: Wake) {
+    if let Wake::JobAt(t, tag) = w {
+        s.at(t, Ev::FrontDone { tag });
+    }
+}
+
+impl FrontEnd {
+    /// An idle front end; `variation_rng`: the `variation.gpu` stream.
+    pub(super) fn new(variation_rng: StreamRng) -> Self {
+        FrontEnd {
+            work: Preemptible::new(),
+            phase: FrontPhase::Idle,
+            cmd: Command::Clear { frame: 0 },
+            frame: None,
+            quiet: None,
+            variation_rng,
+            executed: 0,
+        }
+    }
+
+    /// The phase.
+    #[inline(always)]
+    pub(super) fn phase(&self) -> FrontPhase {
+        self.phase
+    }
+
+    /// The frame it is on (from its clear to its swap).
+    #[inline(always)]
+    pub(super) fn frame(&self) -> Option<u64> {
+        self.frame
+    }
+
+    /// Whether a system task holds it.
+    #[inline(always)]
+    pub(super) fn in_system(&self) -> bool {
+        self.work.in_system()
+    }
+
+    /// Commands executed so far.
+    pub(super) fn executed(&self) -> u64 {
+        self.executed
+    }
+
+    /// For stall reports: the phase with the command it holds.
+    pub(super) fn describe(&self) -> String {
+        match self.phase {
+            FrontPhase::Idle => "Idle".to_string(),
+            p => format!("{p:?}({:?})", self.cmd),
+        }
+    }
+
+    /// The running command's job with `tag` completed (false: a stale tag).
+    #[inline(always)]
+    pub(super) fn complete(&mut self, tag: u32) -> bool {
+        self.work.complete(tag)
+    }
+
+    /// A system task of `d` arrives; returns when it ends, if it runs now.
+    pub(super) fn task_arrives(&mut self, now: Time, d: Duration) -> Result<Option<Time>, SystemError> {
+        Ok(self.work.task_arrives(now, d)?)
+    }
+
+    /// The running system task ends: returns when the next one ends, if one
+    /// runs, and the wake of the job it held ([`FrontEnd::schedule_wake`]).
+    pub(super) fn task_ends(&mut self, now: Time) -> Result<(Option<Time>, Wake), SystemError> {
+        Ok(self.work.task_ends(now)?)
+    }
+
+    /// Schedules the completion of a job the front end started or resumed.
+    #[inline(always)]
+    pub(super) fn schedule_wake(s: &mut Scheduler<Ev>, w: Wake) {
+        schedule(s, w);
+    }
+
+    /// Advances the front end as far as it can go now. Returns whether
+    /// anything changed.
+    pub(super) fn step(
+        &mut self,
+        now: Time,
+        env: &mut Env,
+        down: &mut Downstream<'_>,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<bool, SystemError> {
+        let mut progressed = false;
+        loop {
+            match self.phase {
+                FrontPhase::Idle => {
+                    let Some(c) = env.links.commands.pop() else {
+                        return Ok(progressed);
+                    };
+                    self.executed += command_count(&env.scene, &c);
+                    self.cmd = c;
+                    self.phase = self.begin(now, c, env, down, s)?;
+                }
+                FrontPhase::WaitImage => {
+                    if !env.links.chain.acquire() {
+                        return Ok(progressed);
+                    }
+                    self.phase = self.start_clear(now, self.cmd, env, down, s)?;
+                }
+                FrontPhase::WaitDrain => {
+                    // No triangle anywhere between the front end and the fragment output.
+                    if !(down.geom.drained() && env.links.triangles.is_empty() && !down.frag.busy()) {
+                        return Ok(progressed);
+                    }
+                    let work = env.cfg.gpu.swap.saturating_add(env.cfg.gpu.command);
+                    self.phase = self.job(now, self.cmd, work, env, down, s)?;
+                }
+                FrontPhase::Handoff => {
+                    // Binning: the next draw's geometry waits for the bins to drain.
+                    let bins_busy =
+                        env.cfg.gpu.fragment.binned() && (down.frag.busy() || !env.links.triangles.is_empty());
+                    if down.geom.has_draw() || bins_busy {
+                        return Ok(progressed);
+                    }
+                    if let Command::Draw { draw, .. } = self.cmd {
+                        down.geom.start_draw(now, draw, env, down.frag, s)?;
+                    }
+                    self.phase = FrontPhase::Idle;
+                }
+                FrontPhase::Running => return Ok(progressed),
+            }
+            progressed = true;
+        }
+    }
+
+    fn begin(
+        &mut self,
+        now: Time,
+        c: Command,
+        env: &mut Env,
+        down: &mut Downstream<'_>,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<FrontPhase, SystemError> {
+        let cmd_cost = env.cfg.gpu.command;
+        match c {
+            Command::Clear { .. } => {
+                if env.links.chain.acquire() {
+                    self.start_clear(now, c, env, down, s)
+                } else {
+                    Ok(FrontPhase::WaitImage)
+                }
+            }
+            Command::Fixed { gpu, .. } => {
+                let work = gpu.saturating_add(cmd_cost);
+                self.job(now, c, work, env, down, s)
+            }
+            Command::Draw { draw, .. } => {
+                let work = match &env.scene {
+                    Some(sc) => sc.draws[draw as usize].front,
+                    None => Duration::ZERO,
+                };
+                self.job(now, c, work, env, down, s)
+            }
+            Command::Swap { .. } => Ok(FrontPhase::WaitDrain),
+        }
+    }
+
+    fn start_clear(
+        &mut self,
+        now: Time,
+        c: Command,
+        env: &mut Env,
+        down: &mut Downstream<'_>,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<FrontPhase, SystemError> {
+        if let Command::Clear { frame } = c {
+            self.frame = Some(frame);
+            down.geom.new_frame();
+            env.records[frame as usize].gpu_start = Some(now);
+        }
+        let mut work = env.cfg.gpu.clear.saturating_add(env.cfg.gpu.command);
+        // Per-frame variation (config `variation.gpu`), drawn only when given.
+        if let (Command::Clear { .. }, Some(v)) = (c, env.cfg.variation.gpu()) {
+            work = work.saturating_add(Duration::from_ps_f64(v.sample(&mut self.variation_rng)));
+        }
+        self.job(now, c, work, env, down, s)
+    }
+
+    /// Runs `work` for command `c` on the (preemptible) front end; zero work
+    /// completes at once.
+    fn job(
+        &mut self,
+        now: Time,
+        c: Command,
+        work: Duration,
+        env: &mut Env,
+        down: &mut Downstream<'_>,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<FrontPhase, SystemError> {
+        if work.0 > 0 || self.work.in_system() {
+            self.start_job(now, c, work, down.geom.done_at(), s)?;
+            return Ok(FrontPhase::Running);
+        }
+        self.after(now, c, env, down)
+    }
+
+    /// Starts the job of `work` for `c`; its completion is an event, or
+    /// quiet when it only starts a hand-off ([`super::quiet`]):
+    /// `geometry_done_at` is when the geometry stage's draw ends.
+    #[inline(always)]
+    fn start_job(
+        &mut self,
+        now: Time,
+        c: Command,
+        work: Duration,
+        geometry_done_at: Option<Time>,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
+        match self.work.start_job(now, work)? {
+            Wake::JobAt(end, tag) if quiet_completion(c, end, geometry_done_at) => {
+                self.quiet = Some((s.reserve(end), tag));
+            }
+            w => schedule(s, w),
+        }
+        Ok(())
+    }
+
+    /// The running command's work finished (its event).
+    pub(super) fn command_done(
+        &mut self,
+        now: Time,
+        env: &mut Env,
+        down: &mut Downstream<'_>,
+    ) -> Result<(), SystemError> {
+        if let FrontPhase::Running = self.phase {
+            self.phase = self.after(now, self.cmd, env, down)?;
+        }
+        Ok(())
+    }
+
+    fn after(
+        &mut self,
+        now: Time,
+        c: Command,
+        env: &mut Env,
+        down: &mut Downstream<'_>,
+    ) -> Result<FrontPhase, SystemError> {
+        Ok(match c {
+            Command::Draw { .. } => FrontPhase::Handoff,
+            Command::Swap { frame } => {
+                // The frame is complete: present it.
+                env.links.frames_completed += 1;
+                env.records[frame as usize].gpu_end = Some(now);
+                self.frame = None;
+                down.display
+                    .present(now, frame, &mut env.links.chain, &mut env.records, down.path);
+                FrontPhase::Idle
+            }
+            Command::Clear { .. } | Command::Fixed { .. } => FrontPhase::Idle,
+        })
+    }
+
+    /// The quiet completion whose turn came before the event being handled
+    /// (after a run: before its end), taken off: its instant and job tag.
+    #[inline(always)]
+    pub(super) fn passed_quiet(&mut self, s: &Scheduler<Ev>) -> Option<(Time, u32)> {
+        if let Some((slot, tag)) = self.quiet
+            && s.passed(slot)
+        {
+            self.quiet = None;
+            return Some((slot.time(), tag));
+        }
+        None
+    }
+
+    /// The quiet completion of the draw command's job `tag`: the hand-off
+    /// begins, as [`FrontEnd::command_done`] does for a draw command.
+    /// Returns false, having changed nothing, when a system task that
+    /// preempted the job made the tag stale (the resumed job's completion
+    /// is an event of its own).
+    #[inline(always)]
+    pub(super) fn quiet_done(&mut self, tag: u32) -> bool {
+        if !self.work.complete(tag) {
+            return false;
+        }
+        debug_assert!(matches!(self.cmd, Command::Draw { .. }));
+        // (Calling `command_done` here costs 1.4% of the hour's
+        // instructions: its result goes through memory.)
+        if self.phase == FrontPhase::Running {
+            self.phase = FrontPhase::Handoff;
+        }
+        debug_assert_eq!(self.phase, FrontPhase::Handoff);
+        true
+    }
+
+    /// The front end's first steps of `settle` at a draw's end
+    /// ([`super::quiet`]'s `draw_done_alone`) in their common case, taken
+    /// without the general step's dispatch: the held draw goes to the
+    /// geometry stage (its closed form, its [`Ev::DrawDone`]), and the front
+    /// end takes the next command when it is a draw with front-end work
+    /// (its job, quiet when it ends before the new draw, as in
+    /// [`FrontEnd::job`]), or starts waiting for commands when the FIFO is
+    /// empty. Any other next command, and a draw without its closed form,
+    /// leave everything to `settle`. The CPU's step that `settle` takes
+    /// first does nothing at this instant (a draw's end frees no FIFO space
+    /// and completes no frame), so taking the front end's steps before it
+    /// changes no order; `settle` runs next and takes every step left.
+    /// Returns whether the front end is running the next command's job.
+    #[inline]
+    pub(super) fn handoff_fast(
+        &mut self,
+        now: Time,
+        env: &mut Env,
+        geom: &mut GeometryStage,
+        frag: &mut FragmentStage,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<bool, SystemError> {
+        let (Command::Draw { draw, .. }, Some(sc)) = (self.cmd, &env.scene) else {
+            return Ok(false);
+        };
+        let d = &sc.draws[draw as usize];
+        let Some(t) = d.closed else {
+            return Ok(false);
+        };
+        let triangles = sc.meshes[d.mesh as usize].triangles;
+        let next = match env.links.commands.front() {
+            None => None,
+            Some(&Command::Draw { draw: n, .. }) => {
+                let n = &sc.draws[n as usize];
+                if n.front.0 == 0 {
+                    return Ok(false);
+                }
+                Some((n.front, u64::from(n.commands)))
+            }
+            Some(_) => return Ok(false),
+        };
+        // The geometry stage takes the held draw (`GeometryStage::start_draw`).
+        geom.start_closed_draw(draw, triangles, t, frag, env.traced, s)?;
+        self.phase = FrontPhase::Idle;
+        // The front end takes the next draw command (`begin`, `job`).
+        if let Some((work, commands)) = next
+            && let Some(c) = env.links.commands.pop()
+        {
+            self.executed += commands;
+            self.cmd = c;
+            self.start_job(now, c, work, geom.done_at(), s)?;
+            self.phase = FrontPhase::Running;
+            return Ok(true);
+        }
+        Ok(false)
+    }
+}
+
+/// Whether the front end's job for `c`, ending at `end`, would only start a
+/// hand-off: a draw command finished while the geometry stage's draw ends
+/// later, at `geometry_done_at` (one ending at the same instant runs first,
+/// since it was scheduled first, and frees the stage).
+#[inline(always)]
+fn quiet_completion(c: Command, end: Time, geometry_done_at: Option<Time>) -> bool {
+    matches!(c, Command::Draw { .. }) && geometry_done_at.is_some_and(|d| d > end)
+}

@@ -1,0 +1,394 @@
+//! The GPU's geometry stage (paper 000 §4.5): index fetch -> post-transform
+//! vertex cache -> vertex shader per actually transformed vertex ->
+//! triangle setup, feeding the triangle FIFO. At `triangle` fidelity every
+//! triangle is an event, so the bottleneck can move inside one draw
+//! (§4.5.1); at `draw` fidelity each draw is one closed form
+//! ([`super::closed_form`]) spanning this stage and the fragment stage.
+//! With `gpu.fragment.binning = "draw"` the triangle FIFO becomes
+//! sort-middle bins: a draw's fragments start after its last triangle's
+//! geometry.
+//!
+//! [`GeometryStage`] owns the stage's state (the draw it holds, the
+//! triangle held back by a full FIFO, the running closed form, the
+//! triangle sizes and their random stream) and its transitions; the
+//! triangle FIFO and the shader pool come in an [`Env`], the fragment stage
+//! it feeds as an argument. [`geometry_cost`] is the one formula of the
+//! stage's time, used per mesh by the workload and per triangle here.
+
+use crate::components::shader_pool::Stream;
+use crate::engine::{Duration, Scheduler, StreamRng, Time};
+use crate::scene::config::SizeOrder;
+use crate::systems::error::SystemError;
+
+use super::closed_form::DrawTimes;
+use super::config::{Fidelity, GeometryConfig};
+use super::events::Ev;
+use super::fragment_stage::FragmentStage;
+use super::links::{Env, FragWork};
+use super::workload::{closed_times, ordered_sizes};
+
+/// The geometry stage's time for some work: its vertex-shader part and the
+/// whole (the rest is index fetch and triangle setup).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GeometryCost {
+    /// Vertex shading.
+    pub shader: Duration,
+    /// Index fetch, vertex shading and triangle setup.
+    pub total: Duration,
+}
+
+impl GeometryCost {
+    /// The fixed-function part (index fetch and triangle setup).
+    #[inline(always)]
+    pub fn fixed(&self) -> Duration {
+        Duration(self.total.0 - self.shader.0)
+    }
+}
+
+/// Which part of [`geometry_cost`] left the 64-bit picosecond range.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CostOverflow {
+    /// A cost times its count.
+    Product,
+    /// A sum of costs.
+    Sum,
+}
+
+/// The geometry stage's time for `transformed` vertices shaded (those the
+/// post-transform cache missed), `indices` indices fetched and `triangles`
+/// triangles set up, from the model's per-vertex, per-index and
+/// per-triangle costs (`gpu.geometry`). The first part to overflow is
+/// reported, in the order: shading, fetch, fetch + shading, setup, total.
+#[inline]
+pub fn geometry_cost(
+    geo: &GeometryConfig,
+    transformed: u64,
+    indices: u64,
+    triangles: u64,
+) -> Result<GeometryCost, CostOverflow> {
+    let shader = geo
+        .vertex_shader
+        .checked_mul(transformed)
+        .ok_or(CostOverflow::Product)?;
+    let fetch = geo.index_fetch.checked_mul(indices).ok_or(CostOverflow::Product)?;
+    let fetched = fetch.checked_add(shader).ok_or(CostOverflow::Sum)?;
+    let setup = geo.triangle_setup.checked_mul(triangles).ok_or(CostOverflow::Product)?;
+    let total = fetched.checked_add(setup).ok_or(CostOverflow::Sum)?;
+    Ok(GeometryCost { shader, total })
+}
+
+/// A draw in the geometry stage.
+#[derive(Debug, Clone, Copy)]
+pub struct ActiveDraw {
+    /// Index into the scene's draws.
+    pub draw: u32,
+    /// Next triangle.
+    pub next: u64,
+    /// Triangles.
+    pub triangles: u64,
+}
+
+/// The geometry stage.
+#[derive(Debug)]
+pub struct GeometryStage {
+    draw: Option<ActiveDraw>,
+    busy: bool,
+    /// `draw` fidelity without a trace: the running draw's (geometry,
+    /// fragment, total) times, credited to the stage clocks when it ends
+    /// instead of with two extra events.
+    split: Option<(Duration, Duration, Duration)>,
+    /// `draw` fidelity: whether the running draw is fragment-limited (F >= G);
+    /// the bottleneck of the whole draw goes to that stage.
+    fragment_limited: Option<bool>,
+    /// `draw` fidelity: when the running draw ends (its [`Ev::DrawDone`]).
+    done_at: Option<Time>,
+    /// A finished triangle's fragment work that found the triangle FIFO full.
+    held: Option<FragWork>,
+    /// The running draw's triangle sizes when its group sorts them
+    /// (`size_order`), in drawing order; empty otherwise.
+    sizes: Vec<f64>,
+    pixel_rng: StreamRng,
+    /// The size stream's state at the start, restored every frame for a static view.
+    pixel_rng_start: Option<StreamRng>,
+}
+
+impl GeometryStage {
+    /// An idle stage drawing triangle sizes from `pixel_rng`, restarted at
+    /// every frame from `pixel_rng_start` when given (a static view).
+    pub(super) fn new(pixel_rng: StreamRng, pixel_rng_start: Option<StreamRng>) -> Self {
+        GeometryStage {
+            draw: None,
+            busy: false,
+            split: None,
+            fragment_limited: None,
+            done_at: None,
+            held: None,
+            sizes: Vec::new(),
+            pixel_rng,
+            pixel_rng_start,
+        }
+    }
+
+    /// Whether it is transforming (or, at `draw` fidelity, runs a draw's geometry).
+    #[inline(always)]
+    pub(super) fn busy(&self) -> bool {
+        self.busy
+    }
+
+    /// Whether a finished triangle waits for room in the triangle FIFO.
+    #[inline(always)]
+    pub(super) fn holds_triangle(&self) -> bool {
+        self.held.is_some()
+    }
+
+    /// Whether it holds a draw.
+    #[inline(always)]
+    pub(super) fn has_draw(&self) -> bool {
+        self.draw.is_some()
+    }
+
+    /// The draw it holds (for stall reports).
+    pub(super) fn draw(&self) -> Option<ActiveDraw> {
+        self.draw
+    }
+
+    /// `draw` fidelity: whether the running draw is fragment-limited.
+    #[inline(always)]
+    pub(super) fn fragment_limited(&self) -> Option<bool> {
+        self.fragment_limited
+    }
+
+    /// `draw` fidelity: when the running draw ends.
+    #[inline(always)]
+    pub(super) fn done_at(&self) -> Option<Time> {
+        self.done_at
+    }
+
+    /// Whether no triangle is in the stage (the triangle FIFO and the
+    /// fragment stage are the caller's to check).
+    #[inline]
+    pub(super) fn drained(&self) -> bool {
+        self.draw.is_none() && self.held.is_none() && !self.busy
+    }
+
+    /// A new frame begins (its clear): a static view's triangles get the
+    /// same sizes as every other frame's.
+    #[inline]
+    pub(super) fn new_frame(&mut self) {
+        if let Some(start) = &self.pixel_rng_start {
+            self.pixel_rng = start.clone();
+        }
+    }
+
+    /// Takes `draw` from the front end.
+    pub(super) fn start_draw(
+        &mut self,
+        now: Time,
+        draw: u32,
+        env: &mut Env,
+        frag: &mut FragmentStage,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
+        let Some(sc) = &env.scene else {
+            return Ok(());
+        };
+        let d = &sc.draws[draw as usize];
+        let mesh = &sc.meshes[d.mesh as usize];
+        let triangles = mesh.triangles;
+        match env.cfg.fidelity {
+            Fidelity::Triangle => {
+                let g = &sc.groups[d.group as usize];
+                if g.order == SizeOrder::Random {
+                    self.sizes.clear();
+                } else {
+                    ordered_sizes(g, triangles, &mut self.pixel_rng, &mut self.sizes);
+                }
+                self.draw = Some(ActiveDraw {
+                    draw,
+                    next: 0,
+                    triangles,
+                });
+                self.next_triangle(now, env, s)
+            }
+            Fidelity::Draw => {
+                let t = match d.closed {
+                    Some(t) => t,
+                    None => closed_times(&env.cfg, mesh, &sc.groups[d.group as usize]),
+                };
+                self.start_closed_draw(draw, triangles, t, frag, env.traced, s)
+            }
+        }
+    }
+
+    /// `draw` fidelity: takes `draw` (`triangles` triangles), whose closed
+    /// form `t` spans this stage and `frag`.
+    #[inline(always)]
+    pub(super) fn start_closed_draw(
+        &mut self,
+        draw: u32,
+        triangles: u64,
+        t: DrawTimes,
+        frag: &mut FragmentStage,
+        traced: bool,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
+        self.draw = Some(ActiveDraw {
+            draw,
+            next: 0,
+            triangles,
+        });
+        self.fragment_limited = Some(t.fragment >= t.geometry);
+        if !traced {
+            // Geometry runs [0, G] and fragments [T - F, T] of the draw;
+            // T <= G + F, so the GPU is busy throughout. Without a trace the
+            // split is credited at the end (one event).
+            self.busy = true;
+            frag.set_closed_busy(true);
+            self.split = Some((t.geometry, t.fragment, t.total));
+            self.done_at = Some(s.after(t.total, Ev::DrawDone, "draw")?);
+            return Ok(());
+        }
+        self.closed_draw_traced(t, frag, s)
+    }
+
+    /// [`GeometryStage::start_closed_draw`] with a trace: the geometry
+    /// part's end and the fragment part's start are events of their own, so
+    /// the trace shows each stage's span.
+    #[inline(never)]
+    fn closed_draw_traced(
+        &mut self,
+        t: DrawTimes,
+        frag: &mut FragmentStage,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
+        if t.geometry.0 > 0 {
+            self.busy = true;
+            s.after(t.geometry, Ev::DrawGeometry, "draw geometry")?;
+        }
+        let frag_start = t.total.saturating_sub(t.fragment);
+        if frag_start.0 > 0 {
+            s.after(frag_start, Ev::DrawFragmentStart, "draw fragment start")?;
+        } else {
+            frag.set_closed_busy(true);
+        }
+        self.done_at = Some(s.after(t.total, Ev::DrawDone, "draw")?);
+        Ok(())
+    }
+
+    /// `draw` fidelity with a trace: the running draw's geometry part ended.
+    pub(super) fn closed_geometry_done(&mut self) {
+        self.busy = false;
+    }
+
+    /// `draw` fidelity: the draw's last fragment is done; both stages are
+    /// free. Returns the draw's (geometry, fragment, total) times when they
+    /// are yet to be credited to the stage clocks (no trace).
+    #[inline]
+    pub(super) fn draw_done(&mut self, frag: &mut FragmentStage) -> Option<(Duration, Duration, Duration)> {
+        let split = self.split.take();
+        self.busy = false;
+        frag.set_closed_busy(false);
+        self.draw = None;
+        self.fragment_limited = None;
+        self.done_at = None;
+        split
+    }
+
+    /// Starts the next triangle of the current draw, or finishes the draw.
+    pub(super) fn next_triangle(&mut self, now: Time, env: &mut Env, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+        let Some(a) = self.draw else {
+            return Ok(());
+        };
+        if a.next >= a.triangles {
+            self.draw = None;
+            return Ok(());
+        }
+        let Some(sc) = &env.scene else {
+            return Ok(());
+        };
+        let mesh = &sc.meshes[sc.draws[a.draw as usize].mesh as usize];
+        let tv = mesh.misses.of(a.next, a.triangles);
+        let indices = if mesh.indices > 0 { 3 } else { 0 };
+        // Checked: a huge per-vertex cost times the vertices must not wrap.
+        let cost =
+            geometry_cost(&env.cfg.gpu.geometry, tv, indices, 1).map_err(|_| crate::engine::TimeError::Overflow {
+                context: "computing the geometry time of a triangle (gpu.geometry costs)".into(),
+                at: now,
+                by: Duration(u64::MAX),
+            })?;
+        self.busy = true;
+        if let Some(pool) = &mut env.links.shaders {
+            // Unified: fetch and setup beside the vertex shading on the pool.
+            pool.begin(now, Stream::Vertex, cost.shader, cost.fixed())?;
+            return Ok(());
+        }
+        s.at(
+            now.add(cost.total, "geometry of a triangle")?,
+            Ev::GeomTriangle { tag: 0 },
+        );
+        Ok(())
+    }
+
+    /// `triangle` fidelity: a triangle left the stage; its fragment work
+    /// goes to `frag`, or into the triangle FIFO, or is held while the FIFO
+    /// is full (the stage blocks).
+    pub(super) fn triangle_done(
+        &mut self,
+        now: Time,
+        env: &mut Env,
+        frag: &mut FragmentStage,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
+        self.busy = false;
+        let Some(a) = self.draw.as_mut() else {
+            return Ok(());
+        };
+        a.next += 1;
+        let (next, last, draw) = (a.next, a.next >= a.triangles, a.draw);
+        let Some(sc) = &env.scene else {
+            return Ok(());
+        };
+        let g = &sc.groups[sc.draws[draw as usize].group as usize];
+        let px = match self.sizes.get((next - 1) as usize) {
+            Some(&px) => px,
+            None => g.pixels.sample(&mut self.pixel_rng),
+        };
+        let links = &mut env.links;
+        let f = if links.shaders.is_some() {
+            FragWork {
+                shader: Duration::from_ps_f64(px * g.shade_per_pixel),
+                fixed: Duration::from_ps_f64(px * g.fixed_per_pixel),
+            }
+        } else {
+            FragWork {
+                shader: Duration::from_ps_f64(px * g.cost_per_pixel()),
+                fixed: Duration::ZERO,
+            }
+        };
+        let fifo = &mut links.triangles;
+        if env.cfg.gpu.fragment.binned() {
+            // Sort-middle: bin the triangle; the draw's last triangle opens the bins.
+            fifo.push(f, 1);
+            if last
+                && !frag.busy()
+                && let Some(first) = fifo.pop()
+            {
+                frag.start(now, first, &mut links.shaders, s)?;
+            }
+        } else if !frag.busy() && fifo.is_empty() {
+            frag.start(now, f, &mut links.shaders, s)?;
+        } else if fifo.len() < fifo.capacity() as usize {
+            fifo.push(f, 1);
+        } else {
+            self.held = Some(f);
+            return Ok(());
+        }
+        self.next_triangle(now, env, s)
+    }
+
+    /// Takes the triangle held back by a full triangle FIFO, if any.
+    #[inline]
+    pub(super) fn take_held(&mut self) -> Option<FragWork> {
+        self.held.take()
+    }
+}
