@@ -8,8 +8,6 @@
 //! larger than the whole capacity enters only when the FIFO is empty, so a
 //! big batch can never deadlock.
 
-use std::collections::VecDeque;
-
 /// What the capacity counts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -48,7 +46,7 @@ pub enum FifoUnit {
 /// ```
 #[derive(Debug, Clone)]
 pub struct BoundedFifo<T> {
-    items: VecDeque<(T, u64)>,
+    items: Ring<(T, u64)>,
     capacity: u64,
     used: u64,
     max_used: u64,
@@ -58,7 +56,7 @@ impl<T> BoundedFifo<T> {
     /// An empty FIFO of the given capacity (in the unit its weights use).
     pub fn new(capacity: u64) -> Self {
         BoundedFifo {
-            items: VecDeque::new(),
+            items: Ring::new(),
             capacity,
             used: 0,
             max_used: 0,
@@ -129,9 +127,118 @@ impl<T> BoundedFifo<T> {
     }
 }
 
+/// The entries, oldest first, in a ring of power-of-two size that doubles
+/// when full. `VecDeque` would do, but its `push_back` is not inlined into
+/// the frame pipeline's hottest path (a CPU draw batch entering the command
+/// FIFO), which costs about 1.5% of a long run's instructions.
+#[derive(Debug, Clone)]
+struct Ring<T> {
+    slots: Vec<Option<T>>,
+    head: usize,
+    len: usize,
+}
+
+impl<T> Ring<T> {
+    fn new() -> Self {
+        Ring {
+            slots: Vec::new(),
+            head: 0,
+            len: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.len
+    }
+
+    #[inline(always)]
+    fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    #[inline(always)]
+    fn mask(&self) -> usize {
+        self.slots.len().wrapping_sub(1)
+    }
+
+    #[inline(always)]
+    fn push_back(&mut self, item: T) {
+        if self.len == self.slots.len() {
+            self.grow();
+        }
+        let i = (self.head + self.len) & self.mask();
+        self.slots[i] = Some(item);
+        self.len += 1;
+    }
+
+    /// Doubles the ring (at least 4 slots), the oldest entry first.
+    #[cold]
+    #[inline(never)]
+    fn grow(&mut self) {
+        let size = (self.slots.len() * 2).max(4);
+        let mask = self.mask();
+        let mut slots = Vec::with_capacity(size);
+        for k in 0..self.len {
+            slots.push(self.slots[(self.head + k) & mask].take());
+        }
+        slots.resize_with(size, || None);
+        self.slots = slots;
+        self.head = 0;
+    }
+
+    #[inline(always)]
+    fn pop_front(&mut self) -> Option<T> {
+        if self.len == 0 {
+            return None;
+        }
+        let item = self.slots[self.head].take();
+        self.head = (self.head + 1) & self.mask();
+        self.len -= 1;
+        item
+    }
+
+    fn front(&self) -> Option<&T> {
+        if self.len == 0 {
+            return None;
+        }
+        self.slots[self.head].as_ref()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The ring against `VecDeque` over pushes and pops that wrap around
+    /// and grow it while it holds entries.
+    #[test]
+    fn ring_keeps_fifo_order_through_wraps_and_growth() {
+        let mut ring = Ring::new();
+        let mut oracle = std::collections::VecDeque::new();
+        let mut next = 0u32;
+        // A pattern that pushes more than it pops, then drains.
+        for step in 0..2000u32 {
+            let pushes = 1 + step % 3;
+            let pops = step % 4;
+            for _ in 0..pushes {
+                ring.push_back(next);
+                oracle.push_back(next);
+                next += 1;
+            }
+            for _ in 0..pops {
+                assert_eq!(ring.pop_front(), oracle.pop_front());
+            }
+            assert_eq!(ring.len(), oracle.len());
+            assert_eq!(ring.front(), oracle.front());
+        }
+        while let Some(x) = oracle.pop_front() {
+            assert_eq!(ring.pop_front(), Some(x));
+        }
+        assert!(ring.is_empty());
+        assert_eq!(ring.pop_front(), None);
+        assert_eq!(ring.front(), None);
+    }
 
     #[test]
     fn bounded_by_weight() {

@@ -187,6 +187,7 @@ impl ShaderPool {
 
     /// `stream`'s item ended (its current completion fired). Call
     /// [`ShaderPool::settle`] after the instant's changes.
+    #[inline(never)]
     pub fn end(&mut self, now: Time, stream: Stream) {
         self.advance(now);
         let s = &mut self.slots[stream as usize];
