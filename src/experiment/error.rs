@@ -15,8 +15,10 @@ pub enum ExperimentError {
         /// The underlying I/O error.
         source: std::io::Error,
     },
-    /// A TOML file did not parse (syntax, unknown key, wrong type).
-    #[error("{}: {message}", file.display())]
+    /// A TOML file is not valid TOML (an unknown key or a wrong type is
+    /// [`ExperimentError::Invalid`], with its line). Written as a model's
+    /// syntax error is: `FILE: malformed TOML: MESSAGE`.
+    #[error("{}: malformed TOML: {message}", file.display())]
     Parse {
         /// The file concerned.
         file: PathBuf,
@@ -24,7 +26,8 @@ pub enum ExperimentError {
         message: String,
     },
     /// An experiment file parsed but is not valid.
-    #[error("{}{}: `{key}`: {message}", file.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
+    /// Written as a model's errors are: `FILE:LINE: key `KEY`: MESSAGE`.
+    #[error("{}{}: key `{key}`: {message}", file.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
     Invalid {
         /// The experiment file.
         file: PathBuf,

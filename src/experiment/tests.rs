@@ -176,6 +176,29 @@ fn range_formatting() {
 fn bad_experiment_files() {
     let e = parse_err("name = \"x\"\nreplicatons = 3\n");
     assert!(e.contains("experiments/bad.toml") && e.contains("replicatons"), "{e}");
+    // The loader of model files reads experiments too: file, line, key and
+    // the closest valid key, in a model error's form.
+    assert!(
+        e.starts_with("experiments/bad.toml:2: key `replicatons`: unknown field")
+            && e.ends_with("(did you mean `replications`?)"),
+        "{e}"
+    );
+    let e = parse_err("name = \"x\"\n\n[[sweep]]\nkey = \"a\"\nvalues = [1]\n\n[[sweep]]\nkey = \"b\"\nvaluse = [2]\n");
+    assert!(
+        e.starts_with("experiments/bad.toml:9: key `sweep[1].valuse`: unknown field")
+            && e.contains("did you mean `values`"),
+        "{e}"
+    );
+    let e = parse_err("name = \"x\"\nreplications = \"three\"\n");
+    assert!(
+        e.starts_with("experiments/bad.toml:2: key `replications`: invalid type"),
+        "{e}"
+    );
+    let e = parse_err("name = \"x\"\nreplications = [\n");
+    assert!(
+        e.starts_with("experiments/bad.toml: malformed TOML: ") && e.contains("line 2"),
+        "{e}"
+    );
 
     let e = parse_err("name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1]\nrange = { from = 1, to = 2, steps = 2 }\n");
     assert!(e.contains("sweep[0]") && e.contains("not both"), "{e}");

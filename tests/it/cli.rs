@@ -928,7 +928,7 @@ fn experiment_check_entries_name_their_line() {
         + 1;
     let err = run_err(&["experiment", &e, "--quiet", "--out", out.to_str().unwrap()]);
     assert!(
-        err.contains(&format!("e.toml:{line}: `check[1]")),
+        err.contains(&format!("e.toml:{line}: key `check[1]")),
         "expected line {line}: {err}"
     );
 }

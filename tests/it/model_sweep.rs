@@ -129,7 +129,7 @@ fn a_missing_model_file_is_an_error_naming_the_experiment_and_its_line() {
     let (ok, out, err, _d) = experiment(&[("exp.toml", exp)]);
     assert!(!ok, "ran: {out}");
     assert!(
-        err.contains("exp.toml:2: `model`: model file \"models/none.toml\" not found"),
+        err.contains("exp.toml:2: key `model`: model file \"models/none.toml\" not found"),
         "{err}"
     );
 }

@@ -19,12 +19,66 @@ pub fn load_experiment(path: &Path) -> Result<Experiment, ExperimentError> {
 
 /// Parse and validate experiment TOML `text`; `source` names the file in
 /// messages and anchors a relative `model` path.
+///
+/// The text is read as model files are ([`crate::config::ModelSource`],
+/// [`crate::config::deserialize`]): a misspelt key or a value of the wrong
+/// type is reported with the file, its line, the key and, for a misspelt
+/// key, the closest valid one, in the same form as a model's errors.
 pub fn parse_experiment(text: &str, source: &Path) -> Result<Experiment, ExperimentError> {
-    let raw: RawExperiment = toml::from_str(text).map_err(|e| ExperimentError::Parse {
-        file: source.to_path_buf(),
-        message: e.to_string().trim_end().to_string(),
-    })?;
+    let src = crate::config::ModelSource::from_text(&source.display().to_string(), text);
+    let raw: RawExperiment = src
+        .table()
+        .and_then(|table| crate::config::deserialize(&table, &src))
+        .map_err(|e| from_config_error(e, source))?;
     Validator { file: source, text }.experiment(raw)
+}
+
+/// A loader error of the experiment file, in the experiment's own terms:
+/// keys of `[[tables]]` as `sweep[1].range`, as the validator names them.
+fn from_config_error(e: crate::config::ConfigError, source: &Path) -> ExperimentError {
+    use crate::config::ConfigError;
+    match e {
+        ConfigError::Invalid {
+            key,
+            line,
+            message,
+            suggestion,
+            ..
+        } => ExperimentError::Invalid {
+            file: source.to_path_buf(),
+            line,
+            key: indexed_key(&key),
+            message: match suggestion {
+                Some(s) => format!("{message} (did you mean `{s}`?)"),
+                None => message,
+            },
+        },
+        other => ExperimentError::Parse {
+            file: source.to_path_buf(),
+            message: match other {
+                ConfigError::Syntax { message, .. } => message,
+                e => e.to_string(),
+            },
+        },
+    }
+}
+
+/// `sweep.1.range` as `sweep[1].range`.
+fn indexed_key(dotted: &str) -> String {
+    let mut out = String::with_capacity(dotted.len() + 2);
+    for part in dotted.split('.') {
+        if !out.is_empty() && part.bytes().all(|b| b.is_ascii_digit()) && !part.is_empty() {
+            out.push('[');
+            out.push_str(part);
+            out.push(']');
+        } else {
+            if !out.is_empty() {
+                out.push('.');
+            }
+            out.push_str(part);
+        }
+    }
+    out
 }
 
 pub(super) struct Validator<'a> {
