@@ -26,6 +26,7 @@
 //! timeline) live above it, in the `rendersim` crate's `studies`.
 
 pub mod accounting;
+pub mod checked;
 pub mod closed_form;
 pub mod config;
 mod cpu_thread;
@@ -46,7 +47,7 @@ pub mod system;
 pub mod validate;
 pub mod workload;
 
+pub use checked::CheckedPipeline;
 pub use config::{Fidelity, FramePipelineConfig};
 pub use model::FramePipeline;
 pub use run::{PipelineRun, run_pipeline};
-pub use validate::validate;

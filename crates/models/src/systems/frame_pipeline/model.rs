@@ -25,6 +25,7 @@ use crate::engine::{Control, Model, RngStreams, Scheduler, Time};
 use crate::systems::error::SystemError;
 
 use super::accounting::{Accounting, Units};
+use super::checked::CheckedPipeline;
 use super::config::{Fidelity, FramePipelineConfig, WorkloadConfig};
 use super::cpu_thread::{Alone, CpuThread, FixedWork};
 use super::display::Display;
@@ -112,12 +113,13 @@ fn noise_sources(cfg: &FramePipelineConfig, streams: &RngStreams) -> Result<Vec<
 }
 
 impl FramePipeline {
-    /// Builds the system from a validated model and its compiled workload.
+    /// Builds the system from a checked model and its compiled workload.
     pub fn new(
-        cfg: FramePipelineConfig,
+        checked: CheckedPipeline,
         scene: Option<SceneProgram>,
         trace: Option<crate::output::trace::TraceWriter>,
     ) -> Result<Self, SystemError> {
+        let cfg = checked.into_config();
         let streams = RngStreams::new(cfg.run.seed);
         let (fixed, scene) = match (&cfg.workload, scene) {
             (WorkloadConfig::Fixed(f), _) => (

@@ -15,8 +15,9 @@ use crate::output::trace::TraceWriter;
 use crate::systems::error::SystemError;
 use crate::systems::summary::to_json;
 
+use super::checked::CheckedPipeline;
 use super::summary::{analytic_terms, positive_zeros, summarize};
-use super::validate::{check_events, check_memory, check_time_range, validate};
+use super::validate::{check_events, check_time_range};
 /// Everything a run produced.
 #[derive(Debug)]
 pub struct PipelineRun {
@@ -64,20 +65,20 @@ pub fn run_pipeline(
     base_dir: &Path,
     trace: Option<TraceWriter>,
 ) -> Result<PipelineRun, SystemError> {
-    validate(&cfg)?;
-    check_memory(&cfg)?;
+    let checked = CheckedPipeline::new(cfg)?;
+    let cfg = checked.config();
     let build_start = std::time::Instant::now();
     let scene = match &cfg.workload {
-        WorkloadConfig::Scene(s) => Some(compile_scene(&cfg, s, base_dir).map_err(|e| match e {
+        WorkloadConfig::Scene(s) => Some(compile_scene(cfg, s, base_dir).map_err(|e| match e {
             super::workload::WorkloadError::Invalid { key, message } => SystemError::Invalid { key, message },
         })?),
         WorkloadConfig::Fixed(_) => None,
     };
-    let analytic = analytic_terms(&cfg, scene.as_ref());
-    check_time_range(&cfg, &analytic)?;
-    check_events(&cfg, &analytic, scene.as_ref().map(|s| s.stats.triangles))?;
+    let analytic = analytic_terms(cfg, scene.as_ref());
+    check_time_range(cfg, &analytic)?;
+    check_events(cfg, &analytic, scene.as_ref().map(|s| s.stats.triangles))?;
     let scene_stats = scene.as_ref().map(|s| s.stats.clone());
-    let mut model = FramePipeline::new(cfg, scene, trace)?;
+    let mut model = FramePipeline::new(checked, scene, trace)?;
     let build_seconds = build_start.elapsed().as_secs_f64();
     let mut sched = Scheduler::new();
     model.start(&mut sched)?;
@@ -137,10 +138,10 @@ pub fn run_pipeline(
 /// for `cfg.run.frames` frames, without validating, summarizing or
 /// tracing: the kernel statistics and the per-frame records. For systems
 /// that draw their own frames through the pipeline (the walkthrough draws
-/// each frame's visible objects as a one-frame run); `cfg` must have been
-/// checked with [`validate`] and its workload must be a scene.
+/// each frame's visible objects as a one-frame run); the model's workload
+/// must be a scene.
 pub fn simulate_program(
-    cfg: FramePipelineConfig,
+    cfg: CheckedPipeline,
     program: SceneProgram,
 ) -> Result<(RunStats, Vec<FrameRecord>), SystemError> {
     let mut model = FramePipeline::new(cfg, Some(program), None)?;

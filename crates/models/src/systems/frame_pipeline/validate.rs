@@ -11,8 +11,9 @@ use super::records::FrameRecord;
 use super::summary::AnalyticTerms;
 use crate::systems::error::{SystemError, invalid as bad};
 
-/// Checks values serde cannot (ranges, distributions).
-pub fn validate(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
+/// Checks values serde cannot (ranges, distributions); run through
+/// [`super::checked::CheckedPipeline::new`].
+pub(super) fn validate(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
     if cfg.system != "frame_pipeline" {
         return Err(bad(
             "system",

@@ -18,9 +18,9 @@ use crate::components::distribution::Dist;
 use crate::engine::{Duration, RngStreams, StreamRng};
 use crate::scene::config::{SceneWorkload, StateOrder, View};
 use crate::systems::error::SystemError;
+use crate::systems::frame_pipeline::CheckedPipeline;
 use crate::systems::frame_pipeline::config::{FramePipelineConfig, RunConfig, WorkloadConfig};
 use crate::systems::frame_pipeline::run::simulate_program;
-use crate::systems::frame_pipeline::validate::validate;
 use crate::systems::frame_pipeline::workload::{
     GroupInfo, Instance, MeshInfo, Misses, WorkloadError, build_program, early_z_pass, fragment_costs, timed_mesh,
 };
@@ -59,7 +59,7 @@ pub struct Timing {
 /// Draws frames of a scene through the frame pipeline.
 #[derive(Debug, Clone)]
 pub struct Renderer {
-    template: FramePipelineConfig,
+    template: CheckedPipeline,
     /// Timed meshes per prototype and level.
     meshes: Vec<Vec<MeshInfo>>,
     sigmas: Vec<f64>,
@@ -82,7 +82,7 @@ impl Renderer {
         if !noise {
             noise_cfg.enabled = false;
         }
-        let template = FramePipelineConfig {
+        let template = CheckedPipeline::new(FramePipelineConfig {
             system: "frame_pipeline".into(),
             description: String::new(),
             fidelity: cfg.fidelity,
@@ -110,10 +110,9 @@ impl Renderer {
                 state_order: StateOrder::AsListed,
                 groups: Vec::new(),
             }),
-        };
-        validate(&template)?;
+        })?;
         let pass = early_z_pass(cfg.scene.depth_order, cfg.scene.depth_complexity);
-        let (shade, fixed) = fragment_costs(&template, pass);
+        let (shade, fixed) = fragment_costs(template.config(), pass);
         let mut meshes = Vec::with_capacity(scene.protos.len());
         for p in &scene.protos {
             let mut levels = Vec::with_capacity(p.levels.len());
@@ -130,7 +129,8 @@ impl Renderer {
                     geometry_shader: Duration::ZERO,
                 };
                 levels.push(
-                    timed_mesh(&template, info, &format!("scene ({} level {l})", p.name)).map_err(workload_error)?,
+                    timed_mesh(template.config(), info, &format!("scene ({} level {l})", p.name))
+                        .map_err(workload_error)?,
                 );
             }
             meshes.push(levels);
@@ -176,16 +176,8 @@ impl Renderer {
         seed: u64,
         start: u64,
     ) -> Result<(Timing, Vec<u64>, &'static [&'static str]), SystemError> {
-        let mut cfg = self.template.clone();
-        cfg.run.seed = seed;
-        for p in &mut cfg.noise.periodic {
-            let period = p.period.0.max(1);
-            p.phase = Duration(if start <= p.phase.0 {
-                p.phase.0 - start
-            } else {
-                (period - (start - p.phase.0) % period) % period
-            });
-        }
+        let checked = self.template.for_run_at(seed, start);
+        let cfg = checked.config();
         let mut meshes = Vec::with_capacity(draws.len());
         let mut groups = Vec::with_capacity(draws.len());
         let mut objects = Vec::with_capacity(draws.len());
@@ -206,9 +198,9 @@ impl Renderer {
                 upload: 0,
             });
         }
-        let program = build_program(&cfg, meshes, groups, &objects, self.pass).map_err(workload_error)?;
+        let program = build_program(cfg, meshes, groups, &objects, self.pass).map_err(workload_error)?;
         let cpu_submit = program.draws.iter().fold(0u64, |t, d| t.saturating_add(d.cpu.0));
-        let (stats, records) = simulate_program(cfg, program)?;
+        let (stats, records) = simulate_program(checked, program)?;
         let r = records.first().ok_or_else(|| SystemError::Unfinished {
             at: stats.end_time,
             missing: "the frame was drawn".into(),
