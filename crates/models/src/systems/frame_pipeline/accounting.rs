@@ -172,6 +172,22 @@ pub struct Accounting {
     pub trace: Option<PipelineTrace>,
 }
 
+/// The [`Units`] view of the pipeline `$p` (a [`super::model::FramePipeline`]),
+/// built from its fields so that its accounting can be borrowed mutably
+/// beside it.
+macro_rules! units_of {
+    ($p:ident) => {
+        Units {
+            cpu: &$p.cpu,
+            front: &$p.front,
+            geom: &$p.geom,
+            frag: &$p.frag,
+            links: &$p.env.links,
+        }
+    };
+}
+pub(super) use units_of;
+
 impl Accounting {
     /// The CPU's frame as of the last accounted instant.
     #[inline]

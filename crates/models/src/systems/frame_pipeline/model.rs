@@ -24,7 +24,7 @@ use crate::components::swap_chain::{PresentMode, SwapChain};
 use crate::engine::{Control, Model, RngStreams, Scheduler, Time};
 use crate::systems::error::SystemError;
 
-use super::accounting::{Accounting, Units};
+use super::accounting::{Accounting, Units, units_of};
 use super::checked::CheckedPipeline;
 use super::config::{Fidelity, FramePipelineConfig, WorkloadConfig};
 use super::cpu_thread::{Alone, CpuThread, FixedWork};
@@ -299,14 +299,7 @@ impl FramePipeline {
     /// Accounts the instant `now` in full: every unit's state, read through
     /// an immutable view.
     pub(super) fn account(&mut self, now: Time) {
-        let units = Units {
-            cpu: &self.cpu,
-            front: &self.front,
-            geom: &self.geom,
-            frag: &self.frag,
-            links: &self.env.links,
-        };
-        self.acct.account(now, units, &mut self.env.records);
+        self.acct.account(now, units_of!(self), &mut self.env.records);
     }
 
     /// The CPU thread's operation finished (its event, not stale): the

@@ -45,7 +45,7 @@
 use crate::engine::{Scheduler, Time};
 use crate::systems::error::SystemError;
 
-use super::accounting::Units;
+use super::accounting::{Units, units_of};
 use super::events::Ev;
 use super::front_end::FrontPhase;
 use super::model::FramePipeline;
@@ -112,15 +112,8 @@ impl FramePipeline {
             true
         };
         if self.front.frame() == gpu_frame && self.geom.busy() && self.cpu.frame() == self.acct.cpu_frame() {
-            let units = Units {
-                cpu: &self.cpu,
-                front: &self.front,
-                geom: &self.geom,
-                frag: &self.frag,
-                links: &self.env.links,
-            };
             self.acct
-                .account_draw_handoff(now, cpu_moved, units, &mut self.env.records);
+                .account_draw_handoff(now, cpu_moved, units_of!(self), &mut self.env.records);
         } else {
             self.account(now);
         }
