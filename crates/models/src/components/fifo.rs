@@ -105,7 +105,7 @@ impl<T> BoundedFifo<T> {
     }
 
     /// Adds an entry; the caller checks [`BoundedFifo::can_push`] first.
-    #[inline]
+    #[inline(always)]
     pub fn push(&mut self, item: T, weight: u64) {
         debug_assert!(self.can_push(weight));
         self.used += weight;
@@ -114,7 +114,7 @@ impl<T> BoundedFifo<T> {
     }
 
     /// Takes the oldest entry.
-    #[inline]
+    #[inline(always)]
     pub fn pop(&mut self) -> Option<T> {
         let (item, w) = self.items.pop_front()?;
         self.used -= w;

@@ -346,11 +346,14 @@ impl Accounting {
             );
             return;
         }
+        // The FIFO levels are read here, so that the view is not built in
+        // memory for the traced call.
+        let levels = (u.links.commands.used(), u.links.triangles.len() as u64);
         a.account_traced(
             now,
             [cpu_state, front_state, geom_state, frag_state, gpu_state],
             (cpu_frame, gpu_frame),
-            u,
+            levels,
             records,
         );
     }
@@ -362,7 +365,7 @@ impl Accounting {
         now: Time,
         states: [usize; 5],
         frames: (u64, Option<u64>),
-        u: Units<'_>,
+        (commands, triangles): (u64, u64),
         records: &mut [FrameRecord],
     ) {
         let [cpu_state, front_state, geom_state, frag_state, gpu_state] = states;
@@ -399,7 +402,7 @@ impl Accounting {
         set_traced(&mut a.frag, now, frag_state, Track::Fragment, &mut a.trace, 1, None);
         a.gpu_per_frame(now, gpu_state, gpu_frame, records);
         if let Some(t) = &mut a.trace {
-            t.fifo_levels(now, u.links.commands.used(), u.links.triangles.len() as u64);
+            t.fifo_levels(now, commands, triangles);
         }
     }
 

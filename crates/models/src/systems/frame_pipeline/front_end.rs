@@ -92,6 +92,19 @@ impl FrontEnd {
         self.phase
     }
 
+    /// Whether a [`FrontEnd::step`] now would find nothing to do, whatever
+    /// the links hold: it runs a command, or it holds a draw that the
+    /// geometry stage, busy with the one before, has not taken. Most events
+    /// find it so at `triangle` fidelity.
+    #[inline(always)]
+    pub(super) fn at_rest(&self, geom: &GeometryStage) -> bool {
+        match self.phase {
+            FrontPhase::Running => true,
+            FrontPhase::Handoff => geom.has_draw(),
+            _ => false,
+        }
+    }
+
     /// The frame it is on (from its clear to its swap).
     #[inline(always)]
     pub(super) fn frame(&self) -> Option<u64> {

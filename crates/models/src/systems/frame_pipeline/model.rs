@@ -284,9 +284,9 @@ impl FramePipeline {
     pub(super) fn settle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         loop {
             self.cpu.step(now, &mut self.env, s)?;
-            // A running front end takes no step (most events find it so):
+            // A front end at rest takes no step (most events find it so):
             // its downstream units are not even gathered.
-            if self.front.phase() == FrontPhase::Running {
+            if self.front.at_rest(&self.geom) {
                 return Ok(());
             }
             let mut down = downstream!(self);
