@@ -20,7 +20,7 @@
 
 pub use rendersim_engine as engine;
 pub use rendersim_measure as measure;
-pub use rendersim_models::{components, config, limits, scene};
+pub use rendersim_models::{capture, components, config, limits, scene};
 pub use rendersim_report::{output, plot, stats};
 
 pub mod bench;

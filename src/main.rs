@@ -48,6 +48,8 @@ enum Cmd {
     Bench(BenchArgs),
     /// Draw a few frames as a timeline (paper 000 Figure 4): one lane per unit, frames by colour, vertical blanks marked.
     Timeline(TimelineArgs),
+    /// Replay a PresentMon capture through the frame pipeline: predicted against measured display times (--set for a what-if).
+    Replay(cli::args::ReplayArgs),
     /// Level-of-detail selection on one knapsack instance (paper 001, Funkhouser & Sequin): greedy, incremental, optimal.
     LodSelect(cli::args::LodSelectArgs),
     /// State sorting with a small buffer (paper 001): state changes of LRU, bounded-waste, random, round-robin.
@@ -79,6 +81,7 @@ fn main() -> ExitCode {
         Cmd::Predict(a) => commands::predict(a),
         Cmd::Bench(a) => commands::bench(a),
         Cmd::Timeline(a) => commands::timeline(a),
+        Cmd::Replay(a) => commands::replay(a),
         Cmd::LodSelect(a) => commands::lod_select(a),
         Cmd::Sortbuf(a) => commands::sortbuf(a),
         Cmd::PerceivedSpeed(a) => commands::perceived_speed(a),

@@ -662,3 +662,25 @@ pub struct PerceivedSpeedArgs {
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
 }
+
+/// `rendersim replay`.
+#[derive(Args)]
+pub struct ReplayArgs {
+    /// PresentMon capture (CSV, PresentMon 1 or 2 columns).
+    pub capture: PathBuf,
+    /// Replay this process's swap chain with most frames.
+    #[arg(long, value_name = "NAME")]
+    pub app: Option<String>,
+    /// Replay the swap chain at this address (e.g. 0x224B280A1C0).
+    #[arg(long, value_name = "ADDR")]
+    pub swapchain: Option<String>,
+    /// Patch the replay's model (a what-if): --set cpu.max_frames_ahead=1 (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Write replay.json, frames.csv and model.toml into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+}

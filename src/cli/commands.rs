@@ -550,3 +550,50 @@ pub fn perceived_speed(args: super::args::PerceivedSpeedArgs) -> Result<()> {
     }
     Ok(())
 }
+
+/// The files `replay --out` writes.
+const REPLAY_FILES: [&str; 3] = ["replay.json", "frames.csv", "model.toml"];
+
+/// The JSON document `replay` writes: its summary under `replay`.
+#[derive(serde::Serialize)]
+struct ReplayJson<'a> {
+    replay: &'a rendersim::studies::replay::ReplaySummary,
+}
+
+/// `rendersim replay`: a PresentMon capture through the frame pipeline.
+pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
+    use rendersim::studies::replay::{FRAME_COLUMNS, ReplayOptions, replay};
+    let set = match &args.out {
+        Some(dir) => Some(ResultSet::begin(dir, |name| REPLAY_FILES.contains(&name))?),
+        None => None,
+    };
+    let opts = ReplayOptions {
+        app: args.app.clone(),
+        swap_chain: args.swapchain.clone(),
+        sets: args.sets.clone(),
+    };
+    let r = replay(&args.capture, &opts)?;
+    let json = serde_json::to_string_pretty(&ReplayJson { replay: &r.summary })?;
+    if let Some(set) = set {
+        let dir = set.dir();
+        std::fs::write(dir.join("replay.json"), &json).context("writing replay.json")?;
+        let mut frames = std::io::BufWriter::new(std::fs::File::create(dir.join("frames.csv"))?);
+        rendersim::output::table::write_number_table(&mut frames, &FRAME_COLUMNS, &r.rows())
+            .context("writing frames.csv")?;
+        frames.flush().context("writing frames.csv")?;
+        drop(frames);
+        let model = toml::to_string(&r.model).context("writing model.toml")?;
+        std::fs::write(
+            dir.join("model.toml"),
+            format!("# The replay's model; the workload lists (one value per frame) are left out.\n{model}"),
+        )
+        .context("writing model.toml")?;
+        set.commit()?;
+    }
+    if args.json {
+        println!("{json}");
+        return Ok(());
+    }
+    print::replay(&r.summary, &mut std::io::stdout().lock())?;
+    Ok(())
+}

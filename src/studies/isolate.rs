@@ -113,8 +113,14 @@ pub fn reduced(cfg: &FramePipelineConfig, which: &str, k: f64) -> FramePipelineC
             p.clear = scale(p.clear, k);
             p.swap = scale(p.swap, k);
             scale_states(&mut p.state_change, k);
-            if let WorkloadConfig::Fixed(f) = &mut c.workload {
-                f.cpu = scale_dist(&f.cpu, k);
+            match &mut c.workload {
+                WorkloadConfig::Fixed(f) => f.cpu = scale_dist(&f.cpu, k),
+                WorkloadConfig::Frames(f) => {
+                    for d in f.cpu.iter_mut().chain(f.submit.iter_mut()).chain(f.present.iter_mut()) {
+                        *d = scale(*d, k);
+                    }
+                }
+                WorkloadConfig::Scene(_) => {}
             }
         }
         "front_end" => {
@@ -137,11 +143,15 @@ pub fn reduced(cfg: &FramePipelineConfig, which: &str, k: f64) -> FramePipelineC
             f.per_fragment = scale(f.per_fragment, k);
             f.per_rejected_fragment = scale(f.per_rejected_fragment, k);
         }
-        "gpu" => {
-            if let WorkloadConfig::Fixed(f) = &mut c.workload {
-                f.gpu = scale_dist(&f.gpu, k);
+        "gpu" => match &mut c.workload {
+            WorkloadConfig::Fixed(f) => f.gpu = scale_dist(&f.gpu, k),
+            WorkloadConfig::Frames(f) => {
+                for d in f.gpu.iter_mut() {
+                    *d = scale(*d, k);
+                }
             }
-        }
+            WorkloadConfig::Scene(_) => {}
+        },
         _ => {}
     }
     c
@@ -200,7 +210,7 @@ pub fn isolate(cfg: &FramePipelineConfig, base_dir: &Path, options: IsolateOptio
         base.display.vsync = false;
     }
     let names: &[&str] = match base.workload {
-        WorkloadConfig::Fixed(_) => &["baseline", "cpu", "front_end", "gpu"],
+        WorkloadConfig::Fixed(_) | WorkloadConfig::Frames(_) => &["baseline", "cpu", "front_end", "gpu"],
         WorkloadConfig::Scene(_) => &["baseline", "cpu", "front_end", "geometry", "raster"],
     };
     let mut variants = Vec::new();

@@ -31,6 +31,7 @@ mod pipeline_oracles;
 mod pixelflow;
 mod present;
 mod readback;
+mod replay;
 mod shards;
 mod sortbuf;
 mod state_sorting;

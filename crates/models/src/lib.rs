@@ -1,5 +1,6 @@
 //! rendersim's models: what a model file says and what it simulates.
 //!
+//! - [`capture`]: frame captures read back (PresentMon CSV);
 //! - [`config`]: model files, units, `--set` patches, the one loader;
 //! - [`components`]: reusable parts (bounded FIFOs, vertex caches, swap
 //!   chains, system-task noise, distributions, state-time accounting);
@@ -17,6 +18,7 @@
 use rendersim_engine as engine;
 use rendersim_report::{output, plot, stats};
 
+pub mod capture;
 pub mod components;
 pub mod config;
 pub mod limits;

@@ -567,6 +567,50 @@ pub enum WorkloadConfig {
     Fixed(FixedWorkload),
     /// Objects with meshes, states and screen-space triangle sizes.
     Scene(SceneWorkload),
+    /// Measured times given frame by frame (a replayed capture).
+    Frames(FramesWorkload),
+}
+
+/// A workload given frame by frame, as a frame capture measured it
+/// (`rendersim replay` builds one from PresentMon's columns). Frame `i`'s
+/// CPU works `cpu[i]` in all; after the first `submit[i]` of it the frame's
+/// GPU work (`gpu[i]`, one command on the front end) is submitted; at the
+/// end of `cpu[i]` it presents, and then spends `present[i]` in the present
+/// call before the next frame starts (a wait the model adds on its own, for
+/// frames in flight or a full FIFO, comes on top). Every list holds at least
+/// `run.frames` entries; `submit[i]` is at most `cpu[i]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FramesWorkload {
+    /// CPU work per frame, up to its present.
+    pub cpu: Vec<Duration>,
+    /// CPU work per frame before its GPU work is submitted.
+    pub submit: Vec<Duration>,
+    /// GPU work per frame.
+    pub gpu: Vec<Duration>,
+    /// Time in the present call per frame.
+    pub present: Vec<Duration>,
+}
+
+impl FramesWorkload {
+    /// The four lists with their keys.
+    pub fn lists(&self) -> [(&'static str, &[Duration]); 4] {
+        [
+            ("workload.cpu", &self.cpu),
+            ("workload.submit", &self.submit),
+            ("workload.gpu", &self.gpu),
+            ("workload.present", &self.present),
+        ]
+    }
+
+    /// Mean of a list in picoseconds (0 for an empty one).
+    pub fn mean_ps(list: &[Duration]) -> f64 {
+        if list.is_empty() {
+            0.0
+        } else {
+            list.iter().map(|d| d.0 as f64).sum::<f64>() / list.len() as f64
+        }
+    }
 }
 
 /// A fixed per-frame workload.
@@ -590,11 +634,13 @@ impl<'de> Deserialize<'de> for WorkloadConfig {
             Some(toml::Value::String(k)) => k,
             Some(other) => {
                 return Err(D::Error::custom(format!(
-                    "at `kind`: expected \"fixed\" or \"scene\", got {other}"
+                    "at `kind`: expected \"fixed\", \"scene\" or \"frames\", got {other}"
                 )));
             }
             None => {
-                return Err(D::Error::custom("missing field `kind` (\"fixed\" or \"scene\")"));
+                return Err(D::Error::custom(
+                    "missing field `kind` (\"fixed\", \"scene\" or \"frames\")",
+                ));
             }
         };
         fn inner<T: serde::de::DeserializeOwned, E: Error>(t: toml::Table) -> Result<T, E> {
@@ -612,8 +658,9 @@ impl<'de> Deserialize<'de> for WorkloadConfig {
         match kind.as_str() {
             "fixed" => inner(t).map(WorkloadConfig::Fixed),
             "scene" => inner(t).map(WorkloadConfig::Scene),
+            "frames" => inner(t).map(WorkloadConfig::Frames),
             other => Err(D::Error::custom(format!(
-                "at `kind`: unknown workload kind {other:?} (expected \"fixed\" or \"scene\")"
+                "at `kind`: unknown workload kind {other:?} (expected \"fixed\", \"scene\" or \"frames\")"
             ))),
         }
     }

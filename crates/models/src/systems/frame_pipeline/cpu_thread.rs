@@ -14,6 +14,7 @@ use crate::components::preemptible::{Preemptible, Wake};
 use crate::engine::{Duration, Scheduler, StreamRng, Time};
 use crate::systems::error::SystemError;
 
+use super::config::FramesWorkload;
 use super::events::Ev;
 use super::links::{Command, Env, command_count, command_weight, draw_batch_weight};
 use super::records::FrameRecord;
@@ -42,18 +43,61 @@ pub enum CpuPhase {
     Finished,
 }
 
-/// A fixed workload's CPU and GPU time per frame, drawn by the CPU thread
-/// (the GPU's when it issues the frame's one command).
+/// A fixed workload's CPU and GPU time per frame: drawn from distributions
+/// by the CPU thread (the GPU's when it issues the frame's one command), or
+/// given frame by frame (a replayed capture, `kind = "frames"`).
 #[derive(Debug)]
-pub struct FixedWork {
-    /// CPU time.
-    pub cpu: Dist<Duration>,
-    /// GPU time.
-    pub gpu: Dist<Duration>,
-    /// Stream for the CPU part.
-    pub cpu_rng: StreamRng,
-    /// Stream for the GPU part.
-    pub gpu_rng: StreamRng,
+pub enum FixedWork {
+    /// Drawn each frame (`kind = "fixed"`).
+    Drawn {
+        /// CPU time.
+        cpu: Dist<Duration>,
+        /// GPU time.
+        gpu: Dist<Duration>,
+        /// Stream for the CPU part.
+        cpu_rng: StreamRng,
+        /// Stream for the GPU part.
+        gpu_rng: StreamRng,
+    },
+    /// Given frame by frame (`kind = "frames"`; every list holds at least
+    /// `run.frames` entries, checked by the model's validation).
+    PerFrame(FramesWorkload),
+}
+
+impl FixedWork {
+    /// CPU time of frame `f` before its GPU work is submitted.
+    fn before_submit(&mut self, f: u64) -> Duration {
+        match self {
+            FixedWork::Drawn { cpu, cpu_rng, .. } => Duration::from_ps_f64(cpu.sample(cpu_rng)),
+            FixedWork::PerFrame(w) => w.submit[f as usize],
+        }
+    }
+
+    /// GPU time of frame `f`.
+    fn gpu(&mut self, f: u64) -> Duration {
+        match self {
+            FixedWork::Drawn { gpu, gpu_rng, .. } => Duration::from_ps_f64(gpu.sample(gpu_rng)),
+            FixedWork::PerFrame(w) => w.gpu[f as usize],
+        }
+    }
+
+    /// CPU time of frame `f` after its GPU work is submitted, up to its
+    /// present (none for a drawn workload).
+    fn after_submit(&self, f: u64) -> Duration {
+        match self {
+            FixedWork::Drawn { .. } => Duration::ZERO,
+            FixedWork::PerFrame(w) => Duration(w.cpu[f as usize].0.saturating_sub(w.submit[f as usize].0)),
+        }
+    }
+
+    /// Time frame `f` spends in the previous frame's present call before
+    /// its own work (none for frame 0 or a drawn workload).
+    fn in_present_before(&self, f: u64) -> Duration {
+        match self {
+            FixedWork::PerFrame(w) if f > 0 => w.present[f as usize - 1],
+            _ => Duration::ZERO,
+        }
+    }
 }
 
 /// How a CPU event that only the CPU thread moved ended (the short cuts
@@ -235,7 +279,10 @@ impl CpuThread {
     fn op_work(&mut self, op: Op, env: &Env) -> Duration {
         let c = &env.cfg.cpu;
         match op {
-            Op::Input => c.input_sampling,
+            Op::Input => match &self.fixed {
+                Some(f) => c.input_sampling.saturating_add(f.in_present_before(self.frame)),
+                None => c.input_sampling,
+            },
             Op::NonRender => {
                 let work = Duration::from_ps_f64(c.non_render.sample(&mut self.non_render_rng));
                 // Per-frame variation (config `variation.cpu`), drawn only when given.
@@ -245,9 +292,12 @@ impl CpuThread {
                 }
             }
             Op::Clear => c.clear,
-            Op::Swap => c.swap,
+            Op::Swap => match &self.fixed {
+                Some(f) => c.swap.saturating_add(f.after_submit(self.frame)),
+                None => c.swap,
+            },
             Op::Fixed => match &mut self.fixed {
-                Some(f) => Duration::from_ps_f64(f.cpu.sample(&mut f.cpu_rng)),
+                Some(f) => f.before_submit(self.frame),
                 None => Duration::ZERO,
             },
             Op::Draw(k) => match &env.scene {
@@ -269,7 +319,7 @@ impl CpuThread {
             Op::Clear => self.push_phase(Command::Clear { frame }, env),
             Op::Fixed => {
                 let gpu = match &mut self.fixed {
-                    Some(f) => Duration::from_ps_f64(f.gpu.sample(&mut f.gpu_rng)),
+                    Some(f) => f.gpu(frame),
                     None => Duration::ZERO,
                 };
                 self.push_phase(Command::Fixed { frame, gpu }, env)

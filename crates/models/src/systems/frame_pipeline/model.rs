@@ -123,7 +123,7 @@ impl FramePipeline {
         let streams = RngStreams::new(cfg.run.seed);
         let (fixed, scene) = match (&cfg.workload, scene) {
             (WorkloadConfig::Fixed(f), _) => (
-                Some(FixedWork {
+                Some(FixedWork::Drawn {
                     cpu: f.cpu.clone(),
                     gpu: f.gpu.clone(),
                     cpu_rng: streams.stream("workload.cpu"),
@@ -131,6 +131,7 @@ impl FramePipeline {
                 }),
                 None,
             ),
+            (WorkloadConfig::Frames(f), _) => (Some(FixedWork::PerFrame(f.clone())), None),
             (WorkloadConfig::Scene(_), Some(s)) => (None, Some(s)),
             (WorkloadConfig::Scene(_), None) => {
                 return Err(SystemError::Invalid {

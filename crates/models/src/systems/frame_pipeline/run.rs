@@ -72,7 +72,7 @@ pub fn run_pipeline(
         WorkloadConfig::Scene(s) => Some(compile_scene(cfg, s, base_dir).map_err(|e| match e {
             super::workload::WorkloadError::Invalid { key, message } => SystemError::Invalid { key, message },
         })?),
-        WorkloadConfig::Fixed(_) => None,
+        WorkloadConfig::Fixed(_) | WorkloadConfig::Frames(_) => None,
     };
     let analytic = analytic_terms(cfg, scene.as_ref());
     check_time_range(cfg, &analytic)?;

@@ -10,7 +10,7 @@ use serde_json::Value;
 use crate::engine::{PS_PER_MS, RunStats, StopReason};
 
 use super::accounting::{BOTTLENECKS, CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES};
-use super::config::{FramePipelineConfig, WorkloadConfig};
+use super::config::{FramePipelineConfig, FramesWorkload, WorkloadConfig};
 use super::model::FramePipeline;
 use super::records::frame_rows;
 use super::workload::SceneProgram;
@@ -47,6 +47,12 @@ pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProg
         (WorkloadConfig::Fixed(f), _) => (
             base_cpu + f.cpu.mean(),
             base_front + f.gpu.mean() + cfg.gpu.command.0 as f64,
+            0.0,
+            0.0,
+        ),
+        (WorkloadConfig::Frames(f), _) => (
+            base_cpu + FramesWorkload::mean_ps(&f.cpu) + FramesWorkload::mean_ps(&f.present),
+            base_front + FramesWorkload::mean_ps(&f.gpu) + cfg.gpu.command.0 as f64,
             0.0,
             0.0,
         ),

@@ -47,6 +47,29 @@ pub(super) fn validate(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
         f.cpu.validate().map_err(|e| bad("workload.cpu", e.to_string()))?;
         f.gpu.validate().map_err(|e| bad("workload.gpu", e.to_string()))?;
     }
+    if let WorkloadConfig::Frames(f) = &cfg.workload {
+        for (key, list) in f.lists() {
+            if (list.len() as u64) < cfg.run.frames {
+                return Err(bad(
+                    key,
+                    format!(
+                        "holds {} frames, but run.frames is {}: every list gives one value per frame",
+                        list.len(),
+                        cfg.run.frames
+                    ),
+                ));
+            }
+        }
+        if let Some(i) = (0..f.cpu.len().min(f.submit.len())).find(|&i| f.submit[i] > f.cpu[i]) {
+            return Err(bad(
+                &format!("workload.submit[{i}]"),
+                format!(
+                    "{} is after the frame's CPU work of {} (`workload.cpu[{i}]`): the GPU work is submitted during it",
+                    f.submit[i], f.cpu[i]
+                ),
+            ));
+        }
+    }
     for (i, p) in cfg.noise.periodic.iter().enumerate() {
         p.duration
             .validate()
@@ -295,7 +318,7 @@ pub(super) fn check_memory(cfg: &FramePipelineConfig) -> Result<(), SystemError>
 /// clock's own checks.
 pub(super) fn check_time_range(cfg: &FramePipelineConfig, a: &AnalyticTerms) -> Result<(), SystemError> {
     let (cpu_key, gpu_key) = match &cfg.workload {
-        WorkloadConfig::Fixed(_) => ("workload.cpu", "workload.gpu"),
+        WorkloadConfig::Fixed(_) | WorkloadConfig::Frames(_) => ("workload.cpu", "workload.gpu"),
         WorkloadConfig::Scene(_) => ("workload", "workload"),
     };
     // An expected term that is not a finite number (a distribution whose
@@ -322,6 +345,8 @@ pub(super) fn check_time_range(cfg: &FramePipelineConfig, a: &AnalyticTerms) -> 
                     keys.push("workload.gpu".into());
                 }
             }
+            // Every listed duration is finite.
+            WorkloadConfig::Frames(_) => {}
             WorkloadConfig::Scene(sc) => keys.extend(
                 sc.groups
                     .iter()
@@ -524,7 +549,7 @@ mod tests {
             let cfg: FramePipelineConfig = deserialize(&m.table, &m.source).unwrap();
             let scene = match &cfg.workload {
                 WorkloadConfig::Scene(sc) => Some(compile_scene(&cfg, sc, &m.source.base_dir).unwrap()),
-                WorkloadConfig::Fixed(_) => None,
+                WorkloadConfig::Fixed(_) | WorkloadConfig::Frames(_) => None,
             };
             let a = analytic_terms(&cfg, scene.as_ref());
             let parts = estimate_events(&cfg, &a, scene.as_ref().map(|s| s.stats.triangles));

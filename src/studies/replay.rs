@@ -1,0 +1,409 @@
+//! Replaying a real frame capture through the frame pipeline (issue 26):
+//! PresentMon's measured CPU and GPU times, frame by frame, run through the
+//! CPU -> command FIFO -> GPU -> swap chain -> display model, and what the
+//! model predicts set against what the capture measured.
+//!
+//! How a captured frame becomes the model's (`kind = "frames"`, see
+//! [`FramesWorkload`]): the CPU works `MsCPUBusy`; the GPU work
+//! (`MsGPUBusy`, one command) is submitted after `MsGPULatency` of it (the
+//! GPU cannot start earlier than it did; without that column, at the
+//! present); the CPU then presents and spends `MsCPUWait` in the present
+//! call. Blocking the model adds (frames in flight, swap-chain images)
+//! comes on top, so a what-if that frees the pipeline cannot make the CPU
+//! faster than it was measured. The refresh period is fitted to the
+//! displayed frames' screen times (least squares over their refresh
+//! counts), and the simulation starts at a vertical blank of that grid, at
+//! or before the first frame's CPU start, so the model's vertical blanks
+//! fall where the capture's did.
+//!
+//! Present modes: the hardware flips (`Hardware: Legacy Flip`,
+//! `Hardware: Independent Flip`, ...) are `fifo` at a sync interval of 1 or
+//! more, `immediate` at 0 with tearing allowed, and `mailbox` at 0 without.
+//! Composed modes (the desktop compositor shows the frame, one refresh
+//! later) are not modelled yet and are refused.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::capture::presentmon::{Capture, CaptureError, Columns, Present};
+use crate::config::patch::set_dotted;
+use crate::config::{ModelSource, Overrides, deserialize};
+use crate::stats::quantile::quantile;
+use crate::systems::error::SystemError;
+use crate::systems::frame_pipeline::config::FramesWorkload;
+use crate::systems::frame_pipeline::{FramePipelineConfig, run_pipeline};
+
+/// The replay's base model (the frame pipeline with no costs of its own).
+pub const REPLAY_MODEL: &str = include_str!("../../models/replay.toml");
+
+/// Errors of a replay.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    /// The capture cannot be read or replayed.
+    #[error(transparent)]
+    Capture(#[from] CaptureError),
+    /// The model (base plus `--set`) is wrong.
+    #[error(transparent)]
+    Config(#[from] crate::config::ConfigError),
+    /// The simulation failed.
+    #[error(transparent)]
+    System(#[from] SystemError),
+}
+
+/// What to replay.
+#[derive(Debug, Clone, Default)]
+pub struct ReplayOptions {
+    /// The process whose swap chain to replay (its swap chain with most frames).
+    pub app: Option<String>,
+    /// The swap chain's address.
+    pub swap_chain: Option<String>,
+    /// `--set` patches on the replay's model.
+    pub sets: Vec<String>,
+}
+
+/// |predicted - measured| over the frames where both exist, in ms.
+#[derive(Debug, Clone, Serialize)]
+pub struct ErrorStats {
+    /// Frames compared.
+    pub frames: usize,
+    /// Median.
+    pub median: Option<f64>,
+    /// 0.9 quantile.
+    pub p90: Option<f64>,
+    /// Largest.
+    pub max: Option<f64>,
+}
+
+impl ErrorStats {
+    fn of(pairs: impl Iterator<Item = (Option<f64>, Option<f64>)>) -> ErrorStats {
+        let mut e: Vec<f64> = pairs.filter_map(|(p, m)| Some((p? - m?).abs())).collect();
+        e.sort_by(f64::total_cmp);
+        let q = |x: f64| (!e.is_empty()).then(|| quantile(&e, x));
+        ErrorStats {
+            frames: e.len(),
+            median: q(0.5),
+            p90: q(0.9),
+            max: e.last().copied(),
+        }
+    }
+}
+
+/// The errors per measured quantity.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReplayErrors {
+    /// `MsUntilDisplayed` (present to the frame appearing).
+    pub until_displayed: ErrorStats,
+    /// `MsBetweenDisplayChange`.
+    pub between_display_change: ErrorStats,
+    /// Present to the GPU done (`MsRenderPresentLatency` / `MsUntilRenderComplete`).
+    pub render_complete: ErrorStats,
+    /// The present call's start on the capture's clock (how far the
+    /// model's CPU drifts from the measured one).
+    pub present: ErrorStats,
+}
+
+/// Agreement of the frames' fates.
+#[derive(Debug, Clone, Serialize)]
+pub struct Agreement {
+    /// Fraction of frames whose displayed-or-dropped state matches.
+    pub displayed: f64,
+}
+
+/// A replay's summary (the JSON object `replay`).
+#[derive(Debug, Clone, Serialize)]
+pub struct ReplaySummary {
+    /// The capture as given.
+    pub capture: String,
+    /// Its column set.
+    pub columns: Columns,
+    /// Frames replayed.
+    pub frames: usize,
+    /// The process.
+    pub application: String,
+    /// The swap chain's address.
+    pub swapchain: String,
+    /// The capture's present mode for it.
+    pub present_mode: String,
+    /// The model's present mode (`fifo`, `mailbox`, `immediate`).
+    pub model_present_mode: String,
+    /// Fitted refresh rate.
+    pub refresh_hz: f64,
+    /// Frames displayed in the capture.
+    pub measured_displayed: usize,
+    /// Frames displayed in the replay.
+    pub predicted_displayed: usize,
+    /// Fates that agree.
+    pub agreement: Agreement,
+    /// Errors per quantity, ms.
+    pub error_ms: ReplayErrors,
+    /// Wall time of the simulation alone, seconds.
+    pub simulate_seconds: f64,
+    /// Wall time of the whole replay (reading the capture included), seconds.
+    pub wall_seconds: f64,
+}
+
+/// One frame, measured and predicted, ms (`None`: does not exist).
+#[derive(Debug, Clone)]
+pub struct ReplayFrame {
+    /// The frame's line in the capture.
+    pub line: u64,
+    /// Present call start, measured, on the capture's clock.
+    pub present: f64,
+    /// Present call start, predicted.
+    pub predicted_present: f64,
+    /// Displayed, measured.
+    pub displayed: bool,
+    /// Displayed, predicted.
+    pub predicted_displayed: bool,
+    /// `MsUntilDisplayed`, measured and predicted.
+    pub until_displayed: (Option<f64>, Option<f64>),
+    /// `MsBetweenDisplayChange`, measured and predicted.
+    pub between_display_change: (Option<f64>, Option<f64>),
+    /// Present to GPU done, measured and predicted.
+    pub render_complete: (Option<f64>, Option<f64>),
+}
+
+/// A whole replay.
+#[derive(Debug, Clone)]
+pub struct Replay {
+    /// The summary.
+    pub summary: ReplaySummary,
+    /// Frame by frame.
+    pub frames: Vec<ReplayFrame>,
+    /// The model as simulated, without its workload lists.
+    pub model: FramePipelineConfig,
+}
+
+/// The refresh period (ms) and a screen time on its grid, fitted to the
+/// displayed frames' screen times: a first period from the shorter
+/// display changes, then least squares of screen time on refresh count.
+pub fn fit_refresh(screen: &[f64]) -> Option<(f64, f64)> {
+    let mut d: Vec<f64> = screen.windows(2).map(|w| w[1] - w[0]).filter(|&x| x > 1.0).collect();
+    if d.is_empty() {
+        return None;
+    }
+    d.sort_by(f64::total_cmp);
+    let mut period = quantile(&d, 0.1);
+    let mut phase = screen[0];
+    for _ in 0..4 {
+        let n: Vec<f64> = screen.iter().map(|s| ((s - screen[0]) / period).round()).collect();
+        let k = n.len() as f64;
+        let (mn, ms) = (n.iter().sum::<f64>() / k, screen.iter().sum::<f64>() / k);
+        let sxx: f64 = n.iter().map(|x| (x - mn) * (x - mn)).sum();
+        if sxx == 0.0 {
+            break;
+        }
+        let sxy: f64 = n.iter().zip(screen).map(|(x, y)| (x - mn) * (y - ms)).sum();
+        period = sxy / sxx;
+        phase = ms - period * mn;
+    }
+    (period.is_finite() && period > 0.0).then_some((period, phase))
+}
+
+/// The model's present mode for a capture's, with its vsync.
+fn model_mode(p: &Present, file: &str) -> Result<(&'static str, bool), CaptureError> {
+    let mode = p.present_mode.as_str();
+    let err = |message: String| CaptureError::Row {
+        file: file.to_string(),
+        line: p.line,
+        message,
+    };
+    if mode.starts_with("Composed") {
+        return Err(err(format!(
+            "present mode `{mode}`: composition by the desktop compositor is not modelled yet; \
+             swap chains with a hardware flip (`Hardware: Legacy Flip`, `Hardware: Independent Flip`) can be replayed"
+        )));
+    }
+    if !mode.starts_with("Hardware") {
+        return Err(err(format!(
+            "unknown present mode `{mode}` (replayed: `Hardware: Legacy Flip`, `Hardware: Independent Flip`, \
+             `Hardware Composed: Independent Flip`)"
+        )));
+    }
+    Ok(match (p.sync_interval.unwrap_or(1), p.allows_tearing) {
+        (s, _) if s >= 1 => ("fifo", true),
+        (_, true) => ("immediate", false),
+        (_, false) => ("mailbox", true),
+    })
+}
+
+fn ps(ms: f64) -> toml::Value {
+    toml::Value::String(format!("{}ps", (ms.max(0.0) * 1e9).round() as u64))
+}
+
+/// Replays the capture at `path`.
+pub fn replay(path: &Path, opts: &ReplayOptions) -> Result<Replay, ReplayError> {
+    let wall = std::time::Instant::now();
+    let capture = Capture::read(path)?;
+    let rows = capture.select(opts.app.as_deref(), opts.swap_chain.as_deref())?;
+    let file = capture.file.as_str();
+    // The mode most of its frames use (a swap chain may switch, e.g. from
+    // a composed to an independent flip after its first frame).
+    let common = {
+        let mut counts: Vec<(&str, usize)> = Vec::new();
+        for p in &rows {
+            match counts.iter_mut().find(|(m, _)| *m == p.present_mode) {
+                Some(c) => c.1 += 1,
+                None => counts.push((&p.present_mode, 1)),
+            }
+        }
+        let best = counts.iter().max_by_key(|c| c.1).map_or("", |c| c.0);
+        rows.iter().find(|p| p.present_mode == best).copied().unwrap_or(rows[0])
+    };
+    let (mode, vsync) = model_mode(common, file)?;
+    let screen: Vec<f64> = rows.iter().filter_map(|p| p.screen_time()).collect();
+    let (period, phase) = fit_refresh(&screen).ok_or_else(|| CaptureError::Row {
+        file: file.to_string(),
+        line: rows[0].line,
+        message: "the refresh period cannot be inferred: no two displayed frames are more than 1 ms apart".into(),
+    })?;
+    // The run starts at a vertical blank at or before the first CPU start.
+    let c0 = rows[0].cpu_start;
+    let origin = phase - ((phase - c0) / period).ceil() * period;
+    let lead = c0 - origin;
+
+    let mut src = ModelSource::from_text("the replay model (models/replay.toml)", REPLAY_MODEL);
+    let mut table = src.table()?;
+    let n = rows.len();
+    let list = |f: &dyn Fn(usize, &Present) -> f64| {
+        toml::Value::Array(rows.iter().enumerate().map(|(i, p)| ps(f(i, p))).collect())
+    };
+    let first = |i: usize| if i == 0 { lead } else { 0.0 };
+    let sets: [(&str, toml::Value); 8] = [
+        ("run.frames", toml::Value::Integer(n as i64)),
+        (
+            "display.refresh",
+            toml::Value::String(format!("{}ps", (period * 1e9).round() as u64)),
+        ),
+        ("display.present_mode", toml::Value::String(mode.into())),
+        ("display.vsync", toml::Value::Boolean(vsync)),
+        ("workload.cpu", list(&|i, p| p.cpu_busy + first(i))),
+        (
+            "workload.submit",
+            list(&|i, p| p.gpu_latency.unwrap_or(p.cpu_busy).clamp(0.0, p.cpu_busy) + first(i)),
+        ),
+        (
+            "workload.gpu",
+            list(&|_, p| p.gpu_busy.or(p.render_complete).unwrap_or(0.0)),
+        ),
+        ("workload.present", list(&|_, p| p.cpu_wait)),
+    ];
+    for (key, value) in sets {
+        set_dotted(&mut table, key, value).map_err(|e| CaptureError::Format {
+            file: file.to_string(),
+            message: format!("building the replay model: {}", e.reason),
+        })?;
+    }
+    Overrides::with_sets(&opts.sets).apply(&mut src, &mut table)?;
+    let cfg: FramePipelineConfig = deserialize(&table, &src)?;
+    let sim = std::time::Instant::now();
+    let run = run_pipeline(cfg, &src.base_dir, None)?;
+    let simulate_seconds = sim.elapsed().as_secs_f64();
+
+    let at = |t: crate::engine::Time| origin + t.as_ms_f64();
+    let mut frames = Vec::with_capacity(n);
+    let mut last_shown: Option<f64> = None;
+    for (p, r) in rows.iter().zip(&run.records) {
+        let predicted_present = at(r.present);
+        let shown = r.displayed.map(at);
+        let between = match (shown, last_shown) {
+            (Some(s), Some(l)) => Some(s - l),
+            _ => None,
+        };
+        if shown.is_some() {
+            last_shown = shown;
+        }
+        frames.push(ReplayFrame {
+            line: p.line,
+            present: p.present,
+            predicted_present,
+            displayed: p.displayed(),
+            predicted_displayed: shown.is_some(),
+            until_displayed: (p.until_displayed, shown.map(|s| s - predicted_present)),
+            between_display_change: (p.between_display_change.filter(|_| p.displayed()), between),
+            render_complete: (p.render_complete, r.gpu_end.map(|g| at(g) - predicted_present)),
+        });
+    }
+    let agree = frames.iter().filter(|f| f.displayed == f.predicted_displayed).count();
+    let swap = |(m, p): (Option<f64>, Option<f64>)| (p, m);
+    let summary = ReplaySummary {
+        capture: capture.file.clone(),
+        columns: capture.columns,
+        frames: frames.len(),
+        application: rows[0].application.clone(),
+        swapchain: rows[0].swap_chain.clone(),
+        present_mode: common.present_mode.clone(),
+        model_present_mode: mode.to_string(),
+        refresh_hz: 1000.0 / period,
+        measured_displayed: frames.iter().filter(|f| f.displayed).count(),
+        predicted_displayed: frames.iter().filter(|f| f.predicted_displayed).count(),
+        agreement: Agreement {
+            displayed: agree as f64 / frames.len().max(1) as f64,
+        },
+        error_ms: ReplayErrors {
+            until_displayed: ErrorStats::of(frames.iter().map(|f| swap(f.until_displayed))),
+            between_display_change: ErrorStats::of(frames.iter().map(|f| swap(f.between_display_change))),
+            render_complete: ErrorStats::of(frames.iter().map(|f| swap(f.render_complete))),
+            present: ErrorStats::of(frames.iter().map(|f| (Some(f.predicted_present), Some(f.present)))),
+        },
+        simulate_seconds,
+        wall_seconds: wall.elapsed().as_secs_f64(),
+    };
+    let mut model = run.config;
+    if let crate::systems::frame_pipeline::config::WorkloadConfig::Frames(w) = &mut model.workload {
+        *w = FramesWorkload {
+            cpu: vec![],
+            submit: vec![],
+            gpu: vec![],
+            present: vec![],
+        };
+    }
+    Ok(Replay { summary, frames, model })
+}
+
+/// The per-frame table's header.
+pub const FRAME_COLUMNS: [&str; 12] = [
+    "Line",
+    "PresentTime",
+    "PredictedPresentTime",
+    "Displayed",
+    "PredictedDisplayed",
+    "MsUntilDisplayed",
+    "PredictedMsUntilDisplayed",
+    "MsBetweenDisplayChange",
+    "PredictedMsBetweenDisplayChange",
+    "MsRenderPresentLatency",
+    "PredictedMsRenderPresentLatency",
+    "ErrorMsUntilDisplayed",
+];
+
+impl Replay {
+    /// The per-frame rows (ms; NaN where a value does not exist).
+    pub fn rows(&self) -> Vec<Vec<f64>> {
+        let v = |x: Option<f64>| x.unwrap_or(f64::NAN);
+        self.frames
+            .iter()
+            .map(|f| {
+                let err = match f.until_displayed {
+                    (Some(m), Some(p)) => p - m,
+                    _ => f64::NAN,
+                };
+                vec![
+                    f.line as f64,
+                    f.present,
+                    f.predicted_present,
+                    f64::from(u8::from(f.displayed)),
+                    f64::from(u8::from(f.predicted_displayed)),
+                    v(f.until_displayed.0),
+                    v(f.until_displayed.1),
+                    v(f.between_display_change.0),
+                    v(f.between_display_change.1),
+                    v(f.render_complete.0),
+                    v(f.render_complete.1),
+                    err,
+                ]
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,153 @@
+//! `rendersim replay`: real PresentMon captures (tests/fixtures/presentmon)
+//! through the frame pipeline, predicted against measured, and clear
+//! errors for captures that cannot be replayed.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use rendersim::studies::replay::{ReplayOptions, fit_refresh, replay};
+
+fn capture(i: usize) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/fixtures/presentmon/test_case_{i}.csv"))
+}
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_rendersim"))
+}
+
+#[test]
+fn the_main_swap_chain_of_each_shared_capture_meets_the_accuracy_targets() {
+    for i in 0..3 {
+        let r = replay(&capture(i), &ReplayOptions::default()).unwrap();
+        let s = &r.summary;
+        assert_eq!(s.application, "dwm.exe", "capture {i}");
+        assert_eq!(s.model_present_mode, "fifo");
+        assert!((s.refresh_hz - 59.95).abs() < 0.1, "capture {i}: {} Hz", s.refresh_hz);
+        let e = &s.error_ms;
+        assert!(s.agreement.displayed >= 0.95, "capture {i}: {}", s.agreement.displayed);
+        assert!(
+            e.until_displayed.median.unwrap() <= 0.5,
+            "capture {i}: {:?}",
+            e.until_displayed
+        );
+        assert!(
+            e.until_displayed.p90.unwrap() <= 2.0,
+            "capture {i}: {:?}",
+            e.until_displayed
+        );
+        assert!(
+            e.render_complete.median.unwrap() <= 0.5,
+            "capture {i}: {:?}",
+            e.render_complete
+        );
+        // The CPU replays as measured: presents where the capture has them.
+        assert!(e.present.max.unwrap() < 1e-6, "capture {i}: {:?}", e.present);
+        assert_eq!(r.frames.len(), s.frames);
+    }
+}
+
+#[test]
+fn a_what_if_changes_the_prediction_not_the_measurement() {
+    let base = replay(&capture(0), &ReplayOptions::default()).unwrap();
+    let opts = ReplayOptions {
+        sets: vec!["display.refresh=\"30Hz\"".into()],
+        ..ReplayOptions::default()
+    };
+    let slow = replay(&capture(0), &opts).unwrap();
+    assert_eq!(slow.summary.measured_displayed, base.summary.measured_displayed);
+    let mean = |r: &rendersim::studies::replay::Replay| {
+        let v: Vec<f64> = r.frames.iter().filter_map(|f| f.until_displayed.1).collect();
+        v.iter().sum::<f64>() / v.len() as f64
+    };
+    // Half the refresh rate: frames wait longer for their vertical blank.
+    assert!(mean(&slow) > mean(&base) + 4.0, "{} vs {}", mean(&slow), mean(&base));
+}
+
+#[test]
+fn the_refresh_fit_recovers_a_period_and_phase_from_skipped_refreshes() {
+    let p = 16.683;
+    let screen: Vec<f64> = [0u32, 1, 2, 4, 5, 8, 9, 10, 13]
+        .iter()
+        .map(|&k| 3.2 + p * f64::from(k))
+        .collect();
+    let (period, phase) = fit_refresh(&screen).unwrap();
+    assert!(
+        (period - p).abs() < 1e-9 && (phase - 3.2).abs() < 1e-9,
+        "{period} {phase}"
+    );
+    assert!(fit_refresh(&[1.0]).is_none());
+}
+
+#[test]
+fn cli_prints_json_writes_its_folder_and_names_what_is_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    let o = bin()
+        .args([
+            "replay",
+            capture(1).to_str().unwrap(),
+            "--json",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for key in ["frames", "swapchain", "present_mode", "refresh_hz"] {
+        assert!(
+            v["replay"][key].is_number() || v["replay"][key].is_string(),
+            "{key}: {v}"
+        );
+    }
+    assert!(v["replay"]["agreement"]["displayed"].as_f64().unwrap() >= 0.95);
+    assert!(v["replay"]["error_ms"]["until_displayed"]["median"].is_number());
+    for f in ["replay.json", "frames.csv", "model.toml"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    let frames = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    assert_eq!(frames.lines().count(), 26, "a header and 25 frames");
+
+    let err = |args: &[&str]| {
+        let o = bin().args(args).output().unwrap();
+        let e = String::from_utf8_lossy(&o.stderr).to_string();
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+        assert!(!e.contains("panicked"), "{e}");
+        e
+    };
+    let c0 = capture(0);
+    let c0 = c0.to_str().unwrap();
+    let e = err(&["replay", c0, "--swapchain", "0x20979A6D5F8"]);
+    assert!(
+        e.contains("test_case_0.csv:5: present mode `Composed: Copy with GPU GDI`"),
+        "{e}"
+    );
+    let e = err(&["replay", c0, "--swapchain", "0x1"]);
+    assert!(
+        e.contains("no swap chain 0x1; the capture has: dwm.exe (process 1268) 0x224B280A1C0"),
+        "{e}"
+    );
+    let e = err(&["replay", c0, "--set", "display.bufers=3"]);
+    assert!(
+        e.contains("display.bufers") && e.contains("did you mean `buffers`"),
+        "{e}"
+    );
+    let bad = dir.path().join("bad.csv");
+    let text = std::fs::read_to_string(capture(1)).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let col = lines[0].split(',').position(|h| h == "MsUntilDisplayed").unwrap();
+    let mut cells: Vec<&str> = lines[3].split(',').collect();
+    cells[col] = "garbage";
+    lines[3] = cells.join(",");
+    std::fs::write(&bad, lines.join("\n")).unwrap();
+    let e = err(&["replay", bad.to_str().unwrap()]);
+    assert!(
+        e.contains("bad.csv:4: column `MsUntilDisplayed`: \"garbage\" is not a number"),
+        "{e}"
+    );
+    std::fs::write(&bad, "hello,world\n1,2\n").unwrap();
+    let e = err(&["replay", bad.to_str().unwrap()]);
+    assert!(e.contains("bad.csv: not a PresentMon capture"), "{e}");
+    let e = err(&["replay", dir.path().join("none.csv").to_str().unwrap()]);
+    assert!(e.contains("cannot read capture"), "{e}");
+}
