@@ -236,21 +236,15 @@ fn ps(ms: f64) -> toml::Value {
 pub fn replay(path: &Path, opts: &ReplayOptions) -> Result<Replay, ReplayError> {
     let wall = std::time::Instant::now();
     let capture = Capture::read(path)?;
-    let rows = capture.select(opts.app.as_deref(), opts.swap_chain.as_deref())?;
+    let (chain, rows) = capture.select(opts.app.as_deref(), opts.swap_chain.as_deref())?;
     let file = capture.file.as_str();
     // The mode most of its frames use (a swap chain may switch, e.g. from
     // a composed to an independent flip after its first frame).
-    let common = {
-        let mut counts: Vec<(&str, usize)> = Vec::new();
-        for p in &rows {
-            match counts.iter_mut().find(|(m, _)| *m == p.present_mode) {
-                Some(c) => c.1 += 1,
-                None => counts.push((&p.present_mode, 1)),
-            }
-        }
-        let best = counts.iter().max_by_key(|c| c.1).map_or("", |c| c.0);
-        rows.iter().find(|p| p.present_mode == best).copied().unwrap_or(rows[0])
-    };
+    let common = rows
+        .iter()
+        .find(|p| p.present_mode == chain.present_mode)
+        .copied()
+        .unwrap_or(rows[0]);
     let (mode, vsync) = model_mode(common, file)?;
     let screen: Vec<f64> = rows.iter().filter_map(|p| p.screen_time()).collect();
     let (period, phase) = fit_refresh(&screen).ok_or_else(|| CaptureError::Row {

@@ -310,8 +310,13 @@ impl Capture {
     /// else by `app` (that process's swap chain with most frames), else the
     /// swap chain with most frames. Checks what a replay needs of them: at
     /// least two frames, present times that never go back, and at least
-    /// two displayed frames.
-    pub fn select(&self, app: Option<&str>, swap_chain: Option<&str>) -> Result<Vec<&Present>, CaptureError> {
+    /// two displayed frames. Returns the swap chain (with the present mode
+    /// most of its frames use) and its presents.
+    pub fn select(
+        &self,
+        app: Option<&str>,
+        swap_chain: Option<&str>,
+    ) -> Result<(SwapChainInfo, Vec<&Present>), CaptureError> {
         let chains = self.swap_chains();
         let listing = || {
             chains
@@ -382,7 +387,7 @@ impl Capture {
                 ),
             ));
         }
-        Ok(rows)
+        Ok((pick.clone(), rows))
     }
 }
 
@@ -596,6 +601,6 @@ mod tests {
             e.contains("no swap chain of application \"b.exe\"; the capture has: a.exe (process 1) 0x1"),
             "{e}"
         );
-        assert_eq!(c.select(Some("A.EXE"), Some("0x1")).unwrap().len(), 2);
+        assert_eq!(c.select(Some("A.EXE"), Some("0x1")).unwrap().1.len(), 2);
     }
 }
