@@ -8,12 +8,16 @@
 pub use rendersim_models::systems::*;
 
 pub use crate::studies::device_predictions;
+pub use crate::studies::replay::system::ReplaySystem;
 
 use crate::config::ModelSource;
 use crate::output::trace::TraceWriter;
 
 /// The studies that are also systems (a model file names them in `system`).
-pub const STUDIES: &[&dyn System] = &[&Registered::<device_predictions::system::DevicePredictionsSystem>::new()];
+pub const STUDIES: &[&dyn System] = &[
+    &Registered::<device_predictions::system::DevicePredictionsSystem>::new(),
+    &Registered::<ReplaySystem>::new(),
+];
 
 /// Every system: the models' ([`rendersim_models::systems::SYSTEMS`]) and
 /// the studies', gathered once.

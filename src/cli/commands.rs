@@ -552,7 +552,7 @@ pub fn perceived_speed(args: super::args::PerceivedSpeedArgs) -> Result<()> {
 }
 
 /// The files `replay --out` writes.
-const REPLAY_FILES: [&str; 3] = ["replay.json", "frames.csv", "model.toml"];
+const REPLAY_FILES: [&str; 4] = ["replay.json", "frames.csv", "model.toml", "whatif-model.toml"];
 
 /// The JSON document `replay` writes: its summary under `replay`.
 #[derive(serde::Serialize)]
@@ -562,7 +562,7 @@ struct ReplayJson<'a> {
 
 /// `rendersim replay`: a PresentMon capture through the frame pipeline.
 pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
-    use rendersim::studies::replay::{FRAME_COLUMNS, ReplayOptions, replay};
+    use rendersim::studies::replay::{ReplayOptions, replay};
     let set = match &args.out {
         Some(dir) => Some(ResultSet::begin(dir, |name| REPLAY_FILES.contains(&name))?),
         None => None,
@@ -578,16 +578,23 @@ pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
         let dir = set.dir();
         std::fs::write(dir.join("replay.json"), &json).context("writing replay.json")?;
         let mut frames = std::io::BufWriter::new(std::fs::File::create(dir.join("frames.csv"))?);
-        rendersim::output::table::write_number_table(&mut frames, &FRAME_COLUMNS, &r.rows())
+        rendersim::output::table::write_number_table(&mut frames, &r.columns(), &r.rows())
             .context("writing frames.csv")?;
         frames.flush().context("writing frames.csv")?;
         drop(frames);
-        let model = toml::to_string(&r.model).context("writing model.toml")?;
-        std::fs::write(
-            dir.join("model.toml"),
-            format!("# The replay's model; the workload lists (one value per frame) are left out.\n{model}"),
-        )
-        .context("writing model.toml")?;
+        let models = [
+            ("model.toml", Some(&r.model)),
+            ("whatif-model.toml", r.whatif_model.as_ref()),
+        ];
+        for (name, model) in models {
+            let Some(model) = model else { continue };
+            let text = toml::to_string(model).with_context(|| format!("writing {name}"))?;
+            std::fs::write(
+                dir.join(name),
+                format!("# The replay's model; the workload lists (one value per frame) are left out.\n{text}"),
+            )
+            .with_context(|| format!("writing {name}"))?;
+        }
         set.commit()?;
     }
     if args.json {

@@ -122,42 +122,5 @@ pub fn measurement(mesh: &str, r: &rendersim::measure::Measurement) -> String {
 
 /// A replay's summary as text.
 pub fn replay(s: &rendersim::studies::replay::ReplaySummary, w: &mut impl std::io::Write) -> std::io::Result<()> {
-    let stat = |e: &rendersim::studies::replay::ErrorStats| match (e.median, e.p90, e.max) {
-        (Some(m), Some(p), Some(x)) => format!("median {m:.3}  p90 {p:.3}  max {x:.3}  ({} frames)", e.frames),
-        _ => "no frame to compare".to_string(),
-    };
-    writeln!(w, "replay of {} ({:?} columns)", s.capture, s.columns)?;
-    writeln!(
-        w,
-        "  swap chain {} of {}: {} frames, {} (model: {}), refresh {:.3} Hz",
-        s.swapchain, s.application, s.frames, s.present_mode, s.model_present_mode, s.refresh_hz
-    )?;
-    writeln!(
-        w,
-        "  displayed: measured {}, predicted {}; fates agree on {:.1}% of frames",
-        s.measured_displayed,
-        s.predicted_displayed,
-        100.0 * s.agreement.displayed
-    )?;
-    writeln!(
-        w,
-        "  |error| ms, MsUntilDisplayed        {}",
-        stat(&s.error_ms.until_displayed)
-    )?;
-    writeln!(
-        w,
-        "  |error| ms, MsBetweenDisplayChange  {}",
-        stat(&s.error_ms.between_display_change)
-    )?;
-    writeln!(
-        w,
-        "  |error| ms, render complete         {}",
-        stat(&s.error_ms.render_complete)
-    )?;
-    writeln!(w, "  |error| ms, present time            {}", stat(&s.error_ms.present))?;
-    writeln!(
-        w,
-        "  {:.4} s wall ({:.4} s simulating)",
-        s.wall_seconds, s.simulate_seconds
-    )
+    rendersim::studies::replay::report::write_text(s, w)
 }

@@ -47,20 +47,83 @@ fn the_main_swap_chain_of_each_shared_capture_meets_the_accuracy_targets() {
 }
 
 #[test]
-fn a_what_if_changes_the_prediction_not_the_measurement() {
+fn a_what_if_is_reported_beside_the_measured_and_the_as_captured_figures() {
     let base = replay(&capture(0), &ReplayOptions::default()).unwrap();
+    assert!(base.whatif_frames.is_none() && base.summary.whatif.sets.is_empty());
+    // Without patches the what-if is the replay as captured.
+    assert_eq!(base.summary.whatif.stats, base.summary.as_captured);
     let opts = ReplayOptions {
         sets: vec!["display.refresh=\"30Hz\"".into()],
         ..ReplayOptions::default()
     };
     let slow = replay(&capture(0), &opts).unwrap();
-    assert_eq!(slow.summary.measured_displayed, base.summary.measured_displayed);
-    let mean = |r: &rendersim::studies::replay::Replay| {
-        let v: Vec<f64> = r.frames.iter().filter_map(|f| f.until_displayed.1).collect();
-        v.iter().sum::<f64>() / v.len() as f64
+    let (b, s) = (&base.summary, &slow.summary);
+    // The measurement and the as-captured replay do not move.
+    assert_eq!(s.measured, b.measured);
+    assert_eq!(s.as_captured, b.as_captured);
+    assert_eq!(s.error_ms.until_displayed.median, b.error_ms.until_displayed.median);
+    assert_eq!(s.model_present_mode, "fifo");
+    assert_eq!(slow.whatif_model.as_ref().unwrap().display.refresh.text, "30Hz");
+    // Half the refresh rate: frames wait longer for their vertical blank,
+    // and more refreshes repeat a frame.
+    let (w, a) = (&s.whatif.stats, &s.as_captured);
+    assert!(
+        w.display_latency_ms.median.unwrap() > a.display_latency_ms.median.unwrap() + 8.0,
+        "{w:?} vs {a:?}"
+    );
+    assert!(w.repeated_refreshes > a.repeated_refreshes, "{w:?} vs {a:?}");
+    // The as-captured replay's figures are the measured ones, near enough.
+    let m = &b.measured;
+    assert_eq!((m.frames, m.displayed), (a.frames, a.displayed));
+    assert!((m.display_latency_ms.median.unwrap() - a.display_latency_ms.median.unwrap()).abs() < 0.5);
+    assert_eq!(m.repeated_refreshes, a.repeated_refreshes);
+    let frames = slow.whatif_frames.as_ref().unwrap();
+    assert_eq!(frames.len(), slow.frames.len());
+    assert_eq!(slow.columns().len(), slow.rows()[0].len());
+}
+
+#[test]
+fn the_replay_system_runs_a_what_if_from_a_model_file_as_the_command_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("m.toml");
+    std::fs::write(
+        &model,
+        format!(
+            "system = \"replay\"\ncapture = {:?}\n[whatif]\ncpu.max_frames_ahead = 1\ndisplay.present_mode = \"mailbox\"\n",
+            capture(2)
+        ),
+    )
+    .unwrap();
+    let src = rendersim::config::ModelSource::from_file(&model).unwrap();
+    let table = src.table().unwrap();
+    let run = rendersim::systems::run_model(&src, &table, None).unwrap();
+    let s = run.summary();
+    assert_eq!(s["system"], "replay");
+    let opts = ReplayOptions {
+        sets: vec![
+            "cpu.max_frames_ahead=1".into(),
+            "display.present_mode=\"mailbox\"".into(),
+        ],
+        ..ReplayOptions::default()
     };
-    // Half the refresh rate: frames wait longer for their vertical blank.
-    assert!(mean(&slow) > mean(&base) + 4.0, "{} vs {}", mean(&slow), mean(&base));
+    let direct = replay(&capture(2), &opts).unwrap();
+    let direct = serde_json::to_value(&direct.summary.whatif).unwrap();
+    assert_eq!(s["replay"]["whatif"], direct);
+    // A wrong key in the what-if names it.
+    std::fs::write(
+        &model,
+        format!(
+            "system = \"replay\"\ncapture = {:?}\n[whatif]\ndisplay.bufers = 2\n",
+            capture(2)
+        ),
+    )
+    .unwrap();
+    let src = rendersim::config::ModelSource::from_file(&model).unwrap();
+    let e = rendersim::systems::run_model(&src, &src.table().unwrap(), None)
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("whatif") && e.contains("bufers"), "{e}");
 }
 
 #[test]
@@ -105,6 +168,35 @@ fn cli_prints_json_writes_its_folder_and_names_what_is_wrong() {
     for f in ["replay.json", "frames.csv", "model.toml"] {
         assert!(out.join(f).is_file(), "{f}");
     }
+    assert!(!out.join("whatif-model.toml").exists());
+    // A what-if adds its model and its columns; the text shows three columns.
+    let o = bin()
+        .args([
+            "replay",
+            capture(1).to_str().unwrap(),
+            "--set",
+            "display.buffers=2",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("what-if: display.buffers=2") && text.contains("as captured      what-if"),
+        "{text}"
+    );
+    assert!(
+        std::fs::read_to_string(out.join("whatif-model.toml"))
+            .unwrap()
+            .contains("buffers = 2")
+    );
+    let header = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    assert!(
+        header.lines().next().unwrap().ends_with("WhatIfMsBetweenDisplayChange"),
+        "{header}"
+    );
     let frames = std::fs::read_to_string(out.join("frames.csv")).unwrap();
     assert_eq!(frames.lines().count(), 26, "a header and 25 frames");
 

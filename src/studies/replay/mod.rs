@@ -22,10 +22,16 @@
 //! Composed modes (the desktop compositor shows the frame, one refresh
 //! later) are not modelled yet and are refused.
 
+pub mod config;
+pub mod display_stats;
+pub mod report;
+pub mod system;
+
 use std::path::Path;
 
 use serde::Serialize;
 
+use self::display_stats::{DisplayStats, FrameTimes};
 use crate::capture::presentmon::{Capture, CaptureError, Columns, Present};
 use crate::config::patch::set_dotted;
 use crate::config::{ModelSource, Overrides, deserialize};
@@ -35,7 +41,7 @@ use crate::systems::frame_pipeline::config::FramesWorkload;
 use crate::systems::frame_pipeline::{FramePipelineConfig, run_pipeline};
 
 /// The replay's base model (the frame pipeline with no costs of its own).
-pub const REPLAY_MODEL: &str = include_str!("../../models/replay.toml");
+pub const REPLAY_MODEL: &str = include_str!("../../../models/replay.toml");
 
 /// Errors of a replay.
 #[derive(Debug, thiserror::Error)]
@@ -58,7 +64,8 @@ pub struct ReplayOptions {
     pub app: Option<String>,
     /// The swap chain's address.
     pub swap_chain: Option<String>,
-    /// `--set` patches on the replay's model.
+    /// The what-if: `--set` patches on the replay's model. The capture is
+    /// replayed as captured and, when there are patches, again with them.
     pub sets: Vec<String>,
 }
 
@@ -137,10 +144,26 @@ pub struct ReplaySummary {
     pub agreement: Agreement,
     /// Errors per quantity, ms.
     pub error_ms: ReplayErrors,
-    /// Wall time of the simulation alone, seconds.
+    /// The capture's own frames, measured.
+    pub measured: DisplayStats,
+    /// The frames replayed as captured.
+    pub as_captured: DisplayStats,
+    /// The frames replayed with the what-if's patches.
+    pub whatif: WhatIf,
+    /// Wall time of the simulations alone (both, with a what-if), seconds.
     pub simulate_seconds: f64,
     /// Wall time of the whole replay (reading the capture included), seconds.
     pub wall_seconds: f64,
+}
+
+/// A what-if's patches and what the display shows under them.
+#[derive(Debug, Clone, Serialize)]
+pub struct WhatIf {
+    /// The patches, `key=value` (none: the what-if is the replay as
+    /// captured, and `stats` are its figures).
+    pub sets: Vec<String>,
+    /// The display figures.
+    pub stats: DisplayStats,
 }
 
 /// One frame, measured and predicted, ms (`None`: does not exist).
@@ -148,6 +171,8 @@ pub struct ReplaySummary {
 pub struct ReplayFrame {
     /// The frame's line in the capture.
     pub line: u64,
+    /// CPU start, measured and predicted.
+    pub cpu_start: (f64, f64),
     /// Present call start, measured, on the capture's clock.
     pub present: f64,
     /// Present call start, predicted.
@@ -164,15 +189,39 @@ pub struct ReplayFrame {
     pub render_complete: (Option<f64>, Option<f64>),
 }
 
+impl ReplayFrame {
+    /// The measured times.
+    pub fn measured_times(&self) -> FrameTimes {
+        FrameTimes {
+            cpu_start: self.cpu_start.0,
+            present: self.present,
+            screen: self.until_displayed.0.map(|u| self.present + u),
+        }
+    }
+
+    /// The predicted times.
+    pub fn predicted_times(&self) -> FrameTimes {
+        FrameTimes {
+            cpu_start: self.cpu_start.1,
+            present: self.predicted_present,
+            screen: self.until_displayed.1.map(|u| self.predicted_present + u),
+        }
+    }
+}
+
 /// A whole replay.
 #[derive(Debug, Clone)]
 pub struct Replay {
     /// The summary.
     pub summary: ReplaySummary,
-    /// Frame by frame.
+    /// Frame by frame, replayed as captured.
     pub frames: Vec<ReplayFrame>,
     /// The model as simulated, without its workload lists.
     pub model: FramePipelineConfig,
+    /// Frame by frame under the what-if (with `--set` patches only).
+    pub whatif_frames: Option<Vec<ReplayFrame>>,
+    /// The what-if's model, without its workload lists.
+    pub whatif_model: Option<FramePipelineConfig>,
 }
 
 /// The refresh period (ms) and a screen time on its grid, fitted to the
@@ -232,10 +281,22 @@ fn ps(ms: f64) -> toml::Value {
     toml::Value::String(format!("{}ps", (ms.max(0.0) * 1e9).round() as u64))
 }
 
-/// Replays the capture at `path`.
-pub fn replay(path: &Path, opts: &ReplayOptions) -> Result<Replay, ReplayError> {
-    let wall = std::time::Instant::now();
-    let capture = Capture::read(path)?;
+/// The capture's swap chain made ready to simulate: the base model with the
+/// captured frames, refresh and present mode, before any what-if.
+struct Setup<'a> {
+    rows: Vec<&'a Present>,
+    /// The present mode most frames use, and the model's for it.
+    common: &'a Present,
+    mode: &'static str,
+    /// Fitted refresh period, ms.
+    period: f64,
+    /// The capture's time of the model's time zero, ms.
+    origin: f64,
+    src: ModelSource,
+    table: toml::Table,
+}
+
+fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Setup<'a>, ReplayError> {
     let (chain, rows) = capture.select(opts.app.as_deref(), opts.swap_chain.as_deref())?;
     let file = capture.file.as_str();
     // The mode most of its frames use (a swap chain may switch, e.g. from
@@ -257,15 +318,14 @@ pub fn replay(path: &Path, opts: &ReplayOptions) -> Result<Replay, ReplayError> 
     let origin = phase - ((phase - c0) / period).ceil() * period;
     let lead = c0 - origin;
 
-    let mut src = ModelSource::from_text("the replay model (models/replay.toml)", REPLAY_MODEL);
+    let src = ModelSource::from_text("the replay model (models/replay.toml)", REPLAY_MODEL);
     let mut table = src.table()?;
-    let n = rows.len();
     let list = |f: &dyn Fn(usize, &Present) -> f64| {
         toml::Value::Array(rows.iter().enumerate().map(|(i, p)| ps(f(i, p))).collect())
     };
     let first = |i: usize| if i == 0 { lead } else { 0.0 };
     let sets: [(&str, toml::Value); 8] = [
-        ("run.frames", toml::Value::Integer(n as i64)),
+        ("run.frames", toml::Value::Integer(rows.len() as i64)),
         (
             "display.refresh",
             toml::Value::String(format!("{}ps", (period * 1e9).round() as u64)),
@@ -289,16 +349,30 @@ pub fn replay(path: &Path, opts: &ReplayOptions) -> Result<Replay, ReplayError> 
             message: format!("building the replay model: {}", e.reason),
         })?;
     }
-    Overrides::with_sets(&opts.sets).apply(&mut src, &mut table)?;
+    Ok(Setup {
+        rows,
+        common,
+        mode,
+        period,
+        origin,
+        src,
+        table,
+    })
+}
+
+/// One simulation of the set-up frames with `sets` patched on: the frames
+/// measured and predicted, the model as run, the simulation's wall time.
+fn simulate(s: &Setup, sets: &[String]) -> Result<(Vec<ReplayFrame>, FramePipelineConfig, f64), ReplayError> {
+    let (mut src, mut table) = (s.src.clone(), s.table.clone());
+    Overrides::with_sets(sets).apply(&mut src, &mut table)?;
     let cfg: FramePipelineConfig = deserialize(&table, &src)?;
     let sim = std::time::Instant::now();
     let run = run_pipeline(cfg, &src.base_dir, None)?;
-    let simulate_seconds = sim.elapsed().as_secs_f64();
-
-    let at = |t: crate::engine::Time| origin + t.as_ms_f64();
-    let mut frames = Vec::with_capacity(n);
+    let seconds = sim.elapsed().as_secs_f64();
+    let at = |t: crate::engine::Time| s.origin + t.as_ms_f64();
+    let mut frames = Vec::with_capacity(s.rows.len());
     let mut last_shown: Option<f64> = None;
-    for (p, r) in rows.iter().zip(&run.records) {
+    for (p, r) in s.rows.iter().zip(&run.records) {
         let predicted_present = at(r.present);
         let shown = r.displayed.map(at);
         let between = match (shown, last_shown) {
@@ -310,6 +384,7 @@ pub fn replay(path: &Path, opts: &ReplayOptions) -> Result<Replay, ReplayError> 
         }
         frames.push(ReplayFrame {
             line: p.line,
+            cpu_start: (p.cpu_start, at(r.start)),
             present: p.present,
             predicted_present,
             displayed: p.displayed(),
@@ -319,17 +394,66 @@ pub fn replay(path: &Path, opts: &ReplayOptions) -> Result<Replay, ReplayError> 
             render_complete: (p.render_complete, r.gpu_end.map(|g| at(g) - predicted_present)),
         });
     }
+    let mut model = run.config;
+    if let crate::systems::frame_pipeline::config::WorkloadConfig::Frames(w) = &mut model.workload {
+        *w = FramesWorkload {
+            cpu: vec![],
+            submit: vec![],
+            gpu: vec![],
+            present: vec![],
+        };
+    }
+    Ok((frames, model, seconds))
+}
+
+/// Replays the capture at `path`.
+pub fn replay(path: &Path, opts: &ReplayOptions) -> Result<Replay, ReplayError> {
+    let wall = std::time::Instant::now();
+    let capture = Capture::read(path)?;
+    replay_capture(&capture, opts, wall)
+}
+
+/// Replays a capture already read; `wall` is when the replay began (its
+/// reading included).
+pub fn replay_capture(
+    capture: &Capture,
+    opts: &ReplayOptions,
+    wall: std::time::Instant,
+) -> Result<Replay, ReplayError> {
+    let s = setup(capture, opts)?;
+    let (frames, model, mut simulate_seconds) = simulate(&s, &[])?;
+    let whatif = if opts.sets.is_empty() {
+        None
+    } else {
+        let (w, model, seconds) = simulate(&s, &opts.sets)?;
+        simulate_seconds += seconds;
+        Some((w, model))
+    };
     let agree = frames.iter().filter(|f| f.displayed == f.predicted_displayed).count();
     let swap = |(m, p): (Option<f64>, Option<f64>)| (p, m);
+    let stats = |frames: &[ReplayFrame], measured: bool| {
+        let times: Vec<FrameTimes> = frames
+            .iter()
+            .map(|f| {
+                if measured {
+                    f.measured_times()
+                } else {
+                    f.predicted_times()
+                }
+            })
+            .collect();
+        DisplayStats::of(&times, s.period)
+    };
+    let as_captured = stats(&frames, false);
     let summary = ReplaySummary {
         capture: capture.file.clone(),
         columns: capture.columns,
         frames: frames.len(),
-        application: rows[0].application.clone(),
-        swapchain: rows[0].swap_chain.clone(),
-        present_mode: common.present_mode.clone(),
-        model_present_mode: mode.to_string(),
-        refresh_hz: 1000.0 / period,
+        application: s.rows[0].application.clone(),
+        swapchain: s.rows[0].swap_chain.clone(),
+        present_mode: s.common.present_mode.clone(),
+        model_present_mode: s.mode.to_string(),
+        refresh_hz: 1000.0 / s.period,
         measured_displayed: frames.iter().filter(|f| f.displayed).count(),
         predicted_displayed: frames.iter().filter(|f| f.predicted_displayed).count(),
         agreement: Agreement {
@@ -341,22 +465,29 @@ pub fn replay(path: &Path, opts: &ReplayOptions) -> Result<Replay, ReplayError> 
             render_complete: ErrorStats::of(frames.iter().map(|f| swap(f.render_complete))),
             present: ErrorStats::of(frames.iter().map(|f| (Some(f.predicted_present), Some(f.present)))),
         },
+        measured: stats(&frames, true),
+        whatif: WhatIf {
+            sets: opts.sets.clone(),
+            stats: whatif
+                .as_ref()
+                .map_or_else(|| as_captured.clone(), |(w, _)| stats(w, false)),
+        },
+        as_captured,
         simulate_seconds,
         wall_seconds: wall.elapsed().as_secs_f64(),
     };
-    let mut model = run.config;
-    if let crate::systems::frame_pipeline::config::WorkloadConfig::Frames(w) = &mut model.workload {
-        *w = FramesWorkload {
-            cpu: vec![],
-            submit: vec![],
-            gpu: vec![],
-            present: vec![],
-        };
-    }
-    Ok(Replay { summary, frames, model })
+    let (whatif_frames, whatif_model) = whatif.map_or((None, None), |(f, m)| (Some(f), Some(m)));
+    Ok(Replay {
+        summary,
+        frames,
+        model,
+        whatif_frames,
+        whatif_model,
+    })
 }
 
-/// The per-frame table's header.
+/// The per-frame table's columns: measured and predicted as captured, then,
+/// with a what-if, its present, shown state and time until displayed.
 pub const FRAME_COLUMNS: [&str; 12] = [
     "Line",
     "PresentTime",
@@ -372,18 +503,38 @@ pub const FRAME_COLUMNS: [&str; 12] = [
     "ErrorMsUntilDisplayed",
 ];
 
+/// The what-if's columns after [`FRAME_COLUMNS`].
+pub const WHATIF_COLUMNS: [&str; 4] = [
+    "WhatIfPresentTime",
+    "WhatIfDisplayed",
+    "WhatIfMsUntilDisplayed",
+    "WhatIfMsBetweenDisplayChange",
+];
+
 impl Replay {
+    /// The per-frame table's header: [`FRAME_COLUMNS`], and
+    /// [`WHATIF_COLUMNS`] with a what-if.
+    pub fn columns(&self) -> Vec<String> {
+        let extra = if self.whatif_frames.is_some() {
+            &WHATIF_COLUMNS[..]
+        } else {
+            &[]
+        };
+        FRAME_COLUMNS.iter().chain(extra).map(|c| c.to_string()).collect()
+    }
+
     /// The per-frame rows (ms; NaN where a value does not exist).
     pub fn rows(&self) -> Vec<Vec<f64>> {
         let v = |x: Option<f64>| x.unwrap_or(f64::NAN);
         self.frames
             .iter()
-            .map(|f| {
+            .enumerate()
+            .map(|(i, f)| {
                 let err = match f.until_displayed {
                     (Some(m), Some(p)) => p - m,
                     _ => f64::NAN,
                 };
-                vec![
+                let mut row = vec![
                     f.line as f64,
                     f.present,
                     f.predicted_present,
@@ -396,7 +547,16 @@ impl Replay {
                     v(f.render_complete.0),
                     v(f.render_complete.1),
                     err,
-                ]
+                ];
+                if let Some(w) = self.whatif_frames.as_ref().map(|w| &w[i]) {
+                    row.extend([
+                        w.predicted_present,
+                        f64::from(u8::from(w.predicted_displayed)),
+                        v(w.until_displayed.1),
+                        v(w.between_display_change.1),
+                    ]);
+                }
+                row
             })
             .collect()
     }

@@ -1,0 +1,95 @@
+//! The `replay` model file: a capture replayed as captured and under one
+//! what-if, as a system an experiment can sweep:
+//!
+//! ```toml
+//! system = "replay"
+//! capture = "../tests/fixtures/presentmon/test_case_0.csv"   # relative to this file
+//! app = "dwm.exe"               # optional: the process (its swap chain with most frames)
+//! swapchain = "0x1B1B8F32850"   # optional: the swap chain's address
+//!
+//! [whatif]                      # patches on models/replay.toml (none: as captured)
+//! cpu.max_frames_ahead = 1
+//! display.present_mode = "mailbox"
+//! ```
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+/// The whole model.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReplayConfig {
+    /// Always `"replay"`.
+    pub system: String,
+    /// A one-line description.
+    #[serde(default)]
+    pub description: String,
+    /// The PresentMon CSV, relative to the model file.
+    pub capture: PathBuf,
+    /// The process whose swap chain to replay.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub app: Option<String>,
+    /// The swap chain's address.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub swapchain: Option<String>,
+    /// The what-if: keys of the replay's frame-pipeline model
+    /// (models/replay.toml) and their values, nested as in a model file.
+    #[serde(default)]
+    pub whatif: toml::Table,
+    /// Seed (experiments set it; a replay is deterministic, so it changes
+    /// nothing).
+    #[serde(default)]
+    pub run: RunConfig,
+}
+
+/// `[run]`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunConfig {
+    /// Unused (see [`ReplayConfig::run`]).
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// The what-if table as `key=value` assignments (dotted keys, TOML
+/// values), in key order.
+pub fn whatif_sets(table: &toml::Table) -> Vec<String> {
+    fn walk(prefix: &str, t: &toml::Table, out: &mut Vec<String>) {
+        for (k, v) in t {
+            let key = if prefix.is_empty() {
+                k.clone()
+            } else {
+                format!("{prefix}.{k}")
+            };
+            match v {
+                toml::Value::Table(inner) => walk(&key, inner, out),
+                other => out.push(format!("{key}={other}")),
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk("", table, &mut out);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_nested_what_if_flattens_to_dotted_assignments() {
+        let t: toml::Table = "cpu.max_frames_ahead = 1\n[display]\npresent_mode = \"mailbox\"\nrefresh = \"30Hz\""
+            .parse()
+            .unwrap();
+        assert_eq!(
+            whatif_sets(&t),
+            [
+                "cpu.max_frames_ahead=1",
+                "display.present_mode=\"mailbox\"",
+                "display.refresh=\"30Hz\""
+            ]
+        );
+        assert!(whatif_sets(&toml::Table::new()).is_empty());
+    }
+}

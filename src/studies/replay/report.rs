@@ -1,0 +1,85 @@
+//! A replay's summary as text (`rendersim replay`, and the `replay`
+//! system's report): the swap chain, the fates' agreement, the errors per
+//! measured quantity, and the display figures measured, replayed as
+//! captured and under the what-if.
+
+use super::ReplaySummary;
+
+/// The display figures of a replay: measured, replayed as captured, and
+/// the what-if's when it has patches.
+fn display_figures(s: &ReplaySummary, w: &mut impl std::io::Write) -> std::io::Result<()> {
+    use super::display_stats::DisplayStats;
+    let mut cols: Vec<(&str, &DisplayStats)> = vec![("measured", &s.measured), ("as captured", &s.as_captured)];
+    if !s.whatif.sets.is_empty() {
+        writeln!(w, "  what-if: {}", s.whatif.sets.join(", "))?;
+        cols.push(("what-if", &s.whatif.stats));
+    }
+    let f = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.2}"));
+    type Row<'a> = (&'a str, &'a dyn Fn(&DisplayStats) -> String);
+    let rows: [Row; 8] = [
+        ("display latency median (ms)", &|d| f(d.display_latency_ms.median)),
+        ("display latency p90 (ms)", &|d| f(d.display_latency_ms.p90)),
+        ("display latency p99 (ms)", &|d| f(d.display_latency_ms.p99)),
+        ("frame rate (fps)", &|d| f(d.fps)),
+        ("1% low (fps)", &|d| f(d.low_1pct_fps)),
+        ("dropped frames", &|d| d.dropped.to_string()),
+        ("repeated refreshes", &|d| d.repeated_refreshes.to_string()),
+        ("stutters", &|d| d.stutters.to_string()),
+    ];
+    write!(w, "  {:<30}", "")?;
+    for (name, _) in &cols {
+        write!(w, "{name:>13}")?;
+    }
+    writeln!(w)?;
+    for (label, value) in rows {
+        write!(w, "  {label:<30}")?;
+        for (_, d) in &cols {
+            write!(w, "{:>13}", value(d))?;
+        }
+        writeln!(w)?;
+    }
+    Ok(())
+}
+
+/// A replay's summary as text.
+pub fn write_text(s: &ReplaySummary, w: &mut impl std::io::Write) -> std::io::Result<()> {
+    let stat = |e: &super::ErrorStats| match (e.median, e.p90, e.max) {
+        (Some(m), Some(p), Some(x)) => format!("median {m:.3}  p90 {p:.3}  max {x:.3}  ({} frames)", e.frames),
+        _ => "no frame to compare".to_string(),
+    };
+    writeln!(w, "replay of {} ({:?} columns)", s.capture, s.columns)?;
+    writeln!(
+        w,
+        "  swap chain {} of {}: {} frames, {} (model: {}), refresh {:.3} Hz",
+        s.swapchain, s.application, s.frames, s.present_mode, s.model_present_mode, s.refresh_hz
+    )?;
+    writeln!(
+        w,
+        "  displayed: measured {}, predicted {}; fates agree on {:.1}% of frames",
+        s.measured_displayed,
+        s.predicted_displayed,
+        100.0 * s.agreement.displayed
+    )?;
+    writeln!(
+        w,
+        "  |error| ms, MsUntilDisplayed        {}",
+        stat(&s.error_ms.until_displayed)
+    )?;
+    writeln!(
+        w,
+        "  |error| ms, MsBetweenDisplayChange  {}",
+        stat(&s.error_ms.between_display_change)
+    )?;
+    writeln!(
+        w,
+        "  |error| ms, render complete         {}",
+        stat(&s.error_ms.render_complete)
+    )?;
+    writeln!(w, "  |error| ms, present time            {}", stat(&s.error_ms.present))?;
+    display_figures(s, w)?;
+    writeln!(
+        w,
+        "  {:.4} s wall ({:.4} s simulating)",
+        s.wall_seconds, s.simulate_seconds
+    )
+}

@@ -1,0 +1,123 @@
+//! The `replay` system ([`crate::systems::STUDIES`]): a capture replayed as
+//! captured and under the model file's what-if, so an experiment can sweep
+//! what-ifs on one capture (experiments/replay-whatif.toml). Its summary is
+//! the replay's (`replay.*`, the keys `rendersim replay --json` prints), its
+//! table the per-frame one (`rendersim replay --out`'s frames.csv).
+
+use std::io::Write;
+use std::path::Path;
+
+use serde::Serialize;
+use serde_json::Value;
+
+use crate::output::trace::TraceWriter;
+use crate::systems::error::invalid;
+use crate::systems::{Outcome, SystemError, SystemModel, resolved_toml};
+
+use super::config::{ReplayConfig, whatif_sets};
+use super::{Replay, ReplayError, ReplayOptions, ReplaySummary, replay};
+
+/// `system = "replay"`.
+pub struct ReplaySystem;
+
+/// The summary.
+#[derive(Debug, Serialize)]
+struct Summary<'a> {
+    system: &'static str,
+    seed: u64,
+    wall_seconds: f64,
+    simulate_seconds: f64,
+    replay: &'a ReplaySummary,
+}
+
+/// A finished run.
+#[derive(Debug)]
+pub struct ReplayRun {
+    summary: Value,
+    config: ReplayConfig,
+    /// The replay.
+    pub replay: Replay,
+    trace: Option<TraceWriter>,
+}
+
+fn blame(e: ReplayError) -> SystemError {
+    match e {
+        ReplayError::Capture(e) => invalid("capture", e.to_string()),
+        ReplayError::Config(e) => invalid("whatif", e.to_string()),
+        ReplayError::System(e) => e,
+    }
+}
+
+impl SystemModel for ReplaySystem {
+    const NAME: &'static str = "replay";
+    const WRITES_TRACE: bool = false;
+    type Config = ReplayConfig;
+    type Run = ReplayRun;
+
+    fn run(cfg: ReplayConfig, base_dir: &Path, trace: Option<TraceWriter>) -> Result<ReplayRun, SystemError> {
+        let opts = ReplayOptions {
+            app: cfg.app.clone(),
+            swap_chain: cfg.swapchain.clone(),
+            sets: whatif_sets(&cfg.whatif),
+        };
+        let replay = replay(&base_dir.join(&cfg.capture), &opts).map_err(blame)?;
+        let s = &replay.summary;
+        let summary = Summary {
+            system: "replay",
+            seed: cfg.run.seed,
+            wall_seconds: s.wall_seconds,
+            simulate_seconds: s.simulate_seconds,
+            replay: s,
+        };
+        let summary = serde_json::to_value(&summary).map_err(|e| invalid("capture", e.to_string()))?;
+        Ok(ReplayRun {
+            summary,
+            config: cfg,
+            replay,
+            trace,
+        })
+    }
+}
+
+impl Outcome for ReplayRun {
+    fn summary(&self) -> &Value {
+        &self.summary
+    }
+
+    fn summary_mut(&mut self) -> &mut Value {
+        &mut self.summary
+    }
+
+    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let mut text = Vec::new();
+        crate::studies::replay::report::write_text(&self.replay.summary, &mut text)?;
+        w.write_all(&text)
+    }
+
+    fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
+        (self.replay.columns(), self.replay.rows())
+    }
+
+    fn write_table(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let (columns, rows) = self.table();
+        crate::output::table::write_number_table(std::io::BufWriter::new(w), &columns, &rows)
+    }
+
+    fn resolved_model(&self, base_dir: &Path) -> String {
+        let mut cfg = self.config.clone();
+        cfg.capture = base_dir.join(&cfg.capture);
+        resolved_toml(&cfg)
+    }
+
+    fn take_trace(&mut self) -> Option<TraceWriter> {
+        self.trace.take()
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    fn into_any(self: Box<Self>) -> Box<dyn std::any::Any> {
+        self
+    }
+}
