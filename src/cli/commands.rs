@@ -601,6 +601,6 @@ pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
         println!("{json}");
         return Ok(());
     }
-    print::replay(&r.summary, &mut std::io::stdout().lock())?;
+    rendersim::studies::replay::report::write_text(&r.summary, &mut std::io::stdout().lock())?;
     Ok(())
 }

@@ -119,8 +119,3 @@ pub fn measurement(mesh: &str, r: &rendersim::measure::Measurement) -> String {
         }
     )
 }
-
-/// A replay's summary as text.
-pub fn replay(s: &rendersim::studies::replay::ReplaySummary, w: &mut impl std::io::Write) -> std::io::Result<()> {
-    rendersim::studies::replay::report::write_text(s, w)
-}

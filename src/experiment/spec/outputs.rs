@@ -5,8 +5,9 @@
 //! file's line, as everywhere in [`super::validate`].
 
 use super::raw::*;
-use super::validate::{Validator, flatten};
+use super::validate::Validator;
 use super::*;
+use crate::config::flatten;
 use crate::experiment::ExperimentError;
 use crate::experiment::sweep::values_match;
 

@@ -5,6 +5,7 @@ use std::path::Path;
 
 use super::raw::*;
 use super::*;
+use crate::config::flatten;
 use crate::experiment::ExperimentError;
 use crate::experiment::sweep::expand_range;
 
@@ -381,20 +382,5 @@ impl Validator<'_> {
             bootstrap: bootstrap as usize,
             params,
         })
-    }
-}
-
-/// Flatten nested tables into `(dotted key, value)` pairs, in table order.
-pub(super) fn flatten(prefix: &str, t: &toml::Table, out: &mut Vec<(String, toml::Value)>) {
-    for (k, v) in t {
-        let key = if prefix.is_empty() {
-            k.clone()
-        } else {
-            format!("{prefix}.{k}")
-        };
-        match v {
-            toml::Value::Table(inner) => flatten(&key, inner, out),
-            other => out.push((key, other.clone())),
-        }
     }
 }

@@ -55,22 +55,9 @@ pub struct RunConfig {
 /// The what-if table as `key=value` assignments (dotted keys, TOML
 /// values), in key order.
 pub fn whatif_sets(table: &toml::Table) -> Vec<String> {
-    fn walk(prefix: &str, t: &toml::Table, out: &mut Vec<String>) {
-        for (k, v) in t {
-            let key = if prefix.is_empty() {
-                k.clone()
-            } else {
-                format!("{prefix}.{k}")
-            };
-            match v {
-                toml::Value::Table(inner) => walk(&key, inner, out),
-                other => out.push(format!("{key}={other}")),
-            }
-        }
-    }
-    let mut out = Vec::new();
-    walk("", table, &mut out);
-    out
+    let mut pairs = Vec::new();
+    crate::config::flatten("", table, &mut pairs);
+    pairs.into_iter().map(|(k, v)| format!("{k}={v}")).collect()
 }
 
 #[cfg(test)]

@@ -415,11 +415,7 @@ pub fn replay(path: &Path, opts: &ReplayOptions) -> Result<Replay, ReplayError> 
 
 /// Replays a capture already read; `wall` is when the replay began (its
 /// reading included).
-pub fn replay_capture(
-    capture: &Capture,
-    opts: &ReplayOptions,
-    wall: std::time::Instant,
-) -> Result<Replay, ReplayError> {
+fn replay_capture(capture: &Capture, opts: &ReplayOptions, wall: std::time::Instant) -> Result<Replay, ReplayError> {
     let s = setup(capture, opts)?;
     let (frames, model, mut simulate_seconds) = simulate(&s, &[])?;
     let whatif = if opts.sets.is_empty() {

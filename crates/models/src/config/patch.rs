@@ -119,6 +119,21 @@ fn set_in(cur: &mut toml::Value, parts: &[&str], done: usize, value: toml::Value
     }
 }
 
+/// Flatten nested tables into `(dotted key, value)` pairs, in table order.
+pub fn flatten(prefix: &str, t: &toml::Table, out: &mut Vec<(String, toml::Value)>) {
+    for (k, v) in t {
+        let key = if prefix.is_empty() {
+            k.clone()
+        } else {
+            format!("{prefix}.{k}")
+        };
+        match v {
+            toml::Value::Table(inner) => flatten(&key, inner, out),
+            other => out.push((key, other.clone())),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
