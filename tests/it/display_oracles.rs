@@ -111,3 +111,47 @@ fn refresh_extremes_one_hertz_and_one_kilohertz() {
     let iv = metric(&fast, "metrics.display_interval_ms.mean");
     assert!((17.0..=18.0).contains(&iv), "{iv}");
 }
+
+#[test]
+fn a_composed_flip_shows_every_frame_one_refresh_later() {
+    // The compositor takes each flipped frame at its vertical blank and
+    // shows it at the next one: the same frames, the same intervals, every
+    // display time exactly one refresh later (`display.composition`).
+    let refresh_ps = (1e12f64 / 60.0).round() as u64; // 60 Hz, to the nearest ps
+    for mode in ["fifo", "mailbox"] {
+        for buffers in ["2", "3"] {
+            let base = [
+                format!("display.present_mode=\"{mode}\""),
+                format!("display.buffers={buffers}"),
+                "run.frames=240".to_string(),
+            ];
+            let sets: Vec<&str> = base.iter().map(String::as_str).collect();
+            let flip = run(FIXED, &sets);
+            let mut composed_sets = sets.clone();
+            composed_sets.push("display.composition=\"composed\"");
+            let composed = run(FIXED, &composed_sets);
+            assert_eq!(flip.records.len(), composed.records.len());
+            for (a, b) in flip.records.iter().zip(&composed.records) {
+                assert_eq!(a.dropped, b.dropped, "{mode} x{buffers}: frame {}", a.index);
+                assert_eq!(a.gpu_end, b.gpu_end, "{mode} x{buffers}: frame {}", a.index);
+                match (a.displayed, b.displayed) {
+                    (Some(x), Some(y)) => assert_eq!(y.0 - x.0, refresh_ps, "{mode} x{buffers}: frame {}", a.index),
+                    (x, y) => assert_eq!(x.is_some(), y.is_some()),
+                }
+            }
+            let lat = |r| metric(r, "metrics.display_latency_ms.mean");
+            assert!((lat(&composed) - lat(&flip) - refresh_ps as f64 * 1e-9).abs() < 1e-9);
+            assert_eq!(
+                metric(&flip, "metrics.display_interval_ms.mean"),
+                metric(&composed, "metrics.display_interval_ms.mean")
+            );
+        }
+    }
+}
+
+#[test]
+fn a_composed_display_needs_a_vertical_blank() {
+    let e = common::try_run(FIXED, &["display.composition=\"composed\"", "display.vsync=false"])
+        .expect_err("composed without vsync is refused");
+    assert!(e.contains("display.composition") && e.contains("vsync"), "{e}");
+}

@@ -27,6 +27,7 @@ mod multi_rate;
 mod nvidia_policy;
 mod obj_files;
 mod outputs;
+mod pacing;
 mod pipeline_oracles;
 mod pixelflow;
 mod present;

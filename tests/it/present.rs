@@ -213,3 +213,10 @@ fn the_cli_runs_the_shipped_model_with_a_trace_and_refuses_a_bad_one() {
         "{e}"
     );
 }
+
+#[test]
+fn a_composed_display_is_refused_with_the_key_and_where_it_is_modelled() {
+    let text = model(10, "\"5ms\"", "composition = \"composed\"");
+    let e = try_run_any(&text, &[]).expect_err("composition is the frame pipeline's");
+    assert!(e.contains("display.composition") && e.contains("frame_pipeline"), "{e}");
+}

@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use rendersim::components::swap_chain::Composition;
 use rendersim::studies::replay::{ReplayOptions, fit_refresh, replay};
 
 fn capture(i: usize) -> PathBuf {
@@ -43,6 +44,75 @@ fn the_main_swap_chain_of_each_shared_capture_meets_the_accuracy_targets() {
         // The CPU replays as measured: presents where the capture has them.
         assert!(e.present.max.unwrap() < 1e-6, "capture {i}: {:?}", e.present);
         assert_eq!(r.frames.len(), s.frames);
+    }
+}
+
+fn chain(i: usize, swap_chain: &str) -> rendersim::studies::replay::Replay {
+    let opts = ReplayOptions {
+        swap_chain: Some(swap_chain.into()),
+        ..ReplayOptions::default()
+    };
+    replay(&capture(i), &opts).unwrap()
+}
+
+#[test]
+fn composed_flips_are_shown_one_refresh_after_the_first_vertical_blank() {
+    // `Composed: Flip` at sync interval 0: mailbox, shown by the compositor
+    // one refresh later. Both shared chains land within 0.05 ms.
+    for (i, sc) in [(0, "0x20DBB4358B0"), (1, "0x2019D7777C0")] {
+        let r = chain(i, sc);
+        let s = &r.summary;
+        assert_eq!(s.present_mode, "Composed: Flip");
+        assert_eq!(
+            (s.model_present_mode.as_str(), s.model_composition),
+            ("mailbox", Composition::Composed)
+        );
+        let e = &s.error_ms.until_displayed;
+        assert!(e.median.unwrap() <= 0.05 && e.p90.unwrap() <= 0.05, "{i} {sc}: {e:?}");
+    }
+    // `Composed: Copy with GPU GDI` (a blit, sync interval -1): fifo plus
+    // the compositor's refresh. Every displayed frame is on the capture's
+    // vertical-blank grid; where the model misses, it misses by exactly
+    // one refresh, on one side of the frame the compositor dropped (the
+    // compositor's queue at the capture's start is not in the capture).
+    for (i, sc) in [
+        (0, "0x20979A6D5F8"),
+        (0, "0x0"),
+        (0, "0x29A5884FF18"),
+        (2, "0x1BA6DC82C58"),
+    ] {
+        let r = chain(i, sc);
+        let refresh = 1000.0 / r.summary.refresh_hz;
+        assert_eq!(r.summary.model_composition, Composition::Composed);
+        for f in &r.frames {
+            if let (Some(m), Some(p)) = f.until_displayed {
+                let off = (p - m).abs();
+                assert!(
+                    off < 0.3 || (off - refresh).abs() < 0.3,
+                    "{i} {sc} line {}: {p} vs {m}",
+                    f.line
+                );
+            }
+        }
+    }
+    // Without composition the rule misses these chains by a refresh more.
+    let opts = ReplayOptions {
+        swap_chain: Some("0x20DBB4358B0".into()),
+        sets: vec!["display.composition=\"independent\"".into()],
+        ..ReplayOptions::default()
+    };
+    let flip = replay(&capture(0), &opts).unwrap();
+    let shown: Vec<f64> = flip
+        .whatif_frames
+        .as_ref()
+        .unwrap()
+        .iter()
+        .filter_map(|f| f.until_displayed.1)
+        .collect();
+    let captured: Vec<f64> = flip.frames.iter().filter_map(|f| f.until_displayed.1).collect();
+    let refresh = 1000.0 / flip.summary.refresh_hz;
+    for (a, b) in captured.iter().zip(&shown) {
+        assert!((a - b - refresh).abs() < 1e-6, "{a} vs {b}");
     }
 }
 
@@ -209,9 +279,14 @@ fn cli_prints_json_writes_its_folder_and_names_what_is_wrong() {
     };
     let c0 = capture(0);
     let c0 = c0.to_str().unwrap();
-    let e = err(&["replay", c0, "--swapchain", "0x20979A6D5F8"]);
+    let odd = dir.path().join("odd-mode.csv");
+    let text = std::fs::read_to_string(capture(1))
+        .unwrap()
+        .replace("Hardware: Legacy Flip", "Overlay: Mystery");
+    std::fs::write(&odd, text).unwrap();
+    let e = err(&["replay", odd.to_str().unwrap()]);
     assert!(
-        e.contains("test_case_0.csv:5: present mode `Composed: Copy with GPU GDI`"),
+        e.contains("odd-mode.csv:") && e.contains("unknown present mode `Overlay: Mystery`"),
         "{e}"
     );
     let e = err(&["replay", c0, "--swapchain", "0x1"]);

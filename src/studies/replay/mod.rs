@@ -19,8 +19,10 @@
 //! Present modes: the hardware flips (`Hardware: Legacy Flip`,
 //! `Hardware: Independent Flip`, ...) are `fifo` at a sync interval of 1 or
 //! more, `immediate` at 0 with tearing allowed, and `mailbox` at 0 without.
-//! Composed modes (the desktop compositor shows the frame, one refresh
-//! later) are not modelled yet and are refused.
+//! `Composed: ...` modes are the same with `display.composition =
+//! "composed"` (the desktop compositor shows the frame one refresh after
+//! its flip); a composed present without a sync interval (-1, a blit) is
+//! `fifo`.
 
 pub mod config;
 pub mod display_stats;
@@ -33,6 +35,7 @@ use serde::Serialize;
 
 use self::display_stats::{DisplayStats, FrameTimes};
 use crate::capture::presentmon::{Capture, CaptureError, Columns, Present};
+use crate::components::swap_chain::Composition;
 use crate::config::patch::set_dotted;
 use crate::config::{ModelSource, Overrides, deserialize};
 use crate::stats::quantile::quantile;
@@ -134,6 +137,10 @@ pub struct ReplaySummary {
     pub present_mode: String,
     /// The model's present mode (`fifo`, `mailbox`, `immediate`).
     pub model_present_mode: String,
+    /// The model's composition: `composed` for a `Composed: ...` capture
+    /// (left out of the JSON for a hardware flip).
+    #[serde(skip_serializing_if = "Composition::is_independent")]
+    pub model_composition: Composition,
     /// Fitted refresh rate.
     pub refresh_hz: f64,
     /// Frames displayed in the capture.
@@ -251,29 +258,35 @@ pub fn fit_refresh(screen: &[f64]) -> Option<(f64, f64)> {
 }
 
 /// The model's present mode for a capture's, with its vsync.
-fn model_mode(p: &Present, file: &str) -> Result<(&'static str, bool), CaptureError> {
+/// The model's present mode, vsync and composition for a captured present.
+/// A hardware flip (`Hardware: Legacy Flip`, `Hardware: Independent Flip`,
+/// `Hardware Composed: Independent Flip`) is an independent flip; a
+/// `Composed: ...` present is shown by the compositor one refresh later.
+/// Sync interval 1 or more is `fifo`; 0 is `mailbox`, or `immediate` when
+/// the present allows tearing on a hardware flip (the compositor never
+/// tears); a composed present without a sync interval (-1, PresentMon's
+/// value for a blit) is `fifo`.
+fn model_mode(p: &Present, file: &str) -> Result<(&'static str, bool, bool), CaptureError> {
     let mode = p.present_mode.as_str();
-    let err = |message: String| CaptureError::Row {
-        file: file.to_string(),
-        line: p.line,
-        message,
-    };
-    if mode.starts_with("Composed") {
-        return Err(err(format!(
-            "present mode `{mode}`: composition by the desktop compositor is not modelled yet; \
-             swap chains with a hardware flip (`Hardware: Legacy Flip`, `Hardware: Independent Flip`) can be replayed"
-        )));
+    let composed = mode.starts_with("Composed");
+    if !composed && !mode.starts_with("Hardware") {
+        return Err(CaptureError::Row {
+            file: file.to_string(),
+            line: p.line,
+            message: format!(
+                "unknown present mode `{mode}` (replayed: `Hardware: Legacy Flip`, `Hardware: Independent Flip`, \
+                 `Hardware Composed: Independent Flip`, `Composed: Flip`, `Composed: Copy with GPU GDI`, \
+                 `Composed: Copy with CPU GDI`)"
+            ),
+        });
     }
-    if !mode.starts_with("Hardware") {
-        return Err(err(format!(
-            "unknown present mode `{mode}` (replayed: `Hardware: Legacy Flip`, `Hardware: Independent Flip`, \
-             `Hardware Composed: Independent Flip`)"
-        )));
-    }
-    Ok(match (p.sync_interval.unwrap_or(1), p.allows_tearing) {
-        (s, _) if s >= 1 => ("fifo", true),
-        (_, true) => ("immediate", false),
-        (_, false) => ("mailbox", true),
+    let sync = p.sync_interval.unwrap_or(1);
+    Ok(match (sync, p.allows_tearing, composed) {
+        (s, _, true) if s != 0 => ("fifo", true, true),
+        (_, _, true) => ("mailbox", true, true),
+        (s, _, false) if s >= 1 => ("fifo", true, false),
+        (_, true, false) => ("immediate", false, false),
+        (_, false, false) => ("mailbox", true, false),
     })
 }
 
@@ -288,6 +301,8 @@ struct Setup<'a> {
     /// The present mode most frames use, and the model's for it.
     common: &'a Present,
     mode: &'static str,
+    /// Whether the compositor shows its frames (a `Composed: ...` mode).
+    composed: bool,
     /// Fitted refresh period, ms.
     period: f64,
     /// The capture's time of the model's time zero, ms.
@@ -306,7 +321,7 @@ fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Setup<'a>, Re
         .find(|p| p.present_mode == chain.present_mode)
         .copied()
         .unwrap_or(rows[0]);
-    let (mode, vsync) = model_mode(common, file)?;
+    let (mode, vsync, composed) = model_mode(common, file)?;
     let screen: Vec<f64> = rows.iter().filter_map(|p| p.screen_time()).collect();
     let (period, phase) = fit_refresh(&screen).ok_or_else(|| CaptureError::Row {
         file: file.to_string(),
@@ -343,7 +358,8 @@ fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Setup<'a>, Re
         ),
         ("workload.present", list(&|_, p| p.cpu_wait)),
     ];
-    for (key, value) in sets {
+    let composition = composed.then(|| ("display.composition", toml::Value::String("composed".into())));
+    for (key, value) in sets.into_iter().chain(composition) {
         set_dotted(&mut table, key, value).map_err(|e| CaptureError::Format {
             file: file.to_string(),
             message: format!("building the replay model: {}", e.reason),
@@ -353,6 +369,7 @@ fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Setup<'a>, Re
         rows,
         common,
         mode,
+        composed,
         period,
         origin,
         src,
@@ -449,6 +466,11 @@ fn replay_capture(capture: &Capture, opts: &ReplayOptions, wall: std::time::Inst
         swapchain: s.rows[0].swap_chain.clone(),
         present_mode: s.common.present_mode.clone(),
         model_present_mode: s.mode.to_string(),
+        model_composition: if s.composed {
+            Composition::Composed
+        } else {
+            Composition::Independent
+        },
         refresh_hz: 1000.0 / s.period,
         measured_displayed: frames.iter().filter(|f| f.displayed).count(),
         predicted_displayed: frames.iter().filter(|f| f.predicted_displayed).count(),

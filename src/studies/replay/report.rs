@@ -50,8 +50,18 @@ pub fn write_text(s: &ReplaySummary, w: &mut impl std::io::Write) -> std::io::Re
     writeln!(w, "replay of {} ({:?} columns)", s.capture, s.columns)?;
     writeln!(
         w,
-        "  swap chain {} of {}: {} frames, {} (model: {}), refresh {:.3} Hz",
-        s.swapchain, s.application, s.frames, s.present_mode, s.model_present_mode, s.refresh_hz
+        "  swap chain {} of {}: {} frames, {} (model: {}{}), refresh {:.3} Hz",
+        s.swapchain,
+        s.application,
+        s.frames,
+        s.present_mode,
+        s.model_present_mode,
+        if s.model_composition.is_independent() {
+            ""
+        } else {
+            ", composed"
+        },
+        s.refresh_hz
     )?;
     writeln!(
         w,

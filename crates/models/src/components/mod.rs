@@ -1,9 +1,11 @@
 //! Reusable parts that systems compose: distributions, vertex caches, bounded
-//! FIFOs, swap chains, system-task noise, preemptible processors, a unified
-//! shader-core pool and state-time accounting.
+//! FIFOs, swap chains, frame pacing (limiters, low-latency pacers),
+//! system-task noise, preemptible processors, a unified shader-core pool and
+//! state-time accounting.
 
 pub mod distribution;
 pub mod fifo;
+pub mod frame_pacing;
 pub mod lod_select;
 pub mod noise;
 pub mod preemptible;

@@ -11,6 +11,16 @@
 //!
 //! One image is always the front buffer being scanned out; `buffers` counts
 //! all images, so double buffering leaves one image to render into.
+//!
+//! `composition` says who puts a flipped frame on the screen. `independent`
+//! (a hardware flip: PresentMon's `Hardware: Legacy Flip` and `Hardware:
+//! Independent Flip`) shows it at the flip. `composed` (the desktop
+//! compositor, PresentMon's `Composed: Flip` and `Composed: Copy with GPU
+//! GDI`) takes the frame at the flip's vertical blank and shows its next
+//! composition one refresh later: one refresh of compositor latency on every
+//! frame, no change in which frames are shown or when images are freed (the
+//! compositor copies or holds its own surface). That is the rule the shared
+//! PresentMon captures follow (docs/replay.md, "Composition").
 
 use std::collections::VecDeque;
 
@@ -30,6 +40,25 @@ pub enum PresentMode {
     Immediate,
 }
 
+/// Who shows a flipped frame (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Composition {
+    /// A hardware flip: the frame is on screen at the flip.
+    #[default]
+    Independent,
+    /// The desktop compositor shows the frame one refresh after the flip.
+    Composed,
+}
+
+impl Composition {
+    /// Whether this is the default (`independent`), which model files and
+    /// written models leave out.
+    pub fn is_independent(&self) -> bool {
+        *self == Composition::Independent
+    }
+}
+
 /// A model file's `[display]`: the swap chain and the display it feeds
 /// (paper 004 §4.2), shared by every system that has one.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -43,6 +72,10 @@ pub struct DisplayConfig {
     pub buffers: u32,
     /// How presented frames reach the screen.
     pub present_mode: PresentMode,
+    /// Who shows a flipped frame: a hardware flip (`independent`, the
+    /// default) or the desktop compositor one refresh later (`composed`).
+    #[serde(skip_serializing_if = "Composition::is_independent")]
+    pub composition: Composition,
 }
 
 impl DisplayConfig {
@@ -63,9 +96,19 @@ impl DisplayConfig {
         self.effective_mode() != PresentMode::Immediate
     }
 
+    /// Time from a flip to the frame on screen: one refresh when composed,
+    /// none for a hardware flip.
+    pub fn compositor_delay(&self) -> crate::engine::Duration {
+        match self.composition {
+            Composition::Independent => crate::engine::Duration::ZERO,
+            Composition::Composed => self.refresh.period,
+        }
+    }
+
     /// Checks the display every system can run: a refresh period of at
     /// least [`crate::limits::MIN_REFRESH_PERIOD_PS`] (every refresh is an
-    /// event) and 2 to 16 swap-chain images; the error is (key, message).
+    /// event), 2 to 16 swap-chain images, and composition only with a
+    /// vertical blank to compose at; the error is (key, message).
     pub fn check(&self) -> Result<(), (&'static str, String)> {
         if self.refresh.period.0 < crate::limits::MIN_REFRESH_PERIOD_PS {
             return Err((
@@ -82,6 +125,14 @@ impl DisplayConfig {
                 format!("must be between 2 and 16 swap-chain images, got {}", self.buffers),
             ));
         }
+        if self.composition == Composition::Composed && !self.waits_for_vblank() {
+            return Err((
+                "display.composition",
+                "a composed frame is shown by the desktop compositor at a vertical blank: \
+                 `composed` needs `display.vsync = true` and `present_mode` `fifo` or `mailbox`"
+                    .to_string(),
+            ));
+        }
         Ok(())
     }
 }
@@ -93,6 +144,7 @@ impl Default for DisplayConfig {
             vsync: true,
             buffers: 2,
             present_mode: PresentMode::Fifo,
+            composition: Composition::Independent,
         }
     }
 }

@@ -22,12 +22,14 @@ use super::links::Links;
 use super::records::FrameRecord;
 
 /// CPU states.
-pub const CPU_STATES: [&str; 5] = [
+pub const CPU_STATES: [&str; 7] = [
     "work",
     "system task",
     "wait: command FIFO full",
     "wait: frames in flight",
     "idle",
+    "wait: pacing before a frame",
+    "wait: frame limiter before present",
 ];
 /// GPU front-end states.
 pub const FRONT_STATES: [&str; 6] = [
@@ -155,7 +157,7 @@ impl PipelineTrace {
 #[derive(Debug)]
 pub struct Accounting {
     /// CPU clock.
-    pub cpu: StateClock<5>,
+    pub cpu: StateClock<7>,
     /// Front-end clock.
     pub front: StateClock<6>,
     /// Geometry clock.
@@ -243,7 +245,9 @@ fn attribute_cpu(records: &mut [FrameRecord], old: usize, spent: u64, frame: u64
     if let Some(r) = records.get_mut(frame as usize) {
         match old {
             0 | 1 => r.cpu_busy += spent,
-            2 | 3 => r.cpu_wait += spent,
+            // Pacing before a frame (5) is between frames: the frame
+            // starts when it ends.
+            2 | 3 | 6 => r.cpu_wait += spent,
             _ => {}
         }
     }
@@ -254,8 +258,8 @@ fn attribute_cpu(records: &mut [FrameRecord], old: usize, spent: u64, frame: u64
 fn cpu_state_of(p: CpuPhase) -> usize {
     // A table, not a match: the phase changes from event to event, and a
     // jump table's indirect branch would often be mispredicted.
-    const OF: [u8; 8] = {
-        let mut of = [0u8; 8];
+    const OF: [u8; 10] = {
+        let mut of = [0u8; 10];
         of[CpuPhase::NextFrame as usize] = 0;
         of[CpuPhase::WaitFrames as usize] = 3;
         of[CpuPhase::Ready as usize] = 0;
@@ -264,6 +268,8 @@ fn cpu_state_of(p: CpuPhase) -> usize {
         of[CpuPhase::Rendezvous as usize] = 2;
         of[CpuPhase::ZeroTimeWait as usize] = 0;
         of[CpuPhase::Finished as usize] = 4;
+        of[CpuPhase::PaceStart as usize] = 5;
+        of[CpuPhase::PacePresent as usize] = 6;
         of
     };
     OF[p as usize] as usize
@@ -569,6 +575,9 @@ fn cpu_mode(cpu: &CpuThread) -> Mode {
     match cpu.phase() {
         CpuPhase::WaitFrames | CpuPhase::Push | CpuPhase::Rendezvous => Mode::wait(Unit::Front),
         CpuPhase::Finished => Mode::wait(Unit::Display),
+        // The low-latency pacer waits for the GPU to drain; a limiter's
+        // wait is the CPU's own.
+        CpuPhase::PaceStart if cpu.paced_for_gpu() => Mode::wait(Unit::Front),
         _ if cpu.in_system() => Mode::work(Blame::System),
         _ => Mode::work(Blame::Cpu),
     }

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::components::distribution::Dist;
 use crate::components::fifo::FifoUnit;
+pub use crate::components::frame_pacing::PacingConfig;
 use crate::components::noise::NoiseTarget;
 pub use crate::components::swap_chain::DisplayConfig;
 use crate::components::vertex_cache::CachePolicy;
@@ -65,6 +66,10 @@ pub struct FramePipelineConfig {
     /// given; written to the resolved model only when given).
     #[serde(default, skip_serializing_if = "VariationConfig::is_off")]
     pub variation: VariationConfig,
+    /// Frame limiter and low-latency pacer (off unless given; written to the
+    /// resolved model only when given).
+    #[serde(default, skip_serializing_if = "PacingConfig::is_off")]
+    pub pacing: PacingConfig,
     /// What is rendered.
     pub workload: WorkloadConfig,
 }

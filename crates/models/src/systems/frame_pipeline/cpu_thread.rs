@@ -10,6 +10,7 @@
 //! count of completed frames and the records come in an [`Env`].
 
 use crate::components::distribution::Dist;
+use crate::components::frame_pacing::{GpuForecast, limited, paced_start};
 use crate::components::preemptible::{Preemptible, Wake};
 use crate::engine::{Duration, Scheduler, StreamRng, Time};
 use crate::systems::error::SystemError;
@@ -39,6 +40,12 @@ pub enum CpuPhase {
     /// Waits for its [`Ev::ZeroTimeFrame`] event before starting a frame
     /// that takes no time.
     ZeroTimeWait,
+    /// Held by the frame limiter or the low-latency pacer before starting
+    /// a frame (`[pacing]`); [`Ev::PaceWake`] ends it.
+    PaceStart,
+    /// Held by a present-measured frame limiter before the present
+    /// (`pacing.limit_from = "present"`); [`Ev::PaceWake`] ends it.
+    PacePresent,
     /// All frames submitted.
     Finished,
 }
@@ -156,6 +163,12 @@ pub struct CpuThread {
     zero_time_go: bool,
     /// Commands pushed.
     issued: u64,
+    /// The pending [`Ev::PaceWake`] was handled: go on without pacing again.
+    pace_go: bool,
+    /// The phase a [`Ev::PaceWake`] resumes.
+    pace_resume: CpuPhase,
+    /// Whether the low-latency pacer (not a limiter) set the start wait.
+    pace_for_gpu: bool,
 }
 
 #[inline(always)]
@@ -194,6 +207,9 @@ impl CpuThread {
             zero_time_after,
             zero_time_go: false,
             issued: 0,
+            pace_go: false,
+            pace_resume: CpuPhase::NextFrame,
+            pace_for_gpu: false,
         }
     }
 
@@ -251,6 +267,84 @@ impl CpuThread {
     #[inline(always)]
     pub(super) fn schedule_wake(s: &mut Scheduler<Ev>, w: Wake) {
         schedule(s, w);
+    }
+
+    /// Whether the low-latency pacer holds the thread (it waits for the GPU
+    /// to drain, not for a limiter's interval).
+    #[inline(always)]
+    pub(super) fn paced_for_gpu(&self) -> bool {
+        self.phase == CpuPhase::PaceStart && self.pace_for_gpu
+    }
+
+    /// The [`Ev::PaceWake`] event: the held frame starts, or presents.
+    pub(super) fn pace_wake(&mut self) {
+        self.pace_go = true;
+        self.phase = self.pace_resume;
+    }
+
+    /// The time the frame about to start must wait for (`[pacing]`: a
+    /// start-measured limiter, the low-latency pacer; the later wins), if
+    /// later than `now`.
+    fn start_wait(&mut self, now: Time, env: &Env) -> Option<Time> {
+        let p = &env.cfg.pacing;
+        if p.is_off() || self.frame == 0 {
+            return None;
+        }
+        let prev = &env.records[self.frame as usize - 1];
+        let mut t = now;
+        if let Some(interval) = p.start_limit() {
+            t = t.max(limited(Some(prev.start), interval).unwrap_or(now));
+        }
+        self.pace_for_gpu = false;
+        if p.low_latency {
+            // Times the accounting has closed: busy time is attributed to a
+            // frame at the end of the instant that moves past it, so a
+            // frame finished at `now` (or the CPU's frame just presented)
+            // is read from the frame before it.
+            let completed = env.links.frames_completed as usize;
+            let closed = |i: usize| env.records.get(i).filter(|r| r.gpu_end.is_some_and(|e| e < now));
+            let gpu_frame = (1..=2)
+                .filter_map(|back| completed.checked_sub(back).and_then(closed))
+                .map(|r| Duration(r.gpu_busy))
+                .next();
+            let f = self.frame as usize;
+            let cpu_frame = match f {
+                1 => Some(prev.present.since(prev.start)),
+                _ => Some(Duration(env.records[f - 2].cpu_busy)),
+            };
+            let forecast = GpuForecast {
+                in_flight: self.frame - env.links.frames_completed,
+                oldest_gpu_start: env.records.get(completed).and_then(|r| r.gpu_start),
+                gpu_frame,
+                cpu_frame,
+            };
+            let paced = paced_start(now, forecast);
+            if paced > t {
+                t = paced;
+                self.pace_for_gpu = true;
+            }
+        }
+        (t > now).then_some(t)
+    }
+
+    /// The time the current operation, if it is the swap, must wait for
+    /// under a present-measured limiter: the previous present plus the
+    /// interval, less the swap's own work, if later than `now`.
+    fn present_wait(&mut self, now: Time, env: &Env) -> Option<Time> {
+        let interval = env.cfg.pacing.present_limit()?;
+        if !matches!(self.op_at(self.op), Op::Swap) || self.frame == 0 {
+            return None;
+        }
+        if std::mem::take(&mut self.pace_go) {
+            return None;
+        }
+        let target = limited(Some(env.records[self.frame as usize - 1].present), interval)?;
+        let swap = match &self.fixed {
+            Some(f) => env.cfg.cpu.swap.saturating_add(f.after_submit(self.frame)),
+            None => env.cfg.cpu.swap,
+        };
+        let t = Time(target.0.saturating_sub(swap.0));
+        (t > now).then_some(t)
     }
 
     /// The [`Ev::ZeroTimeFrame`] event: the waiting frame may start.
@@ -483,7 +577,11 @@ impl CpuThread {
         // (most events find it so), and for good once finished or waiting
         // for its zero-time frame: no step, and no call.
         match self.phase {
-            CpuPhase::Running | CpuPhase::ZeroTimeWait | CpuPhase::Finished => return Ok(false),
+            CpuPhase::Running
+            | CpuPhase::ZeroTimeWait
+            | CpuPhase::PaceStart
+            | CpuPhase::PacePresent
+            | CpuPhase::Finished => return Ok(false),
             CpuPhase::WaitFrames if self.frames_ahead_full(env) => {
                 return Ok(false);
             }
@@ -522,6 +620,12 @@ impl CpuThread {
                     }
                 }
                 CpuPhase::Ready => {
+                    if let Some(t) = self.present_wait(now, env) {
+                        s.at(t, Ev::PaceWake);
+                        self.pace_resume = CpuPhase::Ready;
+                        self.phase = CpuPhase::PacePresent;
+                        return Ok(true);
+                    }
                     let work = self.op_work(self.op_at(self.op), env);
                     if work.0 > 0 || self.work.in_system() {
                         let w = self.work.start_job(now, work)?;
@@ -552,7 +656,11 @@ impl CpuThread {
                     }
                     self.phase = self.advance(now, env);
                 }
-                CpuPhase::Running | CpuPhase::ZeroTimeWait | CpuPhase::Finished => return Ok(progressed),
+                CpuPhase::Running
+                | CpuPhase::ZeroTimeWait
+                | CpuPhase::PaceStart
+                | CpuPhase::PacePresent
+                | CpuPhase::Finished => return Ok(progressed),
             }
             progressed = true;
         }
@@ -575,6 +683,17 @@ impl CpuThread {
             let changed = self.phase != CpuPhase::WaitFrames;
             self.phase = CpuPhase::WaitFrames;
             return Some(changed);
+        }
+        // Pacing (`[pacing]`): a limiter or the low-latency pacer holds the
+        // frame; it starts, and samples input, when the wait ends.
+        if std::mem::take(&mut self.pace_go) {
+            let r = &mut env.records[self.frame as usize];
+            (r.start, r.input) = (now, now);
+        } else if let Some(t) = self.start_wait(now, env) {
+            s.at(t, Ev::PaceWake);
+            self.pace_resume = CpuPhase::NextFrame;
+            self.phase = CpuPhase::PaceStart;
+            return Some(true);
         }
         // Frames that take no time would all run at this one instant inside
         // this call, unseen by the run loop and its limits: past the most

@@ -1,7 +1,9 @@
 //! The display (paper 004 §4.2): frames the front end presents into the
 //! swap chain are shown at a vertical blank (`fifo`, `mailbox`) or at once
 //! (`immediate` / vsync off); repeated refreshes and dropped frames are
-//! counted.
+//! counted. A composed display (`display.composition = "composed"`) shows
+//! each flipped frame one refresh later, through the desktop compositor
+//! ([`crate::components::swap_chain::Composition`]).
 //!
 //! [`Display`] owns the display's counters (vertical blanks, repeated
 //! refreshes, the mark where refresh metrics start after warm-up, frames
@@ -20,6 +22,8 @@ use super::records::FrameRecord;
 #[derive(Debug)]
 pub struct Display {
     refresh: Duration,
+    /// From a flip to the frame on screen (one refresh when composed).
+    compositor_delay: Duration,
     frames_total: u64,
     warmup_frames: u64,
     vblanks: u64,
@@ -33,11 +37,17 @@ pub struct Display {
 }
 
 impl Display {
-    /// A display refreshing every `refresh`, for a run of `frames_total`
-    /// frames whose first `warmup_frames` are warm-up.
-    pub(super) fn new(refresh: Duration, frames_total: u64, warmup_frames: u64) -> Self {
+    /// A display refreshing every `refresh` that shows a flipped frame
+    /// `compositor_delay` later, for a run of `frames_total` frames whose
+    /// first `warmup_frames` are warm-up.
+    pub(super) fn new(
+        (refresh, compositor_delay): (Duration, Duration),
+        frames_total: u64,
+        warmup_frames: u64,
+    ) -> Self {
         Display {
             refresh,
+            compositor_delay,
             frames_total,
             warmup_frames,
             vblanks: 0,
@@ -116,7 +126,7 @@ impl Display {
                 let crossed = now.0 / p - prev.0 / p;
                 self.repeated_refreshes += crossed.saturating_sub(1);
             }
-            records[f as usize].displayed = Some(now);
+            records[f as usize].displayed = Some(Time(now.0.saturating_add(self.compositor_delay.0)));
             path.shown(f);
             self.last_display = Some(now);
             self.resolved += 1;

@@ -56,6 +56,9 @@ pub enum Ev {
     /// frame goes through the run loop as an event, and `run.max_events`
     /// holds for it (scheduled only for zero-time frames).
     ZeroTimeFrame,
+    /// A frame limiter's or the low-latency pacer's wait ends
+    /// (`[pacing]`; scheduled only when pacing holds the CPU).
+    PaceWake,
 }
 
 impl EventKind for Ev {
@@ -71,6 +74,7 @@ impl EventKind for Ev {
         "noise_arrival",
         "noise_end",
         "zero_time_frame",
+        "pacing_wake",
     ];
     #[inline]
     fn kind(&self) -> usize {
@@ -86,6 +90,7 @@ impl EventKind for Ev {
             Ev::NoiseArrive { .. } => 8,
             Ev::NoiseEnd { .. } => 9,
             Ev::ZeroTimeFrame => 10,
+            Ev::PaceWake => 11,
         }
     }
 }

@@ -176,7 +176,11 @@ impl FramePipeline {
             front: FrontEnd::new(streams.stream("variation.gpu")),
             geom: GeometryStage::new(streams.stream("fragment.pixels"), pixel_rng_start),
             frag: FragmentStage::default(),
-            display: Display::new(cfg.display.refresh.period, frames_total, cfg.run.warmup_frames),
+            display: Display::new(
+                (cfg.display.refresh.period, cfg.display.compositor_delay()),
+                frames_total,
+                cfg.run.warmup_frames,
+            ),
             frames_total,
             noise,
             acct: Accounting::new(
@@ -410,6 +414,7 @@ impl Model for FramePipeline {
             Ev::NoiseArrive { source } => self.noise_arrive(now, source, s)?,
             Ev::NoiseEnd { target } => self.noise_end(now, target, s)?,
             Ev::ZeroTimeFrame => self.cpu.zero_time_frame(),
+            Ev::PaceWake => self.cpu.pace_wake(),
         }
         self.step(now, s)?;
         Ok(if self.done() { Control::Stop } else { Control::Continue })

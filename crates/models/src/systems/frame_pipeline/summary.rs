@@ -307,7 +307,8 @@ pub(super) fn summarize(
                 .map(|(n, t)| (n.to_string(), t as f64 / elapsed))
                 .collect(),
             states_ms: StatesMs {
-                cpu: states(&CPU_STATES, &cpu),
+                // The pacing states only where `[pacing]` is on.
+                cpu: states(&CPU_STATES[..if m.env.cfg.pacing.is_off() { 5 } else { 7 }], &cpu),
                 gpu_front_end: states(&FRONT_STATES, &front),
                 geometry: states(&GEOM_STATES, &geom),
                 fragment: states(&FRAG_STATES, &frag),

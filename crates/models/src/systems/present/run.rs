@@ -90,6 +90,14 @@ pub fn validate(cfg: &PresentConfig) -> Result<(), SystemError> {
         .validate()
         .map_err(|e| invalid("render.time", e.to_string()))?;
     cfg.display.check().map_err(|(key, message)| invalid(key, message))?;
+    if !cfg.display.composition.is_independent() {
+        return Err(invalid(
+            "display.composition",
+            "the present system models a hardware flip only; a composed display is modelled by \
+             the frame pipeline (`system = \"frame_pipeline\"`)"
+                .to_string(),
+        ));
+    }
     if cfg.run.warmup_frames > cfg.run.frames {
         return Err(invalid(
             "run.warmup_frames",

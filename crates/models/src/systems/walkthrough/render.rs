@@ -101,6 +101,7 @@ impl Renderer {
             display: cfg.display.clone(),
             noise: noise_cfg,
             variation: Default::default(),
+            pacing: Default::default(),
             workload: WorkloadConfig::Scene(SceneWorkload {
                 view: View::Static,
                 preset: None,

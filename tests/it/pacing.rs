@@ -1,0 +1,93 @@
+//! Frame pacing (`[pacing]`, crates/models/src/components/frame_pacing.rs):
+//! the frame limiter and the low-latency pacer against closed forms on the
+//! fixed teaching model (5 ms of CPU, then 17 ms of GPU per frame), and
+//! errors that name the key.
+
+use crate::common::{FIXED, metric, run, try_run};
+
+const OFF: &str = "display.vsync=false";
+
+fn lat(sets: &[&str]) -> (f64, f64) {
+    let r = run(FIXED, sets);
+    (
+        metric(&r, "metrics.display_latency_ms.mean"),
+        metric(&r, "metrics.display_interval_ms.mean"),
+    )
+}
+
+#[test]
+fn the_low_latency_pacer_gives_one_frame_of_latency_at_the_throughput_of_two() {
+    // One frame in flight: CPU then GPU, 22 ms a frame and 22 ms of latency.
+    assert_eq!(lat(&[OFF, "cpu.max_frames_ahead=1"]), (22.0, 22.0));
+    // Two in flight: the GPU never waits (17 ms a frame), but a frame
+    // waits a whole GPU frame in the queue (34 ms).
+    let two = lat(&[OFF, "cpu.max_frames_ahead=2"]);
+    assert!((two.0 - 34.0).abs() < 1e-9 && (two.1 - 17.0).abs() < 1e-9, "{two:?}");
+    // The pacer starts each frame 5 ms before the GPU runs dry: 17 ms a
+    // frame at 22 ms of latency, whatever the frames ahead allow.
+    for ahead in ["2", "3", "8"] {
+        let sets = [OFF, "pacing.low_latency=true", &format!("cpu.max_frames_ahead={ahead}")];
+        let (l, iv) = lat(&sets);
+        assert!(
+            (l - 22.0).abs() < 1e-9 && (iv - 17.0).abs() < 1e-9,
+            "{ahead} ahead: {l} {iv}"
+        );
+    }
+    // The sleep is between frames: counted as its own CPU state, not as any
+    // frame's wait. (Until a GPU frame has closed, frames 2 and 3, the pacer
+    // has no history and the frames-in-flight limit holds them.)
+    let r = run(FIXED, &[OFF, "pacing.low_latency=true"]);
+    assert!(metric(&r, "metrics.states_ms.cpu.wait: pacing before a frame") > 0.0);
+    let waits: Vec<(u64, u64)> = r
+        .records
+        .iter()
+        .skip(4)
+        .filter(|f| f.cpu_wait > 0)
+        .map(|f| (f.index, f.cpu_wait))
+        .collect();
+    assert!(waits.is_empty(), "{waits:?}");
+}
+
+#[test]
+fn a_frame_limiter_holds_frames_to_its_interval_and_no_faster() {
+    // 50 Hz on a pipeline that could run at 58.8: 20 ms apart, and the GPU
+    // idles 3 ms a frame, so no frame queues (22 ms of latency).
+    for from in ["start", "present"] {
+        let sets = [OFF, "pacing.limit=\"50Hz\"", &format!("pacing.limit_from=\"{from}\"")];
+        let r = run(FIXED, &sets);
+        let (l, iv) = (
+            metric(&r, "metrics.display_latency_ms.mean"),
+            metric(&r, "metrics.display_interval_ms.mean"),
+        );
+        assert!((iv - 20.0).abs() < 1e-9 && (l - 22.0).abs() < 1e-9, "{from}: {l} {iv}");
+        let presents: Vec<u64> = r.records.iter().map(|f| f.present.0).collect();
+        for w in presents.windows(2).skip(1) {
+            assert_eq!(w[1] - w[0], 20_000_000_000, "{from}: presents 20 ms apart");
+        }
+    }
+    // A limit above what the pipeline reaches changes nothing.
+    let free = run(FIXED, &[OFF]);
+    let limited = run(FIXED, &[OFF, "pacing.limit=\"100Hz\""]);
+    assert_eq!(
+        metric(&free, "metrics.display_interval_ms.mean"),
+        metric(&limited, "metrics.display_interval_ms.mean")
+    );
+    // With the pacer the later start wins: the limiter's 20 ms.
+    assert_eq!(
+        lat(&[OFF, "pacing.limit=\"50Hz\"", "pacing.low_latency=true"]),
+        (22.0, 20.0)
+    );
+}
+
+#[test]
+fn bad_pacing_keys_name_the_key() {
+    for (set, needle) in [
+        ("pacing.limit=\"0Hz\"", "pacing.limit"),
+        ("pacing.limit=\"fast\"", "pacing.limit"),
+        ("pacing.limit_from=\"end\"", "pacing.limit_from"),
+        ("pacing.lmit=\"50Hz\"", "did you mean `limit`"),
+    ] {
+        let e = try_run(FIXED, &[set]).expect_err(set);
+        assert!(e.contains(needle), "{set}: {e}");
+    }
+}
