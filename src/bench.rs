@@ -15,6 +15,8 @@
 //! - `build`: the vertex-cache reordering against its direct form, and the
 //!   scene build against the simulation of the models that build a mesh
 //!   ([`build`]).
+//! - `replay`: replaying a 10,000-frame PresentMon capture against reading
+//!   its CSV alone ([`replay`]).
 //!
 //! The functions return the measurements; `rendersim bench` prints them.
 
@@ -31,6 +33,7 @@ use crate::engine::{
 use crate::systems::{SimError, run_model};
 
 pub mod build;
+pub mod replay;
 
 /// Hold-model event.
 #[derive(Debug, Clone, Copy)]
@@ -264,6 +267,9 @@ pub enum BenchError {
     /// The reordering benchmark's mesh or its check failed.
     #[error("reordering benchmark: {0}")]
     Reorder(String),
+    /// The replay benchmark's capture did not replay.
+    #[error("replay benchmark: {0}")]
+    Replay(String),
 }
 
 /// One of the benchmarks of `rendersim bench`.
@@ -279,16 +285,19 @@ pub enum Bench {
     Pixelflow,
     /// Scene building against simulation ([`build::build_bench`]).
     Build,
+    /// A 10,000-frame capture's replay against reading it ([`replay::replay_bench`]).
+    Replay,
 }
 
 impl Bench {
     /// Every benchmark, in the order `rendersim bench all` runs them.
-    pub const ALL: [Bench; 5] = [
+    pub const ALL: [Bench; 6] = [
         Bench::Pixelflow,
         Bench::Kernel,
         Bench::Pipeline,
         Bench::Hour,
         Bench::Build,
+        Bench::Replay,
     ];
 }
 

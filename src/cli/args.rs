@@ -402,6 +402,8 @@ pub enum BenchTarget {
     Pixelflow,
     /// Scene building (the vertex-cache reordering) against simulation.
     Build,
+    /// Replaying a 10,000-frame capture against reading it.
+    Replay,
     /// All of them.
     All,
 }
@@ -414,6 +416,7 @@ impl From<BenchTarget> for Vec<Bench> {
             BenchTarget::Hour => vec![Bench::Hour],
             BenchTarget::Pixelflow => vec![Bench::Pixelflow],
             BenchTarget::Build => vec![Bench::Build],
+            BenchTarget::Replay => vec![Bench::Replay],
             BenchTarget::All => Bench::ALL.to_vec(),
         }
     }

@@ -478,6 +478,7 @@ pub fn bench(args: BenchArgs) -> Result<()> {
             Bench::Pipeline => println!("{}", print::pipeline_bench(&bench::pipeline_bench(scale)?)),
             Bench::Hour => println!("{}", print::hour_bench(&bench::hour_bench(scale)?)),
             Bench::Build => println!("{}", print::build_bench(&bench::build::build_bench(scale)?)),
+            Bench::Replay => println!("{}", print::replay_bench(&bench::replay::replay_bench(scale)?)),
         }
     }
     if let Some(path) = args.plot {

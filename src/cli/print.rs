@@ -64,6 +64,23 @@ pub fn hour_bench(h: &HourBench) -> String {
     )
 }
 
+/// The replay benchmark's line: the replay against reading the CSV alone.
+pub fn replay_bench(b: &rendersim::bench::replay::ReplayBench) -> String {
+    let ms = |s: f64| format!("{:.2} ms", s * 1e3);
+    format!(
+        "replay: a {}-frame PresentMon 2 capture ({:.1} MB), median of {}: reading the CSV {}, replaying it {} (the frame pipeline's run {}), {:.2}x reading alone, {:.0} frames replayed per second; agreement {:.1}%",
+        b.frames,
+        b.bytes as f64 / 1e6,
+        b.reps,
+        ms(b.read_s),
+        ms(b.replay_s),
+        ms(b.simulate_s),
+        b.replay_s / b.read_s,
+        b.frames as f64 / b.replay_s,
+        100.0 * b.agreement
+    )
+}
+
 /// The build benchmark's lines: the reordering, fast against direct, then
 /// each model's build, event loop and whole run at both fidelities.
 pub fn build_bench(b: &rendersim::bench::build::BuildBench) -> String {

@@ -431,8 +431,13 @@ pub fn replay(path: &Path, opts: &ReplayOptions) -> Result<Replay, ReplayError> 
 }
 
 /// Replays a capture already read; `wall` is when the replay began (its
-/// reading included).
-fn replay_capture(capture: &Capture, opts: &ReplayOptions, wall: std::time::Instant) -> Result<Replay, ReplayError> {
+/// reading included). For a capture that is not a file
+/// ([`crate::bench::replay`] replays one made in memory).
+pub fn replay_capture(
+    capture: &Capture,
+    opts: &ReplayOptions,
+    wall: std::time::Instant,
+) -> Result<Replay, ReplayError> {
     let s = setup(capture, opts)?;
     let (frames, model, mut simulate_seconds) = simulate(&s, &[])?;
     let whatif = if opts.sets.is_empty() {
