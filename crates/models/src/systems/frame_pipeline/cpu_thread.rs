@@ -339,10 +339,7 @@ impl CpuThread {
             return None;
         }
         let target = limited(Some(env.records[self.frame as usize - 1].present), interval)?;
-        let swap = match &self.fixed {
-            Some(f) => env.cfg.cpu.swap.saturating_add(f.after_submit(self.frame)),
-            None => env.cfg.cpu.swap,
-        };
+        let swap = self.op_work(Op::Swap, env);
         let t = Time(target.0.saturating_sub(swap.0));
         (t > now).then_some(t)
     }
