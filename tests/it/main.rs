@@ -41,6 +41,7 @@ mod timeline;
 mod unified;
 mod view_cells;
 mod vr;
+mod vrr;
 mod walkthrough;
 mod walkthrough_lod;
 mod walkthrough_scenes;

@@ -134,14 +134,27 @@ fn a_what_if_is_reported_beside_the_measured_and_the_as_captured_figures() {
     assert_eq!(s.error_ms.until_displayed.median, b.error_ms.until_displayed.median);
     assert_eq!(s.model_present_mode, "fifo");
     assert_eq!(slow.whatif_model.as_ref().unwrap().display.refresh.text, "30Hz");
-    // Half the refresh rate: frames wait longer for their vertical blank,
-    // and more refreshes repeat a frame.
+    // Half the refresh rate: frames wait longer for their vertical blank.
+    // Repeats are counted on the what-if's own 30 Hz grid: at about 27
+    // frames a second, fewer of its refreshes repeat a frame than of 60 Hz's.
     let (w, a) = (&s.whatif.stats, &s.as_captured);
     assert!(
         w.display_latency_ms.median.unwrap() > a.display_latency_ms.median.unwrap() + 8.0,
         "{w:?} vs {a:?}"
     );
-    assert!(w.repeated_refreshes > a.repeated_refreshes, "{w:?} vs {a:?}");
+    let screens: Vec<f64> = slow
+        .whatif_frames
+        .as_ref()
+        .unwrap()
+        .iter()
+        .filter_map(|f| f.predicted_times().screen)
+        .collect();
+    let on_30hz: u64 = screens
+        .windows(2)
+        .map(|p| (((p[1] - p[0]) / (1000.0 / 30.0)).round() as u64).saturating_sub(1))
+        .sum();
+    assert_eq!(w.repeated_refreshes, on_30hz);
+    assert!(w.repeated_refreshes < a.repeated_refreshes, "{w:?} vs {a:?}");
     // The as-captured replay's figures are the measured ones, near enough.
     let m = &b.measured;
     assert_eq!((m.frames, m.displayed), (a.frames, a.displayed));
@@ -150,6 +163,42 @@ fn a_what_if_is_reported_beside_the_measured_and_the_as_captured_figures() {
     let frames = slow.whatif_frames.as_ref().unwrap();
     assert_eq!(frames.len(), slow.frames.len());
     assert_eq!(slow.columns().len(), slow.rows()[0].len());
+}
+
+#[test]
+fn a_variable_refresh_what_if_shows_most_frames_when_the_gpu_finishes_them() {
+    let opts = ReplayOptions {
+        sets: vec![
+            "display.vrr.min_refresh=\"48Hz\"".into(),
+            "display.vrr.max_refresh=\"144Hz\"".into(),
+        ],
+        ..ReplayOptions::default()
+    };
+    let r = replay(&capture(0), &opts).unwrap();
+    let frames = r.whatif_frames.as_ref().unwrap();
+    // Never two scan-outs closer than the fastest refresh.
+    let changes: Vec<f64> = frames.iter().filter_map(|f| f.between_display_change.1).collect();
+    assert!(changes.len() > 150);
+    assert!(changes.iter().all(|&d| d >= 1000.0 / 144.0 - 1e-6), "{changes:?}");
+    // Most frames (about 41 a second, inside the window) go on screen the
+    // moment the GPU finishes; none waits longer than a scan-out.
+    let waits: Vec<f64> = frames
+        .iter()
+        .filter_map(|f| Some(f.until_displayed.1? - f.render_complete.1?))
+        .collect();
+    let at_once = waits.iter().filter(|&&w| w.abs() < 1e-6).count();
+    assert!(at_once * 10 >= waits.len() * 7, "{at_once} of {}", waits.len());
+    assert!(
+        waits.iter().all(|&w| w > -1e-6 && w <= 1000.0 / 144.0 + 1e-6),
+        "{waits:?}"
+    );
+    // Against the fixed 60 Hz panel as captured: no wait for a vertical
+    // blank, so a lower median latency.
+    let (w, a) = (&r.summary.whatif.stats, &r.summary.as_captured);
+    assert!(
+        w.display_latency_ms.median.unwrap() < a.display_latency_ms.median.unwrap() - 5.0,
+        "{w:?} vs {a:?}"
+    );
 }
 
 #[test]

@@ -377,9 +377,34 @@ fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Setup<'a>, Re
     })
 }
 
-/// One simulation of the set-up frames with `sets` patched on: the frames
-/// measured and predicted, the model as run, the simulation's wall time.
-fn simulate(s: &Setup, sets: &[String]) -> Result<(Vec<ReplayFrame>, FramePipelineConfig, f64), ReplayError> {
+/// One simulation of the set-up frames with `sets` patched on.
+struct Simulated {
+    /// The frames, measured and predicted.
+    frames: Vec<ReplayFrame>,
+    /// The model as run (its per-frame work left out).
+    model: FramePipelineConfig,
+    /// The simulation's wall time, s.
+    seconds: f64,
+    /// The refreshes that repeated an image, as the display counted them.
+    repeated_refreshes: u64,
+}
+
+impl Simulated {
+    /// The display figures of the predicted frames. A fixed refresh counts
+    /// repeats on its grid, as the measured figures do; a variable-refresh
+    /// panel has none, so its own count of repeated scan-outs stands.
+    fn stats(&self) -> DisplayStats {
+        let times: Vec<FrameTimes> = self.frames.iter().map(ReplayFrame::predicted_times).collect();
+        let mut st = DisplayStats::of(&times, self.model.display.shortest_period().as_ms_f64());
+        if self.model.display.vrr.is_some() {
+            st.repeated_refreshes = self.repeated_refreshes;
+        }
+        st
+    }
+}
+
+/// One simulation of the set-up frames with `sets` patched on.
+fn simulate(s: &Setup, sets: &[String]) -> Result<Simulated, ReplayError> {
     let (mut src, mut table) = (s.src.clone(), s.table.clone());
     Overrides::with_sets(sets).apply(&mut src, &mut table)?;
     let cfg: FramePipelineConfig = deserialize(&table, &src)?;
@@ -420,7 +445,13 @@ fn simulate(s: &Setup, sets: &[String]) -> Result<(Vec<ReplayFrame>, FramePipeli
             present: vec![],
         };
     }
-    Ok((frames, model, seconds))
+    let repeated_refreshes = run.summary["metrics"]["repeated_refreshes"].as_u64().unwrap_or(0);
+    Ok(Simulated {
+        frames,
+        model,
+        seconds,
+        repeated_refreshes,
+    })
 }
 
 /// Replays the capture at `path`.
@@ -439,30 +470,18 @@ pub fn replay_capture(
     wall: std::time::Instant,
 ) -> Result<Replay, ReplayError> {
     let s = setup(capture, opts)?;
-    let (frames, model, mut simulate_seconds) = simulate(&s, &[])?;
+    let captured = simulate(&s, &[])?;
     let whatif = if opts.sets.is_empty() {
         None
     } else {
-        let (w, model, seconds) = simulate(&s, &opts.sets)?;
-        simulate_seconds += seconds;
-        Some((w, model))
+        Some(simulate(&s, &opts.sets)?)
     };
+    let simulate_seconds = captured.seconds + whatif.as_ref().map_or(0.0, |w| w.seconds);
+    let frames = &captured.frames;
     let agree = frames.iter().filter(|f| f.displayed == f.predicted_displayed).count();
     let swap = |(m, p): (Option<f64>, Option<f64>)| (p, m);
-    let stats = |frames: &[ReplayFrame], measured: bool| {
-        let times: Vec<FrameTimes> = frames
-            .iter()
-            .map(|f| {
-                if measured {
-                    f.measured_times()
-                } else {
-                    f.predicted_times()
-                }
-            })
-            .collect();
-        DisplayStats::of(&times, s.period)
-    };
-    let as_captured = stats(&frames, false);
+    let measured: Vec<FrameTimes> = frames.iter().map(ReplayFrame::measured_times).collect();
+    let as_captured = captured.stats();
     let summary = ReplaySummary {
         capture: capture.file.clone(),
         columns: capture.columns,
@@ -488,22 +507,20 @@ pub fn replay_capture(
             render_complete: ErrorStats::of(frames.iter().map(|f| swap(f.render_complete))),
             present: ErrorStats::of(frames.iter().map(|f| (Some(f.predicted_present), Some(f.present)))),
         },
-        measured: stats(&frames, true),
+        measured: DisplayStats::of(&measured, s.period),
         whatif: WhatIf {
             sets: opts.sets.clone(),
-            stats: whatif
-                .as_ref()
-                .map_or_else(|| as_captured.clone(), |(w, _)| stats(w, false)),
+            stats: whatif.as_ref().map_or_else(|| as_captured.clone(), Simulated::stats),
         },
         as_captured,
         simulate_seconds,
         wall_seconds: wall.elapsed().as_secs_f64(),
     };
-    let (whatif_frames, whatif_model) = whatif.map_or((None, None), |(f, m)| (Some(f), Some(m)));
+    let (whatif_frames, whatif_model) = whatif.map_or((None, None), |w| (Some(w.frames), Some(w.model)));
     Ok(Replay {
         summary,
-        frames,
-        model,
+        frames: captured.frames,
+        model: captured.model,
         whatif_frames,
         whatif_model,
     })

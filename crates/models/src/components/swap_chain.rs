@@ -21,6 +21,22 @@
 //! frame, no change in which frames are shown or when images are freed (the
 //! compositor copies or holds its own surface). That is the rule the shared
 //! PresentMon captures follow (docs/replay.md, "Composition").
+//!
+//! `vrr` makes the panel's refresh variable (adaptive sync: VESA
+//! Adaptive-Sync, AMD FreeSync, NVIDIA G-Sync, HDMI 2.1 VRR). The panel has
+//! no fixed vertical blank: it starts a scan-out when a frame is flipped,
+//! as soon as the previous scan-out is done (one period of its fastest rate,
+//! `max_refresh`). A frame that arrives while the panel scans waits for the
+//! scan to end (above the window the frame rate is held at `max_refresh`).
+//! A panel may not hold one image longer than a period of its slowest rate,
+//! `min_refresh`: when no new frame came by then, it scans the old one out
+//! again (a repeated refresh; low-framerate compensation, which drivers do
+//! by repeating frames below the window), and a frame that arrives during
+//! that repeat waits for it to end. The model is the timing rule the VESA
+//! Adaptive-Sync and HDMI 2.1 specifications give the source (a vertical
+//! total stretched between the two limits), not any one vendor's driver:
+//! drivers that repeat frames ahead of the deadline (to leave room for the
+//! next one) are not modelled.
 
 use std::collections::VecDeque;
 
@@ -76,6 +92,32 @@ pub struct DisplayConfig {
     /// default) or the desktop compositor one refresh later (`composed`).
     #[serde(skip_serializing_if = "Composition::is_independent")]
     pub composition: Composition,
+    /// Variable refresh (see the module docs); `None`, the default, is a
+    /// fixed refresh.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vrr: Option<VrrConfig>,
+}
+
+/// A variable-refresh panel's window (`[display.vrr]`, see the module docs).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VrrConfig {
+    /// The slowest refresh: no image is held longer than its period (below
+    /// it, frames are repeated).
+    pub min_refresh: Rate,
+    /// The fastest refresh: a scan-out takes its period. Left out, it is
+    /// `display.refresh` (the panel's native rate).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_refresh: Option<Rate>,
+}
+
+/// The periods of a variable-refresh window.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct VrrWindow {
+    /// One scan-out: the period of the fastest refresh.
+    pub shortest: crate::engine::Duration,
+    /// The longest an image is held: the period of the slowest refresh.
+    pub longest: crate::engine::Duration,
 }
 
 impl DisplayConfig {
@@ -96,6 +138,33 @@ impl DisplayConfig {
         self.effective_mode() != PresentMode::Immediate
     }
 
+    /// The shortest time between two refreshes: the period of the refresh,
+    /// or of a variable-refresh panel's fastest rate.
+    pub fn shortest_period(&self) -> crate::engine::Duration {
+        self.vrr_window().map_or(self.refresh.period, |w| w.shortest)
+    }
+
+    /// The variable-refresh window, when `vrr` is set.
+    pub fn vrr_window(&self) -> Option<VrrWindow> {
+        self.vrr.as_ref().map(|v| VrrWindow {
+            shortest: v.max_refresh.as_ref().unwrap_or(&self.refresh).period,
+            longest: v.min_refresh.period,
+        })
+    }
+
+    /// The first key this display sets that only the frame pipeline models
+    /// (composition, variable refresh), with what to say; `None` when a
+    /// system with a plain fixed-refresh display can run it.
+    pub fn beyond_fixed_refresh(&self) -> Option<(&'static str, &'static str)> {
+        if !self.composition.is_independent() {
+            Some(("display.composition", "a composed display"))
+        } else if self.vrr.is_some() {
+            Some(("display.vrr", "a variable-refresh display"))
+        } else {
+            None
+        }
+    }
+
     /// Time from a flip to the frame on screen: one refresh when composed,
     /// none for a hardware flip.
     pub fn compositor_delay(&self) -> crate::engine::Duration {
@@ -108,16 +177,23 @@ impl DisplayConfig {
     /// Checks the display every system can run: a refresh period of at
     /// least [`crate::limits::MIN_REFRESH_PERIOD_PS`] (every refresh is an
     /// event), 2 to 16 swap-chain images, and composition only with a
-    /// vertical blank to compose at; the error is (key, message).
+    /// vertical blank to compose at; a variable-refresh window whose slowest
+    /// rate is below its fastest, with vsync and a hardware flip; the error
+    /// is (key, message).
     pub fn check(&self) -> Result<(), (&'static str, String)> {
-        if self.refresh.period.0 < crate::limits::MIN_REFRESH_PERIOD_PS {
-            return Err((
-                "display.refresh",
+        let short = |key: &'static str, period: crate::engine::Duration| {
+            Err((
+                key,
                 format!(
-                    "a refresh period of {} is shorter than the limit of 1us (1 MHz): every refresh is an event",
-                    self.refresh.period
+                    "a refresh period of {period} is shorter than the limit of 1us (1 MHz): every refresh is an event"
                 ),
-            ));
+            ))
+        };
+        if self.refresh.period.0 < crate::limits::MIN_REFRESH_PERIOD_PS {
+            return short("display.refresh", self.refresh.period);
+        }
+        if let Some(v) = &self.vrr {
+            self.check_vrr(v)?;
         }
         if !(2..=16).contains(&self.buffers) {
             return Err((
@@ -137,6 +213,57 @@ impl DisplayConfig {
     }
 }
 
+impl DisplayConfig {
+    fn check_vrr(&self, v: &VrrConfig) -> Result<(), (&'static str, String)> {
+        if let Some(max) = &v.max_refresh
+            && max.period.0 < crate::limits::MIN_REFRESH_PERIOD_PS
+        {
+            return Err((
+                "display.vrr.max_refresh",
+                format!(
+                    "a refresh period of {} is shorter than the limit of 1us (1 MHz): every refresh is an event",
+                    max.period
+                ),
+            ));
+        }
+        let w = self.vrr_window().expect("vrr is set");
+        if w.longest.0 <= w.shortest.0 {
+            let max = v
+                .max_refresh
+                .as_ref()
+                .map_or(format!("display.refresh = {:?}", self.refresh.text), |m| {
+                    format!("display.vrr.max_refresh = {:?}", m.text)
+                });
+            return Err((
+                "display.vrr.min_refresh",
+                format!(
+                    "the slowest refresh {:?} must be slower than the fastest ({max}): a variable-refresh window runs \
+                     from min_refresh up to max_refresh",
+                    v.min_refresh.text
+                ),
+            ));
+        }
+        if !self.waits_for_vblank() {
+            return Err((
+                "display.vrr",
+                "a variable-refresh panel shows each frame at a scan-out start; with vsync off frames above \
+                 its range would tear, which is not modelled: `display.vrr` needs `display.vsync = true` and \
+                 `present_mode` `fifo` or `mailbox`"
+                    .to_string(),
+            ));
+        }
+        if !self.composition.is_independent() {
+            return Err((
+                "display.vrr",
+                "variable refresh follows the application's own flips: it needs an independent flip, not \
+                 `display.composition = \"composed\"` (the compositor refreshes at a fixed rate)"
+                    .to_string(),
+            ));
+        }
+        Ok(())
+    }
+}
+
 impl Default for DisplayConfig {
     fn default() -> Self {
         DisplayConfig {
@@ -145,6 +272,7 @@ impl Default for DisplayConfig {
             buffers: 2,
             present_mode: PresentMode::Fifo,
             composition: Composition::Independent,
+            vrr: None,
         }
     }
 }

@@ -3,14 +3,18 @@
 //! (`immediate` / vsync off); repeated refreshes and dropped frames are
 //! counted. A composed display (`display.composition = "composed"`) shows
 //! each flipped frame one refresh later, through the desktop compositor
-//! ([`crate::components::swap_chain::Composition`]).
+//! ([`crate::components::swap_chain::Composition`]). A variable-refresh
+//! display (`display.vrr`) has no fixed vertical blank: a flipped frame
+//! starts a scan-out at once when the panel is idle, or when the scan-out
+//! under way ends; a panel that got no new frame within its slowest period
+//! repeats the old one ([`crate::components::swap_chain::VrrConfig`]).
 //!
 //! [`Display`] owns the display's counters (vertical blanks, repeated
 //! refreshes, the mark where refresh metrics start after warm-up, frames
 //! shown or dropped) and its transitions; the swap chain, the records and
 //! the critical path it reports presents and shows to are arguments.
 
-use crate::components::swap_chain::{Flip, PresentMode, SwapChain};
+use crate::components::swap_chain::{Flip, PresentMode, SwapChain, VrrWindow};
 use crate::engine::{Duration, Scheduler, Time};
 use crate::systems::error::SystemError;
 
@@ -34,14 +38,27 @@ pub struct Display {
     last_display: Option<Time>,
     /// Frames shown or dropped.
     resolved: u64,
+    /// The variable-refresh window and the panel's scan-outs, when `vrr`.
+    vrr: Option<Vrr>,
+}
+
+/// A variable-refresh panel's state: its window, the start of its last
+/// scan-out, and the tag of the one display event that is not stale.
+#[derive(Debug)]
+struct Vrr {
+    window: VrrWindow,
+    scan_start: Option<Time>,
+    tag: u32,
 }
 
 impl Display {
     /// A display refreshing every `refresh` that shows a flipped frame
     /// `compositor_delay` later, for a run of `frames_total` frames whose
     /// first `warmup_frames` are warm-up.
+    /// `vrr`: a variable-refresh window (then `refresh` is its shortest
+    /// period).
     pub(super) fn new(
-        (refresh, compositor_delay): (Duration, Duration),
+        (refresh, compositor_delay, vrr): (Duration, Duration, Option<VrrWindow>),
         frames_total: u64,
         warmup_frames: u64,
     ) -> Self {
@@ -55,7 +72,18 @@ impl Display {
             refresh_mark: None,
             last_display: None,
             resolved: 0,
+            vrr: vrr.map(|window| Vrr {
+                window,
+                scan_start: None,
+                tag: 0,
+            }),
         }
+    }
+
+    /// Whether the display refreshes at fixed vertical blanks from time
+    /// zero (vsync without variable refresh).
+    pub(super) fn fixed_vblanks(&self, mode: PresentMode) -> bool {
+        mode != PresentMode::Immediate && self.vrr.is_none()
     }
 
     /// The refresh period.
@@ -91,7 +119,8 @@ impl Display {
         self.resolved >= self.frames_total
     }
 
-    /// The front end presents `frame` (the GPU finished its swap).
+    /// The front end presents `frame` (the GPU finished its swap). A
+    /// variable-refresh panel that is idle starts its scan-out now.
     pub(super) fn present(
         &mut self,
         now: Time,
@@ -99,10 +128,20 @@ impl Display {
         chain: &mut SwapChain,
         records: &mut [FrameRecord],
         path: &mut CriticalPath,
-    ) {
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
         path.presented(frame);
         let flip = chain.present(frame);
         self.apply_flip(now, flip, chain.mode(), records, path);
+        if let Some(v) = &self.vrr {
+            let idle = v
+                .scan_start
+                .is_none_or(|t| now.0 >= t.0.saturating_add(v.window.shortest.0));
+            if idle {
+                self.scan_out(now, chain, records, path, s)?;
+            }
+        }
+        Ok(())
     }
 
     fn apply_flip(
@@ -138,8 +177,41 @@ impl Display {
         }
     }
 
-    /// A vertical blank.
+    /// A vertical blank (fixed refresh), or the display event of a
+    /// variable-refresh panel tagged `tag`: the end of a scan-out or the
+    /// deadline of the slowest refresh. A stale tag (the panel started a
+    /// scan-out at a present since) does nothing.
     pub(super) fn vblank(
+        &mut self,
+        now: Time,
+        tag: u32,
+        chain: &mut SwapChain,
+        records: &mut [FrameRecord],
+        path: &mut CriticalPath,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
+        let Some(v) = &mut self.vrr else {
+            return self.fixed_vblank(now, chain, records, path, s);
+        };
+        if tag != v.tag {
+            return Ok(());
+        }
+        let start = v.scan_start.expect("a variable-refresh event follows a scan-out");
+        let deadline = Time(start.0.saturating_add(v.window.longest.0));
+        if chain.queued() > 0 || now >= deadline {
+            // A frame waits for this scan-out's end, or the old image must
+            // be refreshed (scanned out again).
+            return self.scan_out(now, chain, records, path, s);
+        }
+        // The scan-out ended with nothing to show: the panel waits, up to
+        // the slowest refresh's deadline.
+        v.tag = v.tag.wrapping_add(1);
+        s.at(deadline, Ev::Vblank { tag: v.tag });
+        Ok(())
+    }
+
+    /// A fixed refresh's vertical blank; the next one is one refresh later.
+    fn fixed_vblank(
         &mut self,
         now: Time,
         chain: &mut SwapChain,
@@ -147,15 +219,51 @@ impl Display {
         path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
+        self.refresh_now(now, chain, records, path);
+        if !self.done() {
+            s.after(
+                self.refresh,
+                Ev::Vblank { tag: 0 },
+                "scheduling the next vertical blank",
+            )?;
+        }
+        Ok(())
+    }
+
+    /// A variable-refresh panel starts a scan-out now (of the oldest queued
+    /// frame, or again of the image on screen); its end is the next event.
+    fn scan_out(
+        &mut self,
+        now: Time,
+        chain: &mut SwapChain,
+        records: &mut [FrameRecord],
+        path: &mut CriticalPath,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
+        self.refresh_now(now, chain, records, path);
+        let done = self.done();
+        let v = self.vrr.as_mut().expect("a variable-refresh panel");
+        v.scan_start = Some(now);
+        v.tag = v.tag.wrapping_add(1);
+        if !done {
+            let tag = v.tag;
+            s.after(
+                v.window.shortest,
+                Ev::Vblank { tag },
+                "scheduling the end of a scan-out",
+            )?;
+        }
+        Ok(())
+    }
+
+    /// A refresh at `now`: the swap chain flips its oldest queued frame, if
+    /// any; one with nothing new repeats the image on screen.
+    fn refresh_now(&mut self, now: Time, chain: &mut SwapChain, records: &mut [FrameRecord], path: &mut CriticalPath) {
         self.vblanks += 1;
         let flip = chain.vblank();
         if flip.shown.is_none() && self.last_display.is_some() {
             self.repeated_refreshes += 1;
         }
         self.apply_flip(now, flip, chain.mode(), records, path);
-        if !self.done() {
-            s.after(self.refresh, Ev::Vblank, "scheduling the next vertical blank")?;
-        }
-        Ok(())
     }
 }

@@ -2,7 +2,7 @@
 //! §4.2): the ends of the CPU thread's operations and of the front end's
 //! commands, the geometry and fragment stages' triangles (`triangle`
 //! fidelity) or a draw's closed form (`draw` fidelity), the display's
-//! vertical blanks, and the system tasks' arrivals and ends. Each unit
+//! vertical blanks (or a variable-refresh panel's scan-outs), and the system tasks' arrivals and ends. Each unit
 //! schedules its own; [`super::model::FramePipeline`] dispatches them.
 
 use crate::components::noise::NoiseTarget;
@@ -39,8 +39,13 @@ pub enum Ev {
     DrawFragmentStart,
     /// A draw ended (`draw` fidelity).
     DrawDone,
-    /// Vertical blank.
-    Vblank,
+    /// Vertical blank; with variable refresh, the end of a scan-out or the
+    /// slowest refresh's deadline (the tag tells the one pending event from
+    /// stale ones; always 0 at a fixed refresh).
+    Vblank {
+        /// Generation tag.
+        tag: u32,
+    },
     /// A system task arrives.
     NoiseArrive {
         /// Index of the noise source.
@@ -86,7 +91,7 @@ impl EventKind for Ev {
             Ev::DrawGeometry => 4,
             Ev::DrawFragmentStart => 5,
             Ev::DrawDone => 6,
-            Ev::Vblank => 7,
+            Ev::Vblank { .. } => 7,
             Ev::NoiseArrive { .. } => 8,
             Ev::NoiseEnd { .. } => 9,
             Ev::ZeroTimeFrame => 10,

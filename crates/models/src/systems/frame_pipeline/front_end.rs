@@ -273,7 +273,7 @@ impl FrontEnd {
             self.start_job(now, c, work, down.geom.done_at(), s)?;
             return Ok(FrontPhase::Running);
         }
-        self.after(now, c, env, down)
+        self.after(now, c, env, down, s)
     }
 
     /// Starts the job of `work` for `c`; its completion is an event, or
@@ -303,9 +303,10 @@ impl FrontEnd {
         now: Time,
         env: &mut Env,
         down: &mut Downstream<'_>,
+        s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
         if let FrontPhase::Running = self.phase {
-            self.phase = self.after(now, self.cmd, env, down)?;
+            self.phase = self.after(now, self.cmd, env, down, s)?;
         }
         Ok(())
     }
@@ -316,6 +317,7 @@ impl FrontEnd {
         c: Command,
         env: &mut Env,
         down: &mut Downstream<'_>,
+        s: &mut Scheduler<Ev>,
     ) -> Result<FrontPhase, SystemError> {
         Ok(match c {
             Command::Draw { .. } => FrontPhase::Handoff,
@@ -325,7 +327,7 @@ impl FrontEnd {
                 env.records[frame as usize].gpu_end = Some(now);
                 self.frame = None;
                 down.display
-                    .present(now, frame, &mut env.links.chain, &mut env.records, down.path);
+                    .present(now, frame, &mut env.links.chain, &mut env.records, down.path, s)?;
                 FrontPhase::Idle
             }
             Command::Clear { .. } | Command::Fixed { .. } => FrontPhase::Idle,

@@ -177,7 +177,11 @@ impl FramePipeline {
             geom: GeometryStage::new(streams.stream("fragment.pixels"), pixel_rng_start),
             frag: FragmentStage::default(),
             display: Display::new(
-                (cfg.display.refresh.period, cfg.display.compositor_delay()),
+                (
+                    cfg.display.shortest_period(),
+                    cfg.display.compositor_delay(),
+                    cfg.display.vrr_window(),
+                ),
                 frames_total,
                 cfg.run.warmup_frames,
             ),
@@ -185,7 +189,7 @@ impl FramePipeline {
             noise,
             acct: Accounting::new(
                 trace,
-                (mode != PresentMode::Immediate).then_some(cfg.display.refresh.period),
+                (mode != PresentMode::Immediate).then_some(cfg.display.shortest_period()),
             ),
             env: Env {
                 links,
@@ -202,8 +206,8 @@ impl FramePipeline {
         if self.frames_total == 0 {
             return Ok(());
         }
-        if self.env.links.chain.mode() != PresentMode::Immediate {
-            s.at(Time::ZERO, Ev::Vblank);
+        if self.display.fixed_vblanks(self.env.links.chain.mode()) {
+            s.at(Time::ZERO, Ev::Vblank { tag: 0 });
         }
         for i in 0..self.noise.len() {
             let t = self.noise[i].next_arrival(Time::ZERO)?;
@@ -383,7 +387,7 @@ impl Model for FramePipeline {
             Ev::FrontDone { tag } => {
                 if self.front.complete(tag) {
                     let mut down = downstream!(self);
-                    self.front.command_done(now, &mut self.env, &mut down)?;
+                    self.front.command_done(now, &mut self.env, &mut down, s)?;
                 }
             }
             Ev::GeomTriangle { tag } => {
@@ -406,10 +410,10 @@ impl Model for FramePipeline {
                     return Ok(if self.done() { Control::Stop } else { Control::Continue });
                 }
             }
-            Ev::Vblank => {
+            Ev::Vblank { tag } => {
                 let path = &mut self.acct.path;
                 self.display
-                    .vblank(now, &mut self.env.links.chain, &mut self.env.records, path, s)?;
+                    .vblank(now, tag, &mut self.env.links.chain, &mut self.env.records, path, s)?;
             }
             Ev::NoiseArrive { source } => self.noise_arrive(now, source, s)?,
             Ev::NoiseEnd { target } => self.noise_end(now, target, s)?,

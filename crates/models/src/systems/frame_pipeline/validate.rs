@@ -378,11 +378,16 @@ pub(super) fn check_time_range(cfg: &FramePipelineConfig, a: &AnalyticTerms) -> 
         ("fragment work", gpu_key, term(a.fragment_ms)),
     ];
     // A vsynced FIFO swap chain shows every frame for at least one refresh.
+    // (A variable-refresh panel's fastest refresh.)
     if cfg.display.effective_mode() == PresentMode::Fifo {
         terms.push((
             "display refresh",
-            "display.refresh",
-            cfg.display.refresh.period.0 as f64,
+            if cfg.display.vrr.is_some() {
+                "display.vrr.max_refresh"
+            } else {
+                "display.refresh"
+            },
+            cfg.display.shortest_period().0 as f64,
         ));
     }
     let (what, source, per_frame) = terms.into_iter().max_by(|a, b| a.2.total_cmp(&b.2)).expect("terms");
@@ -407,7 +412,8 @@ pub(super) fn check_time_range(cfg: &FramePipelineConfig, a: &AnalyticTerms) -> 
 /// the frames take (each at least its slowest unit's expected work, the
 /// CPU's and the front end's divided by the share the system tasks leave
 /// them, and a refresh with a vsynced FIFO swap chain), one event per
-/// display refresh (none in immediate mode) and one per system task; at
+/// display refresh (none in immediate mode; with variable refresh, one per
+/// slowest period) and one per system task; at
 /// `triangle` fidelity one per triangle drawn (`triangles`: the scene's
 /// per frame). (Over a few frames the tasks' phase can make the span a
 /// task period shorter than its long-run bound.)
@@ -421,7 +427,7 @@ pub fn estimate_events(
     let free = |l: &NoiseLoad| (1.0 - l.share).max(crate::limits::MIN_FREE_SHARE);
     let ps = |ms: f64| ms * PS_PER_MS as f64;
     let mode = cfg.display.effective_mode();
-    let refresh = cfg.display.refresh.period.0 as f64;
+    let refresh = cfg.display.shortest_period().0 as f64;
     let mut per_frame = [
         ps(a.cpu_ms) / free(&cpu),
         ps(a.gpu_front_end_ms) / free(&gpu),
@@ -436,7 +442,14 @@ pub fn estimate_events(
     }
     let span = frames * per_frame;
     let mut parts: Vec<crate::limits::EventPart> = vec![("run.frames".into(), "frames".into(), frames)];
-    if mode != PresentMode::Immediate {
+    if let Some(w) = cfg.display.vrr_window().filter(|_| mode != PresentMode::Immediate) {
+        // A variable-refresh panel refreshes at least once per slowest period.
+        parts.push((
+            "display.vrr.min_refresh|run.frames".into(),
+            "display refreshes".into(),
+            span / w.longest.0 as f64,
+        ));
+    } else if mode != PresentMode::Immediate {
         parts.push((
             "display.refresh|run.frames".into(),
             "display refreshes".into(),

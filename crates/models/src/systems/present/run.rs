@@ -90,12 +90,13 @@ pub fn validate(cfg: &PresentConfig) -> Result<(), SystemError> {
         .validate()
         .map_err(|e| invalid("render.time", e.to_string()))?;
     cfg.display.check().map_err(|(key, message)| invalid(key, message))?;
-    if !cfg.display.composition.is_independent() {
+    if let Some((key, what)) = cfg.display.beyond_fixed_refresh() {
         return Err(invalid(
-            "display.composition",
-            "the present system models a hardware flip only; a composed display is modelled by \
-             the frame pipeline (`system = \"frame_pipeline\"`)"
-                .to_string(),
+            key,
+            format!(
+                "the present system models a hardware flip at a fixed refresh only; {what} is modelled by \
+                 the frame pipeline (`system = \"frame_pipeline\"`)"
+            ),
         ));
     }
     if cfg.run.warmup_frames > cfg.run.frames {

@@ -25,6 +25,16 @@ pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
             ));
         }
     }
+    cfg.display.check().map_err(|(key, message)| invalid(key, message))?;
+    if let Some((key, what)) = cfg.display.beyond_fixed_refresh() {
+        return Err(invalid(
+            key,
+            format!(
+                "the walkthrough's frame budget is one fixed refresh; {what} is modelled by the frame \
+                 pipeline (`system = \"frame_pipeline\"`)"
+            ),
+        ));
+    }
     if cfg.run.frames > MAX_FRAMES {
         return Err(invalid(
             "run.frames",
