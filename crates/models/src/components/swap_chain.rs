@@ -181,16 +181,8 @@ impl DisplayConfig {
     /// rate is below its fastest, with vsync and a hardware flip; the error
     /// is (key, message).
     pub fn check(&self) -> Result<(), (&'static str, String)> {
-        let short = |key: &'static str, period: crate::engine::Duration| {
-            Err((
-                key,
-                format!(
-                    "a refresh period of {period} is shorter than the limit of 1us (1 MHz): every refresh is an event"
-                ),
-            ))
-        };
         if self.refresh.period.0 < crate::limits::MIN_REFRESH_PERIOD_PS {
-            return short("display.refresh", self.refresh.period);
+            return Err(too_short("display.refresh", self.refresh.period));
         }
         if let Some(v) = &self.vrr {
             self.check_vrr(v)?;
@@ -213,18 +205,20 @@ impl DisplayConfig {
     }
 }
 
+/// The error of a refresh period below [`crate::limits::MIN_REFRESH_PERIOD_PS`].
+fn too_short(key: &'static str, period: crate::engine::Duration) -> (&'static str, String) {
+    (
+        key,
+        format!("a refresh period of {period} is shorter than the limit of 1us (1 MHz): every refresh is an event"),
+    )
+}
+
 impl DisplayConfig {
     fn check_vrr(&self, v: &VrrConfig) -> Result<(), (&'static str, String)> {
         if let Some(max) = &v.max_refresh
             && max.period.0 < crate::limits::MIN_REFRESH_PERIOD_PS
         {
-            return Err((
-                "display.vrr.max_refresh",
-                format!(
-                    "a refresh period of {} is shorter than the limit of 1us (1 MHz): every refresh is an event",
-                    max.period
-                ),
-            ));
+            return Err(too_short("display.vrr.max_refresh", max.period));
         }
         let w = self.vrr_window().expect("vrr is set");
         if w.longest.0 <= w.shortest.0 {
