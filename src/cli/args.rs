@@ -680,10 +680,17 @@ pub struct ReplayArgs {
     /// Patch the replay's model (a what-if): --set cpu.max_frames_ahead=1 (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub sets: Vec<String>,
+    /// What the capture does not say, patched on the replay as captured
+    /// before any what-if: --assume display.buffers=2, cpu.max_frames_ahead,
+    /// display.refresh (repeatable).
+    #[arg(long = "assume", value_name = "KEY=VALUE")]
+    pub assume: Vec<String>,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
-    /// Write replay.json, frames.csv and model.toml into DIR.
+    /// Write replay.json, frames.csv (the replay as PresentMon frames),
+    /// comparison.csv (measured against predicted), model.toml and, with a
+    /// what-if, whatif-frames.csv and whatif-model.toml into DIR.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
 }

@@ -553,7 +553,14 @@ pub fn perceived_speed(args: super::args::PerceivedSpeedArgs) -> Result<()> {
 }
 
 /// The files `replay --out` writes.
-const REPLAY_FILES: [&str; 4] = ["replay.json", "frames.csv", "model.toml", "whatif-model.toml"];
+const REPLAY_FILES: [&str; 6] = [
+    "replay.json",
+    "frames.csv",
+    "comparison.csv",
+    "model.toml",
+    "whatif-frames.csv",
+    "whatif-model.toml",
+];
 
 /// The JSON document `replay` writes: its summary under `replay`.
 #[derive(serde::Serialize)]
@@ -572,17 +579,28 @@ pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
         app: args.app.clone(),
         swap_chain: args.swapchain.clone(),
         sets: args.sets.clone(),
+        assume: args.assume.clone(),
     };
     let r = replay(&args.capture, &opts)?;
     let json = serde_json::to_string_pretty(&ReplayJson { replay: &r.summary })?;
     if let Some(set) = set {
         let dir = set.dir();
         std::fs::write(dir.join("replay.json"), &json).context("writing replay.json")?;
-        let mut frames = std::io::BufWriter::new(std::fs::File::create(dir.join("frames.csv"))?);
-        rendersim::output::table::write_number_table(&mut frames, &r.columns(), &r.rows())
-            .context("writing frames.csv")?;
-        frames.flush().context("writing frames.csv")?;
-        drop(frames);
+        let write = |name: &str, body: &dyn Fn(&mut dyn Write) -> std::io::Result<()>| -> Result<()> {
+            let mut f = std::io::BufWriter::new(
+                std::fs::File::create(dir.join(name)).with_context(|| format!("writing {name}"))?,
+            );
+            body(&mut f)
+                .and_then(|()| f.flush())
+                .with_context(|| format!("writing {name}"))
+        };
+        write("frames.csv", &|w| r.replayed.write_csv(w))?;
+        if let Some(wf) = &r.whatif_replayed {
+            write("whatif-frames.csv", &|w| wf.write_csv(w))?;
+        }
+        write("comparison.csv", &|w| {
+            rendersim::output::table::write_number_table(w, &r.columns(), &r.rows())
+        })?;
         let models = [
             ("model.toml", Some(&r.model)),
             ("whatif-model.toml", r.whatif_model.as_ref()),

@@ -2,7 +2,6 @@
 
 use crate::common;
 use common::{DEFAULT, run};
-use rendersim::systems::frame_pipeline::records::write_frames_csv;
 
 fn outputs(seed: u64) -> (String, String) {
     let r = run(
@@ -10,7 +9,7 @@ fn outputs(seed: u64) -> (String, String) {
         &[&format!("run.seed={seed}"), "run.frames=12", "run.warmup_frames=2"],
     );
     let mut csv = vec![];
-    write_frames_csv(&r.records, &mut csv).unwrap();
+    r.write_frames_csv(&mut csv).unwrap();
     let mut s = r.summary.clone();
     // Wall time is the one field that may differ.
     for k in ["wall_seconds", "events_per_second", "build_seconds", "simulate_seconds"] {

@@ -33,6 +33,7 @@ mod pixelflow;
 mod present;
 mod readback;
 mod replay;
+mod replay_round_trip;
 mod shards;
 mod sortbuf;
 mod state_sorting;

@@ -5,7 +5,6 @@
 
 use crate::common;
 use common::{DEFAULT, FIXED, metric, run, scene_model};
-use rendersim::systems::frame_pipeline::records::write_frames_csv;
 
 /// 20,000 triangles, 1 ns of geometry each; 1% of them cover 100 px (100 ns
 /// of fragments), the rest 0.001 px. G = 20 us, F = 20.02 us.
@@ -141,7 +140,7 @@ triangle_pixels = 50.0"#,
 
 fn csv(r: &rendersim::systems::frame_pipeline::PipelineRun) -> String {
     let mut v = vec![];
-    write_frames_csv(&r.records, &mut v).unwrap();
+    r.write_frames_csv(&mut v).unwrap();
     String::from_utf8(v).unwrap()
 }
 

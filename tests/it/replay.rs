@@ -284,10 +284,10 @@ fn cli_prints_json_writes_its_folder_and_names_what_is_wrong() {
     }
     assert!(v["replay"]["agreement"]["displayed"].as_f64().unwrap() >= 0.95);
     assert!(v["replay"]["error_ms"]["until_displayed"]["median"].is_number());
-    for f in ["replay.json", "frames.csv", "model.toml"] {
+    for f in ["replay.json", "frames.csv", "comparison.csv", "model.toml"] {
         assert!(out.join(f).is_file(), "{f}");
     }
-    assert!(!out.join("whatif-model.toml").exists());
+    assert!(!out.join("whatif-model.toml").exists() && !out.join("whatif-frames.csv").exists());
     // A what-if adds its model and its columns; the text shows three columns.
     let o = bin()
         .args([
@@ -311,13 +311,19 @@ fn cli_prints_json_writes_its_folder_and_names_what_is_wrong() {
             .unwrap()
             .contains("buffers = 2")
     );
-    let header = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    let header = std::fs::read_to_string(out.join("comparison.csv")).unwrap();
     assert!(
         header.lines().next().unwrap().ends_with("WhatIfMsBetweenDisplayChange"),
         "{header}"
     );
-    let frames = std::fs::read_to_string(out.join("frames.csv")).unwrap();
-    assert_eq!(frames.lines().count(), 26, "a header and 25 frames");
+    // The replayed runs as PresentMon frames, on the capture's swap chain.
+    for f in ["frames.csv", "whatif-frames.csv"] {
+        let frames = std::fs::read_to_string(out.join(f)).unwrap();
+        assert_eq!(frames.lines().count(), 26, "{f}: a header and 25 frames");
+        let first = frames.lines().nth(1).unwrap();
+        assert!(first.starts_with("dwm.exe,1564,0x2408E0B7CA0,"), "{f}: {first}");
+        assert!(frames.lines().next().unwrap().contains(",CPUStartTime,"), "{f}");
+    }
 
     let err = |args: &[&str]| {
         let o = bin().args(args).output().unwrap();
@@ -366,4 +372,85 @@ fn cli_prints_json_writes_its_folder_and_names_what_is_wrong() {
     assert!(e.contains("bad.csv: not a PresentMon capture"), "{e}");
     let e = err(&["replay", dir.path().join("none.csv").to_str().unwrap()]);
     assert!(e.contains("cannot read capture"), "{e}");
+}
+
+#[test]
+fn assumptions_patch_the_replay_as_captured_and_their_errors_name_the_option() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    let c = capture(0);
+    let c = c.to_str().unwrap();
+    let o = bin()
+        .args(["replay", c, "--assume", "display.buffers=2", "--json", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["replay"]["assume"], serde_json::json!(["display.buffers=2"]));
+    assert_eq!(v["replay"]["refresh_from"], "fitted");
+    // The as-captured model is the one with the assumption, not a what-if.
+    let model = std::fs::read_to_string(out.join("model.toml")).unwrap();
+    assert!(model.contains("buffers = 2"), "{model}");
+    assert!(!out.join("whatif-model.toml").exists());
+
+    // An assumed refresh replaces the fit (the phase is still fitted).
+    let r = replay(
+        &capture(0),
+        &ReplayOptions {
+            assume: vec!["display.refresh=\"59.95Hz\"".into()],
+            ..ReplayOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(
+        serde_json::to_value(r.summary.refresh_from).unwrap(),
+        serde_json::json!("assumed")
+    );
+    assert!((r.summary.refresh_hz - 59.95).abs() < 1e-6, "{}", r.summary.refresh_hz);
+
+    let err = |args: &[&str]| {
+        let o = bin().args(args).output().unwrap();
+        let e = String::from_utf8_lossy(&o.stderr).to_string();
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+        assert!(!e.contains("panicked"), "{e}");
+        e
+    };
+    let e = err(&["replay", c, "--assume", "display.bufers=2"]);
+    assert!(
+        e.contains("`--assume display.bufers=2`") && e.contains("did you mean `buffers`"),
+        "{e}"
+    );
+    let e = err(&["replay", c, "--assume", "display.buffers=40"]);
+    assert!(
+        e.contains("`--assume display.buffers=40`") && e.contains("between 2 and 16"),
+        "{e}"
+    );
+    let e = err(&["replay", c, "--assume", "display.buffers"]);
+    assert!(e.contains("--assume \"display.buffers\": expected key=value"), "{e}");
+}
+
+#[test]
+fn a_tearing_capture_keeps_the_base_refresh_and_starts_at_its_first_cpu_start() {
+    // Tearing (`immediate`): screen times follow the GPU, so no refresh is
+    // fitted; the run starts at the first CPU start.
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(capture(0))
+        .unwrap()
+        .replace(",1,0,0,Hardware: Legacy Flip,", ",0,0,1,Hardware: Legacy Flip,");
+    let path = dir.path().join("tearing.csv");
+    std::fs::write(&path, text).unwrap();
+    let r = replay(&path, &ReplayOptions::default()).unwrap();
+    assert_eq!(r.summary.model_present_mode, "immediate");
+    assert_eq!(
+        serde_json::to_value(r.summary.refresh_from).unwrap(),
+        serde_json::json!("default")
+    );
+    assert!((r.summary.refresh_hz - 60.0).abs() < 1e-6, "{}", r.summary.refresh_hz);
+    let first = &r.frames[0];
+    assert!(
+        (first.cpu_start.0 - first.cpu_start.1).abs() < 1e-6,
+        "{:?}",
+        first.cpu_start
+    );
 }

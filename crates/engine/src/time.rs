@@ -93,6 +93,11 @@ impl Duration {
     /// The empty span.
     pub const ZERO: Duration = Duration(0);
 
+    /// Whether the span is empty.
+    pub const fn is_zero(&self) -> bool {
+        self.0 == 0
+    }
+
     /// From whole picoseconds.
     pub const fn ps(v: u64) -> Self {
         Duration(v)

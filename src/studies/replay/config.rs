@@ -7,6 +7,9 @@
 //! app = "dwm.exe"               # optional: the process (its swap chain with most frames)
 //! swapchain = "0x1B1B8F32850"   # optional: the swap chain's address
 //!
+//! [assume]                      # optional: what the capture does not say (patches on
+//! display.buffers = 2           # the as-captured model, before the what-if)
+//!
 //! [whatif]                      # patches on models/replay.toml (none: as captured)
 //! cpu.max_frames_ahead = 1
 //! display.present_mode = "mailbox"
@@ -33,6 +36,11 @@ pub struct ReplayConfig {
     /// The swap chain's address.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub swapchain: Option<String>,
+    /// What the capture does not say (swap-chain images, frames in flight,
+    /// the refresh): keys of the replay's frame-pipeline model patched on
+    /// the replay as captured, nested as in a model file.
+    #[serde(default, skip_serializing_if = "toml::Table::is_empty")]
+    pub assume: toml::Table,
     /// The what-if: keys of the replay's frame-pipeline model
     /// (models/replay.toml) and their values, nested as in a model file.
     #[serde(default)]
@@ -52,8 +60,8 @@ pub struct RunConfig {
     pub seed: u64,
 }
 
-/// The what-if table as `key=value` assignments (dotted keys, TOML
-/// values), in key order.
+/// A what-if or assumption table as `key=value` assignments (dotted keys,
+/// TOML values), in key order.
 pub fn whatif_sets(table: &toml::Table) -> Vec<String> {
     let mut pairs = Vec::new();
     crate::config::flatten("", table, &mut pairs);

@@ -5,16 +5,26 @@
 //!
 //! How a captured frame becomes the model's (`kind = "frames"`, see
 //! [`FramesWorkload`]): the CPU works `MsCPUBusy`; the GPU work
-//! (`MsGPUBusy`, one command) is submitted after `MsGPULatency` of it (the
-//! GPU cannot start earlier than it did; without that column, at the
-//! present); the CPU then presents and spends `MsCPUWait` in the present
-//! call. Blocking the model adds (frames in flight, swap-chain images)
-//! comes on top, so a what-if that frees the pipeline cannot make the CPU
-//! faster than it was measured. The refresh period is fitted to the
-//! displayed frames' screen times (least squares over their refresh
+//! (`MsGPUBusy`, one command after the frame's clear) is submitted after
+//! `MsGPULatency` of it (the GPU cannot start earlier than it did; without
+//! that column, at the present), and the GPU does not finish the frame
+//! before `MsGPULatency + MsGPUTime` after its CPU start (it waited for
+//! the CPU's later submissions); the CPU then presents, and the next frame
+//! begins `MsCPUWait` later (the present call) or when the model lets it
+//! (frames in flight), whichever is later: the two waits overlap as they
+//! do in a real present call. So a what-if that frees the pipeline cannot
+//! make the CPU faster than it was measured, and one that holds it longer
+//! does not count the captured wait twice. The refresh period is fitted to
+//! the displayed frames' screen times (least squares over their refresh
 //! counts), and the simulation starts at a vertical blank of that grid, at
 //! or before the first frame's CPU start, so the model's vertical blanks
-//! fall where the capture's did.
+//! fall where the capture's did. With tearing (`immediate`) the screen
+//! times lie off any grid: the refresh is then models/replay.toml's 60 Hz
+//! and the simulation starts at the first CPU start. What a capture does
+//! not record (swap-chain images, frames in flight, the refresh, variable
+//! refresh) can be given as assumptions (`--assume`), which patch the
+//! as-captured model before any what-if. rendersim's own `frames.csv`
+//! replays exactly (`tests/it/replay_round_trip.rs`).
 //!
 //! Present modes: the hardware flips (`Hardware: Legacy Flip`,
 //! `Hardware: Independent Flip`, ...) are `fifo` at a sync interval of 1 or
@@ -37,10 +47,11 @@ use self::display_stats::{DisplayStats, FrameTimes};
 use crate::capture::presentmon::{Capture, CaptureError, Columns, Present};
 use crate::components::swap_chain::Composition;
 use crate::config::patch::set_dotted;
-use crate::config::{ModelSource, Overrides, deserialize};
+use crate::config::{ModelSource, Overrides, apply_patches, deserialize, invalid};
 use crate::stats::quantile::quantile;
 use crate::systems::error::SystemError;
 use crate::systems::frame_pipeline::config::FramesWorkload;
+use crate::systems::frame_pipeline::records::{ChainInfo, FrameRecord, write_frames_csv};
 use crate::systems::frame_pipeline::{FramePipelineConfig, run_pipeline};
 
 /// The replay's base model (the frame pipeline with no costs of its own).
@@ -55,6 +66,9 @@ pub enum ReplayError {
     /// The model (base plus `--set`) is wrong.
     #[error(transparent)]
     Config(#[from] crate::config::ConfigError),
+    /// An assumption (`--assume`) is wrong.
+    #[error("{0}")]
+    Assume(crate::config::ConfigError),
     /// The simulation failed.
     #[error(transparent)]
     System(#[from] SystemError),
@@ -70,6 +84,10 @@ pub struct ReplayOptions {
     /// The what-if: `--set` patches on the replay's model. The capture is
     /// replayed as captured and, when there are patches, again with them.
     pub sets: Vec<String>,
+    /// What the capture does not say: `--assume` patches on the
+    /// as-captured model (swap-chain images, frames in flight, the refresh),
+    /// applied before any what-if's.
+    pub assume: Vec<String>,
 }
 
 /// |predicted - measured| over the frames where both exist, in ms.
@@ -141,8 +159,14 @@ pub struct ReplaySummary {
     /// (left out of the JSON for a hardware flip).
     #[serde(skip_serializing_if = "Composition::is_independent")]
     pub model_composition: Composition,
-    /// Fitted refresh rate.
+    /// The refresh rate of the replay as captured.
     pub refresh_hz: f64,
+    /// Where it comes from: `fitted` to the displayed frames, `assumed`
+    /// (`--assume display.refresh=...`), or the base model's `default` (a
+    /// tearing capture, whose screen times lie off any refresh grid).
+    pub refresh_from: RefreshFrom,
+    /// The assumptions (`--assume` patches) the replay as captured made.
+    pub assume: Vec<String>,
     /// Frames displayed in the capture.
     pub measured_displayed: usize,
     /// Frames displayed in the replay.
@@ -216,6 +240,37 @@ impl ReplayFrame {
     }
 }
 
+/// Where the replay's refresh rate comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RefreshFrom {
+    /// Fitted to the displayed frames' screen times.
+    Fitted,
+    /// Given with `--assume display.refresh=...`.
+    Assumed,
+    /// The base model's (a tearing capture).
+    Default,
+}
+
+/// A replayed run's frames as PresentMon writes them: the records, the
+/// capture's swap chain, and the capture's time of the run's time zero.
+#[derive(Debug, Clone)]
+pub struct ReplayedFrames {
+    /// The run's records.
+    pub records: Vec<FrameRecord>,
+    /// The capture's swap chain.
+    pub chain: ChainInfo,
+    /// The capture's clock at the run's time zero, ps.
+    pub origin_ps: i64,
+}
+
+impl ReplayedFrames {
+    /// Writes them as `frames.csv` (PresentMon 2 columns, the capture's clock).
+    pub fn write_csv(&self, w: impl std::io::Write) -> std::io::Result<()> {
+        write_frames_csv(&self.records, &self.chain, self.origin_ps, w)
+    }
+}
+
 /// A whole replay.
 #[derive(Debug, Clone)]
 pub struct Replay {
@@ -229,6 +284,10 @@ pub struct Replay {
     pub whatif_frames: Option<Vec<ReplayFrame>>,
     /// The what-if's model, without its workload lists.
     pub whatif_model: Option<FramePipelineConfig>,
+    /// The replay as captured, as PresentMon frames.
+    pub replayed: ReplayedFrames,
+    /// The what-if's run, as PresentMon frames (with `--set` patches only).
+    pub whatif_replayed: Option<ReplayedFrames>,
 }
 
 /// The refresh period (ms) and a screen time on its grid, fitted to the
@@ -257,7 +316,17 @@ pub fn fit_refresh(screen: &[f64]) -> Option<(f64, f64)> {
     (period.is_finite() && period > 0.0).then_some((period, phase))
 }
 
-/// The model's present mode for a capture's, with its vsync.
+/// The screen time on a refresh grid of `period` (ms) nearest, in least
+/// squares, to the displayed frames' screen times.
+pub fn fit_phase(screen: &[f64], period: f64) -> f64 {
+    let k = screen.len() as f64;
+    screen
+        .iter()
+        .map(|s| s - ((s - screen[0]) / period).round() * period)
+        .sum::<f64>()
+        / k
+}
+
 /// The model's present mode, vsync and composition for a captured present.
 /// A hardware flip (`Hardware: Legacy Flip`, `Hardware: Independent Flip`,
 /// `Hardware Composed: Independent Flip`) is an independent flip; a
@@ -290,12 +359,19 @@ fn model_mode(p: &Present, file: &str) -> Result<(&'static str, bool, bool), Cap
     })
 }
 
+/// Milliseconds as whole picoseconds (the capture's decimals, exactly where
+/// it has no more than nine).
+fn to_ps(ms: f64) -> i64 {
+    (ms * 1e9).round() as i64
+}
+
 fn ps(ms: f64) -> toml::Value {
-    toml::Value::String(format!("{}ps", (ms.max(0.0) * 1e9).round() as u64))
+    toml::Value::String(format!("{}ps", to_ps(ms.max(0.0))))
 }
 
 /// The capture's swap chain made ready to simulate: the base model with the
-/// captured frames, refresh and present mode, before any what-if.
+/// captured frames, refresh and present mode and the assumptions, before
+/// any what-if.
 struct Setup<'a> {
     rows: Vec<&'a Present>,
     /// The present mode most frames use, and the model's for it.
@@ -303,12 +379,29 @@ struct Setup<'a> {
     mode: &'static str,
     /// Whether the compositor shows its frames (a `Composed: ...` mode).
     composed: bool,
-    /// Fitted refresh period, ms.
+    /// The refresh period of the replay as captured, ms, and where it comes from.
     period: f64,
-    /// The capture's time of the model's time zero, ms.
-    origin: f64,
+    refresh_from: RefreshFrom,
+    /// The capture's time of the model's time zero, ps.
+    origin_ps: i64,
+    /// The capture's swap chain, for the replayed frames.
+    chain: ChainInfo,
     src: ModelSource,
     table: toml::Table,
+}
+
+impl Setup<'_> {
+    /// The capture's time of the model's time zero, ms.
+    fn origin(&self) -> f64 {
+        self.origin_ps as f64 / 1e9
+    }
+}
+
+/// Whether the assumptions (`--assume K=V` patches) set `key`.
+fn assumes(assume: &[String], key: &str) -> bool {
+    assume
+        .iter()
+        .any(|a| a.split_once('=').is_some_and(|(k, _)| k.trim() == key))
 }
 
 fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Setup<'a>, ReplayError> {
@@ -322,35 +415,60 @@ fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Setup<'a>, Re
         .copied()
         .unwrap_or(rows[0]);
     let (mode, vsync, composed) = model_mode(common, file)?;
-    let screen: Vec<f64> = rows.iter().filter_map(|p| p.screen_time()).collect();
-    let (period, phase) = fit_refresh(&screen).ok_or_else(|| CaptureError::Row {
-        file: file.to_string(),
-        line: rows[0].line,
-        message: "the refresh period cannot be inferred: no two displayed frames are more than 1 ms apart".into(),
-    })?;
-    // The run starts at a vertical blank at or before the first CPU start.
-    let c0 = rows[0].cpu_start;
-    let origin = phase - ((phase - c0) / period).ceil() * period;
-    let lead = c0 - origin;
 
-    let src = ModelSource::from_text("the replay model (models/replay.toml)", REPLAY_MODEL);
+    // The base model with the assumptions (they may give the refresh).
+    let mut src = ModelSource::from_text("the replay model (models/replay.toml)", REPLAY_MODEL);
     let mut table = src.table()?;
+    apply_patches("--assume", &opts.assume, &mut src, &mut table).map_err(ReplayError::Assume)?;
+    let model_period = deserialize::<FramePipelineConfig>(&table, &src)
+        .map_err(ReplayError::Assume)?
+        .display
+        .refresh
+        .period
+        .as_ms_f64();
+    let given_period = assumes(&opts.assume, "display.refresh").then_some(model_period);
+
+    let screen: Vec<f64> = rows.iter().filter_map(|p| p.screen_time()).collect();
+    let (period, phase, refresh_from) = match (mode, given_period) {
+        // Tearing: screen times follow the GPU, not a refresh grid.
+        ("immediate", Some(p)) => (p, None, RefreshFrom::Assumed),
+        ("immediate", None) => (model_period, None, RefreshFrom::Default),
+        (_, Some(p)) => (p, Some(fit_phase(&screen, p)), RefreshFrom::Assumed),
+        (_, None) => {
+            let (p, ph) = fit_refresh(&screen).ok_or_else(|| CaptureError::Row {
+                file: file.to_string(),
+                line: rows[0].line,
+                message: "the refresh period cannot be inferred: no two displayed frames are more than 1 ms \
+                          apart (give it: --assume display.refresh=...)"
+                    .into(),
+            })?;
+            (p, Some(ph), RefreshFrom::Fitted)
+        }
+    };
+    // The run starts at a vertical blank at or before the first CPU start
+    // (in whole picoseconds, so a capture written by rendersim lands
+    // exactly on its own grid); with tearing, at the first CPU start.
+    let period_ps = to_ps(period).max(1);
+    let c0_ps = to_ps(rows[0].cpu_start);
+    let origin_ps = match phase {
+        Some(phase) => {
+            let phase_ps = to_ps(phase);
+            phase_ps + (c0_ps - phase_ps).div_euclid(period_ps) * period_ps
+        }
+        None => c0_ps,
+    };
+    let lead_ps = toml::Value::String(format!("{}ps", c0_ps - origin_ps));
+
     let list = |f: &dyn Fn(usize, &Present) -> f64| {
         toml::Value::Array(rows.iter().enumerate().map(|(i, p)| ps(f(i, p))).collect())
     };
-    let first = |i: usize| if i == 0 { lead } else { 0.0 };
-    let sets: [(&str, toml::Value); 8] = [
+    let mut sets: Vec<(&str, toml::Value)> = vec![
         ("run.frames", toml::Value::Integer(rows.len() as i64)),
-        (
-            "display.refresh",
-            toml::Value::String(format!("{}ps", (period * 1e9).round() as u64)),
-        ),
-        ("display.present_mode", toml::Value::String(mode.into())),
-        ("display.vsync", toml::Value::Boolean(vsync)),
-        ("workload.cpu", list(&|i, p| p.cpu_busy + first(i))),
+        ("workload.start", lead_ps),
+        ("workload.cpu", list(&|_, p| p.cpu_busy)),
         (
             "workload.submit",
-            list(&|i, p| p.gpu_latency.unwrap_or(p.cpu_busy).clamp(0.0, p.cpu_busy) + first(i)),
+            list(&|_, p| p.gpu_latency.unwrap_or(p.cpu_busy).clamp(0.0, p.cpu_busy)),
         ),
         (
             "workload.gpu",
@@ -358,20 +476,56 @@ fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Setup<'a>, Re
         ),
         ("workload.present", list(&|_, p| p.cpu_wait)),
     ];
-    let composition = composed.then(|| ("display.composition", toml::Value::String("composed".into())));
-    for (key, value) in sets.into_iter().chain(composition) {
+    if rows.iter().any(|p| p.gpu_latency.is_some() && p.gpu_time.is_some()) {
+        // The frame's GPU end after its CPU start, where the capture has it
+        // (0: no floor).
+        sets.push((
+            "workload.gpu_end",
+            list(&|_, p| match (p.gpu_latency, p.gpu_time) {
+                (Some(l), Some(t)) => l.max(0.0) + t,
+                _ => 0.0,
+            }),
+        ));
+    }
+    // What the capture says of its display, unless assumed otherwise.
+    let display: [(&str, toml::Value); 4] = [
+        ("display.refresh", toml::Value::String(format!("{period_ps}ps"))),
+        ("display.present_mode", toml::Value::String(mode.into())),
+        ("display.vsync", toml::Value::Boolean(vsync)),
+        (
+            "display.composition",
+            toml::Value::String(if composed { "composed" } else { "independent" }.into()),
+        ),
+    ];
+    for (key, value) in display {
+        if !assumes(&opts.assume, key) {
+            sets.push((key, value));
+        }
+    }
+    for (key, value) in sets {
         set_dotted(&mut table, key, value).map_err(|e| CaptureError::Format {
             file: file.to_string(),
             message: format!("building the replay model: {}", e.reason),
         })?;
     }
+    let chain = ChainInfo {
+        application: common.application.clone(),
+        process_id: common.process_id.clone(),
+        swap_chain: common.swap_chain.clone(),
+        runtime: "Other".into(),
+        sync_interval: common.sync_interval.unwrap_or(1),
+        allows_tearing: common.allows_tearing,
+        present_mode: common.present_mode.clone(),
+    };
     Ok(Setup {
         rows,
         common,
         mode,
         composed,
         period,
-        origin,
+        refresh_from,
+        origin_ps,
+        chain,
         src,
         table,
     })
@@ -383,6 +537,8 @@ struct Simulated {
     frames: Vec<ReplayFrame>,
     /// The model as run (its per-frame work left out).
     model: FramePipelineConfig,
+    /// The run's records.
+    records: Vec<FrameRecord>,
     /// The simulation's wall time, s.
     seconds: f64,
     /// The refreshes that repeated an image, as the display counted them.
@@ -409,9 +565,14 @@ fn simulate(s: &Setup, sets: &[String]) -> Result<Simulated, ReplayError> {
     Overrides::with_sets(sets).apply(&mut src, &mut table)?;
     let cfg: FramePipelineConfig = deserialize(&table, &src)?;
     let sim = std::time::Instant::now();
-    let run = run_pipeline(cfg, &src.base_dir, None)?;
+    // A value the model cannot use is blamed on the option that gave it.
+    let run = run_pipeline(cfg, &src.base_dir, None).map_err(|e| match e {
+        SystemError::Invalid { key, message } => ReplayError::Config(invalid(&src, &key, message, None)),
+        e => ReplayError::System(e),
+    })?;
     let seconds = sim.elapsed().as_secs_f64();
-    let at = |t: crate::engine::Time| s.origin + t.as_ms_f64();
+    let origin = s.origin();
+    let at = |t: crate::engine::Time| origin + t.as_ms_f64();
     let mut frames = Vec::with_capacity(s.rows.len());
     let mut last_shown: Option<f64> = None;
     for (p, r) in s.rows.iter().zip(&run.records) {
@@ -426,7 +587,7 @@ fn simulate(s: &Setup, sets: &[String]) -> Result<Simulated, ReplayError> {
         }
         frames.push(ReplayFrame {
             line: p.line,
-            cpu_start: (p.cpu_start, at(r.start)),
+            cpu_start: (p.cpu_start, at(r.begun)),
             present: p.present,
             predicted_present,
             displayed: p.displayed(),
@@ -443,12 +604,15 @@ fn simulate(s: &Setup, sets: &[String]) -> Result<Simulated, ReplayError> {
             submit: vec![],
             gpu: vec![],
             present: vec![],
+            gpu_end: vec![],
+            start: w.start,
         };
     }
     let repeated_refreshes = run.summary["metrics"]["repeated_refreshes"].as_u64().unwrap_or(0);
     Ok(Simulated {
         frames,
         model,
+        records: run.records,
         seconds,
         repeated_refreshes,
     })
@@ -496,6 +660,8 @@ pub fn replay_capture(
             Composition::Independent
         },
         refresh_hz: 1000.0 / s.period,
+        refresh_from: s.refresh_from,
+        assume: opts.assume.clone(),
         measured_displayed: frames.iter().filter(|f| f.displayed).count(),
         predicted_displayed: frames.iter().filter(|f| f.predicted_displayed).count(),
         agreement: Agreement {
@@ -516,13 +682,23 @@ pub fn replay_capture(
         simulate_seconds,
         wall_seconds: wall.elapsed().as_secs_f64(),
     };
-    let (whatif_frames, whatif_model) = whatif.map_or((None, None), |w| (Some(w.frames), Some(w.model)));
+    let replayed = |records: Vec<FrameRecord>| ReplayedFrames {
+        records,
+        chain: s.chain.clone(),
+        origin_ps: s.origin_ps,
+    };
+    let (whatif_frames, whatif_model, whatif_replayed) = match whatif {
+        Some(w) => (Some(w.frames), Some(w.model), Some(replayed(w.records))),
+        None => (None, None, None),
+    };
     Ok(Replay {
         summary,
         frames: captured.frames,
         model: captured.model,
         whatif_frames,
         whatif_model,
+        replayed: replayed(captured.records),
+        whatif_replayed,
     })
 }
 

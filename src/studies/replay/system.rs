@@ -2,7 +2,9 @@
 //! captured and under the model file's what-if, so an experiment can sweep
 //! what-ifs on one capture (experiments/replay-whatif.toml). Its summary is
 //! the replay's (`replay.*`, the keys `rendersim replay --json` prints), its
-//! table the per-frame one (`rendersim replay --out`'s frames.csv).
+//! table the frames of the run the model describes, as PresentMon writes
+//! them (`frames.csv`: the what-if's run, or the replay as captured without
+//! one; `rendersim replay --out` writes the same).
 
 use std::io::Write;
 use std::path::Path;
@@ -12,6 +14,7 @@ use serde_json::Value;
 
 use crate::output::trace::TraceWriter;
 use crate::systems::error::invalid;
+use crate::systems::frame_pipeline::records::{COLUMNS, frame_rows};
 use crate::systems::{Outcome, SystemError, SystemModel, resolved_toml};
 
 use super::config::{ReplayConfig, whatif_sets};
@@ -44,6 +47,7 @@ fn blame(e: ReplayError) -> SystemError {
     match e {
         ReplayError::Capture(e) => invalid("capture", e.to_string()),
         ReplayError::Config(e) => invalid("whatif", e.to_string()),
+        ReplayError::Assume(e) => invalid("assume", e.to_string()),
         ReplayError::System(e) => e,
     }
 }
@@ -59,6 +63,7 @@ impl SystemModel for ReplaySystem {
             app: cfg.app.clone(),
             swap_chain: cfg.swapchain.clone(),
             sets: whatif_sets(&cfg.whatif),
+            assume: whatif_sets(&cfg.assume),
         };
         let replay = replay(&base_dir.join(&cfg.capture), &opts).map_err(blame)?;
         let s = &replay.summary;
@@ -95,12 +100,19 @@ impl Outcome for ReplayRun {
     }
 
     fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
-        (self.replay.columns(), self.replay.rows())
+        let run = self.replay.whatif_replayed.as_ref().unwrap_or(&self.replay.replayed);
+        (
+            COLUMNS.iter().map(|c| c.to_string()).collect(),
+            frame_rows(&run.records, run.origin_ps),
+        )
     }
 
     fn write_table(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        let (columns, rows) = self.table();
-        crate::output::table::write_number_table(std::io::BufWriter::new(w), &columns, &rows)
+        self.replay
+            .whatif_replayed
+            .as_ref()
+            .unwrap_or(&self.replay.replayed)
+            .write_csv(w)
     }
 
     fn resolved_model(&self, base_dir: &Path) -> String {

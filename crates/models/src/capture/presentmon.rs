@@ -1,11 +1,14 @@
 //! PresentMon CSV captures, in both of its column sets.
 //!
 //! - **v2** (PresentMon 2): the frame's CPU start (`CPUStartQPC` with
-//!   `TimeInQPC`, or `CPUStartTime` in milliseconds), `MsCPUBusy` (CPU start
-//!   to the present call), `MsCPUWait` (in the present call), `MsGPULatency`
-//!   (CPU start to the GPU starting the frame), `MsGPUBusy`,
-//!   `MsRenderPresentLatency` (present to GPU done), `MsUntilDisplayed`,
-//!   `MsBetweenDisplayChange`, `DisplayLatency`.
+//!   `TimeInQPC`; or `CPUStartTime`, `CPUStartTimeInMs` or `CPUStartQPCTime`
+//!   in milliseconds, or `CPUStartTimeInSeconds`), `MsCPUBusy` (CPU start
+//!   to the present call), `MsCPUWait` (in the present call; `NA`, as
+//!   rendersim writes for a run's last frame, is none), `MsGPULatency`
+//!   (CPU start to the GPU starting the frame), `MsGPUTime` (from there to
+//!   the GPU finishing it), `MsGPUBusy`, `MsRenderPresentLatency` (present
+//!   to GPU done), `MsUntilDisplayed`, `MsBetweenDisplayChange`,
+//!   `DisplayLatency`. rendersim's own `frames.csv` is such a capture.
 //! - **v1** (PresentMon 1): `TimeInSeconds` (the present), `MsBetweenPresents`,
 //!   `MsInPresentAPI`, `MsUntilRenderComplete`, `MsUntilDisplayed`, `Dropped`.
 //!
@@ -101,6 +104,8 @@ pub struct Present {
     pub gpu_latency: Option<f64>,
     /// GPU busy time (v2).
     pub gpu_busy: Option<f64>,
+    /// GPU start to GPU end (v2, `MsGPUTime`).
+    pub gpu_time: Option<f64>,
     /// Present to the GPU finishing the frame.
     pub render_complete: Option<f64>,
     /// Present to the frame appearing (`None`: never shown).
@@ -206,10 +211,14 @@ impl Capture {
             let (cpu_start, present, cpu_busy, cpu_wait) = match columns {
                 Columns::V2 => {
                     let busy = cell.need(rec, line, "MsCPUBusy")?;
-                    let wait = cell.need(rec, line, "MsCPUWait")?;
+                    // NA: the capture ends in the frame's present call.
+                    let wait = cell.opt(rec, line, "MsCPUWait")?.unwrap_or(0.0);
                     let start = match qpc_per_ms {
                         Some(rate) => cell.need(rec, line, "CPUStartQPC")? / rate,
-                        None => cell.need(rec, line, "CPUStartTime")?,
+                        None => {
+                            let (name, ms_per_unit) = start_column(&col).expect("a v2 header names a CPU start");
+                            cell.need(rec, line, name)? * ms_per_unit
+                        }
                     };
                     let present = match qpc_per_ms {
                         Some(rate) => cell.need(rec, line, "TimeInQPC")? / rate,
@@ -257,6 +266,7 @@ impl Capture {
                 cpu_wait,
                 gpu_latency: cell.opt(rec, line, "MsGPULatency")?,
                 gpu_busy: cell.opt(rec, line, "MsGPUBusy")?,
+                gpu_time: cell.opt(rec, line, "MsGPUTime")?,
                 render_complete,
                 until_displayed,
                 between_display_change: cell.opt(rec, line, "MsBetweenDisplayChange")?,
@@ -391,13 +401,27 @@ impl Capture {
     }
 }
 
+/// A PresentMon 2 CPU start column in time units (not QPC ticks), with its
+/// milliseconds per unit, as the versions of PresentMon 2 name it.
+const START_COLUMNS: [(&str, f64); 4] = [
+    ("CPUStartTime", 1.0),
+    ("CPUStartTimeInMs", 1.0),
+    ("CPUStartQPCTime", 1.0),
+    ("CPUStartTimeInSeconds", 1e3),
+];
+
+/// The header's CPU start column in time units, with its milliseconds per unit.
+fn start_column(col: &HashMap<&str, usize>) -> Option<(&'static str, f64)> {
+    START_COLUMNS.iter().copied().find(|(name, _)| col.contains_key(name))
+}
+
 /// The column set a header uses, checked for the columns a replay needs.
 fn column_set(file: &str, col: &HashMap<&str, usize>) -> Result<Columns, CaptureError> {
     let fmt = |message: String| CaptureError::Format {
         file: file.to_string(),
         message,
     };
-    let columns = if col.contains_key("CPUStartQPC") || col.contains_key("CPUStartTime") {
+    let columns = if col.contains_key("CPUStartQPC") || start_column(col).is_some() {
         Columns::V2
     } else if col.contains_key("TimeInSeconds") {
         Columns::V1
@@ -539,6 +563,30 @@ mod tests {
         assert_eq!(p.until_displayed, None);
         assert_eq!(c.presents[0].screen_time(), Some(15.0));
         assert_eq!(c.presents[0].line, 2);
+    }
+
+    #[test]
+    fn reads_each_name_of_the_cpu_start_and_a_missing_wait_as_none() {
+        for (name, scale) in [
+            ("CPUStartTime", 1.0),
+            ("CPUStartTimeInMs", 1.0),
+            ("CPUStartQPCTime", 1.0),
+            ("CPUStartTimeInSeconds", 1e-3),
+        ] {
+            let text = format!(
+                "Application,ProcessID,SwapChainAddress,PresentMode,{name},MsCPUBusy,MsCPUWait,MsUntilDisplayed\n\
+                 a.exe,1,0x1,Hardware: Legacy Flip,{},10,NA,5\n",
+                250.0 * scale
+            );
+            let c = Capture::parse("t.csv", text.as_bytes()).unwrap();
+            assert_eq!(c.columns, Columns::V2, "{name}");
+            let p = &c.presents[0];
+            assert!(
+                (p.cpu_start - 250.0).abs() < 1e-9 && (p.present - 260.0).abs() < 1e-9,
+                "{name}"
+            );
+            assert_eq!(p.cpu_wait, 0.0, "{name}: NA is no time in the present call");
+        }
     }
 
     #[test]

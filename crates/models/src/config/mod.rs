@@ -7,6 +7,6 @@ pub mod patch;
 pub mod units;
 
 pub use load::{ConfigError, ModelSource, deserialize, invalid};
-pub use overrides::{DEFAULT_MODEL, DEFAULT_MODEL_NAME, Overrides, PreparedModel, load_model, prepare};
+pub use overrides::{DEFAULT_MODEL, DEFAULT_MODEL_NAME, Overrides, PreparedModel, apply_patches, load_model, prepare};
 pub use patch::{PatchError, apply_set, flatten, set_dotted};
 pub use units::{Bandwidth, Bytes, Rate, UnitError};

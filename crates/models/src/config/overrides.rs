@@ -106,6 +106,27 @@ impl Overrides {
     }
 }
 
+/// Applies `key=value` patches that an option other than `--set` gave
+/// (`option`, e.g. `--assume`), noting each on `src` so that an error in
+/// its value names that option.
+pub fn apply_patches(
+    option: &str,
+    patches: &[String],
+    src: &mut ModelSource,
+    table: &mut toml::Table,
+) -> Result<(), ConfigError> {
+    for p in patches {
+        set_noted(src, table, p, format!("{option} {p}")).map_err(|e| match e {
+            ConfigError::Set { assignment, reason } => ConfigError::Override {
+                option: format!("{option} {assignment:?}"),
+                reason,
+            },
+            e => e,
+        })?;
+    }
+    Ok(())
+}
+
 /// Applies `key=value` to the table and records where the value came from
 /// (`origin`), so an error in it names the option rather than the file.
 fn set_noted(src: &mut ModelSource, t: &mut toml::Table, assignment: &str, origin: String) -> Result<(), ConfigError> {

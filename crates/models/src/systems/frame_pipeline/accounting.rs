@@ -22,7 +22,7 @@ use super::links::Links;
 use super::records::FrameRecord;
 
 /// CPU states.
-pub const CPU_STATES: [&str; 7] = [
+pub const CPU_STATES: [&str; 8] = [
     "work",
     "system task",
     "wait: command FIFO full",
@@ -30,6 +30,7 @@ pub const CPU_STATES: [&str; 7] = [
     "idle",
     "wait: pacing before a frame",
     "wait: frame limiter before present",
+    "wait: in the present call",
 ];
 /// GPU front-end states.
 pub const FRONT_STATES: [&str; 6] = [
@@ -157,7 +158,7 @@ impl PipelineTrace {
 #[derive(Debug)]
 pub struct Accounting {
     /// CPU clock.
-    pub cpu: StateClock<7>,
+    pub cpu: StateClock<8>,
     /// Front-end clock.
     pub front: StateClock<6>,
     /// Geometry clock.
@@ -247,7 +248,7 @@ fn attribute_cpu(records: &mut [FrameRecord], old: usize, spent: u64, frame: u64
             0 | 1 => r.cpu_busy += spent,
             // Pacing before a frame (5) is between frames: the frame
             // starts when it ends.
-            2 | 3 | 6 => r.cpu_wait += spent,
+            2 | 3 | 6 | 7 => r.cpu_wait += spent,
             _ => {}
         }
     }
@@ -258,8 +259,8 @@ fn attribute_cpu(records: &mut [FrameRecord], old: usize, spent: u64, frame: u64
 fn cpu_state_of(p: CpuPhase) -> usize {
     // A table, not a match: the phase changes from event to event, and a
     // jump table's indirect branch would often be mispredicted.
-    const OF: [u8; 10] = {
-        let mut of = [0u8; 10];
+    const OF: [u8; 11] = {
+        let mut of = [0u8; 11];
         of[CpuPhase::NextFrame as usize] = 0;
         of[CpuPhase::WaitFrames as usize] = 3;
         of[CpuPhase::Ready as usize] = 0;
@@ -270,6 +271,7 @@ fn cpu_state_of(p: CpuPhase) -> usize {
         of[CpuPhase::Finished as usize] = 4;
         of[CpuPhase::PaceStart as usize] = 5;
         of[CpuPhase::PacePresent as usize] = 6;
+        of[CpuPhase::InPresent as usize] = 7;
         of
     };
     OF[p as usize] as usize
@@ -279,13 +281,15 @@ fn cpu_state_of(p: CpuPhase) -> usize {
 /// system tasks.
 #[inline]
 fn front_state_of(p: FrontPhase) -> usize {
-    const OF: [u8; 5] = {
-        let mut of = [0u8; 5];
+    const OF: [u8; 6] = {
+        let mut of = [0u8; 6];
         of[FrontPhase::Running as usize] = 0;
         of[FrontPhase::Idle as usize] = 1;
         of[FrontPhase::WaitImage as usize] = 2;
         of[FrontPhase::WaitDrain as usize] = 3;
         of[FrontPhase::Handoff as usize] = FRONT_WAIT_GEOMETRY as u8;
+        // A replayed frame's GPU waits for the CPU's later submissions.
+        of[FrontPhase::HoldFrame as usize] = 1;
         of
     };
     OF[p as usize] as usize
@@ -554,7 +558,7 @@ fn front_mode(u: Units<'_>) -> Mode {
     match u.front.phase() {
         FrontPhase::Running if u.front.in_system() => Mode::work(Blame::System),
         FrontPhase::Running => Mode::work(Blame::FrontEnd),
-        FrontPhase::Idle => Mode::wait(Unit::Cpu),
+        FrontPhase::Idle | FrontPhase::HoldFrame => Mode::wait(Unit::Cpu),
         FrontPhase::WaitImage => Mode::wait(Unit::Display),
         FrontPhase::WaitDrain => Mode::wait(Unit::Fragment),
         // Binning: no draw in geometry, the bins still being shaded.

@@ -577,13 +577,19 @@ pub enum WorkloadConfig {
 }
 
 /// A workload given frame by frame, as a frame capture measured it
-/// (`rendersim replay` builds one from PresentMon's columns). Frame `i`'s
-/// CPU works `cpu[i]` in all; after the first `submit[i]` of it the frame's
-/// GPU work (`gpu[i]`, one command on the front end) is submitted; at the
-/// end of `cpu[i]` it presents, and then spends `present[i]` in the present
-/// call before the next frame starts (a wait the model adds on its own, for
-/// frames in flight or a full FIFO, comes on top). Every list holds at least
-/// `run.frames` entries; `submit[i]` is at most `cpu[i]`.
+/// (`rendersim replay` builds one from PresentMon's columns). Frame `i`
+/// begins when the previous frame's present call returns: `present[i - 1]`
+/// after that present, or later when the model holds it (frames in flight,
+/// pacing), the two waits overlapping as they do in a real present call. It
+/// works `cpu[i]` in all: after the first `submit[i]` of it the frame's GPU
+/// work is submitted (its clear, then `gpu[i]` of work as one command on the
+/// front end), and at the end of `cpu[i]` it presents. Where `gpu_end` is
+/// given, the GPU does not finish the frame earlier than `gpu_end[i]` after
+/// the frame began (a capture's GPU start plus its GPU time: the GPU waited
+/// for the CPU's later submissions); the wait counts as GPU idle. Frame 0
+/// begins at `start` (a capture's first CPU start after the vertical blank
+/// the run starts at). Every list holds at least `run.frames` entries
+/// (`gpu_end` may be left out); `submit[i]` is at most `cpu[i]`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FramesWorkload {
@@ -593,12 +599,19 @@ pub struct FramesWorkload {
     pub submit: Vec<Duration>,
     /// GPU work per frame.
     pub gpu: Vec<Duration>,
-    /// Time in the present call per frame.
+    /// Time in the present call per frame (a floor: the model's own waits
+    /// overlap it).
     pub present: Vec<Duration>,
+    /// The earliest GPU end per frame, after the frame began (empty: none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub gpu_end: Vec<Duration>,
+    /// When frame 0 begins.
+    #[serde(default, skip_serializing_if = "Duration::is_zero")]
+    pub start: Duration,
 }
 
 impl FramesWorkload {
-    /// The four lists with their keys.
+    /// The four lists every such workload gives, with their keys.
     pub fn lists(&self) -> [(&'static str, &[Duration]); 4] {
         [
             ("workload.cpu", &self.cpu),

@@ -46,6 +46,10 @@ pub enum CpuPhase {
     /// Held by a present-measured frame limiter before the present
     /// (`pacing.limit_from = "present"`); [`Ev::PaceWake`] ends it.
     PacePresent,
+    /// A replayed frame (`kind = "frames"`) waits for the previous frame's
+    /// present call to return, as long as the capture timed it;
+    /// [`Ev::PresentReturn`] ends it.
+    InPresent,
     /// All frames submitted.
     Finished,
 }
@@ -72,10 +76,21 @@ pub enum FixedWork {
 }
 
 impl FixedWork {
-    /// CPU time of frame `f` before its GPU work is submitted.
-    fn before_submit(&mut self, f: u64) -> Duration {
+    /// CPU time after the frame's clear is pushed, before its GPU work is
+    /// (none for a frame given frame by frame: its GPU work, clear
+    /// included, is submitted together, [`FixedWork::before_clear`]).
+    fn before_submit(&mut self) -> Duration {
         match self {
             FixedWork::Drawn { cpu, cpu_rng, .. } => Duration::from_ps_f64(cpu.sample(cpu_rng)),
+            FixedWork::PerFrame(_) => Duration::ZERO,
+        }
+    }
+
+    /// CPU time of frame `f` before its clear is pushed (a frame given frame
+    /// by frame: its work up to the GPU submission).
+    fn before_clear(&self, f: u64) -> Duration {
+        match self {
+            FixedWork::Drawn { .. } => Duration::ZERO,
             FixedWork::PerFrame(w) => w.submit[f as usize],
         }
     }
@@ -97,13 +112,21 @@ impl FixedWork {
         }
     }
 
-    /// Time frame `f` spends in the previous frame's present call before
-    /// its own work (none for frame 0 or a drawn workload).
-    fn in_present_before(&self, f: u64) -> Duration {
-        match self {
-            FixedWork::PerFrame(w) if f > 0 => w.present[f as usize - 1],
-            _ => Duration::ZERO,
-        }
+    /// When frame `f` may begin: the previous frame's present plus the time
+    /// in its present call, or the workload's start for frame 0 (`None`: at
+    /// once, as for a drawn workload).
+    fn begins_at(&self, f: u64, records: &[FrameRecord]) -> Option<Time> {
+        let FixedWork::PerFrame(w) = self else {
+            return None;
+        };
+        let at = match f {
+            0 => Time::ZERO.0.saturating_add(w.start.0),
+            _ => records[f as usize - 1]
+                .present
+                .0
+                .saturating_add(w.present[f as usize - 1].0),
+        };
+        Some(Time(at))
     }
 }
 
@@ -169,6 +192,8 @@ pub struct CpuThread {
     pace_resume: CpuPhase,
     /// Whether the low-latency pacer (not a limiter) set the start wait.
     pace_for_gpu: bool,
+    /// Whether the workload is given frame by frame (`kind = "frames"`).
+    per_frame: bool,
 }
 
 #[inline(always)]
@@ -202,6 +227,7 @@ impl CpuThread {
             frames_total,
             non_render_rng,
             variation_rng,
+            per_frame: matches!(fixed, Some(FixedWork::PerFrame(_))),
             fixed,
             frames_at_instant: (Time::ZERO, 0),
             zero_time_after,
@@ -370,15 +396,16 @@ impl CpuThread {
     fn op_work(&mut self, op: Op, env: &Env) -> Duration {
         let c = &env.cfg.cpu;
         match op {
-            Op::Input => match &self.fixed {
-                Some(f) => c.input_sampling.saturating_add(f.in_present_before(self.frame)),
-                None => c.input_sampling,
-            },
+            Op::Input => c.input_sampling,
             Op::NonRender => {
                 let work = Duration::from_ps_f64(c.non_render.sample(&mut self.non_render_rng));
                 // Per-frame variation (config `variation.cpu`), drawn only when given.
-                match &env.cfg.variation.cpu() {
+                let work = match &env.cfg.variation.cpu() {
                     Some(v) => work.saturating_add(Duration::from_ps_f64(v.sample(&mut self.variation_rng))),
+                    None => work,
+                };
+                match &self.fixed {
+                    Some(f) => work.saturating_add(f.before_clear(self.frame)),
                     None => work,
                 }
             }
@@ -388,7 +415,7 @@ impl CpuThread {
                 None => c.swap,
             },
             Op::Fixed => match &mut self.fixed {
-                Some(f) => f.before_submit(self.frame),
+                Some(f) => f.before_submit(),
                 None => Duration::ZERO,
             },
             Op::Draw(k) => match &env.scene {
@@ -578,6 +605,7 @@ impl CpuThread {
             | CpuPhase::ZeroTimeWait
             | CpuPhase::PaceStart
             | CpuPhase::PacePresent
+            | CpuPhase::InPresent
             | CpuPhase::Finished => return Ok(false),
             CpuPhase::WaitFrames if self.frames_ahead_full(env) => {
                 return Ok(false);
@@ -657,6 +685,7 @@ impl CpuThread {
                 | CpuPhase::ZeroTimeWait
                 | CpuPhase::PaceStart
                 | CpuPhase::PacePresent
+                | CpuPhase::InPresent
                 | CpuPhase::Finished => return Ok(progressed),
             }
             progressed = true;
@@ -675,6 +704,11 @@ impl CpuThread {
         }
         if env.records.len() as u64 == self.frame {
             env.records.push(FrameRecord::new(self.frame, now));
+        }
+        // A replayed frame begins when the previous present call returns, as
+        // the capture timed it; a wait for frames in flight overlaps it.
+        if self.per_frame && self.wait_in_present_call(now, env, s) {
+            return Some(true);
         }
         if self.frames_ahead_full(env) {
             let changed = self.phase != CpuPhase::WaitFrames;
@@ -705,7 +739,33 @@ impl CpuThread {
         self.zero_time_go = false;
         self.frames_at_instant = (now, n + 1);
         self.op = 0;
+        env.records[self.frame as usize].begun = now;
         self.phase = CpuPhase::Ready;
         None
+    }
+
+    /// A replayed frame (`kind = "frames"`) that may not begin yet, because
+    /// the previous frame's present call has not returned as the capture
+    /// timed it (or the first frame's start is later), waits for it
+    /// ([`CpuPhase::InPresent`]): returns true. Out of line: the other
+    /// workloads never come here.
+    #[inline(never)]
+    fn wait_in_present_call(&mut self, now: Time, env: &Env, s: &mut Scheduler<Ev>) -> bool {
+        let Some(t) = self.fixed.as_ref().and_then(|f| f.begins_at(self.frame, &env.records)) else {
+            return false;
+        };
+        if t <= now {
+            return false;
+        }
+        s.at(t, Ev::PresentReturn);
+        self.phase = CpuPhase::InPresent;
+        true
+    }
+
+    /// The [`Ev::PresentReturn`] event: the previous present call returned.
+    pub(super) fn present_returned(&mut self) {
+        if self.phase == CpuPhase::InPresent {
+            self.phase = CpuPhase::NextFrame;
+        }
     }
 }

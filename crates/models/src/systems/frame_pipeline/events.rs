@@ -2,7 +2,9 @@
 //! §4.2): the ends of the CPU thread's operations and of the front end's
 //! commands, the geometry and fragment stages' triangles (`triangle`
 //! fidelity) or a draw's closed form (`draw` fidelity), the display's
-//! vertical blanks (or a variable-refresh panel's scan-outs), and the system tasks' arrivals and ends. Each unit
+//! vertical blanks (or a variable-refresh panel's scan-outs), the system
+//! tasks' arrivals and ends, and the waits of pacing and of a replayed
+//! capture. Each unit
 //! schedules its own; [`super::model::FramePipeline`] dispatches them.
 
 use crate::components::noise::NoiseTarget;
@@ -64,6 +66,12 @@ pub enum Ev {
     /// A frame limiter's or the low-latency pacer's wait ends
     /// (`[pacing]`; scheduled only when pacing holds the CPU).
     PaceWake,
+    /// A replayed frame's present call returns after the time the capture
+    /// measured in it (`kind = "frames"` only).
+    PresentReturn,
+    /// The GPU reaches a replayed frame's measured end (`kind = "frames"`
+    /// with `gpu_end` only): its swap may finish.
+    GpuHoldEnd,
 }
 
 impl EventKind for Ev {
@@ -80,6 +88,8 @@ impl EventKind for Ev {
         "noise_end",
         "zero_time_frame",
         "pacing_wake",
+        "present_return",
+        "gpu_hold_end",
     ];
     #[inline]
     fn kind(&self) -> usize {
@@ -96,6 +106,8 @@ impl EventKind for Ev {
             Ev::NoiseEnd { .. } => 9,
             Ev::ZeroTimeFrame => 10,
             Ev::PaceWake => 11,
+            Ev::PresentReturn => 12,
+            Ev::GpuHoldEnd => 13,
         }
     }
 }

@@ -61,6 +61,7 @@ impl FragmentStage {
     /// `triangle` fidelity: a triangle is shaded. The next one comes from
     /// the triangle FIFO; a triangle `geom` held back by a full FIFO goes
     /// in (or straight here), and the geometry stage goes on.
+    #[inline(always)]
     pub(super) fn triangle_done(
         &mut self,
         now: Time,

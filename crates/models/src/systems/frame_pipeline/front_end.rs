@@ -36,6 +36,9 @@ pub enum FrontPhase {
     Running,
     /// A draw waits for the geometry stage to take it.
     Handoff,
+    /// A replayed frame's swap waits for the frame's measured GPU end
+    /// (`workload.gpu_end`); [`Ev::GpuHoldEnd`] ends it.
+    HoldFrame,
 }
 
 /// The units a front-end step can reach: the draws it hands on, the drain
@@ -99,7 +102,7 @@ impl FrontEnd {
     #[inline(always)]
     pub(super) fn at_rest(&self, geom: &GeometryStage) -> bool {
         match self.phase {
-            FrontPhase::Running => true,
+            FrontPhase::Running | FrontPhase::HoldFrame => true,
             FrontPhase::Handoff => geom.has_draw(),
             _ => false,
         }
@@ -185,6 +188,13 @@ impl FrontEnd {
                         return Ok(progressed);
                     }
                     let work = env.cfg.gpu.swap.saturating_add(env.cfg.gpu.command);
+                    if let Some(t) = self.held_until(env, work)
+                        && t > now
+                    {
+                        s.at(t, Ev::GpuHoldEnd);
+                        self.phase = FrontPhase::HoldFrame;
+                        return Ok(true);
+                    }
                     self.phase = self.job(now, self.cmd, work, env, down, s)?;
                 }
                 FrontPhase::Handoff => {
@@ -199,9 +209,31 @@ impl FrontEnd {
                     }
                     self.phase = FrontPhase::Idle;
                 }
-                FrontPhase::Running => return Ok(progressed),
+                FrontPhase::Running | FrontPhase::HoldFrame => return Ok(progressed),
             }
             progressed = true;
+        }
+    }
+
+    /// When the swap (of `work`) may start so that a replayed frame ends no
+    /// earlier than its measured GPU end (`workload.gpu_end`, after the
+    /// frame began); `None` for every other workload.
+    #[inline(never)]
+    fn held_until(&self, env: &Env, work: Duration) -> Option<Time> {
+        let crate::systems::frame_pipeline::config::WorkloadConfig::Frames(w) = &env.cfg.workload else {
+            return None;
+        };
+        let f = self.frame? as usize;
+        let end = w.gpu_end.get(f)?;
+        Some(Time(
+            env.records[f].begun.0.saturating_add(end.0).saturating_sub(work.0),
+        ))
+    }
+
+    /// The [`Ev::GpuHoldEnd`] event: the held swap may start.
+    pub(super) fn hold_ends(&mut self) {
+        if self.phase == FrontPhase::HoldFrame {
+            self.phase = FrontPhase::WaitDrain;
         }
     }
 

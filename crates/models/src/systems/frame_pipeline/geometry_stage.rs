@@ -332,6 +332,7 @@ impl GeometryStage {
     /// `triangle` fidelity: a triangle left the stage; its fragment work
     /// goes to `frag`, or into the triangle FIFO, or is held while the FIFO
     /// is full (the stage blocks).
+    #[inline(always)]
     pub(super) fn triangle_done(
         &mut self,
         now: Time,

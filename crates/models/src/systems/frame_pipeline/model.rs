@@ -372,6 +372,24 @@ impl FramePipeline {
     }
 }
 
+impl FramePipeline {
+    /// A unit's timed wait ends (a zero-time frame's turn, pacing, a
+    /// replayed frame's present call or GPU end). Rare beside the units'
+    /// work, so kept out of `handle`, whose inlining of the stages' events
+    /// it would otherwise crowd out.
+    #[cold]
+    #[inline(never)]
+    fn wait_ends(&mut self, ev: Ev) {
+        match ev {
+            Ev::ZeroTimeFrame => self.cpu.zero_time_frame(),
+            Ev::PaceWake => self.cpu.pace_wake(),
+            Ev::PresentReturn => self.cpu.present_returned(),
+            Ev::GpuHoldEnd => self.front.hold_ends(),
+            _ => unreachable!("not a wait's end: {ev:?}"),
+        }
+    }
+}
+
 impl Model for FramePipeline {
     type Event = Ev;
     type Error = SystemError;
@@ -417,8 +435,7 @@ impl Model for FramePipeline {
             }
             Ev::NoiseArrive { source } => self.noise_arrive(now, source, s)?,
             Ev::NoiseEnd { target } => self.noise_end(now, target, s)?,
-            Ev::ZeroTimeFrame => self.cpu.zero_time_frame(),
-            Ev::PaceWake => self.cpu.pace_wake(),
+            Ev::ZeroTimeFrame | Ev::PaceWake | Ev::PresentReturn | Ev::GpuHoldEnd => self.wait_ends(ev),
         }
         self.step(now, s)?;
         Ok(if self.done() { Control::Stop } else { Control::Continue })

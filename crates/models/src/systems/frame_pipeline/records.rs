@@ -1,20 +1,47 @@
-//! Per-frame records and the frames table, with PresentMon's v2 column names
-//! where the meaning matches:
+//! Per-frame records and the frames table (`frames.csv`), written as
+//! PresentMon 2 writes a capture, so that the tools that read PresentMon
+//! read it, and `rendersim replay` reads it back (a rendersim run replays
+//! exactly: `tests/it/replay_round_trip.rs`).
 //!
-//! - `FrameTime`: from this frame's CPU start to the next one's (the CPU
-//!   start is when the thread finished the previous frame's swap; it
-//!   includes any wait for frames in flight);
-//! - `MsCPUBusy` / `MsCPUWait`: CPU time working (system tasks included) /
-//!   blocked (full command FIFO, frames in flight) within the frame; they add
-//!   up to `FrameTime`;
-//! - `MsGPULatency`: CPU start to the GPU starting the frame (its clear);
-//! - `MsGPUTime`: GPU start to GPU end (the swap); `MsGPUBusy` the part of it
-//!   with any GPU unit busy; `MsGPUWait` the rest;
-//! - `MsUntilDisplayed`: the swap call (present) to the frame appearing;
-//! - `DisplayLatency`: input sampling to the frame appearing;
-//! - `MsBetweenDisplayChange`: this frame's appearance to the previous one's;
-//! - `Dropped`: 1 if the frame was never shown.
+//! The PresentMon columns have PresentMon's meaning (its console
+//! application's README, "CSV columns"), with rendersim's present being the
+//! moment the CPU thread pushes the frame's swap into the command FIFO:
+//!
+//! - `CPUStartTime`: when the CPU began working on the frame (after any wait
+//!   for frames in flight and any pacing), in ms from the run's start;
+//! - `MsCPUBusy`: from there to the present (command-FIFO stalls inside the
+//!   frame included, as PresentMon cannot tell them apart either);
+//!   `MsCPUWait` = `MsInPresentAPI`: from the present to the next frame's
+//!   start (the present call, the wait for frames in flight, a pacer's sleep;
+//!   `NA` for the last frame, whose call the run ends in); `FrameTime` their
+//!   sum;
+//! - `MsBetweenPresents`, `MsBetweenSimulationStart` (input sampling to
+//!   input sampling), `MsBetweenDisplayChange`: from the frame before (`NA`
+//!   for the first);
+//! - `MsGPULatency`: CPU start to the GPU beginning the frame (its clear);
+//!   `MsGPUTime`: from there to the GPU finishing it (its swap), of which
+//!   `MsGPUBusy` with a GPU unit busy and `MsGPUWait` the rest;
+//! - `MsRenderPresentLatency`: present to GPU done; `MsUntilDisplayed`:
+//!   present to the frame appearing; `DisplayLatency`: CPU start to the frame
+//!   appearing; `DisplayedTime`: how long it stayed on screen (to the next
+//!   frame shown). A frame never shown has `NA` for all four display columns.
+//!
+//! The text columns name the swap chain ([`ChainInfo`]): rendersim's own
+//! runs write `Application` `rendersim` and the present mode of the
+//! model's display (`fifo`: sync interval 1; `mailbox`: 0; `immediate`: 0
+//! with tearing allowed; a composed display `Composed: Flip`, else
+//! `Hardware: Independent Flip`); a replay writes the capture's.
+//!
+//! After them come rendersim's own columns: `Frame` (index, first of the
+//! numbers), `MsInputLatency` (input sampled to the frame appearing: the
+//! summary's `display_latency_ms`), `MsCPUWork` and `MsCPUBlocked` (the CPU's
+//! work, system tasks included, and its blocked time as the model accounts
+//! them to the frame), `Displayed` and `Dropped` (0 or 1).
+//!
+//! Times are written exactly: integer picoseconds as milliseconds with nine
+//! decimals.
 
+use crate::components::swap_chain::{DisplayConfig, PresentMode};
 use crate::engine::{PS_PER_MS, Time};
 
 /// One frame's timeline.
@@ -22,8 +49,13 @@ use crate::engine::{PS_PER_MS, Time};
 pub struct FrameRecord {
     /// Frame index.
     pub index: u64,
-    /// CPU start (end of the previous frame's swap call).
+    /// The frame's slot on the CPU thread: from the end of the previous
+    /// frame's swap call (so it includes any wait for frames in flight).
     pub start: Time,
+    /// When the CPU began working on the frame: after the wait for frames in
+    /// flight, any pacing and a replayed frame's present call (PresentMon's
+    /// CPU start).
+    pub begun: Time,
     /// Input sampled.
     pub input: Time,
     /// Swap command pushed (end of the CPU frame).
@@ -50,6 +82,7 @@ impl FrameRecord {
         FrameRecord {
             index,
             start,
+            begun: start,
             input: start,
             present: start,
             cpu_busy: 0,
@@ -63,31 +96,34 @@ impl FrameRecord {
     }
 }
 
-/// Columns of `frames.csv`.
-pub const COLUMNS: [&str; 14] = [
-    "Frame",
-    "TimeInSeconds",
-    "FrameTime",
-    "MsCPUBusy",
-    "MsCPUWait",
-    "MsGPULatency",
-    "MsGPUTime",
-    "MsGPUBusy",
-    "MsGPUWait",
-    "MsUntilDisplayed",
-    "DisplayLatency",
-    "MsBetweenDisplayChange",
-    "Displayed",
-    "Dropped",
-];
+/// The per-frame figures the summary's statistics are taken over (columns
+/// of [`metric_rows`]; not an output).
+pub(super) mod metric {
+    /// Slot start to the next slot start (ms).
+    pub const FRAME_TIME: usize = 0;
+    /// CPU work in the frame (ms).
+    pub const CPU_WORK: usize = 1;
+    /// GPU start to GPU end (ms).
+    pub const GPU_TIME: usize = 2;
+    /// GPU busy (ms).
+    pub const GPU_BUSY: usize = 3;
+    /// Present to display (ms).
+    pub const UNTIL_DISPLAYED: usize = 4;
+    /// Input sampled to display (ms).
+    pub const INPUT_LATENCY: usize = 5;
+    /// Display to the previous display (ms).
+    pub const DISPLAY_INTERVAL: usize = 6;
+    /// Figures per row.
+    pub const N: usize = 7;
+}
 
 fn ms(ps: u64) -> f64 {
     ps as f64 / PS_PER_MS as f64
 }
 
-/// The frames table: one row per frame, [`COLUMNS`] in order. Values that do
-/// not exist for a frame (never displayed) are NaN here and empty in CSV.
-pub fn frame_rows(records: &[FrameRecord]) -> Vec<[f64; 14]> {
+/// The summary's per-frame figures ([`metric`] names the columns; NaN where
+/// a figure does not exist for the frame).
+pub(super) fn metric_rows(records: &[FrameRecord]) -> Vec<[f64; metric::N]> {
     let mut rows = Vec::with_capacity(records.len());
     let mut prev_display: Option<Time> = None;
     for (i, r) in records.iter().enumerate() {
@@ -105,49 +141,274 @@ pub fn frame_rows(records: &[FrameRecord]) -> Vec<[f64; 14]> {
             None => (f64::NAN, f64::NAN, f64::NAN),
         };
         rows.push([
-            r.index as f64,
-            r.start.0 as f64 / 1e12,
             ms(end.since(r.start).0),
             ms(r.cpu_busy),
-            ms(r.cpu_wait),
-            r.gpu_start.map(|g| ms(g.since(r.start).0)).unwrap_or(f64::NAN),
             gpu_time,
             ms(r.gpu_busy),
-            if gpu_time.is_nan() {
-                f64::NAN
-            } else {
-                gpu_time - ms(r.gpu_busy)
-            },
             until,
             latency,
             between,
-            r.displayed.is_some() as u8 as f64,
-            r.dropped as u8 as f64,
         ]);
     }
     rows
 }
 
-/// Writes the frames table as CSV (exact decimal text; empty for missing).
-pub fn write_frames_csv<W: std::io::Write>(records: &[FrameRecord], w: W) -> std::io::Result<()> {
-    let rows = frame_rows(records).into_iter().map(|row| {
-        row.iter()
-            .enumerate()
-            .map(|(i, v)| {
-                if v.is_nan() {
-                    String::new()
-                } else if i == 0 || i >= 12 {
-                    format!("{}", *v as u64)
-                } else {
-                    let t = format!("{v:.9}");
-                    // A tiny negative difference (MsGPUWait) must not print as "-0.000000000".
-                    match t.strip_prefix('-') {
-                        Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
-                        _ => t,
-                    }
-                }
-            })
-            .collect()
-    });
-    crate::output::table::write_table(std::io::BufWriter::new(w), &COLUMNS, rows)
+/// The swap chain the frames were presented on, as PresentMon names it
+/// (the text columns of `frames.csv`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ChainInfo {
+    /// `Application`.
+    pub application: String,
+    /// `ProcessID`.
+    pub process_id: String,
+    /// `SwapChainAddress`.
+    pub swap_chain: String,
+    /// `PresentRuntime`.
+    pub runtime: String,
+    /// `SyncInterval`.
+    pub sync_interval: i64,
+    /// `AllowsTearing`.
+    pub allows_tearing: bool,
+    /// `PresentMode`.
+    pub present_mode: String,
+}
+
+impl ChainInfo {
+    /// A rendersim run's swap chain, from the model's display.
+    pub fn of_display(d: &DisplayConfig) -> ChainInfo {
+        let mode = d.effective_mode();
+        ChainInfo {
+            application: "rendersim".into(),
+            process_id: "0".into(),
+            swap_chain: "0x1".into(),
+            runtime: "Other".into(),
+            sync_interval: i64::from(mode == PresentMode::Fifo),
+            allows_tearing: mode == PresentMode::Immediate,
+            present_mode: if d.composition.is_independent() {
+                "Hardware: Independent Flip"
+            } else {
+                "Composed: Flip"
+            }
+            .into(),
+        }
+    }
+}
+
+/// The text columns of `frames.csv`, before [`COLUMNS`].
+pub const TEXT_COLUMNS: [&str; 9] = [
+    "Application",
+    "ProcessID",
+    "SwapChainAddress",
+    "PresentRuntime",
+    "SyncInterval",
+    "PresentFlags",
+    "AllowsTearing",
+    "PresentMode",
+    "FrameType",
+];
+
+/// The numeric columns of `frames.csv` (the frames table experiments read).
+pub const COLUMNS: [&str; 22] = [
+    "Frame",
+    "CPUStartTime",
+    "FrameTime",
+    "MsBetweenSimulationStart",
+    "MsBetweenPresents",
+    "MsBetweenDisplayChange",
+    "MsInPresentAPI",
+    "MsRenderPresentLatency",
+    "MsUntilDisplayed",
+    "MsCPUBusy",
+    "MsCPUWait",
+    "MsGPULatency",
+    "MsGPUTime",
+    "MsGPUBusy",
+    "MsGPUWait",
+    "DisplayLatency",
+    "DisplayedTime",
+    "MsInputLatency",
+    "MsCPUWork",
+    "MsCPUBlocked",
+    "Displayed",
+    "Dropped",
+];
+
+/// Columns of [`COLUMNS`] that are counts or flags, not times.
+const COUNT_COLUMNS: [usize; 3] = [0, 20, 21];
+
+/// One cell of the numeric columns: picoseconds (a time on the run's clock
+/// or a duration, signed), a count, or `NA`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Cell {
+    Ps(i64),
+    Count(u64),
+    Na,
+}
+
+impl Cell {
+    fn ms(self) -> f64 {
+        match self {
+            Cell::Ps(p) => p as f64 / PS_PER_MS as f64,
+            Cell::Count(n) => n as f64,
+            Cell::Na => f64::NAN,
+        }
+    }
+
+    /// Exact text: picoseconds as milliseconds with nine decimals.
+    fn text(self) -> String {
+        match self {
+            Cell::Ps(p) => {
+                let ms = PS_PER_MS as i64;
+                let sign = if p < 0 { "-" } else { "" };
+                let a = p.unsigned_abs();
+                format!("{sign}{}.{:09}", a / ms as u64, a % ms as u64)
+            }
+            Cell::Count(n) => n.to_string(),
+            Cell::Na => "NA".into(),
+        }
+    }
+}
+
+/// Signed picoseconds from `a` to `b`.
+fn span(a: Time, b: Time) -> Cell {
+    Cell::Ps(b.0 as i64 - a.0 as i64)
+}
+
+/// The numeric cells of every frame, [`COLUMNS`] in order; `offset_ps` is
+/// added to `CPUStartTime` (a replay writes the capture's clock).
+fn cells(records: &[FrameRecord], offset_ps: i64) -> Vec<[Cell; 22]> {
+    let mut rows = Vec::with_capacity(records.len());
+    let mut prev_display: Option<Time> = None;
+    for (i, r) in records.iter().enumerate() {
+        let next = records.get(i + 1);
+        let prev = i.checked_sub(1).map(|p| &records[p]);
+        // The run ends in the last frame's present call: its wait is unknown.
+        let wait = next.map_or(Cell::Na, |n| span(r.present, n.begun));
+        let frame_time = next.map_or(Cell::Na, |n| span(r.begun, n.begun));
+        let opt = |a: Option<Time>, b: Option<Time>| match (a, b) {
+            (Some(a), Some(b)) => span(a, b),
+            _ => Cell::Na,
+        };
+        let shown_next = r
+            .displayed
+            .and_then(|_| records[i + 1..].iter().find_map(|n| n.displayed));
+        let gpu_time = opt(r.gpu_start, r.gpu_end);
+        let gpu_wait = match gpu_time {
+            Cell::Ps(t) => Cell::Ps(t - r.gpu_busy as i64),
+            _ => Cell::Na,
+        };
+        rows.push([
+            Cell::Count(r.index),
+            Cell::Ps(r.begun.0 as i64 + offset_ps),
+            frame_time,
+            prev.map_or(Cell::Na, |p| span(p.input, r.input)),
+            prev.map_or(Cell::Na, |p| span(p.present, r.present)),
+            opt(prev_display.filter(|_| r.displayed.is_some()), r.displayed),
+            wait,
+            opt(Some(r.present), r.gpu_end),
+            opt(Some(r.present), r.displayed),
+            span(r.begun, r.present),
+            wait,
+            opt(Some(r.begun), r.gpu_start),
+            gpu_time,
+            Cell::Ps(r.gpu_busy as i64),
+            gpu_wait,
+            opt(Some(r.begun), r.displayed),
+            opt(r.displayed, shown_next),
+            opt(Some(r.input), r.displayed),
+            Cell::Ps(r.cpu_busy as i64),
+            Cell::Ps(r.cpu_wait as i64),
+            Cell::Count(u64::from(r.displayed.is_some())),
+            Cell::Count(u64::from(r.dropped)),
+        ]);
+        if r.displayed.is_some() {
+            prev_display = r.displayed;
+        }
+    }
+    debug_assert!(
+        COUNT_COLUMNS
+            .iter()
+            .all(|&c| rows.iter().all(|r| !matches!(r[c], Cell::Ps(_))))
+    );
+    rows
+}
+
+/// The frames table's numbers: one row per frame, [`COLUMNS`] in order, in
+/// ms (NaN where `frames.csv` has `NA`); `offset_ps` is added to
+/// `CPUStartTime`.
+pub fn frame_rows(records: &[FrameRecord], offset_ps: i64) -> Vec<Vec<f64>> {
+    cells(records, offset_ps)
+        .into_iter()
+        .map(|row| row.iter().map(|c| c.ms()).collect())
+        .collect()
+}
+
+/// Writes `frames.csv`: [`TEXT_COLUMNS`] naming `chain`, then [`COLUMNS`]
+/// (times exact, `NA` for missing); `offset_ps` is added to `CPUStartTime`.
+pub fn write_frames_csv<W: std::io::Write>(
+    records: &[FrameRecord],
+    chain: &ChainInfo,
+    offset_ps: i64,
+    w: W,
+) -> std::io::Result<()> {
+    let text = [
+        chain.application.clone(),
+        chain.process_id.clone(),
+        chain.swap_chain.clone(),
+        chain.runtime.clone(),
+        chain.sync_interval.to_string(),
+        "0".into(),
+        u8::from(chain.allows_tearing).to_string(),
+        chain.present_mode.clone(),
+        "Application".into(),
+    ];
+    let header: Vec<&str> = TEXT_COLUMNS.iter().chain(COLUMNS.iter()).copied().collect();
+    let rows = cells(records, offset_ps)
+        .into_iter()
+        .map(|row| text.iter().cloned().chain(row.iter().map(|c| c.text())).collect());
+    crate::output::table::write_table(std::io::BufWriter::new(w), &header, rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn picoseconds_are_written_exactly() {
+        assert_eq!(Cell::Ps(16_666_666_667).text(), "16.666666667");
+        assert_eq!(Cell::Ps(-1).text(), "-0.000000001");
+        assert_eq!(Cell::Ps(0).text(), "0.000000000");
+        assert_eq!(Cell::Ps(3_600_000_000_000_001).text(), "3600000.000000001");
+        assert_eq!(Cell::Na.text(), "NA");
+        assert_eq!(Cell::Count(7).text(), "7");
+    }
+
+    #[test]
+    fn a_frame_never_shown_has_na_display_columns_and_the_last_frame_no_known_wait() {
+        let mut a = FrameRecord::new(0, Time(0));
+        a.present = Time(5);
+        a.gpu_start = Some(Time(1));
+        a.gpu_end = Some(Time(8));
+        a.displayed = Some(Time(10));
+        let mut b = FrameRecord::new(1, Time(5));
+        b.begun = Time(6);
+        b.present = Time(9);
+        b.dropped = true;
+        let rows = cells(&[a, b], 100);
+        let col = |name: &str| COLUMNS.iter().position(|c| *c == name).unwrap();
+        assert_eq!(rows[0][col("CPUStartTime")], Cell::Ps(100));
+        assert_eq!(rows[0][col("MsCPUWait")], Cell::Ps(1));
+        assert_eq!(rows[0][col("FrameTime")], Cell::Ps(6));
+        assert_eq!(rows[0][col("MsRenderPresentLatency")], Cell::Ps(3));
+        assert_eq!(rows[0][col("DisplayLatency")], Cell::Ps(10));
+        assert_eq!(rows[0][col("DisplayedTime")], Cell::Na);
+        assert_eq!(rows[0][col("MsBetweenPresents")], Cell::Na);
+        assert_eq!(rows[1][col("MsBetweenPresents")], Cell::Ps(4));
+        assert_eq!(rows[1][col("MsCPUBusy")], Cell::Ps(3));
+        assert_eq!(rows[1][col("MsCPUWait")], Cell::Na);
+        assert_eq!(rows[1][col("FrameTime")], Cell::Na);
+        assert_eq!(rows[1][col("MsUntilDisplayed")], Cell::Na);
+        assert_eq!(rows[1][col("MsGPULatency")], Cell::Na);
+        assert_eq!(rows[1][col("Dropped")], Cell::Count(1));
+    }
 }

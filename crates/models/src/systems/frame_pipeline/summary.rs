@@ -12,7 +12,7 @@ use crate::engine::{PS_PER_MS, RunStats, StopReason};
 use super::accounting::{BOTTLENECKS, CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES};
 use super::config::{FramePipelineConfig, FramesWorkload, WorkloadConfig};
 use super::model::FramePipeline;
-use super::records::frame_rows;
+use super::records::{metric, metric_rows};
 use super::workload::SceneProgram;
 use crate::systems::summary::{Dist, EventCounts, events_per_second};
 
@@ -145,9 +145,9 @@ pub struct PipelineMetrics {
     pub frame_time_ms: Dist,
     /// Time between displayed frames (PresentMon's MsBetweenDisplayChange).
     pub display_interval_ms: Dist,
-    /// Present to display.
+    /// Input sampled to display (`frames.csv`'s `MsInputLatency`).
     pub display_latency_ms: Dist,
-    /// CPU start to display.
+    /// Present to display (PresentMon's `MsUntilDisplayed`).
     pub until_displayed_ms: Dist,
     /// GPU time per frame (first to last GPU work).
     pub gpu_time_ms: Dist,
@@ -239,7 +239,7 @@ pub(super) fn summarize(
     let end = stats.end_time;
     let elapsed = end.0.max(1) as f64;
     let warm = m.env.cfg.run.warmup_frames as usize;
-    let rows = frame_rows(&m.env.records);
+    let rows = metric_rows(&m.env.records);
     let col = |i: usize| -> Dist { Dist::of_finite(&rows.iter().skip(warm).map(|r| r[i]).collect::<Vec<f64>>()) };
     let cpu = m.acct.cpu.totals_at(end);
     let front = m.acct.front.totals_at(end);
@@ -281,13 +281,13 @@ pub(super) fn summarize(
         simulated_seconds: end.0 as f64 / 1e12,
         stopped_by: stats.stopped_by,
         metrics: PipelineMetrics {
-            frame_time_ms: col(2),
-            display_interval_ms: col(11),
-            display_latency_ms: col(10),
-            until_displayed_ms: col(9),
-            gpu_time_ms: col(6),
-            cpu_busy_ms: col(3),
-            gpu_busy_ms: col(7),
+            frame_time_ms: col(metric::FRAME_TIME),
+            display_interval_ms: col(metric::DISPLAY_INTERVAL),
+            display_latency_ms: col(metric::INPUT_LATENCY),
+            until_displayed_ms: col(metric::UNTIL_DISPLAYED),
+            gpu_time_ms: col(metric::GPU_TIME),
+            cpu_busy_ms: col(metric::CPU_WORK),
+            gpu_busy_ms: col(metric::GPU_BUSY),
             cpu_busy_fraction: (cpu[0] + cpu[1]) as f64 / elapsed,
             cpu_wait_fraction: (cpu[2] + cpu[3]) as f64 / elapsed,
             gpu_busy_fraction: gpu[0] as f64 / elapsed,
@@ -307,8 +307,20 @@ pub(super) fn summarize(
                 .map(|(n, t)| (n.to_string(), t as f64 / elapsed))
                 .collect(),
             states_ms: StatesMs {
-                // The pacing states only where `[pacing]` is on.
-                cpu: states(&CPU_STATES[..if m.env.cfg.pacing.is_off() { 5 } else { 7 }], &cpu),
+                // The pacing states only where `[pacing]` is on, the present
+                // call only for a workload given frame by frame.
+                cpu: {
+                    let pacing = !m.env.cfg.pacing.is_off();
+                    let frames = matches!(m.env.cfg.workload, WorkloadConfig::Frames(_));
+                    let shown = |i: usize| i < 5 || (pacing && i < 7) || (frames && i == 7);
+                    CPU_STATES
+                        .iter()
+                        .zip(cpu)
+                        .enumerate()
+                        .filter(|&(i, _)| shown(i))
+                        .map(|(_, (n, t))| (n.to_string(), ms(t)))
+                        .collect()
+                },
                 gpu_front_end: states(&FRONT_STATES, &front),
                 geometry: states(&GEOM_STATES, &geom),
                 fragment: states(&FRAG_STATES, &frag),

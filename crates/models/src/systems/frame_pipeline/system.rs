@@ -7,7 +7,7 @@ use crate::output::trace::TraceWriter;
 use crate::systems::{Outcome, SystemError, SystemModel, outcome_basics, resolved_toml};
 
 use super::config::{FramePipelineConfig, WorkloadConfig};
-use super::records::{COLUMNS, frame_rows, write_frames_csv};
+use super::records::{COLUMNS, ChainInfo, frame_rows, write_frames_csv};
 use super::run::{PipelineRun, run_pipeline};
 
 /// `system = "frame_pipeline"` (the default).
@@ -23,18 +23,25 @@ impl SystemModel for FramePipelineSystem {
     }
 }
 
+impl PipelineRun {
+    /// Writes the run's `frames.csv` (PresentMon 2 columns, [`super::records`]).
+    pub fn write_frames_csv(&self, w: impl Write) -> std::io::Result<()> {
+        write_frames_csv(&self.records, &ChainInfo::of_display(&self.config.display), 0, w)
+    }
+}
+
 impl Outcome for PipelineRun {
     outcome_basics!();
 
     fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
         (
             COLUMNS.iter().map(|s| s.to_string()).collect(),
-            frame_rows(&self.records).into_iter().map(|row| row.to_vec()).collect(),
+            frame_rows(&self.records, 0),
         )
     }
 
     fn write_table(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        write_frames_csv(&self.records, w)
+        PipelineRun::write_frames_csv(self, w)
     }
 
     /// Mesh files named relative to the model are made absolute, so the

@@ -60,6 +60,16 @@ pub(super) fn validate(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
                 ));
             }
         }
+        if !f.gpu_end.is_empty() && (f.gpu_end.len() as u64) < cfg.run.frames {
+            return Err(bad(
+                "workload.gpu_end",
+                format!(
+                    "holds {} frames, but run.frames is {}: give one value per frame, or leave the list out",
+                    f.gpu_end.len(),
+                    cfg.run.frames
+                ),
+            ));
+        }
         if let Some(i) = (0..f.cpu.len().min(f.submit.len())).find(|&i| f.submit[i] > f.cpu[i]) {
             return Err(bad(
                 &format!("workload.submit[{i}]"),
@@ -237,7 +247,8 @@ fn check_scene_sizes(sc: &crate::scene::config::SceneWorkload) -> Result<(), Sys
 
 /// Bytes a frame's results take: its record, its table row and the metric
 /// columns built from it.
-const BYTES_PER_FRAME: usize = std::mem::size_of::<FrameRecord>() + 14 * 8 + 8 * 8;
+const BYTES_PER_FRAME: usize =
+    std::mem::size_of::<FrameRecord>() + super::records::COLUMNS.len() * 8 + super::records::metric::N * 8;
 
 /// Estimates the memory a run needs from its inputs, before simulating:
 /// per-frame records, the scene's draws and generated index buffers (a
