@@ -38,6 +38,7 @@ mod shards;
 mod sortbuf;
 mod state_sorting;
 mod table1_split;
+mod tearing;
 mod timeline;
 mod unified;
 mod view_cells;

@@ -69,6 +69,10 @@ pub struct DisplayStats {
     /// Display changes whose interval differs from the previous one by more
     /// than half a refresh (a changed display cadence).
     pub stutters: usize,
+    /// Frames a second whose flip tore the picture, for a simulated display
+    /// whose flips do not wait for a vertical blank (`null` otherwise, and
+    /// for a capture, which does not record tear lines).
+    pub torn_per_second: Option<f64>,
 }
 
 impl DisplayStats {
@@ -109,6 +113,7 @@ impl DisplayStats {
             displayed_fps: rate(changes.len(), span(&changes)),
             repeated_refreshes: repeated,
             stutters,
+            torn_per_second: None,
         }
     }
 }

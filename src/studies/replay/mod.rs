@@ -543,6 +543,8 @@ struct Simulated {
     seconds: f64,
     /// The refreshes that repeated an image, as the display counted them.
     repeated_refreshes: u64,
+    /// Torn frames per second, when flips do not wait for a vertical blank.
+    torn_per_second: Option<f64>,
 }
 
 impl Simulated {
@@ -555,6 +557,7 @@ impl Simulated {
         if self.model.display.vrr.is_some() {
             st.repeated_refreshes = self.repeated_refreshes;
         }
+        st.torn_per_second = self.torn_per_second;
         st
     }
 }
@@ -609,12 +612,14 @@ fn simulate(s: &Setup, sets: &[String]) -> Result<Simulated, ReplayError> {
         };
     }
     let repeated_refreshes = run.summary["metrics"]["repeated_refreshes"].as_u64().unwrap_or(0);
+    let torn_per_second = run.summary["metrics"]["tearing"]["torn_per_second"].as_f64();
     Ok(Simulated {
         frames,
         model,
         records: run.records,
         seconds,
         repeated_refreshes,
+        torn_per_second,
     })
 }
 

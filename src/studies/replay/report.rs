@@ -16,7 +16,7 @@ fn display_figures(s: &ReplaySummary, w: &mut impl std::io::Write) -> std::io::R
     }
     let f = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.2}"));
     type Row<'a> = (&'a str, &'a dyn Fn(&DisplayStats) -> String);
-    let rows: [Row; 8] = [
+    let rows: [Row; 9] = [
         ("display latency median (ms)", &|d| f(d.display_latency_ms.median)),
         ("display latency p90 (ms)", &|d| f(d.display_latency_ms.p90)),
         ("display latency p99 (ms)", &|d| f(d.display_latency_ms.p99)),
@@ -25,7 +25,12 @@ fn display_figures(s: &ReplaySummary, w: &mut impl std::io::Write) -> std::io::R
         ("dropped frames", &|d| d.dropped.to_string()),
         ("repeated refreshes", &|d| d.repeated_refreshes.to_string()),
         ("stutters", &|d| d.stutters.to_string()),
+        ("torn frames per second", &|d| f(d.torn_per_second)),
     ];
+    // Tearing only where a column has it.
+    let rows = rows.into_iter().filter(|(label, _)| {
+        *label != "torn frames per second" || cols.iter().any(|(_, d)| d.torn_per_second.is_some())
+    });
     write!(w, "  {:<30}", "")?;
     for (name, _) in &cols {
         write!(w, "{name:>13}")?;

@@ -1,5 +1,5 @@
 //! Reusable parts that systems compose: distributions, vertex caches, bounded
-//! FIFOs, swap chains, frame pacing (limiters, low-latency pacers),
+//! FIFOs, swap chains, tearing, frame pacing (limiters, low-latency pacers),
 //! system-task noise, preemptible processors, a unified shader-core pool and
 //! state-time accounting.
 
@@ -13,4 +13,5 @@ pub mod shader_pool;
 pub mod sorting_buffer;
 pub mod state_clock;
 pub mod swap_chain;
+pub mod tearing;
 pub mod vertex_cache;

@@ -7,7 +7,9 @@
 //!   the GPU waits for a free image (classic double/triple buffering).
 //! - `mailbox`: a newly presented frame replaces a queued one (the replaced
 //!   frame is dropped and its image freed); each vertical blank shows it.
-//! - `immediate` (or vsync off): a presented frame is shown at once (tearing).
+//! - `immediate` (or vsync off): a presented frame is shown at once, tearing
+//!   the picture where the scan-out is (`display.blanking`, the share of a
+//!   refresh in vertical blanking: [`crate::components::tearing`]).
 //!
 //! One image is always the front buffer being scanned out; `buffers` counts
 //! all images, so double buffering leaves one image to render into.
@@ -96,6 +98,15 @@ pub struct DisplayConfig {
     /// fixed refresh.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub vrr: Option<VrrConfig>,
+    /// The share of each refresh spent in vertical blanking: where an
+    /// `immediate` flip tears ([`crate::components::tearing`]); 0.04 unless
+    /// given.
+    #[serde(skip_serializing_if = "is_default_blanking")]
+    pub blanking: f64,
+}
+
+fn is_default_blanking(b: &f64) -> bool {
+    *b == crate::components::tearing::DEFAULT_BLANKING
 }
 
 /// A variable-refresh panel's window (`[display.vrr]`, see the module docs).
@@ -153,16 +164,25 @@ impl DisplayConfig {
     }
 
     /// The first key this display sets that only the frame pipeline models
-    /// (composition, variable refresh), with what to say; `None` when a
+    /// (composition, variable refresh, the blanking tearing reads), with
+    /// what to say; `None` when a
     /// system with a plain fixed-refresh display can run it.
     pub fn beyond_fixed_refresh(&self) -> Option<(&'static str, &'static str)> {
         if !self.composition.is_independent() {
             Some(("display.composition", "a composed display"))
         } else if self.vrr.is_some() {
             Some(("display.vrr", "a variable-refresh display"))
+        } else if !is_default_blanking(&self.blanking) {
+            Some(("display.blanking", "the tear line of a display's scan-out"))
         } else {
             None
         }
+    }
+
+    /// The scan-out an `immediate` flip tears, `None` when flips wait for a
+    /// vertical blank.
+    pub fn scan_out(&self) -> Option<crate::components::tearing::ScanOut> {
+        (!self.waits_for_vblank()).then(|| crate::components::tearing::ScanOut::new(self.refresh.period, self.blanking))
     }
 
     /// Time from a flip to the frame on screen: one refresh when composed,
@@ -186,6 +206,15 @@ impl DisplayConfig {
         }
         if let Some(v) = &self.vrr {
             self.check_vrr(v)?;
+        }
+        if !(0.0..1.0).contains(&self.blanking) {
+            return Err((
+                "display.blanking",
+                format!(
+                    "must be at least 0 and below 1 (the share of a refresh in vertical blanking), got {}",
+                    self.blanking
+                ),
+            ));
         }
         if !(2..=16).contains(&self.buffers) {
             return Err((
@@ -267,6 +296,7 @@ impl Default for DisplayConfig {
             present_mode: PresentMode::Fifo,
             composition: Composition::Independent,
             vrr: None,
+            blanking: crate::components::tearing::DEFAULT_BLANKING,
         }
     }
 }

@@ -7,7 +7,9 @@
 //! display (`display.vrr`) has no fixed vertical blank: a flipped frame
 //! starts a scan-out at once when the panel is idle, or when the scan-out
 //! under way ends; a panel that got no new frame within its slowest period
-//! repeats the old one ([`crate::components::swap_chain::VrrConfig`]).
+//! repeats the old one ([`crate::components::swap_chain::VrrConfig`]). A
+//! frame flipped at once (`immediate`) tears the picture where the scan-out
+//! is ([`crate::components::tearing`]): its record keeps the tear line.
 //!
 //! [`Display`] owns the display's counters (vertical blanks, repeated
 //! refreshes, the mark where refresh metrics start after warm-up, frames
@@ -15,6 +17,7 @@
 //! the critical path it reports presents and shows to are arguments.
 
 use crate::components::swap_chain::{Flip, PresentMode, SwapChain, VrrWindow};
+use crate::components::tearing::ScanOut;
 use crate::engine::{Duration, Scheduler, Time};
 use crate::systems::error::SystemError;
 
@@ -40,6 +43,8 @@ pub struct Display {
     resolved: u64,
     /// The variable-refresh window and the panel's scan-outs, when `vrr`.
     vrr: Option<Vrr>,
+    /// The scan-out a flip tears, when flips do not wait for a vertical blank.
+    scan: Option<ScanOut>,
 }
 
 /// A variable-refresh panel's state: its window, the start of its last
@@ -56,9 +61,9 @@ impl Display {
     /// `compositor_delay` later, for a run of `frames_total` frames whose
     /// first `warmup_frames` are warm-up.
     /// `vrr`: a variable-refresh window (then `refresh` is its shortest
-    /// period).
+    /// period); `scan`: the scan-out an `immediate` flip tears.
     pub(super) fn new(
-        (refresh, compositor_delay, vrr): (Duration, Duration, Option<VrrWindow>),
+        (refresh, compositor_delay, vrr, scan): (Duration, Duration, Option<VrrWindow>, Option<ScanOut>),
         frames_total: u64,
         warmup_frames: u64,
     ) -> Self {
@@ -77,6 +82,7 @@ impl Display {
                 scan_start: None,
                 tag: 0,
             }),
+            scan,
         }
     }
 
@@ -166,6 +172,9 @@ impl Display {
                 self.repeated_refreshes += crossed.saturating_sub(1);
             }
             records[f as usize].displayed = Some(Time(now.0.saturating_add(self.compositor_delay.0)));
+            if let Some(scan) = &self.scan {
+                records[f as usize].tear_line = scan.tear_line(now);
+            }
             path.shown(f);
             self.last_display = Some(now);
             self.resolved += 1;

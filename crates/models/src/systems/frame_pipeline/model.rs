@@ -181,6 +181,7 @@ impl FramePipeline {
                     cfg.display.shortest_period(),
                     cfg.display.compositor_delay(),
                     cfg.display.vrr_window(),
+                    cfg.display.scan_out(),
                 ),
                 frames_total,
                 cfg.run.warmup_frames,

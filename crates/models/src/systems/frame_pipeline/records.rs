@@ -36,7 +36,10 @@
 //! numbers), `MsInputLatency` (input sampled to the frame appearing: the
 //! summary's `display_latency_ms`), `MsCPUWork` and `MsCPUBlocked` (the CPU's
 //! work, system tasks included, and its blocked time as the model accounts
-//! them to the frame), `Displayed` and `Dropped` (0 or 1).
+//! them to the frame), `TearLine` (where an `immediate` flip tore the
+//! picture, as a fraction of its height from the top; `NA` for a frame
+//! flipped in the vertical blank or at one), `Displayed` and `Dropped` (0
+//! or 1).
 //!
 //! Times are written exactly: integer picoseconds as milliseconds with nine
 //! decimals.
@@ -74,6 +77,9 @@ pub struct FrameRecord {
     pub displayed: Option<Time>,
     /// Discarded without being shown.
     pub dropped: bool,
+    /// Where its flip tore the picture (fraction of the height from the
+    /// top; `immediate` flips during the scan-out only).
+    pub tear_line: Option<f64>,
 }
 
 impl FrameRecord {
@@ -92,6 +98,7 @@ impl FrameRecord {
             gpu_busy: 0,
             displayed: None,
             dropped: false,
+            tear_line: None,
         }
     }
 }
@@ -208,7 +215,7 @@ pub const TEXT_COLUMNS: [&str; 9] = [
 ];
 
 /// The numeric columns of `frames.csv` (the frames table experiments read).
-pub const COLUMNS: [&str; 22] = [
+pub const COLUMNS: [&str; 23] = [
     "Frame",
     "CPUStartTime",
     "FrameTime",
@@ -229,19 +236,21 @@ pub const COLUMNS: [&str; 22] = [
     "MsInputLatency",
     "MsCPUWork",
     "MsCPUBlocked",
+    "TearLine",
     "Displayed",
     "Dropped",
 ];
 
 /// Columns of [`COLUMNS`] that are counts or flags, not times.
-const COUNT_COLUMNS: [usize; 3] = [0, 20, 21];
+const COUNT_COLUMNS: [usize; 3] = [0, 21, 22];
 
 /// One cell of the numeric columns: picoseconds (a time on the run's clock
 /// or a duration, signed), a count, or `NA`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 enum Cell {
     Ps(i64),
     Count(u64),
+    Fraction(f64),
     Na,
 }
 
@@ -250,6 +259,7 @@ impl Cell {
         match self {
             Cell::Ps(p) => p as f64 / PS_PER_MS as f64,
             Cell::Count(n) => n as f64,
+            Cell::Fraction(x) => x,
             Cell::Na => f64::NAN,
         }
     }
@@ -264,6 +274,7 @@ impl Cell {
                 format!("{sign}{}.{:09}", a / ms as u64, a % ms as u64)
             }
             Cell::Count(n) => n.to_string(),
+            Cell::Fraction(x) => format!("{x:.6}"),
             Cell::Na => "NA".into(),
         }
     }
@@ -276,7 +287,7 @@ fn span(a: Time, b: Time) -> Cell {
 
 /// The numeric cells of every frame, [`COLUMNS`] in order; `offset_ps` is
 /// added to `CPUStartTime` (a replay writes the capture's clock).
-fn cells(records: &[FrameRecord], offset_ps: i64) -> Vec<[Cell; 22]> {
+fn cells(records: &[FrameRecord], offset_ps: i64) -> Vec<[Cell; 23]> {
     let mut rows = Vec::with_capacity(records.len());
     let mut prev_display: Option<Time> = None;
     for (i, r) in records.iter().enumerate() {
@@ -318,6 +329,7 @@ fn cells(records: &[FrameRecord], offset_ps: i64) -> Vec<[Cell; 22]> {
             opt(Some(r.input), r.displayed),
             Cell::Ps(r.cpu_busy as i64),
             Cell::Ps(r.cpu_wait as i64),
+            r.tear_line.map_or(Cell::Na, Cell::Fraction),
             Cell::Count(u64::from(r.displayed.is_some())),
             Cell::Count(u64::from(r.dropped)),
         ]);

@@ -56,6 +56,16 @@ pub fn write_report(s: &Value, w: &mut dyn Write) -> io::Result<()> {
         m["repeated_refreshes"],
         m["dropped_frames"]
     )?;
+    let t = &m["tearing"];
+    if t.is_object() {
+        writeln!(
+            w,
+            "  tearing: {} frames torn ({} per second), tear line median {} of the height from the top",
+            t["torn_frames"],
+            fixed(f(&t["torn_per_second"]), 1),
+            fixed(f(&t["tear_line"]["p50"]), 3)
+        )?;
+    }
     if let Some(b) = m["bottleneck"].as_object() {
         let mut v: Vec<(&String, f64)> = b.iter().map(|(k, v)| (k, f(v))).collect();
         v.sort_by(|a, b| b.1.total_cmp(&a.1));

@@ -173,6 +173,10 @@ pub struct PipelineMetrics {
     pub displayed_frames: usize,
     /// Frames replaced before they were shown.
     pub dropped_frames: usize,
+    /// Where `immediate` flips tore the picture (left out when flips wait
+    /// for a vertical blank).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tearing: Option<TearingStats>,
     /// Share of the run each unit was on the critical path (the time
     /// shortening its work would save; see `critical_path.rs`).
     pub bottleneck: BTreeMap<String, f64>,
@@ -182,6 +186,20 @@ pub struct PipelineMetrics {
     pub commands: CommandCounts,
     /// The closed-form terms beside the simulation.
     pub analytic: AnalyticTerms,
+}
+
+/// Tearing of a display whose flips do not wait for a vertical blank
+/// (`metrics.tearing`, frames after the warm-up;
+/// [`crate::components::tearing`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct TearingStats {
+    /// Frames whose flip landed in the scan-out and tore the picture.
+    pub torn_frames: usize,
+    /// Torn frames per second, from the first frame shown after the warm-up
+    /// to the end of the run.
+    pub torn_per_second: f64,
+    /// Where they tore: the fraction of the picture's height from the top.
+    pub tear_line: Dist,
 }
 
 /// The summary of a frame-pipeline run (`summary.json`).
@@ -301,6 +319,15 @@ pub(super) fn summarize(
             },
             displayed_frames: displayed,
             dropped_frames: dropped,
+            tearing: m.env.cfg.display.scan_out().map(|_| {
+                let lines: Vec<f64> = m.env.records.iter().skip(warm).filter_map(|r| r.tear_line).collect();
+                let span = end.0.saturating_sub(mark_time.0) as f64 / 1e12;
+                TearingStats {
+                    torn_frames: lines.len(),
+                    torn_per_second: if span > 0.0 { lines.len() as f64 / span } else { 0.0 },
+                    tear_line: Dist::of_finite(&lines),
+                }
+            }),
             bottleneck: BOTTLENECKS
                 .iter()
                 .zip(bott)
