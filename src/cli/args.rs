@@ -634,7 +634,7 @@ mod tests {
 /// `rendersim timeline`.
 #[derive(Args)]
 pub struct TimelineArgs {
-    /// Model file (TOML, a frame pipeline); the default model when omitted.
+    /// Model file (TOML, a frame pipeline, or a `system = "replay"` capture); the default model when omitted.
     pub model: Option<PathBuf>,
     /// Override a model key (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]

@@ -4,6 +4,10 @@
 //! to, so that a reader sees the CPU preparing frame n+1 while the GPU draws
 //! frame n, with the vertical blanks marked (paper 004 §4.2).
 //!
+//! A replayed capture (a `system = "replay"` model file) is drawn as the
+//! frame-pipeline run its replay makes (as captured, or under the file's
+//! what-if): the capture's frames on the pipeline's lanes.
+//!
 //! The picture is built from the run's own trace ([`crate::systems::frame_pipeline::accounting`]),
 //! read back while it is written ([`crate::output::trace_read`]): the CPU's
 //! and the display's spans carry their frame; GPU work is given the frame
@@ -57,6 +61,14 @@ pub enum TimelineError {
     /// The model could not be loaded or run.
     #[error(transparent)]
     Sim(#[from] SimError),
+    /// A replayed capture (`system = "replay"`) could not be replayed.
+    #[error("{model}: {source}")]
+    Replay {
+        /// The model's name.
+        model: String,
+        /// What went wrong.
+        source: Box<crate::studies::replay::ReplayError>,
+    },
     /// The run's trace could not be read back.
     #[error("{0}")]
     Trace(String),
@@ -136,6 +148,32 @@ fn gpu_bars(spans: &[&ReadSpan], windows: &[(f64, f64, u64)]) -> Vec<Bar> {
     bars
 }
 
+/// The timeline of a replayed capture (`system = "replay"` model): the
+/// frame-pipeline model its replay runs, with the file's assumptions and
+/// what-if.
+fn replay_timeline(
+    src: &ModelSource,
+    table: &toml::Table,
+    opts: TimelineOptions,
+) -> Result<(Timeline, PipelineRun), TimelineError> {
+    use crate::studies::replay::config::{ReplayConfig, whatif_sets};
+    let r: ReplayConfig = deserialize(table, src).map_err(SimError::from)?;
+    let ropts = crate::studies::replay::ReplayOptions {
+        app: r.app.clone(),
+        swap_chain: r.swapchain.clone(),
+        sets: whatif_sets(&r.whatif),
+        assume: whatif_sets(&r.assume),
+    };
+    let (rsrc, rtable) =
+        crate::studies::replay::replay_model(&src.base_dir.join(&r.capture), &ropts).map_err(|source| {
+            TimelineError::Replay {
+                model: src.name.clone(),
+                source: Box::new(source),
+            }
+        })?;
+    timeline_of(&rsrc, &rtable, opts)
+}
+
 /// Runs the frame-pipeline model `src`/`table` for `opts.first +
 /// opts.frames` frames (no warm-up) with its trace read back, and lays out
 /// the timeline of the frames drawn.
@@ -161,6 +199,9 @@ pub fn timeline_of(
         Some(toml::Value::String(s)) => s.clone(),
         Some(other) => other.to_string(),
     };
+    if system == "replay" {
+        return replay_timeline(src, table, opts);
+    }
     if system != "frame_pipeline" {
         return Err(TimelineError::NotFramePipeline {
             model: src.name.clone(),

@@ -92,3 +92,56 @@ fn bad_requests_are_refused_clearly() {
     let err = refused(&["timeline", "--frames", "3", "--from", "100001"], &svg);
     assert!(err.contains("100000"), "{err}");
 }
+
+#[test]
+fn a_replayed_capture_is_drawn_as_the_run_its_replay_makes() {
+    // A `system = "replay"` model: the capture's frames on the pipeline's
+    // lanes, with the model file's what-if applied.
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("capture.toml");
+    let capture = std::path::Path::new(ROOT).join("tests/fixtures/presentmon/test_case_0.csv");
+    std::fs::write(
+        &model,
+        format!(
+            "system = \"replay\"\ncapture = {:?}\n[whatif]\ncpu.max_frames_ahead = 1\n",
+            capture.display().to_string()
+        ),
+    )
+    .unwrap();
+    let svg = dir.path().join("t.svg");
+    let o = bin()
+        .args([
+            "timeline",
+            model.to_str().unwrap(),
+            "--frames",
+            "8",
+            "--from",
+            "20",
+            "--out",
+        ])
+        .arg(&svg)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        text.contains("Frames 20-27") && text.contains("display"),
+        "{}",
+        &text[..200.min(text.len())]
+    );
+    // Past the capture's frames, and a capture that is not there: clear errors.
+    let err = refused(
+        &["timeline", model.to_str().unwrap(), "--frames", "10", "--from", "195"],
+        &svg.with_extension("png"),
+    );
+    assert!(err.contains("workload.cpu") && err.contains("197 frames"), "{err}");
+    std::fs::write(&model, "system = \"replay\"\ncapture = \"none.csv\"\n").unwrap();
+    let err = refused(
+        &["timeline", model.to_str().unwrap(), "--frames", "3"],
+        &svg.with_extension("png"),
+    );
+    assert!(
+        err.contains("capture.toml") && err.contains("cannot read capture"),
+        "{err}"
+    );
+}

@@ -562,10 +562,26 @@ impl Simulated {
     }
 }
 
-/// One simulation of the set-up frames with `sets` patched on.
-fn simulate(s: &Setup, sets: &[String]) -> Result<Simulated, ReplayError> {
+/// The frame-pipeline model of the set-up frames with `sets` patched on.
+fn model_of(s: &Setup, sets: &[String]) -> Result<(ModelSource, toml::Table), ReplayError> {
     let (mut src, mut table) = (s.src.clone(), s.table.clone());
     Overrides::with_sets(sets).apply(&mut src, &mut table)?;
+    Ok((src, table))
+}
+
+/// The frame-pipeline model a replay of the capture at `path` runs (as
+/// captured with `opts.assume`, then `opts.sets`): what `rendersim timeline`
+/// draws for a `system = "replay"` model. Its times start at the vertical
+/// blank before the capture's first CPU start.
+pub fn replay_model(path: &Path, opts: &ReplayOptions) -> Result<(ModelSource, toml::Table), ReplayError> {
+    let capture = Capture::read(path)?;
+    let s = setup(&capture, opts)?;
+    model_of(&s, &opts.sets)
+}
+
+/// One simulation of the set-up frames with `sets` patched on.
+fn simulate(s: &Setup, sets: &[String]) -> Result<Simulated, ReplayError> {
+    let (src, table) = model_of(s, sets)?;
     let cfg: FramePipelineConfig = deserialize(&table, &src)?;
     let sim = std::time::Instant::now();
     // A value the model cannot use is blamed on the option that gave it.
