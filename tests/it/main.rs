@@ -16,6 +16,7 @@ mod display_oracles;
 mod estimation;
 mod extreme;
 mod forsyth;
+mod frame_generation;
 mod fuzz;
 mod golden;
 mod lavapipe_policy;

@@ -129,9 +129,9 @@ fn every_shipped_frame_pipeline_model_replays_exactly_from_its_frames_csv() {
 }
 
 #[test]
-fn present_modes_composition_pacing_and_variable_refresh_replay_exactly() {
+fn present_modes_composition_pacing_variable_refresh_and_frame_generation_replay_exactly() {
     let fixed = repo().join("models/fixed.toml");
-    let cases: [(&[&str], &[&str]); 8] = [
+    let cases: [(&[&str], &[&str]); 10] = [
         (&["display.present_mode=\"mailbox\"", "display.buffers=3"], &[]),
         // Composed, every frame of this GPU-bound model is shown two refreshes
         // after the one before: its screen times fit 30 Hz as well as 60 Hz,
@@ -145,6 +145,31 @@ fn present_modes_composition_pacing_and_variable_refresh_replay_exactly() {
         (
             &["display.refresh=\"144Hz\"", "display.vrr.min_refresh=\"48Hz\""],
             &["display.refresh=\"144Hz\"", "display.vrr.min_refresh=\"48Hz\""],
+        ),
+        // Frame generation (assumed: a capture does not say it), with its
+        // generated rows in the capture, which the replay skips and makes
+        // again.
+        (
+            &[
+                "display.vsync=false",
+                "display.buffers=3",
+                "frame_generation.enabled=true",
+            ],
+            &["frame_generation.enabled=true"],
+        ),
+        (
+            &[
+                "display.buffers=4",
+                "frame_generation.enabled=true",
+                "frame_generation.cost=\"2ms\"",
+            ],
+            // Rendered frames every other refresh: the refresh (fitted to the
+            // rendered frames alone) is given.
+            &[
+                "frame_generation.enabled=true",
+                "frame_generation.cost=\"2ms\"",
+                "display.refresh=\"60Hz\"",
+            ],
         ),
     ];
     for (sets, extra) in cases {

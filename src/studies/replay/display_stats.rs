@@ -49,7 +49,7 @@ impl Percentiles {
 pub struct DisplayStats {
     /// Frames presented.
     pub frames: usize,
-    /// Frames shown.
+    /// Frames shown (generated ones too).
     pub displayed: usize,
     /// Frames presented and never shown.
     pub dropped: usize,
@@ -79,7 +79,21 @@ impl DisplayStats {
     /// The figures of `frames` (in present order) on a display refreshing
     /// every `refresh_ms`.
     pub fn of(frames: &[FrameTimes], refresh_ms: f64) -> DisplayStats {
-        let screens: Vec<f64> = frames.iter().filter_map(|f| f.screen).collect();
+        DisplayStats::with_generated(frames, &[], refresh_ms)
+    }
+
+    /// The figures of `frames` and of frames generated between them, shown
+    /// at `generated` (ms; frame generation): display latency, frame rate
+    /// and the 1% low are the rendered frames'; `displayed`, display
+    /// changes, repeated refreshes and stutters count every frame shown.
+    pub fn with_generated(frames: &[FrameTimes], generated: &[f64], refresh_ms: f64) -> DisplayStats {
+        let mut screens: Vec<f64> = frames
+            .iter()
+            .filter_map(|f| f.screen)
+            .chain(generated.iter().copied())
+            .collect();
+        screens.sort_by(f64::total_cmp);
+        let rendered_shown = frames.iter().filter(|f| f.screen.is_some()).count();
         let latency = frames.iter().filter_map(|f| Some(f.screen? - f.cpu_start)).collect();
         let present_gaps: Vec<f64> = frames.windows(2).map(|w| w[1].present - w[0].present).collect();
         let changes: Vec<f64> = screens.windows(2).map(|w| w[1] - w[0]).collect();
@@ -106,7 +120,7 @@ impl DisplayStats {
         DisplayStats {
             frames: frames.len(),
             displayed: screens.len(),
-            dropped: frames.len() - screens.len(),
+            dropped: frames.len() - rendered_shown,
             display_latency_ms: Percentiles::of(latency),
             fps: rate(present_gaps.len(), span(&present_gaps)),
             low_1pct_fps: low,

@@ -103,7 +103,7 @@ impl Outcome for ReplayRun {
         let run = self.replay.whatif_replayed.as_ref().unwrap_or(&self.replay.replayed);
         (
             COLUMNS.iter().map(|c| c.to_string()).collect(),
-            frame_rows(&run.records, run.origin_ps),
+            frame_rows(&run.records, &run.generated, run.origin_ps),
         )
     }
 

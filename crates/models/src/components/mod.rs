@@ -1,10 +1,11 @@
 //! Reusable parts that systems compose: distributions, vertex caches, bounded
-//! FIFOs, swap chains, tearing, frame pacing (limiters, low-latency pacers),
+//! FIFOs, swap chains, tearing, frame pacing (limiters, low-latency pacers), frame generation,
 //! system-task noise, preemptible processors, a unified shader-core pool and
 //! state-time accounting.
 
 pub mod distribution;
 pub mod fifo;
+pub mod frame_generation;
 pub mod frame_pacing;
 pub mod lod_select;
 pub mod noise;

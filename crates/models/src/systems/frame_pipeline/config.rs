@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::components::distribution::Dist;
 use crate::components::fifo::FifoUnit;
+pub use crate::components::frame_generation::FrameGenerationConfig;
 pub use crate::components::frame_pacing::PacingConfig;
 use crate::components::noise::NoiseTarget;
 pub use crate::components::swap_chain::DisplayConfig;
@@ -70,6 +71,10 @@ pub struct FramePipelineConfig {
     /// resolved model only when given).
     #[serde(default, skip_serializing_if = "PacingConfig::is_off")]
     pub pacing: PacingConfig,
+    /// Frame generation by interpolation (off unless enabled; written to the
+    /// resolved model only when enabled).
+    #[serde(default, skip_serializing_if = "FrameGenerationConfig::is_off")]
+    pub frame_generation: FrameGenerationConfig,
     /// What is rendered.
     pub workload: WorkloadConfig,
 }

@@ -10,12 +10,17 @@
 //! repeats the old one ([`crate::components::swap_chain::VrrConfig`]). A
 //! frame flipped at once (`immediate`) tears the picture where the scan-out
 //! is ([`crate::components::tearing`]): its record keeps the tear line.
+//! With frame generation (`[frame_generation]`,
+//! [`crate::components::frame_generation`]) a rendered frame after the
+//! first is preceded by a generated one and held back half a rendered
+//! interval ([`Display::present_rendered`]).
 //!
 //! [`Display`] owns the display's counters (vertical blanks, repeated
 //! refreshes, the mark where refresh metrics start after warm-up, frames
 //! shown or dropped) and its transitions; the swap chain, the records and
 //! the critical path it reports presents and shows to are arguments.
 
+use crate::components::frame_generation::{generated_before, generated_id, held_present};
 use crate::components::swap_chain::{Flip, PresentMode, SwapChain, VrrWindow};
 use crate::components::tearing::ScanOut;
 use crate::engine::{Duration, Scheduler, Time};
@@ -23,7 +28,7 @@ use crate::systems::error::SystemError;
 
 use super::critical_path::CriticalPath;
 use super::events::Ev;
-use super::records::FrameRecord;
+use super::records::{FrameRecord, GeneratedRecord};
 
 /// The display.
 #[derive(Debug)]
@@ -45,6 +50,35 @@ pub struct Display {
     vrr: Option<Vrr>,
     /// The scan-out a flip tears, when flips do not wait for a vertical blank.
     scan: Option<ScanOut>,
+    /// Frame generation's state, when it is on.
+    generation: Option<Generation>,
+}
+
+/// Frame generation at the display: the rendered frame held back, the
+/// generated frames, and those discarded for want of an image.
+#[derive(Debug, Default)]
+struct Generation {
+    /// The rendered frame held back, and when it goes out.
+    held: Option<(u64, Time)>,
+    /// The tag of the one [`Ev::HeldPresent`] event that is not stale.
+    tag: u32,
+    /// The frames generated and presented, in order.
+    frames: Vec<GeneratedRecord>,
+    /// Generated frames discarded: no swap-chain image was free.
+    skipped: Vec<u64>,
+    /// Per rendered frame held back: (frame, GPU end to its present).
+    hold_backs: Vec<(u64, Duration)>,
+}
+
+/// What frame generation did in a run (for the summary).
+#[derive(Debug, Clone, Copy)]
+pub struct GenerationView<'a> {
+    /// The generated frames presented.
+    pub frames: &'a [GeneratedRecord],
+    /// The rendered frames whose generated frame was discarded (no image).
+    pub skipped: &'a [u64],
+    /// (frame, hold-back) per rendered frame held back.
+    pub hold_backs: &'a [(u64, Duration)],
 }
 
 /// A variable-refresh panel's state: its window, the start of its last
@@ -61,9 +95,11 @@ impl Display {
     /// `compositor_delay` later, for a run of `frames_total` frames whose
     /// first `warmup_frames` are warm-up.
     /// `vrr`: a variable-refresh window (then `refresh` is its shortest
-    /// period); `scan`: the scan-out an `immediate` flip tears.
+    /// period); `scan`: the scan-out an `immediate` flip tears;
+    /// `generation`: whether frames are generated between rendered ones.
     pub(super) fn new(
         (refresh, compositor_delay, vrr, scan): (Duration, Duration, Option<VrrWindow>, Option<ScanOut>),
+        generation: bool,
         frames_total: u64,
         warmup_frames: u64,
     ) -> Self {
@@ -83,6 +119,106 @@ impl Display {
                 tag: 0,
             }),
             scan,
+            generation: generation.then(Generation::default),
+        }
+    }
+
+    /// What frame generation did (`None` when it is off).
+    pub(super) fn generation(&self) -> Option<GenerationView<'_>> {
+        self.generation.as_ref().map(|g| GenerationView {
+            frames: &g.frames,
+            skipped: &g.skipped,
+            hold_backs: &g.hold_backs,
+        })
+    }
+
+    /// The generated frames, taken out at the end of a run.
+    pub(super) fn take_generated(&mut self) -> Vec<GeneratedRecord> {
+        self.generation
+            .as_mut()
+            .map_or_else(Vec::new, |g| std::mem::take(&mut g.frames))
+    }
+
+    /// The GPU finished rendered frame `frame` at `now` (`previous_end`: the
+    /// frame before's GPU end). Without frame generation, or for frame 0, it
+    /// is presented now. With it, a frame held back before is presented
+    /// first; the generated frame is presented now (when a swap-chain image
+    /// is free for it), and `frame` is held back half a rendered interval
+    /// ([`Ev::HeldPresent`]).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn present_rendered(
+        &mut self,
+        now: Time,
+        frame: u64,
+        previous_end: Option<Time>,
+        chain: &mut SwapChain,
+        records: &mut [FrameRecord],
+        path: &mut CriticalPath,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
+        match (&self.generation, previous_end) {
+            (Some(_), Some(prev)) => self.present_generating(now, frame, prev, chain, records, path, s),
+            _ => self.present(now, frame, chain, records, path, s),
+        }
+    }
+
+    /// [`Display::present_rendered`] with frame generation, for a frame
+    /// after the first (out of line: most runs never come here).
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
+    fn present_generating(
+        &mut self,
+        now: Time,
+        frame: u64,
+        prev: Time,
+        chain: &mut SwapChain,
+        records: &mut [FrameRecord],
+        path: &mut CriticalPath,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
+        let held = self.generation.as_mut().and_then(|g| g.held.take());
+        if let Some((h, _)) = held {
+            self.present(now, h, chain, records, path, s)?;
+        }
+        let g = self.generation.as_mut().expect("generation is on");
+        if chain.acquire() {
+            g.frames.push(GeneratedRecord {
+                before: frame,
+                present: now,
+                displayed: None,
+                dropped: false,
+                tear_line: None,
+            });
+            self.present(now, generated_id(frame), chain, records, path, s)?;
+        } else {
+            g.skipped.push(frame);
+        }
+        let g = self.generation.as_mut().expect("generation is on");
+        let at = held_present(now, prev);
+        g.hold_backs.push((frame, at.since(now)));
+        g.held = Some((frame, at));
+        g.tag = g.tag.wrapping_add(1);
+        s.at(at, Ev::HeldPresent { tag: g.tag });
+        Ok(())
+    }
+
+    /// The [`Ev::HeldPresent`] event tagged `tag`: the held rendered frame
+    /// goes out (a stale tag, whose frame went out early, does nothing).
+    pub(super) fn held_present(
+        &mut self,
+        now: Time,
+        tag: u32,
+        chain: &mut SwapChain,
+        records: &mut [FrameRecord],
+        path: &mut CriticalPath,
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
+        let Some(g) = self.generation.as_mut().filter(|g| g.tag == tag) else {
+            return Ok(());
+        };
+        match g.held.take() {
+            Some((frame, _)) => self.present(now, frame, chain, records, path, s),
+            None => Ok(()),
         }
     }
 
@@ -125,9 +261,10 @@ impl Display {
         self.resolved >= self.frames_total
     }
 
-    /// The front end presents `frame` (the GPU finished its swap). A
-    /// variable-refresh panel that is idle starts its scan-out now.
-    pub(super) fn present(
+    /// `frame` (a rendered frame, or a generated frame's id) goes to the
+    /// swap chain now. A variable-refresh panel that is idle starts its
+    /// scan-out now.
+    fn present(
         &mut self,
         now: Time,
         frame: u64,
@@ -136,7 +273,9 @@ impl Display {
         path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
-        path.presented(frame);
+        if generated_before(frame).is_none() {
+            path.presented(frame);
+        }
         let flip = chain.present(frame);
         self.apply_flip(now, flip, chain.mode(), records, path);
         if let Some(v) = &self.vrr {
@@ -159,18 +298,28 @@ impl Display {
         path: &mut CriticalPath,
     ) {
         if let Some(d) = flip.dropped {
-            records[d as usize].dropped = true;
-            self.resolved += 1;
+            match self.generated_mut(d) {
+                Some(g) => g.dropped = true,
+                None => {
+                    records[d as usize].dropped = true;
+                    self.resolved += 1;
+                }
+            }
+        }
+        if let Some(f) = flip.shown
+            && generated_before(f).is_some()
+        {
+            let shown = Time(now.0.saturating_add(self.compositor_delay.0));
+            let tear = self.scan.as_ref().and_then(|scan| scan.tear_line(now));
+            if let Some(g) = self.generated_mut(f) {
+                (g.displayed, g.tear_line) = (Some(shown), tear);
+            }
+            self.count_repeats(now, mode);
+            self.last_display = Some(now);
+            return;
         }
         if let Some(f) = flip.shown {
-            if mode == PresentMode::Immediate
-                && let Some(prev) = self.last_display
-            {
-                // Refresh boundaries crossed without a new frame.
-                let p = self.refresh.0;
-                let crossed = now.0 / p - prev.0 / p;
-                self.repeated_refreshes += crossed.saturating_sub(1);
-            }
+            self.count_repeats(now, mode);
             records[f as usize].displayed = Some(Time(now.0.saturating_add(self.compositor_delay.0)));
             if let Some(scan) = &self.scan {
                 records[f as usize].tear_line = scan.tear_line(now);
@@ -183,6 +332,27 @@ impl Display {
                 // Refresh counts after warm-up start at the first later frame shown.
                 self.refresh_mark = Some((self.vblanks, self.repeated_refreshes, now));
             }
+        }
+    }
+
+    /// The generated frame with swap-chain id `id` (`None` for a rendered
+    /// frame's id).
+    fn generated_mut(&mut self, id: u64) -> Option<&mut GeneratedRecord> {
+        let before = generated_before(id)?;
+        let g = self.generation.as_mut()?;
+        let i = g.frames.binary_search_by_key(&before, |x| x.before).ok()?;
+        Some(&mut g.frames[i])
+    }
+
+    /// An `immediate` display change at `now`: the refresh boundaries it
+    /// crossed without a new frame are repeated refreshes.
+    fn count_repeats(&mut self, now: Time, mode: PresentMode) {
+        if mode == PresentMode::Immediate
+            && let Some(prev) = self.last_display
+        {
+            let p = self.refresh.0;
+            let crossed = now.0 / p - prev.0 / p;
+            self.repeated_refreshes += crossed.saturating_sub(1);
         }
     }
 

@@ -72,6 +72,12 @@ pub enum Ev {
     /// The GPU reaches a replayed frame's measured end (`kind = "frames"`
     /// with `gpu_end` only): its swap may finish.
     GpuHoldEnd,
+    /// A rendered frame held back by frame generation goes to the swap
+    /// chain (the tag tells the one pending event from stale ones).
+    HeldPresent {
+        /// Generation tag.
+        tag: u32,
+    },
 }
 
 impl EventKind for Ev {
@@ -90,6 +96,7 @@ impl EventKind for Ev {
         "pacing_wake",
         "present_return",
         "gpu_hold_end",
+        "held_present",
     ];
     #[inline]
     fn kind(&self) -> usize {
@@ -108,6 +115,7 @@ impl EventKind for Ev {
             Ev::PaceWake => 11,
             Ev::PresentReturn => 12,
             Ev::GpuHoldEnd => 13,
+            Ev::HeldPresent { .. } => 14,
         }
     }
 }

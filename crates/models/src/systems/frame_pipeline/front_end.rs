@@ -187,7 +187,20 @@ impl FrontEnd {
                     if !(down.geom.drained() && env.links.triangles.is_empty() && !down.frag.busy()) {
                         return Ok(progressed);
                     }
-                    let work = env.cfg.gpu.swap.saturating_add(env.cfg.gpu.command);
+                    // With frame generation, the interpolation before the
+                    // frame's present is GPU work of its swap.
+                    let generate = match self.cmd {
+                        Command::Swap { frame } if env.cfg.frame_generation.enabled => {
+                            env.cfg.frame_generation.cost_before_present(frame)
+                        }
+                        _ => Duration::ZERO,
+                    };
+                    let work = env
+                        .cfg
+                        .gpu
+                        .swap
+                        .saturating_add(env.cfg.gpu.command)
+                        .saturating_add(generate);
                     if let Some(t) = self.held_until(env, work)
                         && t > now
                     {
@@ -358,8 +371,19 @@ impl FrontEnd {
                 env.links.frames_completed += 1;
                 env.records[frame as usize].gpu_end = Some(now);
                 self.frame = None;
-                down.display
-                    .present(now, frame, &mut env.links.chain, &mut env.records, down.path, s)?;
+                let previous_end = match frame.checked_sub(1) {
+                    Some(p) if env.cfg.frame_generation.enabled => env.records[p as usize].gpu_end,
+                    _ => None,
+                };
+                down.display.present_rendered(
+                    now,
+                    frame,
+                    previous_end,
+                    &mut env.links.chain,
+                    &mut env.records,
+                    down.path,
+                    s,
+                )?;
                 FrontPhase::Idle
             }
             Command::Clear { .. } | Command::Fixed { .. } => FrontPhase::Idle,

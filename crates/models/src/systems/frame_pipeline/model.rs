@@ -183,6 +183,7 @@ impl FramePipeline {
                     cfg.display.vrr_window(),
                     cfg.display.scan_out(),
                 ),
+                cfg.frame_generation.enabled,
                 frames_total,
                 cfg.run.warmup_frames,
             ),
@@ -375,19 +376,26 @@ impl FramePipeline {
 
 impl FramePipeline {
     /// A unit's timed wait ends (a zero-time frame's turn, pacing, a
-    /// replayed frame's present call or GPU end). Rare beside the units'
+    /// replayed frame's present call or GPU end, a frame held back by frame
+    /// generation). Rare beside the units'
     /// work, so kept out of `handle`, whose inlining of the stages' events
     /// it would otherwise crowd out.
     #[cold]
     #[inline(never)]
-    fn wait_ends(&mut self, ev: Ev) {
+    fn wait_ends(&mut self, now: Time, ev: Ev, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         match ev {
             Ev::ZeroTimeFrame => self.cpu.zero_time_frame(),
             Ev::PaceWake => self.cpu.pace_wake(),
             Ev::PresentReturn => self.cpu.present_returned(),
             Ev::GpuHoldEnd => self.front.hold_ends(),
+            Ev::HeldPresent { tag } => {
+                let path = &mut self.acct.path;
+                self.display
+                    .held_present(now, tag, &mut self.env.links.chain, &mut self.env.records, path, s)?;
+            }
             _ => unreachable!("not a wait's end: {ev:?}"),
         }
+        Ok(())
     }
 }
 
@@ -436,7 +444,9 @@ impl Model for FramePipeline {
             }
             Ev::NoiseArrive { source } => self.noise_arrive(now, source, s)?,
             Ev::NoiseEnd { target } => self.noise_end(now, target, s)?,
-            Ev::ZeroTimeFrame | Ev::PaceWake | Ev::PresentReturn | Ev::GpuHoldEnd => self.wait_ends(ev),
+            Ev::ZeroTimeFrame | Ev::PaceWake | Ev::PresentReturn | Ev::GpuHoldEnd | Ev::HeldPresent { .. } => {
+                self.wait_ends(now, ev, s)?
+            }
         }
         self.step(now, s)?;
         Ok(if self.done() { Control::Stop } else { Control::Continue })

@@ -56,6 +56,18 @@ pub fn write_report(s: &Value, w: &mut dyn Write) -> io::Result<()> {
         m["repeated_refreshes"],
         m["dropped_frames"]
     )?;
+    let g = &m["frame_generation"];
+    if g.is_object() {
+        writeln!(
+            w,
+            "  frame generation: {} generated frames shown ({} discarded, no image), {} frames shown per second ({} rendered), hold-back mean {} ms",
+            g["generated_shown"],
+            g["skipped"],
+            fixed(f(&g["displayed_fps"]), 1),
+            fixed(f(&g["rendered_fps"]), 1),
+            fixed(f(&g["hold_back_ms"]["mean"]), 3)
+        )?;
+    }
     let t = &m["tearing"];
     if t.is_object() {
         writeln!(

@@ -177,6 +177,9 @@ pub struct PipelineMetrics {
     /// for a vertical blank).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tearing: Option<TearingStats>,
+    /// What frame generation did (left out when it is off).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frame_generation: Option<GenerationStats>,
     /// Share of the run each unit was on the critical path (the time
     /// shortening its work would save; see `critical_path.rs`).
     pub bottleneck: BTreeMap<String, f64>,
@@ -193,13 +196,35 @@ pub struct PipelineMetrics {
 /// [`crate::components::tearing`]).
 #[derive(Debug, Clone, Serialize)]
 pub struct TearingStats {
-    /// Frames whose flip landed in the scan-out and tore the picture.
+    /// Frames (generated ones too) whose flip landed in the scan-out and
+    /// tore the picture.
     pub torn_frames: usize,
     /// Torn frames per second, from the first frame shown after the warm-up
     /// to the end of the run.
     pub torn_per_second: f64,
     /// Where they tore: the fraction of the picture's height from the top.
     pub tear_line: Dist,
+}
+
+/// Frame generation (`metrics.frame_generation`, frames after the warm-up;
+/// [`crate::components::frame_generation`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct GenerationStats {
+    /// Generated frames presented.
+    pub generated_frames: usize,
+    /// Of them, shown.
+    pub generated_shown: usize,
+    /// Generated frames discarded: no swap-chain image was free when they
+    /// were ready.
+    pub skipped: usize,
+    /// Frames shown a second, rendered and generated, from the first frame
+    /// shown after the warm-up to the end of the run.
+    pub displayed_fps: f64,
+    /// Rendered frames shown a second, over the same span.
+    pub rendered_fps: f64,
+    /// From a rendered frame's GPU end (its interpolation included) to its
+    /// present: the hold-back.
+    pub hold_back_ms: Dist,
 }
 
 /// The summary of a frame-pipeline run (`summary.json`).
@@ -319,15 +344,8 @@ pub(super) fn summarize(
             },
             displayed_frames: displayed,
             dropped_frames: dropped,
-            tearing: m.env.cfg.display.scan_out().map(|_| {
-                let lines: Vec<f64> = m.env.records.iter().skip(warm).filter_map(|r| r.tear_line).collect();
-                let span = end.0.saturating_sub(mark_time.0) as f64 / 1e12;
-                TearingStats {
-                    torn_frames: lines.len(),
-                    torn_per_second: if span > 0.0 { lines.len() as f64 / span } else { 0.0 },
-                    tear_line: Dist::of_finite(&lines),
-                }
-            }),
+            frame_generation: generation_stats(m, warm, displayed, end.0.saturating_sub(mark_time.0)),
+            tearing: tearing_stats(m, warm, end.0.saturating_sub(mark_time.0)),
             bottleneck: BOTTLENECKS
                 .iter()
                 .zip(bott)
@@ -362,4 +380,56 @@ pub(super) fn summarize(
         },
         scene,
     }
+}
+
+/// `metrics.frame_generation`: the generated frames after the warm-up
+/// (`warm` frames), `displayed` rendered frames shown, over `span_ps`.
+fn generation_stats(m: &FramePipeline, warm: usize, displayed: usize, span_ps: u64) -> Option<GenerationStats> {
+    let g = m.display.generation()?;
+    let after = |f: u64| f >= warm as u64;
+    let span = span_ps as f64 / 1e12;
+    let frames: Vec<_> = g.frames.iter().filter(|x| after(x.before)).collect();
+    let shown = frames.iter().filter(|x| x.displayed.is_some()).count();
+    let per_s = |n: usize| if span > 0.0 { n as f64 / span } else { 0.0 };
+    let holds: Vec<f64> = g
+        .hold_backs
+        .iter()
+        .filter(|(f, _)| after(*f))
+        .map(|(_, d)| d.as_ms_f64())
+        .collect();
+    Some(GenerationStats {
+        generated_frames: frames.len(),
+        generated_shown: shown,
+        skipped: g.skipped.iter().filter(|f| after(**f)).count(),
+        displayed_fps: per_s(displayed + shown),
+        rendered_fps: per_s(displayed),
+        hold_back_ms: Dist::of_finite(&holds),
+    })
+}
+
+/// `metrics.tearing`: every frame flipped after the warm-up (`warm`
+/// frames), generated ones too, over `span_ps`; `None` when flips wait for
+/// a vertical blank.
+fn tearing_stats(m: &FramePipeline, warm: usize, span_ps: u64) -> Option<TearingStats> {
+    m.env.cfg.display.scan_out()?;
+    let generated = m.display.generation().map_or(&[][..], |g| g.frames);
+    let lines: Vec<f64> = m
+        .env
+        .records
+        .iter()
+        .skip(warm)
+        .filter_map(|r| r.tear_line)
+        .chain(
+            generated
+                .iter()
+                .filter(|g| g.before >= warm as u64)
+                .filter_map(|g| g.tear_line),
+        )
+        .collect();
+    let span = span_ps as f64 / 1e12;
+    Some(TearingStats {
+        torn_frames: lines.len(),
+        torn_per_second: if span > 0.0 { lines.len() as f64 / span } else { 0.0 },
+        tear_line: Dist::of_finite(&lines),
+    })
 }

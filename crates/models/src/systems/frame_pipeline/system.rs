@@ -26,7 +26,13 @@ impl SystemModel for FramePipelineSystem {
 impl PipelineRun {
     /// Writes the run's `frames.csv` (PresentMon 2 columns, [`super::records`]).
     pub fn write_frames_csv(&self, w: impl Write) -> std::io::Result<()> {
-        write_frames_csv(&self.records, &ChainInfo::of_display(&self.config.display), 0, w)
+        write_frames_csv(
+            &self.records,
+            &self.generated,
+            &ChainInfo::of_display(&self.config.display),
+            0,
+            w,
+        )
     }
 }
 
@@ -36,7 +42,7 @@ impl Outcome for PipelineRun {
     fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
         (
             COLUMNS.iter().map(|s| s.to_string()).collect(),
-            frame_rows(&self.records, 0),
+            frame_rows(&self.records, &self.generated, 0),
         )
     }
 

@@ -102,6 +102,7 @@ impl Renderer {
             noise: noise_cfg,
             variation: Default::default(),
             pacing: Default::default(),
+            frame_generation: Default::default(),
             workload: WorkloadConfig::Scene(SceneWorkload {
                 view: View::Static,
                 preset: None,
