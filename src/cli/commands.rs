@@ -580,6 +580,7 @@ pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
         swap_chain: args.swapchain.clone(),
         sets: args.sets.clone(),
         assume: args.assume.clone(),
+        from_tables: false,
     };
     let r = replay(&args.capture, &opts)?;
     let json = serde_json::to_string_pretty(&ReplayJson { replay: &r.summary })?;

@@ -163,6 +163,7 @@ fn replay_timeline(
         swap_chain: r.swapchain.clone(),
         sets: whatif_sets(&r.whatif),
         assume: whatif_sets(&r.assume),
+        from_tables: true,
     };
     let (rsrc, rtable) =
         crate::studies::replay::replay_model(&src.base_dir.join(&r.capture), &ropts).map_err(|source| {

@@ -243,6 +243,25 @@ fn the_replay_system_runs_a_what_if_from_a_model_file_as_the_command_does() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("whatif") && e.contains("bufers"), "{e}");
+    // ... as coming from the table, not from a command-line option.
+    assert!(e.contains("`[whatif] display.bufers=2`") && !e.contains("--set"), "{e}");
+    std::fs::write(
+        &model,
+        format!(
+            "system = \"replay\"\ncapture = {:?}\n[assume]\ndisplay.buffers = 40\n",
+            capture(2)
+        ),
+    )
+    .unwrap();
+    let src = rendersim::config::ModelSource::from_file(&model).unwrap();
+    let e = rendersim::systems::run_model(&src, &src.table().unwrap(), None)
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`[assume] display.buffers=40`") && e.contains("between 2 and 16"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -47,7 +47,7 @@ use self::display_stats::{DisplayStats, FrameTimes};
 use crate::capture::presentmon::{Capture, CaptureError, Columns, Present};
 use crate::components::swap_chain::Composition;
 use crate::config::patch::set_dotted;
-use crate::config::{ModelSource, Overrides, apply_patches, deserialize, invalid};
+use crate::config::{ModelSource, apply_patches, deserialize, invalid};
 use crate::stats::quantile::quantile;
 use crate::systems::error::SystemError;
 use crate::systems::frame_pipeline::config::FramesWorkload;
@@ -88,6 +88,21 @@ pub struct ReplayOptions {
     /// as-captured model (swap-chain images, frames in flight, the refresh),
     /// applied before any what-if's.
     pub assume: Vec<String>,
+    /// Whether the patches come from a model file's `[whatif]` and
+    /// `[assume]` tables (errors name them so) rather than the command
+    /// line's `--set` and `--assume`.
+    pub from_tables: bool,
+}
+
+impl ReplayOptions {
+    /// What errors call the what-if's and the assumptions' patches.
+    fn option_names(&self) -> (&'static str, &'static str) {
+        if self.from_tables {
+            ("[whatif]", "[assume]")
+        } else {
+            ("--set", "--assume")
+        }
+    }
 }
 
 /// |predicted - measured| over the frames where both exist, in ms.
@@ -392,6 +407,8 @@ struct Setup<'a> {
     origin_ps: i64,
     /// The capture's swap chain, for the replayed frames.
     chain: ChainInfo,
+    /// What errors call the what-if's patches.
+    whatif_option: &'static str,
     src: ModelSource,
     table: toml::Table,
 }
@@ -425,7 +442,7 @@ fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Setup<'a>, Re
     // The base model with the assumptions (they may give the refresh).
     let mut src = ModelSource::from_text("the replay model (models/replay.toml)", REPLAY_MODEL);
     let mut table = src.table()?;
-    apply_patches("--assume", &opts.assume, &mut src, &mut table).map_err(ReplayError::Assume)?;
+    apply_patches(opts.option_names().1, &opts.assume, &mut src, &mut table).map_err(ReplayError::Assume)?;
     let assumed_cfg = deserialize::<FramePipelineConfig>(&table, &src).map_err(ReplayError::Assume)?;
     let model_period = assumed_cfg.display.refresh.period.as_ms_f64();
     // A capture taken with frame generation (assumed) measured the
@@ -531,6 +548,7 @@ fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Setup<'a>, Re
         refresh_from,
         origin_ps,
         chain,
+        whatif_option: opts.option_names().0,
         src,
         table,
     })
@@ -580,7 +598,7 @@ impl Simulated {
 /// The frame-pipeline model of the set-up frames with `sets` patched on.
 fn model_of(s: &Setup, sets: &[String]) -> Result<(ModelSource, toml::Table), ReplayError> {
     let (mut src, mut table) = (s.src.clone(), s.table.clone());
-    Overrides::with_sets(sets).apply(&mut src, &mut table)?;
+    apply_patches(s.whatif_option, sets, &mut src, &mut table)?;
     Ok((src, table))
 }
 
@@ -601,6 +619,11 @@ fn simulate(s: &Setup, sets: &[String]) -> Result<Simulated, ReplayError> {
     let sim = std::time::Instant::now();
     // A value the model cannot use is blamed on the option that gave it.
     let run = run_pipeline(cfg, &src.base_dir, None).map_err(|e| match e {
+        // Without what-if patches the model is the assumptions' (the
+        // as-captured replay runs first, so theirs surface there).
+        SystemError::Invalid { key, message } if sets.is_empty() => {
+            ReplayError::Assume(invalid(&src, &key, message, None))
+        }
         SystemError::Invalid { key, message } => ReplayError::Config(invalid(&src, &key, message, None)),
         e => ReplayError::System(e),
     })?;

@@ -64,6 +64,7 @@ impl SystemModel for ReplaySystem {
             swap_chain: cfg.swapchain.clone(),
             sets: whatif_sets(&cfg.whatif),
             assume: whatif_sets(&cfg.assume),
+            from_tables: true,
         };
         let replay = replay(&base_dir.join(&cfg.capture), &opts).map_err(blame)?;
         let s = &replay.summary;
