@@ -33,6 +33,7 @@ mod pipeline_oracles;
 mod pixelflow;
 mod present;
 mod readback;
+mod readme_commands;
 mod replay;
 mod replay_round_trip;
 mod shards;
