@@ -60,7 +60,8 @@ pub struct ExperimentArgs {
     /// Output directory (default out/<experiment name>).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Hide the progress bar.
+    /// Print only errors and the final line (no progress bar, no table of
+    /// points, derived values or verdicts: they are in report.md).
     #[arg(long)]
     pub quiet: bool,
     /// Run only shard K of N of the (point, seed) runs, into DIR/shards/

@@ -69,13 +69,16 @@ pub fn experiment(
             set.keep(name)?;
         }
         set.commit()?;
-        println!("{}", result.table(exp));
+        if !args.quiet {
+            println!("{}", result.table(exp));
+        }
         let cost = result.shards.as_ref();
         println!(
-            "experiment {:?}: {} points from {} shards; array wall time {:.2} s, CPU time {:.2} s over all shards; results in {}",
+            "experiment {:?}: {} points from {} shards{}; array wall time {:.2} s, CPU time {:.2} s over all shards; results in {}",
             exp.name,
             result.points.len(),
             cost.map_or(0, |c| c.shards),
+            result.tally(),
             result.wall_seconds,
             cost.map_or(0.0, |c| c.cpu_seconds),
             out.display()

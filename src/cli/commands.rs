@@ -160,11 +160,15 @@ pub fn experiment(args: ExperimentArgs) -> Result<()> {
         }
     };
     set.commit()?;
-    println!("{}", result.table(&exp));
+    // --quiet: the final line alone (with the checks' and claims' tally).
+    if !args.quiet {
+        println!("{}", result.table(&exp));
+    }
     println!(
-        "experiment {:?}: {} points, {:.2} s wall ({:.2} s of simulation); results in {}",
+        "experiment {:?}: {} points{}, {:.2} s wall ({:.2} s of simulation); results in {}",
         exp.name,
         result.points.len(),
+        result.tally(),
         result.wall_seconds,
         result.sim_wall_seconds,
         out.display()

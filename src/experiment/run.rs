@@ -171,6 +171,26 @@ impl ExperimentResult {
         out
     }
 
+    /// The checks' and claims' outcome for the final line: `, checks 2
+    /// passed 0 failed, claims 1 of 2 hold` (empty without either).
+    pub fn tally(&self) -> String {
+        let mut out = String::new();
+        let tests = self.checks.iter().filter(|c| c.claim.is_none()).count();
+        if tests > 0 {
+            out.push_str(&format!(
+                ", checks {} passed {} failed",
+                tests - self.checks_failed,
+                self.checks_failed
+            ));
+        }
+        let claims = self.claims();
+        if !claims.is_empty() {
+            let hold = claims.iter().filter(|(_, h, t)| h == t).count();
+            out.push_str(&format!(", claims {hold} of {} hold", claims.len()));
+        }
+        out
+    }
+
     /// Verdicts per claim, in file order: `(claim, outcomes that hold, outcomes)`.
     pub fn claims(&self) -> Vec<(String, usize, usize)> {
         let mut out: Vec<(String, usize, usize)> = Vec::new();

@@ -560,7 +560,6 @@ fn system_noise_experiment_prints_the_paper_constant_at_the_end() {
         file.to_str().unwrap(),
         "--out",
         d.path().to_str().unwrap(),
-        "--quiet",
     ]);
     // The last lines: derived values per point, the check tally, the
     // claims' verdicts, the wall time.

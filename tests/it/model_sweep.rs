@@ -76,7 +76,7 @@ fn each_point_runs_on_the_model_file_its_sweep_names() {
     let (a, b) = (fixed_model(3.0), fixed_model(7.0));
     let (ok, out, err, d) = experiment(&[("exp.toml", SWEEP), ("models/a.toml", &a), ("models/b.toml", &b)]);
     assert!(ok, "{out}{err}");
-    assert!(out.contains("checks: 4 passed, 0 failed"), "{out}");
+    assert!(out.contains("checks 4 passed 0 failed"), "{out}");
     // `[set]` applies to every model: 12 frames, 2 of them warm-up.
     let points = std::fs::read_to_string(d.path().join("out/points.csv")).unwrap();
     assert!(
