@@ -188,10 +188,24 @@ fn every_model_and_experiment_gives_its_golden_outputs() {
                 .filter_map(move |(name, bytes)| {
                     let (stored_name, stored) = stored_form(&name, &bytes);
                     let path = dir.join(&stored_name);
+                    // The other form (the whole file beside its hash, or a
+                    // hash beside the whole file) is stale.
+                    let other = if stored_name == name {
+                        format!("{name}.fnv")
+                    } else {
+                        name.clone()
+                    };
+                    let stale = dir.join(&other);
                     if bless {
                         std::fs::create_dir_all(&dir).unwrap();
                         std::fs::write(&path, &stored).unwrap();
+                        let _ = std::fs::remove_file(&stale);
                         return None;
+                    }
+                    if stale.exists() {
+                        return Some(format!(
+                            "{kind}/{stem}/{other}: stale beside {stored_name} (bless removes it)"
+                        ));
                     }
                     match std::fs::read(&path) {
                         Ok(old) if old == stored => None,
