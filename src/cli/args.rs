@@ -37,6 +37,10 @@ pub struct RunArgs {
     /// Write summary.json, frames.csv and model.toml into DIR.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Replace an --out folder that holds another command's results (an
+    /// experiment's, a replay's); without it that is an error.
+    #[arg(long)]
+    pub force: bool,
     /// Write a Chrome/Perfetto trace to FILE.
     #[arg(long, value_name = "FILE")]
     pub trace: Option<PathBuf>,
@@ -60,6 +64,10 @@ pub struct ExperimentArgs {
     /// Output directory (default out/<experiment name>).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Replace an --out folder that holds another command's results (an
+    /// experiment's, a replay's); without it that is an error.
+    #[arg(long)]
+    pub force: bool,
     /// Print only errors and the final line (no progress bar, no table of
     /// points, derived values or verdicts: they are in report.md).
     #[arg(long)]
@@ -694,4 +702,8 @@ pub struct ReplayArgs {
     /// what-if, whatif-frames.csv and whatif-model.toml into DIR.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Replace an --out folder that holds another command's results (an
+    /// experiment's, a replay's); without it that is an error.
+    #[arg(long)]
+    pub force: bool,
 }

@@ -35,7 +35,7 @@ pub fn experiment(
     if let Some(id) = args.shard {
         // Refused before the folder is claimed (run_shard checks it too).
         id.check_runs(expand_points(exp).len() * exp.seeds().len())?;
-        let dir = claim_folder(out, ours)?;
+        let dir = claim_folder(out, Some("experiment"), ours, args.force)?;
         match run_shard(exp, base, &runner, &dir, id, !args.quiet)? {
             ShardOutcome::Complete { path, runs } => {
                 println!(
@@ -63,7 +63,7 @@ pub fn experiment(
         return Ok(());
     }
     if args.merge {
-        let set = ResultSet::begin(out, ours)?;
+        let set = ResultSet::begin_kind(out, Some("experiment"), ours, args.force)?;
         let result = merge_shards(exp, base, &runner, set.target(), set.dir())?;
         for name in std::iter::once(SHARDS_DIR).chain(SLURM_FILES) {
             set.keep(name)?;
@@ -105,7 +105,7 @@ fn slurm(args: &ExperimentArgs, exp: &Experiment, out: &Path, ours: impl Fn(&str
     if shards > runs {
         bail!("--shards {shards}: more shards than the experiment's {runs} runs; give at most {runs}");
     }
-    let dir = claim_folder(out, ours)?;
+    let dir = claim_folder(out, Some("experiment"), ours, args.force)?;
     let logs = dir.join("logs");
     std::fs::create_dir_all(&logs).with_context(|| format!("creating folder {}", logs.display()))?;
     let opts = SlurmOptions {

@@ -58,7 +58,12 @@ pub fn run(args: RunArgs) -> Result<()> {
     // Outputs are checked before simulating: a folder that cannot take the
     // results, or a trace path that is a folder, is reported at once.
     let set = match &args.out {
-        Some(dir) => Some(ResultSet::begin(dir, |name| RUN_FILES.contains(&name))?),
+        Some(dir) => Some(ResultSet::begin_kind(
+            dir,
+            Some("run"),
+            |name| RUN_FILES.contains(&name),
+            args.force,
+        )?),
         None => None,
     };
     // The trace is written while the simulation runs (memory stays flat).
@@ -138,7 +143,7 @@ pub fn experiment(args: ExperimentArgs) -> Result<()> {
     if args.shard.is_some() || args.merge || args.slurm {
         return super::cluster::experiment(&args, &exp, &base, &out, experiment_file);
     }
-    let set = ResultSet::begin(&out, experiment_file)?;
+    let set = ResultSet::begin_kind(&out, Some("experiment"), experiment_file, args.force)?;
     let runner = SimRunner::for_experiment(&exp);
     let result = match run_experiment(&exp, &base, &runner, set.dir(), !args.quiet) {
         Ok(r) => r,
@@ -576,7 +581,12 @@ struct ReplayJson<'a> {
 pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
     use rendersim::studies::replay::{ReplayOptions, replay};
     let set = match &args.out {
-        Some(dir) => Some(ResultSet::begin(dir, |name| REPLAY_FILES.contains(&name))?),
+        Some(dir) => Some(ResultSet::begin_kind(
+            dir,
+            Some("replay"),
+            |name| REPLAY_FILES.contains(&name),
+            args.force,
+        )?),
         None => None,
     };
     let opts = ReplayOptions {

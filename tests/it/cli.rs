@@ -1195,3 +1195,33 @@ fn model_path(name: &str) -> String {
         .display()
         .to_string()
 }
+
+#[test]
+fn an_output_folder_of_one_command_is_not_replaced_by_another_unless_forced() {
+    // An experiment's results are not lost to `run --out` (or `replay
+    // --out`) into the same folder; --force replaces them.
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("results");
+    let out_s = out.to_str().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let exp = root.join("experiments/vsync-quantization.toml");
+    run_ok(&["experiment", exp.to_str().unwrap(), "--out", out_s, "--quiet"]);
+    let fixed = root.join("models/fixed.toml");
+    let err = run_err(&["run", fixed.to_str().unwrap(), "--out", out_s]);
+    assert!(
+        err.contains("holds the results of `rendersim experiment`")
+            && err.contains("`rendersim run`")
+            && err.contains("--force"),
+        "{err}"
+    );
+    assert!(out.join("report.md").is_file(), "the experiment's results are kept");
+    let capture = root.join("tests/fixtures/presentmon/test_case_1.csv");
+    let err = run_err(&["replay", capture.to_str().unwrap(), "--out", out_s]);
+    assert!(err.contains("`rendersim replay`"), "{err}");
+    // The same command replaces its own; --force replaces another's.
+    run_ok(&["experiment", exp.to_str().unwrap(), "--out", out_s, "--quiet"]);
+    run_ok(&["run", fixed.to_str().unwrap(), "--out", out_s, "--force"]);
+    assert!(out.join("summary.json").is_file() && !out.join("report.md").exists());
+    let err = run_err(&["experiment", exp.to_str().unwrap(), "--out", out_s, "--quiet"]);
+    assert!(err.contains("holds the results of `rendersim run`"), "{err}");
+}

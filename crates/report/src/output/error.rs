@@ -42,6 +42,21 @@ pub enum OutputError {
         /// A few of the entries that are not rendersim's.
         examples: String,
     },
+    /// A result-set output names a folder holding another command's result
+    /// set (an experiment's folder given to `run --out`): replacing it would
+    /// lose that set.
+    #[error(
+        "output folder {path} holds the results of `rendersim {found}`, and this is `rendersim {wanted}`: \
+         give another folder, or --force to replace those results"
+    )]
+    OtherKind {
+        /// The folder given.
+        path: PathBuf,
+        /// The kind of set it holds.
+        found: String,
+        /// The kind of set being written.
+        wanted: String,
+    },
     /// A result-set output names a folder (or a folder inside it) that
     /// cannot be written: replacing it would leave the old set behind,
     /// unremovable.

@@ -25,7 +25,10 @@
 //!
 //! Each set holds a marker file, [`MARKER`], which is how rendersim knows a
 //! folder is its own to replace. It never replaces a folder holding files
-//! it did not write.
+//! it did not write. A set of a kind ([`ResultSet::begin_kind`]: `run`,
+//! `experiment`, `replay`) names it in its marker, and a set of another
+//! kind does not replace it unless forced (an experiment's folder is not
+//! lost to a `run --out` into it).
 //!
 //! ```
 //! use std::io::Write;
@@ -54,6 +57,44 @@ pub struct ResultSet {
     target: PathBuf,
     staging: PathBuf,
     registered: Option<Registered>,
+    kind: Option<&'static str>,
+}
+
+/// The marker's text for a set of `kind`.
+fn marker_text(kind: Option<&str>) -> String {
+    let mut t = format!(
+        "This folder is a result set written by rendersim {}; rendersim replaces it as a whole when it writes here again.\n",
+        env!("CARGO_PKG_VERSION")
+    );
+    if let Some(k) = kind {
+        t.push_str(&format!("kind: {k}\n"));
+    }
+    t
+}
+
+/// The kind a set's marker names (`None`: none, as markers before kinds).
+fn marker_kind(target: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(target.join(MARKER)).ok()?;
+    text.lines()
+        .find_map(|l| l.strip_prefix("kind: "))
+        .map(|k| k.trim().to_string())
+}
+
+/// A marked set of another kind than `kind` is refused unless `force`.
+fn check_kind(target: &Path, kind: Option<&str>, force: bool) -> Result<(), OutputError> {
+    if force {
+        return Ok(());
+    }
+    if let (Some(wanted), Some(found)) = (kind, marker_kind(target))
+        && found != wanted
+    {
+        return Err(OutputError::OtherKind {
+            path: target.to_path_buf(),
+            found,
+            wanted: wanted.to_string(),
+        });
+    }
+    Ok(())
 }
 
 fn file_name(p: &Path) -> String {
@@ -211,8 +252,23 @@ impl ResultSet {
     /// `legacy` names the files an older rendersim wrote into such a folder
     /// before sets were marked, so those folders can still be replaced.
     pub fn begin(target: &Path, legacy: impl Fn(&str) -> bool) -> Result<Self, OutputError> {
+        ResultSet::begin_kind(target, None, legacy, false)
+    }
+
+    /// [`ResultSet::begin`] for a set of `kind` (the command that writes
+    /// it), which refuses a folder holding a set of another kind unless
+    /// `force`.
+    pub fn begin_kind(
+        target: &Path,
+        kind: Option<&'static str>,
+        legacy: impl Fn(&str) -> bool,
+        force: bool,
+    ) -> Result<Self, OutputError> {
         let target = absolute_folder(&resolve_links(target)?)?;
         check_replaceable(&target, &legacy)?;
+        if target.join(MARKER).is_file() {
+            check_kind(&target, kind, force)?;
+        }
         let parent = parent_of(&target);
         std::fs::create_dir_all(&parent).map_err(OutputError::io("creating folder", &parent))?;
         let name = file_name(&target);
@@ -227,6 +283,7 @@ impl ResultSet {
             target,
             staging,
             registered: Some(registered),
+            kind,
         })
     }
 
@@ -290,14 +347,7 @@ impl ResultSet {
             check_replaceable(&target, &|_| false)?;
         }
         let marker = self.staging.join(MARKER);
-        std::fs::write(
-            &marker,
-            format!(
-                "This folder is a result set written by rendersim {}; rendersim replaces it as a whole when it writes here again.\n",
-                env!("CARGO_PKG_VERSION")
-            ),
-        )
-        .map_err(OutputError::io("writing", &marker))?;
+        std::fs::write(&marker, marker_text(self.kind)).map_err(OutputError::io("writing", &marker))?;
         hold_for_tests();
         let staging = self.staging.clone();
         // Where the old set goes when the two folders cannot be exchanged in
@@ -341,21 +391,20 @@ impl ResultSet {
 /// into the folder piece by piece by several processes (the shards of an
 /// experiment, `DIR/shards/`), which a later result set in the same folder
 /// keeps with [`ResultSet::keep`]. Returns the folder (links resolved).
-pub fn claim_folder(target: &Path, legacy: impl Fn(&str) -> bool) -> Result<PathBuf, OutputError> {
+pub fn claim_folder(
+    target: &Path,
+    kind: Option<&'static str>,
+    legacy: impl Fn(&str) -> bool,
+    force: bool,
+) -> Result<PathBuf, OutputError> {
     let target = absolute_folder(&resolve_links(target)?)?;
     check_replaceable(&target, &legacy)?;
     std::fs::create_dir_all(&target).map_err(OutputError::io("creating folder", &target))?;
     let marker = target.join(MARKER);
-    if !marker.is_file() {
-        super::files::write_output(&marker, |w| {
-            w.write_all(
-                format!(
-                    "This folder is a result set written by rendersim {}; rendersim replaces it as a whole when it writes here again.\n",
-                    env!("CARGO_PKG_VERSION")
-                )
-                .as_bytes(),
-            )
-        })?;
+    if marker.is_file() {
+        check_kind(&target, kind, force)?;
+    } else {
+        super::files::write_output(&marker, |w| w.write_all(marker_text(kind).as_bytes()))?;
     }
     Ok(target)
 }
@@ -504,13 +553,13 @@ mod tests {
     fn a_claimed_folder_keeps_its_kept_entries_through_a_new_set() {
         let d = tempfile::tempdir().unwrap();
         let out = d.path().join("out");
-        let claimed = claim_folder(&out, |_| false).unwrap();
+        let claimed = claim_folder(&out, None, |_| false, false).unwrap();
         assert!(claimed.join(MARKER).is_file());
         std::fs::create_dir_all(out.join("shards")).unwrap();
         std::fs::write(out.join("shards/a.json"), "shard").unwrap();
         std::fs::write(out.join("job.sbatch"), "job").unwrap();
         // Claiming again is fine (the marker is there now).
-        claim_folder(&out, |_| false).unwrap();
+        claim_folder(&out, None, |_| false, false).unwrap();
         let s = ResultSet::begin(&out, |_| false).unwrap();
         std::fs::write(s.dir().join("runs.csv"), "1").unwrap();
         s.keep("shards").unwrap();
@@ -530,9 +579,32 @@ mod tests {
         // A folder holding other files is not claimed.
         std::fs::write(d.path().join("thesis.tex"), "mine").unwrap();
         assert!(matches!(
-            claim_folder(d.path(), |_| false),
+            claim_folder(d.path(), None, |_| false, false),
             Err(OutputError::ForeignFolder { .. })
         ));
+    }
+
+    #[test]
+    fn a_set_of_another_kind_is_not_replaced_unless_forced() {
+        let d = tempfile::tempdir().unwrap();
+        let out = d.path().join("exp");
+        let set = ResultSet::begin_kind(&out, Some("experiment"), |_| false, false).unwrap();
+        std::fs::write(set.dir().join("report.md"), "x").unwrap();
+        set.commit().unwrap();
+        assert_eq!(marker_kind(&out).as_deref(), Some("experiment"));
+        let e = ResultSet::begin_kind(&out, Some("run"), |_| false, false).unwrap_err();
+        assert!(matches!(&e, OutputError::OtherKind { found, wanted, .. } if found == "experiment" && wanted == "run"));
+        assert!(e.to_string().contains("--force"), "{e}");
+        assert!(out.join("report.md").is_file(), "nothing lost");
+        // The same kind, a set without a kind, or forced: replaced.
+        ResultSet::begin_kind(&out, Some("experiment"), |_| false, false).unwrap();
+        ResultSet::begin(&out, |_| false).unwrap();
+        let set = ResultSet::begin_kind(&out, Some("run"), |_| false, true).unwrap();
+        set.commit().unwrap();
+        assert_eq!(marker_kind(&out).as_deref(), Some("run"));
+        assert!(!out.join("report.md").exists());
+        // A claimed folder (shards) of another kind likewise.
+        assert!(claim_folder(&out, Some("experiment"), |_| false, false).is_err());
     }
 
     #[test]
