@@ -139,9 +139,9 @@ echo "array job $array: 4 shards; merge job $merge: $merge_state"
 
 "$bin" experiment "$work/e.toml" --out "$work/single" --quiet > /dev/null
 # Compare: CSVs with the wall_seconds* columns emptied, report.md without
-# its Timing section, everything else byte for byte.
+# its Timing and Provenance sections, everything else byte for byte.
 mask() { awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) w[i] = ($i ~ /^wall_seconds/) } { for (i = 1; i <= NF; i++) if (w[i]) $i = ""; print }' OFS=, "$1"; }
-notiming() { awk '/^## / { skip = ($0 == "## Timing") } !skip' "$1"; }
+notiming() { awk '/^## / { skip = ($0 == "## Timing" || $0 == "## Provenance") } !skip' "$1"; }
 n=0
 for f in "$work"/single/*; do
   name=$(basename "$f")

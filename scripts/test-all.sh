@@ -20,6 +20,14 @@ if ! ls /usr/share/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1; then
   fi
 fi
 
+# Without XDG_RUNTIME_DIR, Mesa's device-selection layer makes libwayland
+# print "error: XDG_RUNTIME_DIR is invalid or not set" on every Vulkan
+# instance the tests open in-process; its own switch turns it off (the
+# binary does the same by itself, see src/main.rs; a test checks that).
+if [ -z "${XDG_RUNTIME_DIR:-}" ] && [ -z "${WAYLAND_DISPLAY:-}" ]; then
+  export NODEVICE_SELECT=1
+fi
+
 step "Python environment for notebooks"
 # A venv left half made by an interrupted run has python but no pip: remake it.
 if [ ! -x .venv/bin/pip ]; then

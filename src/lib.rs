@@ -27,3 +27,14 @@ pub mod bench;
 pub mod experiment;
 pub mod studies;
 pub mod systems;
+
+/// Where a result made now comes from: this build of rendersim (its
+/// version and git revision) and `command`, dated now (see
+/// [`output::provenance`]).
+pub fn provenance(command: Vec<String>) -> output::provenance::Provenance {
+    output::provenance::Provenance::now(
+        concat!("rendersim ", env!("CARGO_PKG_VERSION")),
+        option_env!("RENDERSIM_GIT_REVISION").map(str::to_string),
+        command,
+    )
+}

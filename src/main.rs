@@ -66,10 +66,15 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+    #[cfg(all(unix, feature = "wgpu"))]
+    quiet_vulkan_device_select();
     // An interrupt removes the temporary files and staging folders of
     // outputs being written; finished outputs are never touched.
     rendersim::output::cleanup::remove_on_signals();
     let cli = Cli::parse();
+    // A spinner on a terminal once a command has worked for two seconds
+    // (`experiment` draws its own bar over its runs).
+    let _activity = (!matches!(cli.cmd, Cmd::Experiment(_))).then(|| cli::progress::Activity::start(activity_label()));
     let result = match cli.cmd {
         Cmd::Run(a) => commands::run(a),
         Cmd::Experiment(a) => commands::experiment(a),
@@ -97,6 +102,39 @@ fn main() -> ExitCode {
             })
         }
     }
+}
+
+/// Mesa's Vulkan device-selection layer (`VK_LAYER_MESA_device_select`, an
+/// implicit layer installed with Mesa's drivers) asks a Wayland compositor
+/// which GPU drives the screen. Without `XDG_RUNTIME_DIR` libwayland cannot
+/// look for one and prints `error: XDG_RUNTIME_DIR is invalid or not set in
+/// the environment.` on every instance, in the form of rendersim's own
+/// errors, though nothing failed. Where no Wayland display can exist (no
+/// `WAYLAND_DISPLAY`, no `WAYLAND_SOCKET`, no usable `XDG_RUNTIME_DIR`) the
+/// layer is switched off with its own switch, `NODEVICE_SELECT=1`; it only
+/// orders the adapters, and rendersim picks its adapter by power preference
+/// itself. A `NODEVICE_SELECT` the user set is left as it is.
+#[cfg(all(unix, feature = "wgpu"))]
+fn quiet_vulkan_device_select() {
+    let set = |k: &str| std::env::var_os(k).is_some_and(|v| !v.is_empty());
+    let runtime_dir = std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir());
+    if !set("WAYLAND_DISPLAY")
+        && !set("WAYLAND_SOCKET")
+        && !runtime_dir
+        && std::env::var_os("NODEVICE_SELECT").is_none()
+    {
+        // SAFETY: called at start-up, before any other thread exists.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
+    }
+}
+
+/// What the spinner says: the command line, shortened to fit a terminal.
+fn activity_label() -> String {
+    let mut line = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
+    if line.chars().count() > 60 {
+        line = line.chars().take(59).collect::<String>() + "…";
+    }
+    format!("rendersim {line}")
 }
 
 /// Exit status of an error: a file, key or value that is wrong, an option

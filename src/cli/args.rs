@@ -95,6 +95,13 @@ pub struct ExperimentArgs {
     /// With --slurm: CPUs per task (default 1).
     #[arg(long, value_name = "C", requires = "slurm")]
     pub cpus_per_task: Option<u32>,
+    /// With --slurm: at most T array tasks run at once (Slurm's --array=1-N%T).
+    #[arg(long, value_name = "T", requires = "slurm")]
+    pub throttle: Option<usize>,
+    /// With --slurm: one more #SBATCH option for both scripts, as sbatch takes it
+    /// (repeatable): --slurm-opt=--account=proj --slurm-opt=--mem=4G --slurm-opt=--qos=short.
+    #[arg(long, value_name = "OPTION", requires = "slurm", allow_hyphen_values = true)]
+    pub slurm_opt: Vec<String>,
     /// With --slurm: submit both scripts with sbatch and print the job ids.
     #[arg(long, requires = "slurm")]
     pub submit: bool,

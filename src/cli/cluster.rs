@@ -4,6 +4,7 @@
 //! them). The work is in [`rendersim::experiment`]'s shard and slurm
 //! modules; this is the glue.
 
+use super::progress::{esay, say};
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
@@ -38,7 +39,7 @@ pub fn experiment(
         let dir = claim_folder(out, Some("experiment"), ours, args.force)?;
         match run_shard(exp, base, &runner, &dir, id, !args.quiet)? {
             ShardOutcome::Complete { path, runs } => {
-                println!(
+                say!(
                     "shard {id}: already complete ({runs} runs in {}); nothing to do",
                     path.display()
                 );
@@ -51,10 +52,10 @@ pub fn experiment(
                 redone,
             } => {
                 if let Some(why) = redone {
-                    eprintln!("shard {id}: the earlier file was redone: {why}");
+                    esay!("shard {id}: the earlier file was redone: {why}");
                 }
                 let cpu = cpu_seconds.map(|c| format!(", {c:.2} s CPU")).unwrap_or_default();
-                println!(
+                say!(
                     "shard {id}: {runs} runs in {wall_seconds:.2} s wall{cpu}; wrote {}",
                     path.display()
                 );
@@ -68,12 +69,13 @@ pub fn experiment(
         for name in std::iter::once(SHARDS_DIR).chain(SLURM_FILES) {
             set.keep(name)?;
         }
+        super::commands::add_report_provenance(set.dir())?;
         set.commit()?;
         if !args.quiet {
-            println!("{}", result.table(exp));
+            say!("{}", result.table(exp));
         }
         let cost = result.shards.as_ref();
-        println!(
+        say!(
             "experiment {:?}: {} points from {} shards{}; array wall time {:.2} s, CPU time {:.2} s over all shards; results in {}",
             exp.name,
             result.points.len(),
@@ -105,31 +107,36 @@ fn slurm(args: &ExperimentArgs, exp: &Experiment, out: &Path, ours: impl Fn(&str
     if shards > runs {
         bail!("--shards {shards}: more shards than the experiment's {runs} runs; give at most {runs}");
     }
-    let dir = claim_folder(out, Some("experiment"), ours, args.force)?;
-    let logs = dir.join("logs");
-    std::fs::create_dir_all(&logs).with_context(|| format!("creating folder {}", logs.display()))?;
-    let opts = SlurmOptions {
+    let mut opts = SlurmOptions {
         shards,
         partition: args.partition.clone(),
         time: args.time.clone(),
         cpus_per_task: args.cpus_per_task.unwrap_or(1),
+        throttle: args.throttle,
+        extra: args.slurm_opt.clone(),
         binary: std::env::current_exe().context("finding the rendersim binary")?,
         experiment: std::path::absolute(&args.file).with_context(|| format!("{}", args.file.display()))?,
-        out_dir: dir.clone(),
+        out_dir: std::path::absolute(out).with_context(|| format!("{}", out.display()))?,
     };
+    // Options checked before the folder is made: a bad one leaves nothing.
+    slurm_scripts(exp, &opts)?;
+    let dir = claim_folder(out, Some("experiment"), ours, args.force)?;
+    let logs = dir.join("logs");
+    std::fs::create_dir_all(&logs).with_context(|| format!("creating folder {}", logs.display()))?;
+    opts.out_dir = dir.clone();
     let scripts = slurm_scripts(exp, &opts)?;
     let job = dir.join("job.sbatch");
     let merge = dir.join("merge.sbatch");
     write_output(&job, |w| w.write_all(scripts.job.as_bytes()))?;
     write_output(&merge, |w| w.write_all(scripts.merge.as_bytes()))?;
-    println!(
+    say!(
         "wrote {} (a job array of {shards} shards, {runs} runs) and {}",
         job.display(),
         merge.display()
     );
     if !args.submit {
-        println!(
-            "submit with: jid=$(sbatch --parsable {}) && sbatch --dependency=afterok:${{jid%%;*}} {}",
+        say!(
+            "submit with: jid=$(sbatch --parsable {}) && sbatch --dependency=afterany:${{jid%%;*}} {}",
             job.display(),
             merge.display()
         );
@@ -137,7 +144,10 @@ fn slurm(args: &ExperimentArgs, exp: &Experiment, out: &Path, ours: impl Fn(&str
     }
     let array = sbatch(&job, None)?;
     let merged = sbatch(&merge, Some(&array))?;
-    println!("submitted array job {array} ({shards} tasks) and merge job {merged} (runs after the array succeeds)");
-    println!("results in {} once job {merged} ends", dir.display());
+    say!(
+        "submitted array job {array} ({shards} tasks) and merge job {merged} (runs once every task has ended, \
+         whatever its outcome, and names any shard that is missing)"
+    );
+    say!("results in {} once job {merged} ends", dir.display());
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! What each command does: the library called with the parsed arguments,
 //! its results written to files or printed.
 
+use super::progress::{esay, say};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -41,7 +42,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     }
     let model = load_model(args.model.as_deref(), &(&args).into())?;
     for note in &model.notes {
-        eprintln!("note: {note}");
+        esay!("note: {note}");
     }
     let src = &model.source;
     // A system that writes no trace events would leave an empty trace file
@@ -84,6 +85,8 @@ pub fn run(args: RunArgs) -> Result<()> {
     };
     let mut run = run_model(src, &model.table, writer)?;
     run.summary_mut()["model"] = json!(src.name);
+    let provenance = command_provenance();
+    run.summary_mut()["provenance"] = serde_json::to_value(&provenance)?;
     if let Some(set) = &set {
         let dir = set.dir();
         let summary = serde_json::to_string_pretty(run.summary())?;
@@ -92,7 +95,8 @@ pub fn run(args: RunArgs) -> Result<()> {
         run.write_frames_csv(&mut frames).context("writing frames.csv")?;
         frames.flush().context("writing frames.csv")?;
         drop(frames);
-        std::fs::write(dir.join("model.toml"), run.resolved_model(&src.base_dir)).context("writing model.toml")?;
+        let model_text = provenance.toml_comment() + &run.resolved_model(&src.base_dir);
+        std::fs::write(dir.join("model.toml"), model_text).context("writing model.toml")?;
     }
     // The trace first, then the folder is swapped in: a run whose trace
     // could not be written leaves the earlier results as they were.
@@ -108,14 +112,32 @@ pub fn run(args: RunArgs) -> Result<()> {
     if args.json {
         let text = serde_json::to_string_pretty(run.summary())?;
         if trace_on_stdout {
-            eprintln!("{text}");
+            esay!("{text}");
         } else {
-            println!("{text}");
+            say!("{text}");
         }
     } else if !trace_on_stdout {
-        run.write_report(&mut std::io::stdout().lock())?;
+        super::progress::suspend(|| run.write_report(&mut std::io::stdout().lock()))?;
     }
     Ok(())
+}
+
+/// Where this command's results come from: this build, this process's
+/// command line, now.
+pub(crate) fn command_provenance() -> rendersim::output::provenance::Provenance {
+    rendersim::provenance(std::env::args().collect())
+}
+
+/// `report.md` in `dir` with its `## Provenance` section (this build, this
+/// command, now) added at the end.
+pub(crate) fn add_report_provenance(dir: &Path) -> Result<()> {
+    let path = dir.join("report.md");
+    let mut text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    if !text.ends_with("\n\n") {
+        text.push('\n');
+    }
+    text.push_str(&command_provenance().markdown_section());
+    std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))
 }
 
 /// Whether `path` is this process's standard output: `-`, or the same file
@@ -164,12 +186,13 @@ pub fn experiment(args: ExperimentArgs) -> Result<()> {
             bail!(msg);
         }
     };
+    add_report_provenance(set.dir())?;
     set.commit()?;
     // --quiet: the final line alone (with the checks' and claims' tally).
     if !args.quiet {
-        println!("{}", result.table(&exp));
+        say!("{}", result.table(&exp));
     }
-    println!(
+    say!(
         "experiment {:?}: {} points{}, {:.2} s wall ({:.2} s of simulation); results in {}",
         exp.name,
         result.points.len(),
@@ -224,16 +247,16 @@ pub fn isolate(args: IsolateArgs) -> Result<()> {
     };
     let iso = rendersim::studies::isolate::isolate(&cfg, &src.base_dir, options)?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&iso)?);
+        say!("{}", serde_json::to_string_pretty(&iso)?);
         return Ok(());
     }
-    println!(
+    say!(
         "bottleneck isolation (load x{factor}, vsync {}):",
         if keep_vsync { "on" } else { "off" }
     );
     for v in &iso.variants {
         let change = fixed(100.0 * v.change, 1);
-        println!(
+        say!(
             "  {:<9} frame time {:>9} ms  ({}{change}%)",
             v.name,
             fixed(v.frame_time_ms, 3),
@@ -249,7 +272,7 @@ pub fn isolate(args: IsolateArgs) -> Result<()> {
     } else {
         iso.bottleneck.clone()
     };
-    println!("  => bottleneck: {verdict}   ({:.2} s wall)", iso.wall_seconds);
+    say!("  => bottleneck: {verdict}   ({:.2} s wall)", iso.wall_seconds);
     Ok(())
 }
 
@@ -266,9 +289,9 @@ pub fn vcache(args: VcacheArgs) -> Result<()> {
         "wall_seconds": secs,
     });
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        say!("{}", serde_json::to_string_pretty(&out)?);
     } else {
-        println!(
+        say!(
             "{mesh} under {policy}: {} triangles, {} indices, {} unique vertices, {} transformed; ACMR {:.4}, ATVR {:.4}",
             s.triangles,
             s.indices,
@@ -321,9 +344,9 @@ pub fn measure(args: MeasureArgs) -> Result<()> {
     let mut v = serde_json::to_value(&r)?;
     v["mesh"] = json!({"spec": mesh, "triangles": m.triangles(), "indices": m.index_count(), "unique_vertices": m.unique_vertices()});
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        say!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!("{}", print::measurement(mesh, &r));
+        say!("{}", print::measurement(mesh, &r));
     }
     Ok(())
 }
@@ -362,7 +385,7 @@ pub fn study(args: StudyArgs) -> Result<()> {
     let command = format!("rendersim study {name} --repeats {repeats}");
     let result = studies::run_studies(&gpu, &names, repeats, &command, |s| {
         if !json {
-            println!("{}: {}", s.name, s.verdict);
+            say!("{}: {}", s.name, s.verdict);
         }
     });
     // The passes measured are kept even when a study failed part-way.
@@ -370,14 +393,14 @@ pub fn study(args: StudyArgs) -> Result<()> {
         let passes = gpu.measured_passes();
         let written = append_passes(path, &passes.rows);
         match (&written, &result) {
-            (Ok(()), _) => eprintln!(
+            (Ok(()), _) => esay!(
                 "{} passes appended to {} ({} measurements of H1's probes or of layered or depth-tested passes \
                  left out: the pass CSV has no column for them)",
                 passes.rows.len(),
                 path.display(),
                 passes.left_out
             ),
-            (Err(e), Err(_)) => eprintln!("error: {e}"),
+            (Err(e), Err(_)) => esay!("error: {e}"),
             (Err(_), Ok(_)) => {}
         }
         if result.is_ok() {
@@ -389,9 +412,9 @@ pub fn study(args: StudyArgs) -> Result<()> {
         rendersim::output::files::write_output(&path, |w| w.write_all(r.document.as_bytes()))?;
     }
     if json {
-        println!("{}", serde_json::to_string_pretty(&r.json)?);
+        say!("{}", serde_json::to_string_pretty(&r.json)?);
     } else {
-        println!("\n{}", r.document);
+        say!("\n{}", r.document);
     }
     if let Some(finding) = r.h1_inexact {
         if args.require_exact {
@@ -399,9 +422,9 @@ pub fn study(args: StudyArgs) -> Result<()> {
         }
         // A finding on this device, not a failure.
         if json {
-            eprintln!("finding: {}", finding.describe());
+            esay!("finding: {}", finding.describe());
         } else {
-            println!("finding: {}", finding.describe());
+            say!("finding: {}", finding.describe());
         }
     }
     Ok(())
@@ -435,7 +458,7 @@ fn study_estimation(args: StudyArgs) -> Result<()> {
         setup.single, setup.multi, setup.repeats, setup.seed, setup.load_scale
     );
     if !args.json {
-        eprintln!(
+        esay!(
             "measuring {} passes ({} objects) x {} rounds on {}",
             plan.passes.len(),
             plan.objects(),
@@ -453,9 +476,9 @@ fn study_estimation(args: StudyArgs) -> Result<()> {
         write_output(path, |w| w.write_all(document.as_bytes()))?;
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&run.study)?);
+        say!("{}", serde_json::to_string_pretty(&run.study)?);
     } else {
-        println!("{document}");
+        say!("{document}");
     }
     Ok(())
 }
@@ -477,23 +500,23 @@ pub fn bench(args: BenchArgs) -> Result<()> {
     bench::check_scale(scale)?;
     for b in Vec::<Bench>::from(args.which) {
         match b {
-            Bench::Pixelflow => println!("{}", print::pixelflow_bench(&bench::pixelflow_bench(scale)?)),
+            Bench::Pixelflow => say!("{}", print::pixelflow_bench(&bench::pixelflow_bench(scale)?)),
             Bench::Kernel => {
                 for (work, pop) in KERNEL_CASES {
                     let k = bench::kernel_case(work, pop, bench::kernel_events(pop, scale));
-                    println!("{}", print::kernel_bench(&k));
+                    say!("{}", print::kernel_bench(&k));
                 }
             }
-            Bench::Pipeline => println!("{}", print::pipeline_bench(&bench::pipeline_bench(scale)?)),
-            Bench::Hour => println!("{}", print::hour_bench(&bench::hour_bench(scale)?)),
-            Bench::Build => println!("{}", print::build_bench(&bench::build::build_bench(scale)?)),
-            Bench::Replay => println!("{}", print::replay_bench(&bench::replay::replay_bench(scale)?)),
+            Bench::Pipeline => say!("{}", print::pipeline_bench(&bench::pipeline_bench(scale)?)),
+            Bench::Hour => say!("{}", print::hour_bench(&bench::hour_bench(scale)?)),
+            Bench::Build => say!("{}", print::build_bench(&bench::build::build_bench(scale)?)),
+            Bench::Replay => say!("{}", print::replay_bench(&bench::replay::replay_bench(scale)?)),
         }
     }
     if let Some(path) = args.plot {
         let cases = bench::kernel_scaling(scale);
         bench::plot_kernel(&cases, &path)?;
-        println!("kernel scaling plot: {}", path.display());
+        say!("kernel scaling plot: {}", path.display());
     }
     Ok(())
 }
@@ -513,7 +536,7 @@ pub fn timeline(args: TimelineArgs) -> Result<()> {
     };
     let (picture, _run) = timeline_of(&model.source, &model.table, opts)?;
     rendersim::plot::timeline(&args.out, &picture)?;
-    println!(
+    say!(
         "wrote {}: frames {}-{}, {:.3}-{:.3} ms",
         args.out.display(),
         opts.first,
@@ -544,14 +567,14 @@ pub fn perceived_speed(args: super::args::PerceivedSpeedArgs) -> Result<()> {
     )?;
     let fig = figure6(&model.source, &model.table, args.around, &args.out)?;
     match fig.first_skip {
-        Some(r) => println!(
+        Some(r) => say!(
             "wrote {} (.png and .svg): refreshes {}-{}, centred on the frame skip at refresh {r}, {} skips in the run",
             args.out.with_extension("").display(),
             fig.range.0,
             fig.range.1,
             fig.skips
         ),
-        None => println!(
+        None => say!(
             "wrote {} (.png and .svg): refreshes {}-{}, no frame skip in the run",
             args.out.with_extension("").display(),
             fig.range.0,
@@ -571,10 +594,12 @@ const REPLAY_FILES: [&str; 6] = [
     "whatif-model.toml",
 ];
 
-/// The JSON document `replay` writes: its summary under `replay`.
+/// The JSON document `replay` writes: its summary under `replay`, where it
+/// came from under `provenance`.
 #[derive(serde::Serialize)]
 struct ReplayJson<'a> {
     replay: &'a rendersim::studies::replay::ReplaySummary,
+    provenance: rendersim::output::provenance::Provenance,
 }
 
 /// `rendersim replay`: a PresentMon capture through the frame pipeline.
@@ -597,7 +622,11 @@ pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
         from_tables: false,
     };
     let r = replay(&args.capture, &opts)?;
-    let json = serde_json::to_string_pretty(&ReplayJson { replay: &r.summary })?;
+    let provenance = command_provenance();
+    let json = serde_json::to_string_pretty(&ReplayJson {
+        replay: &r.summary,
+        provenance: provenance.clone(),
+    })?;
     if let Some(set) = set {
         let dir = set.dir();
         std::fs::write(dir.join("replay.json"), &json).context("writing replay.json")?;
@@ -625,16 +654,21 @@ pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
             let text = toml::to_string(model).with_context(|| format!("writing {name}"))?;
             std::fs::write(
                 dir.join(name),
-                format!("# The replay's model; the workload lists (one value per frame) are left out.\n{text}"),
+                format!(
+                    "{}# The replay's model; the workload lists (one value per frame) are left out.\n{text}",
+                    provenance.toml_comment()
+                ),
             )
             .with_context(|| format!("writing {name}"))?;
         }
         set.commit()?;
     }
     if args.json {
-        println!("{json}");
+        say!("{json}");
         return Ok(());
     }
-    rendersim::studies::replay::report::write_text(&r.summary, &mut std::io::stdout().lock())?;
+    super::progress::suspend(|| {
+        rendersim::studies::replay::report::write_text(&r.summary, &mut std::io::stdout().lock())
+    })?;
     Ok(())
 }

@@ -2,6 +2,7 @@
 //! measured passes and passes predicted on them (the library's
 //! `measure::calibrate`, `measure::device_profile`, `measure::device_predict`).
 
+use super::progress::say;
 use std::fmt::Write as _;
 use std::time::Instant;
 
@@ -167,7 +168,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
             "linear_baseline_loo": loo_summary.map(|s| json!({"median_pct": s.1.0, "p90_pct": s.1.1, "worst_pct": s.1.2})),
             "held_out_half": half.map(|((m, p, w), n)| json!({"rows": n, "median_pct": m, "p90_pct": p, "worst_pct": w})),
             "rows": rows_json});
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        say!("{}", serde_json::to_string_pretty(&v)?);
         return check_holdout(args, half.map(|h| h.0.0));
     }
     let calibration = Calibration {
@@ -324,9 +325,9 @@ pub fn predict(args: &PredictArgs) -> Result<()> {
             "layers": args.layers, "depth_test": args.depth_test,
             "predicted": p, "wall_seconds": p.sim_wall_seconds, "measured": comparison,
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        say!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!(
+        say!(
             "{} on {} at {}x{}: {:.4} ms predicted ({} vertex-shader, {} fragment-shader invocations; simulated in {:.3} s)",
             args.mesh,
             profile.device.name,
@@ -338,7 +339,7 @@ pub fn predict(args: &PredictArgs) -> Result<()> {
             p.sim_wall_seconds
         );
         if let Some((ns, wall, adapter)) = &measured {
-            println!(
+            say!(
                 "measured on {adapter}: {:.4} ms (prediction {:+.1}%); measuring took {wall:.3} s, simulating {:.3} s: {:.1}x faster",
                 ns / 1e6,
                 rel_error_pct(p.pass_time_ns, *ns),

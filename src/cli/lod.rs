@@ -2,6 +2,7 @@
 //! on one knapsack instance and its state-sorting buffer on one sequence
 //! (the library's `components::lod_select` and `components::sorting_buffer`).
 
+use super::progress::say;
 use std::path::Path;
 
 use anyhow::{Result, bail};
@@ -59,10 +60,10 @@ pub fn lod_select(args: &LodSelectArgs) -> Result<()> {
     };
     let summary = SelectionSummary::new(&inst, algorithm, &sel, optimum);
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        say!("{}", serde_json::to_string_pretty(&summary)?);
         return Ok(());
     }
-    println!(
+    say!(
         "{} selection, budget {} ms: {} of {} objects drawn",
         algorithm.name(),
         fixed(summary.budget_ms, 3),
@@ -70,15 +71,18 @@ pub fn lod_select(args: &LodSelectArgs) -> Result<()> {
         summary.objects
     );
     let width = inst.objects().iter().map(|o| o.name.len()).max().unwrap_or(6).max(6);
-    println!(
+    say!(
         "{:<width$}  {:>5}  {:>10}  {:>10}",
-        "object", "level", "cost ms", "benefit"
+        "object",
+        "level",
+        "cost ms",
+        "benefit"
     );
     for (o, l) in inst.objects().iter().zip(&summary.selection) {
         match l {
             Some(l) => {
                 let lv = &o.levels[*l as usize];
-                println!(
+                say!(
                     "{:<width$}  {:>5}  {:>10}  {:>10}",
                     o.name,
                     l,
@@ -86,10 +90,10 @@ pub fn lod_select(args: &LodSelectArgs) -> Result<()> {
                     fixed(lv.benefit, 4)
                 );
             }
-            None => println!("{:<width$}  {:>5}  {:>10}  {:>10}", o.name, "-", "-", "-"),
+            None => say!("{:<width$}  {:>5}  {:>10}  {:>10}", o.name, "-", "-", "-"),
         }
     }
-    println!(
+    say!(
         "total: cost {} ms of {} ms, benefit {}",
         fixed(summary.total_cost_ms, 4),
         fixed(summary.budget_ms, 4),
@@ -98,10 +102,10 @@ pub fn lod_select(args: &LodSelectArgs) -> Result<()> {
     if let (Some(opt), Some(gap)) = (summary.optimal_benefit, summary.gap)
         && algorithm != Algorithm::Optimal
     {
-        println!("optimal benefit {} (gap {})", fixed(opt, 4), fixed(gap, 4));
+        say!("optimal benefit {} (gap {})", fixed(opt, 4), fixed(gap, 4));
     }
     for n in &summary.notes {
-        println!("note: {n}");
+        say!("note: {n}");
     }
     Ok(())
 }
@@ -122,24 +126,27 @@ pub fn sortbuf(args: &SortbufArgs) -> Result<()> {
         };
         let sweep = SortbufSweep::run(&args.sequence, &seq, &args.sweep, &strategies, args.seed)?;
         if args.json {
-            println!("{}", serde_json::to_string_pretty(&sweep)?);
+            say!("{}", serde_json::to_string_pretty(&sweep)?);
             return Ok(());
         }
-        println!(
+        say!(
             "{}: {} elements, {} distinct states, {} changes without a buffer",
-            sweep.sequence, sweep.sequence_length, sweep.distinct_states, sweep.input_runs
+            sweep.sequence,
+            sweep.sequence_length,
+            sweep.distinct_states,
+            sweep.input_runs
         );
         let mut head = format!("{:>8}  {:>11}", "buffer", "lower_bound");
         for s in &strategies {
             head.push_str(&format!("  {:>13}", s.name()));
         }
-        println!("{head}");
+        say!("{head}");
         for r in &sweep.rows {
             let mut line = format!("{:>8}  {:>11}", r.buffer, r.lower_bound);
             for s in &strategies {
                 line.push_str(&format!("  {:>13}", r.state_changes[s.name()]));
             }
-            println!("{line}");
+            say!("{line}");
         }
         return Ok(());
     }
@@ -153,10 +160,10 @@ pub fn sortbuf(args: &SortbufArgs) -> Result<()> {
     };
     let s = SortbufSummary::run(&args.sequence, &seq, k, strategy, args.seed)?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&s)?);
+        say!("{}", serde_json::to_string_pretty(&s)?);
         return Ok(());
     }
-    println!(
+    say!(
         "{} with {} slots over {} ({} elements, {} distinct states): {} state changes; {} without a buffer; offline optimum >= {}{}",
         strategy.name(),
         k,

@@ -1,5 +1,6 @@
 //! The `rendersim` command line behind `main.rs`: its arguments in clap's
-//! terms ([`args`]), what each command does ([`commands`]) and the lines it
+//! terms ([`args`]), what each command does ([`commands`]) the spinner of long
+//! commands ([`progress`]) and the lines it
 //! prints for benchmarks and measurements ([`print`]), device profiles ([`device`]). All simulation logic
 //! lives in the library.
 
@@ -9,3 +10,4 @@ pub mod commands;
 pub mod device;
 pub mod lod;
 pub mod print;
+pub mod progress;

@@ -31,6 +31,7 @@ mod shard;
 mod sim_runner;
 mod slurm;
 pub mod sobol;
+pub mod sobol_sequence;
 mod spec;
 mod sweep;
 mod tables;

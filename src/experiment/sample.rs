@@ -7,12 +7,19 @@
 //!   strata of different parameters paired by independent random
 //!   permutations.
 //! - `sobol`: Saltelli's scheme for Sobol' indices (Saltelli et al. 2010,
-//!   "Variance based sensitivity analysis of model output", §3): two
-//!   independent `n x k` matrices `A` and `B` (here the two halves of one
-//!   `2k`-dimensional Latin hypercube of `n` rows) and, for each parameter
-//!   `i`, `A_B^(i)`: `A` with column `i` taken from `B`. Points are `A`,
-//!   then `B`, then `A_B^(1)` .. `A_B^(k)`: `n (k + 2)` in all; the indices
-//!   are computed by [`super::sobol`].
+//!   "Variance based sensitivity analysis of model output", §3) on a
+//!   Sobol' sequence, as SALib's Saltelli sampler does: the first `n`
+//!   points of the `2k`-dimensional Sobol' sequence
+//!   ([`super::sobol_sequence`], Joe and Kuo's direction numbers) give two
+//!   `n x k` matrices, `A` (its first `k` columns) and `B` (the last `k`),
+//!   and for each parameter `i`, `A_B^(i)` is `A` with column `i` taken
+//!   from `B`. Points are `A`, then `B`, then `A_B^(1)` .. `A_B^(k)`:
+//!   `n (k + 2)` in all; the indices are computed by [`super::sobol`].
+//!   With `scramble = true` (the default) the sequence gets a random
+//!   digital shift drawn from the seed; `false` gives the plain sequence,
+//!   the same points as SciPy's `qmc.Sobol(2k, scramble=False)`. The
+//!   sequence is balanced at powers of two: `n` = 2^m is best. At most
+//!   [`MAX_SOBOL_PARAMS`] parameters.
 //!
 //! A parameter maps a unit coordinate `u` in `[0, 1)` to its range:
 //! linearly or logarithmically; integers take every value of `from..=to`
@@ -32,9 +39,13 @@ use super::sweep::format_range_number;
 pub enum SampleMethod {
     /// `n` points of a Latin hypercube.
     LatinHypercube,
-    /// Saltelli's `n (k + 2)` points, analysed for Sobol' indices.
+    /// Saltelli's `n (k + 2)` points on a Sobol' sequence, analysed for
+    /// Sobol' indices.
     Sobol,
 }
+
+/// Parameters a `sobol` sample can have: two sequence dimensions each.
+pub const MAX_SOBOL_PARAMS: usize = super::sobol_sequence::MAX_DIMENSIONS / 2;
 
 /// How a parameter's range is covered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -102,6 +113,8 @@ pub struct Sample {
     pub seed: u64,
     /// Bootstrap resamples for the confidence intervals of Sobol' indices.
     pub bootstrap: usize,
+    /// `sobol`: a random digital shift of the sequence (from `seed`).
+    pub scramble: bool,
     /// The parameters, in file order.
     pub params: Vec<SampleParam>,
 }
@@ -140,7 +153,10 @@ impl Sample {
         match self.method {
             SampleMethod::LatinHypercube => latin_hypercube(self.n, k, &mut rng),
             SampleMethod::Sobol => {
-                let ab = latin_hypercube(self.n, 2 * k, &mut rng);
+                let shift: Vec<u32> = (0..2 * k)
+                    .map(|_| if self.scramble { rng.random::<u32>() } else { 0 })
+                    .collect();
+                let ab = super::sobol_sequence::sobol_points(self.n, 2 * k, &shift);
                 let a: Vec<Vec<f64>> = ab.iter().map(|r| r[..k].to_vec()).collect();
                 let b: Vec<Vec<f64>> = ab.iter().map(|r| r[k..].to_vec()).collect();
                 let mut rows = a.clone();
@@ -228,6 +244,7 @@ mod tests {
             n: 8,
             seed: 5,
             bootstrap: 10,
+            scramble: true,
             params: vec![param(Scale::Linear, false, 0.0, 1.0); 3],
         };
         let rows = s.unit_rows();
@@ -243,5 +260,27 @@ mod tests {
             }
         }
         assert_eq!(rows, s.unit_rows(), "same seed, same points");
+        // A and B are the two halves of one 6-dimensional Sobol' sequence:
+        // unscrambled, exactly SciPy's `qmc.Sobol(6, scramble=False)` points.
+        let plain = Sample {
+            scramble: false,
+            ..s.clone()
+        };
+        let rows = plain.unit_rows();
+        let seq = crate::experiment::sobol_sequence::sobol_points(8, 6, &[0; 6]);
+        for j in 0..8 {
+            assert_eq!(rows[j], seq[j][..3]);
+            assert_eq!(rows[8 + j], seq[j][3..]);
+        }
+        assert_eq!(rows[1], [0.5, 0.5, 0.5]);
+        // Another seed shifts the points, and each column stays balanced:
+        // one point in each eighth of [0, 1).
+        let other = Sample { seed: 6, ..s.clone() }.unit_rows();
+        assert_ne!(other, s.unit_rows());
+        for c in 0..3 {
+            let mut cells: Vec<usize> = other[..8].iter().map(|r| (r[c] * 8.0) as usize).collect();
+            cells.sort();
+            assert_eq!(cells, (0..8).collect::<Vec<_>>());
+        }
     }
 }

@@ -45,6 +45,25 @@ use super::run::{ExperimentResult, JobOutput, Plan, RunRecord, ShardCost, Timing
 use super::runner::Runner;
 use super::spec::Experiment;
 
+/// Ascending indices as Slurm's `--array` list: `2,5-7,9`.
+fn index_ranges(ks: &[usize]) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    let mut i = 0;
+    while i < ks.len() {
+        let mut j = i;
+        while j + 1 < ks.len() && ks[j + 1] == ks[j] + 1 {
+            j += 1;
+        }
+        parts.push(if j > i {
+            format!("{}-{}", ks[i], ks[j])
+        } else {
+            ks[i].to_string()
+        });
+        i = j + 1;
+    }
+    parts.join(",")
+}
+
 /// The format tag of shard files.
 pub const SHARD_FORMAT: &str = "rendersim-shard-1";
 
@@ -481,7 +500,9 @@ pub fn merge_shards(
     names.sort();
     if names.is_empty() {
         return Err(shards_error(
-            "no shard files to merge; run the shards first (`rendersim experiment FILE --out DIR --shard K/N`)".into(),
+            "no shard files to merge; run the shards first (`rendersim experiment FILE --out DIR --shard K/N`; \
+             on Slurm, every task of the array failed: see DIR/logs, then `sbatch job.sbatch` again)"
+                .into(),
         ));
     }
     let files = names
@@ -556,10 +577,12 @@ pub fn merge_shards(
     if !missing.is_empty() {
         let list: Vec<String> = missing.iter().take(10).map(|id| id.file_name()).collect();
         return Err(shards_error(format!(
-            "{} of {n} shards missing: {}{}; run them (`--shard K/{n}`) and merge again",
+            "{} of {n} shards missing: {}{}; run them (`--shard K/{n}`; on Slurm `sbatch --array={} job.sbatch`, \
+             their logs in DIR/logs) and merge again",
             missing.len(),
             list.join(", "),
-            if missing.len() > 10 { ", ..." } else { "" }
+            if missing.len() > 10 { ", ..." } else { "" },
+            index_ranges(&missing.iter().map(|id| id.k).collect::<Vec<_>>())
         )));
     }
     // Check every shard holds exactly its runs, then put the runs in order.
@@ -597,6 +620,14 @@ pub fn merge_shards(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn missing_shards_read_as_a_slurm_array_list() {
+        assert_eq!(index_ranges(&[]), "");
+        assert_eq!(index_ranges(&[3]), "3");
+        assert_eq!(index_ranges(&[1, 2]), "1-2");
+        assert_eq!(index_ranges(&[2, 5, 6, 7, 9, 11, 12]), "2,5-7,9,11-12");
+    }
 
     fn run(values: &str, wall: &str, frames: &[&str]) -> ShardRun {
         ShardRun {

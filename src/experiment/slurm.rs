@@ -1,8 +1,13 @@
 //! Slurm batch scripts for an experiment split into shards: `job.sbatch`,
 //! a job array with one task per shard (each runs `rendersim experiment
-//! FILE --out DIR --shard $SLURM_ARRAY_TASK_ID/N`), and `merge.sbatch`,
-//! which merges the shards (`--merge`) once every task has succeeded
-//! (submitted with `--dependency=afterok:<array job id>`).
+//! FILE --out DIR --shard $SLURM_ARRAY_TASK_ID/N`; `--throttle` caps how
+//! many run at once), and `merge.sbatch`, which merges the shards
+//! (`--merge`) once every task has ended, whatever its outcome (submitted
+//! with `--dependency=afterany:<array job id>`): with all shards there it
+//! writes the results; with some missing (a task failed, timed out or was
+//! cancelled) it fails naming them and the `sbatch --array=...` that runs
+//! them again. Options rendersim has no flag for (`--account`, `--mem`,
+//! `--qos`, ...) pass through `--slurm-opt` into both scripts.
 //!
 //! The scripts name the rendersim binary, the experiment file and the
 //! output folder by absolute paths, so they run from any folder of a
@@ -27,6 +32,11 @@ pub struct SlurmOptions {
     pub time: Option<String>,
     /// CPUs per task (and rayon threads per shard).
     pub cpus_per_task: u32,
+    /// At most this many array tasks at once (Slurm's `--array=1-N%T`).
+    pub throttle: Option<usize>,
+    /// Further `#SBATCH` options for both scripts, each as given
+    /// (`--account=proj`, `--mem=4G`, `--qos=short`, `-A proj`).
+    pub extra: Vec<String>,
     /// The rendersim binary the tasks run (absolute).
     pub binary: PathBuf,
     /// The experiment file (absolute).
@@ -144,6 +154,16 @@ pub fn slurm_scripts(exp: &Experiment, opts: &SlurmOptions) -> Result<SlurmScrip
             message: "Slurm's time formats are MM, MM:SS, HH:MM:SS, D-HH, D-HH:MM and D-HH:MM:SS".into(),
         });
     }
+    if opts.throttle == Some(0) {
+        return Err(SlurmError::Option {
+            option: "throttle",
+            value: "0".into(),
+            message: "needs at least 1 (tasks at once)".into(),
+        });
+    }
+    for o in &opts.extra {
+        check_extra(o)?;
+    }
     let bin = shell_quote(&path_text(&opts.binary, false)?);
     let file = shell_quote(&path_text(&opts.experiment, false)?);
     let out_raw = path_text(&opts.out_dir, true)?;
@@ -169,6 +189,10 @@ pub fn slurm_scripts(exp: &Experiment, opts: &SlurmOptions) -> Result<SlurmScrip
     if let Some(t) = &opts.time {
         common.push_str(&format!("#SBATCH --time={t}\n"));
     }
+    for o in &opts.extra {
+        common.push_str(&format!("#SBATCH {o}\n"));
+    }
+    let throttle = opts.throttle.map_or(String::new(), |t| format!("%{t}"));
     let version = env!("CARGO_PKG_VERSION");
     let job = format!(
         "#!/bin/bash\n\
@@ -177,9 +201,9 @@ pub fn slurm_scripts(exp: &Experiment, opts: &SlurmOptions) -> Result<SlurmScrip
          # {out_raw}/shards/shard-K-of-{n}.json. A task whose shard file is complete\n\
          # does nothing, so a preempted or failed array can be submitted again.\n\
          # Submit with the merge after it:\n\
-         #   jid=$(sbatch --parsable job.sbatch) && sbatch --dependency=afterok:${{jid%%;*}} merge.sbatch\n\
+         #   jid=$(sbatch --parsable job.sbatch) && sbatch --dependency=afterany:${{jid%%;*}} merge.sbatch\n\
          #SBATCH --job-name=rendersim-{name}\n\
-         #SBATCH --array=1-{n}\n\
+         #SBATCH --array=1-{n}{throttle}\n\
          #SBATCH --output={out_raw}/logs/shard-%a.out\n\
          {common}\
          set -eu\n\
@@ -191,7 +215,10 @@ pub fn slurm_scripts(exp: &Experiment, opts: &SlurmOptions) -> Result<SlurmScrip
          # Written by rendersim {version} (`rendersim experiment --slurm`) for experiment {name:?}:\n\
          # merges the {n} shards in {out_raw}/shards into runs.csv, points.csv, the\n\
          # plots and report.md, as one process would have written them. Submit it\n\
-         # after the array job: sbatch --dependency=afterok:<array job id> merge.sbatch\n\
+         # after the array job, whatever its tasks' outcome:\n\
+         #   sbatch --dependency=afterany:<array job id> merge.sbatch\n\
+         # With a shard missing it fails, naming the shards and the sbatch --array\n\
+         # that runs them again; merge.sbatch can then be submitted again.\n\
          #SBATCH --job-name=rendersim-{name}-merge\n\
          #SBATCH --output={out_raw}/logs/merge.out\n\
          {common}\
@@ -202,6 +229,55 @@ pub fn slurm_scripts(exp: &Experiment, opts: &SlurmOptions) -> Result<SlurmScrip
     Ok(SlurmScripts { job, merge })
 }
 
+/// Options the scripts set themselves, each with the flag that sets it.
+const OWN_OPTIONS: [(&str, &str); 9] = [
+    ("array", "--shards and --throttle"),
+    ("output", "--out (the logs go to DIR/logs)"),
+    ("job-name", "the experiment's name"),
+    ("dependency", "--submit (the merge runs after the array)"),
+    ("cpus-per-task", "--cpus-per-task"),
+    ("partition", "--partition"),
+    ("time", "--time"),
+    ("parsable", "--submit"),
+    ("wrap", "the scripts themselves"),
+];
+
+/// One `--slurm-opt`: an option (`-x ...` or `--name[=value]`) on one line,
+/// not one the scripts set themselves.
+fn check_extra(o: &str) -> Result<(), SlurmError> {
+    let bad = |message: String| SlurmError::Option {
+        option: "slurm-opt",
+        value: o.to_string(),
+        message,
+    };
+    if !o.starts_with('-') || o.trim() != o || o.len() < 2 {
+        return Err(bad(
+            "an sbatch option as it would follow #SBATCH, e.g. --account=proj, --mem=4G, --qos=short or \"-A proj\""
+                .into(),
+        ));
+    }
+    if o.contains(['\n', '\r', '#']) {
+        return Err(bad("line breaks and `#` cannot go into an #SBATCH line".into()));
+    }
+    let long = o.strip_prefix("--").map(|r| r.split(['=', ' ']).next().unwrap_or(""));
+    let short = match o.as_bytes().get(1) {
+        Some(b'a') if !o.starts_with("--") => Some("array"),
+        Some(b'o') if !o.starts_with("--") => Some("output"),
+        Some(b'J') if !o.starts_with("--") => Some("job-name"),
+        Some(b'd') if !o.starts_with("--") => Some("dependency"),
+        Some(b'c') if !o.starts_with("--") => Some("cpus-per-task"),
+        Some(b'p') if !o.starts_with("--") => Some("partition"),
+        Some(b't') if !o.starts_with("--") => Some("time"),
+        _ => None,
+    };
+    if let Some(name) = long.or(short)
+        && let Some((_, instead)) = OWN_OPTIONS.iter().find(|(n, _)| *n == name)
+    {
+        return Err(bad(format!("the scripts set --{name} themselves; use {instead}")));
+    }
+    Ok(())
+}
+
 /// The job id `sbatch --parsable` printed (`ID` or `ID;CLUSTER`).
 fn parse_job_id(stdout: &str) -> Option<String> {
     let line = stdout.lines().map(str::trim).rfind(|l| !l.is_empty())?;
@@ -209,15 +285,15 @@ fn parse_job_id(stdout: &str) -> Option<String> {
     (!id.is_empty() && id.bytes().all(|b| b.is_ascii_digit())).then(|| id.to_string())
 }
 
-/// Runs `sbatch --parsable [--dependency=afterok:ID] SCRIPT` and returns
+/// Runs `sbatch --parsable [--dependency=afterany:ID] SCRIPT` and returns
 /// the job id. `sbatch` is taken from `RENDERSIM_SBATCH` if set (a wrapper,
 /// or a stand-in in tests), else from `PATH`.
-pub fn sbatch(script: &Path, after_ok: Option<&str>) -> Result<String, SlurmError> {
+pub fn sbatch(script: &Path, after: Option<&str>) -> Result<String, SlurmError> {
     let program = std::env::var_os("RENDERSIM_SBATCH").unwrap_or_else(|| "sbatch".into());
     let mut cmd = Command::new(&program);
     cmd.arg("--parsable");
-    if let Some(id) = after_ok {
-        cmd.arg(format!("--dependency=afterok:{id}"));
+    if let Some(id) = after {
+        cmd.arg(format!("--dependency=afterany:{id}"));
     }
     cmd.arg(script);
     let shown = script.display().to_string();
@@ -252,6 +328,36 @@ mod tests {
         }
         for bad in ["", "1h", "1:2:3:4", "-5", "a-1", "1-", "1:00;rm"] {
             assert!(!valid_time(bad), "{bad}");
+        }
+    }
+
+    #[test]
+    fn extra_options_are_single_sbatch_options_not_ours() {
+        for ok in [
+            "--account=proj",
+            "--mem=4G",
+            "--qos=short",
+            "-A proj",
+            "--exclusive",
+            "--mail-type=END,FAIL",
+        ] {
+            assert!(check_extra(ok).is_ok(), "{ok}");
+        }
+        for (bad, says) in [
+            ("account=proj", "an sbatch option"),
+            ("", "an sbatch option"),
+            (" --mem=4G", "an sbatch option"),
+            ("--mem=4G\n#SBATCH --x", "line breaks"),
+            ("--comment=a#b", "line breaks"),
+            ("--array=1-3", "use --shards and --throttle"),
+            ("--time=10", "use --time"),
+            ("-t 10", "use --time"),
+            ("--dependency=afterok:1", "use --submit"),
+            ("--output=/tmp/x", "use --out"),
+            ("-J name", "the experiment's name"),
+        ] {
+            let e = check_extra(bad).unwrap_err().to_string();
+            assert!(e.contains(says) && e.starts_with("--slurm-opt "), "{bad}: {e}");
         }
     }
 

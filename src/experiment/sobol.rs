@@ -138,6 +138,7 @@ mod tests {
             n,
             seed,
             bootstrap: 300,
+            scramble: true,
             params: vec![
                 SampleParam {
                     key: "x".into(),

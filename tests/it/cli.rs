@@ -1225,3 +1225,60 @@ fn an_output_folder_of_one_command_is_not_replaced_by_another_unless_forced() {
     let err = run_err(&["experiment", exp.to_str().unwrap(), "--out", out_s, "--quiet"]);
     assert!(err.contains("holds the results of `rendersim run`"), "{err}");
 }
+
+/// `rendersim ARGS` in a pseudo-terminal (util-linux `script`), its screen
+/// output; `None` where `script` is missing.
+fn on_a_terminal(args: &str, after_ms: &str) -> Option<String> {
+    let line = format!("{} {args}", env!("CARGO_BIN_EXE_rendersim"));
+    let o = Command::new("script")
+        .args(["-qec", &line, "/dev/null"])
+        .env("RENDERSIM_PROGRESS_AFTER_MS", after_ms)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .ok()?;
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    Some(String::from_utf8_lossy(&o.stdout).to_string())
+}
+
+#[test]
+fn long_commands_show_a_spinner_on_a_terminal_only() {
+    // On a terminal, once the delay has passed: the command line and the
+    // time so far, cleared at the end, the printed lines intact.
+    // (A run of about 0.4 s, so that the spinner is drawn before the end.)
+    let Some(screen) = on_a_terminal("run --set run.frames=30", "0") else {
+        eprintln!("SKIPPED: no `script` to make a terminal");
+        return;
+    };
+    assert!(screen.contains("rendersim run --set run.frames=30 [0s]"), "{screen:?}");
+    assert!(
+        screen.ends_with("\r\x1b[2K"),
+        "the spinner is cleared at the end: {screen:?}"
+    );
+    let report = "<embedded default model> (triangle), 30 frames, seed 1\r\n";
+    assert!(
+        screen.contains(&format!("\x1b[2K{report}")),
+        "{report:?} whole in {screen:?}"
+    );
+    let iso = on_a_terminal("isolate --set run.frames=70", "0").unwrap();
+    assert!(iso.contains("rendersim isolate --set run.frames=70 ["), "{iso:?}");
+    for line in ["bottleneck isolation (load x0.5, vsync off):", "  => bottleneck: "] {
+        assert!(
+            !iso.contains(&format!("]{line}")),
+            "{line:?} not after the spinner in {iso:?}"
+        );
+        assert!(iso.contains(line), "{line:?} in {iso:?}");
+    }
+    // Work shorter than the delay draws nothing.
+    let quick = on_a_terminal("isolate models/fixed.toml", "60000").unwrap();
+    assert!(!quick.contains("[0s]") && !quick.contains('\x1b'), "{quick:?}");
+    // Not on a terminal: no spinner, even at once.
+    let o = bin()
+        .args(["isolate", "models/fixed.toml"])
+        .env("RENDERSIM_PROGRESS_AFTER_MS", "0")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    assert!(o.stderr.is_empty(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!String::from_utf8_lossy(&o.stdout).contains('\x1b'));
+}

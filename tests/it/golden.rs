@@ -3,8 +3,10 @@
 //! outputs stored under `tests/golden/` — the guard for restructurings that
 //! must not change behaviour.
 //!
-//! Compared: each model's `summary.json` (without its wall-time keys),
-//! `frames.csv` and `model.toml` (the repository's path written `$ROOT`);
+//! Compared: each model's `summary.json` (without its wall-time keys and
+//! its provenance: revision, command line, date), `frames.csv` and
+//! `model.toml` (the repository's path written `$ROOT`, without the
+//! provenance comment at its head);
 //! each experiment's `runs.csv` and `points.csv` without their wall-time
 //! columns (`wall_seconds*`, `*speedup`, build, simulation and calibration
 //! times), and its `searches.csv` if any. A file of at most 16 KiB is stored
@@ -19,8 +21,14 @@ use rayon::prelude::*;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 const WHOLE_LIMIT: usize = 16 * 1024;
-/// Summary keys that measure the machine, not the model.
-const WALL_KEYS: [&str; 4] = ["wall_seconds", "build_seconds", "simulate_seconds", "events_per_second"];
+/// Summary keys that measure the machine or the occasion, not the model.
+const WALL_KEYS: [&str; 5] = [
+    "wall_seconds",
+    "build_seconds",
+    "simulate_seconds",
+    "events_per_second",
+    "provenance",
+];
 /// Keys at any depth that measure the machine (the walkthrough's estimator
 /// costs and view-cell preprocess times), removed wherever they occur; experiment columns naming one are
 /// left out too.
@@ -117,9 +125,15 @@ fn outputs(kind: &str, file: &Path, tmp: &Path) -> Vec<(String, Vec<u8>)> {
     let out = tmp.join(file.file_stem().unwrap());
     if kind == "models" {
         run(&["run", &rel, "--seed", "1"], &out);
-        let model = std::fs::read_to_string(out.join("model.toml"))
-            .unwrap()
+        let text = std::fs::read_to_string(out.join("model.toml")).unwrap();
+        // The provenance comment (this build, the command, the date) goes.
+        let model = text
+            .lines()
+            .skip_while(|l| l.starts_with("# Written by ") || l.starts_with("# Command: "))
+            .map(|l| format!("{l}\n"))
+            .collect::<String>()
             .replace(ROOT, "$ROOT");
+        assert!(text.starts_with("# Written by rendersim "), "{text}");
         vec![
             ("summary.json".into(), summary(&out.join("summary.json"))),
             ("frames.csv".into(), std::fs::read(out.join("frames.csv")).unwrap()),

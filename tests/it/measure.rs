@@ -371,3 +371,34 @@ fn h4_searches_its_loop_count_and_reports_what_it_measured() {
     let passes = g.measured_passes();
     assert!(passes.rows.iter().any(|r| r.vs_loops == found.loops && r.geometry_only));
 }
+
+/// Mesa's device-selection layer made libwayland print `error:
+/// XDG_RUNTIME_DIR is invalid or not set` on every wgpu command without a
+/// runtime folder; the binary switches the layer off there (src/main.rs).
+#[test]
+fn no_stray_loader_errors_without_a_runtime_folder() {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+        .args([
+            "measure",
+            "grid:4x4",
+            "--size",
+            "16x16",
+            "--repeats",
+            "1",
+            "--warmup",
+            "0",
+        ])
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("NODEVICE_SELECT")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    if err.contains("no Vulkan adapter found") {
+        eprintln!("SKIPPED: no Vulkan adapter on this machine ({})", err.trim());
+        return;
+    }
+    assert!(o.status.success(), "{err}");
+    assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
+    assert!(!err.lines().any(|l| l.starts_with("error:")), "{err}");
+}

@@ -698,3 +698,115 @@ fn an_output_that_names_an_input_or_another_output_is_refused() {
         "the input is as it was"
     );
 }
+
+/// The git revision of this checkout, when it is one and git runs.
+fn checkout_revision() -> Option<String> {
+    let o = Command::new("git")
+        .args(["rev-parse", "--short=12", "HEAD"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .ok()?;
+    o.status
+        .success()
+        .then(|| String::from_utf8_lossy(&o.stdout).trim().to_string())
+}
+
+#[test]
+fn run_replay_and_experiment_outputs_say_where_they_came_from() {
+    let d = tempfile::tempdir().unwrap();
+    let m = model(d.path());
+    let out = d.path().join("out");
+    // SOURCE_DATE_EPOCH fixes the date (reproducible outputs).
+    ok(bin().env("SOURCE_DATE_EPOCH", "1796386922").args([
+        "run",
+        &m,
+        "--set",
+        "run.frames=5",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let p = &summary["provenance"];
+    assert_eq!(p["program"], format!("rendersim {}", env!("CARGO_PKG_VERSION")), "{p}");
+    assert_eq!(p["date"], "2026-12-04T12:22:02Z");
+    let command: Vec<&str> = p["command"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_str().unwrap())
+        .collect();
+    assert_eq!(
+        command[1..],
+        [
+            "run",
+            m.as_str(),
+            "--set",
+            "run.frames=5",
+            "--out",
+            out.to_str().unwrap()
+        ]
+    );
+    // Built in a git checkout, the revision is this checkout's (maybe dirty).
+    if let Some(rev) = checkout_revision() {
+        let got = p["git_revision"].as_str().unwrap_or_else(|| panic!("no revision: {p}"));
+        assert!(got == rev || got == format!("{rev}-dirty"), "{got} against {rev}");
+    }
+    // The model file's head says the same, and the file still runs.
+    let text = std::fs::read_to_string(out.join("model.toml")).unwrap();
+    let head: Vec<&str> = text.lines().take(2).collect();
+    assert!(
+        head[0].starts_with("# Written by rendersim ") && head[0].ends_with(", 2026-12-04T12:22:02Z"),
+        "{text}"
+    );
+    assert!(
+        head[1].starts_with("# Command: ") && head[1].contains("--set run.frames=5"),
+        "{text}"
+    );
+    ok(bin().args(["run", out.join("model.toml").to_str().unwrap(), "--json"]));
+
+    // Without SOURCE_DATE_EPOCH the date is now (this year or later).
+    let json = ok(bin().env_remove("SOURCE_DATE_EPOCH").args(["run", &m, "--json"]));
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let year: i32 = v["provenance"]["date"].as_str().unwrap()[..4].parse().unwrap();
+    assert!(year >= 2026, "{v}");
+
+    // An experiment's report ends with the section.
+    let exp = d.path().join("e.toml");
+    std::fs::write(
+        &exp,
+        format!(
+            "name = \"p\"\nmodel = {m:?}\nreplications = 2\n[set]\n\"run.frames\" = 10\n\
+             [[metric]]\npath = \"metrics.frame_time_ms.mean\"\n"
+        ),
+    )
+    .unwrap();
+    let eout = d.path().join("eout");
+    ok(experiment(&exp, &eout).env("SOURCE_DATE_EPOCH", "0"));
+    let report = std::fs::read_to_string(eout.join("report.md")).unwrap();
+    let section = &report[report.find("## Provenance\n").expect(&report)..];
+    assert!(section.contains("- date: 1970-01-01T00:00:00Z"), "{section}");
+    assert!(
+        section.contains("experiment") && section.contains("--quiet"),
+        "{section}"
+    );
+
+    // A replay's JSON and model files.
+    let capture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/presentmon/test_case_0.csv");
+    let rout = d.path().join("rout");
+    ok(bin().env("SOURCE_DATE_EPOCH", "0").args([
+        "replay",
+        capture.to_str().unwrap(),
+        "--out",
+        rout.to_str().unwrap(),
+    ]));
+    let replay: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(rout.join("replay.json")).unwrap()).unwrap();
+    assert_eq!(replay["provenance"]["date"], "1970-01-01T00:00:00Z");
+    assert_eq!(replay["provenance"]["command"][1], "replay");
+    assert!(
+        std::fs::read_to_string(rout.join("model.toml"))
+            .unwrap()
+            .starts_with("# Written by rendersim ")
+    );
+}

@@ -62,13 +62,14 @@ fn mask_wall_columns(text: &str) -> String {
     out.join("\n")
 }
 
-/// `report.md` without its `## Timing` section (wall and CPU times).
+/// `report.md` without its `## Timing` section (wall and CPU times) and its
+/// `## Provenance` (command line and date).
 fn without_timing(text: &str) -> String {
     let mut out = String::new();
     let mut skip = false;
     for l in text.lines() {
         if l.starts_with("## ") {
-            skip = l == "## Timing";
+            skip = l == "## Timing" || l == "## Provenance";
         }
         if !skip {
             out.push_str(l);
@@ -179,6 +180,7 @@ fn a_merge_refuses_missing_duplicated_and_mismatched_shards() {
     }
     let e = merge();
     assert!(e.contains("1 of 3 shards missing: shard-2-of-3.json"), "{e}");
+    assert!(e.contains("on Slurm `sbatch --array=2 job.sbatch`"), "{e}");
     ok(&["experiment", s(&exp), "--quiet", "--out", s(&out), "--shard", "2/3"]);
     let shards = out.join("shards");
     // Twice: a copy under another name.
@@ -281,11 +283,21 @@ fn slurm_writes_an_array_and_a_merge_and_submit_chains_them() {
         "10:00",
         "--cpus-per-task",
         "2",
+        "--throttle",
+        "2",
+        "--slurm-opt=--account=proj",
+        "--slurm-opt",
+        "--mem=4G",
+        "--slurm-opt",
+        "-q short",
     ]);
-    assert!(said.contains("sbatch --dependency=afterok:"), "{said}");
+    assert!(said.contains("sbatch --dependency=afterany:"), "{said}");
     let job = std::fs::read_to_string(out.join("job.sbatch")).unwrap();
     for line in [
-        "#SBATCH --array=1-4\n",
+        "#SBATCH --array=1-4%2\n",
+        "#SBATCH --account=proj\n",
+        "#SBATCH --mem=4G\n",
+        "#SBATCH -q short\n",
         "#SBATCH --partition=short\n",
         "#SBATCH --time=10:00\n",
         "#SBATCH --cpus-per-task=2\n",
@@ -299,7 +311,28 @@ fn slurm_writes_an_array_and_a_merge_and_submit_chains_them() {
         "{job}"
     );
     let merge = std::fs::read_to_string(out.join("merge.sbatch")).unwrap();
-    assert!(merge.contains(" --merge") && !merge.contains("--array"), "{merge}");
+    assert!(
+        merge.contains(" --merge") && !merge.contains("#SBATCH --array"),
+        "{merge}"
+    );
+    assert!(
+        merge.contains("#SBATCH --account=proj\n") && merge.contains("#SBATCH --mem=4G\n"),
+        "{merge}"
+    );
+    // Options the scripts set themselves, or that are not options, are refused
+    // before anything is written.
+    for (opt, says) in [
+        ("--slurm-opt=--array=1-9", "use --shards and --throttle"),
+        ("--slurm-opt=account=proj", "an sbatch option"),
+    ] {
+        let e = err(&["experiment", s(&exp), "--out", s(&out), "--slurm", opt]);
+        assert!(e.contains(says), "{e}");
+        let fresh = d.path().join("fresh");
+        err(&["experiment", s(&exp), "--out", s(&fresh), "--slurm", opt]);
+        assert!(!fresh.exists(), "nothing made for a refused option");
+    }
+    let e = err(&["experiment", s(&exp), "--out", s(&out), "--slurm", "--throttle", "0"]);
+    assert!(e.contains("--throttle \"0\"") && e.contains("at least 1"), "{e}");
     assert!(out.join("logs").is_dir());
 
     // --submit with a stand-in sbatch that logs its arguments and answers ids.
@@ -343,7 +376,7 @@ fn slurm_writes_an_array_and_a_merge_and_submit_chains_them() {
         "{calls:?}"
     );
     assert!(
-        calls[1].contains("--dependency=afterok:101 ") && calls[1].ends_with("merge.sbatch"),
+        calls[1].contains("--dependency=afterany:101 ") && calls[1].ends_with("merge.sbatch"),
         "{calls:?}"
     );
     // sbatch refusing is an error that says so.

@@ -43,6 +43,7 @@ pub(super) struct RawSample {
     #[serde(default = "default_seed")]
     pub(super) seed: u64,
     pub(super) bootstrap: Option<i64>,
+    pub(super) scramble: Option<bool>,
     #[serde(default)]
     pub(super) param: Vec<RawParam>,
 }

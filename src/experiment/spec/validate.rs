@@ -327,6 +327,24 @@ impl Validator<'_> {
         if s.param.is_empty() {
             return Err(self.err("sample", "needs at least one `[[sample.param]]`"));
         }
+        let max = crate::experiment::sample::MAX_SOBOL_PARAMS;
+        if method == SampleMethod::Sobol && s.param.len() > max {
+            return Err(self.err(
+                "sample.param",
+                format!(
+                    "{} parameters; a sobol sample takes at most {max} (its sequence has {} dimensions, two a \
+                     parameter); use latin_hypercube or fewer parameters",
+                    s.param.len(),
+                    2 * max
+                ),
+            ));
+        }
+        if s.scramble.is_some() && method != SampleMethod::Sobol {
+            return Err(self.err(
+                "sample.scramble",
+                "belongs to method = \"sobol\" (the sequence's digital shift)",
+            ));
+        }
         let mut params: Vec<SampleParam> = Vec::new();
         for (i, p) in s.param.into_iter().enumerate() {
             let key = format!("sample.param[{i}]");
@@ -380,6 +398,7 @@ impl Validator<'_> {
             n: s.n as usize,
             seed: s.seed,
             bootstrap: bootstrap as usize,
+            scramble: s.scramble.unwrap_or(true),
             params,
         })
     }

@@ -137,6 +137,20 @@ fn sample_errors_name_the_entry() {
             "give either `[[sweep]]`s or `[sample]`, not both",
         ),
         (SOBOL.replace("seed = 3", "seed = 3\nsize = 4"), "unknown field `size`"),
+        (
+            SOBOL
+                .replace("\"sobol\"", "\"latin_hypercube\"")
+                .replace("seed = 3", "seed = 3\nscramble = false"),
+            "`sample.scramble`: belongs to method = \"sobol\"",
+        ),
+        (SOBOL.replace("seed = 3", "seed = 3\nscramble = 1"), "scramble"),
+        (
+            SOBOL.to_string()
+                + &(0..62)
+                    .map(|i| format!("[[sample.param]]\nkey = \"extra.k{i}\"\nfrom = 0\nto = 1\n"))
+                    .collect::<String>(),
+            "`sample.param`: 65 parameters; a sobol sample takes at most 64",
+        ),
     ];
     for (text, says) in cases {
         let e = parse_err(&text);

@@ -8,6 +8,8 @@
 //!   new one, never a mix.
 //! - [`pipe`]: a FIFO or socket written in place whose reader closes it
 //!   gives a write error, not a SIGPIPE death.
+//! - [`provenance`]: where a result came from (version, git revision,
+//!   command line, date), for summaries, reports and model files.
 //! - [`cleanup`]: temporary paths removed on SIGINT, SIGTERM and SIGHUP.
 //! - [`table`]: per-row tables as CSV through the `csv` crate.
 //! - [`text`]: numbers in human-readable reports.
@@ -19,6 +21,7 @@ pub mod cleanup;
 pub mod error;
 pub mod files;
 pub mod pipe;
+pub mod provenance;
 pub mod result_set;
 pub mod table;
 pub mod text;
