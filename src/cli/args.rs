@@ -44,6 +44,12 @@ pub struct RunArgs {
     /// Write a Chrome/Perfetto trace to FILE.
     #[arg(long, value_name = "FILE")]
     pub trace: Option<PathBuf>,
+    /// How much the trace shows: frame (a slice a frame on the CPU, GPU and
+    /// display tracks, joined by flows), draw (also every unit's states, the
+    /// geometry and fragment stages' work a slice a draw), triangle (every
+    /// state change, a slice a triangle).
+    #[arg(long, value_name = "DETAIL", default_value = "draw", requires = "trace")]
+    pub trace_detail: rendersim::output::trace::TraceDetail,
 }
 
 impl From<&RunArgs> for Overrides {

@@ -12,7 +12,7 @@ use rendersim::config::{ModelSource, load_model};
 use rendersim::output::files::{check_distinct, open_output};
 use rendersim::output::result_set::ResultSet;
 use rendersim::output::text::fixed;
-use rendersim::output::trace::TraceWriter;
+use rendersim::output::trace::{TraceDetail, TraceWriter};
 use rendersim::studies::isolate::IsolateOptions;
 use rendersim::systems::run_model;
 
@@ -76,10 +76,29 @@ pub fn run(args: RunArgs) -> Result<()> {
     };
     // With the trace on standard output, the report goes to standard error.
     let trace_on_stdout = trace.as_deref().is_some_and(is_stdout);
+    let detail = args.trace_detail;
+    if trace.is_some()
+        && let Some((bytes, frames)) = trace_size_estimate(src, &model.table, detail)
+        && bytes > TRACE_WARN_BYTES
+    {
+        esay!(
+            "warning: the trace will be about {} ({frames} frames at about {} each, --trace-detail {}); \
+             traces this large load slowly or not at all in Perfetto's UI: --trace-detail {} or fewer frames \
+             (--frames N) make it smaller",
+            human_bytes(bytes),
+            human_bytes(bytes / frames.max(1)),
+            detail.name(),
+            if detail == TraceDetail::Triangle {
+                "draw or frame"
+            } else {
+                "frame"
+            }
+        );
+    }
     let (trace_file, writer) = match &trace {
         Some(path) => {
             let (file, w) = open_output(path)?;
-            (Some(file), Some(TraceWriter::new(w)))
+            (Some(file), Some(TraceWriter::new(w).with_detail(detail)))
         }
         None => (None, None),
     };
@@ -120,6 +139,36 @@ pub fn run(args: RunArgs) -> Result<()> {
         super::progress::suspend(|| run.write_report(&mut std::io::stdout().lock()))?;
     }
     Ok(())
+}
+
+/// Traces estimated above this get a warning before they are written.
+const TRACE_WARN_BYTES: u64 = 100_000_000;
+
+/// The size of the trace a run of `table` would write at `detail`, and its
+/// frames: the model's first frames (at most 3, no warm-up) traced into a
+/// counter, scaled to `run.frames`. `None` where the model gives no
+/// `run.frames` or the short run fails (the real run then says why).
+fn trace_size_estimate(src: &ModelSource, table: &toml::Table, detail: TraceDetail) -> Option<(u64, u64)> {
+    let frames = table.get("run")?.get("frames")?.as_integer()?;
+    let frames = u64::try_from(frames).ok().filter(|&f| f > 0)?;
+    let pilot = frames.min(3);
+    let mut short = table.clone();
+    let run = short.get_mut("run")?.as_table_mut()?;
+    run.insert("frames".into(), toml::Value::Integer(pilot as i64));
+    run.insert("warmup_frames".into(), toml::Value::Integer(0));
+    let writer = TraceWriter::new(Box::new(std::io::sink())).with_detail(detail);
+    let mut r = run_model(src, &short, Some(writer)).ok()?;
+    let bytes = r.take_trace()?.bytes();
+    Some((bytes.saturating_mul(frames) / pilot, frames))
+}
+
+/// `1.5 GB`, `120 MB`, `900 kB`.
+fn human_bytes(b: u64) -> String {
+    match b {
+        b if b >= 1_000_000_000 => format!("{:.1} GB", b as f64 / 1e9),
+        b if b >= 1_000_000 => format!("{:.0} MB", b as f64 / 1e6),
+        b => format!("{:.0} kB", b as f64 / 1e3),
+    }
 }
 
 /// Where this command's results come from: this build, this process's

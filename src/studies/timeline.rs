@@ -216,7 +216,7 @@ pub fn timeline_of(
     let capacity = cfg.command_fifo.capacity;
     let unit = format!("{:?}", cfg.command_fifo.unit).to_lowercase();
     let collector = SpanCollector::new(MERGE_GAP_US, &["command FIFO"]);
-    let writer = TraceWriter::new(Box::new(collector.clone()));
+    let writer = TraceWriter::new(Box::new(collector.clone())).with_detail(crate::output::trace::TraceDetail::Triangle);
     let mut run = run_pipeline(cfg, &src.base_dir, Some(writer)).map_err(|e| SimError::of(src, e))?;
     if let Some(w) = run.trace.take() {
         w.finish()

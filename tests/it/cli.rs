@@ -97,6 +97,8 @@ fn out_dir_reruns_to_the_same_frames_and_trace_is_valid() {
         a.to_str().unwrap(),
         "--trace",
         trace.to_str().unwrap(),
+        "--trace-detail",
+        "triangle",
     ]);
     for f in ["summary.json", "frames.csv", "model.toml"] {
         assert!(a.join(f).exists(), "{f}");
@@ -743,6 +745,8 @@ fn a_trace_streams_to_its_file_and_takes_no_memory_budget() {
         "run.max_memory=\"4MiB\"",
         "--trace",
         t.to_str().unwrap(),
+        "--trace-detail",
+        "triangle",
     ]);
     let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&t).unwrap()).unwrap();
     assert!(v["traceEvents"].as_array().unwrap().len() > 50_000);
@@ -1281,4 +1285,123 @@ fn long_commands_show_a_spinner_on_a_terminal_only() {
     assert!(o.status.success());
     assert!(o.stderr.is_empty(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(!String::from_utf8_lossy(&o.stdout).contains('\x1b'));
+}
+
+/// `run --trace` at each detail of the default model: the frame number on
+/// every slice, one flow a shown frame from its CPU slice through its GPU
+/// slice to its display slice, each point inside its slice; the sizes in
+/// the order of the details; a warning with the estimate before a trace
+/// over 100 MB, none below.
+#[test]
+fn traces_at_three_details_with_frames_flows_and_a_size_warning() {
+    let d = tempfile::tempdir().unwrap();
+    let mut sizes = Vec::new();
+    for detail in ["frame", "draw", "triangle"] {
+        let t = d.path().join(format!("{detail}.json"));
+        let o = bin()
+            .args([
+                "run",
+                "--frames",
+                "8",
+                "--trace",
+                t.to_str().unwrap(),
+                "--trace-detail",
+                detail,
+            ])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!err.contains("warning"), "{detail}: {err}");
+        let bytes = std::fs::read(&t).unwrap();
+        sizes.push(bytes.len());
+        let v: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+        let ev = v["traceEvents"].as_array().unwrap();
+        let slices: Vec<&serde_json::Value> = ev.iter().filter(|e| e["ph"] == "X").collect();
+        for e in &slices {
+            assert!(e["args"]["frame"].is_u64(), "{detail}: a slice without its frame: {e}");
+        }
+        let tids: std::collections::BTreeSet<i64> = slices.iter().map(|e| e["tid"].as_i64().unwrap()).collect();
+        if detail == "frame" {
+            assert_eq!(
+                tids.into_iter().collect::<Vec<_>>(),
+                [5, 6, 7],
+                "display, CPU frames, GPU frames"
+            );
+        } else {
+            assert!((1..=7).all(|t| tids.contains(&t)), "{detail}: {tids:?}");
+        }
+        if detail == "draw" {
+            // Geometry and fragment work: a slice a draw, with its busy time.
+            let geom: Vec<&&serde_json::Value> = slices.iter().filter(|e| e["tid"] == 3).collect();
+            assert!(geom.iter().all(|e| e["name"].as_str().unwrap().starts_with("draw")));
+            assert!(
+                geom.iter()
+                    .all(|e| e["args"]["busy_ns"].as_f64().unwrap() <= e["dur"].as_f64().unwrap() * 1000.0 + 1.0)
+            );
+        }
+        // Flows: one id a frame, CPU frames -> GPU frames -> display.
+        let mut flows: std::collections::BTreeMap<u64, Vec<&serde_json::Value>> = Default::default();
+        for e in ev
+            .iter()
+            .filter(|e| ["s", "t", "f"].contains(&e["ph"].as_str().unwrap()))
+        {
+            flows.entry(e["id"].as_u64().unwrap()).or_default().push(e);
+        }
+        assert!(flows.len() >= 8, "{detail}: {} flows", flows.len());
+        for (id, points) in &flows {
+            let phases: Vec<&str> = points.iter().map(|e| e["ph"].as_str().unwrap()).collect();
+            let tracks: Vec<i64> = points.iter().map(|e| e["tid"].as_i64().unwrap()).collect();
+            assert!(
+                phases == ["s", "t", "f"] && tracks == [6, 7, 5] || phases == ["s", "f"] && tracks == [6, 7],
+                "{phases:?} {tracks:?}"
+            );
+            for p in points {
+                let at = p["ts"].as_f64().unwrap();
+                let inside = slices.iter().any(|e| {
+                    e["tid"] == p["tid"]
+                        && e["args"]["frame"].as_u64() == Some(id - 1)
+                        && e["ts"].as_f64().unwrap() <= at
+                        && at <= e["ts"].as_f64().unwrap() + e["dur"].as_f64().unwrap()
+                });
+                assert!(inside, "{detail}: flow point {p} is in no slice of its frame");
+            }
+        }
+    }
+    assert!(sizes[0] * 20 < sizes[1] && sizes[1] * 20 < sizes[2], "{sizes:?}");
+    // 20 frames at triangle detail: about 150 MB, said before writing.
+    let t = d.path().join("big.json");
+    let o = bin()
+        .args([
+            "run",
+            "--frames",
+            "20",
+            "--trace",
+            t.to_str().unwrap(),
+            "--trace-detail",
+            "triangle",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    let line = err
+        .lines()
+        .find(|l| l.starts_with("warning: the trace will be about "))
+        .expect(&err);
+    assert!(
+        line.contains("(20 frames at about") && line.contains("--trace-detail draw or frame"),
+        "{line}"
+    );
+    let mb: f64 = line["warning: the trace will be about ".len()..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let real = std::fs::metadata(&t).unwrap().len() as f64 / 1e6;
+    assert!((mb / real - 1.0).abs() < 0.2, "estimate {mb} MB, written {real} MB");
+    // --trace-detail without --trace is refused.
+    let e = run_err(&["run", "--trace-detail", "frame"]);
+    assert!(e.contains("--trace <FILE>"), "{e}");
 }

@@ -10,6 +10,10 @@
 //! Write errors are kept, not raised on the hot path: the first one stops
 //! further writing and is returned by [`TraceWriter::finish`].
 //!
+//! A writer carries the [`TraceDetail`] asked for; systems read it and
+//! leave out what is finer. Flow events ([`TraceWriter::flow`]) draw arrows
+//! between the slices of one frame on different tracks.
+//!
 //! ```
 //! use rendersim_engine::Time;
 //! use rendersim_report::output::trace::TraceWriter;
@@ -49,6 +53,14 @@ struct Event<'a> {
     /// Instant scope (`t`: the thread).
     #[serde(skip_serializing_if = "Option::is_none")]
     s: Option<&'static str>,
+    /// Flow events: their category, id and binding point (`e`: the
+    /// enclosing slice).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cat: Option<&'static str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    id: Option<u64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    bp: Option<&'static str>,
     #[serde(skip_serializing_if = "Option::is_none")]
     args: Option<Args<'a>>,
 }
@@ -62,10 +74,62 @@ enum Args<'a> {
     One(std::collections::BTreeMap<&'a str, u64>),
 }
 
+/// How much a trace shows (`--trace-detail`), coarsest first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
+pub enum TraceDetail {
+    /// One slice a frame per track (CPU, GPU, display) and the flows
+    /// between them: a few hundred bytes a frame.
+    Frame,
+    /// Also every unit's states, with the geometry and fragment stages'
+    /// work merged into one slice a draw.
+    #[default]
+    Draw,
+    /// Every state change of every unit: a slice a triangle a stage (about
+    /// 7 MB a frame of the default model).
+    Triangle,
+}
+
+impl TraceDetail {
+    /// The names `--trace-detail` takes.
+    pub const NAMES: [&'static str; 3] = ["frame", "draw", "triangle"];
+
+    /// Its name.
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
+}
+
+impl std::str::FromStr for TraceDetail {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "frame" => Ok(TraceDetail::Frame),
+            "draw" => Ok(TraceDetail::Draw),
+            "triangle" => Ok(TraceDetail::Triangle),
+            other => Err(format!(
+                "unknown trace detail {other:?} (expected frame, draw or triangle)"
+            )),
+        }
+    }
+}
+
+/// Where a flow event sits in its chain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FlowStep {
+    /// The first slice.
+    Start,
+    /// A slice between.
+    Step,
+    /// The last slice.
+    End,
+}
+
 /// A trace being written (see the module documentation).
 pub struct TraceWriter {
     out: Box<dyn Write + Send>,
     events: u64,
+    bytes: u64,
+    detail: TraceDetail,
     error: Option<std::io::Error>,
 }
 
@@ -81,11 +145,31 @@ impl TraceWriter {
         let mut t = TraceWriter {
             out,
             events: 0,
+            bytes: 0,
+            detail: TraceDetail::default(),
             error: None,
         };
-        let r = t.out.write_all(b"{\"displayTimeUnit\":\"ms\",\"traceEvents\":[");
+        let head = b"{\"displayTimeUnit\":\"ms\",\"traceEvents\":[";
+        t.bytes += head.len() as u64;
+        let r = t.out.write_all(head);
         t.keep(r);
         t
+    }
+
+    /// The writer at detail `d`.
+    pub fn with_detail(mut self, d: TraceDetail) -> Self {
+        self.detail = d;
+        self
+    }
+
+    /// The detail asked for.
+    pub fn detail(&self) -> TraceDetail {
+        self.detail
+    }
+
+    /// Bytes written so far.
+    pub fn bytes(&self) -> u64 {
+        self.bytes
     }
 
     fn keep(&mut self, r: std::io::Result<()>) {
@@ -100,12 +184,17 @@ impl TraceWriter {
         if self.error.is_some() {
             return;
         }
+        let mut counted = Counted {
+            out: &mut self.out,
+            bytes: 0,
+        };
         let r = (|| {
             if self.events > 0 {
-                self.out.write_all(b",")?;
+                counted.write_all(b",")?;
             }
-            serde_json::to_writer(&mut self.out, e).map_err(std::io::Error::from)
+            serde_json::to_writer(&mut counted, e).map_err(std::io::Error::from)
         })();
+        self.bytes += counted.bytes;
         self.events += 1;
         self.keep(r);
     }
@@ -120,6 +209,9 @@ impl TraceWriter {
             ts: None,
             dur: None,
             s: None,
+            cat: None,
+            id: None,
+            bp: None,
             args: Some(Args::Name { name }),
         });
     }
@@ -134,6 +226,9 @@ impl TraceWriter {
             ts: None,
             dur: None,
             s: None,
+            cat: None,
+            id: None,
+            bp: None,
             args: Some(Args::SortIndex { sort_index: index }),
         });
     }
@@ -148,6 +243,9 @@ impl TraceWriter {
             ts: None,
             dur: None,
             s: None,
+            cat: None,
+            id: None,
+            bp: None,
             args: Some(Args::Name { name }),
         });
     }
@@ -163,6 +261,9 @@ impl TraceWriter {
             ts: None,
             dur: None,
             s: None,
+            cat: None,
+            id: None,
+            bp: None,
             args: Some(Args::SortIndex { sort_index: tid }),
         });
     }
@@ -178,7 +279,51 @@ impl TraceWriter {
             ts: Some(us(start)),
             dur: Some(us(end) - us(start)),
             s: None,
+            cat: None,
+            id: None,
+            bp: None,
             args: arg.map(|(k, v)| Args::One([(k, v)].into_iter().collect())),
+        });
+    }
+
+    /// A span with several numeric arguments (`[("frame", 3), ("draw", 12)]`).
+    pub fn span_args(&mut self, pid: u32, tid: u32, name: &str, start: Time, end: Time, args: &[(&str, u64)]) {
+        self.event(&Event {
+            ph: "X",
+            pid,
+            tid: Some(tid),
+            name,
+            ts: Some(us(start)),
+            dur: Some(us(end) - us(start)),
+            s: None,
+            cat: None,
+            id: None,
+            bp: None,
+            args: (!args.is_empty()).then(|| Args::One(args.iter().copied().collect())),
+        });
+    }
+
+    /// One point of flow `id` (an arrow from slice to slice, drawn by
+    /// Perfetto): it binds to the slice enclosing `at` on track `tid`, so
+    /// `at` should fall inside one. `name` groups the flows.
+    pub fn flow(&mut self, pid: u32, tid: u32, name: &str, id: u64, at: Time, step: FlowStep) {
+        let ph = match step {
+            FlowStep::Start => "s",
+            FlowStep::Step => "t",
+            FlowStep::End => "f",
+        };
+        self.event(&Event {
+            ph,
+            pid,
+            tid: Some(tid),
+            name,
+            ts: Some(us(at)),
+            dur: None,
+            s: None,
+            cat: Some("frame"),
+            id: Some(id),
+            bp: (step == FlowStep::End).then_some("e"),
+            args: None,
         });
     }
 
@@ -192,6 +337,9 @@ impl TraceWriter {
             ts: Some(us(at)),
             dur: None,
             s: Some("t"),
+            cat: None,
+            id: None,
+            bp: None,
             args: None,
         });
     }
@@ -206,6 +354,9 @@ impl TraceWriter {
             ts: Some(us(at)),
             dur: None,
             s: None,
+            cat: None,
+            id: None,
+            bp: None,
             args: Some(Args::One([(series, value)].into_iter().collect())),
         });
     }
@@ -224,6 +375,23 @@ impl TraceWriter {
             Some(e) => Err(e),
             None => Ok(self.events),
         }
+    }
+}
+
+/// A `Write` that counts what passes through.
+struct Counted<'a> {
+    out: &'a mut Box<dyn Write + Send>,
+    bytes: u64,
+}
+
+impl Write for Counted<'_> {
+    fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+        let n = self.out.write(b)?;
+        self.bytes += n as u64;
+        Ok(n)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.out.flush()
     }
 }
 
@@ -265,6 +433,40 @@ mod tests {
         assert_eq!(ev[4]["s"], "t");
         assert_eq!(ev[5]["args"]["used"], 4);
         assert_eq!(v["displayTimeUnit"], "ms");
+    }
+
+    #[test]
+    fn flows_spans_with_arguments_and_the_byte_count() {
+        let buf = Shared::default();
+        let mut t = TraceWriter::new(Box::new(buf.clone())).with_detail(TraceDetail::Frame);
+        assert_eq!(t.detail(), TraceDetail::Frame);
+        t.span_args(1, 2, "draw 3", Time(0), Time(2_000_000), &[("frame", 4), ("draw", 3)]);
+        t.flow(1, 2, "frame 4", 5, Time(1_000_000), FlowStep::Start);
+        t.flow(1, 3, "frame 4", 5, Time(3_000_000), FlowStep::Step);
+        t.flow(1, 4, "frame 4", 5, Time(5_000_000), FlowStep::End);
+        let bytes = t.bytes();
+        t.finish().unwrap();
+        let text = buf.0.lock().unwrap().clone();
+        assert_eq!(bytes + 2, text.len() as u64, "all but the closing ]}}");
+        let v: serde_json::Value = serde_json::from_slice(&text).unwrap();
+        let ev = v["traceEvents"].as_array().unwrap();
+        assert_eq!(ev[0]["args"]["frame"], 4);
+        assert_eq!(ev[0]["args"]["draw"], 3);
+        let phases: Vec<&str> = ev[1..].iter().map(|e| e["ph"].as_str().unwrap()).collect();
+        assert_eq!(phases, ["s", "t", "f"]);
+        assert!(ev[1..].iter().all(|e| e["id"] == 5 && e["cat"] == "frame"));
+        assert_eq!(ev[3]["bp"], "e");
+        assert!(ev[1].get("bp").is_none());
+        for name in TraceDetail::NAMES {
+            assert_eq!(name.parse::<TraceDetail>().unwrap().name(), name);
+        }
+        assert!(
+            "pixel"
+                .parse::<TraceDetail>()
+                .unwrap_err()
+                .contains("frame, draw or triangle")
+        );
+        assert_eq!(TraceDetail::default(), TraceDetail::Draw);
     }
 
     #[test]

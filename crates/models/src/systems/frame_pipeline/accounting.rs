@@ -11,7 +11,7 @@
 
 use crate::components::state_clock::StateClock;
 use crate::engine::{Duration, Time};
-use crate::output::trace::TraceWriter;
+use crate::output::trace::{FlowStep, TraceDetail, TraceWriter};
 
 use super::cpu_thread::{CpuPhase, CpuThread};
 use super::critical_path::{Blame, CriticalPath, Mode, Modes, Unit};
@@ -68,39 +68,80 @@ pub enum Track {
 /// (CPU, GPU front end, geometry, fragment, display), a span per state a
 /// unit was in (the CPU's split per frame, so frame n+1's preparation is
 /// seen beside the GPU drawing frame n, as in paper 000 Figure 4), and
-/// counters for the command and triangle FIFOs.
+/// counters for the command and triangle FIFOs; after the run, one slice a
+/// frame on the tracks "CPU frames" (its work, CPU start to present), "GPU
+/// frames" (GPU start to end) and "Display" (shown to replaced), joined by
+/// a flow per frame. Every slice carries its frame number (on the GPU's
+/// unit tracks: the frame the front end is on).
+///
+/// How much is written follows the writer's [`TraceDetail`]: `frame` keeps
+/// the per-frame tracks and flows only; `draw` adds the units' states and
+/// the command FIFO, with the geometry and fragment stages' work merged
+/// into one slice a draw (first to last work on it, its busy time in
+/// `busy_ns`); `triangle` writes every state change and the triangle FIFO.
 #[derive(Debug)]
 pub struct PipelineTrace {
     writer: TraceWriter,
+    detail: TraceDetail,
     command_fifo: Option<u64>,
     triangle_fifo: Option<u64>,
+    /// `draw` detail: the geometry and fragment stages' open merged slice.
+    merged: [Option<Merged>; 2],
+}
+
+/// A stage's work on one draw, merged (`draw` detail).
+#[derive(Debug, Clone, Copy)]
+struct Merged {
+    frame: Option<u64>,
+    draw: Option<u32>,
+    start: Time,
+    end: Time,
+    busy: u64,
 }
 
 const PID: u32 = 1;
 const DISPLAY_TRACK: u32 = 5;
+const CPU_FRAMES_TRACK: u32 = 6;
+const GPU_FRAMES_TRACK: u32 = 7;
 
 impl PipelineTrace {
     /// Names the process and the tracks on `writer`.
     pub fn new(mut writer: TraceWriter) -> Self {
         writer.process(PID, "frame pipeline");
-        for (tid, name) in [
-            (1, "CPU thread"),
-            (2, "GPU front end"),
-            (3, "GPU geometry"),
-            (4, "GPU fragment"),
+        let detail = writer.detail();
+        let units: &[(u32, &str)] = if detail == TraceDetail::Frame {
+            &[]
+        } else {
+            &[
+                (1, "CPU thread"),
+                (2, "GPU front end"),
+                (3, "GPU geometry"),
+                (4, "GPU fragment"),
+            ]
+        };
+        for &(tid, name) in units.iter().chain(&[
             (DISPLAY_TRACK, "Display"),
-        ] {
+            (CPU_FRAMES_TRACK, "CPU frames"),
+            (GPU_FRAMES_TRACK, "GPU frames"),
+        ]) {
             writer.track(PID, tid, name);
         }
         PipelineTrace {
             writer,
+            detail,
             command_fifo: None,
             triangle_fifo: None,
+            merged: [None, None],
         }
     }
 
-    /// A unit's state from `start` to `end` (`frame`: the CPU's frame).
-    fn state(&mut self, track: Track, state: usize, start: Time, end: Time, frame: Option<u64>) {
+    /// A unit's state from `start` to `end` (`frame`: the CPU's frame on
+    /// the CPU track, the front end's on the GPU's; `draw`: the draw on the
+    /// geometry stage).
+    fn state(&mut self, track: Track, state: usize, start: Time, end: Time, frame: Option<u64>, draw: Option<u32>) {
+        if self.detail == TraceDetail::Frame {
+            return;
+        }
         let names: &[&str] = match track {
             Track::Cpu => &CPU_STATES,
             Track::Front => &FRONT_STATES,
@@ -108,47 +149,147 @@ impl PipelineTrace {
             Track::Fragment => &FRAG_STATES,
         };
         let tid = track as u32 + 1;
+        if self.detail == TraceDetail::Draw && matches!(track, Track::Geometry | Track::Fragment) {
+            // Busy spans of one draw merge; waits between them are inside.
+            if state != 0 {
+                return;
+            }
+            let i = track as usize - Track::Geometry as usize;
+            match &mut self.merged[i] {
+                Some(m) if m.frame == frame && (draw.is_none() || m.draw == draw) => {
+                    m.end = end;
+                    m.busy += end.0 - start.0;
+                }
+                slot => {
+                    let old = slot.replace(Merged {
+                        frame,
+                        draw,
+                        start,
+                        end,
+                        busy: end.0 - start.0,
+                    });
+                    if let Some(m) = old {
+                        self.merged_span(tid, m);
+                    }
+                }
+            }
+            return;
+        }
         match frame {
-            Some(f) if state == 0 => {
+            Some(f) if track == Track::Cpu && state == 0 => {
                 let name = format!("frame {f}");
-                self.writer.span(PID, tid, &name, start, end, None);
+                self.writer.span(PID, tid, &name, start, end, Some(("frame", f)));
             }
             Some(f) => self.writer.span(PID, tid, names[state], start, end, Some(("frame", f))),
             None => self.writer.span(PID, tid, names[state], start, end, None),
         }
     }
 
+    fn merged_span(&mut self, tid: u32, m: Merged) {
+        let name = match m.draw {
+            Some(d) => format!("draw {d}"),
+            None => "draw".to_string(),
+        };
+        let mut args: Vec<(&str, u64)> = Vec::with_capacity(3);
+        if let Some(f) = m.frame {
+            args.push(("frame", f));
+        }
+        if let Some(d) = m.draw {
+            args.push(("draw", u64::from(d)));
+        }
+        args.push(("busy_ns", m.busy / 1000));
+        self.writer.span_args(PID, tid, &name, m.start, m.end, &args);
+    }
+
     fn fifo_levels(&mut self, now: Time, commands: u64, triangles: u64) {
+        if self.detail == TraceDetail::Frame {
+            return;
+        }
         if self.command_fifo != Some(commands) {
             self.writer.counter(PID, "command FIFO", "used", now, commands);
             self.command_fifo = Some(commands);
         }
-        if self.triangle_fifo != Some(triangles) {
+        if self.detail == TraceDetail::Triangle && self.triangle_fifo != Some(triangles) {
             self.writer.counter(PID, "triangle FIFO", "triangles", now, triangles);
             self.triangle_fifo = Some(triangles);
         }
     }
 
-    /// After the run: each frame's input as an instant on the CPU track, and
-    /// each displayed frame from its appearance to the next one (the last
-    /// for one refresh) on the display track. Returns the writer, to be
-    /// finished by whoever opened it.
+    /// After the run: the merged draws still open; each frame's input as an
+    /// instant on the CPU track (the CPU frames track at `frame` detail);
+    /// each frame's slices on the CPU frames and GPU frames tracks; each
+    /// displayed frame from its appearance to the next one (the last for
+    /// one refresh) on the display track; and a flow a frame from its CPU
+    /// slice through its GPU slice to its display slice. Returns the
+    /// writer, to be finished by whoever opened it.
     pub fn end(mut self, records: &[FrameRecord], refresh: Duration) -> TraceWriter {
+        for (i, track) in [Track::Geometry, Track::Fragment].into_iter().enumerate() {
+            if let Some(m) = self.merged[i].take() {
+                self.merged_span(track as u32 + 1, m);
+            }
+        }
         let shown: Vec<(u64, Time)> = records
             .iter()
             .filter_map(|r| r.displayed.map(|d| (r.index, d)))
             .collect();
+        let mut shown_span = std::collections::HashMap::with_capacity(shown.len());
         for (i, (frame, t)) in shown.iter().enumerate() {
             let end = shown
                 .get(i + 1)
                 .map(|n| n.1)
                 .unwrap_or_else(|| Time(t.0.saturating_add(refresh.0)));
             let name = format!("frame {frame}");
-            self.writer.span(PID, DISPLAY_TRACK, &name, *t, end, None);
+            self.writer
+                .span(PID, DISPLAY_TRACK, &name, *t, end, Some(("frame", *frame)));
+            shown_span.insert(*frame, (*t, end));
         }
+        let input_track = if self.detail == TraceDetail::Frame {
+            CPU_FRAMES_TRACK
+        } else {
+            1
+        };
         for r in records {
             let name = format!("frame {} input", r.index);
-            self.writer.instant(PID, 1, &name, r.input);
+            self.writer.instant(PID, input_track, &name, r.input);
+        }
+        // A flow point inside its slice (the middle; the start of an empty one).
+        let mid = |a: Time, b: Time| Time(a.0 + (b.0.saturating_sub(a.0)) / 2);
+        for r in records {
+            let name = format!("frame {}", r.index);
+            let cpu = (r.begun, r.present.max(r.begun));
+            self.writer
+                .span(PID, CPU_FRAMES_TRACK, &name, cpu.0, cpu.1, Some(("frame", r.index)));
+            let gpu = match (r.gpu_start, r.gpu_end) {
+                (Some(a), Some(b)) => Some((a, b.max(a))),
+                _ => None,
+            };
+            if let Some((a, b)) = gpu {
+                self.writer
+                    .span(PID, GPU_FRAMES_TRACK, &name, a, b, Some(("frame", r.index)));
+            }
+            let shown = shown_span.get(&r.index).copied();
+            let id = r.index + 1;
+            let points: Vec<(u32, Time)> = [
+                Some((CPU_FRAMES_TRACK, mid(cpu.0, cpu.1))),
+                gpu.map(|(a, b)| (GPU_FRAMES_TRACK, mid(a, b))),
+                shown.map(|(a, b)| (DISPLAY_TRACK, mid(a, b))),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            if points.len() < 2 {
+                continue;
+            }
+            for (k, &(tid, at)) in points.iter().enumerate() {
+                let step = if k == 0 {
+                    FlowStep::Start
+                } else if k + 1 == points.len() {
+                    FlowStep::End
+                } else {
+                    FlowStep::Step
+                };
+                self.writer.flow(PID, tid, &name, id, at, step);
+            }
         }
         self.writer
     }
@@ -173,6 +314,9 @@ pub struct Accounting {
     gpu_frame: Option<u64>,
     /// The trace, when one is written.
     pub trace: Option<PipelineTrace>,
+    /// Traced: the geometry stage's draw as of the last accounted instant
+    /// (the draw of the spans that close at the next one).
+    trace_draw: Option<u32>,
 }
 
 /// The [`Units`] view of the pipeline `$p` (a [`super::model::FramePipeline`]),
@@ -211,6 +355,7 @@ impl Accounting {
             cpu_frame: 0,
             gpu_frame: None,
             trace: trace.map(PipelineTrace::new),
+            trace_draw: None,
         }
     }
 }
@@ -224,7 +369,7 @@ fn set_traced<const N: usize>(
     track: Track,
     trace: &mut Option<PipelineTrace>,
     idle: usize,
-    frame: Option<u64>,
+    (frame, draw): (Option<u64>, Option<u32>),
 ) -> (usize, u64) {
     let old = clock.state();
     let since = clock.since();
@@ -234,7 +379,7 @@ fn set_traced<const N: usize>(
         && old != idle
         && spent.0 > 0
     {
-        t.state(track, old, since, now, frame);
+        t.state(track, old, since, now, frame, draw);
     }
     (old, spent.0)
 }
@@ -359,11 +504,13 @@ impl Accounting {
         // The FIFO levels are read here, so that the view is not built in
         // memory for the traced call.
         let levels = (u.links.commands.used(), u.links.triangles.len() as u64);
+        let draw = u.geom.draw().map(|d| d.draw);
         a.account_traced(
             now,
             [cpu_state, front_state, geom_state, frag_state, gpu_state],
             (cpu_frame, gpu_frame),
             levels,
+            draw,
             records,
         );
     }
@@ -376,6 +523,7 @@ impl Accounting {
         states: [usize; 5],
         frames: (u64, Option<u64>),
         (commands, triangles): (u64, u64),
+        draw: Option<u32>,
         records: &mut [FrameRecord],
     ) {
         let [cpu_state, front_state, geom_state, frag_state, gpu_state] = states;
@@ -389,7 +537,7 @@ impl Accounting {
             Track::Cpu,
             &mut a.trace,
             4,
-            Some(a.cpu_frame),
+            (Some(a.cpu_frame), None),
         );
         attribute_cpu(records, old, spent, a.cpu_frame);
         if cpu_frame != a.cpu_frame {
@@ -403,13 +551,19 @@ impl Accounting {
                 && st != 4
                 && spent > 0
             {
-                t.state(Track::Cpu, st, since, now, Some(a.cpu_frame));
+                t.state(Track::Cpu, st, since, now, Some(a.cpu_frame), None);
             }
             a.cpu_frame = cpu_frame;
         }
-        set_traced(&mut a.front, now, front_state, Track::Front, &mut a.trace, 1, None);
-        set_traced(&mut a.geom, now, geom_state, Track::Geometry, &mut a.trace, 2, None);
-        set_traced(&mut a.frag, now, frag_state, Track::Fragment, &mut a.trace, 1, None);
+        // The GPU's spans carry the frame the front end is on (as of the
+        // span's start) and the geometry stage's draw.
+        let (f, d) = (a.gpu_frame, a.trace_draw);
+        set_traced(&mut a.front, now, front_state, Track::Front, &mut a.trace, 1, (f, None));
+        set_traced(&mut a.geom, now, geom_state, Track::Geometry, &mut a.trace, 2, (f, d));
+        set_traced(&mut a.frag, now, frag_state, Track::Fragment, &mut a.trace, 1, (f, d));
+        if draw.is_some() {
+            a.trace_draw = draw;
+        }
         a.gpu_per_frame(now, gpu_state, gpu_frame, records);
         if let Some(t) = &mut a.trace {
             t.fifo_levels(now, commands, triangles);
