@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Sets up and runs every test of rendersim on a fresh machine:
 #   - Python packages for the notebooks (in .venv, from notebooks/requirements.txt);
+#   - the Python package (python/, built from source into .venv) and its pytest tests;
 #   - one release build, reused by the unit, property and integration tests,
 #     the experiments and the notebook;
 #   - every experiment in experiments/ (its reference checks must pass);
@@ -73,6 +74,12 @@ for ex in examples/*.rs crates/*/examples/*.rs; do
   echo "-- $name"
   "target/release/examples/$name" | tail -n 2
 done
+
+step "Python package: built from source (pip install ./python) and its tests (pytest)"
+# The package's Rust build shares the release build's target folder, so only
+# PyO3 and the crates whose features differ are compiled again.
+CARGO_TARGET_DIR="$root/target" .venv/bin/pip install --quiet --disable-pip-version-check ./python
+.venv/bin/pytest -q -p no:cacheprovider --basetemp "$ci_out/pytest" python/tests
 
 step "Studies H1-H4 on this machine's adapter (H1 must predict its validation meshes exactly)"
 if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then

@@ -1,0 +1,246 @@
+"""rendersim from Python: a discrete-event simulator of GPU rendering
+pipelines and latency.
+
+The functions here call the same library as the ``rendersim`` command line
+(no subprocess), release the GIL while they simulate, and give results as
+dicts and pandas DataFrames:
+
+>>> import rendersim
+>>> r = rendersim.run(set={"display.buffers": 3}, frames=120)
+>>> r.summary["metrics"]["frame_time_ms"]["mean"]     # doctest: +SKIP
+16.666666667
+>>> r.frames[["Frame", "MsUntilDisplayed"]].head()    # doctest: +SKIP
+
+Errors raise :class:`ModelError` (a ``ValueError``) with the command line's
+message and, where it names them, ``file``, ``line`` and ``key``.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping, Optional, Union
+
+from . import _native
+from ._native import ModelError
+
+__all__ = [
+    "ModelError",
+    "Run",
+    "ExperimentResult",
+    "ReplayResult",
+    "run",
+    "experiment",
+    "vcache",
+    "isolate",
+    "replay",
+    "to_toml",
+    "__version__",
+]
+
+__version__: str = _native.version()[0].split(" ", 1)[1]
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+def to_toml(value: Any) -> str:
+    """A Python value as a TOML literal, for ``set={...}``: strings quoted,
+    booleans ``true``/``false``, lists as arrays, dicts as inline tables.
+    (The command line's ``--set`` takes text that is not TOML as a string;
+    here a Python ``str`` is always a string: ``"17ms"``, ``"fifo"``.)"""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value) or math.isinf(value):
+            raise ModelError(f"set: {value!r} is not a number a model can hold")
+        return repr(value)
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(to_toml(v) for v in value) + "]"
+    if isinstance(value, Mapping):
+        return "{ " + ", ".join(f"{json.dumps(str(k))} = {to_toml(v)}" for k, v in value.items()) + " }"
+    raise ModelError(f"set: a {type(value).__name__} ({value!r}) has no TOML form")
+
+
+def _sets(set: Optional[Mapping[str, Any]]) -> list[str]:
+    if set is None:
+        return []
+    if not isinstance(set, Mapping):
+        raise ModelError(f"set: expected a dict of dotted keys to values, got {type(set).__name__}")
+    out = []
+    for k, v in set.items():
+        if not isinstance(k, str) or not k.strip():
+            raise ModelError(f"set: key {k!r} is not a dotted model key")
+        out.append(f"{k}={to_toml(v)}")
+    return out
+
+
+def _path(p: Optional[PathLike]) -> Optional[str]:
+    return None if p is None else os.fspath(p)
+
+
+def _command(name: str, **kwargs: Any) -> list[str]:
+    shown = ", ".join(f"{k}={v!r}" for k, v in kwargs.items() if v not in (None, {}, [], ()))
+    return ["python", f"rendersim.{name}({shown})"]
+
+
+def _csv(text: str):
+    import pandas as pd
+
+    if not text:
+        return pd.DataFrame()
+    return pd.read_csv(io.StringIO(text), na_values=["NA"], keep_default_na=False)
+
+
+@dataclass
+class Run:
+    """One model run: ``summary`` (the JSON summary as a dict, as
+    ``rendersim run --json``), ``frames`` (``frames.csv``: one row a frame,
+    PresentMon 2 columns) and ``model`` (the resolved model as TOML text:
+    written to a file, it reproduces the run)."""
+
+    summary: dict
+    frames: Any
+    model: str
+    notes: list = field(default_factory=list)
+
+    def __repr__(self) -> str:
+        m = self.summary.get("metrics", {}).get("frame_time_ms", {}).get("mean")
+        return f"<rendersim.Run {self.summary.get('model')!r}: {self.summary.get('frames')} frames, frame time {m} ms>"
+
+
+def run(
+    model: Optional[PathLike] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    seed: int = 1,
+    frames: Optional[int] = None,
+) -> Run:
+    """Runs a model file (the embedded default model when ``model`` is
+    None) with ``set`` patches (``{"display.buffers": 3}``, as ``--set``),
+    the master ``seed`` and, when given, ``frames`` frames.
+
+    Raises :class:`ModelError` for a model it cannot use."""
+    if seed is not None and (not isinstance(seed, int) or seed < 0):
+        raise ModelError(f"seed: expected a whole number >= 0, got {seed!r}")
+    if frames is not None and (not isinstance(frames, int) or frames < 0):
+        raise ModelError(f"frames: expected a whole number >= 0, got {frames!r}")
+    command = _command("run", model=_path(model), set=dict(set or {}), seed=seed, frames=frames)
+    summary, csv, model_text, notes = _native.run(_path(model), _sets(set), seed, frames, command)
+    return Run(summary=json.loads(summary), frames=_csv(csv), model=model_text, notes=list(notes))
+
+
+@dataclass
+class ExperimentResult:
+    """An experiment's results, written to ``out`` as ``rendersim experiment
+    --out`` writes them: ``points`` and ``runs`` (DataFrames of
+    ``points.csv`` and ``runs.csv``), ``plots`` (paths of the PNG and SVG
+    plots), ``report`` (``report.md``), ``checks_failed``."""
+
+    name: str
+    out: Path
+    points: Any
+    runs: Any
+    plots: list
+    report: str
+    checks_failed: int
+    wall_seconds: float
+
+    def __repr__(self) -> str:
+        return (
+            f"<rendersim.ExperimentResult {self.name!r}: {len(self.points)} points, "
+            f"{self.checks_failed} checks failed, in {str(self.out)!r}>"
+        )
+
+
+def experiment(
+    path: PathLike,
+    set: Optional[Mapping[str, Any]] = None,
+    out: Optional[PathLike] = None,
+    force: bool = False,
+) -> ExperimentResult:
+    """Runs an experiment file (sweeps, replications, checks, plots) with
+    ``set`` added to its ``[set]`` table, into ``out`` (default
+    ``out/<name>``, as the command line). A failed reference check does not
+    raise: see ``checks_failed``."""
+    import pandas as pd
+
+    command = _command("experiment", path=_path(path), set=dict(set or {}), out=_path(out))
+    out_dir, result = _native.experiment(_path(path), _sets(set), _path(out), bool(force), command)
+    res = json.loads(result)
+    out_dir = Path(out_dir)
+    files = [out_dir / f for f in res["files"]]
+    return ExperimentResult(
+        name=res["name"],
+        out=out_dir,
+        points=pd.read_csv(out_dir / "points.csv"),
+        runs=pd.read_csv(out_dir / "runs.csv"),
+        plots=[f for f in files if f.suffix in (".png", ".svg")],
+        report=(out_dir / "report.md").read_text(),
+        checks_failed=res["checks_failed"],
+        wall_seconds=res["wall_seconds"],
+    )
+
+
+def vcache(mesh: str, policy: str) -> dict:
+    """A post-transform vertex cache over a mesh's index buffer (``mesh``:
+    ``grid:WxH``, ``random:T:V:SEED``, a ``.obj`` file, ...; ``policy``:
+    ``fifo:32``, ``lru:16``, ``nvidia``, ...): triangles, indices, unique
+    and transformed vertices, ACMR and ATVR."""
+    return json.loads(_native.vcache(str(mesh), str(policy)))
+
+
+def isolate(
+    model: Optional[PathLike] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    factor: float = 0.5,
+    keep_vsync: bool = False,
+    tie_tolerance: float = 0.02,
+) -> dict:
+    """Isolates the bottleneck (paper 004 section 4.1): the frame time with
+    the CPU, GPU front end, geometry and raster load each reduced by
+    ``factor`` in turn; returns the variants and the verdict."""
+    return json.loads(
+        _native.isolate(_path(model), _sets(set), float(factor), bool(keep_vsync), float(tie_tolerance))
+    )
+
+
+@dataclass
+class ReplayResult:
+    """A PresentMon capture replayed through the frame pipeline:
+    ``summary`` (the ``replay`` object of ``rendersim replay --json``),
+    ``comparison`` (measured against predicted per frame), ``frames`` (the
+    replay as captured, PresentMon columns) and ``whatif_frames`` (with a
+    what-if, its frames; else None)."""
+
+    summary: dict
+    comparison: Any
+    frames: Any
+    whatif_frames: Any
+
+
+def replay(
+    capture: PathLike,
+    app: Optional[str] = None,
+    swapchain: Optional[str] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    assume: Optional[Mapping[str, Any]] = None,
+) -> ReplayResult:
+    """Replays a PresentMon CSV capture; ``set`` is a what-if on the
+    display and CPU (``{"display.refresh": "120Hz"}``), ``assume`` what the
+    capture does not say (``{"display.buffers": 3}``)."""
+    summary, comparison, frames, whatif = _native.replay(
+        _path(capture), app, swapchain, _sets(set), _sets(assume)
+    )
+    return ReplayResult(
+        summary=json.loads(summary),
+        comparison=_csv(comparison),
+        frames=_csv(frames),
+        whatif_frames=_csv(whatif) if whatif else None,
+    )

@@ -1,0 +1,66 @@
+"""Type stubs of the rendersim package (see its docstrings)."""
+
+import os
+from pathlib import Path
+from typing import Any, Mapping, Optional, Union
+
+import pandas as pd
+
+from ._native import ModelError as ModelError
+
+__version__: str
+PathLike = Union[str, os.PathLike[str]]
+
+def to_toml(value: Any) -> str: ...
+
+class Run:
+    summary: dict[str, Any]
+    frames: pd.DataFrame
+    model: str
+    notes: list[str]
+
+def run(
+    model: Optional[PathLike] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    seed: int = 1,
+    frames: Optional[int] = None,
+) -> Run: ...
+
+class ExperimentResult:
+    name: str
+    out: Path
+    points: pd.DataFrame
+    runs: pd.DataFrame
+    plots: list[Path]
+    report: str
+    checks_failed: int
+    wall_seconds: float
+
+def experiment(
+    path: PathLike,
+    set: Optional[Mapping[str, Any]] = None,
+    out: Optional[PathLike] = None,
+    force: bool = False,
+) -> ExperimentResult: ...
+def vcache(mesh: str, policy: str) -> dict[str, Any]: ...
+def isolate(
+    model: Optional[PathLike] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    factor: float = 0.5,
+    keep_vsync: bool = False,
+    tie_tolerance: float = 0.02,
+) -> dict[str, Any]: ...
+
+class ReplayResult:
+    summary: dict[str, Any]
+    comparison: pd.DataFrame
+    frames: pd.DataFrame
+    whatif_frames: Optional[pd.DataFrame]
+
+def replay(
+    capture: PathLike,
+    app: Optional[str] = None,
+    swapchain: Optional[str] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    assume: Optional[Mapping[str, Any]] = None,
+) -> ReplayResult: ...

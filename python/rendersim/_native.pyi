@@ -1,0 +1,23 @@
+"""rendersim's native module (PyO3); use the functions of ``rendersim``."""
+
+from typing import Optional
+
+class ModelError(ValueError):
+    file: Optional[str]
+    line: Optional[int]
+    key: Optional[str]
+
+def run(
+    model: Optional[str], sets: list[str], seed: Optional[int], frames: Optional[int], command: list[str]
+) -> tuple[str, str, str, list[str]]: ...
+def experiment(
+    path: str, sets: list[str], out: Optional[str], force: bool, command: list[str]
+) -> tuple[str, str]: ...
+def vcache(mesh: str, policy: str) -> str: ...
+def isolate(
+    model: Optional[str], sets: list[str], factor: float, keep_vsync: bool, tie_tolerance: float
+) -> str: ...
+def replay(
+    capture: str, app: Optional[str], swapchain: Optional[str], sets: list[str], assume: list[str]
+) -> tuple[str, str, str, str]: ...
+def version() -> tuple[str, Optional[str]]: ...

@@ -1,0 +1,310 @@
+//! `rendersim._native`: the library calls behind the Python package
+//! (`python/rendersim/__init__.py`), each returning text (JSON, CSV, TOML)
+//! that the package turns into dicts and pandas DataFrames. The simulation
+//! runs with the GIL released, so Python threads go on meanwhile.
+//!
+//! Every error is raised as `rendersim.ModelError` (a `ValueError`) with the
+//! message the command line prints after `error: `, and `file`, `line` and
+//! `key` where the error names them.
+
+use std::error::Error;
+use std::path::{Path, PathBuf};
+
+use pyo3::create_exception;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use rendersim::config::{ConfigError, ModelSource, Overrides, load_model};
+use rendersim::output::result_set::ResultSet;
+use rendersim::systems::run_model;
+
+create_exception!(
+    _native,
+    ModelError,
+    PyValueError,
+    "A model, experiment, mesh or capture rendersim cannot use, or a run that cannot finish."
+);
+
+/// What an error says on the command line: its causes on one line, a cause
+/// whose text the line already holds left out (as `rendersim`'s `error:`).
+fn message(e: &(dyn Error + 'static)) -> String {
+    let mut line = String::new();
+    let mut cause: Option<&(dyn Error + 'static)> = Some(e);
+    while let Some(c) = cause {
+        let text = c.to_string();
+        if !line.contains(&text) {
+            if !line.is_empty() {
+                line.push_str(": ");
+            }
+            line.push_str(&text);
+        }
+        cause = c.source();
+    }
+    line
+}
+
+/// The error as a `ModelError`, with the file, line and key of the first
+/// model-file error in its chain.
+fn model_error(e: &(dyn Error + 'static)) -> PyErr {
+    let (mut file, mut line, mut key): (Option<String>, Option<usize>, Option<String>) = (None, None, None);
+    let mut cause: Option<&(dyn Error + 'static)> = Some(e);
+    while let Some(c) = cause {
+        if let Some(ce) = config_error(c) {
+            match ce {
+                ConfigError::Invalid {
+                    file: f,
+                    key: k,
+                    line: l,
+                    ..
+                } => {
+                    (file, line, key) = (Some(f.clone()), *l, Some(k.clone()));
+                }
+                ConfigError::Syntax { file: f, .. } => file = Some(f.clone()),
+                ConfigError::Io { path, .. } => file = Some(path.clone()),
+                ConfigError::Set { assignment, .. } => key = assignment.split('=').next().map(str::to_string),
+                ConfigError::Override { .. } => {}
+            }
+            break;
+        }
+        cause = c.source();
+    }
+    let msg = message(e);
+    Python::attach(|py| {
+        let err = ModelError::new_err(msg);
+        let v = err.value(py);
+        let _ = v.setattr("file", file);
+        let _ = v.setattr("line", line);
+        let _ = v.setattr("key", key);
+        err
+    })
+}
+
+/// The model-file error `c` is or wraps without a cause of its own (the
+/// errors that forward to a `ConfigError` transparently hide it from the
+/// chain).
+fn config_error<'a>(c: &'a (dyn Error + 'static)) -> Option<&'a ConfigError> {
+    use rendersim::studies::replay::ReplayError;
+    use rendersim::systems::SimError;
+    if let Some(ce) = c.downcast_ref::<ConfigError>() {
+        return Some(ce);
+    }
+    match c.downcast_ref::<SimError>() {
+        Some(SimError::Config(ce)) => return Some(ce),
+        Some(_) => return None,
+        None => {}
+    }
+    match c.downcast_ref::<ReplayError>() {
+        Some(ReplayError::Config(ce) | ReplayError::Assume(ce)) => Some(ce),
+        _ => None,
+    }
+}
+
+fn err<E: Error + 'static>(e: E) -> PyErr {
+    model_error(&e)
+}
+
+/// An error of the package's own (an argument it cannot use).
+fn usage(msg: String) -> PyErr {
+    model_error(&*Box::<dyn Error + Send + Sync>::from(msg))
+}
+
+/// `rendersim.run(...)`: (summary JSON, frames CSV or "", resolved model
+/// TOML, notes).
+#[pyfunction]
+#[pyo3(signature = (model, sets, seed, frames, command))]
+fn run(
+    py: Python<'_>,
+    model: Option<PathBuf>,
+    sets: Vec<String>,
+    seed: Option<u64>,
+    frames: Option<u64>,
+    command: Vec<String>,
+) -> PyResult<(String, String, String, Vec<String>)> {
+    py.detach(move || {
+        let overrides = Overrides { sets, seed, frames };
+        let prepared = load_model(model.as_deref(), &overrides).map_err(err)?;
+        let src = &prepared.source;
+        let mut run = run_model(src, &prepared.table, None).map_err(err)?;
+        run.summary_mut()["model"] = serde_json::Value::String(src.name.clone());
+        let provenance = rendersim::provenance(command);
+        run.summary_mut()["provenance"] = serde_json::to_value(&provenance).map_err(err)?;
+        let summary = serde_json::to_string(run.summary()).map_err(err)?;
+        let mut csv = Vec::new();
+        run.write_frames_csv(&mut csv).map_err(err)?;
+        let model_text = provenance.toml_comment() + &run.resolved_model(&src.base_dir);
+        Ok((
+            summary,
+            String::from_utf8(csv).map_err(err)?,
+            model_text,
+            prepared.notes.clone(),
+        ))
+    })
+}
+
+/// `(key, TOML literal)` pairs as an experiment's `[set]` entries.
+fn set_entries(sets: &[String]) -> PyResult<Vec<(String, toml::Value)>> {
+    sets.iter()
+        .map(|s| {
+            let (k, v) = s
+                .split_once('=')
+                .ok_or_else(|| usage(format!("set {s:?}: needs key=value")))?;
+            let t: toml::Table = toml::from_str(&format!("v = {v}"))
+                .map_err(|e| usage(format!("set {k:?}: {v:?} is not a TOML value: {e}")))?;
+            Ok((k.trim().to_string(), t["v"].clone()))
+        })
+        .collect()
+}
+
+/// `rendersim.experiment(...)`: runs the experiment file into `out` (a
+/// result set, as `rendersim experiment --out`); returns (out, the result
+/// as JSON: checks failed, wall seconds, files).
+#[pyfunction]
+#[pyo3(signature = (path, sets, out, force, command))]
+fn experiment(
+    py: Python<'_>,
+    path: PathBuf,
+    sets: Vec<String>,
+    out: Option<PathBuf>,
+    force: bool,
+    command: Vec<String>,
+) -> PyResult<(String, String)> {
+    let entries = set_entries(&sets)?;
+    py.detach(move || {
+        use rendersim::experiment::{SimRunner, load_experiment, run_experiment};
+        let mut exp = load_experiment(&path).map_err(err)?;
+        exp.set.extend(entries);
+        let default = ModelSource::embedded_default().table().map_err(err)?;
+        let base = exp.resolve_model(&default).map_err(err)?;
+        let out = out.unwrap_or_else(|| PathBuf::from("out").join(&exp.name));
+        let ours = |n: &str| [".csv", ".md", ".svg", ".png"].iter().any(|e| n.ends_with(e));
+        let set = ResultSet::begin_kind(&out, Some("experiment"), ours, force).map_err(err)?;
+        let runner = SimRunner::for_experiment(&exp);
+        let result = run_experiment(&exp, &base, &runner, set.dir(), false).map_err(err)?;
+        let report = set.dir().join("report.md");
+        let mut text = std::fs::read_to_string(&report).map_err(err)?;
+        text.push('\n');
+        text.push_str(&rendersim::provenance(command).markdown_section());
+        std::fs::write(&report, text).map_err(err)?;
+        set.commit().map_err(err)?;
+        let json = serde_json::json!({
+            "name": exp.name,
+            "points": result.points.len(),
+            "checks_failed": result.checks_failed,
+            "wall_seconds": result.wall_seconds,
+            "sim_wall_seconds": result.sim_wall_seconds,
+            "files": result.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>(),
+        });
+        Ok((out.display().to_string(), json.to_string()))
+    })
+}
+
+/// `rendersim.vcache(mesh, policy)`: the cache statistics as JSON.
+#[pyfunction]
+fn vcache(py: Python<'_>, mesh: String, policy: String) -> PyResult<String> {
+    py.detach(move || {
+        let p: rendersim::components::vertex_cache::CachePolicy =
+            policy
+                .parse()
+                .map_err(|e: rendersim::components::vertex_cache::CachePolicyError| {
+                    usage(format!("policy {policy:?}: {e}"))
+                })?;
+        let start = std::time::Instant::now();
+        let m = rendersim::scene::generators::mesh_from_spec(&mesh, Path::new(".")).map_err(err)?;
+        let s = m.cache_stats(&p);
+        Ok(serde_json::json!({
+            "mesh": mesh, "policy": p.to_string(), "indices": s.indices, "triangles": s.triangles,
+            "unique_vertices": s.unique_vertices, "transformed": s.transformed, "acmr": s.acmr(), "atvr": s.atvr(),
+            "wall_seconds": start.elapsed().as_secs_f64(),
+        })
+        .to_string())
+    })
+}
+
+/// `rendersim.isolate(...)`: the isolation as JSON.
+#[pyfunction]
+#[pyo3(signature = (model, sets, factor, keep_vsync, tie_tolerance))]
+fn isolate(
+    py: Python<'_>,
+    model: Option<PathBuf>,
+    sets: Vec<String>,
+    factor: f64,
+    keep_vsync: bool,
+    tie_tolerance: f64,
+) -> PyResult<String> {
+    py.detach(move || {
+        let prepared = load_model(model.as_deref(), &Overrides::with_sets(&sets)).map_err(err)?;
+        let (src, table) = (&prepared.source, &prepared.table);
+        let system = table.get("system").and_then(|v| v.as_str()).unwrap_or("frame_pipeline");
+        if system != "frame_pipeline" {
+            return Err(usage(format!(
+                "isolate applies to the frame pipeline; {} is a {system} model (`system = {system:?}`)",
+                src.name
+            )));
+        }
+        let cfg: rendersim::systems::frame_pipeline::FramePipelineConfig =
+            rendersim::config::deserialize(table, src).map_err(err)?;
+        let options = rendersim::studies::isolate::IsolateOptions {
+            factor,
+            keep_vsync,
+            tie_tolerance,
+        };
+        let iso = rendersim::studies::isolate::isolate(&cfg, &src.base_dir, options)
+            .map_err(|e| err(rendersim::systems::SimError::of(src, e)))?;
+        serde_json::to_string(&iso).map_err(err)
+    })
+}
+
+/// `rendersim.replay(...)`: (summary JSON, comparison CSV, replayed frames
+/// CSV, what-if frames CSV or "").
+#[pyfunction]
+#[pyo3(signature = (capture, app, swapchain, sets, assume))]
+fn replay(
+    py: Python<'_>,
+    capture: PathBuf,
+    app: Option<String>,
+    swapchain: Option<String>,
+    sets: Vec<String>,
+    assume: Vec<String>,
+) -> PyResult<(String, String, String, String)> {
+    py.detach(move || {
+        use rendersim::studies::replay::{ReplayOptions, replay};
+        let opts = ReplayOptions {
+            app,
+            swap_chain: swapchain,
+            sets,
+            assume,
+            from_tables: false,
+        };
+        let r = replay(&capture, &opts).map_err(err)?;
+        let summary = serde_json::to_string(&r.summary).map_err(err)?;
+        let mut comparison = Vec::new();
+        rendersim::output::table::write_number_table(&mut comparison, &r.columns(), &r.rows()).map_err(err)?;
+        let mut frames = Vec::new();
+        r.replayed.write_csv(&mut frames).map_err(err)?;
+        let mut whatif = Vec::new();
+        if let Some(w) = &r.whatif_replayed {
+            w.write_csv(&mut whatif).map_err(err)?;
+        }
+        let text = |b: Vec<u8>| String::from_utf8(b).map_err(err);
+        Ok((summary, text(comparison)?, text(frames)?, text(whatif)?))
+    })
+}
+
+/// The rendersim version and the git revision this module was built from.
+#[pyfunction]
+fn version() -> (String, Option<String>) {
+    let p = rendersim::provenance(Vec::new());
+    (p.program, p.git_revision)
+}
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("ModelError", m.py().get_type::<ModelError>())?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(experiment, m)?)?;
+    m.add_function(wrap_pyfunction!(vcache, m)?)?;
+    m.add_function(wrap_pyfunction!(isolate, m)?)?;
+    m.add_function(wrap_pyfunction!(replay, m)?)?;
+    m.add_function(wrap_pyfunction!(version, m)?)?;
+    Ok(())
+}

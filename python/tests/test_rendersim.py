@@ -1,0 +1,155 @@
+"""The Python package against the library and the command line: results,
+determinism, errors (the CLI's message, file, line, key), the GIL released
+while simulating. Run by scripts/test-all.sh (pytest); every file it writes
+goes into pytest's temporary folders."""
+
+import os
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+import rendersim
+
+ROOT = Path(__file__).resolve().parents[2]
+MODELS = ROOT / "models"
+CAPTURE = ROOT / "tests" / "fixtures" / "presentmon" / "test_case_0.csv"
+
+
+def cli():
+    """The rendersim binary built beside the package, if any."""
+    b = os.environ.get("RENDERSIM_BIN") or str(ROOT / "target" / "release" / "rendersim")
+    return b if Path(b).is_file() else None
+
+
+def test_run_of_the_default_model():
+    r = rendersim.run(frames=90)
+    assert r.summary["frames"] == 90
+    assert r.summary["model"] == "<embedded default model>"
+    ft = r.summary["metrics"]["frame_time_ms"]
+    assert ft["count"] > 0 and ft["mean"] > 0
+    assert isinstance(r.frames, pd.DataFrame)
+    assert len(r.frames) == 90
+    for col in ["Frame", "CPUStartTime", "MsUntilDisplayed", "MsGPUBusy", "Displayed", "Dropped"]:
+        assert col in r.frames.columns
+    assert r.frames["Frame"].tolist() == list(range(90))
+    assert pd.api.types.is_float_dtype(r.frames["MsUntilDisplayed"])
+    assert "[run]" in r.model or "run" in r.model
+    p = r.summary["provenance"]
+    assert p["program"] == f"rendersim {rendersim.__version__}"
+    assert p["command"][1].startswith("rendersim.run(")
+
+
+def test_same_seed_same_frames_and_the_model_text_reproduces_the_run(tmp_path):
+    a = rendersim.run(MODELS / "fixed.toml", set={"workload.gpu": "9ms"}, seed=4, frames=50)
+    b = rendersim.run(str(MODELS / "fixed.toml"), set={"workload.gpu": "9ms"}, seed=4, frames=50)
+    pd.testing.assert_frame_equal(a.frames, b.frames)
+    m = tmp_path / "model.toml"
+    m.write_text(a.model)
+    c = rendersim.run(m)
+    pd.testing.assert_frame_equal(a.frames, c.frames)
+    assert a.summary["metrics"]["gpu_time_ms"]["mean"] == pytest.approx(9.0)
+
+
+def test_set_values_take_python_types():
+    r = rendersim.run(
+        MODELS / "fixed.toml",
+        set={"display.buffers": 3, "display.vsync": False, "workload.gpu": "12ms", "display.refresh": "120Hz"},
+        frames=40,
+    )
+    assert r.summary["metrics"]["frame_time_ms"]["mean"] == pytest.approx(12.0, rel=1e-6)
+    assert rendersim.to_toml({"a": [1, 2.5, "x"], "b": True}) == '{ "a" = [1, 2.5, "x"], "b" = true }'
+    with pytest.raises(rendersim.ModelError):
+        rendersim.to_toml(object())
+
+
+def test_errors_carry_file_line_key_and_the_cli_message(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[run]\nframes = 10\n[display]\nbufers = 3\n")
+    with pytest.raises(rendersim.ModelError) as e:
+        rendersim.run(bad)
+    err = e.value
+    assert isinstance(err, ValueError)
+    assert err.file == str(bad)
+    assert err.line == 4
+    assert err.key == "display.bufers"
+    assert "did you mean" in str(err)
+    exe = cli()
+    if exe is not None:
+        o = subprocess.run([exe, "run", str(bad)], capture_output=True, text=True)
+        assert o.returncode == 2
+        assert o.stderr.strip() == f"error: {err}"
+    with pytest.raises(rendersim.ModelError) as e:
+        rendersim.run(set={"display.buffers": -1}, frames=5)
+    assert e.value.key == "display.buffers"
+    with pytest.raises(rendersim.ModelError) as e:
+        rendersim.run(tmp_path / "missing.toml")
+    assert e.value.file == str(tmp_path / "missing.toml")
+    with pytest.raises(rendersim.ModelError):
+        rendersim.run(frames=-1)
+    with pytest.raises(rendersim.ModelError):
+        rendersim.vcache("grid:4x4", "fifo:zero")
+
+
+def test_experiment_writes_its_folder_and_returns_dataframes(tmp_path):
+    exp = tmp_path / "e.toml"
+    exp.write_text(
+        f'name = "py"\nmodel = "{MODELS / "fixed.toml"}"\nreplications = 2\n'
+        '[set]\n"run.frames" = 80\n'
+        '[[sweep]]\nkey = "workload.gpu"\nvalues = ["5ms", "20ms"]\n'
+        '[[metric]]\npath = "metrics.frame_time_ms.mean"\n'
+        '[[plot]]\nkind = "line"\nx = "workload.gpu"\ny = "metrics.frame_time_ms.mean"\nfile = "ft"\n'
+    )
+    out = tmp_path / "out"
+    r = rendersim.experiment(exp, set={"display.buffers": 3}, out=out)
+    assert r.out == out and (out / "report.md").is_file()
+    assert len(r.points) == 2 and len(r.runs) == 4
+    assert r.checks_failed == 0
+    assert r.plots and all(p.is_file() for p in r.plots)
+    assert "## Provenance" in r.report
+    # The runs carry the added [set].
+    assert (r.runs.filter(like="workload.gpu").shape[1]) >= 1
+
+
+def test_vcache_isolate_and_replay():
+    v = rendersim.vcache("grid:16x16", "fifo:32")
+    assert v["triangles"] == 512 and v["unique_vertices"] == 289
+    assert 0 < v["acmr"] <= 3
+    iso = rendersim.isolate(MODELS / "fixed.toml")
+    assert iso["bottleneck"] == "gpu"
+    rp = rendersim.replay(CAPTURE)
+    assert rp.summary["frames"] > 100
+    assert rp.summary["agreement"]["displayed"] >= 0.99
+    assert len(rp.comparison) == rp.summary["frames"]
+    assert rp.whatif_frames is None
+    w = rendersim.replay(CAPTURE, set={"display.refresh": "120Hz"})
+    assert w.whatif_frames is not None and len(w.whatif_frames) > 0
+
+
+def test_the_gil_is_released_while_simulating():
+    """A Python thread keeps counting while another simulates."""
+    done = threading.Event()
+    count = [0]
+
+    def spin():
+        while not done.is_set():
+            count[0] += 1
+
+    t = threading.Thread(target=spin)
+    t.start()
+    try:
+        start = time.perf_counter()
+        before = count[0]
+        rendersim.run(frames=120)
+        during = count[0] - before
+        elapsed = time.perf_counter() - start
+    finally:
+        done.set()
+        t.join()
+    # Holding the GIL for the whole run would leave the counter at (almost)
+    # nothing; released, it counts throughout.
+    assert elapsed > 0.05
+    assert during > 10_000, f"{during} increments in {elapsed:.2f} s"
