@@ -125,7 +125,16 @@ for f in experiments/*.toml; do
   "$RENDERSIM_BIN" experiment "$f" --out "$ci_out/$name" --quiet | tail -n 3
 done
 
-step "Notebooks"
+step "Notebooks (committed with their outputs; each executed again here)"
+.venv/bin/python - notebooks/*.ipynb <<'PY'
+import json, sys
+for path in sys.argv[1:]:
+    cells = [c for c in json.load(open(path))["cells"] if c["cell_type"] == "code"]
+    bare = [i for i, c in enumerate(cells) if c.get("execution_count") is None]
+    if bare:
+        sys.exit(f"{path}: code cells {bare} have no outputs; run jupyter nbconvert --to notebook --execute --inplace {path}")
+print(f"{len(sys.argv) - 1} notebooks carry their outputs")
+PY
 for nb in notebooks/*.ipynb; do
   [ -e "$nb" ] || continue
   echo "-- $nb"

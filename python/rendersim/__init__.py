@@ -23,7 +23,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping, Optional, Union
+from typing import Any, Mapping, Optional, Sequence, Union
 
 from . import _native
 from ._native import ModelError
@@ -38,6 +38,8 @@ __all__ = [
     "vcache",
     "isolate",
     "replay",
+    "timeline",
+    "perceived_speed",
     "to_toml",
     "__version__",
 ]
@@ -69,12 +71,16 @@ def to_toml(value: Any) -> str:
     raise ModelError(f"set: a {type(value).__name__} ({value!r}) has no TOML form")
 
 
-def _sets(set: Optional[Mapping[str, Any]]) -> list[str]:
+def _sets(set: Optional[Mapping[str, Any]], sets: Sequence[str] = ()) -> list[str]:
+    """`sets` (``"key=value"`` strings, as the command line's ``--set``:
+    the value is TOML, or a string if it is not), then ``set``."""
+    if isinstance(sets, str) or not all(isinstance(s, str) for s in sets):
+        raise ModelError(f"sets: expected a list of \"key=value\" strings, got {sets!r}")
+    out = list(sets)
     if set is None:
-        return []
+        return out
     if not isinstance(set, Mapping):
         raise ModelError(f"set: expected a dict of dotted keys to values, got {type(set).__name__}")
-    out = []
     for k, v in set.items():
         if not isinstance(k, str) or not k.strip():
             raise ModelError(f"set: key {k!r} is not a dotted model key")
@@ -110,6 +116,19 @@ class Run:
     frames: Any
     model: str
     notes: list = field(default_factory=list)
+    summary_json: str = field(default="", repr=False)
+    frames_csv: str = field(default="", repr=False)
+
+    def save(self, out: PathLike) -> Path:
+        """Writes ``summary.json``, ``frames.csv`` and ``model.toml`` into
+        the folder ``out`` (made if missing), the bytes ``rendersim run
+        --out`` writes; returns the folder."""
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "summary.json").write_text(self.summary_json)
+        (out / "frames.csv").write_text(self.frames_csv)
+        (out / "model.toml").write_text(self.model)
+        return out
 
     def __repr__(self) -> str:
         m = self.summary.get("metrics", {}).get("frame_time_ms", {}).get("mean")
@@ -121,19 +140,28 @@ def run(
     set: Optional[Mapping[str, Any]] = None,
     seed: int = 1,
     frames: Optional[int] = None,
+    sets: Sequence[str] = (),
 ) -> Run:
     """Runs a model file (the embedded default model when ``model`` is
-    None) with ``set`` patches (``{"display.buffers": 3}``, as ``--set``),
-    the master ``seed`` and, when given, ``frames`` frames.
+    None) with ``set`` patches (``{"display.buffers": 3}``) and ``sets``
+    (``["display.buffers=3"]``, the command line's ``--set`` text), the
+    master ``seed`` and, when given, ``frames`` frames.
 
     Raises :class:`ModelError` for a model it cannot use."""
     if seed is not None and (not isinstance(seed, int) or seed < 0):
         raise ModelError(f"seed: expected a whole number >= 0, got {seed!r}")
     if frames is not None and (not isinstance(frames, int) or frames < 0):
         raise ModelError(f"frames: expected a whole number >= 0, got {frames!r}")
-    command = _command("run", model=_path(model), set=dict(set or {}), seed=seed, frames=frames)
-    summary, csv, model_text, notes = _native.run(_path(model), _sets(set), seed, frames, command)
-    return Run(summary=json.loads(summary), frames=_csv(csv), model=model_text, notes=list(notes))
+    command = _command("run", model=_path(model), set=dict(set or {}), sets=list(sets), seed=seed, frames=frames)
+    summary, csv, model_text, notes = _native.run(_path(model), _sets(set, sets), seed, frames, command)
+    return Run(
+        summary=json.loads(summary),
+        frames=_csv(csv),
+        model=model_text,
+        notes=list(notes),
+        summary_json=summary,
+        frames_csv=csv,
+    )
 
 
 @dataclass
@@ -164,6 +192,7 @@ def experiment(
     set: Optional[Mapping[str, Any]] = None,
     out: Optional[PathLike] = None,
     force: bool = False,
+    sets: Sequence[str] = (),
 ) -> ExperimentResult:
     """Runs an experiment file (sweeps, replications, checks, plots) with
     ``set`` added to its ``[set]`` table, into ``out`` (default
@@ -171,8 +200,8 @@ def experiment(
     raise: see ``checks_failed``."""
     import pandas as pd
 
-    command = _command("experiment", path=_path(path), set=dict(set or {}), out=_path(out))
-    out_dir, result = _native.experiment(_path(path), _sets(set), _path(out), bool(force), command)
+    command = _command("experiment", path=_path(path), set=dict(set or {}), sets=list(sets), out=_path(out))
+    out_dir, result = _native.experiment(_path(path), _sets(set, sets), _path(out), bool(force), command)
     res = json.loads(result)
     out_dir = Path(out_dir)
     files = [out_dir / f for f in res["files"]]
@@ -202,12 +231,13 @@ def isolate(
     factor: float = 0.5,
     keep_vsync: bool = False,
     tie_tolerance: float = 0.02,
+    sets: Sequence[str] = (),
 ) -> dict:
     """Isolates the bottleneck (paper 004 section 4.1): the frame time with
     the CPU, GPU front end, geometry and raster load each reduced by
     ``factor`` in turn; returns the variants and the verdict."""
     return json.loads(
-        _native.isolate(_path(model), _sets(set), float(factor), bool(keep_vsync), float(tie_tolerance))
+        _native.isolate(_path(model), _sets(set, sets), float(factor), bool(keep_vsync), float(tie_tolerance))
     )
 
 
@@ -231,12 +261,14 @@ def replay(
     swapchain: Optional[str] = None,
     set: Optional[Mapping[str, Any]] = None,
     assume: Optional[Mapping[str, Any]] = None,
+    sets: Sequence[str] = (),
+    assumes: Sequence[str] = (),
 ) -> ReplayResult:
     """Replays a PresentMon CSV capture; ``set`` is a what-if on the
     display and CPU (``{"display.refresh": "120Hz"}``), ``assume`` what the
     capture does not say (``{"display.buffers": 3}``)."""
     summary, comparison, frames, whatif = _native.replay(
-        _path(capture), app, swapchain, _sets(set), _sets(assume)
+        _path(capture), app, swapchain, _sets(set, sets), _sets(assume, assumes)
     )
     return ReplayResult(
         summary=json.loads(summary),
@@ -244,3 +276,33 @@ def replay(
         frames=_csv(frames),
         whatif_frames=_csv(whatif) if whatif else None,
     )
+
+
+def timeline(
+    out: PathLike,
+    model: Optional[PathLike] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    frames: int = 6,
+    first: int = 0,
+    sets: Sequence[str] = (),
+) -> dict:
+    """Draws paper 000 Figure 4 (one lane a unit, frames by colour,
+    vertical blanks marked) for ``frames`` frames from frame ``first`` into
+    ``out`` (``.png`` or ``.svg``), as ``rendersim timeline``; returns the
+    frames and the time range drawn (ms)."""
+    f0, f1, t0, t1 = _native.timeline(_path(model), _sets(set, sets), int(first), int(frames), _path(out))
+    return {"out": Path(out), "frames": (f0, f1), "range_ms": (t0, t1)}
+
+
+def perceived_speed(
+    model: PathLike,
+    out: PathLike,
+    set: Optional[Mapping[str, Any]] = None,
+    around: int = 8,
+    sets: Sequence[str] = (),
+) -> dict:
+    """Paper 000 Figure 6 from a walkthrough model: the perceived speed per
+    displayed refresh around the first frame skip, drawn to ``out`` (its
+    ``.png`` and ``.svg``), as ``rendersim perceived-speed``."""
+    skip, r0, r1, skips = _native.perceived_speed(_path(model), _sets(set, sets), int(around), _path(out))
+    return {"out": Path(out), "first_skip": skip, "refreshes": (r0, r1), "skips": skips}

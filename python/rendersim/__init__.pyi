@@ -2,7 +2,7 @@
 
 import os
 from pathlib import Path
-from typing import Any, Mapping, Optional, Union
+from typing import Any, Mapping, Optional, Sequence, Union
 
 import pandas as pd
 
@@ -18,12 +18,16 @@ class Run:
     frames: pd.DataFrame
     model: str
     notes: list[str]
+    summary_json: str
+    frames_csv: str
+    def save(self, out: PathLike) -> Path: ...
 
 def run(
     model: Optional[PathLike] = None,
     set: Optional[Mapping[str, Any]] = None,
     seed: int = 1,
     frames: Optional[int] = None,
+    sets: Sequence[str] = (),
 ) -> Run: ...
 
 class ExperimentResult:
@@ -41,6 +45,7 @@ def experiment(
     set: Optional[Mapping[str, Any]] = None,
     out: Optional[PathLike] = None,
     force: bool = False,
+    sets: Sequence[str] = (),
 ) -> ExperimentResult: ...
 def vcache(mesh: str, policy: str) -> dict[str, Any]: ...
 def isolate(
@@ -49,6 +54,7 @@ def isolate(
     factor: float = 0.5,
     keep_vsync: bool = False,
     tie_tolerance: float = 0.02,
+    sets: Sequence[str] = (),
 ) -> dict[str, Any]: ...
 
 class ReplayResult:
@@ -63,4 +69,21 @@ def replay(
     swapchain: Optional[str] = None,
     set: Optional[Mapping[str, Any]] = None,
     assume: Optional[Mapping[str, Any]] = None,
+    sets: Sequence[str] = (),
+    assumes: Sequence[str] = (),
 ) -> ReplayResult: ...
+def timeline(
+    out: PathLike,
+    model: Optional[PathLike] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    frames: int = 6,
+    first: int = 0,
+    sets: Sequence[str] = (),
+) -> dict[str, Any]: ...
+def perceived_speed(
+    model: PathLike,
+    out: PathLike,
+    set: Optional[Mapping[str, Any]] = None,
+    around: int = 8,
+    sets: Sequence[str] = (),
+) -> dict[str, Any]: ...

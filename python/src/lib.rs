@@ -128,7 +128,7 @@ fn run(
         run.summary_mut()["model"] = serde_json::Value::String(src.name.clone());
         let provenance = rendersim::provenance(command);
         run.summary_mut()["provenance"] = serde_json::to_value(&provenance).map_err(err)?;
-        let summary = serde_json::to_string(run.summary()).map_err(err)?;
+        let summary = serde_json::to_string_pretty(run.summary()).map_err(err)?;
         let mut csv = Vec::new();
         run.write_frames_csv(&mut csv).map_err(err)?;
         let model_text = provenance.toml_comment() + &run.resolved_model(&src.base_dir);
@@ -148,9 +148,12 @@ fn set_entries(sets: &[String]) -> PyResult<Vec<(String, toml::Value)>> {
             let (k, v) = s
                 .split_once('=')
                 .ok_or_else(|| usage(format!("set {s:?}: needs key=value")))?;
-            let t: toml::Table = toml::from_str(&format!("v = {v}"))
-                .map_err(|e| usage(format!("set {k:?}: {v:?} is not a TOML value: {e}")))?;
-            Ok((k.trim().to_string(), t["v"].clone()))
+            // As `--set`: a value that is not TOML is a string.
+            let value = match toml::from_str::<toml::Table>(&format!("v = {v}")) {
+                Ok(t) => t["v"].clone(),
+                Err(_) => toml::Value::String(v.trim().to_string()),
+            };
+            Ok((k.trim().to_string(), value))
         })
         .collect()
 }
@@ -290,6 +293,60 @@ fn replay(
     })
 }
 
+/// `rendersim.timeline(...)`: paper 000 Figure 4 for a few frames, drawn
+/// to `out` (.png or .svg); returns (first frame, last frame, start ms, end
+/// ms).
+#[pyfunction]
+#[pyo3(signature = (model, sets, first, frames, out))]
+fn timeline(
+    py: Python<'_>,
+    model: Option<PathBuf>,
+    sets: Vec<String>,
+    first: u64,
+    frames: u64,
+    out: PathBuf,
+) -> PyResult<(u64, u64, f64, f64)> {
+    py.detach(move || {
+        use rendersim::studies::timeline::{TimelineOptions, timeline_of};
+        let max = rendersim::studies::timeline::MAX_TIMELINE_FRAMES;
+        if !(1..=max).contains(&frames) {
+            return Err(usage(format!("frames: draws 1 to {max} frames, got {frames}")));
+        }
+        rendersim::plot::ImageFormat::of(&out).map_err(err)?;
+        let prepared = load_model(model.as_deref(), &Overrides::with_sets(&sets)).map_err(err)?;
+        let opts = TimelineOptions { first, frames };
+        let (picture, _run) = timeline_of(&prepared.source, &prepared.table, opts).map_err(err)?;
+        rendersim::plot::timeline(&out, &picture).map_err(err)?;
+        Ok((
+            first,
+            first + frames.saturating_sub(1),
+            picture.range.0,
+            picture.range.1,
+        ))
+    })
+}
+
+/// `rendersim.perceived_speed(...)`: paper 000 Figure 6 from a walkthrough,
+/// drawn to `out` (.png and .svg); returns (first skip, first refresh, last
+/// refresh, skips).
+#[pyfunction]
+#[pyo3(signature = (model, sets, around, out))]
+fn perceived_speed(
+    py: Python<'_>,
+    model: PathBuf,
+    sets: Vec<String>,
+    around: u64,
+    out: PathBuf,
+) -> PyResult<(Option<u64>, u64, u64, u64)> {
+    py.detach(move || {
+        use rendersim::systems::walkthrough::perceived::figure6;
+        rendersim::plot::ImageFormat::of(&out).map_err(err)?;
+        let prepared = load_model(Some(&model), &Overrides::with_sets(&sets)).map_err(err)?;
+        let fig = figure6(&prepared.source, &prepared.table, around, &out).map_err(err)?;
+        Ok((fig.first_skip, fig.range.0, fig.range.1, fig.skips))
+    })
+}
+
 /// The rendersim version and the git revision this module was built from.
 #[pyfunction]
 fn version() -> (String, Option<String>) {
@@ -305,6 +362,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(vcache, m)?)?;
     m.add_function(wrap_pyfunction!(isolate, m)?)?;
     m.add_function(wrap_pyfunction!(replay, m)?)?;
+    m.add_function(wrap_pyfunction!(timeline, m)?)?;
+    m.add_function(wrap_pyfunction!(perceived_speed, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     Ok(())
 }

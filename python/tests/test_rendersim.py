@@ -51,6 +51,17 @@ def test_same_seed_same_frames_and_the_model_text_reproduces_the_run(tmp_path):
     m.write_text(a.model)
     c = rendersim.run(m)
     pd.testing.assert_frame_equal(a.frames, c.frames)
+    # save() writes the files `rendersim run --out` writes, byte for byte
+    # (frames.csv and model.toml's body; the provenance differs by design).
+    saved = a.save(tmp_path / "saved")
+    exe = cli()
+    if exe is not None:
+        out = tmp_path / "cli"
+        subprocess.run([exe, "run", str(MODELS / "fixed.toml"), "--set", "workload.gpu=9ms", "--seed", "4",
+                        "--frames", "50", "--out", str(out)], check=True, capture_output=True)
+        assert (saved / "frames.csv").read_bytes() == (out / "frames.csv").read_bytes()
+        body = lambda p: [l for l in p.read_text().splitlines() if not l.startswith(("# Written by", "# Command:"))]
+        assert body(saved / "model.toml") == body(out / "model.toml")
     assert a.summary["metrics"]["gpu_time_ms"]["mean"] == pytest.approx(9.0)
 
 
@@ -153,3 +164,26 @@ def test_the_gil_is_released_while_simulating():
     # nothing; released, it counts throughout.
     assert elapsed > 0.05
     assert during > 10_000, f"{during} increments in {elapsed:.2f} s"
+
+
+def test_cli_style_sets_timeline_and_perceived_speed(tmp_path):
+    a = rendersim.run(MODELS / "fixed.toml", sets=["workload.gpu=12ms", "display.buffers=3"], frames=40)
+    b = rendersim.run(MODELS / "fixed.toml", set={"workload.gpu": "12ms", "display.buffers": 3}, frames=40)
+    pd.testing.assert_frame_equal(a.frames, b.frames)
+    with pytest.raises(rendersim.ModelError):
+        rendersim.run(sets="display.buffers=3")
+    t = rendersim.timeline(tmp_path / "t.png", MODELS / "fixed.toml", frames=4, first=2)
+    assert t["frames"] == (2, 5) and t["range_ms"][1] > t["range_ms"][0]
+    assert (tmp_path / "t.png").stat().st_size > 1000
+    with pytest.raises(rendersim.ModelError) as e:
+        rendersim.timeline(tmp_path / "t.png", frames=0)
+    assert "frames" in str(e.value)
+    with pytest.raises(rendersim.ModelError):
+        rendersim.timeline(tmp_path / "t.gif", frames=2)
+    p = rendersim.perceived_speed(
+        MODELS / "walkthrough-forest.toml",
+        tmp_path / "f6.png",
+        sets=["run.frames=120"],
+    )
+    assert p["refreshes"][1] >= p["refreshes"][0]
+    assert (tmp_path / "f6.png").is_file() and (tmp_path / "f6.svg").is_file()
