@@ -232,12 +232,17 @@ def isolate(
     keep_vsync: bool = False,
     tie_tolerance: float = 0.02,
     sets: Sequence[str] = (),
+    fidelity: str = "draw",
 ) -> dict:
     """Isolates the bottleneck (paper 004 section 4.1): the frame time with
     the CPU, GPU front end, geometry and raster load each reduced by
-    ``factor`` in turn; returns the variants and the verdict."""
+    ``factor`` in turn; returns the variants and the verdict. ``fidelity``:
+    ``"draw"`` (default, as the command line), ``"triangle"`` or
+    ``"model"`` (the model file's own)."""
     return json.loads(
-        _native.isolate(_path(model), _sets(set, sets), float(factor), bool(keep_vsync), float(tie_tolerance))
+        _native.isolate(
+            _path(model), _sets(set, sets), float(factor), bool(keep_vsync), float(tie_tolerance), str(fidelity)
+        )
     )
 
 

@@ -55,6 +55,7 @@ def isolate(
     keep_vsync: bool = False,
     tie_tolerance: float = 0.02,
     sets: Sequence[str] = (),
+    fidelity: str = "draw",
 ) -> dict[str, Any]: ...
 
 class ReplayResult:

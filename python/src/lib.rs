@@ -225,7 +225,7 @@ fn vcache(py: Python<'_>, mesh: String, policy: String) -> PyResult<String> {
 
 /// `rendersim.isolate(...)`: the isolation as JSON.
 #[pyfunction]
-#[pyo3(signature = (model, sets, factor, keep_vsync, tie_tolerance))]
+#[pyo3(signature = (model, sets, factor, keep_vsync, tie_tolerance, fidelity))]
 fn isolate(
     py: Python<'_>,
     model: Option<PathBuf>,
@@ -233,7 +233,15 @@ fn isolate(
     factor: f64,
     keep_vsync: bool,
     tie_tolerance: f64,
+    fidelity: String,
 ) -> PyResult<String> {
+    use rendersim::systems::frame_pipeline::config::Fidelity;
+    let fidelity = match fidelity.as_str() {
+        "draw" => Some(Fidelity::Draw),
+        "triangle" => Some(Fidelity::Triangle),
+        "model" => None,
+        other => return Err(usage(format!("fidelity {other:?}: expected draw, triangle or model"))),
+    };
     py.detach(move || {
         let prepared = load_model(model.as_deref(), &Overrides::with_sets(&sets)).map_err(err)?;
         let (src, table) = (&prepared.source, &prepared.table);
@@ -250,6 +258,7 @@ fn isolate(
             factor,
             keep_vsync,
             tie_tolerance,
+            fidelity,
         };
         let iso = rendersim::studies::isolate::isolate(&cfg, &src.base_dir, options)
             .map_err(|e| err(rendersim::systems::SimError::of(src, e)))?;

@@ -130,9 +130,36 @@ pub struct IsolateArgs {
     /// Reductions of the frame time within this fraction of the best reduction are reported as a tie.
     #[arg(long, default_value_t = rendersim::studies::isolate::DEFAULT_TIE_TOLERANCE)]
     pub tie_tolerance: f64,
+    /// Fidelity of the runs: draw (the default: the same verdicts as triangle on every shipped
+    /// model, far faster), triangle, or model (the model file's own).
+    #[arg(long, value_enum, default_value_t = IsolateFidelity::Draw)]
+    pub fidelity: IsolateFidelity,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `isolate --fidelity`.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum IsolateFidelity {
+    /// One closed form per draw call.
+    Draw,
+    /// Every triangle as events.
+    Triangle,
+    /// The model file's `fidelity`.
+    Model,
+}
+
+impl IsolateFidelity {
+    /// The fidelity to force, `None` for the model's.
+    pub fn forced(self) -> Option<rendersim::systems::frame_pipeline::config::Fidelity> {
+        use rendersim::systems::frame_pipeline::config::Fidelity;
+        match self {
+            IsolateFidelity::Draw => Some(Fidelity::Draw),
+            IsolateFidelity::Triangle => Some(Fidelity::Triangle),
+            IsolateFidelity::Model => None,
+        }
+    }
 }
 
 impl From<&IsolateArgs> for Overrides {

@@ -293,6 +293,7 @@ pub fn isolate(args: IsolateArgs) -> Result<()> {
         factor,
         keep_vsync,
         tie_tolerance: args.tie_tolerance,
+        fidelity: args.fidelity.forced(),
     };
     let iso = rendersim::studies::isolate::isolate(&cfg, &src.base_dir, options)?;
     if args.json {
@@ -300,8 +301,9 @@ pub fn isolate(args: IsolateArgs) -> Result<()> {
         return Ok(());
     }
     say!(
-        "bottleneck isolation (load x{factor}, vsync {}):",
-        if keep_vsync { "on" } else { "off" }
+        "bottleneck isolation (load x{factor}, vsync {}, {} fidelity):",
+        if keep_vsync { "on" } else { "off" },
+        iso.fidelity
     );
     for v in &iso.variants {
         let change = fixed(100.0 * v.change, 1);

@@ -1263,9 +1263,15 @@ fn long_commands_show_a_spinner_on_a_terminal_only() {
         screen.contains(&format!("\x1b[2K{report}")),
         "{report:?} whole in {screen:?}"
     );
-    let iso = on_a_terminal("isolate --set run.frames=70", "0").unwrap();
-    assert!(iso.contains("rendersim isolate --set run.frames=70 ["), "{iso:?}");
-    for line in ["bottleneck isolation (load x0.5, vsync off):", "  => bottleneck: "] {
+    let iso = on_a_terminal("isolate --fidelity triangle --set run.frames=70", "0").unwrap();
+    assert!(
+        iso.contains("rendersim isolate --fidelity triangle --set run.frames=70 ["),
+        "{iso:?}"
+    );
+    for line in [
+        "bottleneck isolation (load x0.5, vsync off, triangle fidelity):",
+        "  => bottleneck: ",
+    ] {
         assert!(
             !iso.contains(&format!("]{line}")),
             "{line:?} not after the spinner in {iso:?}"
@@ -1404,4 +1410,36 @@ fn traces_at_three_details_with_frames_flows_and_a_size_warning() {
     // --trace-detail without --trace is refused.
     let e = run_err(&["run", "--trace-detail", "frame"]);
     assert!(e.contains("--trace <FILE>"), "{e}");
+}
+
+/// `isolate` runs at draw fidelity unless asked otherwise, and names it;
+/// on a shipped scene model draw and triangle fidelity give the same
+/// verdict and changes within 0.005.
+#[test]
+fn isolate_at_draw_fidelity_agrees_with_triangle() {
+    let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/one-mesh.toml");
+    let m = m.to_str().unwrap();
+    let get = |fid: &str| -> serde_json::Value {
+        serde_json::from_str(&run_ok(&["isolate", m, "--json", "--fidelity", fid])).unwrap()
+    };
+    let (draw, tri, model) = (get("draw"), get("triangle"), get("model"));
+    let default: serde_json::Value = serde_json::from_str(&run_ok(&["isolate", m, "--json"])).unwrap();
+    assert_eq!(draw["fidelity"], "draw");
+    assert_eq!(default["fidelity"], "draw");
+    assert_eq!(tri["fidelity"], "triangle");
+    assert_eq!(model["fidelity"], "triangle", "one-mesh.toml runs at triangle fidelity");
+    assert_eq!(draw["bottleneck"], tri["bottleneck"]);
+    assert_eq!(draw["tied"], tri["tied"]);
+    for (a, b) in draw["variants"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(tri["variants"].as_array().unwrap())
+    {
+        assert_eq!(a["name"], b["name"]);
+        let (ca, cb) = (a["change"].as_f64().unwrap(), b["change"].as_f64().unwrap());
+        assert!((ca - cb).abs() < 0.005, "{}: {ca} against {cb}", a["name"]);
+    }
+    let e = run_err(&["isolate", m, "--fidelity", "pixel"]);
+    assert!(e.contains("pixel") && e.contains("draw"), "{e}");
 }

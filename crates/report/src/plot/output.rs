@@ -45,15 +45,33 @@ pub(crate) fn render_both(
         svg(&root).map_err(draw_err(&svg_path))?;
         root.present().map_err(|e| e.to_string()).map_err(draw_err(&svg_path))?;
     }
+    // The PNG is drawn into a buffer and encoded by the `png` crate (not
+    // plotters' encoder, which would bring the whole `image` crate into the
+    // build).
+    let mut rgb = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
     {
-        let root = BitMapBackend::new(&png_path, (WIDTH, HEIGHT)).into_drawing_area();
+        let root = BitMapBackend::with_buffer(&mut rgb, (WIDTH, HEIGHT)).into_drawing_area();
         root.fill(&WHITE)
             .map_err(|e| e.to_string())
             .map_err(draw_err(&png_path))?;
         png(&root).map_err(draw_err(&png_path))?;
         root.present().map_err(|e| e.to_string()).map_err(draw_err(&png_path))?;
     }
-    Ok(())
+    let bytes = encode_png(&rgb, WIDTH, HEIGHT).map_err(|e| draw_err(&png_path)(e.to_string()))?;
+    std::fs::write(&png_path, bytes).map_err(|source| PlotError::Io { path: png_path, source })
+}
+
+/// An RGB buffer of `width` x `height` pixels as PNG bytes.
+pub(crate) fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>, png::EncodingError> {
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, width, height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc.write_header()?;
+        w.write_image_data(rgb)?;
+    }
+    Ok(out)
 }
 
 /// Draw `notes` as small text lines in the bottom-left corner of `root`.

@@ -349,26 +349,13 @@ pub fn timeline(path: &Path, t: &Timeline) -> Result<(), PlotError> {
                 draw(&root, t).map_err(draw_err)?;
                 root.present().map_err(|e| draw_err(e.to_string()))?;
             }
-            encode_png(&rgb).map_err(|e| draw_err(e.to_string()))?
+            super::output::encode_png(&rgb, WIDTH, HEIGHT).map_err(|e| draw_err(e.to_string()))?
         }
     };
     crate::output::files::write_output(path, |w| w.write_all(&bytes)).map_err(|e| PlotError::Write {
         path: path.to_path_buf(),
         message: e.to_string(),
     })
-}
-
-/// An RGB buffer of [`WIDTH`] x [`HEIGHT`] as PNG bytes.
-fn encode_png(rgb: &[u8]) -> Result<Vec<u8>, png::EncodingError> {
-    let mut out = Vec::new();
-    {
-        let mut enc = png::Encoder::new(&mut out, WIDTH, HEIGHT);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut w = enc.write_header()?;
-        w.write_image_data(rgb)?;
-    }
-    Ok(out)
 }
 
 #[cfg(test)]
