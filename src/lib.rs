@@ -38,3 +38,23 @@ pub fn provenance(command: Vec<String>) -> output::provenance::Provenance {
         command,
     )
 }
+
+/// An error and its causes on one line, `: ` between them, leaving out a
+/// cause whose text the line already holds (a library error that prints
+/// its source, e.g. the OS error of a file that cannot be read): what the
+/// command line prints after `error: `, and the Python package's message.
+pub fn error_line(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut line = String::new();
+    let mut cause = Some(e);
+    while let Some(c) = cause {
+        let text = c.to_string();
+        if !line.contains(&text) {
+            if !line.is_empty() {
+                line.push_str(": ");
+            }
+            line.push_str(&text);
+        }
+        cause = c.source();
+    }
+    line
+}

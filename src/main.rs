@@ -94,7 +94,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", error_line(&e));
+            eprintln!("error: {}", rendersim::error_line(e.as_ref()));
             ExitCode::from(if e.is::<ChecksFailed>() {
                 EXIT_CHECKS_FAILED
             } else {
@@ -145,21 +145,3 @@ const EXIT_ERROR: u8 = 2;
 /// Exit status of `rendersim experiment` when it ran to the end but a
 /// reference check (a `[[check]]` without `claim`) failed.
 const EXIT_CHECKS_FAILED: u8 = 1;
-
-/// The error and its causes on one line, like `{:#}`, but a cause whose text
-/// the line already holds (a library error that prints its source, e.g. the
-/// OS error of a file that cannot be read) is not repeated.
-fn error_line(e: &anyhow::Error) -> String {
-    let mut line = String::new();
-    for cause in e.chain() {
-        let text = cause.to_string();
-        if line.contains(&text) {
-            continue;
-        }
-        if !line.is_empty() {
-            line.push_str(": ");
-        }
-        line.push_str(&text);
-    }
-    line
-}

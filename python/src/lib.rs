@@ -25,24 +25,6 @@ create_exception!(
     "A model, experiment, mesh or capture rendersim cannot use, or a run that cannot finish."
 );
 
-/// What an error says on the command line: its causes on one line, a cause
-/// whose text the line already holds left out (as `rendersim`'s `error:`).
-fn message(e: &(dyn Error + 'static)) -> String {
-    let mut line = String::new();
-    let mut cause: Option<&(dyn Error + 'static)> = Some(e);
-    while let Some(c) = cause {
-        let text = c.to_string();
-        if !line.contains(&text) {
-            if !line.is_empty() {
-                line.push_str(": ");
-            }
-            line.push_str(&text);
-        }
-        cause = c.source();
-    }
-    line
-}
-
 /// The error as a `ModelError`, with the file, line and key of the first
 /// model-file error in its chain.
 fn model_error(e: &(dyn Error + 'static)) -> PyErr {
@@ -68,7 +50,7 @@ fn model_error(e: &(dyn Error + 'static)) -> PyErr {
         }
         cause = c.source();
     }
-    let msg = message(e);
+    let msg = rendersim::error_line(e);
     Python::attach(|py| {
         let err = ModelError::new_err(msg);
         let v = err.value(py);
@@ -183,11 +165,7 @@ fn experiment(
         let set = ResultSet::begin_kind(&out, Some("experiment"), ours, force).map_err(err)?;
         let runner = SimRunner::for_experiment(&exp);
         let result = run_experiment(&exp, &base, &runner, set.dir(), false).map_err(err)?;
-        let report = set.dir().join("report.md");
-        let mut text = std::fs::read_to_string(&report).map_err(err)?;
-        text.push('\n');
-        text.push_str(&rendersim::provenance(command).markdown_section());
-        std::fs::write(&report, text).map_err(err)?;
+        rendersim::experiment::add_provenance(set.dir(), &rendersim::provenance(command)).map_err(err)?;
         set.commit().map_err(err)?;
         let json = serde_json::json!({
             "name": exp.name,

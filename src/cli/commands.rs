@@ -180,13 +180,7 @@ pub(crate) fn command_provenance() -> rendersim::output::provenance::Provenance 
 /// `report.md` in `dir` with its `## Provenance` section (this build, this
 /// command, now) added at the end.
 pub(crate) fn add_report_provenance(dir: &Path) -> Result<()> {
-    let path = dir.join("report.md");
-    let mut text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    if !text.ends_with("\n\n") {
-        text.push('\n');
-    }
-    text.push_str(&command_provenance().markdown_section());
-    std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))
+    Ok(rendersim::experiment::add_provenance(dir, &command_provenance())?)
 }
 
 /// Whether `path` is this process's standard output: `-`, or the same file

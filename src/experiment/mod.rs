@@ -43,6 +43,7 @@ pub use check::{Bound, CheckOutcome, evaluate_between};
 pub use derived::{interval_width, quantile_width_from_min, ratio, relative_error, speedup};
 pub use dotted::{MetricPathError, json_number, json_path};
 pub use error::ExperimentError;
+pub use report::add_provenance;
 pub use run::{ExperimentResult, PathStat, PointResult, RunRecord, ShardCost, point_model, run_experiment};
 pub use runner::{FrameTable, RunError, RunOutput, Runner};
 pub use shard::{SHARD_FORMAT, SHARDS_DIR, ShardId, ShardIdError, ShardOutcome, merge_shards, run_shard};

@@ -451,3 +451,23 @@ fn plots(s: &mut String, exp: &Experiment, r: &ExperimentResult) {
         }
     }
 }
+
+/// Ends `out_dir/report.md` with its `## Provenance` section (who wrote
+/// the results, how, when): added after the report is written, by the
+/// command line and the Python package alike.
+pub fn add_provenance(
+    out_dir: &std::path::Path,
+    provenance: &crate::output::provenance::Provenance,
+) -> Result<(), super::ExperimentError> {
+    let path = out_dir.join("report.md");
+    let io = |source| super::ExperimentError::Io {
+        path: path.clone(),
+        source,
+    };
+    let mut text = std::fs::read_to_string(&path).map_err(io)?;
+    if !text.ends_with("\n\n") {
+        text.push('\n');
+    }
+    text.push_str(&provenance.markdown_section());
+    std::fs::write(&path, text).map_err(io)
+}

@@ -1234,8 +1234,11 @@ fn an_output_folder_of_one_command_is_not_replaced_by_another_unless_forced() {
 /// output; `None` where `script` is missing.
 fn on_a_terminal(args: &str, after_ms: &str) -> Option<String> {
     let line = format!("{} {args}", env!("CARGO_BIN_EXE_rendersim"));
+    // `script` keeps a copy of the session in a file: one in a temp folder.
+    let d = tempfile::tempdir().unwrap();
+    let typescript = d.path().join("typescript");
     let o = Command::new("script")
-        .args(["-qec", &line, "/dev/null"])
+        .args(["-qec", &line, typescript.to_str().unwrap()])
         .env("RENDERSIM_PROGRESS_AFTER_MS", after_ms)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()

@@ -37,8 +37,9 @@ fn us(t: Time) -> f64 {
     t.0 as f64 / 1e6
 }
 
-/// One event of the Trace Event Format (only the fields rendersim uses).
-#[derive(Debug, Serialize)]
+/// One event of the Trace Event Format (only the fields rendersim uses;
+/// those an event does not have stay at their default, left out).
+#[derive(Debug, Default, Serialize)]
 struct Event<'a> {
     /// Phase: `M` metadata, `X` complete span, `i` instant, `C` counter.
     ph: &'static str,
@@ -204,15 +205,9 @@ impl TraceWriter {
         self.event(&Event {
             ph: "M",
             pid,
-            tid: None,
             name: "process_name",
-            ts: None,
-            dur: None,
-            s: None,
-            cat: None,
-            id: None,
-            bp: None,
             args: Some(Args::Name { name }),
+            ..Default::default()
         });
     }
 
@@ -221,15 +216,9 @@ impl TraceWriter {
         self.event(&Event {
             ph: "M",
             pid,
-            tid: None,
             name: "process_sort_index",
-            ts: None,
-            dur: None,
-            s: None,
-            cat: None,
-            id: None,
-            bp: None,
             args: Some(Args::SortIndex { sort_index: index }),
+            ..Default::default()
         });
     }
 
@@ -240,13 +229,8 @@ impl TraceWriter {
             pid,
             tid: Some(tid),
             name: "thread_name",
-            ts: None,
-            dur: None,
-            s: None,
-            cat: None,
-            id: None,
-            bp: None,
             args: Some(Args::Name { name }),
+            ..Default::default()
         });
     }
 
@@ -258,32 +242,15 @@ impl TraceWriter {
             pid,
             tid: Some(tid),
             name: "thread_sort_index",
-            ts: None,
-            dur: None,
-            s: None,
-            cat: None,
-            id: None,
-            bp: None,
             args: Some(Args::SortIndex { sort_index: tid }),
+            ..Default::default()
         });
     }
 
     /// A span from `start` to `end` on a track, with an optional numeric
     /// argument (`("index", 3)`).
     pub fn span(&mut self, pid: u32, tid: u32, name: &str, start: Time, end: Time, arg: Option<(&str, u64)>) {
-        self.event(&Event {
-            ph: "X",
-            pid,
-            tid: Some(tid),
-            name,
-            ts: Some(us(start)),
-            dur: Some(us(end) - us(start)),
-            s: None,
-            cat: None,
-            id: None,
-            bp: None,
-            args: arg.map(|(k, v)| Args::One([(k, v)].into_iter().collect())),
-        });
+        self.span_args(pid, tid, name, start, end, arg.as_slice());
     }
 
     /// A span with several numeric arguments (`[("frame", 3), ("draw", 12)]`).
@@ -295,11 +262,8 @@ impl TraceWriter {
             name,
             ts: Some(us(start)),
             dur: Some(us(end) - us(start)),
-            s: None,
-            cat: None,
-            id: None,
-            bp: None,
             args: (!args.is_empty()).then(|| Args::One(args.iter().copied().collect())),
+            ..Default::default()
         });
     }
 
@@ -318,12 +282,10 @@ impl TraceWriter {
             tid: Some(tid),
             name,
             ts: Some(us(at)),
-            dur: None,
-            s: None,
             cat: Some("frame"),
             id: Some(id),
             bp: (step == FlowStep::End).then_some("e"),
-            args: None,
+            ..Default::default()
         });
     }
 
@@ -335,12 +297,8 @@ impl TraceWriter {
             tid: Some(tid),
             name,
             ts: Some(us(at)),
-            dur: None,
             s: Some("t"),
-            cat: None,
-            id: None,
-            bp: None,
-            args: None,
+            ..Default::default()
         });
     }
 
@@ -349,15 +307,10 @@ impl TraceWriter {
         self.event(&Event {
             ph: "C",
             pid,
-            tid: None,
             name,
             ts: Some(us(at)),
-            dur: None,
-            s: None,
-            cat: None,
-            id: None,
-            bp: None,
             args: Some(Args::One([(series, value)].into_iter().collect())),
+            ..Default::default()
         });
     }
 

@@ -139,9 +139,6 @@ impl PipelineTrace {
     /// the CPU track, the front end's on the GPU's; `draw`: the draw on the
     /// geometry stage).
     fn state(&mut self, track: Track, state: usize, start: Time, end: Time, frame: Option<u64>, draw: Option<u32>) {
-        if self.detail == TraceDetail::Frame {
-            return;
-        }
         let names: &[&str] = match track {
             Track::Cpu => &CPU_STATES,
             Track::Front => &FRONT_STATES,
@@ -202,9 +199,6 @@ impl PipelineTrace {
     }
 
     fn fifo_levels(&mut self, now: Time, commands: u64, triangles: u64) {
-        if self.detail == TraceDetail::Frame {
-            return;
-        }
         if self.command_fifo != Some(commands) {
             self.writer.counter(PID, "command FIFO", "used", now, commands);
             self.command_fifo = Some(commands);
@@ -312,8 +306,12 @@ pub struct Accounting {
     pub path: CriticalPath,
     cpu_frame: u64,
     gpu_frame: Option<u64>,
-    /// The trace, when one is written.
+    /// The trace, when one with the units' states is written (`draw` or
+    /// `triangle` detail): every event goes through the traced path.
     pub trace: Option<PipelineTrace>,
+    /// A `frame`-detail trace: written from the records after the run
+    /// alone, so the events take the untraced path.
+    frame_trace: Option<PipelineTrace>,
     /// Traced: the geometry stage's draw as of the last accounted instant
     /// (the draw of the spans that close at the next one).
     trace_draw: Option<u32>,
@@ -336,6 +334,11 @@ macro_rules! units_of {
 pub(super) use units_of;
 
 impl Accounting {
+    /// The trace, whichever detail it has, for its end ([`PipelineTrace::end`]).
+    pub fn take_trace(&mut self) -> Option<PipelineTrace> {
+        self.trace.take().or_else(|| self.frame_trace.take())
+    }
+
     /// The CPU's frame as of the last accounted instant.
     #[inline]
     pub fn cpu_frame(&self) -> u64 {
@@ -345,6 +348,9 @@ impl Accounting {
     /// Fresh clocks (everything idle at time zero); `pacing`: the refresh
     /// period when frames are shown at vertical blanks.
     pub fn new(trace: Option<TraceWriter>, pacing: Option<Duration>) -> Self {
+        let trace = trace.map(PipelineTrace::new);
+        let per_frame = trace.as_ref().is_some_and(|t| t.detail == TraceDetail::Frame);
+        let (trace, frame_trace) = if per_frame { (None, trace) } else { (trace, None) };
         Accounting {
             cpu: StateClock::new(4),
             front: StateClock::new(1),
@@ -354,7 +360,8 @@ impl Accounting {
             path: CriticalPath::new(pacing),
             cpu_frame: 0,
             gpu_frame: None,
-            trace: trace.map(PipelineTrace::new),
+            trace,
+            frame_trace,
             trace_draw: None,
         }
     }

@@ -141,7 +141,11 @@ impl FramePipeline {
             }
         };
         let noise = noise_sources(&cfg, &streams)?;
-        let traced = trace.is_some();
+        // Only a trace of the units' states needs the events' traced paths
+        // (a `frame`-detail trace is written from the records at the end).
+        let traced = trace
+            .as_ref()
+            .is_some_and(|t| t.detail() != crate::output::trace::TraceDetail::Frame);
         let mode = cfg.display.effective_mode();
         let frames_total = cfg.run.frames;
         let body = match &scene {

@@ -125,7 +125,7 @@ pub fn run_pipeline(
     let commands = model.command_counts();
     let records = std::mem::take(&mut model.env.records);
     let generated = model.display.take_generated();
-    let trace = model.acct.trace.take().map(|t| t.end(&records, refresh));
+    let trace = model.acct.take_trace().map(|t| t.end(&records, refresh));
     Ok(PipelineRun {
         stats,
         summary,
