@@ -9,7 +9,7 @@
 //! what-if): the capture's frames on the pipeline's lanes.
 //!
 //! The picture is built from the run's own trace ([`crate::systems::frame_pipeline::accounting`]),
-//! read back while it is written ([`crate::output::trace_read`]): the CPU's
+//! kept as merged spans while the run makes it ([`crate::output::span_collector`]): the CPU's
 //! and the display's spans carry their frame; GPU work is given the frame
 //! whose GPU interval (its clear to its swap, [`crate::systems::frame_pipeline::records`]) contains
 //! it. Spans of one unit less than [`MERGE_GAP_US`] apart are merged (a
@@ -17,8 +17,8 @@
 
 use crate::config::{ModelSource, deserialize};
 use crate::engine::PS_PER_MS;
+use crate::output::span_collector::{ReadSpan, SpanCollector};
 use crate::output::trace::TraceWriter;
-use crate::output::trace_read::{ReadSpan, SpanCollector};
 use crate::plot::{Bar, Fill, Lane, Level, Timeline};
 use crate::systems::SimError;
 
@@ -216,7 +216,7 @@ pub fn timeline_of(
     let capacity = cfg.command_fifo.capacity;
     let unit = format!("{:?}", cfg.command_fifo.unit).to_lowercase();
     let collector = SpanCollector::new(MERGE_GAP_US, &["command FIFO"]);
-    let writer = TraceWriter::new(Box::new(collector.clone())).with_detail(crate::output::trace::TraceDetail::Triangle);
+    let writer = TraceWriter::collecting(collector.clone()).with_detail(crate::output::trace::TraceDetail::Triangle);
     let mut run = run_pipeline(cfg, &src.base_dir, Some(writer)).map_err(|e| SimError::of(src, e))?;
     if let Some(w) = run.trace.take() {
         w.finish()

@@ -14,8 +14,8 @@
 //! - [`table`]: per-row tables as CSV through the `csv` crate.
 //! - [`text`]: numbers in human-readable reports.
 //! - [`trace`]: Chrome/Perfetto trace JSON, streamed.
-//! - [`trace_read`]: a trace read back as it is written (merged spans per
-//!   track), for pictures.
+//! - [`span_collector`]: a trace kept in memory as merged spans per track,
+//!   for pictures.
 
 pub mod cleanup;
 pub mod error;
@@ -23,9 +23,9 @@ pub mod files;
 pub mod pipe;
 pub mod provenance;
 pub mod result_set;
+pub mod span_collector;
 pub mod table;
 pub mod text;
 pub mod trace;
-pub mod trace_read;
 
 pub use error::OutputError;

@@ -14,6 +14,10 @@
 //! leave out what is finer. Flow events ([`TraceWriter::flow`]) draw arrows
 //! between the slices of one frame on different tracks.
 //!
+//! A writer made with [`TraceWriter::collecting`] formats nothing: it hands
+//! the same events to a [`SpanCollector`], which keeps them as merged spans
+//! for a picture (the timeline).
+//!
 //! ```
 //! use rendersim_engine::Time;
 //! use rendersim_report::output::trace::TraceWriter;
@@ -31,6 +35,7 @@ use std::io::Write;
 use serde::Serialize;
 
 use crate::engine::Time;
+use crate::output::span_collector::SpanCollector;
 
 /// Microseconds (the format's unit) from picoseconds.
 fn us(t: Time) -> f64 {
@@ -125,9 +130,17 @@ pub enum FlowStep {
     End,
 }
 
+/// Where a trace goes.
+enum Target {
+    /// Trace Event Format JSON.
+    Json(Box<dyn Write + Send>),
+    /// Merged spans kept in memory, for pictures.
+    Spans(SpanCollector),
+}
+
 /// A trace being written (see the module documentation).
 pub struct TraceWriter {
-    out: Box<dyn Write + Send>,
+    out: Target,
     events: u64,
     bytes: u64,
     detail: TraceDetail,
@@ -142,19 +155,31 @@ impl std::fmt::Debug for TraceWriter {
 
 impl TraceWriter {
     /// Starts a trace on `out` (buffer it: events are written one by one).
-    pub fn new(out: Box<dyn Write + Send>) -> Self {
+    pub fn new(mut out: Box<dyn Write + Send>) -> Self {
+        let head = b"{\"displayTimeUnit\":\"ms\",\"traceEvents\":[";
+        let r = out.write_all(head);
         let mut t = TraceWriter {
-            out,
+            out: Target::Json(out),
+            events: 0,
+            bytes: head.len() as u64,
+            detail: TraceDetail::default(),
+            error: None,
+        };
+        t.keep(r);
+        t
+    }
+
+    /// A trace kept in `collector` as merged spans instead of written
+    /// ([`SpanCollector`]): what a picture of a run needs, without
+    /// formatting JSON and reading it back. [`Self::bytes`] stays 0.
+    pub fn collecting(collector: SpanCollector) -> Self {
+        TraceWriter {
+            out: Target::Spans(collector),
             events: 0,
             bytes: 0,
             detail: TraceDetail::default(),
             error: None,
-        };
-        let head = b"{\"displayTimeUnit\":\"ms\",\"traceEvents\":[";
-        t.bytes += head.len() as u64;
-        let r = t.out.write_all(head);
-        t.keep(r);
-        t
+        }
     }
 
     /// The writer at detail `d`.
@@ -185,10 +210,14 @@ impl TraceWriter {
         if self.error.is_some() {
             return;
         }
-        let mut counted = Counted {
-            out: &mut self.out,
-            bytes: 0,
+        let out = match &mut self.out {
+            Target::Json(out) => out,
+            Target::Spans(c) => {
+                self.events += 1;
+                return collect(c, e);
+            }
         };
+        let mut counted = Counted { out, bytes: 0 };
         let r = (|| {
             if self.events > 0 {
                 counted.write_all(b",")?;
@@ -322,12 +351,38 @@ impl TraceWriter {
     /// Closes the trace and flushes it; returns the number of events, or the
     /// first write error.
     pub fn finish(mut self) -> std::io::Result<u64> {
-        let r = self.out.write_all(b"]}").and_then(|()| self.out.flush());
+        let r = match &mut self.out {
+            Target::Json(out) => out.write_all(b"]}").and_then(|()| out.flush()),
+            Target::Spans(c) => {
+                c.finish();
+                Ok(())
+            }
+        };
         self.keep(r);
         match self.error.take() {
             Some(e) => Err(e),
             None => Ok(self.events),
         }
+    }
+}
+
+/// Hands one event to a collector: spans, kept counters and instants;
+/// names and flows draw nothing.
+fn collect(c: &SpanCollector, e: &Event<'_>) {
+    // The first argument in name order, as a reader of the JSON sees it.
+    let first = || match &e.args {
+        Some(Args::One(m)) => m.values().next().copied(),
+        _ => None,
+    };
+    match (e.ph, e.tid, e.ts) {
+        ("X", Some(tid), Some(ts)) => c.span(tid, e.name, ts, e.dur.unwrap_or(0.0), first()),
+        ("C", _, Some(ts)) => {
+            if let Some(v) = first() {
+                c.counter(e.name, ts, v as f64)
+            }
+        }
+        ("i", Some(tid), Some(ts)) => c.instant(tid, e.name, ts),
+        _ => {}
     }
 }
 
