@@ -11,12 +11,12 @@ fn kernel(c: &mut Criterion) {
         b.iter(|| std::hint::black_box(rendersim::bench::kernel(1_000, 1_000_000)))
     });
     g.finish();
-    let k = rendersim::bench::kernel(1_000, 10_000_000);
+    let k = rendersim::bench::kernel_case(rendersim::bench::KernelWork::Hold, 1_000, 2_000_000, 5);
     println!(
-        "hold model: engine {:.2} M events/s, bare heap {:.2} M events/s, ratio {:.3}",
-        k.engine_events_per_s / 1e6,
-        k.bare_events_per_s / 1e6,
-        k.ratio
+        "hold model, median (min-max) of 5: engine {}, bare heap {}, ratio {}",
+        k.engine_events_per_s.show(1e-6, 2, " M events/s"),
+        k.bare_events_per_s.show(1e-6, 2, " M events/s"),
+        k.ratio.show(1.0, 3, "")
     );
 }
 
@@ -24,7 +24,7 @@ fn pipeline(c: &mut Criterion) {
     let mut g = c.benchmark_group("one_frame_grid_200x200");
     g.sample_size(10);
     g.bench_function("triangle_and_draw_fidelity", |b| {
-        b.iter(|| std::hint::black_box(rendersim::bench::pipeline(200).unwrap()))
+        b.iter(|| std::hint::black_box(rendersim::bench::pipeline(200, 1).unwrap()))
     });
     g.finish();
 }

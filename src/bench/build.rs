@@ -15,6 +15,7 @@
 use std::time::Instant;
 
 use super::BenchError;
+use super::spread::{Spread, paired_ratio};
 use crate::config::{ModelSource, Overrides};
 use crate::scene::generators::mesh_from_spec;
 use crate::scene::optimize::{optimize_vertex_cache, optimize_vertex_cache_reference};
@@ -27,23 +28,31 @@ pub struct ReorderBench {
     pub spec: String,
     /// Its triangles.
     pub triangles: u64,
-    /// Repetitions (the times are medians).
+    /// Repetitions.
     pub reps: usize,
     /// Seconds of [`optimize_vertex_cache_reference`].
-    pub reference_s: f64,
+    pub reference_s: Spread,
     /// Seconds of [`optimize_vertex_cache`].
-    pub fast_s: f64,
+    pub fast_s: Spread,
+    /// Direct over fast, repetition by repetition.
+    pub speedup: Spread,
 }
 
-/// One model at one fidelity (medians of `reps` runs).
+/// One model at one fidelity, over `reps` runs.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ModelRun {
     /// Scene build seconds (`build_seconds` of the summary).
-    pub build_s: f64,
+    pub build_s: Spread,
     /// Event-loop seconds (`simulate_seconds`).
-    pub simulate_s: f64,
+    pub simulate_s: Spread,
     /// The whole run (`wall_seconds`: build and event loop).
-    pub wall_s: f64,
+    pub wall_s: Spread,
+    /// The whole runs' seconds, in order (for ratios run by run).
+    #[serde(skip)]
+    walls: Vec<f64>,
+    /// The event loops' seconds, in order.
+    #[serde(skip)]
+    simulates: Vec<f64>,
 }
 
 /// One model at both fidelities.
@@ -57,6 +66,10 @@ pub struct ModelBuildBench {
     pub triangle: ModelRun,
     /// At `draw` fidelity.
     pub draw: ModelRun,
+    /// Whole run, triangle over draw, run by run.
+    pub speedup: Spread,
+    /// Event loop, triangle over draw, run by run.
+    pub simulate_speedup: Spread,
 }
 
 /// The build benchmark's results.
@@ -75,11 +88,6 @@ const MODELS: [(&str, &str); 4] = [
     ("single-view", include_str!("../../models/single-view.toml")),
     ("h2-pass", include_str!("../../models/h2-pass.toml")),
 ];
-
-/// The upper middle of `v` ([`crate::measure::fit::median`]), NaN for none.
-fn median(v: Vec<f64>) -> f64 {
-    crate::measure::fit::median(&v).unwrap_or(f64::NAN)
-}
 
 /// Reorders `spec`'s index buffer `reps` times with each form, alternating;
 /// fails if the two forms ever differ.
@@ -105,8 +113,9 @@ pub fn reorder_case(spec: &str, reps: usize) -> Result<ReorderBench, BenchError>
         spec: spec.to_string(),
         triangles: mesh.triangles(),
         reps,
-        reference_s: median(reference),
-        fast_s: median(fast),
+        reference_s: Spread::of(&reference),
+        fast_s: Spread::of(&fast),
+        speedup: paired_ratio(&reference, &fast),
     })
 }
 
@@ -130,18 +139,20 @@ fn model_run(name: &str, text: &str, fidelity: &str, reps: usize) -> Result<Mode
         wall.push(f("wall_seconds"));
     }
     Ok(ModelRun {
-        build_s: median(build),
-        simulate_s: median(simulate),
-        wall_s: median(wall),
+        build_s: Spread::of(&build),
+        simulate_s: Spread::of(&simulate),
+        wall_s: Spread::of(&wall),
+        walls: wall,
+        simulates: simulate,
     })
 }
 
-/// The build benchmark at `scale`: at 1, nine reorderings of `grid:96x96`
-/// (the shipped models' mesh, in the row order it is built from),
-/// `grid:96x96:shuffled:1` and `grid:300x300`, and five runs of each model
-/// at each fidelity; fewer and smaller at smaller scales.
-pub fn build_bench(scale: f64) -> Result<BuildBench, BenchError> {
-    let reps = ((9.0 * scale).round() as usize).max(1);
+/// The build benchmark at `scale`: at 1, `repeats` reorderings of
+/// `grid:96x96` (the shipped models' mesh, in the row order it is built
+/// from), `grid:96x96:shuffled:1` and `grid:300x300` (a smaller grid at
+/// smaller scales), and `repeats` runs of each model at each fidelity.
+pub fn build_bench(scale: f64, repeats: usize) -> Result<BuildBench, BenchError> {
+    let reps = repeats.max(1);
     let big = ((300.0 * scale.sqrt()) as u32).max(8);
     let mut reorders = Vec::new();
     for spec in [
@@ -151,14 +162,17 @@ pub fn build_bench(scale: f64) -> Result<BuildBench, BenchError> {
     ] {
         reorders.push(reorder_case(&spec, reps)?);
     }
-    let runs = ((5.0 * scale).round() as usize).max(1);
     let mut models = Vec::new();
     for (name, text) in MODELS {
+        let triangle = model_run(name, text, "triangle", reps)?;
+        let draw = model_run(name, text, "draw", reps)?;
         models.push(ModelBuildBench {
             model: name.to_string(),
-            reps: runs,
-            triangle: model_run(name, text, "triangle", runs)?,
-            draw: model_run(name, text, "draw", runs)?,
+            reps,
+            speedup: paired_ratio(&triangle.walls, &draw.walls),
+            simulate_speedup: paired_ratio(&triangle.simulates, &draw.simulates),
+            triangle,
+            draw,
         });
     }
     Ok(BuildBench { reorders, models })

@@ -15,10 +15,11 @@ use std::fmt::Write;
 use std::time::Instant;
 
 use super::BenchError;
+use super::spread::{Spread, paired_ratio};
 use crate::capture::presentmon::Capture;
 use crate::studies::replay::{ReplayOptions, replay_capture};
 
-/// The replay benchmark's measurements (medians of `reps`).
+/// The replay benchmark's measurements over `reps` repetitions.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ReplayBench {
     /// Frames in the capture.
@@ -28,11 +29,13 @@ pub struct ReplayBench {
     /// Repetitions.
     pub reps: usize,
     /// Seconds to read the CSV alone.
-    pub read_s: f64,
+    pub read_s: Spread,
     /// Seconds to replay what was read (set-up, simulation, comparison).
-    pub replay_s: f64,
+    pub replay_s: Spread,
     /// Of those, the frame pipeline's run.
-    pub simulate_s: f64,
+    pub simulate_s: Spread,
+    /// Replaying over reading, repetition by repetition.
+    pub ratio: Spread,
     /// Displayed-or-dropped agreement of the replay (a check that the
     /// capture replays as it was generated).
     pub agreement: f64,
@@ -80,17 +83,12 @@ pub fn synthetic_capture(frames: usize) -> String {
     s
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 /// The replay benchmark at `scale`: 10,000 frames at 1 (at least 200),
-/// medians of 5 repetitions.
-pub fn replay_bench(scale: f64) -> Result<ReplayBench, BenchError> {
+/// `repeats` repetitions.
+pub fn replay_bench(scale: f64, repeats: usize) -> Result<ReplayBench, BenchError> {
     let frames = ((10_000.0 * scale) as usize).max(200);
     let text = synthetic_capture(frames);
-    let reps = 5;
+    let reps = repeats.max(1);
     let (mut read, mut whole, mut sim) = (Vec::new(), Vec::new(), Vec::new());
     let mut agreement = 0.0;
     for _ in 0..reps {
@@ -108,9 +106,10 @@ pub fn replay_bench(scale: f64) -> Result<ReplayBench, BenchError> {
         frames,
         bytes: text.len(),
         reps,
-        read_s: median(read),
-        replay_s: median(whole),
-        simulate_s: median(sim),
+        ratio: paired_ratio(&whole, &read),
+        read_s: Spread::of(&read),
+        replay_s: Spread::of(&whole),
+        simulate_s: Spread::of(&sim),
         agreement,
     })
 }
@@ -121,7 +120,8 @@ mod tests {
 
     #[test]
     fn the_synthetic_capture_replays_as_it_was_generated() {
-        let b = replay_bench(0.02).unwrap();
+        let b = replay_bench(0.02, 2).unwrap();
+        assert_eq!(b.ratio.n, 2);
         assert_eq!(b.frames, 200);
         assert!(b.agreement > 0.99, "{}", b.agreement);
         let capture = Capture::parse("bench.csv", synthetic_capture(200).as_bytes()).unwrap();

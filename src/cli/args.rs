@@ -372,9 +372,15 @@ pub struct BenchArgs {
     /// Scale the work down (0.01 .. 1) for a quick check.
     #[arg(long, default_value_t = 1.0)]
     pub scale: f64,
+    /// Repeats of every measurement (1 .. 1000): each line prints the
+    /// median and, in brackets, the minimum and maximum. The kernel splits
+    /// its events into this many slices; the others run whole again.
+    #[arg(long, default_value_t = 5, value_name = "N")]
+    pub repeats: usize,
     /// With `kernel`: also draw ns per event against the number pending
     /// (1e3 .. 1e6, log axes) for the engine and the bare heap, hold and
-    /// stiff, into FILE (.png; an .svg beside it).
+    /// stiff, into FILE (.png; an .svg beside it), from the measurements
+    /// the lines print (medians, bars from minimum to maximum).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
 }

@@ -541,27 +541,29 @@ pub fn bench(args: BenchArgs) -> Result<()> {
     if args.plot.is_some() && args.which != BenchTarget::Kernel {
         bail!("--plot draws the kernel benchmark: use `rendersim bench kernel --plot FILE.png`");
     }
-    let scale = args.scale;
+    let (scale, n) = (args.scale, args.repeats);
     bench::check_scale(scale)?;
+    bench::check_repeats(n)?;
     for b in Vec::<Bench>::from(args.which) {
         match b {
-            Bench::Pixelflow => say!("{}", print::pixelflow_bench(&bench::pixelflow_bench(scale)?)),
+            Bench::Pixelflow => say!("{}", print::pixelflow_bench(&bench::pixelflow_bench(scale, n)?)),
             Bench::Kernel => {
+                let mut cases = Vec::new();
                 for (work, pop) in KERNEL_CASES {
-                    let k = bench::kernel_case(work, pop, bench::kernel_events(pop, scale));
+                    let k = bench::kernel_case(work, pop, bench::kernel_events(pop, scale, n), n);
                     say!("{}", print::kernel_bench(&k));
+                    cases.push(k);
+                }
+                if let Some(path) = &args.plot {
+                    bench::plot_kernel(&cases, path)?;
+                    say!("kernel scaling plot (the lines above): {}", path.display());
                 }
             }
-            Bench::Pipeline => say!("{}", print::pipeline_bench(&bench::pipeline_bench(scale)?)),
-            Bench::Hour => say!("{}", print::hour_bench(&bench::hour_bench(scale)?)),
-            Bench::Build => say!("{}", print::build_bench(&bench::build::build_bench(scale)?)),
-            Bench::Replay => say!("{}", print::replay_bench(&bench::replay::replay_bench(scale)?)),
+            Bench::Pipeline => say!("{}", print::pipeline_bench(&bench::pipeline_bench(scale, n)?)),
+            Bench::Hour => say!("{}", print::hour_bench(&bench::hour_bench(scale, n)?)),
+            Bench::Build => say!("{}", print::build_bench(&bench::build::build_bench(scale, n)?)),
+            Bench::Replay => say!("{}", print::replay_bench(&bench::replay::replay_bench(scale, n)?)),
         }
-    }
-    if let Some(path) = args.plot {
-        let cases = bench::kernel_scaling(scale);
-        bench::plot_kernel(&cases, &path)?;
-        say!("kernel scaling plot: {}", path.display());
     }
     Ok(())
 }

@@ -120,26 +120,34 @@ proptest! {
 
 #[test]
 fn the_build_benchmark_checks_both_forms_and_times_every_model() {
-    // At a small scale: one repetition each; the benchmark fails if the two
+    // At a small scale, two repetitions each; the benchmark fails if the two
     // forms ever return different buffers.
-    let b = rendersim::bench::build::build_bench(0.01).expect("the build benchmark");
+    let b = rendersim::bench::build::build_bench(0.01, 2).expect("the build benchmark");
     let specs: Vec<&str> = b.reorders.iter().map(|r| r.spec.as_str()).collect();
     assert_eq!(specs, ["grid:96x96", "grid:96x96:shuffled:1", "grid:30x30"]);
     assert!(
         b.reorders
             .iter()
-            .all(|r| r.triangles > 0 && r.reference_s > 0.0 && r.fast_s > 0.0)
+            .all(|r| r.triangles > 0 && r.reference_s.min > 0.0 && r.fast_s.min > 0.0 && r.speedup.n == 2)
     );
     let models: Vec<&str> = b.models.iter().map(|m| m.model.as_str()).collect();
     assert_eq!(models, ["default", "one-mesh", "single-view", "h2-pass"]);
     for m in &b.models {
-        // One repetition, so the medians are that run's: the whole run is
-        // its build plus its event loop.
-        assert_eq!(m.reps, 1);
+        // Each run's whole is its build plus its event loop, so the
+        // smallest whole is at least the smallest build plus the smallest loop.
+        assert_eq!(m.reps, 2);
         for run in [&m.triangle, &m.draw] {
-            assert!(run.build_s > 0.0 && run.simulate_s > 0.0, "{}: {run:?}", m.model);
-            assert!((run.wall_s - (run.build_s + run.simulate_s)).abs() <= 1e-9 * run.wall_s.max(1.0));
+            assert!(
+                run.build_s.min > 0.0 && run.simulate_s.min > 0.0,
+                "{}: {run:?}",
+                m.model
+            );
+            assert_eq!(run.wall_s.n, 2);
+            assert!(run.wall_s.min >= (run.build_s.min + run.simulate_s.min) * (1.0 - 1e-9));
+            assert!(run.wall_s.max <= (run.build_s.max + run.simulate_s.max) * (1.0 + 1e-9));
         }
+        let ratio = m.speedup.median;
+        assert!(ratio > 1.0, "{}: draw fidelity is faster: {ratio}", m.model);
     }
 }
 
@@ -155,4 +163,39 @@ fn an_unknown_benchmark_names_build_among_the_choices() {
         err.contains("unknown benchmark \"nosuch\"") && err.contains("build"),
         "{err}"
     );
+}
+
+#[test]
+fn every_benchmark_line_carries_its_repeats_spread_and_bad_repeats_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let plot = d.path().join("kernel.png");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+        .args(["bench", "kernel", "--scale", "0.0001", "--repeats", "2", "--plot"])
+        .arg(&plot)
+        .output()
+        .expect("rendersim runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("kernel hold") || l.starts_with("kernel stiff"))
+        .collect();
+    assert_eq!(lines.len(), rendersim::bench::KERNEL_CASES.len(), "{text}");
+    for l in &lines {
+        assert!(l.contains("median (min-max) of 2"), "{l}");
+        // Every figure of the line: a median and its range in brackets.
+        assert_eq!(l.matches(" M events/s (").count(), 3, "{l}");
+        assert!(l.contains(" ns/event (") && l.contains("engine / bare "), "{l}");
+    }
+    assert!(text.contains("kernel scaling plot (the lines above)"), "{text}");
+    assert!(std::fs::metadata(&plot).unwrap().len() > 1000);
+    for bad in ["0", "1001", "x"] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+            .args(["bench", "hour", "--repeats", bad])
+            .output()
+            .expect("rendersim runs");
+        assert_eq!(out.status.code(), Some(2), "--repeats {bad}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("--repeats"), "{bad}: {err}");
+    }
 }
