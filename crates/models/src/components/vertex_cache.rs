@@ -14,6 +14,7 @@ use std::collections::HashMap;
 
 use serde::{Deserialize, Serialize};
 
+pub mod analyzer;
 mod policy;
 
 pub use policy::{CachePolicy, CachePolicyError, NVIDIA_LOOKBACK};
@@ -25,64 +26,19 @@ const DENSE_LIMIT: usize = 1 << 24;
 /// Fast path for whole triangle lists: meshoptimizer's analyzer loop (FIFO
 /// of `cache` entries, warps of `warp` vertices, groups of `primgroup`
 /// triangles; `fifo:N` is `(N, 0, 0)`), on a dense stamp array of
-/// `vertex_count` entries. Calls `charge(misses)` per triangle; returns
-/// (transformed, warps, unique vertices), or `None` as soon as an index is
-/// not below `vertex_count` (the caller then discards what was charged).
+/// `vertex_count` entries ([`analyzer::analyze`]). Calls `charge(misses)`
+/// per triangle; returns (transformed, warps, unique vertices), or `None` as
+/// soon as an index is not below `vertex_count` (the caller then discards
+/// what was charged).
 pub fn analyze_triangle_list(
     indices: &[u32],
     vertex_count: usize,
     cache: u32,
     warp: u32,
     primgroup: u32,
-    mut charge: impl FnMut(u8),
+    charge: impl FnMut(u8),
 ) -> Option<(u64, u64, u64)> {
-    let mut stamps = vec![0u32; vertex_count];
-    let mut timestamp: u32 = cache.wrapping_add(1);
-    let (mut warp_offset, mut prim_offset, mut warps, mut transformed) = (0u32, 0u32, 0u64, 0u64);
-    for t in indices.chunks_exact(3) {
-        let (sa, sb, sc) = (
-            *stamps.get(t[0] as usize)?,
-            *stamps.get(t[1] as usize)?,
-            *stamps.get(t[2] as usize)?,
-        );
-        let m = u32::from(timestamp.wrapping_sub(sa) > cache)
-            + u32::from(timestamp.wrapping_sub(sb) > cache)
-            + u32::from(timestamp.wrapping_sub(sc) > cache);
-        if (primgroup != 0 && prim_offset == primgroup) || (warp != 0 && warp_offset + m > warp) {
-            warps += u64::from(warp_offset > 0);
-            warp_offset = 0;
-            prim_offset = 0;
-            timestamp = timestamp.wrapping_add(cache.wrapping_add(1));
-        }
-        let mut k = 0u8;
-        for &v in t {
-            // In bounds: checked above.
-            let s = &mut stamps[v as usize];
-            if timestamp.wrapping_sub(*s) > cache {
-                *s = timestamp;
-                timestamp = timestamp.wrapping_add(1);
-                k += 1;
-            }
-        }
-        warp_offset += u32::from(k);
-        prim_offset += 1;
-        transformed += u64::from(k);
-        charge(k);
-    }
-    warps += u64::from(warp_offset > 0);
-    // A stamp stays non-zero after its vertex's first insertion unless the
-    // 32-bit clock wrapped (more than about 4e9 / cache triangles).
-    let ticks = transformed + u64::from(cache) * (warps + 1);
-    let unique = if ticks < u64::from(u32::MAX) {
-        stamps.iter().filter(|&&s| s != 0).count() as u64
-    } else {
-        let mut seen = vec![false; vertex_count];
-        indices
-            .iter()
-            .filter(|&&i| !std::mem::replace(&mut seen[i as usize], true))
-            .count() as u64
-    };
-    Some((transformed, warps, unique))
+    analyzer::analyze(indices, vertex_count, cache, warp, primgroup, charge)
 }
 
 /// A simulated post-transform vertex cache.

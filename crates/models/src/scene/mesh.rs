@@ -330,23 +330,28 @@ impl Mesh {
         out
     }
 
-    /// The dense fast path (`analyze_triangle_list`) for triangle lists
-    /// under FIFO, `meshopt:` and `batch:` policies, when every index is
-    /// below `vertex_count`; `None` otherwise.
-    fn fast_list(&self, policy: &CachePolicy, charge: impl FnMut(u8)) -> Option<(u64, u64, u64)> {
+    /// The policy as meshoptimizer's analyser parameters `(cache, warp,
+    /// primgroup)` and the stamp array's length, when the dense fast path
+    /// applies: a whole triangle list under a FIFO, `meshopt:` or `batch:`
+    /// policy.
+    fn fast_params(&self, policy: &CachePolicy) -> Option<((u32, u32, u32), usize)> {
         if self.topology != Topology::TriangleList || !self.indices.len().is_multiple_of(3) {
             return None;
         }
-        let (c, w, p) = match *policy {
+        let params = match *policy {
             CachePolicy::Fifo(n) if n >= 3 => (n, 0, 0),
             CachePolicy::Meshopt { cache, warp, primgroup } => (cache, warp, primgroup),
             CachePolicy::Batch { vertices, triangles } => (vertices, vertices, triangles),
             _ => return None,
         };
         let n = self.vertex_count as usize;
-        if n > 1 << 28 {
-            return None;
-        }
+        (n <= 1 << 28).then_some((params, n))
+    }
+
+    /// The dense fast path (`analyze_triangle_list`) when it applies and
+    /// every index is below `vertex_count`; `None` otherwise.
+    fn fast_list(&self, policy: &CachePolicy, charge: impl FnMut(u8)) -> Option<(u64, u64, u64)> {
+        let ((c, w, p), n) = self.fast_params(policy)?;
         crate::components::vertex_cache::analyze_triangle_list(&self.indices, n, c, w, p, charge)
     }
 

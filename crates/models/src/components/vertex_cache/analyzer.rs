@@ -1,0 +1,282 @@
+//! meshoptimizer's vertex-cache analyser (`meshopt_analyzeVertexCache`) on
+//! whole triangle lists: the same counts, exactly, computed faster (issue 30
+//! item 3).
+//!
+//! The model (paper 000 section 4.5's FIFO, with the warps and primitive
+//! groups of meshoptimizer's GPU model): every vertex carries the clock
+//! value of its last insertion; a vertex is in the cache while the clock
+//! has moved at most `cache` ticks since; each miss ticks the clock once; a
+//! triangle that would take its warp past `warp` vertices, or that starts a
+//! new group of `primgroup` triangles, first flushes the cache (the clock
+//! jumps by `cache + 1`, so every stamp is stale).
+//!
+//! The loop is arranged for speed without changing a count: the warp and
+//! group tests are compiled only into the variants whose policy has them
+//! ([`run_span`]'s `WARP` and `PRIM`), and the warp test reads the
+//! triangle's three stamps only when the warp has fewer than three free
+//! slots (only then can a triangle of at most three misses overflow it).
+//! `cargo bench --bench vcache` compares it with meshoptimizer's C++ in the
+//! same process; `docs/models.md` has the figures.
+//!
+//! Tried and dropped (slower here, kept out): hit and miss as arithmetic
+//! instead of a branch (every index then stores its stamp, and the next
+//! triangle's loads wait on those stores), checking the whole index buffer
+//! in a first pass, a stamp buffer kept between calls, and splitting the
+//! list across threads with a catch-up at each part's start (the warp and
+//! group policies never fall into step with the true state, so the
+//! catch-up ran whole parts again).
+
+/// The analyser's policy: FIFO of `cache` entries, warps of `warp` vertices
+/// (0: none), groups of `primgroup` triangles (0: none).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Policy {
+    cache: u32,
+    warp: u32,
+    primgroup: u32,
+}
+
+/// The analyser's state beside the stamps: the clock and the fill of the
+/// current warp and group.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Clock {
+    timestamp: u32,
+    warp_offset: u32,
+    prim_offset: u32,
+}
+
+impl Clock {
+    fn start(p: &Policy) -> Self {
+        Clock {
+            timestamp: p.cache.wrapping_add(1),
+            warp_offset: 0,
+            prim_offset: 0,
+        }
+    }
+}
+
+/// Counts of a span of triangles: vertices transformed, warps closed (the
+/// last, open warp is counted once, at the end of the whole list) and
+/// flushes (each moves the clock by `cache + 1`).
+#[derive(Debug, Clone, Copy, Default)]
+struct Counts {
+    transformed: u64,
+    warps: u64,
+    flushes: u64,
+}
+
+impl Counts {
+    /// The most a clock can have moved over these counts, from its start.
+    fn ticks(&self, p: &Policy) -> u64 {
+        (u64::from(p.cache) + 1) * (self.flushes + 1) + self.transformed
+    }
+}
+
+/// An index at or past the stamp array.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct OutOfRange;
+
+/// Whether a vertex with this stamp misses at this clock.
+#[inline(always)]
+fn stale(p: &Policy, clock: &Clock, stamp: u32) -> bool {
+    clock.timestamp.wrapping_sub(stamp) > p.cache
+}
+
+/// Flushes before triangle `t` if its group is full or it would overflow
+/// its warp (meshoptimizer's test, in that order).
+#[inline(always)]
+fn flush_before<const WARP: bool, const PRIM: bool>(
+    p: &Policy,
+    clock: &mut Clock,
+    stamps: &[u32],
+    t: &[u32; 3],
+    counts: &mut Counts,
+) -> Result<bool, OutOfRange> {
+    if !(WARP || PRIM) {
+        return Ok(false);
+    }
+    let full_group = PRIM && clock.prim_offset == p.primgroup;
+    // At most three misses: only a warp with fewer than three free slots
+    // can overflow, so only then are the stamps read.
+    let over_warp = WARP && !full_group && clock.warp_offset + 3 > p.warp && {
+        let mut m = 0;
+        for &v in t {
+            m += u32::from(stale(p, clock, *stamps.get(v as usize).ok_or(OutOfRange)?));
+        }
+        clock.warp_offset + m > p.warp
+    };
+    if full_group || over_warp {
+        counts.warps += u64::from(clock.warp_offset > 0);
+        counts.flushes += 1;
+        clock.warp_offset = 0;
+        clock.prim_offset = 0;
+        clock.timestamp = clock.timestamp.wrapping_add(p.cache.wrapping_add(1));
+        return Ok(true);
+    }
+    Ok(false)
+}
+
+/// The analyser's loop over `tris` from `clock`, charging each triangle's
+/// misses.
+#[inline(always)]
+fn run_span<const WARP: bool, const PRIM: bool>(
+    p: &Policy,
+    clock: &mut Clock,
+    stamps: &mut [u32],
+    tris: &[[u32; 3]],
+    mut charge: impl FnMut(u8),
+) -> Result<Counts, OutOfRange> {
+    let mut counts = Counts::default();
+    for t in tris {
+        flush_before::<WARP, PRIM>(p, clock, stamps, t, &mut counts)?;
+        let mut k = 0u32;
+        for &v in t {
+            let s = stamps.get_mut(v as usize).ok_or(OutOfRange)?;
+            if clock.timestamp.wrapping_sub(*s) > p.cache {
+                *s = clock.timestamp;
+                clock.timestamp = clock.timestamp.wrapping_add(1);
+                k += 1;
+            }
+        }
+        clock.warp_offset = clock.warp_offset.wrapping_add(k);
+        if PRIM {
+            clock.prim_offset += 1;
+        }
+        counts.transformed += u64::from(k);
+        charge(k as u8);
+    }
+    Ok(counts)
+}
+
+/// [`run_span`] in the variant `p` needs.
+fn run_any(
+    p: &Policy,
+    clock: &mut Clock,
+    stamps: &mut [u32],
+    tris: &[[u32; 3]],
+    charge: impl FnMut(u8),
+) -> Result<Counts, OutOfRange> {
+    match (p.warp != 0, p.primgroup != 0) {
+        (false, false) => run_span::<false, false>(p, clock, stamps, tris, charge),
+        (true, false) => run_span::<true, false>(p, clock, stamps, tris, charge),
+        (false, true) => run_span::<false, true>(p, clock, stamps, tris, charge),
+        (true, true) => run_span::<true, true>(p, clock, stamps, tris, charge),
+    }
+}
+
+/// Unique vertices of `indices` without stamps (when a 32-bit clock may
+/// have wrapped to zero).
+fn count_seen(indices: &[u32], vertex_count: usize) -> u64 {
+    let mut seen = vec![false; vertex_count];
+    indices
+        .iter()
+        .filter(|&&i| !std::mem::replace(&mut seen[i as usize], true))
+        .count() as u64
+}
+
+/// meshoptimizer's analyser on a whole triangle list (`indices.len()` a
+/// multiple of 3; see [`crate::components::vertex_cache::analyze_triangle_list`]), one thread,
+/// charging each triangle's misses. Returns (transformed, warps, unique
+/// vertices), or `None` as soon as an index is not below `vertex_count`
+/// (what was charged is then to be discarded).
+pub fn analyze(
+    indices: &[u32],
+    vertex_count: usize,
+    cache: u32,
+    warp: u32,
+    primgroup: u32,
+    charge: impl FnMut(u8),
+) -> Option<(u64, u64, u64)> {
+    let p = Policy { cache, warp, primgroup };
+    let (tris, _) = indices.as_chunks::<3>();
+    let mut stamps = vec![0u32; vertex_count];
+    let mut clock = Clock::start(&p);
+    let counts = run_any(&p, &mut clock, &mut stamps, tris, charge).ok()?;
+    let warps = counts.warps + u64::from(clock.warp_offset > 0);
+    // A stamp stays non-zero after its vertex's first insertion unless the
+    // clock wrapped to zero (about 4e9 / cache triangles would be needed).
+    let unique = if counts.ticks(&p) < u64::from(u32::MAX) {
+        stamps.iter().filter(|&&s| s != 0).count() as u64
+    } else {
+        count_seen(indices, vertex_count)
+    };
+    Some((counts.transformed, warps, unique))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// meshoptimizer's loop as written in its C++ (`indexanalyzer.cpp`):
+    /// the oracle.
+    fn meshopt_loop(indices: &[u32], n: usize, cache: u32, warp: u32, primgroup: u32) -> (u64, u64, u64) {
+        let mut stamps = vec![0u32; n];
+        let mut ts = cache.wrapping_add(1);
+        let (mut wo, mut po, mut warps, mut transformed) = (0u32, 0u32, 0u64, 0u64);
+        for t in indices.chunks_exact(3) {
+            let m: u32 = t
+                .iter()
+                .map(|&v| u32::from(ts.wrapping_sub(stamps[v as usize]) > cache))
+                .sum();
+            if (primgroup != 0 && po == primgroup) || (warp != 0 && wo + m > warp) {
+                warps += u64::from(wo > 0);
+                wo = 0;
+                po = 0;
+                ts = ts.wrapping_add(cache + 1);
+            }
+            for &v in t {
+                if ts.wrapping_sub(stamps[v as usize]) > cache {
+                    stamps[v as usize] = ts;
+                    ts = ts.wrapping_add(1);
+                    transformed += 1;
+                    wo += 1;
+                }
+            }
+            po += 1;
+        }
+        warps += u64::from(wo > 0);
+        (transformed, warps, stamps.iter().filter(|&&s| s != 0).count() as u64)
+    }
+
+    /// Triangle lists over `n` vertices, with repeated and degenerate
+    /// triangles and runs of neighbours (so caches hit).
+    fn list() -> impl Strategy<Value = (Vec<u32>, usize)> {
+        (3usize..300).prop_flat_map(|n| {
+            let tri = prop_oneof![
+                3 => (0..n as u32).prop_map(move |a| vec![a, a.saturating_add(1) % n as u32, a.saturating_add(2) % n as u32]),
+                2 => prop::collection::vec(0..n as u32, 3),
+                1 => (0..n as u32).prop_map(|a| vec![a, a, a]),
+            ];
+            (prop::collection::vec(tri, 0..400).prop_map(|v| v.concat()), Just(n))
+        })
+    }
+
+    fn policy() -> impl Strategy<Value = (u32, u32, u32)> {
+        (
+            3u32..40,
+            prop_oneof![Just(0u32), 3u32..70],
+            prop_oneof![Just(0u32), 1u32..130],
+        )
+    }
+
+    proptest! {
+        #[test]
+        fn the_analyser_counts_what_meshoptimizer_counts((idx, n) in list(), (c, w, p) in policy()) {
+            let oracle = meshopt_loop(&idx, n, c, w, p);
+            let mut charged = 0u64;
+            prop_assert_eq!(analyze(&idx, n, c, w, p, |k| charged += u64::from(k)), Some(oracle));
+            prop_assert_eq!(charged, oracle.0);
+        }
+    }
+
+    #[test]
+    fn an_index_past_the_vertices_is_refused() {
+        let mut idx: Vec<u32> = (0..3000u32).map(|i| i % 90).collect();
+        assert_eq!(
+            analyze(&idx, 90, 16, 0, 0, |_| {}),
+            Some(meshopt_loop(&idx, 90, 16, 0, 0))
+        );
+        idx[2500] = 90;
+        assert_eq!(analyze(&idx, 90, 16, 0, 0, |_| {}), None);
+    }
+}
