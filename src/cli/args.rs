@@ -261,6 +261,12 @@ pub struct CalibrateArgs {
     /// Also predict each row from a fit to the others (leave-one-out) and report it.
     #[arg(long)]
     pub loo: bool,
+    /// Also cross-validate by mesh: the distinct meshes dealt into K folds
+    /// (name order, round-robin), each fold's passes predicted by a fit to
+    /// the others, so every prediction is of a mesh the fit has not seen
+    /// (at least 2; fewer folds when there are fewer meshes).
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u32).range(2..=1000))]
+    pub kfold: Option<u32>,
     /// Also fit on a fixed pseudo-random half of the rows and report the
     /// errors of predicting the other half.
     #[arg(long)]

@@ -10,8 +10,8 @@ use anyhow::{Context, Result};
 use serde_json::json;
 
 use rendersim::measure::calibrate::{
-    CalibrateError, Fit, Invocations, LoadCache, error_summary, fit, held_out_half, leave_one_out, leave_one_out_ns,
-    linear_baseline_loo, read_rows_with_origins, row_load,
+    CalibrateError, Fit, Invocations, LoadCache, MeshFolds, error_summary, fit, held_out_half, k_fold_by_mesh,
+    leave_one_out, leave_one_out_ns, linear_baseline_loo, read_rows_with_origins, row_load,
 };
 use rendersim::measure::device_predict::{DevicePass, predict_on_device};
 use rendersim::measure::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy, ProfileError};
@@ -82,6 +82,12 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     } else {
         None
     };
+    let meshes: Vec<&str> = rows.iter().map(|r| r.mesh.as_str()).collect();
+    let kfold = match args.kfold {
+        Some(k) => Some(k_fold_by_mesh(&fit_loads, &predict_loads, &y, &meshes, k as usize).map_err(of_inputs)?),
+        None => None,
+    };
+    let kfold_summary = kfold.as_ref().map(|k| error_summary(&k.errors));
     let half = if args.holdout {
         let e = held_out_half(&fit_loads, &predict_loads, &y).map_err(of_inputs)?;
         Some((error_summary(&e), e.len()))
@@ -110,6 +116,8 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
             worst_pct: worst,
             loo_median_pct: loo_summary.map(|s| s.0.0),
             loo_p90_pct: loo_summary.map(|s| s.0.1),
+            kfold_median_pct: kfold_summary.map(|s| s.0),
+            kfold_p90_pct: kfold_summary.map(|s| s.1),
         },
     };
     // What is written must read back: the checks `predict` applies to a
@@ -133,6 +141,12 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     if let Some(((m, p, w), (bm, bp, _))) = loo_summary {
         header.push(format!(
             "Leave-one-out (each row predicted by a fit to the others, vertex invocations from the cache policy): median {m:.1}%, 90th percentile {p:.1}%, worst {w:.1}%; a plain linear fit: median {bm:.1}%, 90th percentile {bp:.1}%."
+        ));
+    }
+    if let (Some((m, p, w)), Some(k)) = (kfold_summary, &kfold) {
+        header.push(format!(
+            "K-fold by mesh ({} folds over {} meshes, each fold's meshes held out whole): median {m:.1}%, 90th percentile {p:.1}%, worst {w:.1}%.",
+            k.folds, k.meshes
         ));
     }
     header.push("Cost formula and keys: docs/models.md (Device profiles). Regenerate with the command in docs/measurements/README.md.".into());
@@ -160,13 +174,15 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
             .map(|(i, ((r, p), e))| {
                 json!({"mesh": r.mesh, "size": format!("{}x{}", r.size.width, r.size.height), "vs_loops": r.vs_loops,
                 "fs_loops": r.fs_loops, "geometry_only": r.geometry_only, "measured_ns": r.pass_time_ns,
-                "fitted_ns": p, "error_pct": e, "loo_error_pct": loo.as_ref().map(|l| l.0[i])})
+                "fitted_ns": p, "error_pct": e, "loo_error_pct": loo.as_ref().map(|l| l.0[i]),
+                "kfold_error_pct": kfold.as_ref().map(|k| k.errors[i])})
             })
             .collect();
         let v = json!({"profile": profile, "out": args.out, "fit_seconds": fit_seconds,
             "loo_seconds": loo.as_ref().map(|l| l.2),
             "linear_baseline_loo": loo_summary.map(|s| json!({"median_pct": s.1.0, "p90_pct": s.1.1, "worst_pct": s.1.2})),
             "held_out_half": half.map(|((m, p, w), n)| json!({"rows": n, "median_pct": m, "p90_pct": p, "worst_pct": w})),
+            "kfold_by_mesh": kfold.as_ref().zip(kfold_summary).map(|(k, (m, p, w))| json!({"folds": k.folds, "meshes": k.meshes, "median_pct": m, "p90_pct": p, "worst_pct": w})),
             "rows": rows_json});
         say!("{}", serde_json::to_string_pretty(&v)?);
         return check_holdout(args, half.map(|h| h.0.0));
@@ -181,6 +197,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         summary: (median, p90, worst),
         loo: loo.as_ref(),
         loo_summary,
+        kfold: kfold.as_ref().zip(kfold_summary),
         half,
     };
     print!("{}", calibration_text(&calibration, &args.out)?);
@@ -204,6 +221,8 @@ struct Calibration<'a> {
     loo: Option<&'a (Vec<f64>, Vec<f64>, f64)>,
     /// Leave-one-out's errors and the linear baseline's.
     loo_summary: Option<(ErrorSummary, ErrorSummary)>,
+    /// K-fold by mesh and its summary.
+    kfold: Option<(&'a MeshFolds, ErrorSummary)>,
     /// The held-out half's summary and its row count.
     half: Option<(ErrorSummary, usize)>,
 }
@@ -272,6 +291,13 @@ fn calibration_text(c: &Calibration, out: &std::path::Path) -> Result<String, st
         writeln!(
             s,
             "linear baseline leave-one-out: median {bm:.1}%, p90 {bp:.1}%, worst {bw:.1}%"
+        )?;
+    }
+    if let Some((k, (m, p, w))) = c.kfold {
+        writeln!(
+            s,
+            "k-fold by mesh ({} folds over {} meshes, each fold's meshes held out whole) |error|: median {m:.1}%, p90 {p:.1}%, worst {w:.1}%",
+            k.folds, k.meshes
         )?;
     }
     if let Some(((m, p, w), n)) = c.half {

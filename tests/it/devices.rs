@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use rendersim::measure::calibrate::{
-    Invocations, LoadCache, PassRow, error_summary, fit, held_out_half, leave_one_out, linear_baseline_loo, read_rows,
-    row_load,
+    Invocations, LoadCache, PassRow, error_summary, fit, held_out_half, k_fold_by_mesh, leave_one_out,
+    linear_baseline_loo, mesh_folds, read_rows, row_load,
 };
 use rendersim::measure::device_profile::{DeviceCosts, DeviceProfile};
 
@@ -73,6 +73,14 @@ fn calibrate_recovers_known_costs_from_synthetic_passes() {
             }
         }
     }
+    // With whole meshes held out, each fold is predicted exactly too.
+    let meshes: Vec<&str> = ["grid:16x16", "grid:48x48", "grid:32x32:shuffled:3", "strip:24x24"]
+        .into_iter()
+        .flat_map(|m| std::iter::repeat_n(m, 18))
+        .collect();
+    let k = k_fold_by_mesh(&loads, &loads, &y, &meshes, 4).unwrap();
+    assert_eq!((k.folds, k.meshes, k.errors.len()), (4, 4, y.len()));
+    assert!(k.errors.iter().all(|e| e.abs() < 1.0), "{:?}", k.errors);
     // Fitted on half the passes, the other half is predicted exactly too.
     let half = held_out_half(&loads, &loads, &y).unwrap();
     assert!(
@@ -121,6 +129,19 @@ fn h200_leave_one_out_meets_the_goal_and_beats_the_linear_baseline() {
     // linear baseline's leave-one-out errors.
     let (hm, hp90, _) = error_summary(&held_out_half(&fit_loads, &pred_loads, &y).unwrap());
     eprintln!("H200 held-out half: median {hm:.1}% p90 {hp90:.1}%");
+    // Whole meshes held out (what a new user's pass is): every row gets a
+    // prediction, and the meshes' folds are disjoint.
+    let meshes: Vec<&str> = rows.iter().map(|r| r.mesh.as_str()).collect();
+    let k = k_fold_by_mesh(&fit_loads, &pred_loads, &y, &meshes, 6).unwrap();
+    let (km, kp90, kw) = error_summary(&k.errors);
+    eprintln!("H200 6-fold by mesh: median {km:.1}% p90 {kp90:.1}% worst {kw:.1}%");
+    assert!(k.errors.iter().all(|e| e.is_finite()));
+    let (_, fold) = mesh_folds(&meshes, 6);
+    for (i, a) in meshes.iter().enumerate() {
+        for (j, b) in meshes.iter().enumerate() {
+            assert_eq!(a == b, a == b && fold[i] == fold[j], "{a} {b}");
+        }
+    }
     assert!(
         hm < bm && hp90 < bp90,
         "held-out half {hm}/{hp90} vs linear {bm}/{bp90}"
@@ -137,6 +158,8 @@ fn calibrate_and_predict_through_the_command_line() {
             "calibrate",
             h200("load-grid.csv").to_str().unwrap(),
             h200("load-sweep.csv").to_str().unwrap(),
+            "--kfold",
+            "5",
             "--out",
         ])
         .arg(&out)
@@ -146,6 +169,10 @@ fn calibrate_and_predict_through_the_command_line() {
         .unwrap();
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{stdout}{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        stdout.contains("k-fold by mesh (5 folds over 6 meshes, each fold's meshes held out whole) |error|: median"),
+        "{stdout}"
+    );
     assert!(
         stdout.contains("lane_per_loop_ns") && stdout.contains("median"),
         "{stdout}"
@@ -157,6 +184,12 @@ fn calibrate_and_predict_through_the_command_line() {
     );
     let profile = DeviceProfile::read(&out).unwrap();
     assert_eq!(profile.fit.rows, 95);
+    assert!(text.contains("# K-fold by mesh (5 folds over 6 meshes"), "{text}");
+    let (km, kp) = (
+        profile.fit.kfold_median_pct.unwrap(),
+        profile.fit.kfold_p90_pct.unwrap(),
+    );
+    assert!(km.is_finite() && kp >= km, "{km} {kp}");
     // The report: one table row per pass (simulated by `predict`'s model),
     // then the summary with measuring against simulating time.
     let md = std::fs::read_to_string(&report).unwrap();
@@ -228,4 +261,41 @@ fn calibrate_and_predict_through_the_command_line() {
         d.path().join("x.toml").to_str().unwrap(),
     ]);
     assert!(e.contains("rows.csv: line 1") && e.contains("header"), "{e}");
+}
+
+#[test]
+fn k_fold_by_mesh_needs_two_meshes_and_a_sensible_k() {
+    let d = tempfile::tempdir().unwrap();
+    let one_mesh = d.path().join("one.csv");
+    let grid = std::fs::read_to_string(h200("load-grid.csv")).unwrap();
+    let mut text = String::new();
+    for (i, line) in grid.lines().enumerate() {
+        if i == 0 || line.starts_with("grid:96x96:optimized,") {
+            text.push_str(line);
+            text.push('\n');
+        }
+    }
+    std::fs::write(&one_mesh, text).unwrap();
+    let o = bin()
+        .args(["calibrate", one_mesh.to_str().unwrap(), "--kfold", "3", "--out"])
+        .arg(d.path().join("p.toml"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("at least 2 distinct meshes; these have 1"), "{err}");
+    let o = bin()
+        .args([
+            "calibrate",
+            h200("load-grid.csv").to_str().unwrap(),
+            "--kfold",
+            "1",
+            "--out",
+        ])
+        .arg(d.path().join("p.toml"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("--kfold"), "{err}");
 }

@@ -41,6 +41,9 @@ pub enum CalibrateError {
     /// Not enough rows to fit the costs.
     #[error("{0} rows are too few to fit a device profile (at least {MIN_ROWS})")]
     TooFewRows(usize),
+    /// Cross-validation by mesh needs two meshes at least.
+    #[error("cross-validation by mesh needs passes of at least 2 distinct meshes; these have {0}")]
+    TooFewMeshes(usize),
     /// The fit gave a number that is not finite (no profile is made of it).
     #[error("the fit of {rows} rows gives {what} = {value}, not a finite number; no profile is written")]
     NotFinite {
@@ -553,6 +556,75 @@ pub fn held_out_half(
         .filter(|(i, _)| !in_fitted_half(*i))
         .map(|(_, (l, t))| rel_error_pct(f.costs.cost(l).pass_ns, *t))
         .collect())
+}
+
+/// Cross-validation by mesh: what a new user's pass is, a mesh the fit
+/// has not seen.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshFolds {
+    /// Folds (at most the number of distinct meshes).
+    pub folds: usize,
+    /// Distinct meshes.
+    pub meshes: usize,
+    /// Each row's relative error (percent) when predicted by a fit to the
+    /// rows of the other folds, in row order.
+    pub errors: Vec<f64>,
+}
+
+/// The fold of each row for [`k_fold_by_mesh`]: the distinct meshes in
+/// name order dealt round-robin into `k` folds (so the variants of one
+/// mesh, which sort together, land in different folds), every row of a
+/// mesh in its mesh's fold. Returns the folds used and each row's fold.
+pub fn mesh_folds(meshes: &[&str], k: usize) -> (usize, Vec<usize>) {
+    let mut names: Vec<&str> = meshes.to_vec();
+    names.sort_unstable();
+    names.dedup();
+    let k = k.min(names.len()).max(1);
+    let fold_of = |m: &str| names.binary_search(&m).map_or(0, |i| i % k);
+    (k, meshes.iter().map(|m| fold_of(m)).collect())
+}
+
+/// K-fold cross-validation with whole meshes held out ([`mesh_folds`]):
+/// each fold's rows are predicted (from `predict_loads`, the vertex counts
+/// under the profile's cache policy) by a fit to the other folds' rows.
+/// Needs at least two distinct meshes; a fold whose complement has too few
+/// rows to fit is an error.
+pub fn k_fold_by_mesh(
+    fit_loads: &[PassLoad],
+    predict_loads: &[PassLoad],
+    y: &[f64],
+    meshes: &[&str],
+    k: usize,
+) -> Result<MeshFolds, CalibrateError> {
+    let (folds, fold) = mesh_folds(meshes, k);
+    let distinct = {
+        let mut n: Vec<&str> = meshes.to_vec();
+        n.sort_unstable();
+        n.dedup();
+        n.len()
+    };
+    if folds < 2 {
+        return Err(CalibrateError::TooFewMeshes(distinct));
+    }
+    let mut errors = vec![f64::NAN; y.len()];
+    for f in 0..folds {
+        let (l, t): (Vec<PassLoad>, Vec<f64>) = fit_loads
+            .iter()
+            .zip(y)
+            .zip(&fold)
+            .filter(|(_, g)| **g != f)
+            .map(|((l, t), _)| (*l, *t))
+            .unzip();
+        let fitted = fit(&l, &t)?;
+        for i in (0..y.len()).filter(|&i| fold[i] == f) {
+            errors[i] = rel_error_pct(fitted.costs.cost(&predict_loads[i]).pass_ns, y[i]);
+        }
+    }
+    Ok(MeshFolds {
+        folds,
+        meshes: distinct,
+        errors,
+    })
 }
 
 /// The baseline the profile must beat: time linear in vertex invocations,

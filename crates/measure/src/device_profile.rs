@@ -112,6 +112,13 @@ pub struct FitAccuracy {
     /// 90th percentile of the leave-one-out |error|.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub loo_p90_pct: Option<f64>,
+    /// Median |error| of k-fold cross-validation by mesh (whole meshes
+    /// held out: what a new user's pass is).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kfold_median_pct: Option<f64>,
+    /// 90th percentile of the k-fold |error|.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kfold_p90_pct: Option<f64>,
 }
 
 /// A device profile file.
@@ -612,6 +619,8 @@ mod tests {
                 worst_pct: s[2],
                 loo_median_pct: loo.map(|(a, b)| a.min(b)),
                 loo_p90_pct: loo.map(|(a, b)| a.max(b)),
+                kfold_median_pct: loo.map(|(a, b)| a.min(b) + 1.0),
+                kfold_p90_pct: loo.map(|(a, b)| a.max(b) + 2.0),
             },
         }
     }

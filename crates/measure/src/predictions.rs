@@ -151,6 +151,8 @@ pub fn calibrate_rows(
             worst_pct: worst,
             loo_median_pct: Some(lm),
             loo_p90_pct: Some(lp),
+            kfold_median_pct: None,
+            kfold_p90_pct: None,
         },
     };
     if let Err(super::device_profile::ProfileError::Invalid { key, value, why }) = profile.validate() {
