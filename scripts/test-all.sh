@@ -90,7 +90,8 @@ if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
     exit 1
   fi
   head -n 4 "$ci_out/studies.txt"
-  echo "$(($(wc -l < "$ci_out/study-passes.csv") - 1)) measured passes in the pass CSV"
+  echo "$(($(wc -l < "$ci_out/study-passes.csv") - 1)) measured passes in the pass CSV; the machine's load while measuring:"
+  cat "$ci_out/study-passes.csv.load.csv"
   # A device profile fitted afresh on these passes: each pass predicted by a
   # fit to the others (reported), and a fit on a fixed half predicting the
   # other half (checked: its median |error| must stay under 40%; lavapipe's

@@ -427,6 +427,7 @@ pub fn study(args: StudyArgs) -> Result<()> {
         check_appendable(path)?;
     }
     let gpu = Gpu::open()?;
+    let load_start = rendersim::measure::machine_load::load_average();
     let command = format!("rendersim study {name} --repeats {repeats}");
     let result = studies::run_studies(&gpu, &names, repeats, &command, |s| {
         if !json {
@@ -447,6 +448,9 @@ pub fn study(args: StudyArgs) -> Result<()> {
             ),
             (Err(e), Err(_)) => esay!("error: {e}"),
             (Err(_), Ok(_)) => {}
+        }
+        if written.is_ok() {
+            record_load(path, &command, passes.rows.len(), load_start);
         }
         if result.is_ok() {
             written?;
@@ -511,10 +515,13 @@ fn study_estimation(args: StudyArgs) -> Result<()> {
             gpu.describe()
         );
     }
+    let load_start = rendersim::measure::machine_load::load_average();
     let run = run_estimation(&gpu, plan, &command)?;
     if let Some(path) = &args.csv {
         let rows = csv_rows(&run.plan, &run.measured, &run.study);
+        let n = rows.len();
         write_output(path, |w| rendersim::output::table::write_table(w, &CSV_HEADER, rows))?;
+        record_load(path, &command, n, load_start);
     }
     let document = run.study.markdown();
     if let Some(path) = &args.markdown {
@@ -526,6 +533,29 @@ fn study_estimation(args: StudyArgs) -> Result<()> {
         say!("{document}");
     }
     Ok(())
+}
+
+/// Appends the machine's load while measuring to `FILE.load.csv` beside the
+/// pass CSV `csv` (`rendersim::measure::machine_load`); a failure to write
+/// it is a warning, the measurements being kept.
+#[cfg(feature = "wgpu")]
+fn record_load(csv: &std::path::Path, command: &str, rows: usize, start: Option<[f64; 3]>) {
+    use rendersim::measure::machine_load::{LoadRecord, append_load, load_average};
+    let r = LoadRecord {
+        date_utc: rendersim::provenance(Vec::new()).date,
+        command: command.to_string(),
+        rows,
+        cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        start,
+        end: load_average(),
+    };
+    match append_load(csv, &r) {
+        Ok(p) => esay!("machine load while measuring recorded in {}", p.display()),
+        Err(e) => esay!(
+            "warning: the machine's load could not be recorded beside {}: {e}",
+            csv.display()
+        ),
+    }
 }
 
 /// `rendersim study` without the `wgpu` feature.

@@ -54,6 +54,7 @@ pub mod h2;
 pub mod h3;
 pub mod h4;
 pub mod loops;
+pub mod machine_load;
 pub mod passes;
 pub mod predict;
 pub mod predictions;
