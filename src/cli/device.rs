@@ -14,7 +14,7 @@ use rendersim::measure::calibrate::{
     leave_one_out, leave_one_out_ns, linear_baseline_loo, read_rows_with_origins, row_load,
 };
 use rendersim::measure::device_predict::{DevicePass, predict_on_device};
-use rendersim::measure::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy, ProfileError};
+use rendersim::measure::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy, PassLoad, ProfileError};
 use rendersim::measure::fit::rel_error_pct;
 use rendersim::measure::passes::PassRow;
 use rendersim::measure::predictions::predict_rows;
@@ -74,26 +74,9 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     let fitted: Vec<f64> = fit_loads.iter().map(|l| f.costs.cost(l).pass_ns).collect();
     let errors: Vec<f64> = fitted.iter().zip(&y).map(|(p, m)| rel_error_pct(*p, *m)).collect();
     let (median, p90, worst) = error_summary(&errors);
-    let loo = if args.loo {
-        let t = Instant::now();
-        let e = leave_one_out(&fit_loads, &predict_loads, &y).map_err(of_inputs)?;
-        let b = linear_baseline_loo(&predict_loads, &y);
-        Some((e, b, t.elapsed().as_secs_f64()))
-    } else {
-        None
-    };
-    let meshes: Vec<&str> = rows.iter().map(|r| r.mesh.as_str()).collect();
-    let kfold = match args.kfold {
-        Some(k) => Some(k_fold_by_mesh(&fit_loads, &predict_loads, &y, &meshes, k as usize).map_err(of_inputs)?),
-        None => None,
-    };
+    let Checks { loo, kfold, half } =
+        cross_validate(args, &rows, (&fit_loads, &predict_loads), &y).map_err(of_inputs)?;
     let kfold_summary = kfold.as_ref().map(|k| error_summary(&k.errors));
-    let half = if args.holdout {
-        let e = held_out_half(&fit_loads, &predict_loads, &y).map_err(of_inputs)?;
-        Some((error_summary(&e), e.len()))
-    } else {
-        None
-    };
     let name = args.name.clone().unwrap_or_else(|| {
         args.out
             .file_stem()
@@ -206,6 +189,46 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
 
 /// Median, 90th percentile and worst |error|, percent.
 type ErrorSummary = (f64, f64, f64);
+
+/// The cross-validations `calibrate` was asked for.
+struct Checks {
+    /// Leave-one-out errors, the linear baseline's, and the seconds taken.
+    loo: Option<(Vec<f64>, Vec<f64>, f64)>,
+    /// K-fold by mesh.
+    kfold: Option<MeshFolds>,
+    /// The held-out half's summary and its row count.
+    half: Option<(ErrorSummary, usize)>,
+}
+
+/// `--loo`, `--kfold` and `--holdout` on the rows (`loads`: as fitted, from
+/// measured invocations, and as predicted, from the cache policy).
+fn cross_validate(
+    args: &CalibrateArgs,
+    rows: &[PassRow],
+    (fit_loads, predict_loads): (&[PassLoad], &[PassLoad]),
+    y: &[f64],
+) -> Result<Checks, CalibrateError> {
+    let loo = if args.loo {
+        let t = Instant::now();
+        let e = leave_one_out(fit_loads, predict_loads, y)?;
+        let b = linear_baseline_loo(predict_loads, y);
+        Some((e, b, t.elapsed().as_secs_f64()))
+    } else {
+        None
+    };
+    let meshes: Vec<&str> = rows.iter().map(|r| r.mesh.as_str()).collect();
+    let kfold = match args.kfold {
+        Some(k) => Some(k_fold_by_mesh(fit_loads, predict_loads, y, &meshes, k as usize)?),
+        None => None,
+    };
+    let half = if args.holdout {
+        let e = held_out_half(fit_loads, predict_loads, y)?;
+        Some((error_summary(&e), e.len()))
+    } else {
+        None
+    };
+    Ok(Checks { loo, kfold, half })
+}
 
 /// What `calibrate` fitted, for its text report.
 struct Calibration<'a> {

@@ -299,3 +299,38 @@ fn k_fold_by_mesh_needs_two_meshes_and_a_sensible_k() {
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("--kfold"), "{err}");
 }
+
+#[test]
+fn the_h200_profile_predicts_study_h2_as_a_sum() {
+    // Study H2 on the H200 (docs/measurements/nvidia-h200/studies.json):
+    // grid:96x96:optimized at 384x384, vertex loops 0 / 67390, fragment
+    // loops 0 / 7681. The ratio is the extra vertex cost with the heavy
+    // fragment shader over the extra with the light one: the H200 measured
+    // (40.312 - 22.859) / (18.627 - 0.056) = 0.940. The profile's formula
+    // adds its vertex and fragment terms, so it predicts a sum (1.000);
+    // docs/measurements/README.md reports both, and this test keeps that
+    // statement true.
+    let profile =
+        DeviceProfile::read(&Path::new(env!("CARGO_MANIFEST_DIR")).join("models/devices/nvidia-h200.toml")).unwrap();
+    let cell = |vs_loops, fs_loops| {
+        let pass = rendersim::measure::device_predict::DevicePass {
+            mesh: "grid:96x96:optimized".into(),
+            size: (384, 384),
+            vs_loops,
+            fs_loops,
+            geometry_only: false,
+            layers: 1,
+            order: rendersim::measure::DepthOrder::FrontToBack,
+            depth_test: false,
+        };
+        rendersim::measure::device_predict::predict_on_device(&profile, &pass)
+            .unwrap()
+            .pass_time_ns
+    };
+    let (ss, sc, cs, cc) = (cell(0, 0), cell(0, 7681), cell(67390, 0), cell(67390, 7681));
+    let predicted = (cc - sc) / (cs - ss);
+    let measured: f64 = (40.312128 - 22.8592) / (18.627424 - 0.055552);
+    eprintln!("H2 on the H200: measured ratio {measured:.3}, the profile predicts {predicted:.3}");
+    assert!((measured - 0.940).abs() < 0.001);
+    assert!((predicted - 1.0).abs() < 0.01, "{predicted}");
+}
