@@ -223,3 +223,41 @@ triangle_pixels = 1.0
     let (g, f) = (b["geometry"].as_f64().unwrap(), b["fragment"].as_f64().unwrap());
     assert!((g - f).abs() < 0.05 && g + f > 0.9, "{b:?}");
 }
+
+#[test]
+fn the_documented_examples() {
+    // docs/models.md ("Bottleneck shares"): the numbers it states, as
+    // `rendersim run ... --json` gives them.
+    let share = |s: &serde_json::Value, unit: &str| s["metrics"]["bottleneck"][unit].as_f64().unwrap();
+    let frame = |s: &serde_json::Value| s["metrics"]["frame_time_ms"]["mean"].as_f64().unwrap();
+    let cpu_bound = summary_of(
+        crate::common::DEFAULT,
+        &["display.vsync=false", "noise.enabled=false", "cpu.non_render=\"1ms\""],
+    );
+    assert!((frame(&cpu_bound) - 5.546).abs() < 0.0005, "{}", frame(&cpu_bound));
+    assert!(
+        (share(&cpu_bound, "cpu") - 0.997).abs() < 0.0005,
+        "{}",
+        cpu_bound["metrics"]["bottleneck"]
+    );
+    let gpu = cpu_bound["metrics"]["gpu_time_ms"]["mean"].as_f64().unwrap();
+    assert!((gpu - 5.12).abs() < 0.005, "{gpu}");
+    let default = summary_of(crate::common::DEFAULT, &[]);
+    assert!((frame(&default) - 16.667).abs() < 0.0005);
+    assert!(
+        (share(&default, "display") - 0.997).abs() < 0.0005,
+        "{}",
+        default["metrics"]["bottleneck"]
+    );
+    let fixed = summary_of(include_str!("../../models/fixed.toml"), &[]);
+    assert!(
+        (share(&fixed, "gpu_front_end") - 0.51).abs() < 0.005,
+        "{}",
+        fixed["metrics"]["bottleneck"]
+    );
+    assert!(
+        (share(&fixed, "display") - 0.49).abs() < 0.005,
+        "{}",
+        fixed["metrics"]["bottleneck"]
+    );
+}
