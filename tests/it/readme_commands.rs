@@ -173,6 +173,8 @@ const CASES: &[Case] = &[
         Some(&[
             "perceived-speed",
             "models/walkthrough-forest.toml",
+            "--set",
+            "gpu.fragment.per_fragment=\"1.5ns\"",
             "--out",
             "{out}/speed.png",
         ]),

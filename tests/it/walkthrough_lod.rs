@@ -352,3 +352,30 @@ fn none_draws_every_visible_object_at_its_finest_level() {
         Some(num(&s, "metrics.visible_objects.mean"))
     );
 }
+
+#[test]
+fn the_readmes_perceived_speed_command_shows_a_short_burst_of_skips() {
+    // README, "Using it": the forest with a lighter fragment cost skips
+    // three times, together, after steady 60 Hz (paper 000 Figure 6's
+    // picture); as shipped it skips every other refresh.
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("speed.png");
+    let out = out.to_str().unwrap();
+    let (code, stdout, err) = cli(&[
+        "perceived-speed",
+        "models/walkthrough-forest.toml",
+        "--set",
+        "gpu.fragment.per_fragment=\"1.5ns\"",
+        "--out",
+        out,
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let said = format!("{stdout}{err}");
+    assert!(
+        said.contains("centred on the frame skip at refresh 73, 3 skips in the run"),
+        "{said}"
+    );
+    let (_, stdout, err) = cli(&["perceived-speed", "models/walkthrough-forest.toml", "--out", out]);
+    let said = format!("{stdout}{err}");
+    assert!(said.contains("230 skips in the run"), "{said}");
+}
