@@ -22,6 +22,9 @@ pub struct Sweep {
     /// when some value is not a number (arrays, tables, strings without a
     /// leading number), whose coordinate is only its index.
     pub categorical: bool,
+    /// Whether the file gave `labels` (words for the values): plots then
+    /// show them alone in legends.
+    pub named: bool,
 }
 
 impl Sweep {
@@ -40,6 +43,7 @@ impl Sweep {
             coords,
             labels,
             categorical,
+            named: false,
         }
     }
 
@@ -62,6 +66,7 @@ impl Sweep {
         }
         self.labels = labels;
         self.categorical = true;
+        self.named = true;
         Ok(self)
     }
 }
@@ -183,6 +188,7 @@ pub(crate) fn expand_range(key: String, r: &RawRange) -> Result<Sweep, String> {
         coords: numbers,
         labels,
         categorical: false,
+        named: false,
     })
 }
 
@@ -210,16 +216,19 @@ impl Point {
             .join(", ")
     }
 
-    /// The text plots show for assignment `i`: `key=label`, with the
-    /// sweep's `labels` when the file gave them (`model=city` rather than
-    /// `model=../models/city.toml`), else `key=value` as in [`Point::label`].
+    /// The text plots show for assignment `i`: the sweep's label alone when
+    /// the file gave `labels` (words a reader knows: `triple buffering`
+    /// rather than `display.buffers=3`), else `key=value` as in
+    /// [`Point::label`].
     pub fn plot_assignment(&self, sweeps: &[Sweep], i: usize) -> String {
         let (k, v) = &self.assignments[i];
-        let text = match (sweeps.get(i), self.value_indices.get(i)) {
-            (Some(s), Some(&vi)) if s.key == *k => s.labels.get(vi).cloned().unwrap_or_else(|| value_text(v)),
-            _ => value_text(v),
-        };
-        format!("{k}={text}")
+        match (sweeps.get(i), self.value_indices.get(i)) {
+            (Some(s), Some(&vi)) if s.key == *k && s.named => match s.labels.get(vi) {
+                Some(label) => label.clone(),
+                None => format!("{k}={}", value_text(v)),
+            },
+            _ => format!("{k}={}", value_text(v)),
+        }
     }
 
     /// [`Point::label`] as plots show it: every assignment through

@@ -22,14 +22,8 @@ values = ["10ms", "20ms"]
     // The CSV's and the report's label keeps the values ...
     assert_eq!(pts[3].label(), "display.buffers=3, workload.gpu=20ms");
     // ... plots show the labels where the file gave them, values elsewhere.
-    assert_eq!(
-        pts[3].plot_label(&exp.sweeps),
-        "display.buffers=triple buffering, workload.gpu=20ms"
-    );
-    assert_eq!(
-        pts[0].plot_assignment(&exp.sweeps, 0),
-        "display.buffers=double buffering"
-    );
+    assert_eq!(pts[3].plot_label(&exp.sweeps), "triple buffering, workload.gpu=20ms");
+    assert_eq!(pts[0].plot_assignment(&exp.sweeps, 0), "double buffering");
     assert_eq!(
         expand_points(&parse("name = \"x\"\n"))[0].plot_label(&[]),
         "(single point)"
