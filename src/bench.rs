@@ -297,6 +297,7 @@ pub fn plot_kernel(cases: &[KernelBench], path: &std::path::Path) -> Result<(), 
             log_x: true,
             log_y: true,
             x_categories: Vec::new(),
+            y_bounds: None,
         },
     )
 }

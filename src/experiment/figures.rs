@@ -27,6 +27,7 @@ pub(crate) fn draw(
             log_x,
             log_y,
             filter,
+            y_bounds,
         } => {
             let xi = exp.sweeps.iter().position(|s| &s.key == x).unwrap_or(0);
             let groups = line_groups(points, xi, filter);
@@ -52,6 +53,7 @@ pub(crate) fn draw(
                     log_x: *log_x,
                     log_y: *log_y,
                     x_categories: x_categories(&exp.sweeps[xi]),
+                    y_bounds: *y_bounds,
                 },
             )?;
             Ok(Vec::new())

@@ -63,6 +63,9 @@ pub enum PlotKind {
         /// `where` filter: only the points with these sweep values are
         /// drawn (and the filtered keys are left out of the series names).
         filter: Vec<(String, toml::Value)>,
+        /// `y_bounds`: the values the quantity can take; intervals are cut
+        /// there (a fraction's `[0, 1]`).
+        y_bounds: Option<(f64, f64)>,
     },
     /// Per-frame values of `column`, pooled over the replications of each
     /// point, one group per point (optionally only the points matching `filter`).

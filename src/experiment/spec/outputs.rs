@@ -173,6 +173,9 @@ impl Validator<'_> {
             if p.range.is_some() && !matches!(kind, PlotKind::Histogram { .. }) {
                 return Err(self.err(format!("{key}.range"), "only histogram plots take `range`"));
             }
+            if p.y_bounds.is_some() && !matches!(kind, PlotKind::Line { .. }) {
+                return Err(self.err(format!("{key}.y_bounds"), "only line plots take `y_bounds`"));
+            }
             if p.filter.is_some() && matches!(kind, PlotKind::Scatter { .. }) {
                 return Err(self.err(format!("{key}.where"), "only histogram and line plots take `where`"));
             }
@@ -219,12 +222,25 @@ impl Validator<'_> {
         if f.iter().any(|(k, _)| *k == x) {
             return Err(self.err(format!("{key}.where"), format!("must not fix the x axis key `{x}`")));
         }
+        let y_bounds = match &p.y_bounds {
+            None => None,
+            Some(b) => match b.as_slice() {
+                [lo, hi] if lo.is_finite() && hi.is_finite() && lo < hi && !(p.log_y && *lo <= 0.0) => Some((*lo, *hi)),
+                _ => {
+                    return Err(self.err(
+                        format!("{key}.y_bounds"),
+                        format!("needs [lowest, highest]: two finite numbers, the first below the second (and above 0 on a log axis); got {b:?}"),
+                    ));
+                }
+            },
+        };
         Ok(PlotKind::Line {
             x,
             y,
             log_x: p.log_x,
             log_y: p.log_y,
             filter: f,
+            y_bounds,
         })
     }
 

@@ -129,6 +129,8 @@ pub(super) struct RawPlot {
     pub(super) column: Option<String>,
     pub(super) bins: Option<i64>,
     pub(super) range: Option<Vec<f64>>,
+    /// Line plots: `[lowest, highest]` the quantity can take.
+    pub(super) y_bounds: Option<Vec<f64>>,
     #[serde(default)]
     pub(super) log_x: bool,
     #[serde(default)]

@@ -187,3 +187,33 @@ y = "metrics.display_interval_ms.mean"
     let svg = read(dir.path(), "res.svg");
     assert!(svg.contains("[1024, 768]") && svg.contains("[1280, 1024]"), "{svg}");
 }
+
+#[test]
+fn y_bounds_belong_to_line_plots_and_must_be_an_ordered_pair() {
+    let line = |extra: &str| {
+        format!(
+            "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[plot]]\nfile = \"p\"\nkind = \"line\"\nx = \"a\"\ny = \"m\"\n{extra}"
+        )
+    };
+    let exp = parse(&line("y_bounds = [0, 1]\n"));
+    assert!(matches!(
+        exp.plots[0].kind,
+        PlotKind::Line {
+            y_bounds: Some((0.0, 1.0)),
+            ..
+        }
+    ));
+    for (bad, want) in [
+        ("y_bounds = [1, 0]\n", "the first below the second"),
+        ("y_bounds = [0]\n", "needs [lowest, highest]"),
+        ("y_bounds = [0, inf]\n", "two finite numbers"),
+        ("y_bounds = [0, 1]\nlog_y = true\n", "above 0 on a log axis"),
+    ] {
+        let e = parse_err(&line(bad));
+        assert!(e.contains("plot[0] (p).y_bounds") && e.contains(want), "{bad}: {e}");
+    }
+    let e = parse_err(
+        "name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"FrameTime\"\ny_bounds = [0, 1]\n",
+    );
+    assert!(e.contains("only line plots take `y_bounds`"), "{e}");
+}

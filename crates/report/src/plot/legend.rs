@@ -51,6 +51,28 @@ pub(crate) fn covered(occupied: &[Occupied], left: bool, top: bool, w: f64, h: f
         .count()
 }
 
+/// The middle of the left or the right edge covering fewer occupied things
+/// (the left on a tie), and how many it covers: where a legend goes when
+/// the y axis may not grow to free a corner (a bounded quantity).
+pub(crate) fn middle(occupied: &[Occupied], w: f64, h: f64) -> (SeriesLabelPosition, usize) {
+    let (lo, hi) = (0.5 - h / 2.0, 0.5 + h / 2.0);
+    let count = |left: bool| {
+        occupied
+            .iter()
+            .filter(|o| {
+                let in_x = if left { o.x <= w } else { o.x >= 1.0 - w };
+                in_x && o.y1 >= lo && o.y0 <= hi
+            })
+            .count()
+    };
+    let (l, r) = (count(true), count(false));
+    if r < l {
+        (SeriesLabelPosition::MiddleRight, r)
+    } else {
+        (SeriesLabelPosition::MiddleLeft, l)
+    }
+}
+
 /// The corner covering the fewest occupied things, and how many it covers.
 /// Ties keep the upper right, then upper left, lower right, lower left.
 pub(crate) fn corner(occupied: &[Occupied], w: f64, h: f64) -> (SeriesLabelPosition, usize) {
@@ -125,5 +147,20 @@ mod tests {
         let (lo, hi) = grow((0.0, 10.0), h);
         assert_eq!(lo, 0.0);
         assert!((10.0 / hi - (1.0 - h)).abs() < 1e-12);
+    }
+}
+
+#[cfg(test)]
+mod middle_tests {
+    use super::*;
+
+    #[test]
+    fn the_middle_of_the_freer_edge() {
+        let at = |x: f64, y: f64| Occupied { x, y0: y, y1: y };
+        // Data high and low on the left, through the middle on the right.
+        let occ = [at(0.1, 0.9), at(0.1, 0.05), at(0.9, 0.5), at(0.95, 0.45)];
+        assert!(matches!(middle(&occ, 0.3, 0.3), (SeriesLabelPosition::MiddleLeft, 0)));
+        let occ = [at(0.1, 0.5), at(0.9, 0.95)];
+        assert!(matches!(middle(&occ, 0.3, 0.3), (SeriesLabelPosition::MiddleRight, 0)));
     }
 }

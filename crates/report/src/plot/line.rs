@@ -44,6 +44,10 @@ pub struct LinePlot {
     /// numeric ticks (e.g. resolutions `1024x768`, `1280x1024` drawn at
     /// their indices 0 and 1). Ignored on a logarithmic x axis.
     pub x_categories: Vec<(f64, String)>,
+    /// The values the quantity can take, `(lowest, highest)` (a fraction:
+    /// `(0, 1)`): intervals are cut there, so the y axis never runs past
+    /// what the data could be. `None`: unbounded.
+    pub y_bounds: Option<(f64, f64)>,
 }
 
 /// The ticks of a categorical x axis (positions ascending, labels distinct)
@@ -70,6 +74,16 @@ struct Prepared {
     points: Vec<(f64, f64)>,
     /// `(x, low, y, high)` per point that has an interval.
     bars: Vec<(f64, f64, f64, f64)>,
+}
+
+/// Cuts every interval at `bounds` (the values the quantity can take), so
+/// that the y axis, fitted to points and intervals, stays within them.
+fn bound_bars(series: &mut [Prepared], bounds: Option<(f64, f64)>) {
+    if let Some((lo, hi)) = bounds.filter(|(lo, hi)| lo < hi) {
+        for b in series.iter_mut().flat_map(|s| s.bars.iter_mut()) {
+            (b.1, b.3) = (b.1.clamp(lo, hi), b.3.clamp(lo, hi));
+        }
+    }
 }
 
 fn prepare(plot: &LinePlot) -> (Vec<Prepared>, usize) {
@@ -194,7 +208,17 @@ fn draw<DB: DrawingBackend>(
     // the y axis grows by the legend's height so that the top is free.
     let entries = series.iter().filter(|s| !s.name.is_empty()).count();
     let (mut legend, covered) = legend_corner(series, xr, yr, entries);
-    if covered > 0 {
+    // A bounded quantity (a fraction) keeps its axis: the legend then sits
+    // in the corner that covers the fewest points rather than above 1.
+    let may_grow = plot.y_bounds.is_none_or(|(lo, hi)| lo >= hi);
+    if covered > 0 && !may_grow {
+        let (bw, bh) = legend_box(series, entries);
+        let (m, n) = legend::middle(&occupied(series, xr, yr), bw, bh);
+        if n < covered {
+            legend = m;
+        }
+    }
+    if covered > 0 && may_grow {
         let (bw, bh) = legend_box(series, entries);
         yr = legend::grow(yr, bh);
         // The top band is free now: the upper corner the box fits best.
@@ -282,7 +306,8 @@ fn draw<DB: DrawingBackend>(
 
 /// Write `plot` to `<base>.svg` and `<base>.png`.
 pub fn line_plot(base: &Path, plot: &LinePlot) -> Result<(), PlotError> {
-    let (series, dropped) = prepare(plot);
+    let (mut series, dropped) = prepare(plot);
+    bound_bars(&mut series, plot.y_bounds);
     let mut notes: Vec<String> = omitted_note(dropped, plot.log_x || plot.log_y).into_iter().collect();
     if series.iter().all(|s| s.points.is_empty()) {
         notes.push("note: no data".into());
@@ -318,6 +343,22 @@ mod tests {
             points: points.to_vec(),
             bars: Vec::new(),
         }
+    }
+
+    #[test]
+    fn intervals_are_cut_at_the_bounds_and_the_points_are_kept() {
+        let mut s = vec![Prepared {
+            name: "share".into(),
+            points: vec![(1.0, 0.5), (2.0, 0.9)],
+            bars: vec![(1.0, -0.4, 0.5, 1.6), (2.0, 0.8, 0.9, 1.0)],
+        }];
+        bound_bars(&mut s, None);
+        assert_eq!(s[0].bars[0], (1.0, -0.4, 0.5, 1.6));
+        bound_bars(&mut s, Some((1.0, 0.0)));
+        assert_eq!(s[0].bars[0], (1.0, -0.4, 0.5, 1.6), "empty bounds are ignored");
+        bound_bars(&mut s, Some((0.0, 1.0)));
+        assert_eq!(s[0].bars, vec![(1.0, 0.0, 0.5, 1.0), (2.0, 0.8, 0.9, 1.0)]);
+        assert_eq!(s[0].points, vec![(1.0, 0.5), (2.0, 0.9)]);
     }
 
     #[test]
