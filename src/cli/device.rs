@@ -155,18 +155,25 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
             .zip(&errors)
             .enumerate()
             .map(|(i, ((r, p), e))| {
-                json!({"mesh": r.mesh, "size": format!("{}x{}", r.size.width, r.size.height), "vs_loops": r.vs_loops,
+                let mut row = json!({"mesh": r.mesh, "size": format!("{}x{}", r.size.width, r.size.height), "vs_loops": r.vs_loops,
                 "fs_loops": r.fs_loops, "geometry_only": r.geometry_only, "measured_ns": r.pass_time_ns,
-                "fitted_ns": p, "error_pct": e, "loo_error_pct": loo.as_ref().map(|l| l.0[i]),
-                "kfold_error_pct": kfold.as_ref().map(|k| k.errors[i])})
+                "fitted_ns": p, "error_pct": e, "loo_error_pct": loo.as_ref().map(|l| l.0[i])});
+                if let Some(k) = &kfold {
+                    row["kfold_error_pct"] = json!(k.errors[i]);
+                }
+                row
             })
             .collect();
-        let v = json!({"profile": profile, "out": args.out, "fit_seconds": fit_seconds,
+        let mut v = json!({"profile": profile, "out": args.out, "fit_seconds": fit_seconds,
             "loo_seconds": loo.as_ref().map(|l| l.2),
             "linear_baseline_loo": loo_summary.map(|s| json!({"median_pct": s.1.0, "p90_pct": s.1.1, "worst_pct": s.1.2})),
             "held_out_half": half.map(|((m, p, w), n)| json!({"rows": n, "median_pct": m, "p90_pct": p, "worst_pct": w})),
-            "kfold_by_mesh": kfold.as_ref().zip(kfold_summary).map(|(k, (m, p, w))| json!({"folds": k.folds, "meshes": k.meshes, "median_pct": m, "p90_pct": p, "worst_pct": w})),
             "rows": rows_json});
+        // Present only when asked for (`--kfold`), as the profile's keys are.
+        if let (Some(k), Some((m, p, w))) = (&kfold, kfold_summary) {
+            v["kfold_by_mesh"] =
+                json!({"folds": k.folds, "meshes": k.meshes, "median_pct": m, "p90_pct": p, "worst_pct": w});
+        }
         say!("{}", serde_json::to_string_pretty(&v)?);
         return check_holdout(args, half.map(|h| h.0.0));
     }

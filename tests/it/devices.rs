@@ -284,6 +284,24 @@ fn k_fold_by_mesh_needs_two_meshes_and_a_sensible_k() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("at least 2 distinct meshes; these have 1"), "{err}");
+    // One mesh holds most of load-grid.csv's rows: without it too few are left.
+    let o = bin()
+        .args([
+            "calibrate",
+            h200("load-grid.csv").to_str().unwrap(),
+            "--kfold",
+            "3",
+            "--out",
+        ])
+        .arg(d.path().join("p.toml"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("holding out fold 3 (grid:96x96:optimized) leaves 4 rows to fit"),
+        "{err}"
+    );
     let o = bin()
         .args([
             "calibrate",

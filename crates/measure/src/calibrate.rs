@@ -44,6 +44,18 @@ pub enum CalibrateError {
     /// Cross-validation by mesh needs two meshes at least.
     #[error("cross-validation by mesh needs passes of at least 2 distinct meshes; these have {0}")]
     TooFewMeshes(usize),
+    /// A fold held out leaves too few rows to fit.
+    #[error(
+        "k-fold by mesh: holding out fold {fold} ({meshes}) leaves {rows} rows to fit, and a fit needs at least {MIN_ROWS}: measure more passes of the other meshes, or leave --kfold out"
+    )]
+    FoldTooSmall {
+        /// The fold, 1-based.
+        fold: usize,
+        /// Its meshes, comma-separated.
+        meshes: String,
+        /// The rows left.
+        rows: usize,
+    },
     /// The fit gave a number that is not finite (no profile is made of it).
     #[error("the fit of {rows} rows gives {what} = {value}, not a finite number; no profile is written")]
     NotFinite {
@@ -615,6 +627,21 @@ pub fn k_fold_by_mesh(
             .filter(|(_, g)| **g != f)
             .map(|((l, t), _)| (*l, *t))
             .unzip();
+        if l.len() < MIN_ROWS {
+            let mut held: Vec<&str> = meshes
+                .iter()
+                .zip(&fold)
+                .filter(|(_, g)| **g == f)
+                .map(|(m, _)| *m)
+                .collect();
+            held.sort_unstable();
+            held.dedup();
+            return Err(CalibrateError::FoldTooSmall {
+                fold: f + 1,
+                meshes: held.join(", "),
+                rows: l.len(),
+            });
+        }
         let fitted = fit(&l, &t)?;
         for i in (0..y.len()).filter(|&i| fold[i] == f) {
             errors[i] = rel_error_pct(fitted.costs.cost(&predict_loads[i]).pass_ns, y[i]);
