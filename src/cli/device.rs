@@ -148,35 +148,6 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         rendersim::output::files::write_output(path, |w| w.write_all(md.as_bytes()))?;
     }
 
-    if args.json {
-        let rows_json: Vec<_> = rows
-            .iter()
-            .zip(&fitted)
-            .zip(&errors)
-            .enumerate()
-            .map(|(i, ((r, p), e))| {
-                let mut row = json!({"mesh": r.mesh, "size": format!("{}x{}", r.size.width, r.size.height), "vs_loops": r.vs_loops,
-                "fs_loops": r.fs_loops, "geometry_only": r.geometry_only, "measured_ns": r.pass_time_ns,
-                "fitted_ns": p, "error_pct": e, "loo_error_pct": loo.as_ref().map(|l| l.0[i])});
-                if let Some(k) = &kfold {
-                    row["kfold_error_pct"] = json!(k.errors[i]);
-                }
-                row
-            })
-            .collect();
-        let mut v = json!({"profile": profile, "out": args.out, "fit_seconds": fit_seconds,
-            "loo_seconds": loo.as_ref().map(|l| l.2),
-            "linear_baseline_loo": loo_summary.map(|s| json!({"median_pct": s.1.0, "p90_pct": s.1.1, "worst_pct": s.1.2})),
-            "held_out_half": half.map(|((m, p, w), n)| json!({"rows": n, "median_pct": m, "p90_pct": p, "worst_pct": w})),
-            "rows": rows_json});
-        // Present only when asked for (`--kfold`), as the profile's keys are.
-        if let (Some(k), Some((m, p, w))) = (&kfold, kfold_summary) {
-            v["kfold_by_mesh"] =
-                json!({"folds": k.folds, "meshes": k.meshes, "median_pct": m, "p90_pct": p, "worst_pct": w});
-        }
-        say!("{}", serde_json::to_string_pretty(&v)?);
-        return check_holdout(args, half.map(|h| h.0.0));
-    }
     let calibration = Calibration {
         rows: &rows,
         files: &files,
@@ -190,12 +161,49 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         kfold: kfold.as_ref().zip(kfold_summary),
         half,
     };
+    if args.json {
+        let v = calibration_json(&calibration, &profile, &args.out);
+        say!("{}", serde_json::to_string_pretty(&v)?);
+        return check_holdout(args, half.map(|h| h.0.0));
+    }
     print!("{}", calibration_text(&calibration, &args.out)?);
     check_holdout(args, half.map(|h| h.0.0))
 }
 
 /// Median, 90th percentile and worst |error|, percent.
 type ErrorSummary = (f64, f64, f64);
+
+/// `calibrate --json`: the profile, each row fitted, and the validations
+/// asked for (a key only when its option was given, never a null).
+fn calibration_json(c: &Calibration, profile: &DeviceProfile, out: &std::path::Path) -> serde_json::Value {
+    let rows: Vec<_> = c
+        .rows
+        .iter()
+        .zip(c.fitted)
+        .zip(c.errors)
+        .enumerate()
+        .map(|(i, ((r, p), e))| {
+            let mut row = json!({"mesh": r.mesh, "size": format!("{}x{}", r.size.width, r.size.height),
+                "vs_loops": r.vs_loops, "fs_loops": r.fs_loops, "geometry_only": r.geometry_only,
+                "measured_ns": r.pass_time_ns, "fitted_ns": p, "error_pct": e,
+                "loo_error_pct": c.loo.map(|l| l.0[i])});
+            if let Some((k, _)) = c.kfold {
+                row["kfold_error_pct"] = json!(k.errors[i]);
+            }
+            row
+        })
+        .collect();
+    let mut v = json!({"profile": profile, "out": out, "fit_seconds": c.fit_seconds,
+        "loo_seconds": c.loo.map(|l| l.2),
+        "linear_baseline_loo": c.loo_summary.map(|s| json!({"median_pct": s.1.0, "p90_pct": s.1.1, "worst_pct": s.1.2})),
+        "held_out_half": c.half.map(|((m, p, w), n)| json!({"rows": n, "median_pct": m, "p90_pct": p, "worst_pct": w})),
+        "rows": rows});
+    if let Some((k, (m, p, w))) = c.kfold {
+        v["kfold_by_mesh"] =
+            json!({"folds": k.folds, "meshes": k.meshes, "median_pct": m, "p90_pct": p, "worst_pct": w});
+    }
+    v
+}
 
 /// The cross-validations `calibrate` was asked for.
 struct Checks {
