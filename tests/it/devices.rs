@@ -276,45 +276,28 @@ fn k_fold_by_mesh_needs_two_meshes_and_a_sensible_k() {
         }
     }
     std::fs::write(&one_mesh, text).unwrap();
-    let o = bin()
-        .args(["calibrate", one_mesh.to_str().unwrap(), "--kfold", "3", "--out"])
-        .arg(d.path().join("p.toml"))
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    // `calibrate CSV --kfold K` refused: exit 2, its error line returned.
+    let refused = |csv: &Path, k: &str| {
+        let o = bin()
+            .arg("calibrate")
+            .arg(csv)
+            .args(["--kfold", k, "--out"])
+            .arg(d.path().join("p.toml"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        err
+    };
+    let err = refused(&one_mesh, "3");
     assert!(err.contains("at least 2 distinct meshes; these have 1"), "{err}");
     // One mesh holds most of load-grid.csv's rows: without it too few are left.
-    let o = bin()
-        .args([
-            "calibrate",
-            h200("load-grid.csv").to_str().unwrap(),
-            "--kfold",
-            "3",
-            "--out",
-        ])
-        .arg(d.path().join("p.toml"))
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let err = refused(&h200("load-grid.csv"), "3");
     assert!(
         err.contains("holding out fold 3 (grid:96x96:optimized) leaves 4 rows to fit"),
         "{err}"
     );
-    let o = bin()
-        .args([
-            "calibrate",
-            h200("load-grid.csv").to_str().unwrap(),
-            "--kfold",
-            "1",
-            "--out",
-        ])
-        .arg(d.path().join("p.toml"))
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let err = refused(&h200("load-grid.csv"), "1");
     assert!(err.contains("--kfold"), "{err}");
 }
 

@@ -588,12 +588,18 @@ pub struct MeshFolds {
 /// mesh, which sort together, land in different folds), every row of a
 /// mesh in its mesh's fold. Returns the folds used and each row's fold.
 pub fn mesh_folds(meshes: &[&str], k: usize) -> (usize, Vec<usize>) {
-    let mut names: Vec<&str> = meshes.to_vec();
-    names.sort_unstable();
-    names.dedup();
+    let names = distinct(meshes);
     let k = k.min(names.len()).max(1);
     let fold_of = |m: &str| names.binary_search(&m).map_or(0, |i| i % k);
     (k, meshes.iter().map(|m| fold_of(m)).collect())
+}
+
+/// The distinct names of `meshes`, sorted.
+fn distinct<'a>(meshes: &[&'a str]) -> Vec<&'a str> {
+    let mut names = meshes.to_vec();
+    names.sort_unstable();
+    names.dedup();
+    names
 }
 
 /// K-fold cross-validation with whole meshes held out ([`mesh_folds`]):
@@ -609,14 +615,9 @@ pub fn k_fold_by_mesh(
     k: usize,
 ) -> Result<MeshFolds, CalibrateError> {
     let (folds, fold) = mesh_folds(meshes, k);
-    let distinct = {
-        let mut n: Vec<&str> = meshes.to_vec();
-        n.sort_unstable();
-        n.dedup();
-        n.len()
-    };
+    let names = distinct(meshes).len();
     if folds < 2 {
-        return Err(CalibrateError::TooFewMeshes(distinct));
+        return Err(CalibrateError::TooFewMeshes(names));
     }
     let mut errors = vec![f64::NAN; y.len()];
     for f in 0..folds {
@@ -628,17 +629,15 @@ pub fn k_fold_by_mesh(
             .map(|((l, t), _)| (*l, *t))
             .unzip();
         if l.len() < MIN_ROWS {
-            let mut held: Vec<&str> = meshes
+            let held: Vec<&str> = meshes
                 .iter()
                 .zip(&fold)
                 .filter(|(_, g)| **g == f)
                 .map(|(m, _)| *m)
                 .collect();
-            held.sort_unstable();
-            held.dedup();
             return Err(CalibrateError::FoldTooSmall {
                 fold: f + 1,
-                meshes: held.join(", "),
+                meshes: distinct(&held).join(", "),
                 rows: l.len(),
             });
         }
@@ -649,7 +648,7 @@ pub fn k_fold_by_mesh(
     }
     Ok(MeshFolds {
         folds,
-        meshes: distinct,
+        meshes: names,
         errors,
     })
 }

@@ -23,23 +23,9 @@ pub use policy::{CachePolicy, CachePolicyError, NVIDIA_LOOKBACK};
 /// vertex ids from user files) go to a hash map so memory stays bounded.
 const DENSE_LIMIT: usize = 1 << 24;
 
-/// Fast path for whole triangle lists: meshoptimizer's analyzer loop (FIFO
-/// of `cache` entries, warps of `warp` vertices, groups of `primgroup`
-/// triangles; `fifo:N` is `(N, 0, 0)`), on a dense stamp array of
-/// `vertex_count` entries ([`analyzer::analyze`]). Calls `charge(misses)`
-/// per triangle; returns (transformed, warps, unique vertices), or `None` as
-/// soon as an index is not below `vertex_count` (the caller then discards
-/// what was charged).
-pub fn analyze_triangle_list(
-    indices: &[u32],
-    vertex_count: usize,
-    cache: u32,
-    warp: u32,
-    primgroup: u32,
-    charge: impl FnMut(u8),
-) -> Option<(u64, u64, u64)> {
-    analyzer::analyze(indices, vertex_count, cache, warp, primgroup, charge)
-}
+/// Fast path for whole triangle lists: meshoptimizer's analyser loop
+/// ([`analyzer::analyze`]).
+pub use analyzer::analyze as analyze_triangle_list;
 
 /// A simulated post-transform vertex cache.
 ///

@@ -208,26 +208,25 @@ fn draw<DB: DrawingBackend>(
     // the y axis grows by the legend's height so that the top is free.
     let entries = series.iter().filter(|s| !s.name.is_empty()).count();
     let (mut legend, covered) = legend_corner(series, xr, yr, entries);
-    // A bounded quantity (a fraction) keeps its axis: the legend then sits
-    // in the corner that covers the fewest points rather than above 1.
-    let may_grow = plot.y_bounds.is_none_or(|(lo, hi)| lo >= hi);
-    if covered > 0 && !may_grow {
+    if covered > 0 {
         let (bw, bh) = legend_box(series, entries);
-        let (m, n) = legend::middle(&occupied(series, xr, yr), bw, bh);
-        if n < covered {
-            legend = m;
-        }
-    }
-    if covered > 0 && may_grow {
-        let (bw, bh) = legend_box(series, entries);
-        yr = legend::grow(yr, bh);
-        // The top band is free now: the upper corner the box fits best.
-        let occ = occupied(series, xr, yr);
-        legend = if legend::covered(&occ, true, true, bw, bh) < legend::covered(&occ, false, true, bw, bh) {
-            SeriesLabelPosition::UpperLeft
+        if plot.y_bounds.is_some_and(|(lo, hi)| lo < hi) {
+            // A bounded quantity (a fraction) keeps its axis: the legend
+            // goes to the middle of an edge if that covers fewer points.
+            let (m, n) = legend::middle(&occupied(series, xr, yr), bw, bh);
+            if n < covered {
+                legend = m;
+            }
         } else {
-            SeriesLabelPosition::UpperRight
-        };
+            yr = legend::grow(yr, bh);
+            // The top band is free now: the upper corner the box fits best.
+            let occ = occupied(series, xr, yr);
+            legend = if legend::covered(&occ, true, true, bw, bh) < legend::covered(&occ, false, true, bw, bh) {
+                SeriesLabelPosition::UpperLeft
+            } else {
+                SeriesLabelPosition::UpperRight
+            };
+        }
     }
     let yt = ticks(yr.0, yr.1, plot.log_y, false);
     let mut chart = ChartBuilder::on(root)

@@ -131,7 +131,7 @@ fn run_span<const WARP: bool, const PRIM: bool>(
         let mut k = 0u32;
         for &v in t {
             let s = stamps.get_mut(v as usize).ok_or(OutOfRange)?;
-            if clock.timestamp.wrapping_sub(*s) > p.cache {
+            if stale(p, clock, *s) {
                 *s = clock.timestamp;
                 clock.timestamp = clock.timestamp.wrapping_add(1);
                 k += 1;
@@ -174,10 +174,12 @@ fn count_seen(indices: &[u32], vertex_count: usize) -> u64 {
 }
 
 /// meshoptimizer's analyser on a whole triangle list (`indices.len()` a
-/// multiple of 3; see [`crate::components::vertex_cache::analyze_triangle_list`]), one thread,
-/// charging each triangle's misses. Returns (transformed, warps, unique
-/// vertices), or `None` as soon as an index is not below `vertex_count`
-/// (what was charged is then to be discarded).
+/// multiple of 3): a FIFO of `cache` entries, warps of `warp` vertices,
+/// groups of `primgroup` triangles (`fifo:N` is `(N, 0, 0)`), on a dense
+/// stamp array of `vertex_count` entries, charging each triangle's misses.
+/// Returns (transformed, warps, unique vertices), or `None` as soon as an
+/// index is not below `vertex_count` (what was charged is then to be
+/// discarded). Re-exported as `vertex_cache::analyze_triangle_list`.
 pub fn analyze(
     indices: &[u32],
     vertex_count: usize,
