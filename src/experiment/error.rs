@@ -46,6 +46,10 @@ pub enum ExperimentError {
         /// Why.
         source: Box<super::inverse::SearchError>,
     },
+    /// A model file could not be read as a model (its hardware file
+    /// included).
+    #[error(transparent)]
+    Model(#[from] crate::config::ConfigError),
     /// A dotted-key patch could not be applied to a model.
     #[error(transparent)]
     Patch(#[from] crate::config::PatchError),

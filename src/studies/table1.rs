@@ -243,6 +243,18 @@ pub enum CalibrationError {
     },
 }
 
+/// Probe cost (ps) for the stage rates.
+const PROBE: u64 = 1_000_000;
+
+/// What fixes the split of the simple/simple cell's shader time.
+#[derive(Debug, Clone, Copy)]
+enum FirstCell {
+    /// The geometry share of the stage totals.
+    Share(f64),
+    /// The simple vertex shader's cost (ps).
+    Vertex(u64),
+}
+
 /// A frame-pipeline model whose two shader costs the calibration sets.
 pub struct CellModel<'a> {
     src: &'a ModelSource,
@@ -310,11 +322,70 @@ impl<'a> CellModel<'a> {
         if !(0.0..=1.0).contains(&share) {
             return Err(CalibrationError::Share(share));
         }
+        self.calibrate_from(FirstCell::Share(share), targets)
+    }
+
+    /// Calibrates the three cells of `targets` with the simple vertex
+    /// shader's cost given (`vertex_ps` per transformed vertex, from a
+    /// measurement outside the table), so that the simple/simple cell fixes
+    /// the simple fragment cost; predicts the fourth.
+    pub fn calibrate_with_vertex(&mut self, vertex_ps: u64, targets: &Cells) -> Result<Calibration, CalibrationError> {
+        self.calibrate_from(FirstCell::Vertex(vertex_ps), targets)
+    }
+
+    /// The simple shaders' costs that reproduce the simple/simple cell.
+    fn first_cell(
+        &mut self,
+        first: FirstCell,
+        target: f64,
+        rates: (Times, f64, f64),
+    ) -> Result<(u64, u64), CalibrationError> {
+        let (zero, per_vertex_ps, per_fragment_ps) = rates;
+        let room = (target - zero.gpu).max(0.0);
+        match first {
+            FirstCell::Share(share) => {
+                // The total shader time S (ps), divided by the share.
+                let split = |s: u64| -> (u64, u64) {
+                    let ms = s as f64 * 1e-9;
+                    let v = if per_vertex_ps > 0.0 {
+                        (share * ms / per_vertex_ps).round() as u64
+                    } else {
+                        0
+                    };
+                    let f = if per_fragment_ps > 0.0 {
+                        ((1.0 - share) * ms / per_fragment_ps).round() as u64
+                    } else {
+                        0
+                    };
+                    (v, f)
+                };
+                // A first guess that brackets the target: the split frame
+                // takes at least the fixed time plus the longer stage.
+                let guess = (2.0 * room * 1e9).ceil() as u64;
+                let (s, _) = self.solve("simple/simple", target, (0, zero.gpu), guess, |m, s| {
+                    let (v, f) = split(s);
+                    m.gpu_ms(v, f)
+                })?;
+                Ok(split(s))
+            }
+            FirstCell::Vertex(v) => {
+                let at_zero = self.gpu_ms(v, 0)?;
+                let guess = if per_fragment_ps > 0.0 {
+                    (room / per_fragment_ps).ceil() as u64
+                } else {
+                    PROBE
+                };
+                let (f, _) = self.solve("simple/simple", target, (0, at_zero), guess, |m, f| m.gpu_ms(v, f))?;
+                Ok((v, f))
+            }
+        }
+    }
+
+    fn calibrate_from(&mut self, first: FirstCell, targets: &Cells) -> Result<Calibration, CalibrationError> {
         let runs_before = self.runs;
         // The stage totals are affine in the costs: ms per picosecond of
         // cost (transformed vertices and shaded fragments, in effect).
-        const PROBE: u64 = 1_000_000;
-        let (zero, per_vertex_ps, per_fragment_ps) = match self.rates {
+        let rates = match self.rates {
             Some(r) => r,
             None => {
                 let zero = self.times(0, 0)?;
@@ -328,24 +399,7 @@ impl<'a> CellModel<'a> {
                 r
             }
         };
-        // 1. The simple/simple cell over the total shader time S (ps).
-        let split = |s: u64| -> (u64, u64) {
-            let ms = s as f64 * 1e-9;
-            let v = if per_vertex_ps > 0.0 {
-                (share * ms / per_vertex_ps).round() as u64
-            } else {
-                0
-            };
-            let f = if per_fragment_ps > 0.0 {
-                ((1.0 - share) * ms / per_fragment_ps).round() as u64
-            } else {
-                0
-            };
-            (v, f)
-        };
-        // First guesses that bracket each target: the split frame takes at
-        // least the fixed time plus the longer stage, the pool at least the
-        // fixed time plus both.
+        let (zero, per_vertex_ps, per_fragment_ps) = rates;
         let room = |target: f64| (target - zero.gpu).max(0.0);
         let guess = |ms: f64, per_ps: f64| {
             if per_ps > 0.0 {
@@ -354,18 +408,8 @@ impl<'a> CellModel<'a> {
                 PROBE
             }
         };
-        let s_guess = (2.0 * room(targets.simple_simple) * 1e9).ceil() as u64;
-        let (s, _) = self.solve(
-            "simple/simple",
-            targets.simple_simple,
-            (0, zero.gpu),
-            s_guess,
-            |m, s| {
-                let (v, f) = split(s);
-                m.gpu_ms(v, f)
-            },
-        )?;
-        let (v0, f0) = split(s);
+        // 1. The simple/simple cell.
+        let (v0, f0) = self.first_cell(first, targets.simple_simple, rates)?;
         let base = self.times(v0, f0)?;
         // 2. The complex fragment shader.
         let f_guess = guess(room(targets.simple_complex), per_fragment_ps);
@@ -388,7 +432,7 @@ impl<'a> CellModel<'a> {
         // 4. The prediction.
         let complex_complex = self.gpu_ms(v1, f1)?;
         Ok(Calibration {
-            geometry_share: share,
+            geometry_share: base.geometry / (base.geometry + base.fragment),
             costs: Costs {
                 vertex_simple_ps: v0,
                 vertex_complex_ps: v1,

@@ -1446,3 +1446,39 @@ fn isolate_at_draw_fidelity_agrees_with_triangle() {
     let e = run_err(&["isolate", m, "--fidelity", "pixel"]);
     assert!(e.contains("pixel") && e.contains("draw"), "{e}");
 }
+
+#[test]
+fn hardware_files_merge_under_the_model_and_their_errors_name_their_line() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::create_dir(d.path().join("hw")).unwrap();
+    let model = format!("hardware = \"hw/gpu.toml\"\n{SMALL}");
+    let m = write(d.path(), "m.toml", &model);
+    // A good hardware file: the model runs, and its model.toml holds the
+    // merged keys (it runs without the hardware file).
+    write(&d.path().join("hw"), "gpu.toml", "# a device\n[gpu]\nclear = \"1ms\"\n");
+    let out = d.path().join("out");
+    run_ok(&["run", &m, "--out", out.to_str().unwrap()]);
+    let resolved = std::fs::read_to_string(out.join("model.toml")).unwrap();
+    assert!(resolved.contains("clear = \"1ms\""), "{resolved}");
+    assert!(!resolved.contains("hardware ="), "{resolved}");
+    // A bad value in it names the hardware file and its line.
+    write(
+        &d.path().join("hw"),
+        "gpu.toml",
+        "# a device\n[gpu]\nclear = \"fast\"\n",
+    );
+    let err = run_err(&["run", &m]);
+    assert!(err.contains("gpu.toml:3: key `gpu.clear`"), "{err}");
+    // A section that is not hardware, and a missing file.
+    write(&d.path().join("hw"), "gpu.toml", "[workload]\nkind = \"fixed\"\n");
+    let err = run_err(&["run", &m]);
+    assert!(
+        err.contains("gpu.toml:1: key `workload`: is not a hardware section"),
+        "{err}"
+    );
+    std::fs::remove_file(d.path().join("hw/gpu.toml")).unwrap();
+    let err = run_err(&["run", &m]);
+    assert!(err.contains("m.toml:1: key `hardware`: cannot read"), "{err}");
+    // The earlier results are still there.
+    assert!(out.join("summary.json").exists());
+}

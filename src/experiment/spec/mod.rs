@@ -441,14 +441,21 @@ impl Experiment {
     }
 }
 
-/// A model file as a TOML table.
+/// A model file as a TOML table, read as every model is
+/// ([`crate::config::ModelSource::table`]: its hardware file merged in).
 fn read_model(path: &std::path::Path) -> Result<toml::Table, ExperimentError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ExperimentError::Io {
-        path: path.to_path_buf(),
-        source,
+    let src = crate::config::ModelSource::from_file(path).map_err(|e| match e {
+        crate::config::ConfigError::Io { source, .. } => ExperimentError::Io {
+            path: path.to_path_buf(),
+            source,
+        },
+        e => e.into(),
     })?;
-    text.parse::<toml::Table>().map_err(|e| ExperimentError::Parse {
-        file: path.to_path_buf(),
-        message: e.to_string(),
+    src.table().map_err(|e| match e {
+        crate::config::ConfigError::Syntax { message, .. } => ExperimentError::Parse {
+            file: path.to_path_buf(),
+            message,
+        },
+        e => e.into(),
     })
 }

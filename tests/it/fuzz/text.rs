@@ -31,7 +31,9 @@ fn model_bounds(name: &str) -> Option<Vec<&'static str>> {
     const MEM: &str = "run.max_memory=\"1GiB\"";
     const EVENTS: &str = "run.max_events=3000000";
     Some(match name {
-        "h2-pass.toml" | "terrain.toml" => vec!["run.frames=2", "run.warmup_frames=0", MEM, EVENTS],
+        "h2-pass.toml" | "terrain.toml" | "terrain-geforce3.toml" => {
+            vec!["run.frames=2", "run.warmup_frames=0", MEM, EVENTS]
+        }
         "walkthrough-city.toml" | "walkthrough-forest.toml" => vec!["run.frames=20", MEM],
         "mfr-multigpu.toml" => vec!["run.events=40", MEM, EVENTS],
         _ => return None,

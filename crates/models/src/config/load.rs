@@ -114,8 +114,17 @@ impl ModelSource {
         last(&|k| key == k || below(key, k)).or_else(|| last(&|k| below(k, key)))
     }
 
-    /// Parses the text into a TOML table.
+    /// Parses the text into a TOML table, with the hardware file that a
+    /// top-level `hardware = "PATH"` names merged under it
+    /// ([`super::hardware`]).
     pub fn table(&self) -> Result<toml::Table, ConfigError> {
+        let mut t = self.own_table()?;
+        super::hardware::merge_hardware(self, &mut t)?;
+        Ok(t)
+    }
+
+    /// Parses the text alone into a TOML table.
+    pub fn own_table(&self) -> Result<toml::Table, ConfigError> {
         self.text.parse::<toml::Table>().map_err(|e| ConfigError::Syntax {
             file: self.name.clone(),
             message: e.to_string().trim().to_string(),
@@ -292,7 +301,13 @@ pub fn invalid(src: &ModelSource, key: &str, message: String, suggestion: Option
     };
     let (file, line) = match src.override_of(key) {
         Some(origin) => (format!("value from `{origin}` (applied to {})", src.name), None),
-        None => (src.name.clone(), src.line_of(key)),
+        None => match src.line_of(key) {
+            Some(line) => (src.name.clone(), Some(line)),
+            None => match super::hardware::hardware_line_of(src, key) {
+                Some((file, line)) => (file, Some(line)),
+                None => (src.name.clone(), None),
+            },
+        },
     };
     ConfigError::Invalid {
         file,
