@@ -29,6 +29,7 @@ mod nvidia_policy;
 mod obj_files;
 mod outputs;
 mod pacing;
+mod paper000_city;
 mod pipeline_oracles;
 mod pixelflow;
 mod present;

@@ -31,7 +31,7 @@ fn model_bounds(name: &str) -> Option<Vec<&'static str>> {
     const MEM: &str = "run.max_memory=\"1GiB\"";
     const EVENTS: &str = "run.max_events=3000000";
     Some(match name {
-        "h2-pass.toml" | "terrain.toml" | "terrain-geforce3.toml" => {
+        "h2-pass.toml" | "terrain.toml" | "terrain-geforce3.toml" | "city-geforce3.toml" => {
             vec!["run.frames=2", "run.warmup_frames=0", MEM, EVENTS]
         }
         "walkthrough-city.toml" | "walkthrough-forest.toml" => vec!["run.frames=20", MEM],
