@@ -275,8 +275,7 @@ pub fn plot_kernel(cases: &[KernelBench], path: &std::path::Path) -> Result<(), 
             series,
             log_x: true,
             log_y: true,
-            x_categories: Vec::new(),
-            y_bounds: None,
+            ..Default::default()
         },
     )
 }

@@ -28,6 +28,7 @@ pub(crate) fn draw(
             log_y,
             filter,
             y_bounds,
+            paper,
         } => {
             let xi = exp.sweeps.iter().position(|s| &s.key == x).unwrap_or(0);
             let groups = line_groups(points, xi, filter);
@@ -54,6 +55,7 @@ pub(crate) fn draw(
                     log_y: *log_y,
                     x_categories: x_categories(&exp.sweeps[xi]),
                     y_bounds: *y_bounds,
+                    reference: paper_reference(exp, points, xi, paper),
                 },
             )?;
             Ok(Vec::new())
@@ -192,6 +194,27 @@ fn series_points(
         }
     }
     (pts, ci)
+}
+
+/// A line plot's published values as crosses: each at the x of the first
+/// point its `where` selects (none when it selects no point).
+fn paper_reference(
+    exp: &Experiment,
+    points: &[Point],
+    xi: usize,
+    paper: &[super::spec::PaperValue],
+) -> Option<crate::plot::Reference> {
+    let pts: Vec<(f64, f64)> = paper
+        .iter()
+        .filter_map(|v| {
+            let p = points.iter().find(|p| p.matches(&v.filter))?;
+            Some((exp.sweeps[xi].coords[p.value_indices[xi]], v.value))
+        })
+        .collect();
+    (!pts.is_empty()).then(|| crate::plot::Reference {
+        label: "paper".into(),
+        points: pts,
+    })
 }
 
 /// The x axis's categories (coordinate, label) of a categorical sweep

@@ -66,6 +66,9 @@ pub enum PlotKind {
         /// `y_bounds`: the values the quantity can take; intervals are cut
         /// there (a fraction's `[0, 1]`).
         y_bounds: Option<(f64, f64)>,
+        /// `paper`: published values, each at the points its `where`
+        /// selects (it fixes the x key), drawn as crosses.
+        paper: Vec<PaperValue>,
     },
     /// Per-frame values of `column`, pooled over the replications of each
     /// point, one group per point (optionally only the points matching `filter`).
@@ -94,6 +97,15 @@ pub enum PlotKind {
         /// Logarithmic y axis.
         log_y: bool,
     },
+}
+
+/// A published value drawn on a line plot at the points `filter` selects.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PaperValue {
+    /// Sweep key = value; includes the plot's x key.
+    pub filter: Vec<(String, toml::Value)>,
+    /// The published value.
+    pub value: f64,
 }
 
 /// A plot to write as `<file>.svg` and `<file>.png` in the output directory.

@@ -173,6 +173,9 @@ impl Validator<'_> {
             if p.range.is_some() && !matches!(kind, PlotKind::Histogram { .. }) {
                 return Err(self.err(format!("{key}.range"), "only histogram plots take `range`"));
             }
+            if p.paper.is_some() && !matches!(kind, PlotKind::Line { .. }) {
+                return Err(self.err(format!("{key}.paper"), "only line plots take `paper`"));
+            }
             if p.y_bounds.is_some() && !matches!(kind, PlotKind::Line { .. }) {
                 return Err(self.err(format!("{key}.y_bounds"), "only line plots take `y_bounds`"));
             }
@@ -234,6 +237,7 @@ impl Validator<'_> {
                 }
             },
         };
+        let paper = self.paper_values(p, key, sweeps, &x)?;
         Ok(PlotKind::Line {
             x,
             y,
@@ -241,7 +245,42 @@ impl Validator<'_> {
             log_y: p.log_y,
             filter: f,
             y_bounds,
+            paper,
         })
+    }
+
+    /// A line plot's `paper` values: at most 64, each finite, each `where`
+    /// naming swept values and fixing the x key `x`.
+    fn paper_values(
+        &self,
+        p: &RawPlot,
+        key: &str,
+        sweeps: &[Sweep],
+        x: &str,
+    ) -> Result<Vec<super::PaperValue>, ExperimentError> {
+        let raw = p.paper.as_deref().unwrap_or_default();
+        if raw.len() > 64 {
+            return Err(self.err(format!("{key}.paper"), "at most 64 values"));
+        }
+        let mut out = Vec::new();
+        for (i, v) in raw.iter().enumerate() {
+            let vkey = format!("{key}.paper.{i}");
+            if !v.value.is_finite() {
+                return Err(self.err(
+                    format!("{vkey}.value"),
+                    format!("must be a finite number, got {}", v.value),
+                ));
+            }
+            let filter = self.filter(sweeps, &format!("{vkey}.where"), &v.filter)?;
+            if !filter.iter().any(|(k, _)| k == x) {
+                return Err(self.err(
+                    format!("{vkey}.where"),
+                    format!("must fix the x axis key `{x}` (the value is drawn at that x)"),
+                ));
+            }
+            out.push(super::PaperValue { filter, value: v.value });
+        }
+        Ok(out)
     }
 
     /// A histogram's column, bins, filter, range and marks.

@@ -138,6 +138,17 @@ pub(super) struct RawPlot {
     #[serde(rename = "where")]
     pub(super) filter: Option<toml::Table>,
     pub(super) marks: Option<Vec<RawMark>>,
+    /// Line plots: published values to draw beside the simulated ones.
+    pub(super) paper: Option<Vec<RawPaperValue>>,
+}
+
+/// A published value on a line plot: `{ where = { KEY = VALUE, ... }, value = 4.969 }`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawPaperValue {
+    #[serde(rename = "where")]
+    pub(super) filter: toml::Table,
+    pub(super) value: f64,
 }
 
 /// A value marked on a histogram: `{ at = 337.0, label = "paper: best 337 ms" }`.

@@ -217,3 +217,54 @@ fn y_bounds_belong_to_line_plots_and_must_be_an_ordered_pair() {
     );
     assert!(e.contains("only line plots take `y_bounds`"), "{e}");
 }
+
+#[test]
+fn paper_values_are_drawn_as_crosses_at_their_points() {
+    let text = format!(
+        "{BASIC}\n[[plot]]\nfile = \"ref\"\nkind = \"line\"\nx = \"workload.gpu\"\n\
+         y = \"metrics.display_interval_ms.mean\"\n\
+         paper = [{{ where = {{ \"workload.gpu\" = \"12ms\", \"display.buffers\" = 2 }}, value = 16.7 }},\n\
+         {{ where = {{ \"workload.gpu\" = \"16ms\" }}, value = 33.3 }}]\n"
+    );
+    let exp = parse(&text);
+    let PlotKind::Line { paper, .. } = &exp.plots[1].kind else {
+        panic!("not a line plot")
+    };
+    assert_eq!(paper.len(), 2);
+    assert_eq!(paper[0].value, 16.7);
+    let dir = tempfile::tempdir().unwrap();
+    run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap();
+    let with = read(dir.path(), "ref.svg");
+    assert!(with.contains("paper"), "no legend entry for the paper's values");
+    // The same plot without them has no such entry and fewer strokes.
+    let plain = read(dir.path(), "interval.svg");
+    assert!(!plain.contains("paper"));
+    let line = |extra: &str| {
+        format!(
+            "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[sweep]]\nkey = \"b\"\nvalues = [3, 4]\n\
+             [[plot]]\nfile = \"p\"\nkind = \"line\"\nx = \"a\"\ny = \"m\"\n{extra}"
+        )
+    };
+    for (bad, want) in [
+        (
+            "paper = [{ where = { b = 3 }, value = 1 }]\n",
+            "paper.0.where`: must fix the x axis key `a`",
+        ),
+        (
+            "paper = [{ where = { a = 5 }, value = 1 }]\n",
+            "`a` = 5 is not one of the swept values",
+        ),
+        (
+            "paper = [{ where = { a = 1 }, value = nan }]\n",
+            "paper.0.value`: must be a finite number",
+        ),
+        ("paper = [{ where = { c = 1 }, value = 1 }]\n", "`c` is not a sweep key"),
+        ("paper = [{ where = { a = 1 } }]\n", "missing field `value`"),
+    ] {
+        let e = parse_err(&line(bad));
+        assert!(e.contains(want), "{bad}: {e}");
+    }
+    let e =
+        parse_err("name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"FrameTime\"\npaper = []\n");
+    assert!(e.contains("only line plots take `paper`"), "{e}");
+}

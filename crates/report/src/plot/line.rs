@@ -48,6 +48,19 @@ pub struct LinePlot {
     /// `(0, 1)`): intervals are cut there, so the y axis never runs past
     /// what the data could be. `None`: unbounded.
     pub y_bounds: Option<(f64, f64)>,
+    /// Published values to compare with (a paper's numbers): drawn as black
+    /// crosses without a line, one legend entry.
+    pub reference: Option<Reference>,
+}
+
+/// Reference values drawn on a [`LinePlot`]: points in data coordinates
+/// and their legend entry (e.g. `paper`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Reference {
+    /// Legend entry.
+    pub label: String,
+    /// `(x, y)` points.
+    pub points: Vec<(f64, f64)>,
 }
 
 /// The ticks of a categorical x axis (positions ascending, labels distinct)
@@ -71,6 +84,8 @@ fn category_ticks(cats: &[(f64, String)]) -> (Ticks, (f64, f64)) {
 /// A series mapped to axis coordinates.
 struct Prepared {
     name: String,
+    /// Reference values: crosses, no line.
+    reference: bool,
     points: Vec<(f64, f64)>,
     /// `(x, low, y, high)` per point that has an interval.
     bars: Vec<(f64, f64, f64, f64)>,
@@ -106,6 +121,7 @@ fn prepare(plot: &LinePlot) -> (Vec<Prepared>, usize) {
         rows.sort_by(|a, b| a.0.total_cmp(&b.0));
         out.push(Prepared {
             name: s.name.clone(),
+            reference: false,
             points: rows.iter().map(|r| (r.0, r.1)).collect(),
             bars: rows
                 .iter()
@@ -113,12 +129,32 @@ fn prepare(plot: &LinePlot) -> (Vec<Prepared>, usize) {
                 .collect(),
         });
     }
+    if let Some(r) = &plot.reference {
+        let mut pts: Vec<(f64, f64)> = Vec::new();
+        for &(x, y) in &r.points {
+            match (to_axis(x, plot.log_x), to_axis(y, plot.log_y)) {
+                (Some(ax), Some(ay)) => pts.push((ax, ay)),
+                _ => dropped += 1,
+            }
+        }
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        if !pts.is_empty() {
+            out.push(Prepared {
+                name: r.label.clone(),
+                reference: true,
+                points: pts,
+                bars: Vec::new(),
+            });
+        }
+    }
     (out, dropped)
 }
 
 /// Whether two series draw the same curve (same x, y within 1e-9 relative).
 fn coincide(a: &Prepared, b: &Prepared) -> bool {
-    !a.points.is_empty()
+    !a.reference
+        && !b.reference
+        && !a.points.is_empty()
         && a.points.len() == b.points.len()
         && a.points
             .iter()
@@ -163,7 +199,7 @@ fn occupied(series: &[Prepared], xr: (f64, f64), yr: (f64, f64)) -> Vec<Occupied
         for p in &s.points {
             samples.push(at(p.0, p.1));
         }
-        for p in s.points.windows(2) {
+        for p in s.points.windows(2).filter(|_| !s.reference) {
             for k in 1..10 {
                 let t = k as f64 / 10.0;
                 samples.push(at(p[0].0 + t * (p[1].0 - p[0].0), p[0].1 + t * (p[1].1 - p[0].1)));
@@ -252,6 +288,17 @@ fn draw<DB: DrawingBackend>(
     let mut any_legend = false;
     let twins = coinciding(series);
     for (i, s) in series.iter().enumerate() {
+        if s.reference {
+            let cross = |p: (f64, f64)| EmptyElement::at(p) + Cross::new((0, 0), 6, BLACK.stroke_width(2));
+            let marks = chart.draw_series(s.points.iter().map(|&p| cross(p))).map_err(e)?;
+            if !s.name.is_empty() {
+                any_legend = true;
+                marks
+                    .label(s.name.as_str())
+                    .legend(move |(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
+            }
+            continue;
+        }
         let c = color(i);
         // A series drawn exactly over an earlier one is dashed, with open
         // square markers, so that both stay visible (and a note says so).

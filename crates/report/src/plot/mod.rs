@@ -25,7 +25,7 @@ mod timeline;
 pub use bar::{BarChart, BarSeries, bar_chart};
 pub use error::PlotError;
 pub use histogram::{Histogram, Mark, histogram};
-pub use line::{LinePlot, Series, line_plot};
+pub use line::{LinePlot, Reference, Series, line_plot};
 pub use scatter::{Scatter, ScatterPoint, scatter};
 pub use timeline::{Bar, Fill, ImageFormat, Lane, Level, Timeline, timeline};
 

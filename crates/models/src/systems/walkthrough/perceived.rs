@@ -173,8 +173,7 @@ pub fn figure6(src: &ModelSource, table: &toml::Table, around: u64, out: &Path) 
             ],
             log_x: false,
             log_y: false,
-            x_categories: Vec::new(),
-            y_bounds: None,
+            ..Default::default()
         },
     )?;
     Ok(Figure6 {
