@@ -386,6 +386,7 @@ mod tests {
     fn prepared(name: &str, points: &[(f64, f64)]) -> Prepared {
         Prepared {
             name: name.into(),
+            reference: false,
             points: points.to_vec(),
             bars: Vec::new(),
         }
@@ -395,6 +396,7 @@ mod tests {
     fn intervals_are_cut_at_the_bounds_and_the_points_are_kept() {
         let mut s = vec![Prepared {
             name: "share".into(),
+            reference: false,
             points: vec![(1.0, 0.5), (2.0, 0.9)],
             bars: vec![(1.0, -0.4, 0.5, 1.6), (2.0, 0.8, 0.9, 1.0)],
         }];
