@@ -2,7 +2,10 @@
 
 use std::path::Path;
 
-use crate::plot::{Histogram, LinePlot, PlotError, Scatter, ScatterPoint, Series, histogram, line_plot, scatter};
+use crate::plot::{
+    BarChart, BarSeries, Histogram, LinePlot, PlotError, Scatter, ScatterPoint, Series, bar_chart, histogram,
+    line_plot, scatter,
+};
 
 use super::run::PointResult;
 use super::spec::{Experiment, PlotKind, PlotSpec};
@@ -86,6 +89,15 @@ pub(crate) fn draw(
             };
             histogram(&base, &h)?;
             Ok(h.outside_range_notes())
+        }
+        PlotKind::Bars {
+            y,
+            log_y,
+            filter,
+            paper,
+        } => {
+            bar_chart(&base, &bars(exp, spec, points, results, (y, *log_y, filter, paper)))?;
+            Ok(Vec::new())
         }
         PlotKind::Scatter { x, y, log_x, log_y } => {
             let pts = results
@@ -194,6 +206,79 @@ fn series_points(
         }
     }
     (pts, ci)
+}
+
+/// A bar plot: one group per `y` path, a bar per kept point (its mean,
+/// with its interval), each followed by the `paper` entries that select it
+/// (a tint of its colour); entries for points the filter left out come
+/// last, named after the first point they select.
+#[allow(clippy::type_complexity)]
+fn bars(
+    exp: &Experiment,
+    spec: &PlotSpec,
+    points: &[Point],
+    results: &[PointResult],
+    (y, log_y, filter, paper): (&[String], bool, &[(String, toml::Value)], &[super::spec::PaperValues]),
+) -> BarChart {
+    let mut series = Vec::new();
+    let mut drawn = vec![false; paper.len()];
+    for p in points.iter().filter(|p| p.matches(filter)) {
+        let r = &results[p.index];
+        let mut values = Vec::new();
+        let mut ci = Vec::new();
+        for path in y {
+            match r.stat(path) {
+                Some(c) if c.n > 0 => {
+                    values.push(c.mean);
+                    ci.push((c.low, c.high));
+                }
+                _ => {
+                    let v = r.value(path).unwrap_or(f64::NAN);
+                    values.push(v);
+                    ci.push((v, v));
+                }
+            }
+        }
+        let label = p.plot_label(&exp.sweeps);
+        series.push(BarSeries {
+            name: format!("{label} (simulated)"),
+            values,
+            ci: Some(ci),
+            tint_of_previous: false,
+        });
+        // The paper's values for this point, beside it in a tint of its colour.
+        for (i, v) in paper.iter().enumerate() {
+            if !drawn[i] && p.matches(&v.filter) {
+                drawn[i] = true;
+                series.push(BarSeries {
+                    name: format!("{label} (paper)"),
+                    values: v.values.clone(),
+                    ci: None,
+                    tint_of_previous: true,
+                });
+            }
+        }
+    }
+    // Paper entries for points the filter left out.
+    for (i, v) in paper.iter().enumerate().filter(|(i, _)| !drawn[*i]) {
+        let name = points.iter().find(|p| p.matches(&v.filter)).map_or_else(
+            || format!("paper {}", i + 1),
+            |p| format!("{} (paper)", p.plot_label(&exp.sweeps)),
+        );
+        series.push(BarSeries {
+            name,
+            values: v.values.clone(),
+            ci: None,
+            tint_of_previous: false,
+        });
+    }
+    BarChart {
+        title: spec.title.clone(),
+        y_label: spec.y_label.clone(),
+        categories: y.iter().map(|p| exp.label_of(p)).collect(),
+        series,
+        log_y,
+    }
 }
 
 /// A line plot's published values as crosses: each at the x of the first

@@ -437,6 +437,7 @@ fn plots(s: &mut String, exp: &Experiment, r: &ExperimentResult) {
                 PlotKind::Line { .. } => "line",
                 PlotKind::Histogram { .. } => "histogram",
                 PlotKind::Scatter { .. } => "scatter",
+                PlotKind::Bars { .. } => "bar",
             };
             let _ = writeln!(
                 s,

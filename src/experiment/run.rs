@@ -594,6 +594,7 @@ fn write_sensitivity(
             name: name.into(),
             values: indices.iter().map(|(_, i)| v(i).0).collect(),
             ci: Some(indices.iter().map(|(_, i)| v(i).1).collect()),
+            tint_of_previous: false,
         };
         let chart = crate::plot::BarChart {
             title: format!("Sobol' indices of {}", s.label),
@@ -603,6 +604,7 @@ fn write_sensitivity(
                 series("first order S_i", |i| (i.first, i.first_ci)),
                 series("total S_Ti", |i| (i.total, i.total_ci)),
             ],
+            log_y: false,
         };
         crate::plot::bar_chart(&out_dir.join(&s.plot), &chart).map_err(|source| ExperimentError::Plot {
             file: s.plot.clone(),

@@ -85,6 +85,19 @@ pub enum PlotKind {
         /// Values marked with a labelled vertical line (the paper's numbers).
         marks: Vec<crate::plot::Mark>,
     },
+    /// Grouped bars: one group per `y` path (metric or derived name), one
+    /// bar per point (those `filter` keeps) and one per `paper` entry.
+    Bars {
+        /// Metric paths or derived names, one group of bars each.
+        y: Vec<String>,
+        /// Logarithmic y axis.
+        log_y: bool,
+        /// `where` filter: sweep key = value.
+        filter: Vec<(String, toml::Value)>,
+        /// `paper`: published values, one per `y` path, with the points
+        /// they belong to.
+        paper: Vec<PaperValues>,
+    },
     /// One labelled point per experiment point; `x` and `y` are metric
     /// paths (replication means) or derived names.
     Scatter {
@@ -106,6 +119,16 @@ pub struct PaperValue {
     pub filter: Vec<(String, toml::Value)>,
     /// The published value.
     pub value: f64,
+}
+
+/// Published values drawn on a bar plot, one per `y` path, for the points
+/// `filter` selects (named after the first of them).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PaperValues {
+    /// Sweep key = value.
+    pub filter: Vec<(String, toml::Value)>,
+    /// One value per `y` path.
+    pub values: Vec<f64>,
 }
 
 /// A plot to write as `<file>.svg` and `<file>.png` in the output directory.
@@ -318,7 +341,7 @@ impl Experiment {
         }
         for p in &self.plots {
             match &p.kind {
-                PlotKind::Line { y, .. } => y.iter().for_each(|y| add(y)),
+                PlotKind::Line { y, .. } | PlotKind::Bars { y, .. } => y.iter().for_each(|y| add(y)),
                 PlotKind::Scatter { x, y, .. } => {
                     add(x);
                     add(y);

@@ -160,10 +160,11 @@ impl Validator<'_> {
                 "line" => self.line_plot(&mut p, &key, sweeps)?,
                 "histogram" => self.histogram_plot(&p, &key, sweeps)?,
                 "scatter" => self.scatter_plot(&mut p, &key)?,
+                "bars" => self.bar_plot(&mut p, &key, sweeps)?,
                 other => {
                     return Err(self.err(
                         format!("{key}.kind"),
-                        format!("unknown kind `{other}` (expected line, histogram or scatter)"),
+                        format!("unknown kind `{other}` (expected line, histogram, scatter or bars)"),
                     ));
                 }
             };
@@ -173,8 +174,8 @@ impl Validator<'_> {
             if p.range.is_some() && !matches!(kind, PlotKind::Histogram { .. }) {
                 return Err(self.err(format!("{key}.range"), "only histogram plots take `range`"));
             }
-            if p.paper.is_some() && !matches!(kind, PlotKind::Line { .. }) {
-                return Err(self.err(format!("{key}.paper"), "only line plots take `paper`"));
+            if p.paper.is_some() && !matches!(kind, PlotKind::Line { .. } | PlotKind::Bars { .. }) {
+                return Err(self.err(format!("{key}.paper"), "only line and bar plots take `paper`"));
             }
             if p.y_bounds.is_some() && !matches!(kind, PlotKind::Line { .. }) {
                 return Err(self.err(format!("{key}.y_bounds"), "only line plots take `y_bounds`"));
@@ -186,6 +187,7 @@ impl Validator<'_> {
                 PlotKind::Line { x, y, .. } => (x.clone(), y.first().cloned().unwrap_or_default()),
                 PlotKind::Histogram { column, .. } => (column.clone(), "density".into()),
                 PlotKind::Scatter { x, y, .. } => (x.clone(), y.clone()),
+                PlotKind::Bars { y, .. } => (String::new(), y.first().cloned().unwrap_or_default()),
             };
             let label = |p: &str| {
                 metrics
@@ -265,12 +267,18 @@ impl Validator<'_> {
         let mut out = Vec::new();
         for (i, v) in raw.iter().enumerate() {
             let vkey = format!("{key}.paper.{i}");
-            if !v.value.is_finite() {
-                return Err(self.err(
-                    format!("{vkey}.value"),
-                    format!("must be a finite number, got {}", v.value),
-                ));
-            }
+            let value = match (v.value, &v.values) {
+                (Some(x), None) if x.is_finite() => x,
+                (Some(x), None) => {
+                    return Err(self.err(format!("{vkey}.value"), format!("must be a finite number, got {x}")));
+                }
+                _ => {
+                    return Err(self.err(
+                        vkey,
+                        "a line plot's paper value needs `value` (one number; `values` is for bar plots)",
+                    ));
+                }
+            };
             let filter = self.filter(sweeps, &format!("{vkey}.where"), &v.filter)?;
             if !filter.iter().any(|(k, _)| k == x) {
                 return Err(self.err(
@@ -278,9 +286,59 @@ impl Validator<'_> {
                     format!("must fix the x axis key `{x}` (the value is drawn at that x)"),
                 ));
             }
-            out.push(super::PaperValue { filter, value: v.value });
+            out.push(super::PaperValue { filter, value });
         }
         Ok(out)
+    }
+
+    /// A bar plot's `y` paths (the groups), scale, filter and `paper`
+    /// values (one per `y` path each, finite; at most 64 entries).
+    fn bar_plot(&self, p: &mut RawPlot, key: &str, sweeps: &[Sweep]) -> Result<PlotKind, ExperimentError> {
+        if p.x.is_some() || p.log_x {
+            return Err(self.err(key, "kind `bars` has no x axis: its groups are the `y` paths"));
+        }
+        let y = p.y.take().map(OneOrMany::into_vec).unwrap_or_default();
+        if y.is_empty() || y.iter().any(|s| s.trim().is_empty()) {
+            return Err(self.err(
+                format!("{key}.y"),
+                "needs one or more metric paths (one group of bars each)",
+            ));
+        }
+        let filter = match &p.filter {
+            Some(t) => self.filter(sweeps, &format!("{key}.where"), t)?,
+            None => Vec::new(),
+        };
+        let raw = p.paper.as_deref().unwrap_or_default();
+        if raw.len() > 64 {
+            return Err(self.err(format!("{key}.paper"), "at most 64 entries"));
+        }
+        let mut paper = Vec::new();
+        for (i, v) in raw.iter().enumerate() {
+            let vkey = format!("{key}.paper.{i}");
+            let values = match (&v.values, v.value) {
+                (Some(vs), None) if vs.len() == y.len() && vs.iter().all(|x| x.is_finite()) => vs.clone(),
+                (Some(vs), None) => {
+                    return Err(self.err(
+                        format!("{vkey}.values"),
+                        format!("needs {} finite numbers, one per `y` path; got {vs:?}", y.len()),
+                    ));
+                }
+                _ => {
+                    return Err(self.err(
+                        vkey,
+                        "a bar plot's paper entry needs `values` (one number per `y` path)",
+                    ));
+                }
+            };
+            let filter = self.filter(sweeps, &format!("{vkey}.where"), &v.filter)?;
+            paper.push(super::PaperValues { filter, values });
+        }
+        Ok(PlotKind::Bars {
+            y,
+            log_y: p.log_y,
+            filter,
+            paper,
+        })
     }
 
     /// A histogram's column, bins, filter, range and marks.

@@ -142,13 +142,15 @@ pub(super) struct RawPlot {
     pub(super) paper: Option<Vec<RawPaperValue>>,
 }
 
-/// A published value on a line plot: `{ where = { KEY = VALUE, ... }, value = 4.969 }`.
+/// A published value on a line plot, `{ where = { KEY = VALUE, ... }, value = 4.969 }`,
+/// or one per `y` path on a bar plot, `{ where = { ... }, values = [3.27, 0.7] }`.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawPaperValue {
     #[serde(rename = "where")]
     pub(super) filter: toml::Table,
-    pub(super) value: f64,
+    pub(super) value: Option<f64>,
+    pub(super) values: Option<Vec<f64>>,
 }
 
 /// A value marked on a histogram: `{ at = 337.0, label = "paper: best 337 ms" }`.

@@ -259,12 +259,67 @@ fn paper_values_are_drawn_as_crosses_at_their_points() {
             "paper.0.value`: must be a finite number",
         ),
         ("paper = [{ where = { c = 1 }, value = 1 }]\n", "`c` is not a sweep key"),
-        ("paper = [{ where = { a = 1 } }]\n", "missing field `value`"),
+        ("paper = [{ where = { a = 1 } }]\n", "needs `value`"),
     ] {
         let e = parse_err(&line(bad));
         assert!(e.contains(want), "{bad}: {e}");
     }
     let e =
         parse_err("name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"FrameTime\"\npaper = []\n");
-    assert!(e.contains("only line plots take `paper`"), "{e}");
+    assert!(e.contains("only line and bar plots take `paper`"), "{e}");
+}
+
+#[test]
+fn bar_plots_group_by_path_and_put_the_paper_beside() {
+    let text = format!(
+        "{BASIC}\n[[plot]]\nfile = \"bars\"\nkind = \"bars\"\n\
+         y = [\"metrics.display_interval_ms.mean\", \"metrics.fixed_kind\"]\nlog_y = true\n\
+         where = {{ \"workload.gpu\" = \"10ms\" }}\n\
+         paper = [{{ where = {{ \"workload.gpu\" = \"10ms\", \"display.buffers\" = 2 }}, values = [16.7, 1.0] }}]\n"
+    );
+    let exp = parse(&text);
+    let PlotKind::Bars {
+        y,
+        log_y,
+        filter,
+        paper,
+    } = &exp.plots[1].kind
+    else {
+        panic!("not a bar plot")
+    };
+    assert_eq!((y.len(), *log_y, filter.len(), paper.len()), (2, true, 1, 1));
+    let dir = tempfile::tempdir().unwrap();
+    run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap();
+    let svg = read(dir.path(), "bars.svg");
+    // Two kept points, simulated, and the paper's entry named after its point.
+    assert_eq!(svg.matches("(simulated)").count(), 2, "{svg}");
+    assert!(svg.contains("workload.gpu=10ms, display.buffers=2 (paper)"), "{svg}");
+    assert!(
+        svg.contains("display interval (ms)"),
+        "categories from the metric labels"
+    );
+    let bars = |extra: &str| {
+        format!(
+            "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[plot]]\nfile = \"p\"\nkind = \"bars\"\n{extra}"
+        )
+    };
+    for (bad, want) in [
+        ("", "needs one or more metric paths"),
+        ("y = \"m\"\nx = \"a\"\n", "has no x axis"),
+        (
+            "y = [\"m\", \"n\"]\npaper = [{ where = { a = 1 }, values = [1] }]\n",
+            "needs 2 finite numbers",
+        ),
+        (
+            "y = \"m\"\npaper = [{ where = { a = 1 }, value = 1 }]\n",
+            "needs `values`",
+        ),
+        (
+            "y = \"m\"\npaper = [{ where = { a = 3 }, values = [1] }]\n",
+            "`a` = 3 is not one of the swept values",
+        ),
+    ] {
+        let e = parse_err(&bars(bad));
+        assert!(e.contains(want), "{bad}: {e}");
+    }
 }

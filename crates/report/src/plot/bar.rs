@@ -9,7 +9,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::PlotError;
-use super::axis::widen;
+use super::axis::{coord, ticks, to_axis, widen};
 use super::font::{AXIS_PX, FAMILY, TICK_PX, TITLE_PX};
 use super::output::{draw_notes, render_both};
 use super::palette::color;
@@ -21,8 +21,12 @@ pub struct BarSeries {
     pub name: String,
     /// One value per category (NaN or infinite: no bar, noted).
     pub values: Vec<f64>,
-    /// An interval per category, drawn as a whisker (optional).
+    /// An interval per category, drawn as a whisker (optional; none where
+    /// the interval has no width).
     pub ci: Option<Vec<(f64, f64)>>,
+    /// Drawn in a light tint of the previous series' colour (a reference
+    /// beside the values it belongs to, e.g. a paper's number).
+    pub tint_of_previous: bool,
 }
 
 /// A grouped bar chart description.
@@ -36,48 +40,65 @@ pub struct BarChart {
     pub categories: Vec<String>,
     /// The series, each in its own colour.
     pub series: Vec<BarSeries>,
+    /// Logarithmic y axis: bars rise from below the smallest value, and
+    /// values that are not positive get no bar (noted).
+    pub log_y: bool,
 }
 
 fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &BarChart) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let n = c.categories.len().max(1);
-    let finite = |v: &f64| v.is_finite();
-    let mut lo: f64 = 0.0;
-    let mut hi: f64 = 0.0;
+    let axis = |v: f64| to_axis(v, c.log_y);
+    let mut lo: f64 = if c.log_y { f64::INFINITY } else { 0.0 };
+    let mut hi: f64 = if c.log_y { f64::NEG_INFINITY } else { 0.0 };
     let mut dropped = 0usize;
     for s in &c.series {
         for v in &s.values {
-            if finite(v) {
-                lo = lo.min(*v);
-                hi = hi.max(*v);
-            } else {
-                dropped += 1;
+            match axis(*v) {
+                Some(a) => {
+                    lo = lo.min(a);
+                    hi = hi.max(a);
+                }
+                None => dropped += 1,
             }
         }
         for (a, b) in s.ci.iter().flatten() {
-            for v in [a, b].into_iter().filter(|v| finite(v)) {
-                lo = lo.min(*v);
-                hi = hi.max(*v);
+            for a in [a, b].into_iter().filter_map(|v| axis(*v)) {
+                lo = lo.min(a);
+                hi = hi.max(a);
             }
         }
     }
-    let (lo, hi) = if hi > lo {
+    let (lo, hi) = if !(lo.is_finite() && hi.is_finite()) {
+        (0.0, 1.0)
+    } else if c.log_y {
+        // Bars rise from a third of a decade below the smallest value.
+        // Headroom above the tallest bar for the legend.
+        (
+            lo - 0.35,
+            hi + (hi - lo).max(1.0) * (0.1 + 0.06 * c.series.len() as f64),
+        )
+    } else if hi > lo {
         (lo - (hi - lo) * 0.02, hi + (hi - lo) * 0.08)
     } else {
         widen(lo, hi, 0.05)
     };
+    let yt = ticks(lo, hi, c.log_y, false);
+    let base = if c.log_y { lo } else { 0.0 };
     let mut chart = ChartBuilder::on(root)
         .margin(20)
         .caption(&c.title, (FAMILY, TITLE_PX))
         .x_label_area_size(50)
         .y_label_area_size(60)
-        .build_cartesian_2d(-0.5..(n as f64 - 0.5), lo..hi)
+        .build_cartesian_2d(-0.5..(n as f64 - 0.5), coord(lo, hi, &yt))
         .map_err(e)?;
+    let fy = |v: &f64| yt.label_at(*v);
     chart
         .configure_mesh()
         .disable_x_mesh()
         .x_labels(0)
         .y_desc(c.y_label.as_str())
+        .y_label_formatter(&fy)
         .label_style((FAMILY, TICK_PX))
         .axis_desc_style((FAMILY, AXIS_PX))
         .draw()
@@ -85,23 +106,35 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &BarChart) -> Resu
     let k = c.series.len().max(1) as f64;
     let group = 0.8;
     let w = group / k;
+    // Colours count the series that are not tints; a tint takes the
+    // previous colour, lightened.
+    let (mut next, mut last) = (0usize, color(0).to_rgba());
     for (j, s) in c.series.iter().enumerate() {
-        let col = color(j);
+        let col = if s.tint_of_previous && j > 0 {
+            last.mix(0.4)
+        } else {
+            last = color(next).to_rgba();
+            next += 1;
+            last
+        };
         let left = |i: usize| i as f64 - group / 2.0 + j as f64 * w;
         chart
             .draw_series(
                 s.values
                     .iter()
                     .enumerate()
-                    .filter(|(_, v)| v.is_finite())
-                    .map(|(i, &v)| Rectangle::new([(left(i) + w * 0.05, 0.0), (left(i) + w * 0.95, v)], col.filled())),
+                    .filter_map(|(i, &v)| Some((i, axis(v)?)))
+                    .map(|(i, v)| Rectangle::new([(left(i) + w * 0.05, base), (left(i) + w * 0.95, v)], col.filled())),
             )
             .map_err(e)?
             .label(s.name.as_str())
             .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], col.filled()));
         if let Some(ci) = &s.ci {
             for (i, &(a, b)) in ci.iter().enumerate() {
-                if !(a.is_finite() && b.is_finite()) {
+                let (Some(a), Some(b)) = (axis(a), axis(b)) else {
+                    continue;
+                };
+                if a == b {
                     continue;
                 }
                 let x = left(i) + w / 2.0;
@@ -140,7 +173,11 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &BarChart) -> Resu
             .map_err(e)?;
     }
     let notes: Vec<String> = if dropped > 0 {
-        vec![format!("{dropped} value(s) not finite: no bar drawn")]
+        vec![if c.log_y {
+            format!("{dropped} value(s) not finite or not positive: no bar drawn on the log axis")
+        } else {
+            format!("{dropped} value(s) not finite: no bar drawn")
+        }]
     } else {
         Vec::new()
     };
@@ -172,13 +209,16 @@ mod tests {
                         name: "first order".into(),
                         values: vec![0.3, 0.44, -0.01],
                         ci: Some(vec![(0.25, 0.35), (0.4, 0.5), (-0.05, 0.03)]),
+                        tint_of_previous: false,
                     },
                     BarSeries {
                         name: "total".into(),
                         values: vec![0.55, f64::NAN, 0.24],
                         ci: None,
+                        tint_of_previous: false,
                     },
                 ],
+                log_y: false,
             },
         )
         .unwrap();
@@ -188,5 +228,35 @@ mod tests {
         // Nothing at all still draws.
         bar_chart(&d.path().join("empty"), &BarChart::default()).unwrap();
         assert_plot_files(&d.path().join("empty"));
+    }
+
+    #[test]
+    fn a_log_axis_drops_what_it_cannot_show_and_says_so() {
+        let d = tempfile::tempdir().unwrap();
+        let base = d.path().join("log");
+        let chart = BarChart {
+            title: "mse".into(),
+            y_label: "ms^2".into(),
+            categories: vec!["h1".into(), "h2".into()],
+            series: vec![
+                BarSeries {
+                    name: "simulated".into(),
+                    values: vec![32.2, 0.0],
+                    ci: None,
+                    tint_of_previous: false,
+                },
+                BarSeries {
+                    name: "paper".into(),
+                    values: vec![3.27, 0.7],
+                    ci: None,
+                    tint_of_previous: false,
+                },
+            ],
+            log_y: true,
+        };
+        bar_chart(&base, &chart).unwrap();
+        assert_plot_files(&base);
+        let svg = std::fs::read_to_string(d.path().join("log.svg")).unwrap();
+        assert!(svg.contains("not positive"), "the zero is noted");
     }
 }
