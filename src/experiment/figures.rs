@@ -239,7 +239,7 @@ fn bars(
                 }
             }
         }
-        let label = p.plot_label(&exp.sweeps);
+        let label = label_without(exp, p, filter);
         series.push(BarSeries {
             name: format!("{label} (simulated)"),
             values,
@@ -278,6 +278,23 @@ fn bars(
         categories: y.iter().map(|p| exp.label_of(p)).collect(),
         series,
         log_y,
+    }
+}
+
+/// A point's plot label without the keys `filter` fixes (they are the
+/// same for every bar); the whole label when that leaves nothing.
+fn label_without(exp: &Experiment, p: &Point, filter: &[(String, toml::Value)]) -> String {
+    let parts: Vec<String> = p
+        .assignments
+        .iter()
+        .enumerate()
+        .filter(|(_, (k, _))| !filter.iter().any(|(f, _)| f == k))
+        .map(|(i, _)| p.plot_assignment(&exp.sweeps, i))
+        .collect();
+    if parts.is_empty() {
+        p.plot_label(&exp.sweeps)
+    } else {
+        parts.join(", ")
     }
 }
 
