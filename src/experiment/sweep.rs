@@ -48,7 +48,9 @@ impl Sweep {
     }
 
     /// Replaces the axis labels (one per value) and makes the sweep
-    /// categorical on plot axes.
+    /// categorical on plot axes: the values are drawn evenly spaced, in
+    /// their order (coordinates are their indices), so that numbers spread
+    /// over decades (`0, 1k, 10k, 1M`) do not crowd one end.
     pub fn with_labels(mut self, labels: Vec<String>) -> Result<Sweep, LabelsError> {
         if labels.len() != self.values.len() {
             return Err(LabelsError::Count {
@@ -65,6 +67,7 @@ impl Sweep {
             }
         }
         self.labels = labels;
+        self.coords = (0..self.values.len()).map(|i| i as f64).collect();
         self.categorical = true;
         self.named = true;
         Ok(self)
