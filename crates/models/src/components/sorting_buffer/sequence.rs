@@ -1,5 +1,5 @@
 //! Sequences of state ids for the sorting buffer: read from a file, or
-//! built (the lecture's worst case for LRU).
+//! built (the lecture's worst case for LRU; independent random states).
 //!
 //! **File format.** State ids are non-negative integers separated by
 //! whitespace (spaces, tabs, newlines, in any mix); `#` starts a comment
@@ -21,9 +21,71 @@
 //! time, in every block: m(m + 1) changes, a ratio of (m + 1) / 2 ≈ √K / 2
 //! (measured in `tests/it/sortbuf.rs` and `docs/lod-and-state-sorting.md`).
 
+//!
+//! **Random states** (`random:N:D:S:SEED`): N ids drawn independently,
+//! state i of D with probability proportional to 1 / (i + 1)^S (Zipf's law;
+//! S = 0 is uniform), from the named RNG stream `sortbuf.sequence` of
+//! SEED. The average case the lecture's verdict on round robin speaks of
+//! ("worst cases say little about practical performance").
+
 use std::path::Path;
 
+use rand::Rng;
+
 use super::{SortBufferError, StateId};
+use crate::engine::RngStreams;
+
+/// Largest N and D of [`random_states`].
+pub const MAX_RANDOM_STATES: u64 = 1 << 24;
+
+/// `n` ids drawn independently from `d` states with Zipf exponent `s` (0:
+/// uniform) from the stream `sortbuf.sequence` of `seed` (see the module).
+pub fn random_states(n: u64, d: u64, s: f64, seed: u64) -> Result<Vec<StateId>, SortBufferError> {
+    if !(1..=MAX_RANDOM_STATES).contains(&n) || !(1..=MAX_RANDOM_STATES).contains(&d) {
+        return Err(SortBufferError::Source(format!(
+            "random:{n}:{d}:...: the length N and the states D must be between 1 and {MAX_RANDOM_STATES}"
+        )));
+    }
+    if !(s.is_finite() && (0.0..=10.0).contains(&s)) {
+        return Err(SortBufferError::Source(format!(
+            "random:{n}:{d}:{s}:...: the Zipf exponent S must be a number from 0 to 10"
+        )));
+    }
+    // Cumulative weights, drawn by binary search.
+    let mut cumulative = Vec::with_capacity(d as usize);
+    let mut total = 0.0;
+    for i in 0..d {
+        total += ((i + 1) as f64).powf(-s);
+        cumulative.push(total);
+    }
+    let mut rng = RngStreams::new(seed).stream("sortbuf.sequence");
+    Ok((0..n)
+        .map(|_| {
+            let u = rng.random::<f64>() * total;
+            cumulative.partition_point(|&c| c <= u).min(d as usize - 1) as StateId
+        })
+        .collect())
+}
+
+/// `random:N:D:S:SEED` parsed, or the error naming what is wrong.
+fn random_spec(spec: &str, rest: &str) -> Result<Vec<StateId>, SortBufferError> {
+    let bad = || {
+        SortBufferError::Source(format!(
+            "{spec:?}: expected random:N:D:S:SEED (N ids, D states, Zipf exponent S >= 0, 0 = uniform; SEED an integer)"
+        ))
+    };
+    let parts: Vec<&str> = rest.split(':').collect();
+    let [n, d, s, seed] = parts.as_slice() else {
+        return Err(bad());
+    };
+    let (n, d, s, seed) = (
+        n.parse::<u64>().map_err(|_| bad())?,
+        d.parse::<u64>().map_err(|_| bad())?,
+        s.parse::<f64>().map_err(|_| bad())?,
+        seed.parse::<u64>().map_err(|_| bad())?,
+    );
+    random_states(n, d, s, seed)
+}
 
 /// Largest m of [`lru_worst`] ([`crate::limits::MAX_LRU_WORST_M`]).
 pub const MAX_LRU_WORST_M: u64 = crate::limits::MAX_LRU_WORST_M;
@@ -74,9 +136,18 @@ pub fn lru_worst(m: u64) -> Result<Vec<StateId>, SortBufferError> {
     Ok(seq)
 }
 
-/// A sequence from a spec: `lru-worst:M`, or a file path (relative paths
-/// from `base`). Returns the sequence and the name to report.
+/// Whether `spec` is built rather than read from a file.
+pub fn is_generated(spec: &str) -> bool {
+    spec.starts_with("lru-worst:") || spec.starts_with("random:")
+}
+
+/// A sequence from a spec: `lru-worst:M`, `random:N:D:S:SEED`, or a file
+/// path (relative paths from `base`). Returns the sequence and the name to
+/// report.
 pub fn sequence_from_spec(spec: &str, base: &Path) -> Result<Vec<StateId>, SortBufferError> {
+    if let Some(rest) = spec.strip_prefix("random:") {
+        return random_spec(spec, rest);
+    }
     if let Some(m) = spec.strip_prefix("lru-worst:") {
         let m: u64 = m.parse().map_err(|_| {
             SortBufferError::Source(format!("{spec:?}: expected lru-worst:M with M a positive integer"))
@@ -88,7 +159,7 @@ pub fn sequence_from_spec(spec: &str, base: &Path) -> Result<Vec<StateId>, SortB
         std::fs::metadata(&path).map_err(|e| SortBufferError::Source(format!("reading sequence file {spec}: {e}")))?;
     if meta.is_dir() {
         return Err(SortBufferError::Source(format!(
-            "{spec} is a folder; give a file of state ids or lru-worst:M"
+            "{spec} is a folder; give a file of state ids, lru-worst:M or random:N:D:S:SEED"
         )));
     }
     let bytes =

@@ -198,3 +198,37 @@ fn bounded_waste_chooses_as_its_direct_form() {
         }
     }
 }
+
+#[test]
+fn random_sequences_are_reproducible_and_follow_their_law() {
+    use super::sequence::{random_states, sequence_from_spec};
+    let a = random_states(50_000, 8, 0.0, 7).unwrap();
+    assert_eq!(a, random_states(50_000, 8, 0.0, 7).unwrap(), "same seed, same ids");
+    assert_ne!(a, random_states(50_000, 8, 0.0, 8).unwrap(), "another seed, other ids");
+    // Uniform: every state about 1/8 of the ids (6,250 each; 5 sigma is about 370).
+    let mut counts = [0u64; 8];
+    a.iter().for_each(|&s| counts[s as usize] += 1);
+    assert!(counts.iter().all(|&c| c.abs_diff(6_250) < 370), "{counts:?}");
+    // Zipf with exponent 1 over 4 states: weights 1, 1/2, 1/3, 1/4 (sum 25/12).
+    let z = random_states(60_000, 4, 1.0, 1).unwrap();
+    let mut zc = [0u64; 4];
+    z.iter().for_each(|&s| zc[s as usize] += 1);
+    for (i, &c) in zc.iter().enumerate() {
+        let want = 60_000.0 * (1.0 / (i + 1) as f64) / (25.0 / 12.0);
+        assert!((c as f64 - want).abs() < 5.0 * want.sqrt(), "state {i}: {c} vs {want}");
+    }
+    // The spec form, and its errors.
+    let base = std::path::Path::new(".");
+    assert_eq!(sequence_from_spec("random:50000:8:0:7", base).unwrap(), a);
+    for (bad, want) in [
+        ("random:10:4:0", "expected random:N:D:S:SEED"),
+        ("random:x:4:0:1", "expected random:N:D:S:SEED"),
+        ("random:0:4:0:1", "must be between 1 and"),
+        ("random:10:0:0:1", "must be between 1 and"),
+        ("random:10:4:-1:1", "Zipf exponent S must be a number from 0 to 10"),
+        ("random:10:4:nan:1", "Zipf exponent S must be a number from 0 to 10"),
+    ] {
+        let e = sequence_from_spec(bad, base).unwrap_err().to_string();
+        assert!(e.contains(want), "{bad}: {e}");
+    }
+}

@@ -1,5 +1,6 @@
 //! The `state_sorting` run, its summary (`metrics.state_changes.<strategy>`,
-//! `metrics.lower_bound`, `metrics.over_bound.<strategy>`, ...), its table
+//! `metrics.lower_bound`, `metrics.over_bound.<strategy>`,
+//! `metrics.over_best.<strategy>`, ...), its table
 //! (one row per strategy) and the registry entry
 //! ([`crate::systems::SYSTEMS`]).
 
@@ -45,6 +46,9 @@ struct Metrics {
     over_input: BTreeMap<&'static str, f64>,
     /// Overflows (the strategy's choices), per strategy.
     overflows: BTreeMap<&'static str, u64>,
+    /// State changes over the fewest any of the strategies run sent, per
+    /// strategy (1 for the best).
+    over_best: BTreeMap<&'static str, f64>,
 }
 
 /// The summary.
@@ -133,6 +137,7 @@ pub fn run_state_sorting(cfg: StateSortingConfig, base_dir: &Path) -> Result<Sta
         over_bound: BTreeMap::new(),
         over_input: BTreeMap::new(),
         overflows: BTreeMap::new(),
+        over_best: BTreeMap::new(),
     };
     if seq.len() <= MAX_OFFLINE_LEN {
         metrics.offline_optimum =
@@ -156,6 +161,10 @@ pub fn run_state_sorting(cfg: StateSortingConfig, base_dir: &Path) -> Result<Sta
             .insert(s.name(), ratio(r.state_changes, metrics.input_runs));
         metrics.overflows.insert(s.name(), r.overflows);
         rows.push((s, r.state_changes, r.overflows));
+    }
+    let best = metrics.state_changes.values().copied().min().unwrap_or(0);
+    for (&name, &changes) in &metrics.state_changes {
+        metrics.over_best.insert(name, ratio(changes, best));
     }
     let simulate_seconds = sim_start.elapsed().as_secs_f64();
     let lower = metrics.lower_bound;
@@ -227,7 +236,7 @@ impl Outcome for StateSortingRun {
         let mut cfg = self.config.clone();
         // A file or a scene's model, made absolute so the resolved model runs anywhere.
         let spec = &cfg.sequence;
-        if !spec.starts_with("lru-worst:") {
+        if !crate::components::sorting_buffer::sequence::is_generated(spec) {
             let (prefix, rest) = match spec.strip_prefix("scene:") {
                 Some(r) => ("scene:", r),
                 None => ("", spec.as_str()),
