@@ -35,6 +35,7 @@ mod pixelflow;
 mod present;
 mod readback;
 mod readme_commands;
+mod readme_numbers;
 mod replay;
 mod replay_round_trip;
 mod shards;

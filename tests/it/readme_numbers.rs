@@ -1,0 +1,139 @@
+//! The numbers the README's "Reproducing the papers" table states for paper
+//! 000 are the shipped experiments' outputs (issue 25 item 4): each is read
+//! from the experiment's golden `points.csv` (which
+//! `golden::every_model_and_experiment_gives_its_golden_outputs` holds to a
+//! fresh run), rounded as the README writes it, and must stand in the
+//! README's row for that result. A re-blessed golden with other values
+//! fails here until the README says them.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+/// The rows of an experiment's golden points.csv, as column -> text.
+fn points(experiment: &str) -> Vec<HashMap<String, String>> {
+    let path = Path::new(ROOT)
+        .join("tests/golden/experiments")
+        .join(experiment)
+        .join("points.csv");
+    let mut r = csv::Reader::from_path(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let header: Vec<String> = r.headers().unwrap().iter().map(str::to_string).collect();
+    r.records()
+        .map(|row| {
+            header
+                .iter()
+                .cloned()
+                .zip(row.unwrap().iter().map(str::to_string))
+                .collect()
+        })
+        .collect()
+}
+
+/// The value of `column` at the point whose sweep keys have these values.
+fn value(experiment: &str, at: &[(&str, &str)], column: &str) -> f64 {
+    let rows = points(experiment);
+    let row = rows
+        .iter()
+        .find(|r| at.iter().all(|(k, v)| r.get(*k).map(String::as_str) == Some(*v)))
+        .unwrap_or_else(|| panic!("{experiment}: no point {at:?}"));
+    row[column]
+        .parse()
+        .unwrap_or_else(|_| panic!("{experiment} {column}: {}", row[column]))
+}
+
+/// The README's table row that starts with `| {result}`.
+fn row<'a>(readme: &'a str, result: &str) -> &'a str {
+    readme
+        .lines()
+        .find(|l| l.trim_start().starts_with(&format!("| {result}")))
+        .unwrap_or_else(|| panic!("the README has no row for {result:?}"))
+}
+
+const GPU: &str = "metrics.gpu_time_ms.mean:mean";
+
+#[test]
+fn the_readme_states_what_the_experiments_give() {
+    let readme = std::fs::read_to_string(Path::new(ROOT).join("README.md")).unwrap();
+    let mut checked = 0;
+    let mut expect = |result: &str, text: String| {
+        let r = row(&readme, result);
+        assert!(r.contains(&text), "README row {result:?} should say {text:?}: {r}");
+        checked += 1;
+    };
+    let t1 = [
+        ("gpu.geometry.vertex_shader", "45337ps"),
+        ("gpu.fragment.per_fragment", "8441ps"),
+    ];
+    expect(
+        "Table 1, 4th cell (both shaders complex), unified pool",
+        format!("{:.3} ms", value("table1-sum-vs-max", &t1, GPU)),
+    );
+    let t1s = [
+        ("gpu.geometry.vertex_shader", "79640ps"),
+        ("gpu.fragment.per_fragment", "8124ps"),
+    ];
+    let split = value("table1-split", &t1s, GPU);
+    expect(
+        "Table 1, 4th cell, split GeForce3",
+        format!("{split:.3} ms ({:+.1}%)", 100.0 * (split / 11.856 - 1.0)),
+    );
+    let order = |o: &str| value("table3-depth-order", &[("workload.depth_order", o)], GPU);
+    let normal = order("random");
+    for (result, o) in [
+        ("Table 3, front to back", "front_to_back"),
+        ("Table 3, back to front", "back_to_front"),
+    ] {
+        let t = order(o);
+        expect(result, format!("{t:.3} ms ({:+.1}%)", 100.0 * (t / normal - 1.0)));
+    }
+    for scene in ["city", "forest"] {
+        let mse: Vec<String> = ["h1", "h2", "h3", "h4", "pos"]
+            .iter()
+            .map(|h| {
+                let v = value(
+                    "table6",
+                    &[("scene.preset", scene)],
+                    &format!("metrics.estimation.{h}.mse_ms2:mean"),
+                );
+                // Two decimals below 10, one above, as the README writes them.
+                if v < 10.0 { format!("{v:.2}") } else { format!("{v:.1}") }
+            })
+            .collect();
+        expect(&format!("Table 6, {scene} h1"), mse.join(" / "));
+    }
+    let cells = |timing: &str, column: &str| {
+        value(
+            "view-cells",
+            &[("estimation.timing", timing), ("estimation.view_cells.samples", "16")],
+            column,
+        )
+    };
+    let vcs = cells("cpu_clock", "metrics.estimation.vcs.mse_ms2:mean");
+    let under = cells("cpu_clock", "metrics.estimation.vcs.underestimated_fraction:mean");
+    expect(
+        "§7.3, view-cell sampling",
+        format!("{vcs:.2} ms^2, {:.0} of 1000", under * 1000.0),
+    );
+    let pvc = |t| cells(t, "metrics.estimation.pvc.mse_ms2:mean");
+    expect(
+        "§7.3, per-object sampling",
+        format!(
+            "{:.1} (time stamps) / {:.1} (CPU clock)",
+            pvc("timestamps"),
+            pvc("cpu_clock")
+        ),
+    );
+    let c = |variation: &str| {
+        value(
+            "system-noise",
+            &[("noise.enabled", "true"), ("variation.enabled", variation)],
+            "c99_from_min",
+        )
+    };
+    expect(
+        "Figure 3, the 99% constant c",
+        format!("{:.2} ms ({:.2} with variation", c("false"), c("true")),
+    );
+    assert_eq!(checked, 9);
+}
