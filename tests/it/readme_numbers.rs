@@ -137,3 +137,23 @@ fn the_readme_states_what_the_experiments_give() {
     );
     assert_eq!(checked, 9);
 }
+
+#[test]
+fn the_models_doc_states_what_the_geforce3_experiments_give() {
+    // docs/models.md, "Paper 000 on the GeForce3": Table 1 on the split
+    // pipeline and Table 3's two predictions.
+    let doc = std::fs::read_to_string(Path::new(ROOT).join("docs/models.md")).unwrap();
+    let t1s = [
+        ("gpu.geometry.vertex_shader", "79640ps"),
+        ("gpu.fragment.per_fragment", "8124ps"),
+    ];
+    let split = value("table1-split", &t1s, GPU);
+    let order = |o: &str| value("table3-depth-order", &[("workload.depth_order", o)], GPU);
+    for text in [
+        format!("fourth cell comes out at {split:.3} ms"),
+        format!("| front to back | 9.143 | {:.3} |", order("front_to_back")),
+        format!("| back to front | 12.552 | {:.3} |", order("back_to_front")),
+    ] {
+        assert!(doc.contains(&text), "docs/models.md should say {text:?}");
+    }
+}
