@@ -198,6 +198,8 @@ pub enum DerivedKind {
 pub struct Derived {
     /// Column name in `points.csv` and the report.
     pub name: String,
+    /// Text for plots (legends, axes): `label`, else the name.
+    pub label: String,
     /// What to compute.
     pub kind: DerivedKind,
 }
@@ -384,6 +386,7 @@ impl Experiment {
             .iter()
             .find(|m| m.path == path)
             .map(|m| m.label.clone())
+            .or_else(|| self.derived.iter().find(|d| d.name == path).map(|d| d.label.clone()))
             .unwrap_or_else(|| path.to_string())
     }
 

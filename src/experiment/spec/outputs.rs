@@ -130,7 +130,18 @@ impl Validator<'_> {
                     ));
                 }
             };
-            derived.push(Derived { name: d.name, kind });
+            let label = match d.label {
+                Some(l) if l.trim().is_empty() => {
+                    return Err(self.err(format!("{key}.label"), "must not be empty"));
+                }
+                Some(l) => l,
+                None => d.name.clone(),
+            };
+            derived.push(Derived {
+                name: d.name,
+                label,
+                kind,
+            });
         }
         Ok(derived)
     }

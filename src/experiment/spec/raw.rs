@@ -170,6 +170,8 @@ pub(super) struct RawDerived {
     pub(super) level: Option<f64>,
     pub(super) path: Option<String>,
     pub(super) reference: Option<toml::Table>,
+    /// Text for plots (legends, axes); the name by default.
+    pub(super) label: Option<String>,
 }
 
 #[derive(Deserialize)]

@@ -327,3 +327,18 @@ fn bar_plots_group_by_path_and_put_the_paper_beside() {
         assert!(e.contains(want), "{bad}: {e}");
     }
 }
+
+#[test]
+fn derived_values_are_named_on_plots_by_their_label() {
+    let text = "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[metric]]\npath = \"m\"\n\
+                [[derived]]\nname = \"r\"\nkind = \"ratio\"\npath = \"m\"\nreference = { a = 1 }\nlabel = \"m against a = 1\"\n\
+                [[derived]]\nname = \"plain\"\nkind = \"ratio\"\npath = \"m\"\nreference = { a = 1 }\n";
+    let exp = parse(text);
+    assert_eq!(exp.label_of("r"), "m against a = 1");
+    assert_eq!(exp.label_of("plain"), "plain");
+    let e = parse_err(&text.replace("label = \"m against a = 1\"", "label = \" \""));
+    assert!(
+        e.contains("derived[0] (r).label") && e.contains("must not be empty"),
+        "{e}"
+    );
+}
