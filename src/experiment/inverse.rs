@@ -9,7 +9,7 @@
 //! from = 0.1                           # bracket
 //! to = 5.0
 //! format = "{}us"                      # optional, like a sweep range's
-//! integer = false                      # true: write the value rounded, as an integer
+//! integer = false                      # true: only whole values are tried (and reported)
 //! path = "metrics.analytic_primitives_at_30ms"
 //! target = 186572                      # or target_from = { path, set, scale }
 //! set = { architecture = "presort" }   # overrides for this search only
@@ -210,7 +210,13 @@ pub(crate) fn validate(
 }
 
 impl Search {
+    /// `x` as the search tries it: whole when `integer`.
+    fn snap(&self, x: f64) -> f64 {
+        if self.integer { x.round() } else { x }
+    }
+
     fn value(&self, x: f64) -> toml::Value {
+        let x = self.snap(x);
         match &self.format {
             Some(f) => toml::Value::String(f.replacen("{}", &format_range_number(x), 1)),
             None if self.integer => toml::Value::Integer(x.round() as i64),
@@ -256,7 +262,7 @@ impl Search {
             set.push((self.vary.clone(), self.value(x)));
             self.metric(runner, base, &set, &self.path, seed)
         };
-        let (mut lo, mut hi) = (self.from, self.to);
+        let (mut lo, mut hi) = (self.snap(self.from), self.snap(self.to));
         let (flo, fhi) = (at(lo)?, at(hi)?);
         let mut result = SearchResult {
             name: self.name.clone(),
@@ -279,7 +285,11 @@ impl Search {
                     result.converged = true;
                     break;
                 }
-                let mid = 0.5 * (lo + hi);
+                let mid = self.snap(0.5 * (lo + hi));
+                if mid == lo || mid == hi {
+                    // Whole values: the bracket cannot shrink further.
+                    break;
+                }
                 let m = at(mid)?;
                 if (m - target).abs() < (best_m - target).abs() {
                     (best, best_m) = (mid, m);
@@ -426,6 +436,21 @@ mod tests {
             .run(&Linear, &toml::Table::new(), 1)
             .unwrap();
         assert!((r.value.unwrap() - 3.0).abs() < 1e-6, "{r:?}");
+    }
+
+    #[test]
+    fn an_integer_search_tries_and_reports_whole_values() {
+        // y = 3x + 1 = 11.5 lies between x = 3 (10) and 4 (13): the closer
+        // whole value is 3, with a format and without.
+        for format in [None, Some("{}us")] {
+            let mut s = search(Target::Value(11.5), format);
+            s.integer = true;
+            let r = s.run(&Linear, &toml::Table::new(), 1).unwrap();
+            assert_eq!(r.value, Some(3.0), "{format:?}: {r:?}");
+            assert_eq!(r.metric, Some(10.0));
+            assert!(!r.converged);
+            assert!(r.runs < 10, "the bracket stops at whole values: {r:?}");
+        }
     }
 
     #[test]
