@@ -58,7 +58,7 @@ pub(crate) fn draw(
                     log_y: *log_y,
                     x_categories: x_categories(&exp.sweeps[xi]),
                     y_bounds: *y_bounds,
-                    reference: paper_reference(exp, points, xi, paper),
+                    reference: paper_reference(exp, points, xi, paper, &spec.paper_label),
                 },
             )?;
             Ok(Vec::new())
@@ -251,7 +251,7 @@ fn bars(
             if !drawn[i] && p.matches(&v.filter) {
                 drawn[i] = true;
                 series.push(BarSeries {
-                    name: format!("{label} (paper)"),
+                    name: format!("{label} ({})", spec.paper_label),
                     values: v.values.clone(),
                     ci: None,
                     tint_of_previous: true,
@@ -262,8 +262,8 @@ fn bars(
     // Paper entries for points the filter left out.
     for (i, v) in paper.iter().enumerate().filter(|(i, _)| !drawn[*i]) {
         let name = points.iter().find(|p| p.matches(&v.filter)).map_or_else(
-            || format!("paper {}", i + 1),
-            |p| format!("{} (paper)", p.plot_label(&exp.sweeps)),
+            || format!("{} {}", spec.paper_label, i + 1),
+            |p| format!("{} ({})", p.plot_label(&exp.sweeps), spec.paper_label),
         );
         series.push(BarSeries {
             name,
@@ -305,6 +305,7 @@ fn paper_reference(
     points: &[Point],
     xi: usize,
     paper: &[super::spec::PaperValue],
+    label: &str,
 ) -> Option<crate::plot::Reference> {
     let pts: Vec<(f64, f64)> = paper
         .iter()
@@ -314,7 +315,7 @@ fn paper_reference(
         })
         .collect();
     (!pts.is_empty()).then(|| crate::plot::Reference {
-        label: "paper".into(),
+        label: label.into(),
         points: pts,
     })
 }

@@ -144,6 +144,9 @@ pub struct PlotSpec {
     pub y_label: String,
     /// The kind and its parameters.
     pub kind: PlotKind,
+    /// What a line or bar plot's `paper` values are called ("paper", or
+    /// e.g. "measured on the H200").
+    pub paper_label: String,
 }
 
 /// How a derived value is computed for each point.

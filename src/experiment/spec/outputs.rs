@@ -188,6 +188,19 @@ impl Validator<'_> {
             if p.paper.is_some() && !matches!(kind, PlotKind::Line { .. } | PlotKind::Bars { .. }) {
                 return Err(self.err(format!("{key}.paper"), "only line and bar plots take `paper`"));
             }
+            let paper_label = match p.paper_label.take() {
+                Some(_) if p.paper.is_none() => {
+                    return Err(self.err(
+                        format!("{key}.paper_label"),
+                        "names the `paper` values; give `paper` too",
+                    ));
+                }
+                Some(l) if l.trim().is_empty() || l.chars().count() > 60 => {
+                    return Err(self.err(format!("{key}.paper_label"), "must be 1 to 60 characters"));
+                }
+                Some(l) => l,
+                None => "paper".to_string(),
+            };
             if p.y_bounds.is_some() && !matches!(kind, PlotKind::Line { .. }) {
                 return Err(self.err(format!("{key}.y_bounds"), "only line plots take `y_bounds`"));
             }
@@ -208,6 +221,7 @@ impl Validator<'_> {
                     .unwrap_or_else(|| p.to_string())
             };
             plots.push(PlotSpec {
+                paper_label,
                 title: p.title.unwrap_or_else(|| name.to_string()),
                 x_label: p.x_label.unwrap_or_else(|| label(&dx)),
                 y_label: p.y_label.unwrap_or_else(|| label(&dy)),

@@ -140,6 +140,8 @@ pub(super) struct RawPlot {
     pub(super) marks: Option<Vec<RawMark>>,
     /// Line plots: published values to draw beside the simulated ones.
     pub(super) paper: Option<Vec<RawPaperValue>>,
+    /// What the `paper` values are called on the plot (default "paper").
+    pub(super) paper_label: Option<String>,
 }
 
 /// A published value on a line plot, `{ where = { KEY = VALUE, ... }, value = 4.969 }`,

@@ -267,6 +267,19 @@ fn paper_values_are_drawn_as_crosses_at_their_points() {
     let e =
         parse_err("name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"FrameTime\"\npaper = []\n");
     assert!(e.contains("only line and bar plots take `paper`"), "{e}");
+    // What the values are called.
+    let named = parse(&line(
+        "paper = [{ where = { a = 1 }, value = 1 }]\npaper_label = \"measured\"\n",
+    ));
+    assert_eq!(named.plots[0].paper_label, "measured");
+    assert_eq!(parse(&line("")).plots[0].paper_label, "paper");
+    for (bad, want) in [
+        ("paper_label = \"measured\"\n", "give `paper` too"),
+        ("paper = []\npaper_label = \" \"\n", "1 to 60 characters"),
+    ] {
+        let e = parse_err(&line(bad));
+        assert!(e.contains("paper_label") && e.contains(want), "{bad}: {e}");
+    }
 }
 
 #[test]
