@@ -238,7 +238,9 @@ def isolate(
     the CPU, GPU front end, geometry and raster load each reduced by
     ``factor`` in turn; returns the variants and the verdict. ``fidelity``:
     ``"draw"`` (default, as the command line), ``"triangle"`` or
-    ``"model"`` (the model file's own)."""
+    ``"model"`` (the model file's own). The dict has the keys of
+    ``rendersim isolate --json``: ``frames`` each variant ran, and ``note``
+    when a run too short to judge from was lengthened."""
     return json.loads(
         _native.isolate(
             _path(model), _sets(set, sets), float(factor), bool(keep_vsync), float(tie_tolerance), str(fidelity)

@@ -294,6 +294,9 @@ pub fn isolate(args: IsolateArgs) -> Result<()> {
         say!("{}", serde_json::to_string_pretty(&iso)?);
         return Ok(());
     }
+    if let Some(note) = &iso.note {
+        esay!("note: {note}");
+    }
     say!(
         "bottleneck isolation (load x{factor}, vsync {}, {} fidelity):",
         if keep_vsync { "on" } else { "off" },

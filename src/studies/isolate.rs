@@ -61,6 +61,12 @@ pub struct Isolation {
     pub tie_tolerance: f64,
     /// The fidelity the variants ran at (`triangle` or `draw`).
     pub fidelity: String,
+    /// Frames each variant simulated (warm-up included).
+    pub frames: u64,
+    /// Set when the model's run was too short to judge from and was
+    /// lengthened: why, in one sentence.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
     /// Wall time of all runs, seconds.
     pub wall_seconds: f64,
 }
@@ -227,6 +233,7 @@ pub fn isolate(cfg: &FramePipelineConfig, base_dir: &Path, options: IsolateOptio
     if !keep_vsync {
         base.display.vsync = false;
     }
+    let note = lengthen_to_steady_state(&mut base);
     let names: &[&str] = match base.workload {
         WorkloadConfig::Fixed(_) | WorkloadConfig::Frames(_) => &["baseline", "cpu", "front_end", "gpu"],
         WorkloadConfig::Scene(_) => &["baseline", "cpu", "front_end", "geometry", "raster"],
@@ -274,8 +281,35 @@ pub fn isolate(cfg: &FramePipelineConfig, base_dir: &Path, options: IsolateOptio
             Fidelity::Draw => "draw",
         }
         .to_string(),
+        frames: base.run.frames,
+        note,
         wall_seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// Measured frames (after the warm-up) a verdict needs: the CPU may run
+/// `max_frames_ahead` frames ahead before it waits for a slow GPU, so
+/// fewer frames measure the pipeline filling, not its steady state (a
+/// GPU-bound model of one measured frame looks CPU-bound).
+pub fn steady_frames(cfg: &FramePipelineConfig) -> u64 {
+    u64::from(cfg.cpu.max_frames_ahead) + 1
+}
+
+/// Lengthens `cfg`'s run to [`steady_frames`] measured frames when it is
+/// shorter (a run bounded by `run.until` is left as it is), and says so.
+fn lengthen_to_steady_state(cfg: &mut FramePipelineConfig) -> Option<String> {
+    let need = steady_frames(cfg);
+    let measured = cfg.run.frames.saturating_sub(cfg.run.warmup_frames);
+    if measured >= need || cfg.run.until.is_some() {
+        return None;
+    }
+    let from = cfg.run.frames;
+    cfg.run.frames = cfg.run.warmup_frames + need;
+    Some(format!(
+        "run.frames raised from {from} to {} for every variant: {measured} measured frame(s) after the warm-up \
+         show the pipeline filling (the CPU runs up to {} frames ahead), not its steady state",
+        cfg.run.frames, cfg.cpu.max_frames_ahead
+    ))
 }
 
 #[cfg(test)]

@@ -1482,3 +1482,30 @@ fn hardware_files_merge_under_the_model_and_their_errors_name_their_line() {
     // The earlier results are still there.
     assert!(out.join("summary.json").exists());
 }
+
+#[test]
+fn isolate_lengthens_a_run_too_short_to_judge() {
+    // The GPU-bound GeForce3 terrain with one measured frame: the CPU has
+    // not yet waited for the GPU, so the verdict would be the CPU. Isolate
+    // runs enough frames for the steady state, and says so.
+    let m = concat!(env!("CARGO_MANIFEST_DIR"), "/models/terrain-geforce3.toml");
+    let o = bin()
+        .args(["isolate", m, "--set", "run.frames=2", "--json"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["bottleneck"], "geometry", "{v}");
+    assert_eq!(v["frames"], 4);
+    assert!(
+        v["note"].as_str().unwrap().contains("run.frames raised from 2 to 4"),
+        "{v}"
+    );
+    // As text, the note goes to stderr before the table.
+    let o = bin().args(["isolate", m, "--set", "run.frames=2"]).output().unwrap();
+    assert!(String::from_utf8_lossy(&o.stderr).contains("note: run.frames raised from 2 to 4"));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("=> bottleneck: geometry"));
+    // A run long enough is left alone, without a note.
+    let v: serde_json::Value = serde_json::from_str(&run_ok(&["isolate", m, "--json"])).unwrap();
+    assert_eq!((v["frames"].as_u64(), v.get("note")), (Some(4), None), "{v}");
+}
