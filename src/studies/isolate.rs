@@ -63,8 +63,8 @@ pub struct Isolation {
     pub fidelity: String,
     /// Frames each variant simulated (warm-up included).
     pub frames: u64,
-    /// Set when the model's run was too short to judge from and was
-    /// lengthened: why, in one sentence.
+    /// Set when the model's run was too short to judge from: that it was
+    /// lengthened, or (a `frames` workload) that it could not be.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
     /// Wall time of all runs, seconds.
@@ -296,12 +296,23 @@ pub fn steady_frames(cfg: &FramePipelineConfig) -> u64 {
 }
 
 /// Lengthens `cfg`'s run to [`steady_frames`] measured frames when it is
-/// shorter (a run bounded by `run.until` is left as it is), and says so.
+/// shorter (a run bounded by `run.until` is left as it is; a `frames`
+/// workload, whose lists fix its length, only gets the warning), and says
+/// so.
 fn lengthen_to_steady_state(cfg: &mut FramePipelineConfig) -> Option<String> {
     let need = steady_frames(cfg);
     let measured = cfg.run.frames.saturating_sub(cfg.run.warmup_frames);
     if measured >= need || cfg.run.until.is_some() {
         return None;
+    }
+    if matches!(cfg.workload, WorkloadConfig::Frames(_)) {
+        // One value per frame in its lists: a replay cannot run longer.
+        return Some(format!(
+            "only {measured} measured frame(s) after the warm-up, and a `kind = \"frames\"` workload cannot run \
+             longer than its lists: the verdict may show the pipeline filling (the CPU runs up to {} frames ahead), \
+             not its steady state",
+            cfg.cpu.max_frames_ahead
+        ));
     }
     let from = cfg.run.frames;
     cfg.run.frames = cfg.run.warmup_frames + need;

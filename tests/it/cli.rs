@@ -1505,6 +1505,14 @@ fn isolate_lengthens_a_run_too_short_to_judge() {
     let o = bin().args(["isolate", m, "--set", "run.frames=2"]).output().unwrap();
     assert!(String::from_utf8_lossy(&o.stderr).contains("note: run.frames raised from 2 to 4"));
     assert!(String::from_utf8_lossy(&o.stdout).contains("=> bottleneck: geometry"));
+    // A replay's lists fix its length: it runs as it is, with the warning.
+    let r = concat!(env!("CARGO_MANIFEST_DIR"), "/models/replay.toml");
+    let v: serde_json::Value = serde_json::from_str(&run_ok(&["isolate", r, "--json"])).unwrap();
+    assert_eq!(v["frames"], 2, "{v}");
+    assert!(
+        v["note"].as_str().unwrap().contains("cannot run longer than its lists"),
+        "{v}"
+    );
     // A run long enough is left alone, without a note.
     let v: serde_json::Value = serde_json::from_str(&run_ok(&["isolate", m, "--json"])).unwrap();
     assert_eq!((v["frames"].as_u64(), v.get("note")), (Some(4), None), "{v}");
