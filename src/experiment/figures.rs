@@ -191,21 +191,22 @@ fn series_points(
     let mut ci = Vec::new();
     for &m in members {
         let xv = exp.sweeps[xi].coords[points[m].value_indices[xi]];
-        let r = &results[m];
-        match (is_derived, r.stat(path)) {
-            (false, Some(c)) if c.n > 0 => {
-                pts.push((xv, c.mean));
-                ci.push((c.low, c.high));
-            }
-            _ => {
-                if let Some(v) = r.value(path) {
-                    pts.push((xv, v));
-                    ci.push((v, v));
-                }
-            }
+        if let Some((v, interval)) = mean_and_interval(&results[m], path, is_derived) {
+            pts.push((xv, v));
+            ci.push(interval);
         }
     }
     (pts, ci)
+}
+
+/// A point's value of `path` and its interval: the replication mean and
+/// its confidence interval, or a derived (or single) value as its own
+/// interval; `None` when the point has no value.
+fn mean_and_interval(r: &PointResult, path: &str, is_derived: bool) -> Option<(f64, (f64, f64))> {
+    match (is_derived, r.stat(path)) {
+        (false, Some(c)) if c.n > 0 => Some((c.mean, (c.low, c.high))),
+        _ => r.value(path).map(|v| (v, (v, v))),
+    }
 }
 
 /// A bar plot: one group per `y` path, a bar per kept point (its mean,
@@ -224,21 +225,13 @@ fn bars(
     let mut drawn = vec![false; paper.len()];
     for p in points.iter().filter(|p| p.matches(filter)) {
         let r = &results[p.index];
-        let mut values = Vec::new();
-        let mut ci = Vec::new();
-        for path in y {
-            match r.stat(path) {
-                Some(c) if c.n > 0 => {
-                    values.push(c.mean);
-                    ci.push((c.low, c.high));
-                }
-                _ => {
-                    let v = r.value(path).unwrap_or(f64::NAN);
-                    values.push(v);
-                    ci.push((v, v));
-                }
-            }
-        }
+        let (values, ci): (Vec<f64>, Vec<(f64, f64)>) = y
+            .iter()
+            .map(|path| {
+                let is_derived = exp.derived.iter().any(|d| &d.name == path);
+                mean_and_interval(r, path, is_derived).unwrap_or((f64::NAN, (f64::NAN, f64::NAN)))
+            })
+            .unzip();
         let label = label_without(exp, p, filter);
         series.push(BarSeries {
             name: format!("{label} (simulated)"),

@@ -27,14 +27,10 @@ pub fn experiment_fingerprint(exp: &Experiment, base_model: &toml::Table) -> Res
     data.extend_from_slice(base_model.to_string().as_bytes());
     // The model files a `[[sweep]] key = "model"` runs on.
     for path in exp.swept_files() {
-        let text = std::fs::read(&path).map_err(|source| ExperimentError::Io {
-            path: path.clone(),
-            source,
-        })?;
+        let src = super::spec::model_source(&path)?;
         data.push(0);
-        data.extend_from_slice(&text);
+        data.extend_from_slice(src.text.as_bytes());
         // and the hardware file it names, as merged into it
-        let src = crate::config::ModelSource::from_file(&path)?;
         if src.own_table()?.contains_key(crate::config::HARDWARE_KEY) {
             data.push(0);
             data.extend_from_slice(src.table()?.to_string().as_bytes());

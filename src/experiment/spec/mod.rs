@@ -482,16 +482,22 @@ impl Experiment {
     }
 }
 
-/// A model file as a TOML table, read as every model is
-/// ([`crate::config::ModelSource::table`]: its hardware file merged in).
-fn read_model(path: &std::path::Path) -> Result<toml::Table, ExperimentError> {
-    let src = crate::config::ModelSource::from_file(path).map_err(|e| match e {
+/// A model file as a source, its read error naming the path as the
+/// experiment's other file errors do.
+pub(crate) fn model_source(path: &std::path::Path) -> Result<crate::config::ModelSource, ExperimentError> {
+    crate::config::ModelSource::from_file(path).map_err(|e| match e {
         crate::config::ConfigError::Io { source, .. } => ExperimentError::Io {
             path: path.to_path_buf(),
             source,
         },
         e => e.into(),
-    })?;
+    })
+}
+
+/// A model file as a TOML table, read as every model is
+/// ([`crate::config::ModelSource::table`]: its hardware file merged in).
+fn read_model(path: &std::path::Path) -> Result<toml::Table, ExperimentError> {
+    let src = model_source(path)?;
     src.table().map_err(|e| match e {
         crate::config::ConfigError::Syntax { message, .. } => ExperimentError::Parse {
             file: path.to_path_buf(),

@@ -11,6 +11,8 @@ use crate::config::flatten;
 use crate::experiment::ExperimentError;
 use crate::experiment::sweep::values_match;
 
+/// Sweep key = value pairs selecting points.
+type Filter = Vec<(String, toml::Value)>;
 impl Validator<'_> {
     /// A `where`-like table of `key` = value: every key a sweep key, every
     /// value one of that sweep's values; flattened to dotted keys.
@@ -276,8 +278,33 @@ impl Validator<'_> {
         })
     }
 
-    /// A line plot's `paper` values: at most 64, each finite, each `where`
-    /// naming swept values and fixing the x key `x`.
+    /// A plot's `paper` entries: at most 64 (`what` names them in that
+    /// error), each read by `read` (given the entry and its key) and its
+    /// `where` checked against the sweeps.
+    fn paper_entries<T>(
+        &self,
+        p: &RawPlot,
+        key: &str,
+        sweeps: &[Sweep],
+        what: &str,
+        mut read: impl FnMut(&super::raw::RawPaperValue, &str) -> Result<T, ExperimentError>,
+    ) -> Result<Vec<(Filter, T)>, ExperimentError> {
+        let raw = p.paper.as_deref().unwrap_or_default();
+        if raw.len() > 64 {
+            return Err(self.err(format!("{key}.paper"), format!("at most 64 {what}")));
+        }
+        raw.iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let vkey = format!("{key}.paper.{i}");
+                let read = read(v, &vkey)?;
+                Ok((self.filter(sweeps, &format!("{vkey}.where"), &v.filter)?, read))
+            })
+            .collect()
+    }
+
+    /// A line plot's `paper` values: each finite, each `where` naming
+    /// swept values and fixing the x key `x`.
     fn paper_values(
         &self,
         p: &RawPlot,
@@ -285,35 +312,27 @@ impl Validator<'_> {
         sweeps: &[Sweep],
         x: &str,
     ) -> Result<Vec<super::PaperValue>, ExperimentError> {
-        let raw = p.paper.as_deref().unwrap_or_default();
-        if raw.len() > 64 {
-            return Err(self.err(format!("{key}.paper"), "at most 64 values"));
-        }
-        let mut out = Vec::new();
-        for (i, v) in raw.iter().enumerate() {
-            let vkey = format!("{key}.paper.{i}");
-            let value = match (v.value, &v.values) {
-                (Some(x), None) if x.is_finite() => x,
-                (Some(x), None) => {
-                    return Err(self.err(format!("{vkey}.value"), format!("must be a finite number, got {x}")));
-                }
-                _ => {
+        let entries = self.paper_entries(p, key, sweeps, "values", |v, vkey| match (v.value, &v.values) {
+            (Some(x), None) if x.is_finite() => Ok(x),
+            (Some(x), None) => Err(self.err(format!("{vkey}.value"), format!("must be a finite number, got {x}"))),
+            _ => Err(self.err(
+                vkey,
+                "a line plot's paper value needs `value` (one number; `values` is for bar plots)",
+            )),
+        })?;
+        entries
+            .into_iter()
+            .enumerate()
+            .map(|(i, (filter, value))| {
+                if !filter.iter().any(|(k, _)| k == x) {
                     return Err(self.err(
-                        vkey,
-                        "a line plot's paper value needs `value` (one number; `values` is for bar plots)",
+                        format!("{key}.paper.{i}.where"),
+                        format!("must fix the x axis key `{x}` (the value is drawn at that x)"),
                     ));
                 }
-            };
-            let filter = self.filter(sweeps, &format!("{vkey}.where"), &v.filter)?;
-            if !filter.iter().any(|(k, _)| k == x) {
-                return Err(self.err(
-                    format!("{vkey}.where"),
-                    format!("must fix the x axis key `{x}` (the value is drawn at that x)"),
-                ));
-            }
-            out.push(super::PaperValue { filter, value });
-        }
-        Ok(out)
+                Ok(super::PaperValue { filter, value })
+            })
+            .collect()
     }
 
     /// A bar plot's `y` paths (the groups), scale, filter and `paper`
@@ -333,31 +352,21 @@ impl Validator<'_> {
             Some(t) => self.filter(sweeps, &format!("{key}.where"), t)?,
             None => Vec::new(),
         };
-        let raw = p.paper.as_deref().unwrap_or_default();
-        if raw.len() > 64 {
-            return Err(self.err(format!("{key}.paper"), "at most 64 entries"));
-        }
-        let mut paper = Vec::new();
-        for (i, v) in raw.iter().enumerate() {
-            let vkey = format!("{key}.paper.{i}");
-            let values = match (&v.values, v.value) {
-                (Some(vs), None) if vs.len() == y.len() && vs.iter().all(|x| x.is_finite()) => vs.clone(),
-                (Some(vs), None) => {
-                    return Err(self.err(
-                        format!("{vkey}.values"),
-                        format!("needs {} finite numbers, one per `y` path; got {vs:?}", y.len()),
-                    ));
-                }
-                _ => {
-                    return Err(self.err(
-                        vkey,
-                        "a bar plot's paper entry needs `values` (one number per `y` path)",
-                    ));
-                }
-            };
-            let filter = self.filter(sweeps, &format!("{vkey}.where"), &v.filter)?;
-            paper.push(super::PaperValues { filter, values });
-        }
+        let paper = self
+            .paper_entries(p, key, sweeps, "entries", |v, vkey| match (&v.values, v.value) {
+                (Some(vs), None) if vs.len() == y.len() && vs.iter().all(|x| x.is_finite()) => Ok(vs.clone()),
+                (Some(vs), None) => Err(self.err(
+                    format!("{vkey}.values"),
+                    format!("needs {} finite numbers, one per `y` path; got {vs:?}", y.len()),
+                )),
+                _ => Err(self.err(
+                    vkey,
+                    "a bar plot's paper entry needs `values` (one number per `y` path)",
+                )),
+            })?
+            .into_iter()
+            .map(|(filter, values)| super::PaperValues { filter, values })
+            .collect();
         Ok(PlotKind::Bars {
             y,
             log_y: p.log_y,
