@@ -281,7 +281,7 @@ pub fn isolate(args: IsolateArgs) -> Result<()> {
             src.name
         );
     }
-    let cfg: rendersim::systems::frame_pipeline::FramePipelineConfig = rendersim::config::deserialize(table, src)?;
+    let cfg = rendersim::systems::frame_pipeline::FramePipelineConfig::from_table(table, src)?;
     let (factor, keep_vsync) = (args.factor, args.keep_vsync);
     let options = IsolateOptions {
         factor,
@@ -731,7 +731,7 @@ pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
         ];
         for (name, model) in models {
             let Some(model) = model else { continue };
-            let text = toml::to_string(model).with_context(|| format!("writing {name}"))?;
+            let text = model.to_toml().with_context(|| format!("writing {name}"))?;
             std::fs::write(
                 dir.join(name),
                 format!(

@@ -209,7 +209,7 @@ pub fn timeline_of(
             system,
         });
     }
-    let mut cfg: FramePipelineConfig = deserialize(table, src).map_err(SimError::from)?;
+    let mut cfg = FramePipelineConfig::from_table(table, src).map_err(SimError::from)?;
     cfg.run.frames = opts.first + opts.frames;
     cfg.run.warmup_frames = 0;
     let vsync = cfg.display.waits_for_vblank();

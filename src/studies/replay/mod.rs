@@ -47,7 +47,7 @@ use self::display_stats::{DisplayStats, FrameTimes};
 use crate::capture::presentmon::{Capture, CaptureError, Columns, Present};
 use crate::components::swap_chain::Composition;
 use crate::config::patch::set_dotted;
-use crate::config::{ModelSource, apply_patches, deserialize, invalid};
+use crate::config::{ModelSource, apply_patches, invalid};
 use crate::stats::quantile::quantile;
 use crate::systems::error::SystemError;
 use crate::systems::frame_pipeline::config::FramesWorkload;
@@ -443,7 +443,7 @@ fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Setup<'a>, Re
     let mut src = ModelSource::from_text("the replay model (models/replay.toml)", REPLAY_MODEL);
     let mut table = src.table()?;
     apply_patches(opts.option_names().1, &opts.assume, &mut src, &mut table).map_err(ReplayError::Assume)?;
-    let assumed_cfg = deserialize::<FramePipelineConfig>(&table, &src).map_err(ReplayError::Assume)?;
+    let assumed_cfg = FramePipelineConfig::from_table(&table, &src).map_err(ReplayError::Assume)?;
     let model_period = assumed_cfg.display.refresh.period.as_ms_f64();
     // A capture taken with frame generation (assumed) measured the
     // interpolation in each frame's GPU busy time; the model adds it again.
@@ -615,7 +615,7 @@ pub fn replay_model(path: &Path, opts: &ReplayOptions) -> Result<(ModelSource, t
 /// One simulation of the set-up frames with `sets` patched on.
 fn simulate(s: &Setup, sets: &[String]) -> Result<Simulated, ReplayError> {
     let (src, table) = model_of(s, sets)?;
-    let cfg: FramePipelineConfig = deserialize(&table, &src)?;
+    let cfg = FramePipelineConfig::from_table(&table, &src)?;
     let sim = std::time::Instant::now();
     // A value the model cannot use is blamed on the option that gave it.
     let run = run_pipeline(cfg, &src.base_dir, None).map_err(|e| match e {

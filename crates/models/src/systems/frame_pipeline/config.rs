@@ -171,6 +171,24 @@ impl Default for CpuConfig {
     }
 }
 
+impl FramePipelineConfig {
+    /// Reads the model from its `table` (with `--set` patches applied), as
+    /// [`crate::config::deserialize`] does; one function, so the crates
+    /// above compile this model's reader once, here, not again each.
+    pub fn from_table(
+        table: &toml::Table,
+        src: &crate::config::ModelSource,
+    ) -> Result<Self, crate::config::ConfigError> {
+        crate::config::deserialize(table, src)
+    }
+
+    /// The model as TOML text (no header), for the crates above to write
+    /// without compiling its writer again.
+    pub fn to_toml(&self) -> Result<String, toml::ser::Error> {
+        toml::to_string(self)
+    }
+}
+
 /// The bus uploads cross (paper 000 §4.3.1 memory management).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
