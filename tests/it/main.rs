@@ -39,6 +39,7 @@ mod readme_numbers;
 mod replay;
 mod replay_round_trip;
 mod shards;
+mod shared_bus;
 mod sortbuf;
 mod state_sorting;
 mod table1_split;

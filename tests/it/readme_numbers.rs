@@ -135,13 +135,43 @@ fn the_readme_states_what_the_experiments_give() {
         "Figure 3, the 99% constant c",
         format!("{:.2} ms ({:.2} with variation", c("false"), c("true")),
     );
-    assert_eq!(checked, 9);
+    let t4 = |memory: &str, bytes: &str, column: &str| {
+        value(
+            "table4-agp",
+            &[
+                ("workload.groups.0.geometry_memory", memory),
+                ("workload.groups.0.vertex_bytes", bytes),
+                ("workload.groups.0.geometry_upload", "1332800"),
+            ],
+            column,
+        )
+    };
+    let render = "metrics.gpu_time_ms.p50:mean";
+    for (result, memory, bytes, paper) in [
+        ("Table 4, Test 1 parallel", "video", "55", 4.59),
+        ("Table 4, Test 2 parallel", "agp", "55", 6.27),
+        ("Table 4, Test 3 parallel", "agp", "32", 5.04),
+    ] {
+        let t = t4(memory, bytes, render);
+        expect(result, format!("{t:.3} ms ({:+.1}%)", 100.0 * (t / paper - 1.0)));
+    }
+    let copy = |memory, bytes| format!("{:.3}", t4(memory, bytes, "metrics.copy_ms.p50:mean"));
+    expect(
+        "Table 4, copying beside rendering",
+        format!(
+            "{} / {} / {} ms",
+            copy("video", "55"),
+            copy("agp", "55"),
+            copy("agp", "32")
+        ),
+    );
+    assert_eq!(checked, 13);
 }
 
 #[test]
 fn the_models_doc_states_what_the_geforce3_experiments_give() {
     // docs/models.md, "Paper 000 on the GeForce3": Table 1 on the split
-    // pipeline and Table 3's two predictions.
+    // pipeline, Table 3's two predictions and Table 4's parallel cells.
     let doc = std::fs::read_to_string(Path::new(ROOT).join("docs/models.md")).unwrap();
     let t1s = [
         ("gpu.geometry.vertex_shader", "79640ps"),
@@ -149,10 +179,31 @@ fn the_models_doc_states_what_the_geforce3_experiments_give() {
     ];
     let split = value("table1-split", &t1s, GPU);
     let order = |o: &str| value("table3-depth-order", &[("workload.depth_order", o)], GPU);
+    // "AGP memory and copies": Table 4's parallel cells.
+    let t4 = |memory: &str, bytes: &str, column: &str| {
+        let at = [
+            ("workload.groups.0.geometry_memory", memory),
+            ("workload.groups.0.vertex_bytes", bytes),
+            ("workload.groups.0.geometry_upload", "1332800"),
+        ];
+        value("table4-agp", &at, column)
+    };
+    let cell = |memory, bytes, paper: (f64, f64)| {
+        let r = t4(memory, bytes, "metrics.gpu_time_ms.p50:mean");
+        let c = t4(memory, bytes, "metrics.copy_ms.p50:mean");
+        let pct = |v: f64, p: f64| format!("{:+.1}%", 100.0 * (v / p - 1.0));
+        format!("{r:.3} ({}) / {c:.3} ({})", pct(r, paper.0), pct(c, paper.1))
+    };
     for text in [
         format!("fourth cell comes out at {split:.3} ms"),
         format!("| front to back | 9.143 | {:.3} |", order("front_to_back")),
         format!("| back to front | 12.552 | {:.3} |", order("back_to_front")),
+        format!(
+            "| Test 1 parallel | 4.59 / 1.9 | {} |",
+            cell("video", "55", (4.59, 1.9))
+        ),
+        format!("| Test 2 parallel | 6.27 / 3.3 | {} |", cell("agp", "55", (6.27, 3.3))),
+        format!("| Test 3 parallel | 5.04 / 2.9 | {} |", cell("agp", "32", (5.04, 2.9))),
     ] {
         assert!(doc.contains(&text), "docs/models.md should say {text:?}");
     }

@@ -1,7 +1,7 @@
 //! Reusable parts that systems compose: distributions, vertex caches, bounded
 //! FIFOs, swap chains, tearing, frame pacing (limiters, low-latency pacers), frame generation,
-//! system-task noise, preemptible processors, a unified shader-core pool and
-//! state-time accounting.
+//! system-task noise, preemptible processors, a unified shader-core pool, a
+//! bus shared by copies and vertex fetch, and state-time accounting.
 
 pub mod distribution;
 pub mod fifo;
@@ -11,6 +11,7 @@ pub mod lod_select;
 pub mod noise;
 pub mod preemptible;
 pub mod shader_pool;
+pub mod shared_bus;
 pub mod sorting_buffer;
 pub mod state_clock;
 pub mod swap_chain;

@@ -108,6 +108,24 @@ impl Preemptible {
         true
     }
 
+    /// The job's speed changes at `now`: what is left of it takes `factor`
+    /// times as long (a copy whose share of a bus moved). A running job gets
+    /// a new completion (returned, with a new generation; the old one goes
+    /// stale); a suspended one keeps the scaled rest for when it resumes.
+    pub fn rescale(&mut self, now: Time, factor: f64) -> Result<Wake, TimeError> {
+        let scale = |d: Duration| Duration::from_ps_f64(d.0 as f64 * factor);
+        if let Some(end) = self.running_until {
+            let end = now.add(scale(end.since(now)), "rescaling a job")?;
+            self.generation = self.generation.wrapping_add(1);
+            self.running_until = Some(end);
+            return Ok(Wake::JobAt(end, self.generation));
+        }
+        if let Some(rem) = self.remaining {
+            self.remaining = Some(scale(rem));
+        }
+        Ok(Wake::Nothing)
+    }
+
     /// A system task of `d` arrives at `now`. Returns the end time of the
     /// task if it starts now (the owner schedules a task-end event then).
     pub fn task_arrives(&mut self, now: Time, d: Duration) -> Result<Option<Time>, TimeError> {
@@ -170,6 +188,26 @@ mod tests {
         assert_eq!(end, Time(100 + 55));
         assert!(p.complete(g));
         assert!(!p.has_job());
+    }
+
+    #[test]
+    fn a_rescaled_job_ends_when_its_rest_at_the_new_speed_is_done() {
+        let mut p = Preemptible::new();
+        let Wake::JobAt(_, g0) = p.start_job(Time(0), Duration(100)).unwrap() else {
+            panic!()
+        };
+        // At 40, 60 left; half the speed: 120 more.
+        let Wake::JobAt(end, g1) = p.rescale(Time(40), 2.0).unwrap() else {
+            panic!()
+        };
+        assert_eq!(end, Time(160));
+        assert!(!p.complete(g0), "the old completion is stale");
+        // Suspended by a task at 100 (60 left), then back to full speed: 30.
+        p.task_arrives(Time(100), Duration(10)).unwrap();
+        assert_eq!(p.rescale(Time(105), 0.5).unwrap(), Wake::Nothing);
+        let (_, w) = p.task_ends(Time(110)).unwrap();
+        assert!(matches!(w, Wake::JobAt(Time(140), _)), "{w:?}");
+        let _ = g1;
     }
 
     #[test]

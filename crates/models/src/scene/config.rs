@@ -38,6 +38,27 @@ pub enum SizeOrder {
     Descending,
 }
 
+/// Where a group's vertices live (paper 000 §4.5.3, Table 4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum GeometryMemory {
+    /// Video memory: the GPU fetches vertices without crossing the bus; an
+    /// upload is copied at `bus.video_copy`.
+    #[default]
+    Video,
+    /// AGP memory: the GPU fetches `vertex_bytes` per transformed vertex
+    /// over the bus, sharing it with any copy running then; an upload is
+    /// copied at `bus.bandwidth`.
+    Agp,
+}
+
+impl GeometryMemory {
+    /// Whether this is the default (left out of a resolved model).
+    pub fn is_video(&self) -> bool {
+        *self == GeometryMemory::Video
+    }
+}
+
 /// Whether consecutive frames show the same view.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -154,6 +175,23 @@ pub struct ObjectGroup {
     /// Texture data uploaded per instance per frame.
     #[serde(default)]
     pub texture_upload: Bytes,
+    /// Where the vertices live: `"video"` (default) or `"agp"` (fetched
+    /// over the bus, Table 4).
+    #[serde(default, skip_serializing_if = "GeometryMemory::is_video")]
+    pub geometry_memory: GeometryMemory,
+    /// Bytes fetched over the bus per transformed vertex when
+    /// `geometry_memory = "agp"` (default 32: position, normal and one
+    /// texture coordinate, interleaved).
+    #[serde(default = "vertex_bytes", skip_serializing_if = "is_default_vertex_bytes")]
+    pub vertex_bytes: Bytes,
+}
+
+fn vertex_bytes() -> Bytes {
+    Bytes(32)
+}
+
+fn is_default_vertex_bytes(b: &Bytes) -> bool {
+    b.0 == 32
 }
 
 fn one_u64() -> u64 {

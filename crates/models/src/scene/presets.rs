@@ -36,6 +36,8 @@ pub fn preset_groups(name: &str, scale: f64) -> Option<Vec<ObjectGroup>> {
         matrix_per_object: true,
         geometry_upload: Bytes(0),
         texture_upload: Bytes(0),
+        geometry_memory: Default::default(),
+        vertex_bytes: Bytes(32),
     };
     Some(match name {
         // 3,453,465 / 5609 = 616 triangles per building.

@@ -79,7 +79,11 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &BarChart) -> Resu
             hi + (hi - lo).max(1.0) * (0.1 + 0.06 * c.series.len() as f64),
         )
     } else if hi > lo {
-        (lo - (hi - lo) * 0.02, hi + (hi - lo) * 0.08)
+        // Headroom above the tallest bar for the legend (a line a series).
+        (
+            lo - (hi - lo) * 0.02,
+            hi + (hi - lo) * (0.1 + 0.06 * c.series.len() as f64),
+        )
     } else {
         widen(lo, hi, 0.05)
     };

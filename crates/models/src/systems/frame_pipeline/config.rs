@@ -17,6 +17,7 @@ pub use crate::components::swap_chain::DisplayConfig;
 use crate::components::vertex_cache::CachePolicy;
 use crate::config::{Bandwidth, Bytes, Rate};
 use crate::engine::Duration;
+use crate::scene::config::GeometryMemory;
 pub use crate::scene::config::SceneWorkload;
 
 /// How finely the GPU's geometry and fragment work is simulated.
@@ -193,14 +194,31 @@ impl FramePipelineConfig {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct BusConfig {
-    /// Copy bandwidth from main memory to GPU-visible memory.
+    /// The bus's bandwidth: a copy into AGP memory runs at it, and the
+    /// GPU's vertex fetch from AGP memory shares it with any copy running
+    /// then ([`crate::components::shared_bus`]).
     pub bandwidth: Bandwidth,
+    /// The rate of a copy into video memory (a group with
+    /// `geometry_memory = "video"`, the default); unset, `bandwidth`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub video_copy: Option<Bandwidth>,
+}
+
+impl BusConfig {
+    /// The rate a copy into `memory` runs at alone.
+    pub fn copy_bandwidth(&self, memory: GeometryMemory) -> &Bandwidth {
+        match (memory, &self.video_copy) {
+            (GeometryMemory::Video, Some(v)) => v,
+            _ => &self.bandwidth,
+        }
+    }
 }
 
 impl Default for BusConfig {
     fn default() -> Self {
         BusConfig {
             bandwidth: Bandwidth::parse("4GB/s").expect("valid literal"),
+            video_copy: None,
         }
     }
 }

@@ -15,6 +15,7 @@ use crate::components::preemptible::{Preemptible, Wake};
 use crate::engine::{Duration, Scheduler, StreamRng, Time};
 use crate::systems::error::SystemError;
 
+use super::bus_copy::BusCopy;
 use super::config::FramesWorkload;
 use super::events::Ev;
 use super::links::{Command, Env, command_count, command_weight, draw_batch_weight};
@@ -194,6 +195,9 @@ pub struct CpuThread {
     pace_for_gpu: bool,
     /// Whether the workload is given frame by frame (`kind = "frames"`).
     per_frame: bool,
+    /// The current draw's copy over a shared bus, while it runs
+    /// ([`super::bus_copy`]).
+    copy: Option<BusCopy>,
 }
 
 #[inline(always)]
@@ -236,6 +240,7 @@ impl CpuThread {
             pace_go: false,
             pace_resume: CpuPhase::NextFrame,
             pace_for_gpu: false,
+            copy: None,
         }
     }
 
@@ -469,6 +474,56 @@ impl CpuThread {
         }
     }
 
+    /// On a shared bus ([`super::bus_copy`]), the running operation's work
+    /// finished: a draw with an upload then copies it (returns true: the
+    /// thread runs on, the copy's end is its next event), and a copy's end
+    /// is recorded in the frame (returns false: the draw's batch is pushed
+    /// as after any work).
+    pub(super) fn copy_turn(&mut self, now: Time, env: &mut Env, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
+        if let Some(c) = self.copy.take() {
+            let took = c.end(now, &mut env.links.bus);
+            env.records[self.frame as usize].copy += took.0;
+            return Ok(false);
+        }
+        let Some(bytes) = self.pending_copy(env) else {
+            return Ok(false);
+        };
+        let Some(d) = env.scene.as_ref().map(|sc| &sc.draws[self.op as usize - 3]) else {
+            return Ok(false);
+        };
+        // The rate alone: the bytes over their time into their memory.
+        let alone = bytes as f64 / d.copy.0.max(1) as f64;
+        let (copy, t) = BusCopy::begin(now, bytes, alone, &mut env.links.bus);
+        self.copy = Some(copy);
+        let w = self.work.start_job(now, t)?;
+        schedule(s, w);
+        Ok(true)
+    }
+
+    /// The bytes the current operation still has to copy: a draw with an
+    /// upload on a shared bus whose copy has not run.
+    fn pending_copy(&self, env: &Env) -> Option<u64> {
+        let sc = env.scene.as_ref().filter(|sc| sc.bus_shared)?;
+        if self.copy.is_some() {
+            return None;
+        }
+        match self.op_at(self.op) {
+            Op::Draw(k) => Some(sc.draws[k as usize].upload).filter(|&b| b > 0),
+            _ => None,
+        }
+    }
+
+    /// The bus's shares moved: a running copy goes on at its new rate.
+    pub(super) fn bus_changed(&mut self, now: Time, env: &mut Env, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+        if let Some(c) = &mut self.copy
+            && let Some(factor) = c.retime(&env.links.bus)
+        {
+            let w = self.work.rescale(now, factor)?;
+            schedule(s, w);
+        }
+        Ok(())
+    }
+
     /// The running operation's work finished.
     pub(super) fn op_done(&mut self, now: Time, env: &mut Env) {
         debug_assert_eq!(self.phase, CpuPhase::Running);
@@ -652,7 +707,9 @@ impl CpuThread {
                         return Ok(true);
                     }
                     let work = self.op_work(self.op_at(self.op), env);
-                    if work.0 > 0 || self.work.in_system() {
+                    // A draw with nothing but its copy still runs (for no
+                    // time), so its end starts the copy.
+                    if work.0 > 0 || self.work.in_system() || self.pending_copy(env).is_some() {
                         let w = self.work.start_job(now, work)?;
                         schedule(s, w);
                         self.phase = CpuPhase::Running;

@@ -16,6 +16,7 @@
 //! stage's time, used per mesh by the workload and per triangle here.
 
 use crate::components::shader_pool::Stream;
+use crate::components::shared_bus::SharedBus;
 use crate::engine::{Duration, Scheduler, StreamRng, Time};
 use crate::scene::config::SizeOrder;
 use crate::systems::error::SystemError;
@@ -25,7 +26,31 @@ use super::config::{Fidelity, GeometryConfig};
 use super::events::Ev;
 use super::fragment_stage::FragmentStage;
 use super::links::{Env, FragWork};
-use super::workload::{closed_times, ordered_sizes};
+use super::workload::{MeshInfo, closed_times, ordered_sizes};
+
+/// `mesh` as a draw from AGP memory sees it at the bus's share now: its
+/// geometry time no shorter than its vertices' bytes take to cross the bus
+/// (`draw` fidelity; the share is the one at the draw's start).
+fn agp_mesh(mesh: &MeshInfo, fetch: f64, bus: &SharedBus, unified: bool) -> MeshInfo {
+    let t = Duration::from_ps_f64(mesh.transformed as f64 * fetch / bus.fetch_rate());
+    MeshInfo {
+        geometry_time: fetch_bound(mesh.geometry_time, mesh.geometry_shader, t, unified),
+        ..mesh.clone()
+    }
+}
+
+/// A geometry time `total` (of which `shader` is vertex shading) when its
+/// vertices take `fetch` to cross the bus: the fetch is pipelined with the
+/// work, so split it is the longer of the two; unified it runs beside the
+/// shading as the fixed-function part does (index fetch, setup), and the
+/// longer of those two is the fixed part.
+fn fetch_bound(total: Duration, shader: Duration, fetch: Duration, unified: bool) -> Duration {
+    if unified {
+        shader.saturating_add(total.saturating_sub(shader).max(fetch))
+    } else {
+        total.max(fetch)
+    }
+}
 
 /// The geometry stage's time for some work: its vertex-shader part and the
 /// whole (the rest is index fetch and triangle setup).
@@ -195,6 +220,17 @@ impl GeometryStage {
         let d = &sc.draws[draw as usize];
         let mesh = &sc.meshes[d.mesh as usize];
         let triangles = mesh.triangles;
+        let fetch = sc.groups[d.group as usize].fetch_bytes_per_vertex;
+        if fetch > 0.0 {
+            // From AGP memory: the fetch asks the bus for the draw's bytes
+            // over its time alone (all of it for a draw of no time).
+            let bytes = mesh.transformed as f64 * fetch;
+            let ask = match mesh.geometry_time.0 {
+                0 => env.links.bus.capacity(),
+                t => bytes / t as f64,
+            };
+            env.links.bus_changed |= env.links.bus.set_fetch(ask);
+        }
         match env.cfg.fidelity {
             Fidelity::Triangle => {
                 let g = &sc.groups[d.group as usize];
@@ -211,9 +247,14 @@ impl GeometryStage {
                 self.next_triangle(now, env, s)
             }
             Fidelity::Draw => {
+                let g = &sc.groups[d.group as usize];
                 let t = match d.closed {
                     Some(t) => t,
-                    None => closed_times(&env.cfg, mesh, &sc.groups[d.group as usize]),
+                    None if fetch > 0.0 => {
+                        let m = agp_mesh(mesh, fetch, &env.links.bus, env.cfg.gpu.pool().is_some());
+                        closed_times(&env.cfg, &m, g)
+                    }
+                    None => closed_times(&env.cfg, mesh, g),
                 };
                 self.start_closed_draw(draw, triangles, t, frag, env.traced, s)
             }
@@ -301,21 +342,31 @@ impl GeometryStage {
         };
         if a.next >= a.triangles {
             self.draw = None;
+            // The draw's vertex fetch from AGP memory (if any) ends.
+            env.links.bus_changed |= env.links.bus.set_fetch(0.0);
             return Ok(());
         }
         let Some(sc) = &env.scene else {
             return Ok(());
         };
-        let mesh = &sc.meshes[sc.draws[a.draw as usize].mesh as usize];
+        let d = &sc.draws[a.draw as usize];
+        let mesh = &sc.meshes[d.mesh as usize];
         let tv = mesh.misses.of(a.next, a.triangles);
         let indices = if mesh.indices > 0 { 3 } else { 0 };
         // Checked: a huge per-vertex cost times the vertices must not wrap.
-        let cost =
+        let mut cost =
             geometry_cost(&env.cfg.gpu.geometry, tv, indices, 1).map_err(|_| crate::engine::TimeError::Overflow {
                 context: "computing the geometry time of a triangle (gpu.geometry costs)".into(),
                 at: now,
                 by: Duration(u64::MAX),
             })?;
+        let fetch = sc.groups[d.group as usize].fetch_bytes_per_vertex;
+        if fetch > 0.0 && tv > 0 {
+            // From AGP memory: no faster than the vertices cross the bus
+            // at the share it leaves the fetch now (a fixed-function part).
+            let t = Duration::from_ps_f64(tv as f64 * fetch / env.links.bus.fetch_rate());
+            cost.total = fetch_bound(cost.total, cost.shader, t, env.links.shaders.is_some());
+        }
         self.busy = true;
         if let Some(pool) = &mut env.links.shaders {
             // Unified: fetch and setup beside the vertex shading on the pool.

@@ -3,14 +3,17 @@
 //! buffer whose being full or empty idles one side), the triangle FIFO
 //! between the geometry and fragment stages (§4.5), the unified
 //! architecture's shader-core pool that both stages run on, the swap chain
-//! between the front end and the display (paper 004 §4.2), and the count of
-//! frames the GPU completed that the CPU's frames-in-flight limit waits on.
+//! between the front end and the display (paper 004 §4.2), the count of
+//! frames the GPU completed that the CPU's frames-in-flight limit waits on,
+//! and the bus that copies and the vertex fetch from AGP memory share
+//! (paper 000 §4.5.3, Table 4).
 //!
 //! No unit holds another's state: each unit's methods get these links as
 //! arguments, in an [`Env`] with the model and the per-frame records.
 
 use crate::components::fifo::{BoundedFifo, FifoUnit};
 use crate::components::shader_pool::{ShaderPool, Stream};
+use crate::components::shared_bus::SharedBus;
 use crate::components::swap_chain::SwapChain;
 use crate::engine::{Duration, Scheduler, Time};
 use crate::systems::error::SystemError;
@@ -73,6 +76,11 @@ pub struct Links {
     /// Frames whose swap the GPU finished (what the CPU's
     /// `cpu.max_frames_ahead` counts against).
     pub(super) frames_completed: u64,
+    /// The bus the CPU's copies and the GPU's vertex fetch from AGP memory
+    /// share (paper 000 Table 4): what each asks for now.
+    pub(super) bus: SharedBus,
+    /// The fetch's ask changed since the CPU's copy last took its rate.
+    pub(super) bus_changed: bool,
 }
 
 impl Links {

@@ -26,6 +26,7 @@
 //! timeline) live above it, in the `rendersim` crate's `studies`.
 
 pub mod accounting;
+mod bus_copy;
 pub mod checked;
 pub mod closed_form;
 pub mod config;

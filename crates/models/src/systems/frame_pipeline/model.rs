@@ -20,6 +20,7 @@
 use crate::components::fifo::BoundedFifo;
 use crate::components::noise::{Arrivals, NoiseSource, NoiseTarget};
 use crate::components::shader_pool::{ShaderPool, Stream};
+use crate::components::shared_bus::SharedBus;
 use crate::components::swap_chain::{PresentMode, SwapChain};
 use crate::engine::{Control, Model, RngStreams, Scheduler, Time};
 use crate::systems::error::SystemError;
@@ -174,6 +175,8 @@ impl FramePipeline {
             },
             chain: SwapChain::new(cfg.display.buffers, mode),
             frames_completed: 0,
+            bus: SharedBus::new(cfg.bus.bandwidth.bytes_per_s() / 1e12),
+            bus_changed: false,
         };
         Ok(FramePipeline {
             cpu: CpuThread::new(frames_total, body, cpu_rngs, fixed, zero_time_after),
@@ -297,6 +300,24 @@ impl FramePipeline {
     /// end made no progress after a CPU step, another round would change
     /// nothing: the loop ends there.
     pub(super) fn settle(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+        self.settle_units(now, s)?;
+        self.settle_bus(now, s)
+    }
+
+    /// When the GPU's vertex fetch from AGP memory began or ended a draw
+    /// (the bus's shares moved), the CPU's running copy takes its new rate
+    /// ([`CpuThread::bus_changed`]). Nothing to do otherwise (no call).
+    #[inline(always)]
+    pub(super) fn settle_bus(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+        if !self.env.links.bus_changed {
+            return Ok(());
+        }
+        self.env.links.bus_changed = false;
+        self.cpu.bus_changed(now, &mut self.env, s)
+    }
+
+    /// [`FramePipeline::settle`]'s steps of the units.
+    fn settle_units(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         loop {
             self.cpu.step(now, &mut self.env, s)?;
             // A front end at rest takes no step (most events find it so):
@@ -325,6 +346,11 @@ impl FramePipeline {
     /// any other operation's [`CpuThread::step_alone`].
     #[inline(always)]
     fn cpu_done(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
+        // A shared bus: a draw's copy is a step of its own (its start ends
+        // the event's work here; its end goes on as any operation's).
+        if self.env.scene.as_ref().is_some_and(|sc| sc.bus_shared) && self.cpu.copy_turn(now, &mut self.env, s)? {
+            return Ok(false);
+        }
         let alone = !self.env.traced && self.front.phase() != FrontPhase::Idle;
         if alone && let Some(a) = self.cpu.draw_done_fast(now, &mut self.env, s)? {
             self.account_cpu_alone(now, a);
@@ -436,6 +462,11 @@ impl Model for FramePipeline {
             Ev::DrawDone => {
                 if let Some(split) = self.geom.draw_done(&mut self.frag) {
                     self.acct.credit_draw_split(split);
+                }
+                // The draw's vertex fetch from AGP memory (if any) ends.
+                if self.env.links.bus.set_fetch(0.0) {
+                    self.env.links.bus_changed = true;
+                    self.settle_bus(now, s)?;
                 }
                 if self.draw_done_alone(now, s)? {
                     return Ok(if self.done() { Control::Stop } else { Control::Continue });

@@ -80,6 +80,9 @@ pub struct FrameRecord {
     /// Where its flip tore the picture (fraction of the height from the
     /// top; `immediate` flips during the scan-out only).
     pub tear_line: Option<f64>,
+    /// Picoseconds the CPU spent copying the frame's uploads over a shared
+    /// bus (0 unless [`super::workload::SceneProgram::bus_shared`]).
+    pub copy: u64,
 }
 
 impl FrameRecord {
@@ -99,6 +102,7 @@ impl FrameRecord {
             displayed: None,
             dropped: false,
             tear_line: None,
+            copy: 0,
         }
     }
 }

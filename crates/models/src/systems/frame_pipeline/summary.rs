@@ -180,6 +180,12 @@ pub struct PipelineMetrics {
     /// What frame generation did (left out when it is off).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frame_generation: Option<GenerationStats>,
+    /// The CPU's copies of the frame's uploads (scenes only; 0 without uploads):
+    /// their bytes at their memory's rate, or, when copies share the bus
+    /// with vertex fetch from AGP memory, as long as the bus's shares made
+    /// them (paper 000 Table 4's copying times).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub copy_ms: Option<Dist>,
     /// Share of the run each unit was on the critical path (the time
     /// shortening its work would save; see `critical_path.rs`).
     pub bottleneck: BTreeMap<String, f64>,
@@ -346,6 +352,7 @@ pub(super) fn summarize(
             dropped_frames: dropped,
             frame_generation: generation_stats(m, warm, displayed, end.0.saturating_sub(mark_time.0)),
             tearing: tearing_stats(m, warm, end.0.saturating_sub(mark_time.0)),
+            copy_ms: copy_stats(m, warm),
             bottleneck: BOTTLENECKS
                 .iter()
                 .zip(bott)
@@ -405,6 +412,20 @@ fn generation_stats(m: &FramePipeline, warm: usize, displayed: usize, span_ps: u
         rendered_fps: per_s(displayed),
         hold_back_ms: Dist::of_finite(&holds),
     })
+}
+
+/// `metrics.copy_ms`: the frames after the warm-up (`warm`); `None` for
+/// a workload without a scene (0 for a scene without uploads).
+fn copy_stats(m: &FramePipeline, warm: usize) -> Option<Dist> {
+    let sc = m.env.scene.as_ref()?;
+    let frames = m.env.records.iter().skip(warm);
+    let ms: Vec<f64> = if sc.bus_shared {
+        frames.map(|r| r.copy as f64 / PS_PER_MS as f64).collect()
+    } else {
+        let per_frame = sc.draws.iter().map(|d| d.copy.0 as f64).sum::<f64>() / PS_PER_MS as f64;
+        frames.map(|_| per_frame).collect()
+    };
+    Some(Dist::of_finite(&ms))
 }
 
 /// `metrics.tearing`: every frame flipped after the warm-up (`warm`

@@ -11,7 +11,7 @@ use std::path::Path;
 use crate::components::distribution::Dist;
 use crate::components::vertex_cache::CachePolicy;
 use crate::engine::Duration;
-use crate::scene::config::{DepthOrder, MeshRef, SceneWorkload, SizeOrder, StateOrder};
+use crate::scene::config::{DepthOrder, GeometryMemory, MeshRef, SceneWorkload, SizeOrder, StateOrder};
 use crate::scene::generators::mesh_from_spec;
 use crate::scene::states::{StateNumbering, scene_groups};
 
@@ -104,6 +104,10 @@ pub struct GroupInfo {
     /// Unified: expected fixed-function time per covered pixel (depth test
     /// of rejected fragments, rasterization and blending of shaded ones), ps.
     pub fixed_per_pixel: f64,
+    /// Where the group's vertices live (and so where its uploads go).
+    pub memory: GeometryMemory,
+    /// Bytes fetched over the bus per transformed vertex (0 in video memory).
+    pub fetch_bytes_per_vertex: f64,
 }
 
 impl GroupInfo {
@@ -132,6 +136,12 @@ pub struct DrawItem {
     pub bytes: u64,
     /// The draw's closed-form times (computed at `draw` fidelity only).
     pub closed: Option<DrawTimes>,
+    /// Bytes the CPU copies for the draw (geometry and texture uploads).
+    pub upload: u64,
+    /// The copy's time alone, at its memory's rate (`bus.bandwidth` into
+    /// AGP memory, `bus.video_copy` into video memory); inside `cpu` unless
+    /// the scene shares its bus ([`SceneProgram::bus_shared`]).
+    pub copy: Duration,
 }
 
 /// Scene statistics per frame, reported in the summary.
@@ -153,8 +163,15 @@ pub struct SceneStats {
     pub matrix_changes: u64,
     /// Bytes uploaded over the bus.
     pub upload_bytes: u64,
+    /// Bytes of vertices fetched from AGP memory over the bus.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub agp_fetch_bytes: u64,
     /// Probability that a fragment passes early-z.
     pub early_z_pass: f64,
+}
+
+fn is_zero(v: &u64) -> bool {
+    *v == 0
 }
 
 /// A compiled scene.
@@ -168,6 +185,11 @@ pub struct SceneProgram {
     pub groups: Vec<GroupInfo>,
     /// Per-frame statistics.
     pub stats: SceneStats,
+    /// Whether copies and vertex fetch can meet on the bus (some group's
+    /// vertices are in AGP memory and some draw uploads): then a draw's copy
+    /// is a step of its own on the CPU thread, at the rate the bus gives it
+    /// ([`crate::components::shared_bus`]), and not inside its `cpu` time.
+    pub bus_shared: bool,
 }
 
 /// One object instance before ordering: its group, mesh, state ids
@@ -351,12 +373,23 @@ pub fn compile_scene(
                 ),
             ));
         }
+        if g.geometry_memory == GeometryMemory::Agp && g.vertex_bytes.0 == 0 {
+            return Err(invalid(
+                format!("{key}.vertex_bytes"),
+                "must be at least 1 byte when geometry_memory = \"agp\" (the bytes fetched over the bus per transformed vertex)",
+            ));
+        }
         groups.push(GroupInfo {
             name: g.name.clone(),
             pixels: g.triangle_pixels.clone(),
             shade_per_pixel,
             fixed_per_pixel,
             order: g.size_order,
+            memory: g.geometry_memory,
+            fetch_bytes_per_vertex: match g.geometry_memory {
+                GeometryMemory::Agp => g.vertex_bytes.0 as f64,
+                GeometryMemory::Video => 0.0,
+            },
         });
         for i in 0..g.count {
             objects.push(Instance {
@@ -424,6 +457,10 @@ pub fn build_program(
     };
     let mut draws = Vec::with_capacity(objects.len());
     let mut prev: Option<(u64, u64, u64)> = None;
+    let bus_shared = objects.iter().any(|o| o.upload > 0)
+        && objects
+            .iter()
+            .any(|o| groups[o.group as usize].fetch_bytes_per_vertex > 0.0);
     // Closed forms per (mesh, group): computed once, only at `draw` fidelity.
     let mut closed_cache: HashMap<(u32, u32), DrawTimes> = HashMap::new();
     for o in objects {
@@ -469,8 +506,12 @@ pub fn build_program(
         stats.texture_changes += changed[1] as u64;
         stats.material_changes += changed[2] as u64;
         stats.matrix_changes += changed[3] as u64;
+        let mut copy = Duration::ZERO;
         if up > 0 {
-            c = add(c, cfg.bus.bandwidth.transfer_time(up), "bus.bandwidth")?;
+            copy = cfg.bus.copy_bandwidth(groups[group as usize].memory).transfer_time(up);
+            if !bus_shared {
+                c = add(c, copy, "bus.bandwidth")?;
+            }
             commands += 1;
             b += bytes.upload.0;
             stats.upload_bytes += up;
@@ -480,7 +521,11 @@ pub fn build_program(
         stats.objects += 1;
         stats.triangles += m.triangles;
         stats.transformed_vertices += m.transformed;
-        let closed = (cfg.fidelity == Fidelity::Draw).then(|| {
+        stats.agp_fetch_bytes += (m.transformed as f64 * groups[group as usize].fetch_bytes_per_vertex).round() as u64;
+        // A draw fetching from AGP memory takes its closed form when it
+        // starts, at the bus's share then.
+        let agp = groups[group as usize].fetch_bytes_per_vertex > 0.0;
+        let closed = (cfg.fidelity == Fidelity::Draw && !agp).then(|| {
             *closed_cache
                 .entry((mesh, group))
                 .or_insert_with(|| closed_times(cfg, m, &groups[group as usize]))
@@ -493,6 +538,8 @@ pub fn build_program(
             commands,
             bytes: b,
             closed,
+            upload: up,
+            copy,
         });
     }
     Ok(SceneProgram {
@@ -500,6 +547,7 @@ pub fn build_program(
         meshes,
         groups,
         stats,
+        bus_shared,
     })
 }
 

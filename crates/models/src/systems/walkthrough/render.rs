@@ -191,6 +191,8 @@ impl Renderer {
                 order: Default::default(),
                 shade_per_pixel: self.shade,
                 fixed_per_pixel: self.fixed,
+                memory: Default::default(),
+                fetch_bytes_per_vertex: 0.0,
             });
             objects.push(Instance {
                 group: i as u32,
