@@ -59,6 +59,9 @@ fn agp_fetch_alone_is_the_longer_of_vertex_work_and_bytes_over_the_bus() {
     assert!((gpu(&agp40) - gpu(&video)).abs() < 1e-9, "{}", gpu(&agp40));
     assert!((gpu(&agp80) - 0.8).abs() < 1e-3, "{}", gpu(&agp80));
     assert_eq!(agp80.summary["scene"]["agp_fetch_bytes"], 800_000);
+    // The closed-form geometry term is the longer one too.
+    assert!((metric(&agp80, "metrics.analytic.geometry_ms") - 0.8).abs() < 1e-9);
+    assert!((metric(&agp40, "metrics.analytic.geometry_ms") - 0.5).abs() < 1e-9);
     // No upload: no copy.
     assert_eq!(p50("copy_ms", &agp80), 0.0);
 }
@@ -82,6 +85,9 @@ fn a_copy_beside_agp_fetch_halves_both_and_the_frame_is_all_bytes_over_the_bus()
     let alone = run(&terrain("geometry_memory = \"agp\"\nvertex_bytes = 80"), &[]);
     let extra = p50("cpu_busy_ms", &r) - p50("cpu_busy_ms", &alone);
     assert!((extra - 0.4).abs() < 1e-3, "cpu extra {extra}");
+    // The closed-form CPU term counts the copy at its rate alone (0.2 ms).
+    let analytic = metric(&r, "metrics.analytic.cpu_ms") - metric(&alone, "metrics.analytic.cpu_ms");
+    assert!((analytic - 0.2).abs() < 1e-9, "analytic copy {analytic}");
 }
 
 #[test]
@@ -119,4 +125,24 @@ fn agp_geometry_needs_bytes_per_vertex() {
     assert!(e.contains("at least 1 byte"), "{e}");
     let e = try_run(&terrain("geometry_memory = \"pci\""), &[]).unwrap_err();
     assert!(e.contains("geometry_memory"), "{e}");
+}
+
+#[test]
+fn a_shared_bus_under_system_tasks_is_deterministic_and_never_copies_faster() {
+    // System tasks on the CPU suspend its copy (and the copy's rest is
+    // retimed while it is suspended): the same seed gives the same run, and
+    // a copy never beats its time with the whole bus to itself.
+    let text = terrain("geometry_memory = \"agp\"\nvertex_bytes = 80\ngeometry_upload = 200000").replace(
+        "[noise]\nenabled = false",
+        "[noise]\nenabled = true\n[[noise.random]]\nname = \"os\"\ntarget = \"cpu\"\nrate = \"5kHz\"\nduration = { kind = \"lognormal\", median = \"50us\", sigma = 0.5 }",
+    );
+    let a = run(&text, &[]);
+    let b = run(&text, &[]);
+    assert_eq!(a.summary["metrics"], b.summary["metrics"]);
+    let copy = metric(&a, "metrics.copy_ms.min");
+    assert!(copy >= 0.2 - 1e-9, "copy {copy}");
+    assert!(
+        metric(&a, "metrics.copy_ms.max") > 0.4,
+        "system tasks lengthen some copies"
+    );
 }

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 use serde_json::Value;
 
-use crate::engine::{PS_PER_MS, RunStats, StopReason};
+use crate::engine::{PS_PER_MS, PS_PER_S, RunStats, StopReason};
 
 use super::accounting::{BOTTLENECKS, CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES};
 use super::config::{FramePipelineConfig, FramesWorkload, WorkloadConfig};
@@ -57,12 +57,21 @@ pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProg
             0.0,
         ),
         (WorkloadConfig::Scene(_), Some(s)) => {
-            let cpu: f64 = s.draws.iter().map(|d| d.cpu.0 as f64).sum();
+            // A copy on a shared bus is a step of its own: at least its
+            // time alone (at its memory's rate).
+            let copies = |d: &super::workload::DrawItem| if s.bus_shared { d.copy.0 as f64 } else { 0.0 };
+            let cpu: f64 = s.draws.iter().map(|d| d.cpu.0 as f64 + copies(d)).sum();
             let front: f64 = s.draws.iter().map(|d| d.front.0 as f64).sum();
+            // A draw from AGP memory: no shorter than its bytes over the whole bus.
+            let bus = cfg.bus.bandwidth.bytes_per_s() / PS_PER_S as f64;
             let geo: f64 = s
                 .draws
                 .iter()
-                .map(|d| s.meshes[d.mesh as usize].geometry_time.0 as f64)
+                .map(|d| {
+                    let m = &s.meshes[d.mesh as usize];
+                    let fetch = m.transformed as f64 * s.groups[d.group as usize].fetch_bytes_per_vertex / bus;
+                    (m.geometry_time.0 as f64).max(fetch)
+                })
                 .sum();
             let frag: f64 = s
                 .draws
