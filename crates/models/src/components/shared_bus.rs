@@ -78,11 +78,6 @@ impl SharedBus {
         self.copy = rate;
     }
 
-    /// Whether a copy is running.
-    pub fn copying(&self) -> bool {
-        self.copy > 0.0
-    }
-
     /// The rate the copy gets now.
     pub fn copy_rate(&self) -> f64 {
         max_min_fair(self.capacity, self.fetch, self.copy).1

@@ -166,6 +166,11 @@ impl Bandwidth {
     pub fn bytes_per_s(&self) -> f64 {
         self.milli_bytes_per_s as f64 / 1000.0
     }
+
+    /// Bytes per picosecond, the simulation's rate unit.
+    pub fn bytes_per_ps(&self) -> f64 {
+        self.bytes_per_s() / 1e12
+    }
 }
 
 /// A size in bytes: an integer, or a string with a unit (`"64KiB"`, `"2MB"`).

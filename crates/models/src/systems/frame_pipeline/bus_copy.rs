@@ -70,6 +70,6 @@ mod tests {
         bus.set_fetch(0.0);
         assert_eq!(c.retime(&bus), Some(0.5));
         assert_eq!(c.end(Time(1500), &mut bus), Duration(1500));
-        assert!(!bus.copying());
+        assert_eq!(bus.copy_rate(), 0.0);
     }
 }

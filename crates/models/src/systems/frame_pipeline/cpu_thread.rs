@@ -485,14 +485,11 @@ impl CpuThread {
             env.records[self.frame as usize].copy += took.0;
             return Ok(false);
         }
-        let Some(bytes) = self.pending_copy(env) else {
-            return Ok(false);
-        };
-        let Some(d) = env.scene.as_ref().map(|sc| &sc.draws[self.op as usize - 3]) else {
+        let Some((bytes, alone)) = self.pending_copy(env) else {
             return Ok(false);
         };
         // The rate alone: the bytes over their time into their memory.
-        let alone = bytes as f64 / d.copy.0.max(1) as f64;
+        let alone = bytes as f64 / alone.0.max(1) as f64;
         let (copy, t) = BusCopy::begin(now, bytes, alone, &mut env.links.bus);
         self.copy = Some(copy);
         let w = self.work.start_job(now, t)?;
@@ -500,15 +497,17 @@ impl CpuThread {
         Ok(true)
     }
 
-    /// The bytes the current operation still has to copy: a draw with an
-    /// upload on a shared bus whose copy has not run.
-    fn pending_copy(&self, env: &Env) -> Option<u64> {
+    /// The bytes the current operation still has to copy and their time
+    /// alone: a draw with an upload on a shared bus whose copy has not run.
+    fn pending_copy(&self, env: &Env) -> Option<(u64, Duration)> {
         let sc = env.scene.as_ref().filter(|sc| sc.bus_shared)?;
         if self.copy.is_some() {
             return None;
         }
         match self.op_at(self.op) {
-            Op::Draw(k) => Some(sc.draws[k as usize].upload).filter(|&b| b > 0),
+            Op::Draw(k) => Some(&sc.draws[k as usize])
+                .filter(|d| d.upload > 0)
+                .map(|d| (d.upload, d.copy)),
             _ => None,
         }
     }

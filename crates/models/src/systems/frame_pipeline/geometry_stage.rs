@@ -111,6 +111,9 @@ pub struct ActiveDraw {
     pub next: u64,
     /// Triangles.
     pub triangles: u64,
+    /// Bytes each transformed vertex fetches over the bus (0: the draw's
+    /// vertices are in video memory).
+    pub fetch: f64,
 }
 
 /// The geometry stage.
@@ -243,6 +246,7 @@ impl GeometryStage {
                     draw,
                     next: 0,
                     triangles,
+                    fetch,
                 });
                 self.next_triangle(now, env, s)
             }
@@ -277,6 +281,7 @@ impl GeometryStage {
             draw,
             next: 0,
             triangles,
+            fetch: 0.0,
         });
         self.fragment_limited = Some(t.fragment >= t.geometry);
         if !traced {
@@ -349,8 +354,7 @@ impl GeometryStage {
         let Some(sc) = &env.scene else {
             return Ok(());
         };
-        let d = &sc.draws[a.draw as usize];
-        let mesh = &sc.meshes[d.mesh as usize];
+        let mesh = &sc.meshes[sc.draws[a.draw as usize].mesh as usize];
         let tv = mesh.misses.of(a.next, a.triangles);
         let indices = if mesh.indices > 0 { 3 } else { 0 };
         // Checked: a huge per-vertex cost times the vertices must not wrap.
@@ -360,7 +364,7 @@ impl GeometryStage {
                 at: now,
                 by: Duration(u64::MAX),
             })?;
-        let fetch = sc.groups[d.group as usize].fetch_bytes_per_vertex;
+        let fetch = a.fetch;
         if fetch > 0.0 && tv > 0 {
             // From AGP memory: no faster than the vertices cross the bus
             // at the share it leaves the fetch now (a fixed-function part).

@@ -175,7 +175,7 @@ impl FramePipeline {
             },
             chain: SwapChain::new(cfg.display.buffers, mode),
             frames_completed: 0,
-            bus: SharedBus::new(cfg.bus.bandwidth.bytes_per_s() / 1e12),
+            bus: SharedBus::new(cfg.bus.bandwidth.bytes_per_ps()),
             bus_changed: false,
         };
         Ok(FramePipeline {
@@ -464,10 +464,8 @@ impl Model for FramePipeline {
                     self.acct.credit_draw_split(split);
                 }
                 // The draw's vertex fetch from AGP memory (if any) ends.
-                if self.env.links.bus.set_fetch(0.0) {
-                    self.env.links.bus_changed = true;
-                    self.settle_bus(now, s)?;
-                }
+                self.env.links.bus_changed |= self.env.links.bus.set_fetch(0.0);
+                self.settle_bus(now, s)?;
                 if self.draw_done_alone(now, s)? {
                     return Ok(if self.done() { Control::Stop } else { Control::Continue });
                 }

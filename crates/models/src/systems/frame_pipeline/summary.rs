@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 use serde_json::Value;
 
-use crate::engine::{PS_PER_MS, PS_PER_S, RunStats, StopReason};
+use crate::engine::{PS_PER_MS, RunStats, StopReason};
 
 use super::accounting::{BOTTLENECKS, CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES};
 use super::config::{FramePipelineConfig, FramesWorkload, WorkloadConfig};
@@ -63,7 +63,7 @@ pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProg
             let cpu: f64 = s.draws.iter().map(|d| d.cpu.0 as f64 + copies(d)).sum();
             let front: f64 = s.draws.iter().map(|d| d.front.0 as f64).sum();
             // A draw from AGP memory: no shorter than its bytes over the whole bus.
-            let bus = cfg.bus.bandwidth.bytes_per_s() / PS_PER_S as f64;
+            let bus = cfg.bus.bandwidth.bytes_per_ps();
             let geo: f64 = s
                 .draws
                 .iter()

@@ -521,11 +521,11 @@ pub fn build_program(
         stats.objects += 1;
         stats.triangles += m.triangles;
         stats.transformed_vertices += m.transformed;
-        stats.agp_fetch_bytes += (m.transformed as f64 * groups[group as usize].fetch_bytes_per_vertex).round() as u64;
+        let fetch = groups[group as usize].fetch_bytes_per_vertex;
+        stats.agp_fetch_bytes += (m.transformed as f64 * fetch).round() as u64;
         // A draw fetching from AGP memory takes its closed form when it
         // starts, at the bus's share then.
-        let agp = groups[group as usize].fetch_bytes_per_vertex > 0.0;
-        let closed = (cfg.fidelity == Fidelity::Draw && !agp).then(|| {
+        let closed = (cfg.fidelity == Fidelity::Draw && fetch == 0.0).then(|| {
             *closed_cache
                 .entry((mesh, group))
                 .or_insert_with(|| closed_times(cfg, m, &groups[group as usize]))
