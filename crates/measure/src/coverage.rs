@@ -35,7 +35,17 @@ pub struct Coverage {
     pub quads: u64,
     /// Warps of up to [`WARP_QUADS`] quads.
     pub warps: u64,
+    /// Covered triangles by how many screen tiles ([`TILE_PIXELS`] square)
+    /// they touch: [`SIZE_CLASSES`] (one tile; up to 16; more).
+    pub by_size: [u64; 3],
+    /// Screen tiles touched, summed over the triangles.
+    pub tiles: u64,
 }
+
+/// Upper bounds (tiles touched) of the size classes of [`Coverage::by_size`]
+/// but the last: a triangle within one tile, within 16 tiles (a 64x64-pixel
+/// square), and larger.
+pub const SIZE_CLASSES: [u64; 2] = [1, 16];
 
 /// Open warp of the packing model.
 struct Packer {
@@ -297,6 +307,10 @@ pub fn coverage(mesh: &Mesh, spec: &str, width: u32, height: u32) -> Coverage {
             c.triangles += part.triangles;
             c.fragments += part.fragments;
             c.quads += part.quads;
+            c.tiles += part.tiles;
+            for (a, b) in c.by_size.iter_mut().zip(part.by_size) {
+                *a += b;
+            }
             for t in touches {
                 // The first tile may continue the previous triangle's open
                 // warp; every later tile differs from the open warp's tile,
@@ -396,7 +410,13 @@ fn count_chunk(indices: &[u32], pos: &[[f32; 2]], width: u32, height: u32) -> (C
         }
         if frags > 0 {
             c.triangles += 1;
+            let class = SIZE_CLASSES
+                .iter()
+                .position(|&b| acc.tiles <= b)
+                .unwrap_or(SIZE_CLASSES.len());
+            c.by_size[class] += 1;
         }
+        c.tiles += acc.tiles;
         c.fragments += frags;
         c.quads += quads;
     }
@@ -495,11 +515,20 @@ mod tests {
                 }
                 qr += 1;
             }
+            let n_tiles = touched.len() as u64;
             for tile in touched.drain(..) {
                 pack.emit(tile, std::mem::take(&mut counts[tile as usize]));
             }
+            c.tiles += n_tiles;
             if frags > 0 {
                 c.triangles += 1;
+                c.by_size[if n_tiles <= 1 {
+                    0
+                } else if n_tiles <= 16 {
+                    1
+                } else {
+                    2
+                }] += 1;
             }
             c.fragments += frags;
             c.quads += quads;

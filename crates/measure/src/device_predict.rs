@@ -5,8 +5,10 @@
 //! the frame-pipeline model ([`PassModel`], unified shader pool, triangle
 //! fidelity) then runs the pass with the mesh's own triangles and the
 //! profile's vertex-cache policy. What the pipeline model does not model is
-//! added around it: the pass overhead, and the part of the target's clear
-//! and store that the geometry work does not hide.
+//! added around it: the pass overhead, the part of the target's clear and
+//! store that the geometry work does not hide, and (taken off) the overlap
+//! of vertex and fragment work on the shared cores that the profile
+//! fitted (`shared_core_overlap`).
 
 use std::path::Path;
 
@@ -176,7 +178,11 @@ pub fn predict_on_device(profile: &DeviceProfile, pass: &DevicePass) -> Result<D
     };
     let sim = simulate_pass(&model)?;
     let geometry_total = layers * terms.geometry_ns;
-    let pass_time_ns = sim.gpu_ms * 1e6 + c.pass_overhead_ns + (terms.clear_ns - geometry_total).max(0.0);
+    // The simulated pool runs a layer's vertex and fragment work one after
+    // the other; the overlap the profile fitted (`shared_core_overlap`) is
+    // taken off its time as the closed form takes it off the sum.
+    let overlap = layers * terms.overlap_ns;
+    let pass_time_ns = sim.gpu_ms * 1e6 + c.pass_overhead_ns + (terms.clear_ns - geometry_total).max(0.0) - overlap;
     let shaded_layers = match (pass.depth_test, pass.order) {
         (false, _) | (true, DepthOrder::BackToFront) => layers,
         (true, DepthOrder::FrontToBack) => 1.0,
@@ -186,7 +192,7 @@ pub fn predict_on_device(profile: &DeviceProfile, pass: &DevicePass) -> Result<D
         pass_time_ns,
         vs_invocations: sim.transformed_vertices,
         fs_invocations: (cov.fragments as f64 * shaded_layers).round() as u64,
-        closed_form_ns: c.pass_overhead_ns + terms.clear_ns.max(geometry_total) + layers * terms.fragment_ns,
+        closed_form_ns: c.pass_overhead_ns + terms.clear_ns.max(geometry_total) + layers * terms.fragment_ns - overlap,
         terms,
         coverage: cov,
         events: sim.events,

@@ -15,6 +15,8 @@
 //!             + (fragment_per_loop F + helper_lane_per_loop H
 //!                + empty_lane_per_loop E + fragment_loop_latency) Lf
 //! pass      = pass_overhead + max(clear_store_per_pixel P, G) + R
+//!             - shared_core_overlap Gl R / (Gl + R)
+//!   with Gl the loop part of G: (vertex_loop_latency + vertex_lane_per_loop 32B) Lv
 //! ```
 //!
 //! Why this shape (fitted to the H200 passes of `docs/measurements`): a
@@ -31,8 +33,19 @@
 //! its dependent-instruction latency however few warps run); clearing and
 //! storing the target overlaps the geometry work (the H200's geometry-only
 //! passes at 2048x2048 cost the same 0.603 ms under any vertex load up to
-//! it). Every cost is linear, so calibration is one non-negative least
-//! squares fit per side of the max.
+//! it). Vertex and fragment work share the shader cores, so the pass is
+//! close to their sum, not their maximum, but not quite the sum: the
+//! H200's heavy vertex and heavy fragment loads together (67,390 and 7,681
+//! loop iterations) take 40.3 ms against 18.8 + 22.8 ms apart. The last
+//! term takes that overlap off: a fraction `shared_core_overlap` (0 to 1)
+//! of `Gl R / (Gl + R)`, which is 0 when either side is absent, about the
+//! smaller side when one dominates, and half of either when they are equal.
+//! Only the vertex shader's loop work enters it (the work that occupies the
+//! shader cores); fitted on the H200 rows, an overlap of the loop parts of
+//! both sides came out at 0, and one of the whole of G predicted whole meshes
+//! held out less well. Every cost but the overlap is linear, so calibration
+//! is a non-negative least squares fit per side of the max, with the
+//! overlap's `Gl R / (Gl + R)` taken from the previous fit until it settles.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -79,6 +92,12 @@ pub struct DeviceCosts {
     pub empty_lane_per_loop_ns: f64,
     /// One fragment loop iteration of the whole pass (latency floor).
     pub fragment_loop_latency_ns: f64,
+    /// Fraction (0 to 1) of `Gl R / (Gl + R)` (Gl the vertex loop work) by
+    /// which vertex and fragment work on the shared cores overlap (not a time; 0 when absent, as in
+    /// profiles written before it). At 1 a pass is never shorter than the
+    /// larger of G and R.
+    #[serde(default)]
+    pub shared_core_overlap: f64,
 }
 
 /// The structural part of a profile: what is not fitted.
@@ -197,6 +216,11 @@ pub struct PassCost {
     pub fragment_ns: f64,
     /// The part of R that does not depend on the loop count, ns.
     pub fragment_base_ns: f64,
+    /// The vertex loop part of G (Gl), ns.
+    pub vertex_loop_ns: f64,
+    /// What vertex loop and fragment work overlap on the shared cores, ns
+    /// (taken off the pass).
+    pub overlap_ns: f64,
     /// The pass, ns.
     pub pass_ns: f64,
 }
@@ -256,16 +280,32 @@ impl PassLoad {
     }
 }
 
-/// Number of fitted costs.
+/// Number of linear costs (every fitted value but the overlap).
 pub const COSTS: usize = 14;
 
+/// Number of fitted values: the linear costs and `shared_core_overlap`.
+pub const FITTED: usize = COSTS + 1;
+
+/// `Gl R / (Gl + R)`: the work the overlap term scales (0 when both are
+/// 0), from the vertex loop work Gl and the fragment work R.
+pub fn shared_work(vertex_loop_ns: f64, fragment_ns: f64) -> f64 {
+    let sum = vertex_loop_ns + fragment_ns;
+    if sum > 0.0 {
+        vertex_loop_ns * fragment_ns / sum
+    } else {
+        0.0
+    }
+}
+
 impl DeviceCosts {
-    /// The costs as an array, in [`DeviceCosts::entries`] order.
+    /// The linear costs as an array, in [`DeviceCosts::entries`] order.
     pub fn to_array(&self) -> [f64; COSTS] {
-        self.entries().map(|(_, v)| v)
+        let e = self.entries();
+        std::array::from_fn(|i| e[i].1)
     }
 
-    /// Costs from an array in [`DeviceCosts::entries`] order.
+    /// Linear costs from an array in [`DeviceCosts::entries`] order, no
+    /// overlap.
     pub fn from_array(b: &[f64; COSTS]) -> DeviceCosts {
         DeviceCosts {
             pass_overhead_ns: b[0],
@@ -282,6 +322,7 @@ impl DeviceCosts {
             helper_lane_per_loop_ns: b[11],
             empty_lane_per_loop_ns: b[12],
             fragment_loop_latency_ns: b[13],
+            shared_core_overlap: 0.0,
         }
     }
 
@@ -294,17 +335,22 @@ impl DeviceCosts {
         let fragment_base_ns: f64 = (7..=9).map(term).sum();
         let fragment_ns = fragment_base_ns + (10..COSTS).map(term).sum::<f64>();
         let clear_ns = term(1);
+        let vertex_loop_ns = term(5) + term(6);
+        let overlap_ns = self.shared_core_overlap * shared_work(vertex_loop_ns, fragment_ns);
         PassCost {
             geometry_ns,
             clear_ns,
             fragment_ns,
             fragment_base_ns,
-            pass_ns: self.pass_overhead_ns + clear_ns.max(geometry_ns) + fragment_ns,
+            vertex_loop_ns,
+            overlap_ns,
+            pass_ns: self.pass_overhead_ns + clear_ns.max(geometry_ns) + fragment_ns - overlap_ns,
         }
     }
 
-    /// `(key, value)` of every cost, in file order.
-    pub fn entries(&self) -> [(&'static str, f64); COSTS] {
+    /// `(key, value)` of every fitted value, in file order: the linear
+    /// costs ([`COSTS`] of them), then `shared_core_overlap`.
+    pub fn entries(&self) -> [(&'static str, f64); FITTED] {
         [
             ("pass_overhead_ns", self.pass_overhead_ns),
             ("clear_store_per_pixel_ns", self.clear_store_per_pixel_ns),
@@ -320,6 +366,7 @@ impl DeviceCosts {
             ("helper_lane_per_loop_ns", self.helper_lane_per_loop_ns),
             ("empty_lane_per_loop_ns", self.empty_lane_per_loop_ns),
             ("fragment_loop_latency_ns", self.fragment_loop_latency_ns),
+            ("shared_core_overlap", self.shared_core_overlap),
         ]
     }
 }
@@ -349,8 +396,8 @@ impl DeviceProfile {
     /// The checks every profile keeps, read ([`DeviceProfile::parse`]) or
     /// about to be written (`rendersim calibrate`): a known vertex-cache
     /// policy; 1 to [`MAX_SHADER_CORES`] shader cores; every cost finite and
-    /// non-negative, and not all zero (such a profile predicts 0 ns for
-    /// every pass); standard errors only of costs, finite and non-negative;
+    /// non-negative, the linear ones not all zero (such a profile predicts
+    /// 0 ns for every pass), the overlap at most 1; standard errors only of costs, finite and non-negative;
     /// at least [`super::calibrate::MIN_ROWS`] rows; the error statistics
     /// finite, non-negative and ordered (median <= 90th percentile <=
     /// worst). The error is [`ProfileError::Invalid`] naming the key.
@@ -394,7 +441,16 @@ impl DeviceProfile {
                 );
             }
         }
-        if self.costs.entries().iter().all(|(_, v)| *v == 0.0) {
+        let overlap = self.costs.shared_core_overlap;
+        if overlap > 1.0 {
+            return bad(
+                "costs.shared_core_overlap",
+                overlap.to_string(),
+                "must be at most 1 (beyond it a pass would take less than the larger of its vertex and \
+                 fragment work)",
+            );
+        }
+        if self.costs.to_array().iter().all(|v| *v == 0.0) {
             return bad(
                 "costs",
                 "0 for every cost".into(),
@@ -519,6 +575,51 @@ mod tests {
     }
 
     #[test]
+    fn a_profile_without_the_overlap_reads_as_none() {
+        // Profiles written before the shared-core term read with it at 0,
+        // and their passes cost what they did: the sum of the sides.
+        let (text, path) = shipped("nvidia-h200.toml");
+        let old: String = text
+            .lines()
+            .filter(|l| !l.starts_with("shared_core_overlap = "))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let p = DeviceProfile::parse(&old, &path).unwrap();
+        assert_eq!(p.costs.shared_core_overlap, 0.0);
+        let load = PassLoad {
+            pixels: 147456.0,
+            vertices: 15570.0,
+            vertex_batches: 576.0,
+            triangles: 18432.0,
+            vs_loops: 67390.0,
+            fs_loops: 7681.0,
+            coverage: Coverage {
+                triangles: 18432,
+                drawn_triangles: 18432,
+                fragments: 147456,
+                quads: 55296,
+                warps: 9695,
+                ..Coverage::default()
+            },
+        };
+        let c = p.costs.cost(&load);
+        assert_eq!(c.overlap_ns, 0.0);
+        assert_eq!(
+            c.pass_ns,
+            p.costs.pass_overhead_ns + c.clear_ns.max(c.geometry_ns) + c.fragment_ns
+        );
+        // With it: Gl R / (Gl + R) of it taken off, and never below the
+        // larger side.
+        let with = DeviceProfile::parse(&text, &path).unwrap().costs;
+        let k = with.cost(&load);
+        let w = with.shared_core_overlap;
+        assert!(w > 0.0 && w <= 1.0);
+        let want = w * k.vertex_loop_ns * k.fragment_ns / (k.vertex_loop_ns + k.fragment_ns);
+        assert!((k.overlap_ns - want).abs() < 1e-6 * want, "{k:?}");
+        assert!(k.pass_ns >= k.geometry_ns.max(k.fragment_ns));
+    }
+
+    #[test]
     fn the_shipped_profiles_read_and_validate() {
         for name in ["nvidia-h200.toml", "llvmpipe.toml"] {
             let (text, path) = shipped(name);
@@ -553,6 +654,13 @@ mod tests {
             ("shader_cores", "0", "key `device.shader_cores`: 0"),
             ("shader_cores", "4294967295", "key `device.shader_cores`: 4294967295"),
             ("vertex_cache", "\"bogus\"", "key `device.vertex_cache`"),
+            (
+                "shared_core_overlap",
+                "1.5",
+                "key `costs.shared_core_overlap`: 1.5: must be at most 1",
+            ),
+            ("shared_core_overlap", "-0.1", "key `costs.shared_core_overlap`: -0.1"),
+            ("shared_core_overlap", "nan", "key `costs.shared_core_overlap`: NaN"),
         ] {
             let bad = edit(&text, key, &format!("{key} = {value}"));
             let line = line_of(&bad, key);
