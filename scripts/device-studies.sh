@@ -18,6 +18,9 @@
 #   estimation.md estimation.json         `rendersim study estimation` (h1-h4 and pos fitted on measured
 #   estimation-passes.csv estimation.err  single-object passes, scored on multi-object passes; one CSV row per object)
 #   load-grid.csv                         the passes of docs/measurements/nvidia-h200/load-grid.csv
+#   fixed-costs.csv                       passes of no draw (3 sizes), and grid:32x32 and grid:256x256 at
+#                                         128x128 in 1, 4, 16, 64, 256 and 4096 draws (a profile's
+#                                         pass_overhead_ns and draw_ns)
 #   load-sweep.csv                        every pass of the H200 sweep's lists (6 meshes x 3 sizes x 7 loads),
 #                                         the rows the shared file held out included, less the capped ones
 #   vertex-reuse.csv corpus-passes.csv    VS invocations of each corpus/*.idx (one draw, 256x256)
@@ -64,6 +67,8 @@ collect() {
   local grid_mesh=grid:96x96:optimized grid_size=384x384
   local grid_vs=(0 2000 67390) grid_fs=(0 500 2000 7681)
   local extra_meshes=(grid:256x256 grid:32x32) extra_sizes=(64x64 1024x1024)
+  local fixed_meshes=(grid:32x32 grid:256x256) fixed_sizes=(128x128 512x512 2048x2048)
+  local fixed_draws=(1 4 16 64 256 4096)
   local sweep_meshes=(grid:32x32 grid:96x96:optimized grid:256x256 grid:64x64:shuffled:1 strip:64x64 random:30000:5000:7)
   local sweep_sizes=(128x128 512x512 2048x2048)
   local sweep_loads=("0 0" "1000 0" "0 300" "1000 300" "10000 3000" "1000 0 geo" "10000 0 geo")
@@ -75,6 +80,7 @@ collect() {
     grid_mesh=grid:16x16:optimized grid_size=64x64
     grid_vs=(0 20 670) grid_fs=(0 5 77)
     extra_meshes=(grid:8x8 grid:4x4) extra_sizes=(32x32 64x64)
+    fixed_meshes=(grid:8x8) fixed_sizes=(32x32 64x64) fixed_draws=(1 4 256)
     sweep_meshes=(grid:16x16 strip:8x8 random:300:50:7)
     sweep_sizes=(32x32 64x64)
     sweep_loads=("0 0" "10 0" "0 3" "10 3" "100 30" "10 0 geo" "100 0 geo")
@@ -197,6 +203,20 @@ collect() {
     done
   done
 
+  # 3b. Fixed costs (issue 30): passes that draw nothing (the pass overhead
+  #     and the clear), and two meshes split into more and more draw calls
+  #     (a draw's cost apart from its triangles'; more draws than
+  #     triangles leave some empty).
+  for size in "${fixed_sizes[@]}"; do
+    measure "$dir/fixed-costs.csv" "${fixed_meshes[0]}" --size "$size" --draws 0 "${passes[@]}"
+  done
+  local draws
+  for mesh in "${fixed_meshes[@]}"; do
+    for draws in "${fixed_draws[@]}"; do
+      measure "$dir/fixed-costs.csv" "$mesh" --size "${fixed_sizes[0]}" --draws "$draws" "${passes[@]}"
+    done
+  done
+
   # 4. Vertex reuse of the corpus: one draw of each index buffer.
   local f json counts
   if [ -z "$dry" ]; then echo "file,indices,unique_vertices,vs_invocations" > "$dir/vertex-reuse.csv"; fi
@@ -266,6 +286,7 @@ queries around the render pass, medians of the recorded passes.
 | \`estimation-passes.csv\` | $(rows estimation-passes.csv) rows: one per object drawn (one per empty pass) with the pass's time and counters and each estimator's estimate | as above |
 | \`load-grid.csv\` | $(rows load-grid.csv) passes: the lists of \`docs/measurements/nvidia-h200/load-grid.csv\` | \`rendersim measure MESH --size S --vs-loops V --fs-loops F [--geometry-only] $passes --csv load-grid.csv\` |
 | \`load-sweep.csv\` | $(rows load-sweep.csv) passes: every mesh, size and load of \`docs/measurements/nvidia-h200/load-sweep.csv\`'s lists, held-out rows included; the capped ones are in \`skipped.txt\` | as above (the random mesh: \`$heavy\`), \`--csv load-sweep.csv\` |
+| \`fixed-costs.csv\` | $(rows fixed-costs.csv) passes: no draw at each size, and each mesh at the first size in more and more draw calls (a profile's \`pass_overhead_ns\` and \`draw_ns\`: calibrate it with the load files) | \`rendersim measure MESH --size S --draws N $passes --csv fixed-costs.csv\` |
 | \`vertex-reuse.csv\`, \`corpus-passes.csv\` | $(rows vertex-reuse.csv) corpus meshes: indices, unique vertices, vertex-shader invocations of one draw (compare with \`docs/measurements/nvidia-h200/vertex-reuse.csv\`) | \`rendersim measure CORPUS/X.idx --size 256x256 --repeats 1 --warmup 0 --json --csv corpus-passes.csv\` (the measured shaders; counters do not depend on them) |
 | \`skipped.txt\` | $(wc -l < "$dir/skipped.txt") passes left out: capped (estimated over 30 s per pass), timed out (${PASS_TIMEOUT:-60} s), or past the ${DEADLINE:-450} s deadline | |
 | \`commands.txt\`, \`stderr.txt\` | every command with its exit status and seconds; their standard error | |

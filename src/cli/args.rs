@@ -214,11 +214,17 @@ pub struct MeasureArgs {
     /// Collapse every vertex to one point: no fragments, the geometry stage alone.
     #[arg(long)]
     pub geometry_only: bool,
+    /// Split the mesh's triangles into N draw calls, in order (0: no draw, a pass that only
+    /// clears and stores its target; more draws than triangles leave some empty).
+    #[arg(long, value_name = "N", default_value_t = 1,
+          value_parser = clap::value_parser!(u32).range(0..=i64::from(rendersim::measure::passes::MAX_DRAWS)))]
+    pub draws: u32,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
-    /// Append the pass as a row to FILE (header `mesh,size,vs_loops,...,pass_time_ns`,
-    /// written when FILE is new or empty; a file with another header is refused).
+    /// Append the pass as a row to FILE (header `mesh,size,vs_loops,...,pass_time_ns,draws`,
+    /// written when FILE is new or empty; a file with another header is refused, and one
+    /// with the header before `draws` takes passes of one draw only).
     #[arg(long, value_name = "FILE")]
     pub csv: Option<PathBuf>,
 }
@@ -236,6 +242,7 @@ impl From<&MeasureArgs> for rendersim::measure::MeasureOptions {
             warmup: a.warmup,
             repeats: a.repeats,
             geometry_only: a.geometry_only,
+            draws: a.draws,
         }
     }
 }
@@ -243,7 +250,7 @@ impl From<&MeasureArgs> for rendersim::measure::MeasureOptions {
 /// `rendersim calibrate`.
 #[derive(Args)]
 pub struct CalibrateArgs {
-    /// Measured passes (CSV: mesh,size,vs_loops,fs_loops,geometry_only,vs_invocations,fs_invocations,pass_time_ns).
+    /// Measured passes (CSV: mesh,size,vs_loops,fs_loops,geometry_only,vs_invocations,fs_invocations,pass_time_ns[,draws]).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     /// Where to write the profile (TOML), e.g. models/devices/NAME.toml.
@@ -314,6 +321,11 @@ pub struct PredictArgs {
     /// Early depth test on.
     #[arg(long)]
     pub depth_test: bool,
+    /// Split the mesh's triangles into N draw calls (0: no draw, a pass that only clears and
+    /// stores its target).
+    #[arg(long, value_name = "N", default_value_t = 1,
+          value_parser = clap::value_parser!(u32).range(0..=i64::from(rendersim::measure::passes::MAX_DRAWS)))]
+    pub draws: u32,
     /// Also measure the same pass on this machine's adapter (feature `wgpu`)
     /// and print the prediction's error and the wall times of measuring and
     /// simulating, both timed in this run.

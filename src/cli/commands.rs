@@ -380,7 +380,7 @@ pub fn measure(args: MeasureArgs) -> Result<()> {
             );
         }
         // A file with another header is refused before any device time is spent.
-        check_appendable(path)?;
+        check_appendable(path, args.draws)?;
     }
     let m = rendersim::scene::generators::mesh_from_spec(mesh, Path::new("."))?;
     let r = rendersim::measure::measure(&m, mesh, &(&args).into())?;
@@ -427,7 +427,7 @@ pub fn study(args: StudyArgs) -> Result<()> {
         bail!("--repeats must be at least 1");
     }
     if let Some(path) = &args.csv {
-        check_appendable(path)?;
+        check_appendable(path, 1)?;
     }
     let gpu = Gpu::open()?;
     let load_start = rendersim::measure::machine_load::load_average();

@@ -371,6 +371,7 @@ pub fn predict(args: &PredictArgs) -> Result<()> {
         layers: args.layers,
         order: args.order.into(),
         depth_test: args.depth_test,
+        draws: args.draws,
     };
     let p = predict_on_device(&profile, &pass)?;
     let measured = if args.measure { Some(measure_pass(args)?) } else { None };
@@ -429,6 +430,7 @@ fn measure_pass(args: &PredictArgs) -> Result<(f64, f64, String)> {
         size: (args.size.width, args.size.height),
         repeats: args.repeats,
         geometry_only: args.geometry_only,
+        draws: args.draws,
         ..Default::default()
     };
     let start = Instant::now();

@@ -3,6 +3,8 @@
 //! Mesa's lavapipe so they run there.
 #![cfg(feature = "wgpu")]
 
+use std::path::Path;
+
 use rendersim::components::vertex_cache::CachePolicy;
 use rendersim::measure::{MeasureError, MeasureOptions, measure};
 use rendersim::scene::generators::mesh_from_spec;
@@ -264,6 +266,76 @@ fn measure_csv_appends_one_row_per_pass_and_the_header_once() {
         assert_eq!(r.size.to_string(), "32x32");
         assert!(!r.geometry_only && r.vs_invocations > 0 && r.fs_invocations > 0 && r.pass_time_ns > 0.0);
     }
+}
+
+#[test]
+fn passes_split_into_draws_count_their_vertex_work_draw_by_draw() {
+    // `measure --draws N` splits the triangles into N draw calls; each draw
+    // starts with an empty vertex cache, as `predict` counts it; 0 draws
+    // nothing. Rows carry the draws, and calibrate reads them.
+    use rendersim::measure::passes::read_passes;
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("draws.csv");
+    let csv_arg = csv.to_str().unwrap();
+    for draws in ["0", "1", "4", "64"] {
+        let args = [
+            "measure",
+            "grid:16x16",
+            "--size",
+            "64x64",
+            "--repeats",
+            "1",
+            "--warmup",
+            "0",
+            "--draws",
+            draws,
+            "--csv",
+            csv_arg,
+        ];
+        let Some(o) = rendersim(&args) else { return };
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let rows = read_passes(&csv).unwrap();
+    assert_eq!(rows.iter().map(|r| r.draws).collect::<Vec<_>>(), [0, 1, 4, 64]);
+    assert_eq!((rows[0].vs_invocations, rows[0].fs_invocations), (0, 0));
+    let device = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/devices/llvmpipe.toml");
+    for r in &rows {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+            .args(["predict", "grid:16x16", "--size", "64x64", "--json", "--draws"])
+            .arg(r.draws.to_string())
+            .arg("--device")
+            .arg(&device)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(v["predicted"]["vs_invocations"], r.vs_invocations, "{} draws", r.draws);
+    }
+    // Too many draws, and a pass of several draws for a file of the header
+    // before the column: refused before measuring, the file untouched.
+    let old = dir.path().join("old.csv");
+    let before = "mesh,size,vs_loops,fs_loops,geometry_only,vs_invocations,fs_invocations,pass_time_ns\n";
+    std::fs::write(&old, before).unwrap();
+    for (args, want) in [
+        (vec!["measure", "grid:4x4", "--draws", "4097"], "--draws"),
+        (
+            vec!["predict", "grid:4x4", "--draws=-1", "--device", "x.toml"],
+            "--draws",
+        ),
+        (
+            vec!["measure", "grid:4x4", "--draws", "4", "--csv", old.to_str().unwrap()],
+            "written before the `draws` column",
+        ),
+    ] {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(want) && !err.contains("panicked"), "{args:?}: {err}");
+    }
+    assert_eq!(std::fs::read_to_string(&old).unwrap(), before);
 }
 
 #[test]

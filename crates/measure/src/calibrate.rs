@@ -157,7 +157,7 @@ pub enum Invocations {
 #[derive(Default)]
 pub struct LoadCache {
     coverage: HashMap<(String, u32, u32), Coverage>,
-    vertices: HashMap<String, VertexWork>,
+    vertices: HashMap<(String, u32), VertexWork>,
 }
 
 impl LoadCache {
@@ -175,11 +175,23 @@ impl LoadCache {
 
     /// Vertex work of one draw of `spec` under `policy`.
     pub fn vertex_work(&mut self, spec: &str, policy: &CachePolicy) -> Result<VertexWork, CalibrateError> {
-        if let Some(v) = self.vertices.get(spec) {
+        self.vertex_work_in(spec, policy, 1)
+    }
+
+    /// Vertex work of `spec` drawn in `draws` draw calls under `policy`
+    /// ([`vertex_work_in_draws`]).
+    pub fn vertex_work_in(
+        &mut self,
+        spec: &str,
+        policy: &CachePolicy,
+        draws: u32,
+    ) -> Result<VertexWork, CalibrateError> {
+        let key = (spec.to_string(), draws);
+        if let Some(v) = self.vertices.get(&key) {
             return Ok(*v);
         }
-        let v = vertex_work(&mesh(spec)?, policy);
-        self.vertices.insert(spec.to_string(), v);
+        let v = vertex_work_in_draws(&mesh(spec)?, policy, draws);
+        self.vertices.insert(key, v);
         Ok(v)
     }
 
@@ -196,7 +208,12 @@ impl LoadCache {
             .collect();
         keys.sort();
         keys.dedup();
-        let mut specs: Vec<&str> = rows.iter().map(|r| r.mesh.as_str()).collect();
+        let mut specs: Vec<(&str, u32)> = rows
+            .iter()
+            .filter(|r| r.draws > 0)
+            .map(|r| (r.mesh.as_str(), r.draws))
+            .filter(|(m, d)| !self.vertices.contains_key(&(m.to_string(), *d)))
+            .collect();
         specs.sort_unstable();
         specs.dedup();
         let covs: Vec<Coverage> = keys
@@ -205,10 +222,11 @@ impl LoadCache {
             .collect::<Result<_, CalibrateError>>()?;
         let works: Vec<VertexWork> = specs
             .par_iter()
-            .map(|spec| Ok(vertex_work(&mesh(spec)?, policy)))
+            .map(|(spec, draws)| Ok(vertex_work_in_draws(&mesh(spec)?, policy, *draws)))
             .collect::<Result<_, CalibrateError>>()?;
         self.coverage.extend(keys.into_iter().zip(covs));
-        self.vertices.extend(specs.into_iter().map(str::to_string).zip(works));
+        self.vertices
+            .extend(specs.into_iter().map(|(m, d)| (m.to_string(), d)).zip(works));
         Ok(())
     }
 
@@ -220,23 +238,35 @@ impl LoadCache {
 
 /// Vertex work of one draw of `mesh` under `policy` (its triangle list).
 pub fn vertex_work(mesh: &crate::scene::mesh::Mesh, policy: &CachePolicy) -> VertexWork {
+    vertex_work_in_draws(mesh, policy, 1)
+}
+
+/// Vertex work of `mesh` drawn in `draws` draw calls (its triangle list
+/// split in order, as `rendersim measure --draws` splits it): each draw
+/// starts with an empty vertex cache and its own batches. 0 draws do no
+/// work.
+pub fn vertex_work_in_draws(mesh: &crate::scene::mesh::Mesh, policy: &CachePolicy, draws: u32) -> VertexWork {
     let list = mesh.to_triangle_list();
-    let mut cache = VertexCache::new(policy, list.vertex_count as usize);
-    let mut invocations = 0u64;
-    for t in list.indices.chunks_exact(3) {
-        invocations += u64::from(cache.access_triangle([t[0], t[1], t[2]]));
+    let triangles = list.indices.len() as u64 / 3;
+    let mut work = VertexWork::default();
+    for k in 0..u64::from(draws) {
+        let at = |k: u64| (3 * (k * triangles / u64::from(draws))) as usize;
+        let mut cache = VertexCache::new(policy, list.vertex_count as usize);
+        let mut invocations = 0u64;
+        for t in list.indices[at(k)..at(k + 1)].chunks_exact(3) {
+            invocations += u64::from(cache.access_triangle([t[0], t[1], t[2]]));
+        }
+        // Direct-mapped caches count their flush segments as warps; those
+        // are not shader batches.
+        let batches = match (policy, cache.warps()) {
+            (CachePolicy::Direct { .. } | CachePolicy::Lavapipe, _) | (_, 0) => invocations.div_ceil(32),
+            (_, w) => w,
+        };
+        work.invocations += invocations;
+        work.batches += batches;
     }
-    // Direct-mapped caches count their flush segments as warps; those are
-    // not shader batches.
-    let batches = match (policy, cache.warps()) {
-        (CachePolicy::Direct { .. } | CachePolicy::Lavapipe, _) | (_, 0) => invocations.div_ceil(32),
-        (_, w) => w,
-    };
-    VertexWork {
-        invocations,
-        batches,
-        triangles: list.indices.len() as u64 / 3,
-    }
+    work.triangles = if draws > 0 { triangles } else { 0 };
+    work
 }
 
 fn mesh(spec: &str) -> Result<crate::scene::mesh::Mesh, CalibrateError> {
@@ -247,20 +277,29 @@ fn mesh(spec: &str) -> Result<crate::scene::mesh::Mesh, CalibrateError> {
 }
 
 /// The load of a row: vertex batches and triangles from `policy`, the
-/// vertex invocations measured or predicted.
+/// vertex invocations measured or predicted. A pass of 0 draws is its
+/// target's pixels alone (its mesh and loop counts do no work).
 pub fn row_load(
     row: &PassRow,
     cache: &mut LoadCache,
     policy: &CachePolicy,
     invocations: Invocations,
 ) -> Result<PassLoad, CalibrateError> {
-    let work = cache.vertex_work(&row.mesh, policy)?;
+    let pixels = f64::from(row.size.width) * f64::from(row.size.height);
+    if row.draws == 0 {
+        return Ok(PassLoad {
+            pixels,
+            ..PassLoad::default()
+        });
+    }
+    let work = cache.vertex_work_in(&row.mesh, policy, row.draws)?;
     let vertices = match invocations {
         Invocations::Measured => row.vs_invocations,
         Invocations::Predicted => work.invocations,
     };
     Ok(PassLoad {
-        pixels: f64::from(row.size.width) * f64::from(row.size.height),
+        pixels,
+        draws: f64::from(row.draws),
         vertices: vertices as f64,
         vertex_batches: work.batches as f64,
         triangles: work.triangles as f64,
@@ -288,10 +327,15 @@ pub struct Fit {
 /// Design row: the load's regressors with the clear term (side 2) or the
 /// geometry terms (side 1) zeroed (side 0, the first pass, keeps both),
 /// then the overlap's column: minus the row's `Gl R / (Gl + R)` under the
-/// previous fit (`shared`).
-fn design(l: &PassLoad, side: u8, shared: f64) -> [f64; Q] {
+/// previous fit (`shared`). Without `draws_vary` the draws' column is left
+/// out (0): with the same draws in every pass, a draw's cost cannot be told
+/// from the pass's, and the pass overhead takes it.
+fn design(l: &PassLoad, side: u8, shared: f64, draws_vary: bool) -> [f64; Q] {
     let r = l.regressors();
     let mut x: [f64; Q] = std::array::from_fn(|i| if i < P { r[i] } else { -shared });
+    if !draws_vary {
+        x[DRAWS] = 0.0;
+    }
     match side {
         1 => x[2..=6].fill(0.0),
         2 => x[1] = 0.0,
@@ -299,6 +343,9 @@ fn design(l: &PassLoad, side: u8, shared: f64) -> [f64; Q] {
     }
     x
 }
+
+/// The draws' column in [`PassLoad::regressors`].
+const DRAWS: usize = 14;
 
 /// Solves `a x = b` (n x n, row-major) by Gaussian elimination with partial
 /// pivoting; `None` when singular.
@@ -451,6 +498,7 @@ fn objective(costs: &DeviceCosts, loads: &[PassLoad], y: &[f64]) -> f64 {
 /// side of `max(clear, geometry)` each row is on is iterated to a fixed
 /// point (starting from both terms summed), keeping the best fit visited.
 fn fit_sides(loads: &[PassLoad], y: &[f64], shared: &[f64]) -> Option<([f64; Q], [f64; Q])> {
+    let draws_vary = loads.iter().any(|l| l.draws != loads[0].draws);
     let mut side = vec![0u8; loads.len()];
     let mut best: Option<([f64; Q], [f64; Q], f64)> = None;
     for _ in 0..12 {
@@ -458,7 +506,7 @@ fn fit_sides(loads: &[PassLoad], y: &[f64], shared: &[f64]) -> Option<([f64; Q],
             .iter()
             .zip(&side)
             .zip(shared)
-            .map(|((l, s), h)| design(l, *s, *h))
+            .map(|((l, s), h)| design(l, *s, *h, draws_vary))
             .collect();
         let (b, se, obj) = nnls(&rows, y);
         let c = costs_of(&b);
@@ -767,6 +815,7 @@ mod tests {
         let loads: Vec<PassLoad> = (1..=20)
             .map(|i| PassLoad {
                 pixels: 4096.0 * f64::from(i),
+                draws: 1.0,
                 vertices: 81.0 * f64::from(i % 5 + 1),
                 vertex_batches: 3.0,
                 triangles: 128.0,

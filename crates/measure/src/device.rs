@@ -59,6 +59,10 @@ pub struct MeasureOptions {
     /// no fragments, so the pass measures the geometry stage alone (index
     /// fetch, vertex shading, setup of empty triangles).
     pub geometry_only: bool,
+    /// Draw calls the mesh's triangles are split into, in order (as equal
+    /// as whole triangles allow; more draws than triangles leave some
+    /// empty). 0 draws nothing: the pass only clears and stores its target.
+    pub draws: u32,
 }
 
 impl Default for MeasureOptions {
@@ -73,6 +77,7 @@ impl Default for MeasureOptions {
             warmup: 2,
             repeats: 5,
             geometry_only: false,
+            draws: 1,
         }
     }
 }
@@ -377,7 +382,7 @@ impl Gpu {
         let mut times = Vec::new();
         let mut counters: Vec<[u64; 4]> = Vec::new();
         for round in 0..opts.warmup + opts.repeats {
-            let words = pass.run(&self.device, &self.queue, opts.layers)?;
+            let words = pass.run(&self.device, &self.queue, opts.layers, opts.draws)?;
             if round >= opts.warmup {
                 counters.push([words[0], words[1], words[2], words[3]]);
                 let (t0, t1) = (words[32], words[33]);
@@ -412,6 +417,13 @@ fn check_options(opts: &MeasureOptions) -> Result<(), MeasureError> {
     }
     if opts.size.0 > 8192 || opts.size.1 > 8192 {
         return Err(MeasureError::Option("render target larger than 8192x8192".into()));
+    }
+    if opts.draws > super::passes::MAX_DRAWS {
+        return Err(MeasureError::Option(format!(
+            "{} draws: at most {} in one pass",
+            opts.draws,
+            super::passes::MAX_DRAWS
+        )));
     }
     Ok(())
 }
@@ -505,9 +517,16 @@ impl MeasuredPass {
         }
     }
 
-    /// Draws one pass of `layers` instances and reads its queries back:
-    /// words 0-3 the pipeline statistics, 32 and 33 the time stamps.
-    fn run(&self, device: &wgpu::Device, queue: &wgpu::Queue, layers: u32) -> Result<Vec<u64>, MeasureError> {
+    /// Draws one pass of `layers` instances in `draws` draw calls and reads
+    /// its queries back: words 0-3 the pipeline statistics, 32 and 33 the
+    /// time stamps.
+    fn run(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        layers: u32,
+        draws: u32,
+    ) -> Result<Vec<u64>, MeasureError> {
         let mut enc = device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -542,7 +561,9 @@ impl MeasuredPass {
             pass.set_vertex_buffer(0, self.vbuf.slice(..));
             pass.set_index_buffer(self.ibuf.slice(..), wgpu::IndexFormat::Uint32);
             pass.begin_pipeline_statistics_query(&self.stats_q, 0);
-            pass.draw_indexed(0..self.index_count, 0, 0..layers);
+            for range in draw_ranges(self.index_count, draws) {
+                pass.draw_indexed(range, 0, 0..layers);
+            }
             pass.end_pipeline_statistics_query();
         }
         enc.resolve_query_set(&self.stats_q, 0..1, &self.resolve, 0);
@@ -557,6 +578,17 @@ impl MeasuredPass {
         queue.submit([enc.finish()]);
         read_words(device, &read)
     }
+}
+
+/// The index ranges of `draws` draw calls over `index_count` indices (a
+/// triangle list): consecutive, whole triangles, as equal as they allow.
+pub(crate) fn draw_ranges(index_count: u32, draws: u32) -> impl Iterator<Item = std::ops::Range<u32>> {
+    let triangles = u64::from(index_count / 3);
+    let n = u64::from(draws);
+    (0..n).map(move |k| {
+        let at = |k: u64| (3 * (k * triangles / n)) as u32;
+        at(k)..at(k + 1)
+    })
 }
 
 /// The measuring shader's pipeline (depth test on or off) and its bind
@@ -639,4 +671,27 @@ fn bytes_f32(v: &[[f32; 2]]) -> Vec<u8> {
 
 fn bytes_u32(v: &[u32]) -> Vec<u8> {
     v.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::draw_ranges;
+
+    #[test]
+    fn draws_split_the_triangles_in_order_and_whole() {
+        let all = |n, d| draw_ranges(n, d).collect::<Vec<_>>();
+        assert_eq!(all(30, 1), vec![std::ops::Range { start: 0, end: 30 }]);
+        assert_eq!(all(30, 0), []);
+        assert_eq!(all(30, 3), [0..9, 9..18, 18..30]);
+        assert_eq!(all(30, 4), [0..6, 6..15, 15..21, 21..30]);
+        // More draws than triangles: some draws are empty.
+        assert_eq!(all(6, 4), [0..0, 0..3, 3..3, 3..6]);
+        for (n, d) in [(3 * 131_072, 4096), (3 * 7, 5), (0, 3), (3 * 1000, 1)] {
+            let r = all(n, d);
+            assert_eq!(r.len(), d as usize);
+            assert!(r.windows(2).all(|w| w[0].end == w[1].start));
+            assert!(r.iter().all(|x| x.start % 3 == 0 && x.end % 3 == 0 && x.start <= x.end));
+            assert_eq!((r[0].start, r[r.len() - 1].end), (0, n));
+        }
+    }
 }

@@ -5,7 +5,8 @@
 //! the frame-pipeline model ([`PassModel`], unified shader pool, triangle
 //! fidelity) then runs the pass with the mesh's own triangles and the
 //! profile's vertex-cache policy. What the pipeline model does not model is
-//! added around it: the pass overhead, the part of the target's clear and
+//! added around it: the pass overhead and the draw calls' fixed costs
+//! (a pass of 0 draws is these alone, not simulated), the part of the target's clear and
 //! store that the geometry work does not hide, and (taken off) the overlap
 //! of vertex and fragment work on the shared cores that the profile
 //! fitted (`shared_core_overlap`).
@@ -14,7 +15,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::calibrate::{CalibrateError, vertex_work};
+use super::calibrate::{CalibrateError, vertex_work, vertex_work_in_draws};
 use super::coverage::{Coverage, coverage};
 use super::device_profile::{DeviceProfile, PassCost, PassLoad};
 use super::geometry::DepthOrder;
@@ -39,6 +40,9 @@ pub struct DevicePass {
     pub layers: u32,
     /// Their depth order.
     pub order: DepthOrder,
+    /// Draw calls the mesh is split into (0: the pass only clears and
+    /// stores its target).
+    pub draws: u32,
     /// Early depth test on.
     pub depth_test: bool,
 }
@@ -55,6 +59,7 @@ impl From<&super::passes::PassRow> for DevicePass {
             layers: 1,
             order: DepthOrder::FrontToBack,
             depth_test: false,
+            draws: r.draws,
         }
     }
 }
@@ -106,6 +111,13 @@ pub fn predict_on_device(profile: &DeviceProfile, pass: &DevicePass) -> Result<D
     if pass.layers == 0 {
         return Err(DevicePredictError::Option("layers must be at least 1".into()));
     }
+    let max_draws = super::passes::MAX_DRAWS;
+    if pass.draws > max_draws {
+        return Err(DevicePredictError::Option(format!(
+            "--draws {}: at most {max_draws} draws in one pass",
+            pass.draws
+        )));
+    }
     use crate::limits::{MAX_PASS_LAYERS, MAX_PASS_TRIANGLES};
     if pass.layers > MAX_PASS_LAYERS {
         return Err(DevicePredictError::Option(format!(
@@ -134,15 +146,42 @@ pub fn predict_on_device(profile: &DeviceProfile, pass: &DevicePass) -> Result<D
         .vertex_cache
         .parse()
         .map_err(|e| DevicePredictError::Option(format!("device.vertex_cache: {e}")))?;
-    let work = vertex_work(&mesh, &policy);
+    // The load counts the vertex work of the pass's draws (each starts with
+    // an empty cache); the simulation runs the mesh as one draw, so each
+    // of its vertices carries the draws' geometry cost over its own count.
+    let work = vertex_work_in_draws(&mesh, &policy, pass.draws);
     let vertices = work.invocations;
+    let sim_vertices = if pass.draws == 1 {
+        vertices
+    } else {
+        vertex_work(&mesh, &policy).invocations
+    };
     let cov = if pass.geometry_only {
         Coverage::default()
     } else {
         coverage(&mesh, &pass.mesh, w, h)
     };
+    if pass.draws == 0 {
+        // Nothing drawn: the pass clears and stores its target.
+        let load = PassLoad {
+            pixels: f64::from(w) * f64::from(h),
+            ..PassLoad::default()
+        };
+        let terms = profile.costs.cost(&load);
+        return Ok(DevicePrediction {
+            pass_time_ns: terms.pass_ns,
+            vs_invocations: 0,
+            fs_invocations: 0,
+            closed_form_ns: terms.pass_ns,
+            terms,
+            coverage: Coverage::default(),
+            events: 0,
+            sim_wall_seconds: 0.0,
+        });
+    }
     let load = PassLoad {
         pixels: f64::from(w) * f64::from(h),
+        draws: f64::from(pass.draws),
         vertices: vertices as f64,
         vertex_batches: work.batches as f64,
         triangles: work.triangles as f64,
@@ -162,7 +201,7 @@ pub fn predict_on_device(profile: &DeviceProfile, pass: &DevicePass) -> Result<D
         mesh: pass.mesh.clone(),
         cache: profile.device.vertex_cache.clone(),
         layers: pass.layers,
-        per_vertex: duration_ps(1e3 * per_ns(terms.geometry_ns, vertices as f64)),
+        per_vertex: duration_ps(1e3 * per_ns(terms.geometry_ns, sim_vertices as f64)),
         per_fragment: duration_ps(1e3 * frag_cost),
         per_rejected_fragment: duration_ps(1e3 * per_ns(terms.fragment_base_ns, cov.fragments as f64)),
         fragments_per_triangle: cov.fragments as f64 / drawn,
@@ -182,7 +221,8 @@ pub fn predict_on_device(profile: &DeviceProfile, pass: &DevicePass) -> Result<D
     // the other; the overlap the profile fitted (`shared_core_overlap`) is
     // taken off its time as the closed form takes it off the sum.
     let overlap = layers * terms.overlap_ns;
-    let pass_time_ns = sim.gpu_ms * 1e6 + c.pass_overhead_ns + (terms.clear_ns - geometry_total).max(0.0) - overlap;
+    let pass_time_ns =
+        sim.gpu_ms * 1e6 + c.pass_overhead_ns + terms.draws_ns + (terms.clear_ns - geometry_total).max(0.0) - overlap;
     let shaded_layers = match (pass.depth_test, pass.order) {
         (false, _) | (true, DepthOrder::BackToFront) => layers,
         (true, DepthOrder::FrontToBack) => 1.0,
@@ -190,9 +230,17 @@ pub fn predict_on_device(profile: &DeviceProfile, pass: &DevicePass) -> Result<D
     };
     Ok(DevicePrediction {
         pass_time_ns,
-        vs_invocations: sim.transformed_vertices,
+        vs_invocations: if pass.draws == 1 {
+            sim.transformed_vertices
+        } else {
+            vertices * u64::from(pass.layers)
+        },
         fs_invocations: (cov.fragments as f64 * shaded_layers).round() as u64,
-        closed_form_ns: c.pass_overhead_ns + terms.clear_ns.max(geometry_total) + layers * terms.fragment_ns - overlap,
+        closed_form_ns: c.pass_overhead_ns
+            + terms.draws_ns
+            + terms.clear_ns.max(geometry_total)
+            + layers * terms.fragment_ns
+            - overlap,
         terms,
         coverage: cov,
         events: sim.events,

@@ -1,7 +1,8 @@
 //! A device profile: the costs of one GPU fitted to measured passes by
 //! `rendersim calibrate` (`calibrate.rs`) and run by `rendersim predict`
 //! (`device_predict.rs`). Stored as TOML under `models/devices/`. The cost
-//! of a pass (all times in nanoseconds; V vertex-shader invocations, B the
+//! of a pass (all times in nanoseconds; D draw calls, V vertex-shader
+//! invocations, B the
 //! vertex batches (warps of 32 lanes) the cache policy cuts, T triangles
 //! drawn, Tc triangles covering a pixel centre, Lv and Lf the vertex and
 //! fragment loop counts, P target pixels; from `coverage.rs`: F fragments,
@@ -14,7 +15,7 @@
 //! fragments R = fragment F + helper_lane H + empty_lane E
 //!             + (fragment_per_loop F + helper_lane_per_loop H
 //!                + empty_lane_per_loop E + fragment_loop_latency) Lf
-//! pass      = pass_overhead + max(clear_store_per_pixel P, G) + R
+//! pass      = pass_overhead + draw D + max(clear_store_per_pixel P, G) + R
 //!             - shared_core_overlap Gl R / (Gl + R)
 //!   with Gl the loop part of G: (vertex_loop_latency + vertex_lane_per_loop 32B) Lv
 //! ```
@@ -66,6 +67,10 @@ pub const MAX_COST_NS: f64 = 1e9;
 pub struct DeviceCosts {
     /// Fixed cost of a render pass.
     pub pass_overhead_ns: f64,
+    /// Fixed cost of a draw call (0 when absent, as in profiles written
+    /// before it; rows of one draw a pass cannot tell it from the pass's).
+    #[serde(default)]
+    pub draw_ns: f64,
     /// Clearing and storing one target pixel (overlaps the geometry work).
     pub clear_store_per_pixel_ns: f64,
     /// One vertex-shader invocation with no loop.
@@ -191,6 +196,8 @@ pub const MAX_SHADER_CORES: u32 = 1 << 20;
 pub struct PassLoad {
     /// Target pixels.
     pub pixels: f64,
+    /// Draw calls (0: the pass only clears and stores its target).
+    pub draws: f64,
     /// Vertex-shader invocations.
     pub vertices: f64,
     /// Vertex batches (warps of up to 32 vertices) the cache policy cuts.
@@ -221,6 +228,8 @@ pub struct PassCost {
     /// What vertex loop and fragment work overlap on the shared cores, ns
     /// (taken off the pass).
     pub overlap_ns: f64,
+    /// The draw calls' fixed costs, ns.
+    pub draws_ns: f64,
     /// The pass, ns.
     pub pass_ns: f64,
 }
@@ -255,7 +264,8 @@ impl PassLoad {
     /// The regressors of the cost formula, in [`DeviceCosts::entries`]
     /// order, with the clear term (index 1) and the geometry terms (2..=6)
     /// as they enter `max(clear, G)`: the cost is
-    /// `x[0] + max(x[1], sum x[2..=6]) + sum x[7..]`, each `x` times its cost.
+    /// `x[0] + max(x[1], sum x[2..=6]) + sum x[7..]` (R is 7..=13, the
+    /// draws 14), each `x` times its cost, less the overlap.
     pub fn regressors(&self) -> [f64; COSTS] {
         let l = self.lanes();
         let frag = self.coverage.fragments > 0;
@@ -276,12 +286,13 @@ impl PassLoad {
             f(l.helper * lf),
             f(l.empty * lf),
             f(lf),
+            self.draws,
         ]
     }
 }
 
 /// Number of linear costs (every fitted value but the overlap).
-pub const COSTS: usize = 14;
+pub const COSTS: usize = 15;
 
 /// Number of fitted values: the linear costs and `shared_core_overlap`.
 pub const FITTED: usize = COSTS + 1;
@@ -322,6 +333,7 @@ impl DeviceCosts {
             helper_lane_per_loop_ns: b[11],
             empty_lane_per_loop_ns: b[12],
             fragment_loop_latency_ns: b[13],
+            draw_ns: b[14],
             shared_core_overlap: 0.0,
         }
     }
@@ -333,7 +345,8 @@ impl DeviceCosts {
         let term = |i: usize| x[i] * b[i];
         let geometry_ns: f64 = (2..=6).map(term).sum();
         let fragment_base_ns: f64 = (7..=9).map(term).sum();
-        let fragment_ns = fragment_base_ns + (10..COSTS).map(term).sum::<f64>();
+        let fragment_ns = fragment_base_ns + (10..=13).map(term).sum::<f64>();
+        let draws_ns = term(14);
         let clear_ns = term(1);
         let vertex_loop_ns = term(5) + term(6);
         let overlap_ns = self.shared_core_overlap * shared_work(vertex_loop_ns, fragment_ns);
@@ -344,7 +357,8 @@ impl DeviceCosts {
             fragment_base_ns,
             vertex_loop_ns,
             overlap_ns,
-            pass_ns: self.pass_overhead_ns + clear_ns.max(geometry_ns) + fragment_ns - overlap_ns,
+            draws_ns,
+            pass_ns: self.pass_overhead_ns + draws_ns + clear_ns.max(geometry_ns) + fragment_ns - overlap_ns,
         }
     }
 
@@ -366,6 +380,7 @@ impl DeviceCosts {
             ("helper_lane_per_loop_ns", self.helper_lane_per_loop_ns),
             ("empty_lane_per_loop_ns", self.empty_lane_per_loop_ns),
             ("fragment_loop_latency_ns", self.fragment_loop_latency_ns),
+            ("draw_ns", self.draw_ns),
             ("shared_core_overlap", self.shared_core_overlap),
         ]
     }
@@ -588,6 +603,7 @@ mod tests {
         assert_eq!(p.costs.shared_core_overlap, 0.0);
         let load = PassLoad {
             pixels: 147456.0,
+            draws: 1.0,
             vertices: 15570.0,
             vertex_batches: 576.0,
             triangles: 18432.0,
@@ -754,7 +770,7 @@ mod tests {
         #[test]
         fn what_calibrate_writes_reads_back(
             name in names(),
-            costs in proptest::array::uniform14(prop_oneof![Just(0.0), 0.0f64..1e6, 0.0f64..=MAX_COST_NS]),
+            costs in proptest::array::uniform15(prop_oneof![Just(0.0), 0.0f64..1e6, 0.0f64..=MAX_COST_NS]),
             stats in proptest::array::uniform3(0.0f64..1e6),
             loo in proptest::option::of((0.0f64..1e6, 0.0f64..1e6)),
         ) {

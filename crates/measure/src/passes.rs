@@ -4,16 +4,20 @@
 //! `load-sweep.csv`). The header is [`PASS_HEADER`]:
 //!
 //! ```text
-//! mesh,size,vs_loops,fs_loops,geometry_only,vs_invocations,fs_invocations,pass_time_ns
-//! grid:96x96:optimized,384x384,0,500,false,15570,147456,1512832.0
+//! mesh,size,vs_loops,fs_loops,geometry_only,vs_invocations,fs_invocations,pass_time_ns,draws
+//! grid:96x96:optimized,384x384,0,500,false,15570,147456,1512832.0,1
 //! ```
 //!
 //! A row describes a pass of one layer without the depth test (the format
-//! has no column for either); `pass_time_ns` is the median of the recorded
-//! passes. Files are appended to: the header is written only into a new or
-//! empty file, and a file whose first line is another header is refused
-//! untouched. [`read_passes`] reads the format back, naming file, line and
-//! column of anything that does not parse.
+//! has no column for either); `draws` is how many draw calls the mesh's
+//! triangles were split into (0: a pass that only clears and stores its
+//! target); `pass_time_ns` is the median of the recorded passes. Files
+//! written before the `draws` column ([`LEGACY_PASS_HEADER`], the shared
+//! H200 files) read as one draw a pass, and rows of one draw are appended
+//! to them in their own format. Files are appended to: the header is
+//! written only into a new or empty file, and a file whose first line is
+//! another header is refused untouched. [`read_passes`] reads the format
+//! back, naming file, line and column of anything that does not parse.
 
 use std::fmt;
 use std::io::{BufRead, Write};
@@ -24,11 +28,17 @@ use serde::{Deserialize, Serialize};
 
 use super::fit::median;
 
-/// The first line of every pass CSV.
-pub const PASS_HEADER: &str = "mesh,size,vs_loops,fs_loops,geometry_only,vs_invocations,fs_invocations,pass_time_ns";
+/// The first line of every pass CSV written.
+pub const PASS_HEADER: &str =
+    "mesh,size,vs_loops,fs_loops,geometry_only,vs_invocations,fs_invocations,pass_time_ns,draws";
+
+/// The header of pass CSVs written before the `draws` column (every pass
+/// one draw): read, and appended to with rows of one draw.
+pub const LEGACY_PASS_HEADER: &str =
+    "mesh,size,vs_loops,fs_loops,geometry_only,vs_invocations,fs_invocations,pass_time_ns";
 
 /// The column names of [`PASS_HEADER`], in order.
-const COLUMNS: [&str; 8] = [
+const COLUMNS: [&str; 9] = [
     "mesh",
     "size",
     "vs_loops",
@@ -37,7 +47,12 @@ const COLUMNS: [&str; 8] = [
     "vs_invocations",
     "fs_invocations",
     "pass_time_ns",
+    "draws",
 ];
+
+/// Most draw calls one pass may split its mesh into (`rendersim measure
+/// --draws`, a CSV row).
+pub const MAX_DRAWS: u32 = 4096;
 
 /// A render target size, written `WxH` (`384x384`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -113,10 +128,26 @@ pub struct PassRow {
     pub fs_invocations: u64,
     /// Median pass time, nanoseconds.
     pub pass_time_ns: f64,
+    /// Draw calls the mesh's triangles were split into (0: none, a pass
+    /// that only clears and stores its target).
+    pub draws: u32,
+}
+
+/// A row in the format of [`LEGACY_PASS_HEADER`] (no `draws` column).
+#[derive(Serialize)]
+struct LegacyRow<'a> {
+    mesh: &'a str,
+    size: TargetSize,
+    vs_loops: u32,
+    fs_loops: u32,
+    geometry_only: bool,
+    vs_invocations: u64,
+    fs_invocations: u64,
+    pass_time_ns: f64,
 }
 
 /// What identifies a pass: everything but its results.
-type PassKey = (String, TargetSize, u32, u32, bool);
+type PassKey = (String, TargetSize, u32, u32, bool, u32);
 
 impl PassRow {
     fn key(&self) -> PassKey {
@@ -126,6 +157,7 @@ impl PassRow {
             self.vs_loops,
             self.fs_loops,
             self.geometry_only,
+            self.draws,
         )
     }
 }
@@ -149,6 +181,7 @@ impl PassRow {
             vs_invocations: m.vs_invocations,
             fs_invocations: m.fs_invocations,
             pass_time_ns: m.pass_time_ns,
+            draws: o.draws,
         })
     }
 }
@@ -174,7 +207,8 @@ pub enum PassCsvError {
         #[source]
         source: std::io::Error,
     },
-    /// The file's first line is not [`PASS_HEADER`].
+    /// The file's first line is not [`PASS_HEADER`] (nor
+    /// [`LEGACY_PASS_HEADER`]).
     #[error(
         "{path} has the header {found:?}, not the pass CSV header {PASS_HEADER:?}; \
          give a new file or one with that header ({path} is left as it was)"
@@ -185,7 +219,20 @@ pub enum PassCsvError {
         /// Its first line.
         found: String,
     },
-    /// A file read as pass rows does not start with [`PASS_HEADER`].
+    /// A pass of other than one draw for a file of [`LEGACY_PASS_HEADER`].
+    #[error(
+        "{path} has the header written before the `draws` column, so every pass in it is one draw; \
+         a pass of {draws} draws needs a file with the header {PASS_HEADER:?}: give a new file \
+         ({path} is left as it was)"
+    )]
+    LegacyDraws {
+        /// The file.
+        path: PathBuf,
+        /// The draws of the pass refused.
+        draws: u32,
+    },
+    /// A file read as pass rows does not start with [`PASS_HEADER`] (nor
+    /// [`LEGACY_PASS_HEADER`]).
     #[error("{path}: line 1 is the header {found:?}, not the pass CSV header {PASS_HEADER:?}")]
     NotPasses {
         /// The file.
@@ -232,14 +279,30 @@ fn first_line(path: &Path) -> Result<Option<String>, PassCsvError> {
     Ok(Some(line.trim_end_matches(['\n', '\r']).to_string()))
 }
 
-/// Checks that rows can be appended to `path`: it is new, empty, or starts
-/// with [`PASS_HEADER`]. Returns whether the header still has to be
-/// written. Commands call it before measuring, so a wrong file costs no
-/// device time.
-pub fn check_appendable(path: &Path) -> Result<bool, PassCsvError> {
+/// The format rows are appended to a file in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AppendTo {
+    /// A new or empty file: the header [`PASS_HEADER`] first.
+    New,
+    /// A file with [`PASS_HEADER`].
+    Current,
+    /// A file with [`LEGACY_PASS_HEADER`]: only passes of one draw.
+    Legacy,
+}
+
+/// Checks that passes of `draws` draws can be appended to `path`: it is
+/// new, empty, or starts with [`PASS_HEADER`], or with
+/// [`LEGACY_PASS_HEADER`] when `draws` is 1. Returns the format to write.
+/// Commands call it before measuring, so a wrong file costs no device time.
+pub fn check_appendable(path: &Path, draws: u32) -> Result<AppendTo, PassCsvError> {
     match first_line(path)? {
-        None => Ok(true),
-        Some(line) if line == PASS_HEADER => Ok(false),
+        None => Ok(AppendTo::New),
+        Some(line) if line == PASS_HEADER => Ok(AppendTo::Current),
+        Some(line) if line == LEGACY_PASS_HEADER && draws == 1 => Ok(AppendTo::Legacy),
+        Some(line) if line == LEGACY_PASS_HEADER => Err(PassCsvError::LegacyDraws {
+            path: path.to_path_buf(),
+            draws,
+        }),
         Some(found) => Err(PassCsvError::Header {
             path: path.to_path_buf(),
             found,
@@ -248,10 +311,13 @@ pub fn check_appendable(path: &Path) -> Result<bool, PassCsvError> {
 }
 
 /// Appends `rows` to `path` (created when missing), with the header first
-/// when the file is new or empty. A file with another header is refused
-/// and left untouched.
+/// when the file is new or empty. A file with another header, or with the
+/// header before the `draws` column when a row is not of one draw, is
+/// refused and left untouched.
 pub fn append_passes(path: &Path, rows: &[PassRow]) -> Result<(), PassCsvError> {
-    let needs_header = check_appendable(path)?;
+    let draws = rows.iter().map(|r| r.draws).find(|d| *d != 1).unwrap_or(1);
+    let to = check_appendable(path, draws)?;
+    let needs_header = to == AppendTo::New;
     let mut file = std::fs::OpenOptions::new()
         .create(true)
         .append(true)
@@ -266,7 +332,21 @@ pub fn append_passes(path: &Path, rows: &[PassRow]) -> Result<(), PassCsvError> 
         .has_headers(needs_header)
         .from_writer(std::io::BufWriter::new(file));
     for row in rows {
-        w.serialize(row).map_err(|e| csv_io(e, "appending to", path))?;
+        let written = if to == AppendTo::Legacy {
+            w.serialize(LegacyRow {
+                mesh: &row.mesh,
+                size: row.size,
+                vs_loops: row.vs_loops,
+                fs_loops: row.fs_loops,
+                geometry_only: row.geometry_only,
+                vs_invocations: row.vs_invocations,
+                fs_invocations: row.fs_invocations,
+                pass_time_ns: row.pass_time_ns,
+            })
+        } else {
+            w.serialize(row)
+        };
+        written.map_err(|e| csv_io(e, "appending to", path))?;
     }
     w.flush().map_err(io("appending to", path))
 }
@@ -300,7 +380,8 @@ pub const MAX_TARGET_SIDE: u32 = 16384;
 /// seconds).
 pub const MAX_PASS_TIME_NS: f64 = 3.6e12;
 
-/// Reads every row of a pass CSV. The header must be [`PASS_HEADER`]; a
+/// Reads every row of a pass CSV. The header must be [`PASS_HEADER`] (or
+/// [`LEGACY_PASS_HEADER`], every row one draw); a
 /// field that does not parse, or a value no measurement gives (a time that
 /// is not a finite number of nanoseconds above 0, a zero target side, a
 /// mesh no spec rebuilds, no vertex-shader invocations), is reported with
@@ -350,10 +431,22 @@ fn check_row(row: &PassRow) -> Result<(), (usize, String)> {
             format!("{width}x{height}: width and height must be 1..{MAX_TARGET_SIDE}"),
         ));
     }
-    if row.vs_invocations == 0 {
+    if row.draws > MAX_DRAWS {
+        return Err((9, format!("{}: more than {MAX_DRAWS} draws in one pass", row.draws)));
+    }
+    if row.vs_invocations == 0 && row.draws > 0 {
         return Err((
             6,
             "0: a pass that draws a triangle runs the vertex shader at least once".into(),
+        ));
+    }
+    if row.draws == 0 && (row.vs_invocations > 0 || row.fs_invocations > 0) {
+        return Err((
+            if row.vs_invocations > 0 { 6 } else { 7 },
+            format!(
+                "{}: a pass of 0 draws runs no shader",
+                row.vs_invocations.max(row.fs_invocations)
+            ),
         ));
     }
     let t = row.pass_time_ns;
@@ -402,7 +495,7 @@ fn read_passes_lines_from(mut reader: impl std::io::Read, path: &Path) -> Result
         .has_headers(true)
         .from_reader(bytes.as_slice());
     let header = r.headers().map_err(row_error)?.clone();
-    if header.iter().ne(COLUMNS) {
+    if header.iter().ne(COLUMNS) && header.iter().ne(COLUMNS[..8].iter().copied()) {
         return Err(PassCsvError::NotPasses {
             path: path.to_path_buf(),
             found: header.iter().collect::<Vec<_>>().join(","),
@@ -442,6 +535,13 @@ struct RawRow {
     vs_invocations: u64,
     fs_invocations: u64,
     pass_time_ns: f64,
+    /// Absent from files of [`LEGACY_PASS_HEADER`]: one draw.
+    #[serde(default = "one_draw")]
+    draws: u32,
+}
+
+fn one_draw() -> u32 {
+    1
 }
 
 impl RawRow {
@@ -462,6 +562,7 @@ impl RawRow {
             vs_invocations: self.vs_invocations,
             fs_invocations: self.fs_invocations,
             pass_time_ns: self.pass_time_ns,
+            draws: self.draws,
         })
     }
 }
@@ -516,7 +617,7 @@ fn row_error(e: csv::Error, path: &Path, line: u64) -> PassCsvError {
 }
 
 /// Pools repeated measurements of the same pass (same mesh, size, loop
-/// counts and geometry-only flag) into one row each, in the order each
+/// counts, geometry-only flag and draws) into one row each, in the order each
 /// pass was first measured: the recorded pass times of every measurement
 /// are pooled and their median is the row's time; the counters are the
 /// last measurement's.
@@ -562,6 +663,7 @@ mod tests {
             vs_invocations: 15570,
             fs_invocations: 147456,
             pass_time_ns: t,
+            draws: 1,
         }
     }
 
@@ -579,7 +681,7 @@ mod tests {
         let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
         assert_eq!(
             text,
-            format!("{PASS_HEADER}\ngrid:96x96:optimized,384x384,0,0,false,15570,147456,55200.0\n")
+            format!("{PASS_HEADER}\ngrid:96x96:optimized,384x384,0,0,false,15570,147456,55200.0,1\n")
         );
     }
 
@@ -601,9 +703,12 @@ mod tests {
                 height: 2048
             }
         );
-        // Every row written back reads the same.
+        assert!(sweep.iter().chain(&grid).all(|r| r.draws == 1));
+        // Every row written back reads the same; appended to a file of the
+        // same (older) header, it is written in that format.
         let dir = tempfile::tempdir().unwrap();
         let copy = dir.path().join("copy.csv");
+        std::fs::write(&copy, format!("{LEGACY_PASS_HEADER}\n")).unwrap();
         append_passes(&copy, &sweep).unwrap();
         assert_eq!(read_passes(&copy).unwrap(), sweep);
         // Byte for byte, but for the shared file's CRLF line endings.
@@ -623,17 +728,21 @@ mod tests {
                 .to_string()
         };
         let e = bad(&format!(
-            "{PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,1.0\ngrid:8x8,64by64,0,0,false,81,4096,1.0\n"
+            "{LEGACY_PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,1.0\ngrid:8x8,64by64,0,0,false,81,4096,1.0\n"
         ));
         assert!(e.starts_with("x.csv: line 3, column 2 (size): "), "{e}");
         assert!(e.contains("expected WxH"), "{e}");
-        let e = bad(&format!("{PASS_HEADER}\ngrid:8x8,64x64,-1,0,false,81,4096,1.0\n"));
+        let e = bad(&format!(
+            "{LEGACY_PASS_HEADER}\ngrid:8x8,64x64,-1,0,false,81,4096,1.0\n"
+        ));
         assert!(e.starts_with("x.csv: line 2, column 3 (vs_loops): "), "{e}");
-        let e = bad(&format!("{PASS_HEADER}\ngrid:8x8,64x64,0,0,yes,81,4096,1.0\n"));
+        let e = bad(&format!("{LEGACY_PASS_HEADER}\ngrid:8x8,64x64,0,0,yes,81,4096,1.0\n"));
         assert!(e.starts_with("x.csv: line 2, column 5 (geometry_only): "), "{e}");
-        let e = bad(&format!("{PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,fast\n"));
+        let e = bad(&format!(
+            "{LEGACY_PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,fast\n"
+        ));
         assert!(e.starts_with("x.csv: line 2, column 8 (pass_time_ns): "), "{e}");
-        let e = bad(&format!("{PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81\n"));
+        let e = bad(&format!("{LEGACY_PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81\n"));
         assert!(
             e.starts_with("x.csv: line 2, column 0 (row): 6 fields, expected 8"),
             "{e}"
@@ -650,7 +759,7 @@ mod tests {
     fn values_no_measurement_gives_name_file_line_and_column() {
         let bad = |cells: &str| {
             read_passes_from(
-                format!("{PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,1.0\n{cells}\n").as_bytes(),
+                format!("{LEGACY_PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,1.0\n{cells}\n").as_bytes(),
                 Path::new("x.csv"),
             )
             .unwrap_err()
@@ -685,7 +794,7 @@ mod tests {
         }
         // The largest values a measurement can give still read.
         let ok = read_passes_from(
-            format!("{PASS_HEADER}\ngrid:8x8,16384x16384,4294967295,4294967295,true,1,0,3.6e12\n").as_bytes(),
+            format!("{LEGACY_PASS_HEADER}\ngrid:8x8,16384x16384,4294967295,4294967295,true,1,0,3.6e12\n").as_bytes(),
             Path::new("x.csv"),
         )
         .unwrap();
@@ -698,7 +807,9 @@ mod tests {
         let path = dir.path().join("p.csv");
         std::fs::write(
             &path,
-            format!("{PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,1.0\n\"grid:8x8\",64x64,0,0,false,81,4096,2.0\n"),
+            format!(
+                "{LEGACY_PASS_HEADER}\ngrid:8x8,64x64,0,0,false,81,4096,1.0\n\"grid:8x8\",64x64,0,0,false,81,4096,2.0\n"
+            ),
         )
         .unwrap();
         let rows = read_passes_with_lines(&path).unwrap();
@@ -706,7 +817,7 @@ mod tests {
         // CRLF line endings (the shared H200 files): the file's own line
         // numbers, for rows and for every kind of error.
         let crlf = format!(
-            "{PASS_HEADER}\r\ngrid:8x8,64x64,0,0,false,81,4096,1.0\r\ngrid:8x8,64x64,0,0,false,81,4096,2.0\r\ngrid:8x8,64x64,0,0,false,81,4096,nan\r\n"
+            "{LEGACY_PASS_HEADER}\r\ngrid:8x8,64x64,0,0,false,81,4096,1.0\r\ngrid:8x8,64x64,0,0,false,81,4096,2.0\r\ngrid:8x8,64x64,0,0,false,81,4096,nan\r\n"
         );
         let e = read_passes_from(crlf.as_bytes(), Path::new("c.csv"))
             .unwrap_err()
@@ -758,7 +869,80 @@ mod tests {
             .to_string();
         assert!(e.contains("other.csv has the header \"a,b\""), "{e}");
         assert_eq!(std::fs::read_to_string(&other).unwrap(), "a,b\n1,2\n");
-        assert!(check_appendable(&dir.path().join("new.csv")).unwrap());
+        assert_eq!(check_appendable(&dir.path().join("new.csv"), 0).unwrap(), AppendTo::New);
+    }
+
+    #[test]
+    fn the_draws_column_is_written_and_older_files_keep_their_format() {
+        let dir = tempfile::tempdir().unwrap();
+        // A new file: the header with `draws`, and rows of any draws.
+        let path = dir.path().join("p.csv");
+        let empty = PassRow {
+            draws: 0,
+            vs_invocations: 0,
+            fs_invocations: 0,
+            ..row("grid:8x8", 0, 1.0)
+        };
+        let split = PassRow {
+            draws: 16,
+            ..row("grid:8x8", 0, 2.0)
+        };
+        append_passes(&path, &[empty.clone(), split.clone(), row("grid:8x8", 3, 3.0)]).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            text.starts_with(&format!("{PASS_HEADER}\ngrid:8x8,384x384,0,0,false,0,0,1.0,0\n")),
+            "{text}"
+        );
+        let back = read_passes(&path).unwrap();
+        assert_eq!(back, [empty.clone(), split.clone(), row("grid:8x8", 3, 3.0)]);
+        assert_eq!(check_appendable(&path, 7).unwrap(), AppendTo::Current);
+
+        // A file of the older header: read as one draw a pass; rows of one
+        // draw appended in its format; other draws refused, the file kept.
+        let old = dir.path().join("old.csv");
+        let before = format!("{LEGACY_PASS_HEADER}\ngrid:8x8,384x384,0,0,false,81,4096,5.0\n");
+        std::fs::write(&old, &before).unwrap();
+        assert_eq!(read_passes(&old).unwrap()[0].draws, 1);
+        append_passes(&old, &[row("grid:8x8", 4, 6.0)]).unwrap();
+        let text = std::fs::read_to_string(&old).unwrap();
+        assert_eq!(text, format!("{before}grid:8x8,384x384,4,0,false,15570,147456,6.0\n"));
+        for r in [&empty, &split] {
+            let e = append_passes(&old, &[row("grid:8x8", 5, 7.0), r.clone()])
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("written before the `draws` column")
+                    && e.contains(&format!("a pass of {} draws", r.draws))
+                    && e.contains("old.csv is left as it was"),
+                "{e}"
+            );
+            assert_eq!(std::fs::read_to_string(&old).unwrap(), text);
+        }
+        assert!(check_appendable(&old, 0).is_err());
+        assert_eq!(check_appendable(&old, 1).unwrap(), AppendTo::Legacy);
+
+        // Values no measurement gives, by column.
+        let bad = |cells: &str| {
+            read_passes_from(format!("{PASS_HEADER}\n{cells}\n").as_bytes(), Path::new("d.csv"))
+                .unwrap_err()
+                .to_string()
+        };
+        let e = bad("grid:8x8,64x64,0,0,false,0,0,1.0,4097");
+        assert!(
+            e.contains("column 9 (draws)") && e.contains("more than 4096 draws"),
+            "{e}"
+        );
+        let e = bad("grid:8x8,64x64,0,0,false,81,0,1.0,0");
+        assert!(
+            e.contains("column 6 (vs_invocations)") && e.contains("0 draws runs no shader"),
+            "{e}"
+        );
+        let e = bad("grid:8x8,64x64,0,0,false,0,9,1.0,0");
+        assert!(e.contains("column 7 (fs_invocations)"), "{e}");
+        let e = bad("grid:8x8,64x64,0,0,false,0,0,1.0,-1");
+        assert!(e.contains("column 9 (draws)"), "{e}");
+        let e = bad("grid:8x8,64x64,0,0,false,0,0,1.0");
+        assert!(e.contains("8 fields, expected 9"), "{e}");
     }
 
     #[test]
