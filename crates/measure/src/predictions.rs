@@ -14,7 +14,8 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::calibrate::{
-    CalibrateError, Invocations, LoadCache, error_summary, fit, leave_one_out_ns, linear_baseline_loo, row_load,
+    CalibrateError, Invocations, LoadCache, error_summary, fit, k_fold_by_mesh, leave_one_out_ns, linear_baseline_loo,
+    row_load,
 };
 use super::device_predict::{DevicePass, DevicePredictError, predict_on_device};
 use super::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy};
@@ -76,6 +77,9 @@ pub struct DevicePredictions {
     pub loo: ErrorStats,
     /// A plain linear fit's leave-one-out errors (the baseline to beat).
     pub linear_loo: ErrorStats,
+    /// Errors with whole meshes held out (k-fold by mesh), when computed:
+    /// (folds, the statistics).
+    pub kfold: Option<(usize, ErrorStats)>,
     /// The full profile's simulation's errors.
     pub simulated: ErrorStats,
     /// Sum of the rows' measuring times, seconds.
@@ -105,9 +109,19 @@ pub struct Calibration {
     pub loo_ns: Vec<f64>,
     /// Per row, a plain linear fit's leave-one-out error, percent.
     pub linear_loo_pct: Vec<f64>,
+    /// Per row, the error (percent) of the prediction by a fit without any
+    /// pass of its mesh ([`KFOLD`] folds by mesh, as `calibrate --kfold`);
+    /// `None` with fewer than two meshes or a fold that leaves too few rows.
+    pub kfold_pct: Option<Vec<f64>>,
+    /// The folds of `kfold_pct` (fewer than [`KFOLD`] with fewer meshes).
+    pub kfold_folds: usize,
     /// Wall time of the fits, seconds.
     pub seconds: f64,
 }
+
+/// Folds of the k-fold cross-validation by mesh a calibration reports (at
+/// most one per distinct mesh).
+pub const KFOLD: usize = 6;
 
 /// Fits a profile named `name` to `rows` (fit on the measured vertex
 /// invocations, leave-one-out predictions on the cache policy's), as
@@ -134,8 +148,13 @@ pub fn calibrate_rows(
     let loo_ns = leave_one_out_ns(&fit_loads, &predict_loads, &y)?;
     let loo: Vec<f64> = loo_ns.iter().zip(&y).map(|(p, m)| rel_error_pct(*p, *m)).collect();
     let linear_loo_pct = linear_baseline_loo(&predict_loads, &y);
+    let meshes: Vec<&str> = rows.iter().map(|r| r.mesh.as_str()).collect();
+    let kfolded = k_fold_by_mesh(&fit_loads, &predict_loads, &y, &meshes, KFOLD).ok();
+    let kfold_folds = kfolded.as_ref().map_or(0, |k| k.folds);
+    let kfold_pct = kfolded.map(|k| k.errors);
     let (median, p90, worst) = error_summary(&errors);
     let (lm, lp, _) = error_summary(&loo);
+    let kfold = kfold_pct.as_deref().map(error_summary);
     let profile = DeviceProfile {
         device: DeviceInfo {
             name: name.to_string(),
@@ -151,8 +170,8 @@ pub fn calibrate_rows(
             worst_pct: worst,
             loo_median_pct: Some(lm),
             loo_p90_pct: Some(lp),
-            kfold_median_pct: None,
-            kfold_p90_pct: None,
+            kfold_median_pct: kfold.map(|k| k.0),
+            kfold_p90_pct: kfold.map(|k| k.1),
         },
     };
     if let Err(super::device_profile::ProfileError::Invalid { key, value, why }) = profile.validate() {
@@ -162,17 +181,21 @@ pub fn calibrate_rows(
         profile,
         loo_ns,
         linear_loo_pct,
+        kfold_pct,
+        kfold_folds,
         seconds: start.elapsed().as_secs_f64(),
     })
 }
 
 /// Every row of `rows` with its leave-one-out prediction (`loo_ns`, from
-/// [`calibrate_rows`]) and its simulation on `profile`.
+/// [`calibrate_rows`]) and its simulation on `profile`; `kfold` the folds
+/// and errors of a k-fold cross-validation by mesh, when there is one.
 pub fn predict_rows(
     profile: &DeviceProfile,
     rows: &[PassRow],
     loo_ns: &[f64],
     linear_loo_pct: &[f64],
+    kfold: Option<(usize, &[f64])>,
 ) -> Result<DevicePredictions, PredictionsError> {
     let mut out = Vec::with_capacity(rows.len());
     for (r, &loo) in rows.iter().zip(loo_ns) {
@@ -193,6 +216,7 @@ pub fn predict_rows(
         loo: stats(|r| r.loo_error_pct),
         simulated: stats(|r| r.simulated_error_pct),
         linear_loo: ErrorStats::of(linear_loo_pct),
+        kfold: kfold.map(|(k, e)| (k, ErrorStats::of(e))),
         measuring_seconds: out.iter().map(|r| r.measuring_seconds).sum(),
         simulating_seconds: out.iter().map(|r| r.simulating_seconds).sum(),
         rows: out,
@@ -259,6 +283,14 @@ impl DevicePredictions {
             self.measuring_seconds,
             self.simulating_seconds
         );
+        if let Some((k, e)) = &self.kfold {
+            let _ = writeln!(
+                s,
+                "\nWhole meshes held out ({k} folds by mesh, each predicted by a fit to the others' meshes: \
+                 what a new pass of an unseen mesh is): median {:.1}%, 90th percentile {:.1}%, worst {:.1}%.",
+                e.median, e.p90, e.worst
+            );
+        }
         s
     }
 }

@@ -1,4 +1,5 @@
 //! The `device_predictions` run, its summary (`metrics.loo_error_pct`,
+//! `metrics.kfold_error_pct` (whole meshes held out),
 //! `metrics.simulated_error_pct`, ... as median / p90 / worst), its table
 //! (one row per measured pass) and its report (the markdown table
 //! `rendersim calibrate --report` writes), in the system registry
@@ -28,6 +29,9 @@ pub struct DevicePredictionsSystem;
 struct Metrics {
     rows: usize,
     loo_error_pct: ErrorStats,
+    /// Whole meshes held out (`KFOLD` folds by mesh): what a new pass is.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    kfold_error_pct: Option<ErrorStats>,
     linear_baseline_loo_pct: ErrorStats,
     simulated_error_pct: ErrorStats,
     fit_error_pct: ErrorStats,
@@ -99,12 +103,14 @@ pub fn run_device_predictions(
     }
     let cal =
         calibrate_rows(&rows, &cfg.device, &policy, cfg.shader_cores).map_err(|e| invalid("files", e.to_string()))?;
-    let predictions = predict_rows(&cal.profile, &rows, &cal.loo_ns, &cal.linear_loo_pct)
+    let kfold = cal.kfold_pct.as_deref().map(|e| (cal.kfold_folds, e));
+    let predictions = predict_rows(&cal.profile, &rows, &cal.loo_ns, &cal.linear_loo_pct, kfold)
         .map_err(|e| invalid("files", e.to_string()))?;
     let fit = &cal.profile.fit;
     let metrics = Metrics {
         rows: rows.len(),
         loo_error_pct: predictions.loo,
+        kfold_error_pct: predictions.kfold.map(|(_, e)| e),
         linear_baseline_loo_pct: predictions.linear_loo,
         simulated_error_pct: predictions.simulated,
         fit_error_pct: ErrorStats {
