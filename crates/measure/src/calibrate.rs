@@ -379,8 +379,8 @@ fn solve(mut a: Vec<f64>, mut b: Vec<f64>, n: usize) -> Option<Vec<f64>> {
 /// Hanson's active-set method on the normal equations of unit-norm
 /// columns); returns the coefficients, their standard errors and the
 /// objective (sum of squared relative errors).
-fn nnls<const P: usize>(rows: &[[f64; P]], y: &[f64]) -> ([f64; P], [f64; P], f64) {
-    let mut scale = [0.0f64; P];
+fn nnls<const N: usize>(rows: &[[f64; N]], y: &[f64]) -> ([f64; N], [f64; N], f64) {
+    let mut scale = [0.0f64; N];
     for (r, yi) in rows.iter().zip(y) {
         for (s, v) in scale.iter_mut().zip(r) {
             *s += (v / yi).powi(2);
@@ -391,12 +391,12 @@ fn nnls<const P: usize>(rows: &[[f64; P]], y: &[f64]) -> ([f64; P], [f64; P], f6
         *s = if *s > 0.0 { s.sqrt() } else { 1.0 };
     }
     // Gram matrix and right-hand side of the scaled system.
-    let (mut g, mut c) = ([[0.0f64; P]; P], [0.0f64; P]);
+    let (mut g, mut c) = ([[0.0f64; N]; N], [0.0f64; N]);
     for (r, yi) in rows.iter().zip(y) {
-        let x: [f64; P] = std::array::from_fn(|j| r[j] / yi / scale[j]);
-        for i in 0..P {
+        let x: [f64; N] = std::array::from_fn(|j| r[j] / yi / scale[j]);
+        for i in 0..N {
             c[i] += x[i];
-            for k in 0..P {
+            for k in 0..N {
                 g[i][k] += x[i] * x[k];
             }
         }
@@ -406,12 +406,12 @@ fn nnls<const P: usize>(rows: &[[f64; P]], y: &[f64]) -> ([f64; P], [f64; P], f6
         let a: Vec<f64> = set.iter().flat_map(|&i| set.iter().map(move |&k| g[i][k])).collect();
         solve(a, set.iter().map(|&i| c[i]).collect(), n)
     };
-    let mut x = [0.0f64; P];
+    let mut x = [0.0f64; N];
     let mut passive: Vec<usize> = Vec::new();
-    let mut excluded = [false; P];
-    for _ in 0..10 * P {
-        let w: [f64; P] = std::array::from_fn(|j| c[j] - (0..P).map(|k| g[j][k] * x[k]).sum::<f64>());
-        let Some(j) = (0..P)
+    let mut excluded = [false; N];
+    for _ in 0..10 * N {
+        let w: [f64; N] = std::array::from_fn(|j| c[j] - (0..N).map(|k| g[j][k] * x[k]).sum::<f64>());
+        let Some(j) = (0..N)
             .filter(|&j| usable[j] && !excluded[j] && !passive.contains(&j) && w[j] > 1e-10)
             .max_by(|&a, &b| w[a].total_cmp(&w[b]))
         else {
@@ -450,7 +450,7 @@ fn nnls<const P: usize>(rows: &[[f64; P]], y: &[f64]) -> ([f64; P], [f64; P], f6
             });
         }
     }
-    let beta: [f64; P] = std::array::from_fn(|j| x[j] / scale[j]);
+    let beta: [f64; N] = std::array::from_fn(|j| x[j] / scale[j]);
     let obj: f64 = rows
         .iter()
         .zip(y)
@@ -461,7 +461,7 @@ fn nnls<const P: usize>(rows: &[[f64; P]], y: &[f64]) -> ([f64; P], [f64; P], f6
         .sum();
     let n = passive.len();
     let s2 = obj / rows.len().saturating_sub(n).max(1) as f64;
-    let mut se = [0.0; P];
+    let mut se = [0.0; N];
     let a: Vec<f64> = passive
         .iter()
         .flat_map(|&i| passive.iter().map(move |&k| g[i][k]))
