@@ -534,7 +534,7 @@ fn fit_sides(loads: &[PassLoad], y: &[f64], shared: &[f64]) -> Option<([f64; Q],
 const OVERLAP_ROUNDS: usize = 12;
 
 /// Fits a profile's costs to `loads` measured at `y` ns. The first round
-/// fits the linear costs alone ([`fit_sides`]); each later round gives the
+/// fits the linear costs alone (`fit_sides`); each later round gives the
 /// overlap term the `Gl R / (Gl + R)` of every row under the previous round's
 /// costs and fits again, until the overlap settles. The round with the
 /// smallest sum of squared relative errors (the whole formula) is kept, so
