@@ -6,7 +6,7 @@
 //!   each handled event schedules one more at a random later time) and a
 //!   stiff mix (nanosecond delays with one-second ones) through the engine,
 //!   on its radix heap and on its binary heap, against a bare `BinaryHeap`
-//!   loop doing the same work ([`kernel`]).
+//!   loop doing the same work ([`kernel`](mod@kernel)).
 //! - `pipeline`: one frame of about one million triangles at `triangle`
 //!   fidelity against the same frame at `draw` fidelity.
 //! - `hour`: one simulated hour of the default (noisy, 60 Hz) model at `draw`

@@ -15,7 +15,7 @@
 //!   device profiles, calibration and predictions.
 //! - here: [`studies`] that run whole models (isolation, paper 000 Table 1,
 //!   the Figure 4 timeline, device predictions), [`experiment`],
-//!   [`bench`], and the command-line tool (`src/main.rs`, `src/cli`).
+//!   [`bench`](mod@bench), and the command-line tool (`src/main.rs`, `src/cli`).
 #![warn(missing_docs)]
 
 pub use rendersim_engine as engine;

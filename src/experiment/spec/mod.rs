@@ -428,7 +428,7 @@ impl Experiment {
     }
 
     /// The model file a point runs on when a `[[sweep]] key = "model"`
-    /// picks it ([`MODEL_SWEEP_KEY`]); `None` without such a sweep (every
+    /// picks it (`MODEL_SWEEP_KEY`); `None` without such a sweep (every
     /// point runs on [`Experiment::model`]).
     pub fn point_source(&self, point: &super::Point) -> Option<ModelSource> {
         point

@@ -69,7 +69,7 @@ pub struct MixturePart<V: Quantity> {
 /// A non-negative random variable with parameters in quantity `V`.
 ///
 /// Uniform on [0, 10]: mean 5, variance 100 / 12, P(X > 4) = 0.6, and
-/// `E[max(4, X)]` = 4 P(X < 4) + E[X; X > 4] = 1.6 + (100 - 16) / 20 = 5.8;
+/// `E[max(4, X)]` = 4 P(X < 4) + `E[X; X > 4]` = 1.6 + (100 - 16) / 20 = 5.8;
 /// samples average to the mean. A duration's parameters are in picoseconds.
 ///
 /// ```

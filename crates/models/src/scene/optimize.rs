@@ -12,7 +12,7 @@
 //! from the first not yet emitted triangle in input order, which keeps the
 //! whole run linear in the triangle count.
 //!
-//! [`optimize_vertex_cache`] is the fast form; [`reference`] keeps the
+//! [`optimize_vertex_cache`] is the fast form; `reference` keeps the
 //! first, direct form, which it must match byte for byte (the tests and
 //! `rendersim bench build` compare them).
 
@@ -93,7 +93,7 @@ impl ScoreTable {
 /// The output is byte for byte that of
 /// [`optimize_vertex_cache_reference`], the direct form, several times
 /// faster (`rendersim bench build`): vertex scores come from a table
-/// ([`ScoreTable`]) instead of two `powf` each; each vertex's live
+/// (`ScoreTable`) instead of two `powf` each; each vertex's live
 /// triangles are one `[start, len]` pair into a flat adjacency array; the
 /// cache keeps only the vertices that still have live triangles (about 12
 /// of the 32 in a grid), with their positions, so the rest are neither

@@ -12,7 +12,7 @@
 //!
 //! The loop is arranged for speed without changing a count: the warp and
 //! group tests are compiled only into the variants whose policy has them
-//! ([`run_span`]'s `WARP` and `PRIM`), and the warp test reads the
+//! (`run_span`'s `WARP` and `PRIM`), and the warp test reads the
 //! triangle's three stamps only when the warp has fewer than three free
 //! slots (only then can a triangle of at most three misses overflow it).
 //! `cargo bench --bench vcache` compares it with meshoptimizer's C++ in the

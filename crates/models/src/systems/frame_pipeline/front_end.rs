@@ -23,7 +23,7 @@ use super::geometry_stage::GeometryStage;
 use super::links::{Command, Env, command_count};
 
 /// What the GPU front end is doing (its command is its own, see
-/// [`FrontEnd::describe`]).
+/// `FrontEnd::describe`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FrontPhase {
     /// Waiting for commands (starved when at rest).

@@ -10,11 +10,11 @@
 //! (`cpu_thread.rs`), the front end (`front_end.rs`), the geometry and
 //! fragment stages (`geometry_stage.rs`, `fragment_stage.rs`) and the
 //! display (`display.rs`); the FIFOs, the shader pool and the swap chain
-//! between them are the [`Links`] (`links.rs`), passed to the units'
+//! between them are the `Links` (`links.rs`), passed to the units'
 //! methods; the events they schedule are [`Ev`] (`events.rs`).
 //! [`FramePipeline`] holds the units, dispatches each event to the
 //! unit it concerns, then lets the units take their steps in the order the
-//! data flows ([`FramePipeline::settle`]) and has the instant accounted
+//! data flows (`FramePipeline::settle`) and has the instant accounted
 //! (`accounting.rs`, which reads the units through an immutable view).
 
 use crate::components::fifo::BoundedFifo;
