@@ -7,7 +7,7 @@ use crate::plot::{
     line_plot, scatter,
 };
 
-use super::run::PointResult;
+use super::results::PointResult;
 use super::spec::{Experiment, PlotKind, PlotSpec};
 use super::sweep::{Point, Sweep};
 

@@ -24,6 +24,7 @@ mod figures;
 pub mod fingerprint;
 pub mod inverse;
 mod report;
+mod results;
 mod run;
 mod runner;
 pub mod sample;
@@ -44,7 +45,8 @@ pub use derived::{interval_width, quantile_width_from_min, ratio, relative_error
 pub use dotted::{MetricPathError, json_number, json_path};
 pub use error::ExperimentError;
 pub use report::add_provenance;
-pub use run::{ExperimentResult, PathStat, PointResult, RunRecord, ShardCost, point_model, run_experiment};
+pub use results::{ExperimentResult, PathStat, PointResult, RunRecord, ShardCost};
+pub use run::{point_model, run_experiment};
 pub use runner::{FrameTable, RunError, RunOutput, Runner};
 pub use shard::{SHARD_FORMAT, SHARDS_DIR, ShardId, ShardIdError, ShardOutcome, merge_shards, run_shard};
 pub use sim_runner::SimRunner;

@@ -5,7 +5,7 @@ use std::fmt::Write;
 
 use crate::stats::ci::MeanCi;
 
-use super::run::{ExperimentResult, PointResult};
+use super::results::{ExperimentResult, PointResult};
 use super::sample::Sample;
 use super::spec::{DerivedKind, Experiment, ModelSource, PlotKind};
 use super::sweep::value_text;

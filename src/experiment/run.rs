@@ -6,217 +6,18 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
-use serde::Serialize;
 
 use crate::stats::ci::{MeanCi, mean_ci};
 
 use super::check::{Bound, CheckOutcome, evaluate, evaluate_between};
 use super::derived::{DerivedInputs, compute};
 use super::dotted::json_number;
+use super::results::{ExperimentResult, JobOutput, PathStat, PointResult, RunRecord, ShardCost};
 use super::runner::Runner;
 use super::spec::{BoundRef, Expect, Experiment, MODEL_SWEEP_KEY, ModelSource};
 use super::sweep::{Point, expand_points};
 use super::{ExperimentError, figures, report, tables};
 use crate::config::set_dotted;
-
-/// The numbers read from one run.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct RunRecord {
-    /// Point index.
-    pub point: usize,
-    /// Seed.
-    pub seed: u64,
-    /// One value per [`Experiment::tracked_paths`] entry (`None`: JSON null).
-    pub values: Vec<Option<f64>>,
-    /// The summary's `wall_seconds`, or the measured call time if absent.
-    pub wall_seconds: f64,
-}
-
-/// Replication statistics of one summary path at one point.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PathStat {
-    /// Dotted summary path.
-    pub path: String,
-    /// Mean and confidence interval over the replications.
-    pub ci: MeanCi,
-}
-
-/// Aggregated results of one point.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PointResult {
-    /// Position in expansion order.
-    pub index: usize,
-    /// `key=value, ...` label.
-    pub label: String,
-    /// `(sweep key, value as text)` pairs.
-    pub assignments: Vec<(String, String)>,
-    /// One entry per tracked path.
-    pub stats: Vec<PathStat>,
-    /// `(name, value)` per derived value (`None`: undefined here).
-    pub derived: Vec<(String, Option<f64>)>,
-}
-
-impl PointResult {
-    /// The replication statistics of `path`, if tracked.
-    pub fn stat(&self, path: &str) -> Option<&MeanCi> {
-        self.stats.iter().find(|s| s.path == path).map(|s| &s.ci)
-    }
-
-    /// The replication mean of `path` (`None` if untracked or no values).
-    pub fn mean(&self, path: &str) -> Option<f64> {
-        self.stat(path).filter(|c| c.n > 0).map(|c| c.mean)
-    }
-
-    /// A derived value by name.
-    pub fn derived_value(&self, name: &str) -> Option<f64> {
-        self.derived.iter().find(|d| d.0 == name).and_then(|d| d.1)
-    }
-
-    /// A derived value if `name` is one, else the mean of the path `name`.
-    pub fn value(&self, name: &str) -> Option<f64> {
-        if self.derived.iter().any(|d| d.0 == name) {
-            self.derived_value(name)
-        } else {
-            self.mean(name)
-        }
-    }
-}
-
-/// Everything an experiment produced.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ExperimentResult {
-    /// Experiment name.
-    pub name: String,
-    /// The summary paths tracked, in the order of `PointResult::stats`.
-    pub paths: Vec<String>,
-    /// Per-point aggregates, in point order.
-    pub points: Vec<PointResult>,
-    /// Every run, sorted by point then seed.
-    pub runs: Vec<RunRecord>,
-    /// Check outcomes, in file order (one per matching point).
-    pub checks: Vec<CheckOutcome>,
-    /// How many checks failed (verdicts on claims never count).
-    pub checks_failed: usize,
-    /// Wall time of the whole experiment, in seconds.
-    pub wall_seconds: f64,
-    /// Sum of the runs' `wall_seconds`.
-    pub sim_wall_seconds: f64,
-    /// CPU time (user + system) of this process, in seconds, where the
-    /// system reports it (for a merge: the merging process alone).
-    pub cpu_seconds: Option<f64>,
-    /// For outputs merged from shards: their count and cost
-    /// (`wall_seconds` is then the array's wall time).
-    pub shards: Option<ShardCost>,
-    /// Files written, relative to the output directory.
-    pub files: Vec<PathBuf>,
-    /// Caption lines for the plots, as `(plot file, line)` in plot order
-    /// (e.g. histogram values outside the plot's `range`).
-    pub plot_captions: Vec<(String, String)>,
-    /// Inverse what-ifs, in file order.
-    pub searches: Vec<super::inverse::SearchResult>,
-    /// Sobol' indices per metric (`[sample] method = "sobol"`; else empty).
-    pub sensitivity: Vec<super::sobol::Sensitivity>,
-}
-
-impl ExperimentResult {
-    /// A short plain-text table: one line per point with each metric's mean
-    /// and half-width, then the derived values (`[[derived]]`: the numbers
-    /// an experiment is usually run for) one line per point where any is
-    /// defined, then the check tally.
-    pub fn table(&self, exp: &Experiment) -> String {
-        let mut out = String::new();
-        for p in &self.points {
-            let cells: Vec<String> = exp
-                .metrics
-                .iter()
-                .map(|m| match p.stat(&m.path) {
-                    Some(c) => format!("{} = {}", m.label, report::mean_pm(c)),
-                    None => format!("{} = n/a", m.label),
-                })
-                .collect();
-            out.push_str(&format!("{}: {}\n", p.label, cells.join("; ")));
-        }
-        let derived: Vec<String> = self
-            .points
-            .iter()
-            .filter_map(|p| {
-                let cells: Vec<String> = p
-                    .derived
-                    .iter()
-                    .filter_map(|(name, v)| v.map(|v| format!("{name} = {}", report::fmt_num(v))))
-                    .collect();
-                (!cells.is_empty()).then(|| format!("  {}: {}\n", p.label, cells.join("; ")))
-            })
-            .collect();
-        if !derived.is_empty() {
-            out.push_str("derived values:\n");
-            derived.iter().for_each(|l| out.push_str(l));
-        }
-        let tests = self.checks.iter().filter(|c| c.claim.is_none()).count();
-        if tests > 0 {
-            out.push_str(&format!(
-                "checks: {} passed, {} failed\n",
-                tests - self.checks_failed,
-                self.checks_failed
-            ));
-        }
-        for (claim, holds, total) in self.claims() {
-            let verdict = match holds {
-                h if h == total => "HOLDS".to_string(),
-                0 => "DOES NOT HOLD".to_string(),
-                h => format!("HOLDS IN PART ({h} of {total})"),
-            };
-            out.push_str(&format!("claim {verdict}: {claim}\n"));
-        }
-        out
-    }
-
-    /// The checks' and claims' outcome for the final line: `, checks 2
-    /// passed 0 failed, claims 1 of 2 hold` (empty without either).
-    pub fn tally(&self) -> String {
-        let mut out = String::new();
-        let tests = self.checks.iter().filter(|c| c.claim.is_none()).count();
-        if tests > 0 {
-            out.push_str(&format!(
-                ", checks {} passed {} failed",
-                tests - self.checks_failed,
-                self.checks_failed
-            ));
-        }
-        let claims = self.claims();
-        if !claims.is_empty() {
-            let hold = claims.iter().filter(|(_, h, t)| h == t).count();
-            out.push_str(&format!(", claims {hold} of {} hold", claims.len()));
-        }
-        out
-    }
-
-    /// Verdicts per claim, in file order: `(claim, outcomes that hold, outcomes)`.
-    pub fn claims(&self) -> Vec<(String, usize, usize)> {
-        let mut out: Vec<(String, usize, usize)> = Vec::new();
-        for c in &self.checks {
-            let Some(claim) = &c.claim else { continue };
-            let i = match out.iter().position(|o| &o.0 == claim) {
-                Some(i) => i,
-                None => {
-                    out.push((claim.clone(), 0, 0));
-                    out.len() - 1
-                }
-            };
-            out[i].1 += usize::from(c.passed);
-            out[i].2 += 1;
-        }
-        out
-    }
-}
-
-/// What one job returns.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct JobOutput {
-    pub(crate) record: RunRecord,
-    /// Frame columns in `Experiment::frame_columns` order.
-    pub(crate) frames: Vec<Vec<f64>>,
-}
 
 /// The model for `point`: `base` (or the model file a `[[sweep]] key =
 /// "model"` picks for the point) with `[set]` then the point's other sweep
@@ -307,18 +108,6 @@ pub(crate) enum Timing {
     Single(Instant),
     /// Merged from shards.
     Shards(ShardCost),
-}
-
-/// The cost of an experiment run as shards (`--shard K/N`, merged with
-/// `--merge`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ShardCost {
-    /// Number of shards.
-    pub shards: usize,
-    /// CPU time (user + system) summed over the shard processes, in seconds.
-    pub cpu_seconds: f64,
-    /// From the start of the first shard to the end of the last, in seconds.
-    pub array_wall_seconds: f64,
 }
 
 /// Run `exp` on `base_model` through `runner`, writing `runs.csv`,

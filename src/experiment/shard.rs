@@ -41,7 +41,8 @@ use serde::{Deserialize, Serialize};
 use super::ExperimentError;
 use super::cost::{process_cpu_seconds, unix_seconds};
 use super::fingerprint::experiment_fingerprint;
-use super::run::{ExperimentResult, JobOutput, Plan, RunRecord, ShardCost, Timing, finish};
+use super::results::{ExperimentResult, JobOutput, RunRecord, ShardCost};
+use super::run::{Plan, Timing, finish};
 use super::runner::Runner;
 use super::spec::Experiment;
 

@@ -237,7 +237,7 @@ pub struct Sensitivity {
 
 /// Sobol' indices of every `[[metric]]` of `exp` from the replication means
 /// of its points (empty unless `exp` samples with `method = "sobol"`).
-pub(crate) fn analyse(exp: &super::spec::Experiment, results: &[super::run::PointResult]) -> Vec<Sensitivity> {
+pub(crate) fn analyse(exp: &super::spec::Experiment, results: &[super::results::PointResult]) -> Vec<Sensitivity> {
     use super::sample::SampleMethod;
     let Some(s) = exp.sample.as_ref().filter(|s| s.method == SampleMethod::Sobol) else {
         return Vec::new();

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use super::ExperimentError;
-use super::run::{PointResult, RunRecord};
+use super::results::{PointResult, RunRecord};
 use super::spec::Experiment;
 use super::sweep::{Point, value_text};
 
