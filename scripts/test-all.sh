@@ -49,7 +49,7 @@ fi
 cargo build --release --locked --workspace --all-targets --features wgpu
 export RENDERSIM_BIN="$root/target/release/rendersim"
 
-step "Formatting and lints (cargo fmt --check; clippy with warnings as errors)"
+step "Formatting and lints (cargo fmt --check; clippy and rustdoc with warnings as errors)"
 for tool in rustfmt clippy; do
   cargo "${tool/rustfmt/fmt}" --version >/dev/null 2>&1 || rustup component add "$tool" || true
 done
@@ -59,6 +59,9 @@ if cargo clippy --version >/dev/null 2>&1; then
 else
   echo "clippy unavailable: skipped"
 fi
+# The API documentation builds without a warning (a broken or private link
+# fails); it reuses clippy's checked dependencies (about 16 s here).
+RUSTDOCFLAGS="-D warnings" cargo doc --release --locked --no-deps --workspace --features wgpu
 
 step "Rust tests (unit, property, integration, doc; wgpu measurements on lavapipe)"
 # (The fuzz test runs in its own step below, so that its counts are shown.)
