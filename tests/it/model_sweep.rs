@@ -164,6 +164,20 @@ fn device_predictions_report_the_leave_one_out_errors_of_the_calibration() {
         (got("median") - med).abs() < 1e-9 && (got("p90") - p90).abs() < 1e-9 && (got("worst") - worst).abs() < 1e-9
     );
     assert!((m["linear_baseline_loo_pct"]["median"].as_f64().unwrap() - bm).abs() < 1e-9);
+    // Study H2's ratio: the load grid's four cells measured (0.931), the
+    // profile's prediction and that of a fit without H2's mesh (0.935), as
+    // tests/it/devices.rs computes them through the library.
+    let h2 = &m["sum_vs_max"];
+    let f = |k: &str| h2[k].as_f64().unwrap_or(f64::NAN);
+    assert!(
+        (f("measured_rows") - (40.336128 - 22.84464) / (18.8376 - 0.0552)).abs() < 1e-6,
+        "{h2}"
+    );
+    assert_eq!(f("measured_study"), 0.94, "{h2}");
+    assert!(
+        (f("predicted") - 0.931).abs() < 0.002 && (f("predicted_without_mesh") - 0.935).abs() < 0.002,
+        "{h2}"
+    );
     // Measuring: 7 passes per row.
     let measuring: f64 = y.iter().map(|t| 7.0 * t * 1e-9).sum();
     assert!((m["measuring_seconds"].as_f64().unwrap() - measuring).abs() < 1e-9 * measuring);
@@ -197,6 +211,27 @@ fn a_bad_device_predictions_model_is_an_error_naming_the_key() {
             "colour",
         ),
     ] {
+        let p = write(&format!("{head}{body}"));
+        let o = bin().arg("run").arg(&p).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{body}");
+        assert!(err.contains(want) && !err.contains("panicked"), "{body}: {err}");
+    }
+    // `[sum_vs_max]` (study H2's cells) on real rows: each bad value named.
+    let grid = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/measurements/nvidia-h200/load-grid.csv");
+    let files = format!(
+        "files = [{:?}]\nvertex_cache = \"nvidia\"\n",
+        grid.display().to_string()
+    );
+    let cells = "mesh = \"grid:96x96:optimized\"\nsize = \"384x384\"\nvs_loops = 67390\nfs_loops = 7681\n";
+    for (table, want) in [
+        (cells.replace("384x384", "384"), "sum_vs_max.size"),
+        (cells.replace("67390", "0"), "`sum_vs_max`: vs_loops = 0"),
+        (cells.replace("grid:96x96:optimized", "grid:oops"), "grid:oops"),
+        (format!("{cells}measured = nan\n"), "sum_vs_max.measured"),
+        (format!("{cells}colour = 1\n"), "colour"),
+    ] {
+        let body = format!("{files}[sum_vs_max]\n{table}");
         let p = write(&format!("{head}{body}"));
         let o = bin().arg("run").arg(&p).output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);

@@ -6,6 +6,13 @@
 //! files = ["../../docs/measurements/nvidia-h200/load-grid.csv"]   # relative to this file
 //! vertex_cache = "nvidia"              # the device's vertex-reuse policy
 //! shader_cores = 132                   # default 132
+//!
+//! [sum_vs_max]                         # optional: study H2's four cells
+//! mesh = "grid:96x96:optimized"
+//! size = "384x384"
+//! vs_loops = 67390                     # the heavy loads (the light ones are 0)
+//! fs_loops = 7681
+//! measured = 0.940                     # the study's measured ratio, when known
 //! ```
 
 use std::path::PathBuf;
@@ -36,6 +43,10 @@ pub struct DevicePredictionsConfig {
     /// deterministic, so it changes nothing).
     #[serde(default)]
     pub run: RunConfig,
+    /// Study H2's cells, whose sum-against-max ratio the profile predicts
+    /// (`metrics.sum_vs_max`).
+    #[serde(default)]
+    pub sum_vs_max: Option<super::sum_vs_max::SumVsMaxConfig>,
 }
 
 /// `[run]`.

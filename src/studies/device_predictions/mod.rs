@@ -10,9 +10,11 @@
 //! took against the wall time simulating took (`measure::predictions`).
 //!
 //! - `config`: the model file;
-//! - `system`: the run, its summary and table, the registry entry.
+//! - `system`: the run, its summary and table, the registry entry;
+//! - `sum_vs_max`: study H2's ratio as the profile predicts it (`[sum_vs_max]`).
 
 pub mod config;
+pub mod sum_vs_max;
 pub mod system;
 
 pub use config::DevicePredictionsConfig;

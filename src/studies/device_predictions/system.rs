@@ -39,6 +39,9 @@ struct Metrics {
     simulating_seconds: f64,
     measuring_over_simulating: f64,
     calibrate_seconds: f64,
+    /// Study H2's ratio, measured and predicted (`[sum_vs_max]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    sum_vs_max: Option<super::sum_vs_max::SumVsMax>,
 }
 
 /// The summary.
@@ -106,6 +109,11 @@ pub fn run_device_predictions(
     let kfold = cal.kfold_pct.as_deref().map(|e| (cal.kfold_folds, e));
     let predictions = predict_rows(&cal.profile, &rows, &cal.loo_ns, &cal.linear_loo_pct, kfold)
         .map_err(|e| invalid("files", e.to_string()))?;
+    let sum_vs_max = cfg
+        .sum_vs_max
+        .as_ref()
+        .map(|s| s.evaluate(&cal.profile, &rows, &policy, cfg.shader_cores))
+        .transpose()?;
     let fit = &cal.profile.fit;
     let metrics = Metrics {
         rows: rows.len(),
@@ -122,6 +130,7 @@ pub fn run_device_predictions(
         simulating_seconds: predictions.simulating_seconds,
         measuring_over_simulating: predictions.measuring_seconds / predictions.simulating_seconds,
         calibrate_seconds: cal.seconds,
+        sum_vs_max,
     };
     let summary = Summary {
         system: "device_predictions",
