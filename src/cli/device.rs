@@ -144,8 +144,8 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
             Some((_, b, _)) => b.clone(),
             None => linear_baseline_loo(&predict_loads, &y),
         };
-        let kfolded = kfold.as_ref().map(|k| (k.folds, k.errors.as_slice()));
-        let md = predict_rows(&profile, &rows, &loo_ns, &linear, kfolded)?.markdown("`rendersim calibrate --report`");
+        let md =
+            predict_rows(&profile, &rows, &loo_ns, &linear, kfold.as_ref())?.markdown("`rendersim calibrate --report`");
         rendersim::output::files::write_output(path, |w| w.write_all(md.as_bytes()))?;
     }
 

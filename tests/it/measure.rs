@@ -272,7 +272,7 @@ fn measure_csv_appends_one_row_per_pass_and_the_header_once() {
 fn passes_split_into_draws_count_their_vertex_work_draw_by_draw() {
     // `measure --draws N` splits the triangles into N draw calls; each draw
     // starts with an empty vertex cache, as `predict` counts it; 0 draws
-    // nothing. Rows carry the draws, and calibrate reads them.
+    // nothing. Rows carry the draws, and read back with them.
     use rendersim::measure::passes::read_passes;
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("draws.csv");

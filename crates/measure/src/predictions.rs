@@ -14,10 +14,11 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::calibrate::{
-    CalibrateError, Invocations, LoadCache, error_summary, fit, k_fold_by_mesh, leave_one_out_ns, linear_baseline_loo,
-    row_load,
+    CalibrateError, Invocations, LoadCache, MeshFolds, error_summary, fit, k_fold_by_mesh, leave_one_out_ns,
+    linear_baseline_loo, row_load,
 };
 use super::device_predict::{DevicePass, DevicePredictError, predict_on_device};
+use super::device_profile::{DeviceCosts, PassLoad};
 use super::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy};
 use super::fit::rel_error_pct;
 use super::passes::PassRow;
@@ -109,12 +110,10 @@ pub struct Calibration {
     pub loo_ns: Vec<f64>,
     /// Per row, a plain linear fit's leave-one-out error, percent.
     pub linear_loo_pct: Vec<f64>,
-    /// Per row, the error (percent) of the prediction by a fit without any
-    /// pass of its mesh ([`KFOLD`] folds by mesh, as `calibrate --kfold`);
-    /// `None` with fewer than two meshes or a fold that leaves too few rows.
-    pub kfold_pct: Option<Vec<f64>>,
-    /// The folds of `kfold_pct` (fewer than [`KFOLD`] with fewer meshes).
-    pub kfold_folds: usize,
+    /// Per row, the error of the prediction by a fit without any pass of
+    /// its mesh ([`KFOLD`] folds by mesh, as `calibrate --kfold`); `None`
+    /// with fewer than two meshes or a fold that leaves too few rows.
+    pub kfold: Option<MeshFolds>,
     /// Wall time of the fits, seconds.
     pub seconds: f64,
 }
@@ -122,6 +121,29 @@ pub struct Calibration {
 /// Folds of the k-fold cross-validation by mesh a calibration reports (at
 /// most one per distinct mesh).
 pub const KFOLD: usize = 6;
+
+/// The loads of `rows` as fitted (measured vertex invocations) and as
+/// predicted (the cache policy's), and their pass times.
+type RowLoads = (Vec<PassLoad>, Vec<PassLoad>, Vec<f64>);
+
+fn row_loads(rows: &[PassRow], policy: &CachePolicy) -> Result<RowLoads, CalibrateError> {
+    let mut cache = LoadCache::default();
+    cache.prefetch(rows, policy)?;
+    let mut fit_loads = Vec::with_capacity(rows.len());
+    let mut predict_loads = Vec::with_capacity(rows.len());
+    for r in rows {
+        fit_loads.push(row_load(r, &mut cache, policy, Invocations::Measured)?);
+        predict_loads.push(row_load(r, &mut cache, policy, Invocations::Predicted)?);
+    }
+    Ok((fit_loads, predict_loads, rows.iter().map(|r| r.pass_time_ns).collect()))
+}
+
+/// The costs fitted to `rows` alone: the fit of [`calibrate_rows`],
+/// without its cross-validations.
+pub fn fit_rows(rows: &[PassRow], policy: &CachePolicy) -> Result<DeviceCosts, CalibrateError> {
+    let (fit_loads, _, y) = row_loads(rows, policy)?;
+    Ok(fit(&fit_loads, &y)?.costs)
+}
 
 /// Fits a profile named `name` to `rows` (fit on the measured vertex
 /// invocations, leave-one-out predictions on the cache policy's), as
@@ -133,15 +155,7 @@ pub fn calibrate_rows(
     shader_cores: u32,
 ) -> Result<Calibration, CalibrateError> {
     let start = Instant::now();
-    let mut cache = LoadCache::default();
-    cache.prefetch(rows, policy)?;
-    let mut fit_loads = Vec::with_capacity(rows.len());
-    let mut predict_loads = Vec::with_capacity(rows.len());
-    for r in rows {
-        fit_loads.push(row_load(r, &mut cache, policy, Invocations::Measured)?);
-        predict_loads.push(row_load(r, &mut cache, policy, Invocations::Predicted)?);
-    }
-    let y: Vec<f64> = rows.iter().map(|r| r.pass_time_ns).collect();
+    let (fit_loads, predict_loads, y) = row_loads(rows, policy)?;
     let f = fit(&fit_loads, &y)?;
     let fitted: Vec<f64> = fit_loads.iter().map(|l| f.costs.cost(l).pass_ns).collect();
     let errors: Vec<f64> = fitted.iter().zip(&y).map(|(p, m)| rel_error_pct(*p, *m)).collect();
@@ -149,12 +163,10 @@ pub fn calibrate_rows(
     let loo: Vec<f64> = loo_ns.iter().zip(&y).map(|(p, m)| rel_error_pct(*p, *m)).collect();
     let linear_loo_pct = linear_baseline_loo(&predict_loads, &y);
     let meshes: Vec<&str> = rows.iter().map(|r| r.mesh.as_str()).collect();
-    let kfolded = k_fold_by_mesh(&fit_loads, &predict_loads, &y, &meshes, KFOLD).ok();
-    let kfold_folds = kfolded.as_ref().map_or(0, |k| k.folds);
-    let kfold_pct = kfolded.map(|k| k.errors);
+    let kfold = k_fold_by_mesh(&fit_loads, &predict_loads, &y, &meshes, KFOLD).ok();
     let (median, p90, worst) = error_summary(&errors);
     let (lm, lp, _) = error_summary(&loo);
-    let kfold = kfold_pct.as_deref().map(error_summary);
+    let kfold_summary = kfold.as_ref().map(|k| error_summary(&k.errors));
     let profile = DeviceProfile {
         device: DeviceInfo {
             name: name.to_string(),
@@ -170,8 +182,8 @@ pub fn calibrate_rows(
             worst_pct: worst,
             loo_median_pct: Some(lm),
             loo_p90_pct: Some(lp),
-            kfold_median_pct: kfold.map(|k| k.0),
-            kfold_p90_pct: kfold.map(|k| k.1),
+            kfold_median_pct: kfold_summary.map(|k| k.0),
+            kfold_p90_pct: kfold_summary.map(|k| k.1),
         },
     };
     if let Err(super::device_profile::ProfileError::Invalid { key, value, why }) = profile.validate() {
@@ -181,21 +193,20 @@ pub fn calibrate_rows(
         profile,
         loo_ns,
         linear_loo_pct,
-        kfold_pct,
-        kfold_folds,
+        kfold,
         seconds: start.elapsed().as_secs_f64(),
     })
 }
 
 /// Every row of `rows` with its leave-one-out prediction (`loo_ns`, from
-/// [`calibrate_rows`]) and its simulation on `profile`; `kfold` the folds
-/// and errors of a k-fold cross-validation by mesh, when there is one.
+/// [`calibrate_rows`]) and its simulation on `profile`; `kfold` the
+/// cross-validation by mesh, when there is one.
 pub fn predict_rows(
     profile: &DeviceProfile,
     rows: &[PassRow],
     loo_ns: &[f64],
     linear_loo_pct: &[f64],
-    kfold: Option<(usize, &[f64])>,
+    kfold: Option<&MeshFolds>,
 ) -> Result<DevicePredictions, PredictionsError> {
     let mut out = Vec::with_capacity(rows.len());
     for (r, &loo) in rows.iter().zip(loo_ns) {
@@ -216,7 +227,7 @@ pub fn predict_rows(
         loo: stats(|r| r.loo_error_pct),
         simulated: stats(|r| r.simulated_error_pct),
         linear_loo: ErrorStats::of(linear_loo_pct),
-        kfold: kfold.map(|(k, e)| (k, ErrorStats::of(e))),
+        kfold: kfold.map(|k| (k.folds, ErrorStats::of(&k.errors))),
         measuring_seconds: out.iter().map(|r| r.measuring_seconds).sum(),
         simulating_seconds: out.iter().map(|r| r.simulating_seconds).sum(),
         rows: out,

@@ -14,7 +14,7 @@ use crate::components::vertex_cache::CachePolicy;
 use crate::measure::device_predict::{DevicePass, predict_on_device};
 use crate::measure::device_profile::DeviceProfile;
 use crate::measure::passes::{PassRow, TargetSize};
-use crate::measure::predictions::calibrate_rows;
+use crate::measure::predictions::fit_rows;
 use crate::systems::SystemError;
 use crate::systems::error::invalid;
 
@@ -123,14 +123,13 @@ impl SumVsMaxConfig {
         })
     }
 
-    /// The ratios: measured (study, rows), predicted by `profile` and by a
-    /// profile fitted to `rows` without the study's mesh.
+    /// The ratios: measured (study, rows), predicted by `profile` and by
+    /// `profile` with its costs fitted to `rows` without the study's mesh.
     pub fn evaluate(
         &self,
         profile: &DeviceProfile,
         rows: &[PassRow],
         policy: &CachePolicy,
-        shader_cores: u32,
     ) -> Result<SumVsMax, SystemError> {
         if self.vs_loops == 0 || self.fs_loops == 0 {
             return Err(invalid(
@@ -147,9 +146,14 @@ impl SumVsMaxConfig {
             return Err(invalid("sum_vs_max.measured", format!("{m}: must be a finite number")));
         }
         let others: Vec<PassRow> = rows.iter().filter(|r| r.mesh != self.mesh).cloned().collect();
-        let without = calibrate_rows(&others, &profile.device.name, policy, shader_cores)
+        let without = fit_rows(&others, policy)
             .ok()
-            .map(|c| self.predict(&c.profile))
+            .map(|costs| {
+                self.predict(&DeviceProfile {
+                    costs,
+                    ..profile.clone()
+                })
+            })
             .transpose()?;
         Ok(SumVsMax {
             measured_study: self.measured,

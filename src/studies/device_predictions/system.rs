@@ -106,13 +106,18 @@ pub fn run_device_predictions(
     }
     let cal =
         calibrate_rows(&rows, &cfg.device, &policy, cfg.shader_cores).map_err(|e| invalid("files", e.to_string()))?;
-    let kfold = cal.kfold_pct.as_deref().map(|e| (cal.kfold_folds, e));
-    let predictions = predict_rows(&cal.profile, &rows, &cal.loo_ns, &cal.linear_loo_pct, kfold)
-        .map_err(|e| invalid("files", e.to_string()))?;
+    let predictions = predict_rows(
+        &cal.profile,
+        &rows,
+        &cal.loo_ns,
+        &cal.linear_loo_pct,
+        cal.kfold.as_ref(),
+    )
+    .map_err(|e| invalid("files", e.to_string()))?;
     let sum_vs_max = cfg
         .sum_vs_max
         .as_ref()
-        .map(|s| s.evaluate(&cal.profile, &rows, &policy, cfg.shader_cores))
+        .map(|s| s.evaluate(&cal.profile, &rows, &policy))
         .transpose()?;
     let fit = &cal.profile.fit;
     let metrics = Metrics {
