@@ -111,7 +111,13 @@ fn scale(d: Duration, k: f64) -> Duration {
 }
 
 fn scale_states(s: &mut StateCosts, k: f64) {
-    for d in [&mut s.shader, &mut s.texture, &mut s.material, &mut s.matrix] {
+    for d in [
+        &mut s.shader,
+        &mut s.texture,
+        &mut s.material,
+        &mut s.matrix,
+        &mut s.alpha,
+    ] {
         *d = scale(*d, k);
     }
 }
@@ -130,6 +136,7 @@ pub fn reduced(cfg: &FramePipelineConfig, which: &str, k: f64) -> FramePipelineC
             p.non_render = scale_dist(&p.non_render, k);
             p.per_object = scale(p.per_object, k);
             p.per_draw = scale(p.per_draw, k);
+            p.sort_per_draw = scale(p.sort_per_draw, k);
             p.clear = scale(p.clear, k);
             p.swap = scale(p.swap, k);
             scale_states(&mut p.state_change, k);

@@ -30,6 +30,7 @@ mod obj_files;
 mod outputs;
 mod pacing;
 mod paper000_city;
+mod paper000_table2;
 mod pipeline_oracles;
 mod pixelflow;
 mod present;

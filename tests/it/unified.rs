@@ -133,7 +133,7 @@ fn reserved_cores_are_slower_than_sharing() {
 }
 
 /// The shipped models that name a hardware file.
-const HARDWARE_MODELS: [&str; 2] = ["terrain-geforce3", "city-geforce3"];
+const HARDWARE_MODELS: [&str; 3] = ["terrain-geforce3", "city-geforce3", "city-table2-geforce3"];
 
 #[test]
 fn draw_fidelity_follows_the_triangle_simulation_within_two_percent() {

@@ -189,6 +189,47 @@ y = "metrics.display_interval_ms.mean"
 }
 
 #[test]
+fn a_sweep_of_tables_is_selected_by_its_whole_table() {
+    let head = r#"
+name = "tables"
+[[sweep]]
+key = "workload.groups.0.changes"
+values = [{ texture = 4, matrix = 1 }, { texture = 2, matrix = 4 }]
+[[sweep]]
+key = "display.buffers"
+values = [2, 3]
+[[metric]]
+path = "metrics.display_interval_ms.mean"
+"#;
+    let exp = parse(&format!(
+        "{head}[[check]]\npath = \"metrics.display_interval_ms.mean\"\n\
+         where = {{ \"workload.groups.0.changes\" = {{ matrix = 4, texture = 2 }}, \"display.buffers\" = 3 }}\n\
+         at_least = 0\ntolerance = 0\n"
+    ));
+    let filter = &exp.checks[0].filter;
+    assert_eq!(filter.len(), 2, "{filter:?}");
+    assert!(
+        filter
+            .iter()
+            .any(|(k, v)| k == "workload.groups.0.changes" && v.is_table()),
+        "{filter:?}"
+    );
+    assert_eq!(expand_points(&exp).iter().filter(|p| p.matches(filter)).count(), 1);
+    // A table that is not one of the values, and a key below the sweep's.
+    let e = parse_err(&format!(
+        "{head}[[check]]\npath = \"x\"\nwhere = {{ \"workload.groups.0.changes\" = {{ texture = 3 }} }}\nexpect = 1\ntolerance = 0\n"
+    ));
+    assert!(e.contains("is not one of the swept values"), "{e}");
+    let e = parse_err(&format!(
+        "{head}[[check]]\npath = \"x\"\nwhere = {{ \"workload.groups.0.changes.texture\" = 4 }}\nexpect = 1\ntolerance = 0\n"
+    ));
+    assert!(
+        e.contains("`workload.groups.0.changes.texture` is not a sweep key"),
+        "{e}"
+    );
+}
+
+#[test]
 fn y_bounds_belong_to_line_plots_and_must_be_an_ordered_pair() {
     let line = |extra: &str| {
         format!(

@@ -184,6 +184,41 @@ pub struct ObjectGroup {
     /// texture coordinate, interleaved).
     #[serde(default = "vertex_bytes", skip_serializing_if = "is_default_vertex_bytes")]
     pub vertex_bytes: Bytes,
+    /// The group's draws as a measured state sequence instead of cycled
+    /// ids: how many of its draws change each kind of state (paper 000
+    /// Table 2 counts them per sort order). Replaces `shaders`,
+    /// `textures`, `materials` and `matrix_per_object`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub changes: Option<StateChanges>,
+}
+
+/// How many of a group's `count` draws change each kind of state, in the
+/// order drawn; the changes of a kind are spread evenly over the draws,
+/// the first draw always among them (it sets the group's first state).
+/// Paper 000 Table 2 gives these counts for four sort orders of one city
+/// view; `docs/models.md`, "Table 2", says how they are read.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct StateChanges {
+    /// Draws that bind a shader (1 to `count`; default 1: one shader).
+    #[serde(default = "one_u64")]
+    pub shader: u64,
+    /// Draws that bind a texture (1 to `count`).
+    pub texture: u64,
+    /// Draws that set material parameters (1 to `count`).
+    pub material: u64,
+    /// Draws that switch blending (alpha) state (0 to `count`; the frame
+    /// starts opaque, and a group with 0 draws opaque: its first draw
+    /// switches back if the draw before it blended).
+    #[serde(default)]
+    pub alpha: u64,
+    /// Draws that set a transformation matrix (0 to `count`).
+    pub matrix: u64,
+    /// Whether the CPU sorts the draws into this order every frame:
+    /// each draw then costs `cpu.sort_per_draw` more (a dynamic sort;
+    /// `false`: presorted, or not sorted at all).
+    #[serde(default)]
+    pub sorted_each_frame: bool,
 }
 
 fn vertex_bytes() -> Bytes {

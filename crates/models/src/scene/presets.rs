@@ -38,6 +38,7 @@ pub fn preset_groups(name: &str, scale: f64) -> Option<Vec<ObjectGroup>> {
         texture_upload: Bytes(0),
         geometry_memory: Default::default(),
         vertex_bytes: Bytes(32),
+        changes: None,
     };
     Some(match name {
         // 3,453,465 / 5609 = 616 triangles per building.

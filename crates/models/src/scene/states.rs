@@ -7,7 +7,9 @@
 //! `docs/models.md`, "Scenes"): a preset's groups first, then
 //! `[[workload.groups]]`; instance i of a group gets shader
 //! `i % shaders`, texture `i % textures`, material `i % materials`, each
-//! numbered after the previous groups' ids; `state_order = "sorted"` sorts
+//! numbered after the previous groups' ids (a group with `changes` numbers
+//! each kind `i * n / count` instead, so that exactly `n` of its draws
+//! change it: paper 000 Table 2's counts); `state_order = "sorted"` sorts
 //! the objects by (shader, texture, material). `tests/it/sortbuf.rs`
 //! checks the changes this sequence implies against the pipeline's own
 //! counts.
@@ -41,15 +43,18 @@ pub enum StatesError {
     /// More objects than the limit.
     #[error("the scene has {0} objects, more than the limit of {max}", max = MAX_SCENE_OBJECTS)]
     TooManyObjects(u64),
-    /// A group with no shaders, textures or materials.
-    #[error("group {index} ({name}): {what} must be at least 1")]
-    NoIds {
+    /// A group's state ids are not valid (no shaders, textures or
+    /// materials; `changes` out of range or beside cycled ids).
+    #[error("group {index} ({name}): {what} {message}")]
+    GroupStates {
         /// The group's index.
         index: usize,
         /// The group's name.
         name: String,
-        /// `shaders`, `textures` or `materials`.
+        /// The field: `shaders`, `textures`, `changes.texture`, ...
         what: &'static str,
+        /// What is wrong with it.
+        message: String,
     },
     /// `scene:` names no model file.
     #[error("scene:{spec}: names no model file before the attribute; {EXPECTED}")]
@@ -111,29 +116,114 @@ pub fn scene_groups(scene: &SceneWorkload) -> Result<Vec<ObjectGroup>, StatesErr
 
 /// The state numbering of a scene: instance `i` of a group gets shader
 /// `i % shaders`, texture `i % textures`, material `i % materials`, each
-/// numbered after the previous groups' ids. Walk the groups in order,
-/// calling [`StateNumbering::next_group`] after each.
+/// numbered after the previous groups' ids. A group with `changes` instead
+/// numbers each kind `i * n / count` for its `n` changes, so that exactly
+/// `n` of its draws change it, spread evenly, the first draw among them.
+/// Walk the groups in order, calling [`StateNumbering::next_group`] after
+/// each.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct StateNumbering {
     base: ObjectState,
+    alpha: u64,
+}
+
+/// The id offset of draw `i` of `count` for `n` changes spread evenly:
+/// `i * n / count` takes each value 0 to n - 1 once it has begun.
+fn spread(i: u64, n: u64, count: u64) -> u64 {
+    if count == 0 {
+        return 0;
+    }
+    (i as u128 * n as u128 / count as u128) as u64
 }
 
 impl StateNumbering {
     /// The state of instance `i` of group `g` (the current group).
     pub fn state(&self, g: &ObjectGroup, i: u64) -> ObjectState {
-        (
-            self.base.0 + i % g.shaders,
-            self.base.1 + i % g.textures,
-            self.base.2 + i % g.materials,
-        )
+        match &g.changes {
+            Some(c) => (
+                self.base.0 + spread(i, c.shader, g.count),
+                self.base.1 + spread(i, c.texture, g.count),
+                self.base.2 + spread(i, c.material, g.count),
+            ),
+            None => (
+                self.base.0 + i % g.shaders,
+                self.base.1 + i % g.textures,
+                self.base.2 + i % g.materials,
+            ),
+        }
+    }
+
+    /// The blending state of instance `i` of group `g`: 0 (opaque) unless
+    /// the group gives `changes.alpha`.
+    pub fn alpha(&self, g: &ObjectGroup, i: u64) -> u64 {
+        match &g.changes {
+            Some(c) if c.alpha > 0 => 1 + self.alpha + spread(i, c.alpha, g.count),
+            _ => 0,
+        }
+    }
+
+    /// Whether instance `i` of group `g` sets a transformation matrix.
+    pub fn sets_matrix(g: &ObjectGroup, i: u64) -> bool {
+        match &g.changes {
+            Some(c) => c.matrix > 0 && (i == 0 || spread(i, c.matrix, g.count) != spread(i - 1, c.matrix, g.count)),
+            None => g.matrix_per_object,
+        }
     }
 
     /// Moves past group `g`'s ids.
     pub fn next_group(&mut self, g: &ObjectGroup) {
-        self.base.0 += g.shaders;
-        self.base.1 += g.textures;
-        self.base.2 += g.materials;
+        match &g.changes {
+            Some(c) => {
+                self.base.0 += c.shader;
+                self.base.1 += c.texture;
+                self.base.2 += c.material;
+                self.alpha += c.alpha;
+            }
+            None => {
+                self.base.0 += g.shaders;
+                self.base.1 += g.textures;
+                self.base.2 += g.materials;
+            }
+        }
     }
+}
+
+/// Why group `g`'s state ids are not valid: the field (below the group's
+/// key, such as `changes.texture`) and what is wrong with it.
+pub fn group_states_error(g: &ObjectGroup) -> Option<(&'static str, String)> {
+    for (what, v) in [
+        ("shaders", g.shaders),
+        ("textures", g.textures),
+        ("materials", g.materials),
+    ] {
+        if v == 0 {
+            return Some((what, "must be at least 1".into()));
+        }
+        if v > 1 && g.changes.is_some() {
+            return Some((
+                what,
+                format!(
+                    "is {v}, but the group gives `changes`, which numbers its states itself: give one or the other"
+                ),
+            ));
+        }
+    }
+    let c = g.changes.as_ref()?;
+    for (what, v, least) in [
+        ("changes.shader", c.shader, 1),
+        ("changes.texture", c.texture, 1),
+        ("changes.material", c.material, 1),
+        ("changes.alpha", c.alpha, 0),
+        ("changes.matrix", c.matrix, 0),
+    ] {
+        if v < least || v > g.count {
+            return Some((
+                what,
+                format!("must be {least} to the group's count of draws ({}), got {v}", g.count),
+            ));
+        }
+    }
+    None
 }
 
 /// The scene's objects' states in submission order, or why the scene is
@@ -150,18 +240,13 @@ pub fn state_sequence(scene: &SceneWorkload) -> Result<Vec<ObjectState>, StatesE
     let mut out = Vec::with_capacity(total as usize);
     let mut numbering = StateNumbering::default();
     for (gi, g) in groups.iter().enumerate() {
-        for (what, v) in [
-            ("shaders", g.shaders),
-            ("textures", g.textures),
-            ("materials", g.materials),
-        ] {
-            if v == 0 {
-                return Err(StatesError::NoIds {
-                    index: gi,
-                    name: g.name.clone(),
-                    what,
-                });
-            }
+        if let Some((what, message)) = group_states_error(g) {
+            return Err(StatesError::GroupStates {
+                index: gi,
+                name: g.name.clone(),
+                what,
+                message,
+            });
         }
         out.extend((0..g.count).map(|i| numbering.state(g, i)));
         numbering.next_group(g);
@@ -231,4 +316,83 @@ pub fn scene_state_ids(spec: &str, base: &std::path::Path) -> Result<Vec<u64>, S
             *ids.entry(key).or_insert(n)
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::config::StateChanges;
+
+    fn group(count: u64, changes: StateChanges) -> ObjectGroup {
+        let mut g = crate::scene::presets::preset_groups("city", 1.0).unwrap().remove(0);
+        g.count = count;
+        g.textures = 1;
+        g.materials = 1;
+        g.changes = Some(changes);
+        g
+    }
+
+    fn changes(texture: u64, alpha: u64, matrix: u64) -> StateChanges {
+        StateChanges {
+            shader: 1,
+            texture,
+            material: 1,
+            alpha,
+            matrix,
+            sorted_each_frame: false,
+        }
+    }
+
+    /// The draws of `g` that change texture, alpha and matrix, walking
+    /// from a previous group's last state.
+    fn counted(g: &ObjectGroup) -> [u64; 3] {
+        let mut n = StateNumbering::default();
+        // A group before it, so the first draw changes against real ids.
+        let before = group(3, changes(2, 1, 1));
+        let mut prev = (n.state(&before, 2), n.alpha(&before, 2));
+        n.next_group(&before);
+        let mut out = [0; 3];
+        for i in 0..g.count {
+            let (s, a) = (n.state(g, i), n.alpha(g, i));
+            out[0] += (s.1 != prev.0.1) as u64;
+            out[1] += (a != prev.1) as u64;
+            out[2] += StateNumbering::sets_matrix(g, i) as u64;
+            prev = (s, a);
+        }
+        out
+    }
+
+    #[test]
+    fn changes_are_exactly_the_counts_given_for_any_count() {
+        for count in [1u64, 2, 7, 984, 1000] {
+            for n in [1, 2, count / 3 + 1, count] {
+                let n = n.min(count);
+                let g = group(count, changes(n, n, n));
+                assert_eq!(counted(&g), [n, n, n], "{n} of {count}");
+            }
+            // No alpha and no matrix: no matrix set, and opaque throughout
+            // (its first draw switches back from the blended draw before).
+            assert_eq!(counted(&group(count, changes(1, 0, 0)))[1..], [1, 0]);
+        }
+    }
+
+    #[test]
+    fn changes_out_of_range_or_beside_cycled_ids_are_refused() {
+        let g = group(10, changes(11, 0, 0));
+        let (what, message) = group_states_error(&g).unwrap();
+        assert_eq!(what, "changes.texture");
+        assert!(
+            message.contains("1 to the group's count of draws (10), got 11"),
+            "{message}"
+        );
+        let mut g = group(10, changes(0, 0, 0));
+        assert_eq!(group_states_error(&g).unwrap().0, "changes.texture");
+        g.changes = Some(changes(3, 0, 0));
+        g.textures = 4;
+        let (what, message) = group_states_error(&g).unwrap();
+        assert_eq!(what, "textures");
+        assert!(message.contains("give one or the other"), "{message}");
+        g.textures = 1;
+        assert!(group_states_error(&g).is_none());
+    }
 }

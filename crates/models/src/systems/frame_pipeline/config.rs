@@ -133,6 +133,9 @@ pub struct StateCosts {
     pub material: Duration,
     /// Transformation matrix.
     pub matrix: Duration,
+    /// Blending (alpha) state.
+    #[serde(skip_serializing_if = "Duration::is_zero")]
+    pub alpha: Duration,
 }
 
 /// The CPU thread's costs.
@@ -149,6 +152,11 @@ pub struct CpuConfig {
     pub per_draw: Duration,
     /// Driver cost per state change.
     pub state_change: StateCosts,
+    /// Sorting cost per draw, paid by the draws of a group sorted into
+    /// its order every frame (`changes.sorted_each_frame`; paper 000
+    /// Table 2's dynamic sorts).
+    #[serde(skip_serializing_if = "Duration::is_zero")]
+    pub sort_per_draw: Duration,
     /// API cost of the clear command.
     pub clear: Duration,
     /// API cost of the swap (present) command.
@@ -165,6 +173,7 @@ impl Default for CpuConfig {
             per_object: Duration::ZERO,
             per_draw: Duration::ZERO,
             state_change: StateCosts::default(),
+            sort_per_draw: Duration::ZERO,
             clear: Duration::ZERO,
             swap: Duration::ZERO,
             max_frames_ahead: 2,
@@ -281,6 +290,13 @@ pub struct GpuConfig {
     pub command: Duration,
     /// Front-end cost per state change.
     pub state_change: StateCosts,
+    /// Whether a draw's state changes wait for the geometry stage to
+    /// finish the draw before (a pipeline bubble): their front-end time
+    /// then adds to the geometry stage's instead of running beside it
+    /// (paper 000 §4.5, state setup as a stage of the pipeline; Table 2).
+    /// Default false: they overlap the draw before, as any command does.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub state_change_stalls: bool,
     /// Clearing the frame buffer.
     pub clear: Duration,
     /// The swap at the end of a frame.

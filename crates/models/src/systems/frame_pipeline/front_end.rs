@@ -66,6 +66,9 @@ pub struct FrontEnd {
     variation_rng: StreamRng,
     /// Commands executed.
     executed: u64,
+    /// Whether the held draw's stalling state setup has run
+    /// (`gpu.state_change_stalls`).
+    set_up: bool,
 }
 
 #[inline(always)]
@@ -86,6 +89,7 @@ impl FrontEnd {
             quiet: None,
             variation_rng,
             executed: 0,
+            set_up: false,
         }
     }
 
@@ -218,6 +222,18 @@ impl FrontEnd {
                         return Ok(progressed);
                     }
                     if let Command::Draw { draw, .. } = self.cmd {
+                        // A stalling state setup runs now that the stage is free.
+                        let setup = env
+                            .scene
+                            .as_ref()
+                            .map_or(Duration::ZERO, |sc| sc.draws[draw as usize].setup);
+                        if setup.0 > 0 && !self.set_up {
+                            self.set_up = true;
+                            self.phase = self.job(now, self.cmd, setup, env, down, s)?;
+                            progressed = true;
+                            continue;
+                        }
+                        self.set_up = false;
                         down.geom.start_draw(now, draw, env, down.frag, s)?;
                     }
                     self.phase = FrontPhase::Idle;
@@ -452,6 +468,9 @@ impl FrontEnd {
         let Some(t) = d.closed else {
             return Ok(false);
         };
+        if d.setup.0 > 0 {
+            return Ok(false);
+        }
         let triangles = sc.meshes[d.mesh as usize].triangles;
         let next = match env.links.commands.front() {
             None => None,

@@ -61,7 +61,7 @@ pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProg
             // time alone (at its memory's rate).
             let copies = |d: &super::workload::DrawItem| if s.bus_shared { d.copy.0 as f64 } else { 0.0 };
             let cpu: f64 = s.draws.iter().map(|d| d.cpu.0 as f64 + copies(d)).sum();
-            let front: f64 = s.draws.iter().map(|d| d.front.0 as f64).sum();
+            let front: f64 = s.draws.iter().map(|d| d.front.0 as f64 + d.setup.0 as f64).sum();
             // A draw from AGP memory: no shorter than its bytes over the whole bus.
             let bus = cfg.bus.bandwidth.bytes_per_ps();
             let geo: f64 = s

@@ -13,7 +13,7 @@ use crate::components::vertex_cache::CachePolicy;
 use crate::engine::Duration;
 use crate::scene::config::{DepthOrder, GeometryMemory, MeshRef, SceneWorkload, SizeOrder, StateOrder};
 use crate::scene::generators::mesh_from_spec;
-use crate::scene::states::{StateNumbering, scene_groups};
+use crate::scene::states::{StateNumbering, group_states_error, scene_groups};
 
 use super::closed_form::{DrawTimes, draw_times, draw_times_unified, ordered_draw_total};
 use super::config::{Fidelity, FramePipelineConfig};
@@ -130,6 +130,10 @@ pub struct DrawItem {
     pub cpu: Duration,
     /// GPU front-end time for the batch.
     pub front: Duration,
+    /// GPU front-end time for its state changes that waits for the
+    /// geometry stage to finish the draw before (`gpu.state_change_stalls`;
+    /// zero otherwise, the changes being inside `front`).
+    pub setup: Duration,
     /// Commands in the batch (state changes + upload + draw).
     pub commands: u32,
     /// Bytes of the batch.
@@ -161,6 +165,10 @@ pub struct SceneStats {
     pub material_changes: u64,
     /// Matrix changes.
     pub matrix_changes: u64,
+    /// Blending (alpha) state changes (only groups with `changes.alpha`
+    /// have them).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub alpha_changes: u64,
     /// Bytes uploaded over the bus.
     pub upload_bytes: u64,
     /// Bytes of vertices fetched from AGP memory over the bus.
@@ -204,6 +212,11 @@ pub struct Instance {
     pub state: (u64, u64, u64),
     /// Whether the instance sets its own matrix.
     pub matrix: bool,
+    /// Blending (alpha) state id (0: opaque).
+    pub alpha: u64,
+    /// Whether the CPU sorts this draw into place every frame
+    /// (`cpu.sort_per_draw`).
+    pub sorted: bool,
     /// Upload bytes per frame.
     pub upload: u64,
 }
@@ -344,14 +357,8 @@ pub fn compile_scene(
         g.triangle_pixels
             .validate()
             .map_err(|e| invalid(format!("{key}.triangle_pixels"), e.to_string()))?;
-        for (what, v) in [
-            ("shaders", g.shaders),
-            ("textures", g.textures),
-            ("materials", g.materials),
-        ] {
-            if v == 0 {
-                return Err(invalid(format!("{key}.{what}"), "must be at least 1"));
-            }
+        if let Some((what, message)) = group_states_error(g) {
+            return Err(invalid(format!("{key}.{what}"), message));
         }
         let mesh_key = (format!("{:?}", g.mesh), g.indexed);
         let mesh_id = match mesh_ids.get(&mesh_key) {
@@ -396,7 +403,9 @@ pub fn compile_scene(
                 group: gi as u32,
                 mesh: mesh_id,
                 state: numbering.state(g, i),
-                matrix: g.matrix_per_object,
+                matrix: StateNumbering::sets_matrix(g, i),
+                alpha: numbering.alpha(g, i),
+                sorted: g.changes.as_ref().is_some_and(|c| c.sorted_each_frame),
                 upload: g.geometry_upload.0.saturating_add(g.texture_upload.0),
             });
         }
@@ -457,6 +466,7 @@ pub fn build_program(
     };
     let mut draws = Vec::with_capacity(objects.len());
     let mut prev: Option<(u64, u64, u64)> = None;
+    let mut prev_alpha = 0;
     let bus_shared = objects.iter().any(|o| o.upload > 0)
         && objects
             .iter()
@@ -469,6 +479,8 @@ pub fn build_program(
             mesh,
             state: (sh, tx, mt),
             matrix,
+            alpha,
+            sorted,
             upload: up,
         } = *o;
         let changed = [
@@ -476,28 +488,40 @@ pub fn build_program(
             prev.is_none_or(|p| p.1 != tx),
             prev.is_none_or(|p| p.2 != mt),
             matrix,
+            alpha != prev_alpha,
         ];
         prev = Some((sh, tx, mt));
+        prev_alpha = alpha;
         let cpu_costs = [
             cpu.state_change.shader,
             cpu.state_change.texture,
             cpu.state_change.material,
             cpu.state_change.matrix,
+            cpu.state_change.alpha,
         ];
         let gpu_costs = [
             gpu.state_change.shader,
             gpu.state_change.texture,
             gpu.state_change.material,
             gpu.state_change.matrix,
+            gpu.state_change.alpha,
         ];
         let mut c = add(cpu.per_object, cpu.per_draw, "cpu")?;
+        if sorted {
+            c = add(c, cpu.sort_per_draw, "cpu.sort_per_draw")?;
+        }
         let mut f = Duration::ZERO;
+        let mut setup = Duration::ZERO;
         let mut commands = 1u32;
         let mut b = bytes.draw.0;
-        for k in 0..4 {
+        for k in 0..changed.len() {
             if changed[k] {
                 c = add(c, cpu_costs[k], "cpu.state_change")?;
-                f = add(f, gpu_costs[k], "gpu.state_change")?;
+                if gpu.state_change_stalls {
+                    setup = add(setup, gpu_costs[k], "gpu.state_change")?;
+                } else {
+                    f = add(f, gpu_costs[k], "gpu.state_change")?;
+                }
                 commands += 1;
                 b += bytes.state.0;
             }
@@ -506,6 +530,7 @@ pub fn build_program(
         stats.texture_changes += changed[1] as u64;
         stats.material_changes += changed[2] as u64;
         stats.matrix_changes += changed[3] as u64;
+        stats.alpha_changes += changed[4] as u64;
         let mut copy = Duration::ZERO;
         if up > 0 {
             copy = cfg.bus.copy_bandwidth(groups[group as usize].memory).transfer_time(up);
@@ -535,6 +560,7 @@ pub fn build_program(
             mesh,
             cpu: c,
             front: f,
+            setup,
             commands,
             bytes: b,
             closed,

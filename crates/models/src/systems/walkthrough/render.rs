@@ -199,6 +199,8 @@ impl Renderer {
                 mesh: i as u32,
                 state: d.state,
                 matrix: true,
+                alpha: 0,
+                sorted: false,
                 upload: 0,
             });
         }
