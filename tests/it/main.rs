@@ -43,6 +43,7 @@ mod shards;
 mod shared_bus;
 mod sortbuf;
 mod state_sorting;
+mod system_noise;
 mod table1_split;
 mod tearing;
 mod timeline;

@@ -239,12 +239,24 @@ fn tracing_does_not_change_results_at_either_fidelity() {
         &["command_fifo.capacity=0"],
         &["command_fifo.capacity=1", "display.vsync=false"],
         &["display.present_mode=\"mailbox\"", "display.buffers=3"],
+        // State changes that wait for the geometry stage (a setup job on
+        // the front end once the stage is free; the draw's quick hand-off
+        // steps aside), alone and under the stressed settings.
+        &["gpu.state_change_stalls=true"],
+        &[
+            "gpu.state_change_stalls=true",
+            "noise.periodic.0.target=\"gpu\"",
+            "noise.random.0.target=\"gpu\"",
+            "noise.random.0.rate=\"300Hz\"",
+            "command_fifo.capacity=8",
+        ],
     ];
     for (fid, extra) in [
         ("triangle", &[][..]),
         ("draw", &[][..]),
         ("draw", stressed),
         ("triangle", &stressed[3..]),
+        ("triangle", &["gpu.state_change_stalls=true"][..]),
     ]
     .into_iter()
     .chain(draw_variants.iter().map(|v| ("draw", *v)))

@@ -166,9 +166,10 @@ pub struct ObjectGroup {
     /// Distinct materials cycled over the instances.
     #[serde(default = "one_u64")]
     pub materials: u64,
-    /// Each instance sets its own transformation matrix.
-    #[serde(default = "yes")]
-    pub matrix_per_object: bool,
+    /// Each instance sets its own transformation matrix (default true;
+    /// not beside `changes`, whose `matrix` count replaces it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub matrix_per_object: Option<bool>,
     /// Dynamic geometry uploaded per instance per frame.
     #[serde(default)]
     pub geometry_upload: Bytes,

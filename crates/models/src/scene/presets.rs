@@ -33,7 +33,7 @@ pub fn preset_groups(name: &str, scale: f64) -> Option<Vec<ObjectGroup>> {
         shaders: 1,
         textures: tex,
         materials: mat,
-        matrix_per_object: true,
+        matrix_per_object: None,
         geometry_upload: Bytes(0),
         texture_upload: Bytes(0),
         geometry_memory: Default::default(),

@@ -141,14 +141,14 @@ impl StateNumbering {
     pub fn state(&self, g: &ObjectGroup, i: u64) -> ObjectState {
         match &g.changes {
             Some(c) => (
-                self.base.0 + spread(i, c.shader, g.count),
-                self.base.1 + spread(i, c.texture, g.count),
-                self.base.2 + spread(i, c.material, g.count),
+                self.base.0.saturating_add(spread(i, c.shader, g.count)),
+                self.base.1.saturating_add(spread(i, c.texture, g.count)),
+                self.base.2.saturating_add(spread(i, c.material, g.count)),
             ),
             None => (
-                self.base.0 + i % g.shaders,
-                self.base.1 + i % g.textures,
-                self.base.2 + i % g.materials,
+                self.base.0.saturating_add(i % g.shaders),
+                self.base.1.saturating_add(i % g.textures),
+                self.base.2.saturating_add(i % g.materials),
             ),
         }
     }
@@ -157,7 +157,7 @@ impl StateNumbering {
     /// the group gives `changes.alpha`.
     pub fn alpha(&self, g: &ObjectGroup, i: u64) -> u64 {
         match &g.changes {
-            Some(c) if c.alpha > 0 => 1 + self.alpha + spread(i, c.alpha, g.count),
+            Some(c) if c.alpha > 0 => self.alpha.saturating_add(1).saturating_add(spread(i, c.alpha, g.count)),
             _ => 0,
         }
     }
@@ -166,25 +166,25 @@ impl StateNumbering {
     pub fn sets_matrix(g: &ObjectGroup, i: u64) -> bool {
         match &g.changes {
             Some(c) => c.matrix > 0 && (i == 0 || spread(i, c.matrix, g.count) != spread(i - 1, c.matrix, g.count)),
-            None => g.matrix_per_object,
+            None => g.matrix_per_object.unwrap_or(true),
         }
     }
 
     /// Moves past group `g`'s ids.
     pub fn next_group(&mut self, g: &ObjectGroup) {
-        match &g.changes {
+        // Saturating: ids cycle over at most `count` instances, so huge
+        // `shaders` (or the like) only need to stay apart from the next
+        // group's, not to add up exactly.
+        let (sh, tx, mt) = match &g.changes {
             Some(c) => {
-                self.base.0 += c.shader;
-                self.base.1 += c.texture;
-                self.base.2 += c.material;
-                self.alpha += c.alpha;
+                self.alpha = self.alpha.saturating_add(c.alpha);
+                (c.shader, c.texture, c.material)
             }
-            None => {
-                self.base.0 += g.shaders;
-                self.base.1 += g.textures;
-                self.base.2 += g.materials;
-            }
-        }
+            None => (g.shaders, g.textures, g.materials),
+        };
+        self.base.0 = self.base.0.saturating_add(sh);
+        self.base.1 = self.base.1.saturating_add(tx);
+        self.base.2 = self.base.2.saturating_add(mt);
     }
 }
 
@@ -209,6 +209,18 @@ pub fn group_states_error(g: &ObjectGroup) -> Option<(&'static str, String)> {
         }
     }
     let c = g.changes.as_ref()?;
+    if g.matrix_per_object.is_some() {
+        return Some((
+            "matrix_per_object",
+            "is given, but the group gives `changes`, whose `matrix` count says which draws set a matrix: give one or the other".into(),
+        ));
+    }
+    if g.count == 0 {
+        return Some((
+            "changes",
+            "needs draws to change states in, but the group has none (count = 0)".into(),
+        ));
+    }
     for (what, v, least) in [
         ("changes.shader", c.shader, 1),
         ("changes.texture", c.texture, 1),
@@ -394,5 +406,23 @@ mod tests {
         assert!(message.contains("give one or the other"), "{message}");
         g.textures = 1;
         assert!(group_states_error(&g).is_none());
+        g.matrix_per_object = Some(false);
+        assert_eq!(group_states_error(&g).unwrap().0, "matrix_per_object");
+        g.matrix_per_object = None;
+        g.count = 0;
+        let (what, message) = group_states_error(&g).unwrap();
+        assert_eq!(what, "changes");
+        assert!(message.contains("count = 0"), "{message}");
+    }
+
+    #[test]
+    fn huge_id_counts_do_not_overflow() {
+        let mut g = crate::scene::presets::preset_groups("city", 1.0).unwrap().remove(0);
+        g.shaders = u64::MAX;
+        g.textures = u64::MAX;
+        let mut n = StateNumbering::default();
+        n.next_group(&g);
+        n.next_group(&g);
+        assert_eq!(n.state(&g, 5).0, u64::MAX);
     }
 }

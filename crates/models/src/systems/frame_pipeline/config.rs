@@ -291,9 +291,10 @@ pub struct GpuConfig {
     /// Front-end cost per state change.
     pub state_change: StateCosts,
     /// Whether a draw's state changes wait for the geometry stage to
-    /// finish the draw before (a pipeline bubble): their front-end time
-    /// then adds to the geometry stage's instead of running beside it
-    /// (paper 000 §4.5, state setup as a stage of the pipeline; Table 2).
+    /// finish the draw before (a pipeline bubble): their
+    /// `gpu.state_change` time then runs while that stage waits instead of
+    /// beside its work (paper 000 §4.5, state setup as a stage of the
+    /// pipeline; Table 2); the commands' `gpu.command` cost still overlaps.
     /// Default false: they overlap the draw before, as any command does.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub state_change_stalls: bool,

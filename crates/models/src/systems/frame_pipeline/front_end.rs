@@ -446,8 +446,9 @@ impl FrontEnd {
     /// end takes the next command when it is a draw with front-end work
     /// (its job, quiet when it ends before the new draw, as in
     /// [`FrontEnd::job`]), or starts waiting for commands when the FIFO is
-    /// empty. Any other next command, and a draw without its closed form,
-    /// leave everything to `settle`. The CPU's step that `settle` takes
+    /// empty. Any other next command, a draw without its closed form, and
+    /// a draw with a stalling state setup (it runs first, now that the
+    /// stage is free), leave everything to `settle`. The CPU's step that `settle` takes
     /// first does nothing at this instant (a draw's end frees no FIFO space
     /// and completes no frame), so taking the front end's steps before it
     /// changes no order; `settle` runs next and takes every step left.

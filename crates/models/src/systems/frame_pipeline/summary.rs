@@ -37,16 +37,19 @@ pub(super) fn ms(ps: u64) -> f64 {
 /// front end, geometry and fragment. `gpu_max_ms` = max of the three (the
 /// front end overlaps the stages: it prepares the next draw while they work),
 /// a lower bound of the GPU time when the GPU never starves; `gpu_sum_ms` =
-/// their sum, the time with no overlap at all (§4.5.1's "sum" estimate).
+/// their sum, the time with no overlap at all (§4.5.1's "sum" estimate). A
+/// stalling state setup (`gpu.state_change_stalls`) is in both the front
+/// end's and the geometry stage's term (it holds both), once in the sum.
 pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProgram>) -> AnalyticTerms {
     let c = &cfg.cpu;
     // In f64: sums of huge costs must not wrap before the range check.
     let base_cpu = c.input_sampling.0 as f64 + c.clear.0 as f64 + c.swap.0 as f64 + c.non_render.mean();
     let base_front = cfg.gpu.clear.0 as f64 + cfg.gpu.swap.0 as f64 + 2.0 * cfg.gpu.command.0 as f64;
-    let (cpu, front, geo, frag) = match (&cfg.workload, scene) {
+    let (cpu, front, geo, frag, setup) = match (&cfg.workload, scene) {
         (WorkloadConfig::Fixed(f), _) => (
             base_cpu + f.cpu.mean(),
             base_front + f.gpu.mean() + cfg.gpu.command.0 as f64,
+            0.0,
             0.0,
             0.0,
         ),
@@ -55,13 +58,17 @@ pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProg
             base_front + FramesWorkload::mean_ps(&f.gpu) + cfg.gpu.command.0 as f64,
             0.0,
             0.0,
+            0.0,
         ),
         (WorkloadConfig::Scene(_), Some(s)) => {
             // A copy on a shared bus is a step of its own: at least its
             // time alone (at its memory's rate).
             let copies = |d: &super::workload::DrawItem| if s.bus_shared { d.copy.0 as f64 } else { 0.0 };
             let cpu: f64 = s.draws.iter().map(|d| d.cpu.0 as f64 + copies(d)).sum();
-            let front: f64 = s.draws.iter().map(|d| d.front.0 as f64 + d.setup.0 as f64).sum();
+            let front: f64 = s.draws.iter().map(|d| d.front.0 as f64).sum();
+            // A stalling state setup (`gpu.state_change_stalls`) runs on the
+            // front end while the geometry stage waits: in series with both.
+            let setup: f64 = s.draws.iter().map(|d| d.setup.0 as f64).sum();
             // A draw from AGP memory: no shorter than its bytes over the whole bus.
             let bus = cfg.bus.bandwidth.bytes_per_ps();
             let geo: f64 = s
@@ -72,7 +79,8 @@ pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProg
                     let fetch = m.transformed as f64 * s.groups[d.group as usize].fetch_bytes_per_vertex / bus;
                     (m.geometry_time.0 as f64).max(fetch)
                 })
-                .sum();
+                .sum::<f64>()
+                + setup;
             let frag: f64 = s
                 .draws
                 .iter()
@@ -81,9 +89,9 @@ pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProg
                     s.meshes[d.mesh as usize].triangles as f64 * g.pixels.mean() * g.cost_per_pixel()
                 })
                 .sum();
-            (base_cpu + cpu, base_front + front, geo, frag)
+            (base_cpu + cpu, base_front + front + setup, geo, frag, setup)
         }
-        _ => (base_cpu, base_front, 0.0, 0.0),
+        _ => (base_cpu, base_front, 0.0, 0.0, 0.0),
     };
     let p = PS_PER_MS as f64;
     AnalyticTerms {
@@ -92,9 +100,9 @@ pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProg
         geometry_ms: geo / p,
         fragment_ms: frag / p,
         gpu_max_ms: front.max(geo).max(frag) / p,
-        gpu_sum_ms: (front + geo + frag) / p,
+        gpu_sum_ms: (front + geo + frag - setup) / p,
         frame_max_ms: cpu.max(front.max(geo).max(frag)) / p,
-        frame_sum_ms: cpu.max(front + geo + frag) / p,
+        frame_sum_ms: cpu.max(front + geo + frag - setup) / p,
     }
 }
 
