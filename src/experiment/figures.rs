@@ -239,12 +239,14 @@ fn bars(
             ci: Some(ci),
             tint_of_previous: false,
         });
-        // The paper's values for this point, beside it in a tint of its colour.
+        // The paper's values for this point, beside it in a tint of its
+        // colour, named by what its `where` fixes (the paper has one value
+        // there, whatever the sweeps it leaves free).
         for (i, v) in paper.iter().enumerate() {
             if !drawn[i] && p.matches(&v.filter) {
                 drawn[i] = true;
                 series.push(BarSeries {
-                    name: format!("{label} ({})", spec.paper_label),
+                    name: format!("{} ({})", label_of_keys(exp, p, &v.filter, filter), spec.paper_label),
                     values: v.values.clone(),
                     ci: None,
                     tint_of_previous: true,
@@ -256,7 +258,7 @@ fn bars(
     for (i, v) in paper.iter().enumerate().filter(|(i, _)| !drawn[*i]) {
         let name = points.iter().find(|p| p.matches(&v.filter)).map_or_else(
             || format!("{} {}", spec.paper_label, i + 1),
-            |p| format!("{} ({})", p.plot_label(&exp.sweeps), spec.paper_label),
+            |p| format!("{} ({})", label_of_keys(exp, p, &v.filter, &[]), spec.paper_label),
         );
         series.push(BarSeries {
             name,
@@ -276,6 +278,29 @@ fn bars(
 
 /// A point's plot label without the keys `filter` fixes (they are the
 /// same for every bar); the whole label when that leaves nothing.
+/// `p`'s label from the keys `keys` fixes, less those `filter` fixes (the
+/// plot's own filter, said in its title); [`label_without`] when that
+/// leaves nothing.
+fn label_of_keys(
+    exp: &Experiment,
+    p: &Point,
+    keys: &[(String, toml::Value)],
+    filter: &[(String, toml::Value)],
+) -> String {
+    let parts: Vec<String> = p
+        .assignments
+        .iter()
+        .enumerate()
+        .filter(|(_, (k, _))| keys.iter().any(|(f, _)| f == k) && !filter.iter().any(|(f, _)| f == k))
+        .map(|(i, _)| p.plot_assignment(&exp.sweeps, i))
+        .collect();
+    if parts.is_empty() {
+        label_without(exp, p, filter)
+    } else {
+        parts.join(", ")
+    }
+}
+
 fn label_without(exp: &Experiment, p: &Point, filter: &[(String, toml::Value)]) -> String {
     let parts: Vec<String> = p
         .assignments

@@ -268,6 +268,44 @@ fn bad_keys_name_the_key() {
     assert!(e.contains("scene.lod_ratio"), "{e}");
     let e = err(CITY, &["gpu.shader_cores=0"]);
     assert!(e.contains("gpu.shader_cores"), "{e}");
+    let e = err(CITY, &["estimation.fit_views=\"everywhere\""]);
+    assert!(e.contains("fit_views") && e.contains("walk"), "{e}");
+    // A keyframes path's second walk would be the recorded path itself.
+    let e = err(LINEAR, &["estimation.fit_views=\"walk\""]);
+    assert!(e.contains("estimation.fit_views") && e.contains("keyframes"), "{e}");
+}
+
+/// The heuristics' errors (h1-h4 mse, ms²) on the shipped walkthrough
+/// `text` with the fit's renders chosen as `views` says.
+fn heuristic_mse(text: &str, views: &str) -> [f64; 4] {
+    let sets = [
+        format!("estimation.fit_views=\"{views}\""),
+        "estimation.estimators=[\"h1\", \"h2\", \"h3\", \"h4\"]".into(),
+    ];
+    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+    let s = summary_of(text, &sets);
+    ["h1", "h2", "h3", "h4"].map(|h| num(&s, &format!("metrics.estimation.{h}.mse_ms2")))
+}
+
+#[test]
+fn fitting_on_objects_as_a_walk_draws_them_moves_h1_and_h2_as_the_docs_say() {
+    // docs/models.md, "Walkthrough and rendering-time estimation": in the
+    // city h1 and h2 fall from over 30 ms² to about 1; in the forest they
+    // rise from about 0.5 to over 40; h3 and h4 stay below 2 either way.
+    let (log, walk) = (heuristic_mse(CITY, "log_uniform"), heuristic_mse(CITY, "walk"));
+    assert!(log[0] > 30.0 && log[1] > 30.0, "city, log-uniform: {log:?}");
+    assert!(walk[0] < 1.5 && walk[1] < 1.5, "city, walk: {walk:?}");
+    assert!(
+        log[2..].iter().chain(&walk[2..]).all(|m| *m < 2.0),
+        "city h3, h4: {log:?} {walk:?}"
+    );
+    let (log, walk) = (heuristic_mse(FOREST, "log_uniform"), heuristic_mse(FOREST, "walk"));
+    assert!(log[0] < 1.0 && log[1] < 1.0, "forest, log-uniform: {log:?}");
+    assert!(walk[0] > 40.0 && walk[1] > 40.0, "forest, walk: {walk:?}");
+    assert!(
+        log[2..].iter().chain(&walk[2..]).all(|m| *m < 2.0),
+        "forest h3, h4: {log:?} {walk:?}"
+    );
 }
 
 #[test]

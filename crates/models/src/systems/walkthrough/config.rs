@@ -245,6 +245,11 @@ pub struct EstimationConfig {
     pub estimators: Vec<String>,
     /// Single-object renders the heuristics' constants are fitted to.
     pub fit_samples: u64,
+    /// How those renders' objects and views are chosen (paper 000 §7.2
+    /// says only "10,000 test measurements of different objects"):
+    /// `"log_uniform"` (default) or `"walk"`.
+    #[serde(skip_serializing_if = "FitViews::is_default")]
+    pub fit_views: FitViews,
     /// Copies of the object drawn in each single-object render (its state
     /// set once), the time divided among them (paper 000 §7.1 rendered
     /// each timed object several times between the two readings).
@@ -283,6 +288,29 @@ fn is_default_noise(d: &Duration) -> bool {
     *d == DEFAULT_CLOCK_NOISE
 }
 
+/// How the heuristics' single-object renders choose their objects and
+/// views (`estimation.fit_views`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FitViews {
+    /// A random object of the scene at a random level, seen from a random
+    /// direction at a size log-uniform from a one-pixel disk to the whole
+    /// image: every size weighted alike.
+    #[default]
+    LogUniform,
+    /// Objects as a walk sees them: a second walk of the camera path's
+    /// kind (its own random turns, not the recorded path), a random pose
+    /// on it, a random object that pose draws (its view cell's set, the
+    /// frustum) at a random level, with the projection it has there.
+    Walk,
+}
+
+impl FitViews {
+    fn is_default(&self) -> bool {
+        *self == FitViews::LogUniform
+    }
+}
+
 /// The view-cell estimators' preprocess (paper 000 §5.1, §5.2): view
 /// directions are discretized into `directions` equal sectors of heading
 /// (bin k centred on k · 360° / directions).
@@ -319,6 +347,7 @@ impl Default for EstimationConfig {
                 .map(|s| s.to_string())
                 .collect(),
             fit_samples: 10_000,
+            fit_views: FitViews::LogUniform,
             repeats: 4,
             pos: PosConfig::default(),
             timing: TimingMode::Timestamps,

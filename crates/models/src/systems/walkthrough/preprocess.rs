@@ -11,8 +11,8 @@ use crate::engine::RngStreams;
 use crate::systems::error::{SystemError, invalid};
 
 use super::camera::Pose;
-use super::config::WalkthroughConfig;
-use super::culling::{Pvs, sample_projection};
+use super::config::{FitViews, WalkthroughConfig};
+use super::culling::{Pvs, View, project, sample_projection};
 use super::estimators::{Constants, fit};
 use super::lod::Policy;
 use super::pos::{PosTable, build as build_table};
@@ -148,17 +148,37 @@ fn fit_constants(
     }
     let alpha_range = super::pos::alphas(&cfg.estimation.pos, focal, w, h);
     let (alpha_lo, alpha_hi) = (alpha_range[0].ln(), alpha_range[alpha_range.len() - 1].ln());
-    let mut rng = RngStreams::new(cfg.run.seed).stream("estimation.fit");
+    let streams = RngStreams::new(cfg.run.seed);
+    let mut rng = streams.stream("estimation.fit");
     let p = &cfg.estimation.pos;
+    let mut walk = match cfg.estimation.fit_views {
+        FitViews::LogUniform => None,
+        FitViews::Walk => Some(CalibrationWalk::new(
+            cfg,
+            scene,
+            streams.stream("estimation.fit.walk").random(),
+        )?),
+    };
     let mut samples = Vec::with_capacity(cfg.estimation.fit_samples as usize);
     for _ in 0..cfg.estimation.fit_samples {
-        let o = &scene.objects[rng.random_range(0..scene.objects.len())];
-        let proto = &scene.protos[o.proto as usize];
-        let level = rng.random_range(0..proto.levels.len());
-        let alpha = rng.random_range(alpha_lo..=alpha_hi).exp();
-        let gamma = rng.random_range(0.0..std::f64::consts::TAU);
-        let phi = rng.random_range(p.phi_min..=p.phi_max).to_radians();
-        let pr = sample_projection(proto, alpha, gamma, phi, focal, w, h);
+        // (The draws keep the order of the log-uniform samples: object,
+        // level, size, direction.)
+        let (o, level, pr) = match &mut walk {
+            Some(walk) => {
+                let (o, pr) = walk.sample(cfg, scene, &mut rng)?;
+                let level = rng.random_range(0..scene.protos[o.proto as usize].levels.len());
+                (o, level, pr)
+            }
+            None => {
+                let o = &scene.objects[rng.random_range(0..scene.objects.len())];
+                let proto = &scene.protos[o.proto as usize];
+                let level = rng.random_range(0..proto.levels.len());
+                let alpha = rng.random_range(alpha_lo..=alpha_hi).exp();
+                let gamma = rng.random_range(0.0..std::f64::consts::TAU);
+                let phi = rng.random_range(p.phi_min..=p.phi_max).to_radians();
+                (o, level, sample_projection(proto, alpha, gamma, phi, focal, w, h))
+            }
+        };
         let d = Draw {
             proto: o.proto,
             level: level as u32,
@@ -169,6 +189,73 @@ fn fit_constants(
         samples.push((features(scene, o.proto, level, &pr), y));
     }
     Ok(Some(fit(&samples)))
+}
+
+/// `estimation.fit_views = "walk"`: a second walk of the camera path's
+/// kind, with its own seed, whose poses the fit samples are seen from.
+struct CalibrationWalk {
+    poses: Vec<Pose>,
+    pvs: Pvs,
+    visible: Vec<u32>,
+}
+
+/// Poses tried for one sample before the walk is declared blind.
+const WALK_TRIES: usize = 10_000;
+
+impl CalibrationWalk {
+    fn new(cfg: &WalkthroughConfig, scene: &Scene, seed: u64) -> Result<Self, SystemError> {
+        if super::camera::resolved_kind(&cfg.camera, scene)? == "keyframes" {
+            return Err(invalid(
+                "estimation.fit_views",
+                "\"walk\" needs a procedural camera path (street, forest or flight): a keyframes path \
+                 would walk the recorded path itself, and the fit would see the frames it is tested on",
+            ));
+        }
+        let dt = cfg.display.refresh.period.0.max(1) as f64 * 1e-12;
+        let poses = super::camera::path(&cfg.camera, scene, cfg.run.frames.max(1), dt, seed)?;
+        Ok(CalibrationWalk {
+            poses,
+            pvs: Pvs::default(),
+            visible: Vec::new(),
+        })
+    }
+
+    /// A random object that a random pose of the walk draws, with its
+    /// projection there.
+    fn sample<'s>(
+        &mut self,
+        cfg: &WalkthroughConfig,
+        scene: &'s Scene,
+        rng: &mut impl Rng,
+    ) -> Result<(&'s super::scene::Object, super::culling::Projection), SystemError> {
+        for _ in 0..WALK_TRIES {
+            let pose = self.poses[rng.random_range(0..self.poses.len())];
+            let view = View::new(&pose, &cfg.camera);
+            self.visible.clear();
+            let seen = |i: u32| {
+                let o = &scene.objects[i as usize];
+                view.sees_sphere(o.center, o.radius)
+            };
+            match scene.view_cell {
+                Some(c) => {
+                    let set = self.pvs.set(scene, c, pose.eye, cfg.camera.far);
+                    self.visible.extend(set.iter().copied().filter(|&i| seen(i)));
+                }
+                None => self
+                    .visible
+                    .extend((0..scene.objects.len() as u32).filter(|&i| seen(i))),
+            }
+            if self.visible.is_empty() {
+                continue;
+            }
+            let o = &scene.objects[self.visible[rng.random_range(0..self.visible.len())] as usize];
+            return Ok((o, project(&view, o, &scene.protos[o.proto as usize])));
+        }
+        Err(invalid(
+            "estimation.fit_views",
+            format!("the calibration walk drew no object from {WALK_TRIES} of its poses"),
+        ))
+    }
 }
 
 /// The pos tables (when pos or pvc is wanted), one per prototype in use,
