@@ -52,6 +52,36 @@ fn row<'a>(readme: &'a str, result: &str) -> &'a str {
 
 const GPU: &str = "metrics.gpu_time_ms.mean:mean";
 
+/// Table 2's unsorted order, and its three predicted cells (order, vertex
+/// cost of the setting) with the decimals the docs give their change in.
+const TABLE2_NONE: &str = "{ alpha = 186, material = 639, matrix = 151, texture = 984 }";
+const TABLE2_MATRIX_FIRST: &str =
+    "{ alpha = 28, material = 525, matrix = 151, sorted_each_frame = true, texture = 449 }";
+const TABLE2_TEXTURE_FIRST: &str =
+    "{ alpha = 12, material = 110, matrix = 984, sorted_each_frame = true, texture = 211 }";
+const TABLE2_PREDICTED: [((&str, &str), usize); 3] = [
+    ((TABLE2_MATRIX_FIRST, "25342ps"), 1),
+    ((TABLE2_MATRIX_FIRST, "79640ps"), 2),
+    ((TABLE2_TEXTURE_FIRST, "79640ps"), 2),
+];
+
+/// A Table 2 cell's frame time (ms) and its change from the unsorted
+/// order in the same setting (%).
+fn table2_cell((order, setting): (&str, &str)) -> (f64, f64) {
+    let at = |order| {
+        value(
+            "table2-state-sorting",
+            &[
+                ("workload.groups.0.changes", order),
+                ("gpu.geometry.vertex_shader", setting),
+            ],
+            "metrics.frame_time_ms.mean:mean",
+        )
+    };
+    let t = at(order);
+    (t, 100.0 * (t / at(TABLE2_NONE) - 1.0))
+}
+
 #[test]
 fn the_readme_states_what_the_experiments_give() {
     let readme = std::fs::read_to_string(Path::new(ROOT).join("README.md")).unwrap();
@@ -87,36 +117,15 @@ fn the_readme_states_what_the_experiments_give() {
         let t = order(o);
         expect(result, format!("{t:.3} ms ({:+.1}%)", 100.0 * (t / normal - 1.0)));
     }
-    let sorted = |order: &str, setting: &str| {
-        value(
-            "table2-state-sorting",
-            &[
-                ("workload.groups.0.changes", order),
-                ("gpu.geometry.vertex_shader", setting),
-            ],
-            "metrics.frame_time_ms.mean:mean",
-        )
-    };
-    let none = "{ alpha = 186, material = 639, matrix = 151, texture = 984 }";
-    let matrix_first = "{ alpha = 28, material = 525, matrix = 151, sorted_each_frame = true, texture = 449 }";
-    let texture_first = "{ alpha = 12, material = 110, matrix = 984, sorted_each_frame = true, texture = 211 }";
-    for (result, order, setting, decimals) in [
-        ("Table 2, CPU-limited, matrix then texture", matrix_first, "25342ps", 1),
-        (
-            "Table 2, geometry-limited, matrix then texture",
-            matrix_first,
-            "79640ps",
-            2,
-        ),
-        (
-            "Table 2, geometry-limited, texture then matrix",
-            texture_first,
-            "79640ps",
-            2,
-        ),
-    ] {
-        let t = sorted(order, setting);
-        let change = 100.0 * (t / sorted(none, setting) - 1.0);
+    for (result, (cell, decimals)) in [
+        "Table 2, CPU-limited, matrix then texture",
+        "Table 2, geometry-limited, matrix then texture",
+        "Table 2, geometry-limited, texture then matrix",
+    ]
+    .into_iter()
+    .zip(TABLE2_PREDICTED)
+    {
+        let (t, change) = table2_cell(cell);
         expect(result, format!("{t:.3} ms ({change:+.decimals$}%)"));
     }
     for (scene, views, row) in [
@@ -268,46 +277,20 @@ fn the_models_doc_states_what_the_geforce3_experiments_give() {
         assert!(doc.contains(&text), "docs/models.md should say {text:?}");
     }
     // "Table 2 (mode sorting), read and predicted": the three predictions.
-    let sorted = |order: &str, setting: &str| {
-        let at = [
-            ("workload.groups.0.changes", order),
-            ("gpu.geometry.vertex_shader", setting),
-        ];
-        value("table2-state-sorting", &at, "metrics.frame_time_ms.mean:mean")
-    };
-    let none = "{ alpha = 186, material = 639, matrix = 151, texture = 984 }";
-    let matrix_first = "{ alpha = 28, material = 525, matrix = 151, sorted_each_frame = true, texture = 449 }";
-    let texture_first = "{ alpha = 12, material = 110, matrix = 984, sorted_each_frame = true, texture = 211 }";
-    for (cell, order, setting, paper, decimals) in [
-        (
-            "CPU-limited, matrix then texture",
-            matrix_first,
-            "25342ps",
-            "7.725 | 7.999",
-            1,
-        ),
-        (
-            "geometry-limited, matrix then texture",
-            matrix_first,
-            "79640ps",
-            "14.328 | 14.370",
-            2,
-        ),
-        (
-            "geometry-limited, texture then matrix",
-            texture_first,
-            "79640ps",
-            "14.138 | 14.151",
-            2,
-        ),
-    ] {
-        let t = sorted(order, setting);
-        let change = 100.0 * (t / sorted(none, setting) - 1.0);
-        let text = format!("| {cell} | {paper} |");
+    for ((name, paper), (cell, decimals)) in [
+        ("CPU-limited, matrix then texture", "7.725 | 7.999"),
+        ("geometry-limited, matrix then texture", "14.328 | 14.370"),
+        ("geometry-limited, texture then matrix", "14.138 | 14.151"),
+    ]
+    .into_iter()
+    .zip(TABLE2_PREDICTED)
+    {
+        let (t, change) = table2_cell(cell);
+        let text = format!("| {name} | {paper} |");
         assert!(doc.contains(&text), "docs/models.md should say {text:?}");
         assert!(
             paper.ends_with(&format!("{t:.3}")),
-            "{cell}: {t:.3} ms, the doc says {paper}"
+            "{name}: {t:.3} ms, the doc says {paper}"
         );
         let text = format!("| {change:.decimals$}% (holds");
         assert!(doc.contains(&text), "docs/models.md should say {text:?}");

@@ -7,30 +7,12 @@
 use super::raw::*;
 use super::validate::Validator;
 use super::*;
-use crate::config::flatten;
+use crate::config::{flatten, flatten_until};
 use crate::experiment::ExperimentError;
 use crate::experiment::sweep::values_match;
 
 /// Sweep key = value pairs selecting points.
 type Filter = Vec<(String, toml::Value)>;
-/// [`flatten`], stopping at the sweep keys: a table under a sweep's key
-/// is that sweep's value, not more keys.
-fn flatten_to_sweeps(prefix: &str, t: &toml::Table, sweeps: &[Sweep], out: &mut Vec<(String, toml::Value)>) {
-    for (k, v) in t {
-        let key = if prefix.is_empty() {
-            k.clone()
-        } else {
-            format!("{prefix}.{k}")
-        };
-        match v {
-            toml::Value::Table(inner) if !sweeps.iter().any(|s| s.key == key) => {
-                flatten_to_sweeps(&key, inner, sweeps, out)
-            }
-            other => out.push((key, other.clone())),
-        }
-    }
-}
-
 impl Validator<'_> {
     /// A `where`-like table of `key` = value: every key a sweep key, every
     /// value one of that sweep's values; flattened to dotted keys, except
@@ -43,7 +25,7 @@ impl Validator<'_> {
         t: &toml::Table,
     ) -> Result<Vec<(String, toml::Value)>, ExperimentError> {
         let mut flat = Vec::new();
-        flatten_to_sweeps("", t, sweeps, &mut flat);
+        flatten_until("", t, &|k| sweeps.iter().any(|s| s.key == k), &mut flat);
         for (k, v) in &flat {
             let Some(s) = sweeps.iter().find(|s| s.key == *k) else {
                 return Err(self.err(key, format!("`{k}` is not a sweep key")));

@@ -10,5 +10,5 @@ pub mod units;
 pub use hardware::{HARDWARE_KEY, HARDWARE_SECTIONS};
 pub use load::{ConfigError, ModelSource, deserialize, invalid};
 pub use overrides::{DEFAULT_MODEL, DEFAULT_MODEL_NAME, Overrides, PreparedModel, apply_patches, load_model, prepare};
-pub use patch::{PatchError, apply_set, flatten, set_dotted};
+pub use patch::{PatchError, apply_set, flatten, flatten_until, set_dotted};
 pub use units::{Bandwidth, Bytes, Rate, UnitError};

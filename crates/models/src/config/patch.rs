@@ -121,6 +121,17 @@ fn set_in(cur: &mut toml::Value, parts: &[&str], done: usize, value: toml::Value
 
 /// Flatten nested tables into `(dotted key, value)` pairs, in table order.
 pub fn flatten(prefix: &str, t: &toml::Table, out: &mut Vec<(String, toml::Value)>) {
+    flatten_until(prefix, t, &|_| false, out)
+}
+
+/// [`flatten`], except that a table under a dotted key for which `whole`
+/// is true is one value (a sweep of tables, say), not more keys.
+pub fn flatten_until(
+    prefix: &str,
+    t: &toml::Table,
+    whole: &dyn Fn(&str) -> bool,
+    out: &mut Vec<(String, toml::Value)>,
+) {
     for (k, v) in t {
         let key = if prefix.is_empty() {
             k.clone()
@@ -128,7 +139,7 @@ pub fn flatten(prefix: &str, t: &toml::Table, out: &mut Vec<(String, toml::Value
             format!("{prefix}.{k}")
         };
         match v {
-            toml::Value::Table(inner) => flatten(&key, inner, out),
+            toml::Value::Table(inner) if !whole(&key) => flatten_until(&key, inner, whole, out),
             other => out.push((key, other.clone())),
         }
     }
