@@ -75,9 +75,20 @@ pub struct FrameTable {
 
 impl FrameTable {
     /// The values of column `name`, or `None` if there is no such column.
-    /// Rows too short to hold the column are skipped.
+    /// Rows too short to hold the column are skipped. `A+B` (any number of
+    /// names joined by `+`) is the columns' sum row by row, `None` unless
+    /// every one exists: `MsGPULatency+MsGPUTime` is a frame's time from
+    /// its CPU start to its GPU end.
     pub fn column(&self, name: &str) -> Option<Vec<f64>> {
-        let i = self.columns.iter().position(|c| c == name)?;
-        Some(self.rows.iter().filter_map(|r| r.get(i).copied()).collect())
+        let idx: Vec<usize> = name
+            .split('+')
+            .map(|part| self.columns.iter().position(|c| c == part.trim()))
+            .collect::<Option<_>>()?;
+        Some(
+            self.rows
+                .iter()
+                .filter_map(|r| idx.iter().map(|&i| r.get(i).copied()).sum::<Option<f64>>())
+                .collect(),
+        )
     }
 }

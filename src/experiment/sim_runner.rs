@@ -141,6 +141,10 @@ mod tests {
         let t = without_warmup(table(&[0.0, 1.0, 2.0, 3.0]), 2);
         assert_eq!(t.column("Frame").unwrap(), vec![2.0, 3.0]);
         assert_eq!(t.column("FrameTime").unwrap(), vec![12.0, 13.0]);
+        // A sum of columns, row by row; a missing part is no column.
+        assert_eq!(t.column("Frame+FrameTime").unwrap(), vec![14.0, 16.0]);
+        assert_eq!(t.column("Frame + FrameTime + Frame").unwrap(), vec![16.0, 19.0]);
+        assert_eq!(t.column("Frame+Missing"), None);
         assert_eq!(without_warmup(table(&[0.0, 1.0]), 0).rows.len(), 2);
         assert!(without_warmup(table(&[0.0, 1.0]), 5).rows.is_empty());
         let no_index = FrameTable {
