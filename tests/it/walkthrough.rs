@@ -273,6 +273,8 @@ fn bad_keys_name_the_key() {
     // A keyframes path's second walk would be the recorded path itself.
     let e = err(LINEAR, &["estimation.fit_views=\"walk\""]);
     assert!(e.contains("estimation.fit_views") && e.contains("keyframes"), "{e}");
+    let e = err(CITY, &["estimation.fit_views=\"walk\"", "camera.speed=0.0"]);
+    assert!(e.contains("estimation.fit_views") && e.contains("moving camera"), "{e}");
 }
 
 /// The heuristics' errors (h1-h4 mse, ms²) on the shipped walkthrough

@@ -299,9 +299,10 @@ pub enum FitViews {
     #[default]
     LogUniform,
     /// Objects as a walk sees them: a second walk of the camera path's
-    /// kind (its own random turns, not the recorded path), a random pose
-    /// on it, a random object that pose draws (its view cell's set, the
-    /// frustum) at a random level, with the projection it has there.
+    /// kind (its own random turns, not the recorded path; a moving camera
+    /// on a procedural path), a random pose on it, a random object that
+    /// pose draws (its view cell's set, the frustum) at a random level,
+    /// with the projection it has there.
     Walk,
 }
 

@@ -211,6 +211,13 @@ impl CalibrationWalk {
                  would walk the recorded path itself, and the fit would see the frames it is tested on",
             ));
         }
+        if cfg.camera.speed == Some(0.0) {
+            return Err(invalid(
+                "estimation.fit_views",
+                "\"walk\" needs a moving camera (camera.speed > 0): standing still, the second walk \
+                 would see the recorded frames' own view",
+            ));
+        }
         let dt = cfg.display.refresh.period.0.max(1) as f64 * 1e-12;
         let poses = super::camera::path(&cfg.camera, scene, cfg.run.frames.max(1), dt, seed)?;
         Ok(CalibrationWalk {
