@@ -276,8 +276,24 @@ fn bars(
     }
 }
 
-/// A point's plot label without the keys `filter` fixes (they are the
-/// same for every bar); the whole label when that leaves nothing.
+/// Whether `filter` fixes the sweep key `k`.
+fn fixes(filter: &[(String, toml::Value)], k: &str) -> bool {
+    filter.iter().any(|(f, _)| f == k)
+}
+
+/// `p`'s assignments whose key `keep` accepts, in words, joined; `None`
+/// when it accepts none.
+fn label_of(exp: &Experiment, p: &Point, keep: impl Fn(&str) -> bool) -> Option<String> {
+    let parts: Vec<String> = p
+        .assignments
+        .iter()
+        .enumerate()
+        .filter(|(_, (k, _))| keep(k))
+        .map(|(i, _)| p.plot_assignment(&exp.sweeps, i))
+        .collect();
+    (!parts.is_empty()).then(|| parts.join(", "))
+}
+
 /// `p`'s label from the keys `keys` fixes, less those `filter` fixes (the
 /// plot's own filter, said in its title); [`label_without`] when that
 /// leaves nothing.
@@ -287,33 +303,13 @@ fn label_of_keys(
     keys: &[(String, toml::Value)],
     filter: &[(String, toml::Value)],
 ) -> String {
-    let parts: Vec<String> = p
-        .assignments
-        .iter()
-        .enumerate()
-        .filter(|(_, (k, _))| keys.iter().any(|(f, _)| f == k) && !filter.iter().any(|(f, _)| f == k))
-        .map(|(i, _)| p.plot_assignment(&exp.sweeps, i))
-        .collect();
-    if parts.is_empty() {
-        label_without(exp, p, filter)
-    } else {
-        parts.join(", ")
-    }
+    label_of(exp, p, |k| fixes(keys, k) && !fixes(filter, k)).unwrap_or_else(|| label_without(exp, p, filter))
 }
 
+/// A point's plot label without the keys `filter` fixes (they are the
+/// same for every bar); the whole label when that leaves nothing.
 fn label_without(exp: &Experiment, p: &Point, filter: &[(String, toml::Value)]) -> String {
-    let parts: Vec<String> = p
-        .assignments
-        .iter()
-        .enumerate()
-        .filter(|(_, (k, _))| !filter.iter().any(|(f, _)| f == k))
-        .map(|(i, _)| p.plot_assignment(&exp.sweeps, i))
-        .collect();
-    if parts.is_empty() {
-        p.plot_label(&exp.sweeps)
-    } else {
-        parts.join(", ")
-    }
+    label_of(exp, p, |k| !fixes(filter, k)).unwrap_or_else(|| p.plot_label(&exp.sweeps))
 }
 
 /// A line plot's published values as crosses: each at the x of the first

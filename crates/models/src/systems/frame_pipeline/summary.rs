@@ -38,8 +38,8 @@ pub(super) fn ms(ps: u64) -> f64 {
 /// front end overlaps the stages: it prepares the next draw while they work),
 /// a lower bound of the GPU time when the GPU never starves; `gpu_sum_ms` =
 /// their sum, the time with no overlap at all (§4.5.1's "sum" estimate). A
-/// stalling state setup (`gpu.state_change_stalls`) is in both the front
-/// end's and the geometry stage's term (it holds both), once in the sum.
+/// stalling state setup (`gpu.state_change_stalls`) holds the front end and
+/// the geometry stage together: it is in both their terms, once in the sum.
 pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProgram>) -> AnalyticTerms {
     let c = &cfg.cpu;
     // In f64: sums of huge costs must not wrap before the range check.
@@ -66,8 +66,6 @@ pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProg
             let copies = |d: &super::workload::DrawItem| if s.bus_shared { d.copy.0 as f64 } else { 0.0 };
             let cpu: f64 = s.draws.iter().map(|d| d.cpu.0 as f64 + copies(d)).sum();
             let front: f64 = s.draws.iter().map(|d| d.front.0 as f64).sum();
-            // A stalling state setup (`gpu.state_change_stalls`) runs on the
-            // front end while the geometry stage waits: in series with both.
             let setup: f64 = s.draws.iter().map(|d| d.setup.0 as f64).sum();
             // A draw from AGP memory: no shorter than its bytes over the whole bus.
             let bus = cfg.bus.bandwidth.bytes_per_ps();
@@ -79,8 +77,7 @@ pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProg
                     let fetch = m.transformed as f64 * s.groups[d.group as usize].fetch_bytes_per_vertex / bus;
                     (m.geometry_time.0 as f64).max(fetch)
                 })
-                .sum::<f64>()
-                + setup;
+                .sum();
             let frag: f64 = s
                 .draws
                 .iter()
@@ -89,20 +86,22 @@ pub(super) fn analytic_terms(cfg: &FramePipelineConfig, scene: Option<&SceneProg
                     s.meshes[d.mesh as usize].triangles as f64 * g.pixels.mean() * g.cost_per_pixel()
                 })
                 .sum();
-            (base_cpu + cpu, base_front + front + setup, geo, frag, setup)
+            (base_cpu + cpu, base_front + front, geo, frag, setup)
         }
         _ => (base_cpu, base_front, 0.0, 0.0, 0.0),
     };
     let p = PS_PER_MS as f64;
+    // The setup holds both the front end and the geometry stage.
+    let (front, geo, sum) = (front + setup, geo + setup, front + geo + frag + setup);
     AnalyticTerms {
         cpu_ms: cpu / p,
         gpu_front_end_ms: front / p,
         geometry_ms: geo / p,
         fragment_ms: frag / p,
         gpu_max_ms: front.max(geo).max(frag) / p,
-        gpu_sum_ms: (front + geo + frag - setup) / p,
+        gpu_sum_ms: sum / p,
         frame_max_ms: cpu.max(front.max(geo).max(frag)) / p,
-        frame_sum_ms: cpu.max(front + geo + frag - setup) / p,
+        frame_sum_ms: cpu.max(sum) / p,
     }
 }
 

@@ -108,6 +108,9 @@ pub struct GroupInfo {
     pub memory: GeometryMemory,
     /// Bytes fetched over the bus per transformed vertex (0 in video memory).
     pub fetch_bytes_per_vertex: f64,
+    /// Whether the CPU sorts the group's draws into place every frame
+    /// (`changes.sorted_each_frame`: each pays `cpu.sort_per_draw`).
+    pub sorted_each_frame: bool,
 }
 
 impl GroupInfo {
@@ -214,9 +217,6 @@ pub struct Instance {
     pub matrix: bool,
     /// Blending (alpha) state id (0: opaque).
     pub alpha: u64,
-    /// Whether the CPU sorts this draw into place every frame
-    /// (`cpu.sort_per_draw`).
-    pub sorted: bool,
     /// Upload bytes per frame.
     pub upload: u64,
 }
@@ -397,6 +397,7 @@ pub fn compile_scene(
                 GeometryMemory::Agp => g.vertex_bytes.0 as f64,
                 GeometryMemory::Video => 0.0,
             },
+            sorted_each_frame: g.changes.as_ref().is_some_and(|c| c.sorted_each_frame),
         });
         for i in 0..g.count {
             objects.push(Instance {
@@ -405,7 +406,6 @@ pub fn compile_scene(
                 state: numbering.state(g, i),
                 matrix: StateNumbering::sets_matrix(g, i),
                 alpha: numbering.alpha(g, i),
-                sorted: g.changes.as_ref().is_some_and(|c| c.sorted_each_frame),
                 upload: g.geometry_upload.0.saturating_add(g.texture_upload.0),
             });
         }
@@ -480,7 +480,6 @@ pub fn build_program(
             state: (sh, tx, mt),
             matrix,
             alpha,
-            sorted,
             upload: up,
         } = *o;
         let changed = [
@@ -507,21 +506,18 @@ pub fn build_program(
             gpu.state_change.alpha,
         ];
         let mut c = add(cpu.per_object, cpu.per_draw, "cpu")?;
-        if sorted {
+        if groups[group as usize].sorted_each_frame {
             c = add(c, cpu.sort_per_draw, "cpu.sort_per_draw")?;
         }
-        let mut f = Duration::ZERO;
-        let mut setup = Duration::ZERO;
+        // The GPU's state changes: on the front end beside the draw before,
+        // or (stalling) once the geometry stage is free.
+        let mut states = Duration::ZERO;
         let mut commands = 1u32;
         let mut b = bytes.draw.0;
         for k in 0..changed.len() {
             if changed[k] {
                 c = add(c, cpu_costs[k], "cpu.state_change")?;
-                if gpu.state_change_stalls {
-                    setup = add(setup, gpu_costs[k], "gpu.state_change")?;
-                } else {
-                    f = add(f, gpu_costs[k], "gpu.state_change")?;
-                }
+                states = add(states, gpu_costs[k], "gpu.state_change")?;
                 commands += 1;
                 b += bytes.state.0;
             }
@@ -541,7 +537,12 @@ pub fn build_program(
             b += bytes.upload.0;
             stats.upload_bytes += up;
         }
-        f = add(f, mul(gpu.command, commands as u64, "gpu.command")?, "gpu.command")?;
+        let (f, setup) = if gpu.state_change_stalls {
+            (Duration::ZERO, states)
+        } else {
+            (states, Duration::ZERO)
+        };
+        let f = add(f, mul(gpu.command, commands as u64, "gpu.command")?, "gpu.command")?;
         let m = &meshes[mesh as usize];
         stats.objects += 1;
         stats.triangles += m.triangles;

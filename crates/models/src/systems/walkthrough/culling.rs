@@ -269,6 +269,23 @@ impl Pvs {
         let key = ((eye[0] / cell).floor() as i64, (eye[1] / cell).floor() as i64);
         self.cells.entry(key).or_insert_with(|| compute(scene, cell, key, far))
     }
+
+    /// Culling on the object level: calls `f` with each object (by index)
+    /// that `view`, from `eye`, may draw: in the view cell's set when the
+    /// scene has view cells (every object otherwise), in ascending order,
+    /// whose bounding sphere meets the frustum.
+    pub fn for_each_visible(&mut self, scene: &Scene, eye: [f64; 3], view: &View, far: f64, mut f: impl FnMut(u32)) {
+        let mut one = |i: u32| {
+            let o = &scene.objects[i as usize];
+            if view.sees_sphere(o.center, o.radius) {
+                f(i);
+            }
+        };
+        match scene.view_cell {
+            Some(c) => self.set(scene, c, eye, far).iter().for_each(|&i| one(i)),
+            None => (0..scene.objects.len() as u32).for_each(one),
+        }
+    }
 }
 
 fn compute(scene: &Scene, cell: f64, key: (i64, i64), far: f64) -> Vec<u32> {

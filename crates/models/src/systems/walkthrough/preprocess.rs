@@ -239,19 +239,9 @@ impl CalibrationWalk {
             let pose = self.poses[rng.random_range(0..self.poses.len())];
             let view = View::new(&pose, &cfg.camera);
             self.visible.clear();
-            let seen = |i: u32| {
-                let o = &scene.objects[i as usize];
-                view.sees_sphere(o.center, o.radius)
-            };
-            match scene.view_cell {
-                Some(c) => {
-                    let set = self.pvs.set(scene, c, pose.eye, cfg.camera.far);
-                    self.visible.extend(set.iter().copied().filter(|&i| seen(i)));
-                }
-                None => self
-                    .visible
-                    .extend((0..scene.objects.len() as u32).filter(|&i| seen(i))),
-            }
+            let visible = &mut self.visible;
+            self.pvs
+                .for_each_visible(scene, pose.eye, &view, cfg.camera.far, |i| visible.push(i));
             if self.visible.is_empty() {
                 continue;
             }

@@ -193,6 +193,7 @@ impl Renderer {
                 fixed_per_pixel: self.fixed,
                 memory: Default::default(),
                 fetch_bytes_per_vertex: 0.0,
+                sorted_each_frame: false,
             });
             objects.push(Instance {
                 group: i as u32,
@@ -200,7 +201,6 @@ impl Renderer {
                 state: d.state,
                 matrix: true,
                 alpha: 0,
-                sorted: false,
                 upload: 0,
             });
         }

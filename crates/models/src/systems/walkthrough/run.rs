@@ -326,8 +326,6 @@ struct Walk<'a> {
     count: Counter,
     /// The frames' run seeds.
     seeds: StreamRng,
-    /// Every object (the candidates without view cells).
-    all: Vec<u32>,
     /// Per estimator: its estimate per frame (ms), its wall time (s) and
     /// its operations.
     est: Vec<Vec<f64>>,
@@ -391,7 +389,6 @@ impl<'a> Walk<'a> {
         let n_objects = m.scene.objects.len();
         Walk {
             seeds: frame_seeds(m.cfg.run.seed),
-            all: (0..n_objects as u32).collect(),
             est: vec![Vec::with_capacity(frames); ESTIMATORS.len()],
             wall: [0.0f64; ESTIMATORS.len()],
             ops: [0u64; ESTIMATORS.len()],
@@ -459,18 +456,13 @@ impl<'a> Walk<'a> {
     /// each visible object's projection.
     fn cull(&mut self, pose: &Pose, view: &View) {
         let scene = self.m.scene;
-        let candidates: &[u32] = match scene.view_cell {
-            Some(c) => self.pvs.set(scene, c, pose.eye, self.m.cfg.camera.far),
-            None => &self.all,
-        };
         self.visible.clear();
-        for &i in candidates {
-            let o = &scene.objects[i as usize];
-            if view.sees_sphere(o.center, o.radius) {
-                let p = project(view, o, &scene.protos[o.proto as usize]);
-                self.visible.push((i, p));
-            }
-        }
+        let visible = &mut self.visible;
+        self.pvs
+            .for_each_visible(scene, pose.eye, view, self.m.cfg.camera.far, |i| {
+                let o = &scene.objects[i as usize];
+                visible.push((i, project(view, o, &scene.protos[o.proto as usize])));
+            });
         if self.visible.iter().any(|(_, p)| p.inside) {
             self.inside_frames += 1;
         }
