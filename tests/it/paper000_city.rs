@@ -23,7 +23,7 @@ fn gpu_ms(sets: &[String]) -> f64 {
 fn table2_geometry_presorted(count: u64) -> f64 {
     gpu_ms(&[
         format!("workload.groups.0.count={count}"),
-        "gpu.geometry.vertex_shader=\"79640ps\"".into(),
+        "gpu.geometry.vertex_shader=\"79636ps\"".into(),
         "workload.state_order=\"sorted\"".into(),
     ])
 }
@@ -32,7 +32,7 @@ fn table2_geometry_presorted(count: u64) -> f64 {
 fn table3_fill(median: f64, order: &str) -> f64 {
     gpu_ms(&[
         format!("workload.groups.0.triangle_pixels.median={median}"),
-        "gpu.fragment.per_fragment=\"8124ps\"".into(),
+        "gpu.fragment.per_fragment=\"8123ps\"".into(),
         format!("workload.depth_order=\"{order}\""),
     ])
 }
@@ -76,11 +76,13 @@ fn the_city_viewpoint_is_calibrated_one_cell_per_figure() {
 }
 
 #[test]
-fn table_3_front_to_back_holds_and_back_to_front_overshoots() {
-    // The predictions of experiments/table3-depth-order.toml: front to back
-    // within 25% of the paper's -14.6% change; back to front +27.6%
-    // against +17.3% (the split pipeline is fragment-bound on every
-    // triangle once every fragment is shaded).
+fn table_3_front_to_back_falls_short_and_back_to_front_overshoots() {
+    // The predictions of experiments/table3-depth-order.toml, neither
+    // within 25% of the paper's change: front to back -10.5% against
+    // -14.6% (the device's state-change stall adds time no order changes;
+    // without it, -10.8%), back to front +26.4% against +17.3% (the split
+    // pipeline is fragment-bound on every triangle once every fragment is
+    // shaded).
     let median = shipped()["workload"]["groups"][0]["triangle_pixels"]["median"]
         .as_float()
         .unwrap();
@@ -88,7 +90,11 @@ fn table_3_front_to_back_holds_and_back_to_front_overshoots() {
     let f2b = table3_fill(median, "front_to_back") / normal - 1.0;
     let b2f = table3_fill(median, "back_to_front") / normal - 1.0;
     let paper = (9.143 / 10.7 - 1.0, 12.552 / 10.7 - 1.0);
-    assert!((f2b / paper.0 - 1.0).abs() < 0.25, "front to back {f2b}");
+    assert!(
+        (f2b / paper.0 - 1.0).abs() > 0.25,
+        "front to back {f2b} now within 25%: make it a check"
+    );
+    assert!((-0.11..-0.10).contains(&f2b), "front to back {f2b}");
     assert!(
         b2f / paper.1 - 1.0 > 0.25,
         "back to front {b2f} now within 25%: make it a check"
