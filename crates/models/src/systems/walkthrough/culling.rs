@@ -23,6 +23,7 @@ use std::collections::HashMap;
 
 use super::camera::Pose;
 use super::config::CameraConfig;
+use super::estimators::Features;
 use super::scene::{Layout, Object, Prototype, Scene};
 
 /// The camera's view: basis, focal length and frustum.
@@ -365,4 +366,15 @@ fn compute(scene: &Scene, cell: f64, key: (i64, i64), far: f64) -> Vec<u32> {
             o.block == u32::MAX || visible.get(o.block as usize).copied().unwrap_or(true)
         })
         .collect()
+}
+
+/// One object's features at `level` in projection `p`.
+pub(super) fn features(scene: &Scene, proto: u32, level: usize, p: &Projection) -> Features {
+    let l = scene.protos[proto as usize].levels[level];
+    Features {
+        triangles: l.triangles as f64,
+        transformed: l.transformed as f64,
+        vertices: l.vertices as f64,
+        pixels: p.disk_pixels,
+    }
 }

@@ -12,15 +12,15 @@ use crate::systems::error::{SystemError, invalid};
 
 use super::camera::Pose;
 use super::config::{FitViews, WalkthroughConfig};
-use super::culling::{Pvs, View, project, sample_projection};
+use super::culling::{Pvs, View, features, project, sample_projection};
 use super::estimators::{Constants, fit};
 use super::lod::Policy;
 use super::pos::{PosTable, build as build_table};
-use super::render::{Draw, Renderer};
-use super::run::{Counter, MAX_FRAMES, features};
+use super::render::{Counter, Draw, Renderer};
 use super::scene::Scene;
 use super::summary::PosTables;
 use super::timing::Clock;
+use super::validate::MAX_FRAMES;
 use super::view_cells::{PVC, VCS, ViewCellSummary, ViewCellTables};
 
 /// What the preprocess built, for the frames and the summary.

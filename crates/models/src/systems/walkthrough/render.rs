@@ -243,3 +243,32 @@ pub fn frame_seeds(seed: u64) -> StreamRng {
 pub fn next_seed(rng: &mut StreamRng) -> u64 {
     rng.random()
 }
+
+/// The simulator's events over every frame-pipeline run of a walkthrough
+/// (the preprocess's renders and the frames), by kind.
+#[derive(Debug, Default)]
+pub(super) struct Counter {
+    /// Events handled.
+    pub(super) events: u64,
+    /// Events by kind, indexed like `names`.
+    pub(super) by_kind: Vec<u64>,
+    /// The kinds' names.
+    pub(super) names: &'static [&'static str],
+    /// Pipeline runs.
+    pub(super) runs: u64,
+}
+
+impl Counter {
+    /// Adds one run's events.
+    pub(super) fn add(&mut self, events: u64, by_kind: &[u64], names: &'static [&'static str]) {
+        self.events += events;
+        if self.by_kind.len() < by_kind.len() {
+            self.by_kind.resize(by_kind.len(), 0);
+        }
+        for (a, b) in self.by_kind.iter_mut().zip(by_kind) {
+            *a += b;
+        }
+        self.names = names;
+        self.runs += 1;
+    }
+}

@@ -7,7 +7,9 @@ use crate::systems::error::{SystemError, invalid};
 
 use super::config::WalkthroughConfig;
 use super::estimators::ESTIMATORS;
-use super::run::MAX_FRAMES;
+
+/// Most frames and fit samples a run may ask for.
+pub const MAX_FRAMES: u64 = 10_000_000;
 
 /// Checks the keys serde cannot.
 pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
