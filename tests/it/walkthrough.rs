@@ -275,6 +275,45 @@ fn bad_keys_name_the_key() {
     assert!(e.contains("estimation.fit_views") && e.contains("keyframes"), "{e}");
     let e = err(CITY, &["estimation.fit_views=\"walk\"", "camera.speed=0.0"]);
     assert!(e.contains("estimation.fit_views") && e.contains("moving camera"), "{e}");
+    let e = err(CITY, &["camera.look_around=181"]);
+    assert!(e.contains("camera.look_around") && e.contains("180 degrees"), "{e}");
+    let e = err(CITY, &["camera.look_around=nan"]);
+    assert!(e.contains("camera.look_around"), "{e}");
+    let e = err(CITY, &["camera.look_period=\"0ms\""]);
+    assert!(e.contains("camera.look_period"), "{e}");
+}
+
+#[test]
+fn looking_around_moves_the_load_and_the_shipped_walk_is_25_degrees_every_5_s() {
+    // The shipped street walk is the default look-around, said out loud.
+    let explicit = [
+        SMALL_CITY.as_slice(),
+        &["camera.look_around=25.0", "camera.look_period=\"5s\""],
+    ]
+    .concat();
+    let csv = |sets: &[&str]| {
+        let mut out = Vec::new();
+        try_run_any(CITY, sets).unwrap().write_frames_csv(&mut out).unwrap();
+        out
+    };
+    assert_eq!(csv(&SMALL_CITY), csv(&explicit));
+    // Looking straight along the street against 60 degrees to either side:
+    // the view turns onto facades and down cross streets, fewer objects are
+    // drawn on average and the frame time varies several times as much.
+    let sd = |look: &str| {
+        let s = summary_of(CITY, &[SMALL_CITY.as_slice(), &[look]].concat());
+        (
+            num(&s, "metrics.frame_time_ms.std"),
+            num(&s, "metrics.visible_objects.mean"),
+        )
+    };
+    let (straight, seen_straight) = sd("camera.look_around=0.0");
+    let (around, seen_around) = sd("camera.look_around=60.0");
+    assert!(around > 3.0 * straight, "{around} ms against {straight} ms");
+    assert!(
+        seen_around < seen_straight,
+        "{seen_around} against {seen_straight} objects"
+    );
 }
 
 /// The heuristics' errors (h1-h4 mse, ms²) on the shipped walkthrough

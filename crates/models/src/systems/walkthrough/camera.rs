@@ -109,6 +109,15 @@ pub fn validate(cfg: &CameraConfig, scene: &Scene) -> Result<(), SystemError> {
             format!("must be a distance beyond camera.near ({}), got {}", cfg.near, cfg.far),
         ));
     }
+    if !(cfg.look_around.is_finite() && (0.0..=180.0).contains(&cfg.look_around)) {
+        return Err(invalid(
+            "camera.look_around",
+            format!("must be between 0 and 180 degrees, got {}", cfg.look_around),
+        ));
+    }
+    if cfg.look_period.0 == 0 {
+        return Err(invalid("camera.look_period", "must be longer than 0"));
+    }
     for (i, k) in cfg.keyframes.iter().enumerate() {
         if k.position.iter().chain([&k.yaw, &k.pitch]).any(|v| !v.is_finite()) {
             return Err(invalid(
@@ -133,7 +142,11 @@ pub fn path(cfg: &CameraConfig, scene: &Scene, frames: u64, dt: f64, seed: u64) 
     let mut rng = RngStreams::new(seed).stream("camera.path");
     Ok(match (kind, scene.layout) {
         ("street", Layout::City { blocks, block, street }) => {
-            street_walk(frames, step, dt, blocks, block + street, street, &mut rng)
+            let look = LookAround {
+                amplitude: cfg.look_around.to_radians(),
+                period: cfg.look_period.0 as f64 / 1e12,
+            };
+            street_walk(frames, step, dt, blocks, block + street, street, look, &mut rng)
         }
         ("forest", Layout::Forest { side }) => forest_walk(frames, step, side, &mut rng),
         ("flight", Layout::Terrain { side }) => (0..frames)
@@ -150,9 +163,22 @@ pub fn path(cfg: &CameraConfig, scene: &Scene, frames: u64, dt: f64, seed: u64) 
     })
 }
 
+/// A street walker's head turns: the heading swings `amplitude` radians to
+/// either side of the street's direction, sinusoidally, once every
+/// `period` seconds (`camera.look_around`, `camera.look_period`; 25° and
+/// 5 s unless given). Paper 000 §7.2 says only that a path was recorded;
+/// how far its walker looked around is not given, and it decides how much
+/// a frame's load changes along the walk (experiments/table6-look-around.toml).
+#[derive(Debug, Clone, Copy)]
+struct LookAround {
+    amplitude: f64,
+    period: f64,
+}
+
 /// Walks the street grid: from the crossing nearest the centre, along a
 /// street; at every crossing straight on (1/2), left or right (1/4 each),
-/// never leaving the city; looking around (±25° with a 5 s period).
+/// never leaving the city; looking around as `look` says.
+#[allow(clippy::too_many_arguments)]
 fn street_walk(
     frames: u64,
     step: f64,
@@ -160,6 +186,7 @@ fn street_walk(
     blocks: u32,
     pitch: f64,
     street: f64,
+    look: LookAround,
     rng: &mut crate::engine::StreamRng,
 ) -> Vec<Pose> {
     let n = blocks as i64;
@@ -198,7 +225,7 @@ fn street_walk(
                 iy as f64 * pitch + 0.5 * street + dy as f64 * s,
                 EYE_HEIGHT,
             ],
-            yaw: heading + 25f64.to_radians() * (std::f64::consts::TAU * t / 5.0).sin(),
+            yaw: heading + look.amplitude * (std::f64::consts::TAU * t / look.period).sin(),
             pitch: 3f64.to_radians(),
         });
         s += step;

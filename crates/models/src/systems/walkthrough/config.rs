@@ -204,6 +204,27 @@ pub struct CameraConfig {
     pub near: f64,
     /// Far plane, metres.
     pub far: f64,
+    /// A street walk's looking around: the heading swings this many
+    /// degrees to either side of the street's direction (0 to 180; 0
+    /// looks straight along the street).
+    #[serde(skip_serializing_if = "is_default_look_around")]
+    pub look_around: f64,
+    /// A street walk's looking around: the period of one swing to both
+    /// sides and back.
+    #[serde(skip_serializing_if = "is_default_look_period")]
+    pub look_period: Duration,
+}
+
+/// Default `camera.look_around` (degrees to either side).
+pub const DEFAULT_LOOK_AROUND: f64 = 25.0;
+/// Default `camera.look_period` (5 s).
+pub const DEFAULT_LOOK_PERIOD: Duration = Duration(5_000_000_000_000);
+
+fn is_default_look_around(v: &f64) -> bool {
+    *v == DEFAULT_LOOK_AROUND
+}
+fn is_default_look_period(d: &Duration) -> bool {
+    *d == DEFAULT_LOOK_PERIOD
 }
 
 impl Default for CameraConfig {
@@ -217,6 +238,8 @@ impl Default for CameraConfig {
             height: 768,
             near: 0.5,
             far: 1500.0,
+            look_around: DEFAULT_LOOK_AROUND,
+            look_period: DEFAULT_LOOK_PERIOD,
         }
     }
 }
