@@ -39,6 +39,7 @@ pub mod display_stats;
 pub mod refresh;
 pub mod report;
 pub mod results;
+mod setup;
 pub mod system;
 
 pub use refresh::{fit_phase, fit_refresh};
@@ -49,13 +50,13 @@ pub use results::{
 use std::path::Path;
 
 use self::display_stats::{DisplayStats, FrameTimes};
-use crate::capture::presentmon::{Capture, CaptureError, Present};
+use self::setup::{Setup, model_of, setup};
+use crate::capture::presentmon::{Capture, CaptureError};
 use crate::components::swap_chain::Composition;
-use crate::config::patch::set_dotted;
-use crate::config::{ModelSource, apply_patches, invalid};
+use crate::config::{ModelSource, invalid};
 use crate::systems::error::SystemError;
 use crate::systems::frame_pipeline::config::FramesWorkload;
-use crate::systems::frame_pipeline::records::{ChainInfo, FrameRecord, GeneratedRecord};
+use crate::systems::frame_pipeline::records::{FrameRecord, GeneratedRecord};
 use crate::systems::frame_pipeline::{FramePipelineConfig, run_pipeline};
 
 /// The replay's base model (the frame pipeline with no costs of its own).
@@ -109,212 +110,6 @@ impl ReplayOptions {
     }
 }
 
-/// The model's present mode, vsync and composition for a captured present.
-/// A hardware flip (`Hardware: Legacy Flip`, `Hardware: Independent Flip`,
-/// `Hardware Composed: Independent Flip`) is an independent flip; a
-/// `Composed: ...` present is shown by the compositor one refresh later.
-/// Sync interval 1 or more is `fifo`; 0 is `mailbox`, or `immediate` when
-/// the present allows tearing on a hardware flip (the compositor never
-/// tears); a composed present without a sync interval (-1, PresentMon's
-/// value for a blit) is `fifo`.
-fn model_mode(p: &Present, file: &str) -> Result<(&'static str, bool, bool), CaptureError> {
-    let mode = p.present_mode.as_str();
-    let composed = mode.starts_with("Composed");
-    if !composed && !mode.starts_with("Hardware") {
-        return Err(CaptureError::Row {
-            file: file.to_string(),
-            line: p.line,
-            message: format!(
-                "unknown present mode `{mode}` (replayed: `Hardware: Legacy Flip`, `Hardware: Independent Flip`, \
-                 `Hardware Composed: Independent Flip`, `Composed: Flip`, `Composed: Copy with GPU GDI`, \
-                 `Composed: Copy with CPU GDI`)"
-            ),
-        });
-    }
-    let sync = p.sync_interval.unwrap_or(1);
-    Ok(match (sync, p.allows_tearing, composed) {
-        (s, _, true) if s != 0 => ("fifo", true, true),
-        (_, _, true) => ("mailbox", true, true),
-        (s, _, false) if s >= 1 => ("fifo", true, false),
-        (_, true, false) => ("immediate", false, false),
-        (_, false, false) => ("mailbox", true, false),
-    })
-}
-
-/// Milliseconds as whole picoseconds (the capture's decimals, exactly where
-/// it has no more than nine).
-fn to_ps(ms: f64) -> i64 {
-    (ms * 1e9).round() as i64
-}
-
-fn ps(ms: f64) -> toml::Value {
-    toml::Value::String(format!("{}ps", to_ps(ms.max(0.0))))
-}
-
-/// The capture's swap chain made ready to simulate: the base model with the
-/// captured frames, refresh and present mode and the assumptions, before
-/// any what-if.
-struct Setup<'a> {
-    rows: Vec<&'a Present>,
-    /// The present mode most frames use, and the model's for it.
-    common: &'a Present,
-    mode: &'static str,
-    /// Whether the compositor shows its frames (a `Composed: ...` mode).
-    composed: bool,
-    /// The refresh period of the replay as captured, ms, and where it comes from.
-    period: f64,
-    refresh_from: RefreshFrom,
-    /// The capture's time of the model's time zero, ps.
-    origin_ps: i64,
-    /// The capture's swap chain, for the replayed frames.
-    chain: ChainInfo,
-    /// What errors call the what-if's patches.
-    whatif_option: &'static str,
-    src: ModelSource,
-    table: toml::Table,
-}
-
-impl Setup<'_> {
-    /// The capture's time of the model's time zero, ms.
-    fn origin(&self) -> f64 {
-        self.origin_ps as f64 / 1e9
-    }
-}
-
-/// Whether the assumptions (`--assume K=V` patches) set `key`.
-fn assumes(assume: &[String], key: &str) -> bool {
-    assume
-        .iter()
-        .any(|a| a.split_once('=').is_some_and(|(k, _)| k.trim() == key))
-}
-
-fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Setup<'a>, ReplayError> {
-    let (chain, rows) = capture.select(opts.app.as_deref(), opts.swap_chain.as_deref())?;
-    let file = capture.file.as_str();
-    // The mode most of its frames use (a swap chain may switch, e.g. from
-    // a composed to an independent flip after its first frame).
-    let common = rows
-        .iter()
-        .find(|p| p.present_mode == chain.present_mode)
-        .copied()
-        .unwrap_or(rows[0]);
-    let (mode, vsync, composed) = model_mode(common, file)?;
-
-    // The base model with the assumptions (they may give the refresh).
-    let mut src = ModelSource::from_text("the replay model (models/replay.toml)", REPLAY_MODEL);
-    let mut table = src.table()?;
-    apply_patches(opts.option_names().1, &opts.assume, &mut src, &mut table).map_err(ReplayError::Assume)?;
-    let assumed_cfg = FramePipelineConfig::from_table(&table, &src).map_err(ReplayError::Assume)?;
-    let model_period = assumed_cfg.display.refresh.period.as_ms_f64();
-    // A capture taken with frame generation (assumed) measured the
-    // interpolation in each frame's GPU busy time; the model adds it again.
-    let generation_ms = |i: usize| assumed_cfg.frame_generation.cost_before_present(i as u64).as_ms_f64();
-    let given_period = assumes(&opts.assume, "display.refresh").then_some(model_period);
-
-    let screen: Vec<f64> = rows.iter().filter_map(|p| p.screen_time()).collect();
-    let (period, phase, refresh_from) = match (mode, given_period) {
-        // Tearing: screen times follow the GPU, not a refresh grid.
-        ("immediate", Some(p)) => (p, None, RefreshFrom::Assumed),
-        ("immediate", None) => (model_period, None, RefreshFrom::Default),
-        (_, Some(p)) => (p, Some(fit_phase(&screen, p)), RefreshFrom::Assumed),
-        (_, None) => {
-            let (p, ph) = fit_refresh(&screen).ok_or_else(|| CaptureError::Row {
-                file: file.to_string(),
-                line: rows[0].line,
-                message: "the refresh period cannot be inferred: no two displayed frames are more than 1 ms \
-                          apart (give it: --assume display.refresh=...)"
-                    .into(),
-            })?;
-            (p, Some(ph), RefreshFrom::Fitted)
-        }
-    };
-    // The run starts at a vertical blank at or before the first CPU start
-    // (in whole picoseconds, so a capture written by rendersim lands
-    // exactly on its own grid); with tearing, at the first CPU start.
-    let period_ps = to_ps(period).max(1);
-    let c0_ps = to_ps(rows[0].cpu_start);
-    let origin_ps = match phase {
-        Some(phase) => {
-            let phase_ps = to_ps(phase);
-            phase_ps + (c0_ps - phase_ps).div_euclid(period_ps) * period_ps
-        }
-        None => c0_ps,
-    };
-    let lead_ps = toml::Value::String(format!("{}ps", c0_ps - origin_ps));
-
-    let list = |f: &dyn Fn(usize, &Present) -> f64| {
-        toml::Value::Array(rows.iter().enumerate().map(|(i, p)| ps(f(i, p))).collect())
-    };
-    let mut sets: Vec<(&str, toml::Value)> = vec![
-        ("run.frames", toml::Value::Integer(rows.len() as i64)),
-        ("workload.start", lead_ps),
-        ("workload.cpu", list(&|_, p| p.cpu_busy)),
-        (
-            "workload.submit",
-            list(&|_, p| p.gpu_latency.unwrap_or(p.cpu_busy).clamp(0.0, p.cpu_busy)),
-        ),
-        (
-            "workload.gpu",
-            list(&|i, p| (p.gpu_busy.or(p.render_complete).unwrap_or(0.0) - generation_ms(i)).max(0.0)),
-        ),
-        ("workload.present", list(&|_, p| p.cpu_wait)),
-    ];
-    if rows.iter().any(|p| p.gpu_latency.is_some() && p.gpu_time.is_some()) {
-        // The frame's GPU end after its CPU start, where the capture has it
-        // (0: no floor).
-        sets.push((
-            "workload.gpu_end",
-            list(&|_, p| match (p.gpu_latency, p.gpu_time) {
-                (Some(l), Some(t)) => l.max(0.0) + t,
-                _ => 0.0,
-            }),
-        ));
-    }
-    // What the capture says of its display, unless assumed otherwise.
-    let display: [(&str, toml::Value); 4] = [
-        ("display.refresh", toml::Value::String(format!("{period_ps}ps"))),
-        ("display.present_mode", toml::Value::String(mode.into())),
-        ("display.vsync", toml::Value::Boolean(vsync)),
-        (
-            "display.composition",
-            toml::Value::String(if composed { "composed" } else { "independent" }.into()),
-        ),
-    ];
-    for (key, value) in display {
-        if !assumes(&opts.assume, key) {
-            sets.push((key, value));
-        }
-    }
-    for (key, value) in sets {
-        set_dotted(&mut table, key, value).map_err(|e| CaptureError::Format {
-            file: file.to_string(),
-            message: format!("building the replay model: {}", e.reason),
-        })?;
-    }
-    let chain = ChainInfo {
-        application: common.application.clone(),
-        process_id: common.process_id.clone(),
-        swap_chain: common.swap_chain.clone(),
-        runtime: "Other".into(),
-        sync_interval: common.sync_interval.unwrap_or(1),
-        allows_tearing: common.allows_tearing,
-        present_mode: common.present_mode.clone(),
-    };
-    Ok(Setup {
-        rows,
-        common,
-        mode,
-        composed,
-        period,
-        refresh_from,
-        origin_ps,
-        chain,
-        whatif_option: opts.option_names().0,
-        src,
-        table,
-    })
-}
-
 /// One simulation of the set-up frames with `sets` patched on.
 struct Simulated {
     /// The frames, measured and predicted.
@@ -354,13 +149,6 @@ impl Simulated {
         st.torn_per_second = self.torn_per_second;
         st
     }
-}
-
-/// The frame-pipeline model of the set-up frames with `sets` patched on.
-fn model_of(s: &Setup, sets: &[String]) -> Result<(ModelSource, toml::Table), ReplayError> {
-    let (mut src, mut table) = (s.src.clone(), s.table.clone());
-    apply_patches(s.whatif_option, sets, &mut src, &mut table)?;
-    Ok((src, table))
 }
 
 /// The frame-pipeline model a replay of the capture at `path` runs (as
