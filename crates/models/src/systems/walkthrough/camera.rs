@@ -313,3 +313,55 @@ fn keyframe_path(cfg: &CameraConfig, frames: u64, step: f64) -> Vec<Pose> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::Duration;
+    use crate::systems::walkthrough::config::SceneConfig;
+    use crate::systems::walkthrough::scene::build_scene;
+    use proptest::prelude::*;
+
+    /// The smallest angle (radians) between `yaw` and a street's direction
+    /// (a multiple of 90 degrees).
+    fn off_street(yaw: f64) -> f64 {
+        let q = std::f64::consts::FRAC_PI_2;
+        let r = yaw.rem_euclid(q);
+        r.min(q - r)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+        /// A street walk's heading never leaves the street's direction by
+        /// more than the look-around (below 45 degrees, where the nearest
+        /// street direction is the walked one), and reaches it within a
+        /// frame's step of the swing when the walk lasts a whole period.
+        #[test]
+        fn the_heading_stays_within_the_look_around(
+            amplitude in 0.0f64..44.0,
+            period_ms in 100u64..3000,
+            seed in 0u64..1000,
+        ) {
+            let scene = build_scene(
+                &SceneConfig { preset: Some("city".into()), scale: 0.01, ..SceneConfig::default() },
+                seed,
+            )
+            .unwrap();
+            let cfg = CameraConfig {
+                look_around: amplitude,
+                look_period: Duration(period_ms * 1_000_000_000),
+                ..CameraConfig::default()
+            };
+            let dt = 1.0 / 60.0;
+            let frames = (period_ms as f64 / 1e3 / dt).ceil() as u64 + 1;
+            let poses = path(&cfg, &scene, frames, dt, seed).unwrap();
+            let a = amplitude.to_radians();
+            let widest = poses.iter().map(|p| off_street(p.yaw)).fold(0.0f64, f64::max);
+            prop_assert!(widest <= a + 1e-9, "{widest} against {a}");
+            // One frame moves the swing by at most 2 pi dt / period of its
+            // amplitude: the widest frame is that close to the amplitude.
+            let step = a * std::f64::consts::TAU * dt / (period_ms as f64 / 1e3);
+            prop_assert!(widest >= a - step - 1e-9, "{widest} against {a} (step {step})");
+        }
+    }
+}
