@@ -42,6 +42,17 @@ fn value(experiment: &str, at: &[(&str, &str)], column: &str) -> f64 {
         .unwrap_or_else(|_| panic!("{experiment} {column}: {}", row[column]))
 }
 
+/// Table 6's five average squared errors (h1, h2, h3, h4, pos) of
+/// `experiment` at the point `at`, each written by `show`, joined as the
+/// README joins them.
+fn five_mse(experiment: &str, at: &[(&str, &str)], show: impl Fn(f64) -> String) -> String {
+    ["h1", "h2", "h3", "h4", "pos"]
+        .iter()
+        .map(|h| show(value(experiment, at, &format!("metrics.estimation.{h}.mse_ms2:mean"))))
+        .collect::<Vec<_>>()
+        .join(" / ")
+}
+
 /// The README's table row that starts with `| {result}`.
 fn row<'a>(readme: &'a str, result: &str) -> &'a str {
     readme
@@ -138,35 +149,21 @@ fn the_readme_states_what_the_experiments_give() {
             "Table 6, forest, fitted on objects as a walk draws them",
         ),
     ] {
-        let mse: Vec<String> = ["h1", "h2", "h3", "h4", "pos"]
-            .iter()
-            .map(|h| {
-                let v = value(
-                    "table6",
-                    &[("scene.preset", scene), ("estimation.fit_views", views)],
-                    &format!("metrics.estimation.{h}.mse_ms2:mean"),
-                );
-                // Two decimals below 10, one above, as the README writes them.
-                if v < 10.0 { format!("{v:.2}") } else { format!("{v:.1}") }
-            })
-            .collect();
-        expect(row, mse.join(" / "));
+        let at = [("scene.preset", scene), ("estimation.fit_views", views)];
+        // Two decimals below 10, one above, as the README writes them.
+        let mse = five_mse("table6", &at, |v| {
+            if v < 10.0 { format!("{v:.2}") } else { format!("{v:.1}") }
+        });
+        expect(row, mse);
     }
     // The look-around what-if: the city on the GeForce3, the walker 60
-    // degrees around, fits on a walk's objects.
-    let mse: Vec<String> = ["h1", "h2", "h3", "h4", "pos"]
-        .iter()
-        .map(|h| {
-            let v = value(
-                "table6-look-around",
-                &[("camera.look_around", "60"), ("estimation.fit_views", "walk")],
-                &format!("metrics.estimation.{h}.mse_ms2:mean"),
-            );
-            // Two decimals from 0.1, three below, as the README writes them.
-            if v < 0.1 { format!("{v:.3}") } else { format!("{v:.2}") }
-        })
-        .collect();
-    expect("Table 6, city on the GeForce3, the walker looking 60", mse.join(" / "));
+    // degrees around, fits on a walk's objects. Two decimals from 0.1, three
+    // below, as the README writes them.
+    let at = [("camera.look_around", "60"), ("estimation.fit_views", "walk")];
+    let mse = five_mse("table6-look-around", &at, |v| {
+        if v < 0.1 { format!("{v:.3}") } else { format!("{v:.2}") }
+    });
+    expect("Table 6, city on the GeForce3, the walker looking 60", mse);
     let cells = |timing: &str, column: &str| {
         value(
             "view-cells",
