@@ -6,6 +6,16 @@ use rendersim::systems::frame_pipeline::PipelineRun;
 use rendersim::systems::{SystemRun, run_model};
 use serde_json::Value;
 
+/// A shipped TOML file (a model, a hardware file, an experiment) as a
+/// table, by its path from the repository root.
+pub fn shipped_table(rel: &str) -> toml::Table {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+    std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .parse()
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
 /// Runs a model of any system given as TOML text with `--set` patches (the
 /// command line's way, [`rendersim::config::prepare`]).
 pub fn try_run_any(text: &str, sets: &[&str]) -> Result<SystemRun, String> {

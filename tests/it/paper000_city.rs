@@ -7,7 +7,7 @@
 use rendersim::config::{ModelSource, Overrides, prepare};
 use rendersim::systems::run_model;
 
-use crate::common::num;
+use crate::common::{num, shipped_table};
 
 const MODEL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/models/city-geforce3.toml");
 
@@ -37,13 +37,9 @@ fn table3_fill(median: f64, order: &str) -> f64 {
     ])
 }
 
-fn shipped() -> toml::Table {
-    std::fs::read_to_string(MODEL).unwrap().parse().unwrap()
-}
-
 #[test]
 fn the_city_viewpoint_is_calibrated_one_cell_per_figure() {
-    let group = &shipped()["workload"]["groups"][0];
+    let group = &shipped_table("models/city-geforce3.toml")["workload"]["groups"][0];
     let count = group["count"].as_integer().unwrap() as u64;
     let median = group["triangle_pixels"]["median"].as_float().unwrap();
     // The building count: the closest to Table 2's 14.138 ms (the time
@@ -83,7 +79,7 @@ fn table_3_front_to_back_falls_short_and_back_to_front_overshoots() {
     // without it, -10.8%), back to front +26.4% against +17.3% (the split
     // pipeline is fragment-bound on every triangle once every fragment is
     // shaded).
-    let median = shipped()["workload"]["groups"][0]["triangle_pixels"]["median"]
+    let median = shipped_table("models/city-geforce3.toml")["workload"]["groups"][0]["triangle_pixels"]["median"]
         .as_float()
         .unwrap();
     let normal = table3_fill(median, "random");

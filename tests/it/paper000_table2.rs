@@ -9,10 +9,9 @@
 use rendersim::config::{ModelSource, Overrides, prepare};
 use rendersim::systems::run_model;
 
-use crate::common::num;
+use crate::common::{num, shipped_table};
 
 const MODEL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/models/city-table2-geforce3.toml");
-const HARDWARE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/models/hardware/geforce3.toml");
 
 /// The four sort orders: the table's counts, and the matrix changes of
 /// the reading (docs/models.md).
@@ -64,16 +63,6 @@ fn cpu_costs(per_draw: f64, change: f64, sort: f64) -> Vec<String> {
     v
 }
 
-/// The view's shipped file.
-fn shipped() -> toml::Table {
-    std::fs::read_to_string(MODEL).unwrap().parse().unwrap()
-}
-
-/// The device's shipped file (the costs calibrated here).
-fn device() -> toml::Table {
-    std::fs::read_to_string(HARDWARE).unwrap().parse().unwrap()
-}
-
 fn ps_of(v: &toml::Value) -> f64 {
     v.as_str().unwrap().trim_end_matches("ps").parse().unwrap()
 }
@@ -93,10 +82,10 @@ fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, target: f64) -> f64 
 
 #[test]
 fn the_table_2_view_is_calibrated_one_cell_per_cost() {
-    let triangles = shipped()["workload"]["groups"][0]["mesh"]["triangles"]
+    let triangles = shipped_table("models/city-table2-geforce3.toml")["workload"]["groups"][0]["mesh"]["triangles"]
         .as_integer()
         .unwrap();
-    let t = device();
+    let t = shipped_table("models/hardware/geforce3.toml");
     assert_eq!(
         t["cpu"]["per_object"].as_str(),
         Some("0ns"),
@@ -184,7 +173,7 @@ fn without_the_stall_state_changes_hide_behind_the_geometry_stage() {
     assert!(times.iter().all(|t| (t / times[0] - 1.0).abs() < 1e-6), "{times:?}");
     // With the stall, the unsorted order pays its 1476 more texture,
     // material and alpha changes than the presorted one, one at a time.
-    let g = ps_of(&device()["gpu"]["state_change"]["texture"]) * 1e-9;
+    let g = ps_of(&shipped_table("models/hardware/geforce3.toml")["gpu"]["state_change"]["texture"]) * 1e-9;
     let extra = frame_ms(NONE, GEOMETRY, &[]) - frame_ms(PRESORTED, GEOMETRY, &[]);
     assert!(
         (extra / (1476.0 * g) - 1.0).abs() < 0.02,

@@ -8,7 +8,7 @@
 //! with the preset's spread and a ratio under 0.5; the paper's ratio needs
 //! sizes spread far wider.
 
-use crate::common::{metric, run};
+use crate::common::{metric, run, shipped_table};
 use rendersim::scene::config::SizeOrder;
 use rendersim::studies::table1::{
     Calibration, CalibrationError, CellModel, Cells, PAPER, SplitTerrain, TERRAIN, terrain_variant,
@@ -217,11 +217,6 @@ fn unreachable_targets_are_errors_naming_the_cell() {
 }
 
 /// The shipped file at `rel` (from the repository root) as a table.
-fn shipped_table(rel: &str) -> toml::Table {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
-    std::fs::read_to_string(&path).unwrap().parse().unwrap()
-}
-
 #[test]
 fn the_geforce3_costs_are_table_1s_calibration() {
     // The simple vertex shader from Table 4 Test 1 (19.73 M transformed
