@@ -14,6 +14,7 @@ use super::ExperimentError;
 use super::sweep::Sweep;
 
 mod outputs;
+mod plots;
 mod raw;
 mod validate;
 
