@@ -142,11 +142,9 @@ pub fn path(cfg: &CameraConfig, scene: &Scene, frames: u64, dt: f64, seed: u64) 
     let mut rng = RngStreams::new(seed).stream("camera.path");
     Ok(match (kind, scene.layout) {
         ("street", Layout::City { blocks, block, street }) => {
-            let look = LookAround {
-                amplitude: cfg.look_around.to_radians(),
-                period: cfg.look_period.0 as f64 / 1e12,
-            };
-            street_walk(frames, step, dt, blocks, block + street, street, look, &mut rng)
+            let mut poses = street_walk(frames, step, blocks, block + street, street, &mut rng);
+            look_around(&mut poses, cfg, dt);
+            poses
         }
         ("forest", Layout::Forest { side }) => forest_walk(frames, step, side, &mut rng),
         ("flight", Layout::Terrain { side }) => (0..frames)
@@ -163,30 +161,32 @@ pub fn path(cfg: &CameraConfig, scene: &Scene, frames: u64, dt: f64, seed: u64) 
     })
 }
 
-/// A street walker's head turns: the heading swings `amplitude` radians to
-/// either side of the street's direction, sinusoidally, once every
-/// `period` seconds (`camera.look_around`, `camera.look_period`; 25° and
-/// 5 s unless given). Paper 000 §7.2 says only that a path was recorded;
-/// how far its walker looked around is not given, and it decides how much
-/// a frame's load changes along the walk (experiments/table6-look-around.toml).
-#[derive(Debug, Clone, Copy)]
-struct LookAround {
-    amplitude: f64,
-    period: f64,
+/// A street walker's head turns, on poses `dt` seconds apart that look along
+/// the street: the heading swings `camera.look_around` degrees to either
+/// side, sinusoidally, once every `camera.look_period` (25° and 5 s unless
+/// given). Paper 000 §7.2 says only that a path was recorded; how far its
+/// walker looked around is not given, and it decides how much a frame's
+/// load changes along the walk (experiments/table6-look-around.toml).
+fn look_around(poses: &mut [Pose], cfg: &CameraConfig, dt: f64) {
+    let amplitude = cfg.look_around.to_radians();
+    // Whole picoseconds over 1e12: exact for whole seconds.
+    let period = cfg.look_period.0 as f64 / 1e12;
+    for (f, p) in poses.iter_mut().enumerate() {
+        let t = f as f64 * dt;
+        p.yaw += amplitude * (std::f64::consts::TAU * t / period).sin();
+    }
 }
 
 /// Walks the street grid: from the crossing nearest the centre, along a
 /// street; at every crossing straight on (1/2), left or right (1/4 each),
-/// never leaving the city; looking around as `look` says.
-#[allow(clippy::too_many_arguments)]
+/// never leaving the city; looking along the street ([`look_around`]
+/// turns the head).
 fn street_walk(
     frames: u64,
     step: f64,
-    dt: f64,
     blocks: u32,
     pitch: f64,
     street: f64,
-    look: LookAround,
     rng: &mut crate::engine::StreamRng,
 ) -> Vec<Pose> {
     let n = blocks as i64;
@@ -215,17 +215,16 @@ fn street_walk(
     }
     let mut s = 0.0;
     let mut out = Vec::with_capacity(frames as usize);
-    for f in 0..frames {
+    for _ in 0..frames {
         let (dx, dy) = dirs[d];
         let heading = (dy as f64).atan2(dx as f64);
-        let t = f as f64 * dt;
         out.push(Pose {
             eye: [
                 ix as f64 * pitch + 0.5 * street + dx as f64 * s,
                 iy as f64 * pitch + 0.5 * street + dy as f64 * s,
                 EYE_HEIGHT,
             ],
-            yaw: heading + look.amplitude * (std::f64::consts::TAU * t / look.period).sin(),
+            yaw: heading,
             pitch: 3f64.to_radians(),
         });
         s += step;
