@@ -17,6 +17,8 @@
 #   studies-passes.csv                    every pass the studies measured (pass CSV format)
 #   estimation.md estimation.json         `rendersim study estimation` (h1-h4 and pos fitted on measured
 #   estimation-passes.csv estimation.err  single-object passes, scored on multi-object passes; one CSV row per object)
+#   profile.md profile-passes.csv         `rendersim study profile`: 135 designed passes for `calibrate`
+#   profile.err                           (short, no-draw and many-draw passes among them), rounds interleaved
 #   load-grid.csv                         the passes of docs/measurements/nvidia-h200/load-grid.csv
 #   fixed-costs.csv                       passes of no draw (3 sizes), and grid:32x32 and grid:256x256 at
 #                                         128x128 in 1, 4, 16, 64, 256 and 4096 draws (a profile's
@@ -75,6 +77,7 @@ collect() {
   local passes=(--repeats 5 --warmup 2) heavy_passes=(--repeats 3 --warmup 1)
   local study=all corpus_files
   local est_args=(--load-scale "${EST_LOAD_SCALE:-10}" --repeats 5)
+  local profile_args=(--repeats 9)
   corpus_files=$(ls "$corpus"/*.idx 2>/dev/null || true)
   if [ -n "$quick" ]; then
     grid_mesh=grid:16x16:optimized grid_size=64x64
@@ -87,6 +90,7 @@ collect() {
     passes=(--repeats 1 --warmup 0) heavy_passes=(--repeats 1 --warmup 0)
     study=h1
     est_args=(--load-scale "${EST_LOAD_SCALE:-1}" --single 100 --multi 30 --repeats 1)
+    profile_args=(--repeats 1)
     corpus_files=$(printf '%s\n' $corpus_files | head -n 4)
   fi
 
@@ -189,6 +193,19 @@ collect() {
       "$est_rc" "$((SECONDS - t0))" >> "$dir/commands.txt"
   fi
 
+  # 2c. The profile study: designed passes for `calibrate` in one process,
+  # rounds interleaved (short passes, no-draw and many-draw passes among them).
+  local profile_rc=0
+  if [ -n "$dry" ]; then
+    echo "$bin study profile ${profile_args[*]} --markdown $dir/profile.md --csv $dir/profile-passes.csv > /dev/null 2> $dir/profile.err"
+  else
+    local t0=$SECONDS
+    limit 120 "$bin" study profile "${profile_args[@]}" --markdown "$dir/profile.md" \
+      --csv "$dir/profile-passes.csv" > /dev/null 2> "$dir/profile.err" || profile_rc=$?
+    printf '%s\t# exit %s, %s s\n' "$bin study profile ${profile_args[*]} --markdown profile.md --csv profile-passes.csv" \
+      "$profile_rc" "$((SECONDS - t0))" >> "$dir/commands.txt"
+  fi
+
   # 3. The load grid, in the shared file's order.
   local vs fs mesh size
   for vs in "${grid_vs[@]}"; do
@@ -284,6 +301,7 @@ queries around the render pass, medians of the recorded passes.
 | \`studies-passes.csv\` | $(rows studies-passes.csv) passes the studies measured, loop searches included (pass CSV: \`$(head -n 1 "$dir/studies-passes.csv" 2>/dev/null)\`); H1's probes and H3's layered passes have no row | as above |
 | \`estimation.md\`, \`estimation.json\`, \`estimation.err\` | \`rendersim study estimation\` (exit status $est_rc): h1-h4 fitted on measured single-object passes, pos tables from table passes, both scored on multi-object passes | \`rendersim study estimation $est_args --markdown estimation.md --json --csv estimation-passes.csv\` |
 | \`estimation-passes.csv\` | $(rows estimation-passes.csv) rows: one per object drawn (one per empty pass) with the pass's time and counters and each estimator's estimate | as above |
+| \`profile.md\`, \`profile-passes.csv\`, \`profile.err\` | \`rendersim study profile\` (exit status $profile_rc): $(rows profile-passes.csv) designed passes for \`calibrate\` (6 meshes x 64x64, 128x128, 256x256 x 7 loads, and passes of 0, 16 and 256 draws), one process, rounds interleaved, the median kept | \`rendersim study profile ${profile_args[*]} --markdown profile.md --csv profile-passes.csv\` |
 | \`load-grid.csv\` | $(rows load-grid.csv) passes: the lists of \`docs/measurements/nvidia-h200/load-grid.csv\` | \`rendersim measure MESH --size S --vs-loops V --fs-loops F [--geometry-only] $passes --csv load-grid.csv\` |
 | \`load-sweep.csv\` | $(rows load-sweep.csv) passes: every mesh, size and load of \`docs/measurements/nvidia-h200/load-sweep.csv\`'s lists, held-out rows included; the capped ones are in \`skipped.txt\` | as above (the random mesh: \`$heavy\`), \`--csv load-sweep.csv\` |
 | \`fixed-costs.csv\` | $(rows fixed-costs.csv) passes: no draw at each size, and each mesh at the first size in more and more draw calls (a profile's \`pass_overhead_ns\` and \`draw_ns\`: calibrate it with the load files) | \`rendersim measure MESH --size S --draws N $passes --csv fixed-costs.csv\` |

@@ -95,7 +95,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {}", rendersim::error_line(e.as_ref()));
-            ExitCode::from(if e.is::<ChecksFailed>() {
+            ExitCode::from(if e.is::<ChecksFailed>() || e.is::<cli::device::HoldoutFailed>() {
                 EXIT_CHECKS_FAILED
             } else {
                 EXIT_ERROR

@@ -318,6 +318,55 @@ fn calibrate_and_predict_through_the_command_line() {
 }
 
 #[test]
+fn the_held_out_half_fails_the_command_past_either_bound_and_keeps_the_profile() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("p.toml");
+    let run = |bounds: &[&str]| {
+        bin()
+            .arg("calibrate")
+            .arg(h200("load-grid.csv"))
+            .arg(h200("load-sweep.csv"))
+            .args(["--holdout", "--out"])
+            .arg(&out)
+            .args(bounds)
+            .output()
+            .unwrap()
+    };
+    // Generous bounds pass.
+    let o = run(&["--holdout-max-median", "1000", "--holdout-max-p90", "1000"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::remove_file(&out).unwrap();
+    // A p90 bound of 0.001% fails alone, naming only itself.
+    let o = run(&["--holdout-max-median", "1000", "--holdout-max-p90", "0.001"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("held-out half: 90th percentile |error|") && err.contains("exceeds --holdout-max-p90 0.001%"),
+        "{err}"
+    );
+    assert!(!err.contains("--holdout-max-median"), "{err}");
+    assert!(out.exists(), "the profile is still written");
+    // Both bounds exceeded: both named.
+    let o = run(&["--holdout-max-median", "0.001", "--holdout-max-p90", "0.001"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("median |error|") && err.contains("exceeds --holdout-max-median 0.001%; 90th percentile"),
+        "{err}"
+    );
+    // The bounds need --holdout.
+    let o = bin()
+        .arg("calibrate")
+        .arg(h200("load-grid.csv"))
+        .args(["--holdout-max-p90", "30", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--holdout"));
+}
+
+#[test]
 fn k_fold_by_mesh_needs_two_meshes_and_a_sensible_k() {
     let d = tempfile::tempdir().unwrap();
     let one_mesh = d.path().join("one.csv");

@@ -474,3 +474,44 @@ fn no_stray_loader_errors_without_a_runtime_folder() {
     assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
     assert!(!err.lines().any(|l| l.starts_with("error:")), "{err}");
 }
+
+#[test]
+fn interleaved_rounds_keep_every_round_and_pool_one_row_per_pass() {
+    use rendersim::measure::Gpu;
+    let gpu = match Gpu::open() {
+        Ok(g) => g,
+        Err(MeasureError::NoAdapter(e)) => {
+            eprintln!("SKIPPED: no Vulkan adapter on this machine ({e})");
+            return;
+        }
+        Err(e) => panic!("{e}"),
+    };
+    let a = mesh_from_spec("grid:8x8", Path::new(".")).unwrap();
+    let b = mesh_from_spec("strip:8x8", Path::new(".")).unwrap();
+    let opts = |geometry_only| MeasureOptions {
+        size: (64, 64),
+        warmup: 1,
+        repeats: 99, // ignored: the rounds argument counts
+        geometry_only,
+        ..Default::default()
+    };
+    let conds = [
+        ("grid:8x8", &a, opts(false)),
+        ("strip:8x8", &b, opts(false)),
+        ("grid:8x8", &a, opts(true)),
+    ];
+    let r = gpu.measure_interleaved(&conds, 4).unwrap();
+    assert_eq!(r.len(), 3);
+    for m in &r {
+        assert_eq!(m.pass_times_ns.len(), 4, "{m:?}");
+        assert!(m.stable_counters, "{m:?}");
+        let mut t = m.pass_times_ns.clone();
+        t.sort_by(f64::total_cmp);
+        assert_eq!(m.pass_time_ns, t[2], "the (upper) median of the rounds");
+    }
+    assert_eq!(r[0].clipper_invocations, 2 * 8 * 8);
+    assert_eq!(r[2].fs_invocations, 0, "geometry only shades nothing");
+    // One pass-CSV row per condition, each with its four rounds pooled.
+    let rows = gpu.measured_passes().rows;
+    assert_eq!(rows.len(), 3);
+}

@@ -99,6 +99,7 @@ const CASES: &[Case] = &[
     ("rendersim measure", None),
     ("rendersim study all", None),
     ("rendersim study estimation", None),
+    ("rendersim study profile", None),
     (
         "rendersim calibrate",
         Some(&[

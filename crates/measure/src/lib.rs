@@ -68,6 +68,8 @@ mod geometry;
 #[cfg(feature = "wgpu")]
 pub mod h1;
 #[cfg(feature = "wgpu")]
+pub mod profile_passes;
+#[cfg(feature = "wgpu")]
 pub mod studies;
 
 #[cfg(feature = "wgpu")]

@@ -10,7 +10,6 @@ use crate::scene::generators::mesh_from_spec;
 use crate::scene::mesh::Mesh;
 
 use super::device::{Gpu, MeasureError, MeasureOptions, Measurement};
-use super::fit::median;
 use super::geometry::DepthOrder;
 use super::h1;
 use super::h2::{self, H2, H2Measured, H2Setup};
@@ -34,7 +33,8 @@ pub enum StudyError {
     Mesh(String),
 }
 
-fn mesh(spec: &str) -> Result<Mesh, StudyError> {
+/// A study's mesh from its spec.
+pub(crate) fn study_mesh(spec: &str) -> Result<Mesh, StudyError> {
     mesh_from_spec(spec, Path::new(".")).map_err(|e| StudyError::Mesh(e.to_string()))
 }
 
@@ -43,41 +43,25 @@ type Condition<'a> = (&'a str, &'a Mesh, MeasureOptions);
 
 /// Measures every condition `rounds` times, interleaved (round 1 of every
 /// condition, then round 2, ...), so that a slow spell of the machine
-/// touches all conditions alike rather than one; the first round of each
-/// condition is preceded by one unrecorded warm-up pass. Returns one
-/// measurement per condition whose `pass_times_ns` holds every round and
-/// whose `pass_time_ns` is their median.
-fn interleaved(gpu: &Gpu, conds: &[Condition], rounds: u32) -> Result<Vec<Measurement>, StudyError> {
-    let mut out: Vec<Option<Measurement>> = vec![None; conds.len()];
-    for round in 0..rounds.max(1) {
-        for (slot, (spec, mesh, opts)) in out.iter_mut().zip(conds) {
-            let r = gpu.measure(
-                mesh,
-                spec,
-                &MeasureOptions {
-                    warmup: u32::from(round == 0),
-                    repeats: 1,
+/// touches all conditions alike rather than one; each condition's pass is
+/// built once and warmed up by one unrecorded pass ([`Gpu::measure_interleaved`]).
+/// Returns one measurement per condition whose `pass_times_ns` holds every
+/// round and whose `pass_time_ns` is their median.
+pub(crate) fn interleaved(gpu: &Gpu, conds: &[Condition], rounds: u32) -> Result<Vec<Measurement>, StudyError> {
+    let conds: Vec<Condition> = conds
+        .iter()
+        .map(|(spec, mesh, opts)| {
+            (
+                *spec,
+                *mesh,
+                MeasureOptions {
+                    warmup: 1,
                     ..opts.clone()
                 },
-            )?;
-            match slot {
-                None => *slot = Some(r),
-                Some(m) => {
-                    m.stable_counters &= r.vs_invocations == m.vs_invocations && r.fs_invocations == m.fs_invocations;
-                    m.pass_times_ns.extend(r.pass_times_ns);
-                    m.wall_seconds += r.wall_seconds;
-                }
-            }
-        }
-    }
-    Ok(out
-        .into_iter()
-        .flatten()
-        .map(|mut m| {
-            m.pass_time_ns = median(&m.pass_times_ns).unwrap_or(f64::NAN);
-            m
+            )
         })
-        .collect())
+        .collect();
+    Ok(gpu.measure_interleaved(&conds, rounds)?)
 }
 
 /// A short measurement (a warm-up, then the median of three passes), ns.
@@ -88,8 +72,8 @@ fn quick(gpu: &Gpu, spec: &str, m: &Mesh, opts: MeasureOptions) -> Result<f64, S
 /// Measures and analyses H2 (sum vs max).
 pub fn run_h2(gpu: &Gpu, mut setup: H2Setup, rounds: u32) -> Result<H2, StudyError> {
     let t = Instant::now();
-    let grid = mesh(&setup.mesh)?;
-    let tiny = mesh("grid:1x1")?;
+    let grid = study_mesh(&setup.mesh)?;
+    let tiny = study_mesh("grid:1x1")?;
     let base = MeasureOptions {
         size: setup.size,
         ..MeasureOptions::default()
@@ -155,7 +139,7 @@ pub fn run_h2(gpu: &Gpu, mut setup: H2Setup, rounds: u32) -> Result<H2, StudyErr
 /// Measures and analyses H3 (draw order).
 pub fn run_h3(gpu: &Gpu, mut setup: H3Setup, rounds: u32) -> Result<H3, StudyError> {
     let t = Instant::now();
-    let m = mesh(&setup.mesh)?;
+    let m = study_mesh(&setup.mesh)?;
     if let Some(target) = setup.auto_target_ms {
         let one = |fs_loops| MeasureOptions {
             size: setup.size,
@@ -211,7 +195,7 @@ pub fn run_h4(gpu: &Gpu, mut setup: H4Setup, rounds: u32) -> Result<H4, StudyErr
         .parse()
         .map_err(|e| StudyError::Mesh(format!("cache policy: {e}")))?;
     let specs = setup.orders();
-    let meshes: Vec<Mesh> = specs.iter().map(|s| mesh(s)).collect::<Result<_, _>>()?;
+    let meshes: Vec<Mesh> = specs.iter().map(|s| study_mesh(s)).collect::<Result<_, _>>()?;
     let t = Instant::now();
     if let Some(target) = setup.auto_target_ms {
         // The cache-optimized order's geometry-only pass, as a whole.
@@ -260,13 +244,14 @@ pub fn run_h4(gpu: &Gpu, mut setup: H4Setup, rounds: u32) -> Result<H4, StudyErr
 
 /// A study name that is not one.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown study {0:?} (available: h1, h2, h3, h4, all, estimation)")]
+#[error("unknown study {0:?} (available: h1, h2, h3, h4, all, estimation, profile)")]
 pub struct UnknownStudy(pub String);
 
 /// The studies `name` stands for: `h1` .. `h4`, or `all`.
 pub fn study_names(name: &str) -> Result<Vec<&'static str>, UnknownStudy> {
     match name {
         "all" => Ok(vec!["h1", "h2", "h3", "h4"]),
+        "profile" => Ok(vec!["profile"]),
         "h1" => Ok(vec!["h1"]),
         "h2" => Ok(vec!["h2"]),
         "h3" => Ok(vec!["h3"]),
@@ -339,7 +324,7 @@ pub fn run_studies(
     // H2-H4 price vertices with the reuse policy H1 identifies on this
     // device: run H1 first (it only reads counters, one pass per mesh).
     let mut fitted: Option<(h1::H1, f64)> = None;
-    if names.iter().any(|n| *n != "h1") {
+    if names.iter().any(|n| !matches!(*n, "h1" | "profile")) {
         let t = Instant::now();
         fitted = Some((h1::h1(gpu, 1)?, t.elapsed().as_secs_f64()));
     }
@@ -392,6 +377,10 @@ pub fn run_studies(
                     ..H4Setup::default()
                 };
                 let r = run_h4(gpu, setup, rounds)?;
+                (r.verdict(), r.markdown(), to_json(&r))
+            }
+            "profile" => {
+                let r = super::profile_passes::run_profile(gpu, rounds)?;
                 (r.verdict(), r.markdown(), to_json(&r))
             }
             other => return Err(StudyError::Mesh(format!("unknown study {other:?}"))),

@@ -112,6 +112,10 @@ pub struct CalibrateArgs {
     /// |error| exceeds PCT percent (the profile is still written).
     #[arg(long, value_name = "PCT", requires = "holdout")]
     pub holdout_max_median: Option<f64>,
+    /// With --holdout: fail (exit status 1) when the held-out half's 90th
+    /// percentile |error| exceeds PCT percent (the profile is still written).
+    #[arg(long, value_name = "PCT", requires = "holdout")]
+    pub holdout_max_p90: Option<f64>,
     /// Also write a Markdown report: every row measured against its
     /// leave-one-out prediction and against `predict`'s simulation, with
     /// the wall time of measuring vs simulating.
@@ -173,12 +177,13 @@ pub struct PredictArgs {
 #[derive(Args)]
 #[cfg_attr(not(feature = "wgpu"), allow(dead_code))] // read only with the `wgpu` feature
 pub struct StudyArgs {
-    /// Study name: h1, h2, h3, h4, all (H1-H4), or estimation (h1-h4 and pos
-    /// fitted on single-object passes, scored on multi-object passes).
+    /// Study name: h1, h2, h3, h4, all (H1-H4), estimation (h1-h4 and pos
+    /// fitted on single-object passes, scored on multi-object passes), or
+    /// profile (designed passes for `rendersim calibrate`).
     #[arg(value_parser = Choice::<Study>::new(unknown_study))]
     pub name: Study,
     /// Recorded passes per timed measurement, interleaved across a study's
-    /// passes (the median is used). Default 5.
+    /// passes (the median is used). Default 5 (9 for `profile`).
     #[arg(long)]
     pub repeats: Option<u32>,
     /// Also write the device's Markdown document to FILE (e.g. docs/measurements/<adapter>.md).
@@ -254,6 +259,8 @@ pub enum Study {
     All,
     /// Rendering-time estimation: h1-h4 and pos on measured passes.
     Estimation,
+    /// Profile passes: a designed set for `rendersim calibrate`, rounds interleaved.
+    Profile,
 }
 
 #[cfg_attr(not(feature = "wgpu"), allow(dead_code))]
@@ -267,5 +274,5 @@ impl Study {
 }
 
 fn unknown_study(s: &str) -> String {
-    format!("unknown study {s:?} (available: h1, h2, h3, h4, all, estimation)")
+    format!("unknown study {s:?} (available: h1, h2, h3, h4, all, estimation, profile)")
 }
