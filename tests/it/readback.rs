@@ -158,14 +158,14 @@ fn predict_refuses_profiles_calibrate_would_not_write() {
     let text = std::fs::read_to_string(shipped).unwrap();
     for (from, to, key) in [
         ("shader_cores = 132", "shader_cores = 0", "device.shader_cores"),
-        ("rows = 37", "rows = 3", "fit.rows"),
+        ("rows = 135", "rows = 3", "fit.rows"),
         (
             "[uncertainty]\n",
             "[uncertainty]\nbogus_ns = 1.0\n",
             "uncertainty.bogus_ns",
         ),
         (
-            "fragment_ns = 2.2869061602986327",
+            "fragment_ns = 0.5549780826227038",
             "fragment_ns = inf",
             "costs.fragment_ns",
         ),

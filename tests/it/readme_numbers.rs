@@ -167,7 +167,10 @@ fn the_readme_states_what_the_experiments_give() {
     let cells_at = |samples: &str, timing: &str, column: &str| {
         value(
             "view-cells",
-            &[("estimation.timing", timing), ("estimation.view_cells.samples", samples)],
+            &[
+                ("estimation.timing", timing),
+                ("estimation.view_cells.samples", samples),
+            ],
             column,
         )
     };

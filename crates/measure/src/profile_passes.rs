@@ -92,10 +92,11 @@ impl ProfileStudy {
     /// One line.
     pub fn verdict(&self) -> String {
         format!(
-            "{} passes for `rendersim calibrate` ({} interleaved rounds each, the median kept; \
+            "{} passes for `rendersim calibrate` ({} interleaved round{} each, the median kept; \
              a pass's rounds spread over {:.0}% of its median, the median pass)",
             self.passes.len(),
             self.rounds,
+            if self.rounds == 1 { "" } else { "s" },
             self.median_spread * 100.0
         )
     }
