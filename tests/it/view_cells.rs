@@ -159,6 +159,44 @@ fn per_view_cell_estimation_bounds_pos_on_every_frame() {
     assert_eq!(num(s, "metrics.estimation.view_cells.vcs_renders"), cells * 8.0 * 16.0);
 }
 
+/// The paper's reading of pvc (`estimation.view_cells.pvc = "point"`):
+/// on the closed-form walk it is exactly the frame's time; on a city it
+/// never exceeds the bound reading on any frame (its views are among the
+/// bound's, its lookup among the bound's table entries), and it is closer
+/// to the frames on average.
+#[test]
+fn the_point_reading_of_pvc_lies_below_the_bound() {
+    let run = try_run_any(AHEAD, &["estimation.view_cells.pvc=\"point\""]).unwrap();
+    let actual = column(&run, "ActualMs");
+    for (f, (e, a)) in column(&run, "EstPVCMs").iter().zip(&actual).enumerate() {
+        assert!((e - a).abs() < 1e-9, "frame {f}: {e} vs {a}");
+    }
+    assert!(
+        run.resolved_model(std::path::Path::new("."))
+            .contains("pvc = \"point\""),
+        "the reading is written back into model.toml"
+    );
+    let bound = try_run_any(CITY, &SMALL_CITY).unwrap();
+    assert!(
+        !bound.resolved_model(std::path::Path::new(".")).contains("pvc ="),
+        "the default is not written"
+    );
+    let mut sets = SMALL_CITY.to_vec();
+    sets.push("estimation.view_cells.pvc=\"point\"");
+    let point = try_run_any(CITY, &sets).unwrap();
+    let (b, p) = (column(&bound, "EstPVCMs"), column(&point, "EstPVCMs"));
+    for (f, (b, p)) in b.iter().zip(&p).enumerate() {
+        assert!(p <= &(b + 1e-9), "frame {f}: point {p} above bound {b}");
+    }
+    let err = |r: &rendersim::systems::SystemRun| num(r.summary(), "metrics.estimation.pvc.mean_error_ms");
+    assert!(err(&point) < err(&bound), "{} vs {}", err(&point), err(&bound));
+    assert_eq!(
+        column(&bound, "ActualMs"),
+        column(&point, "ActualMs"),
+        "the frames are the same"
+    );
+}
+
 #[test]
 fn a_cpu_clock_without_overhead_or_jitter_reads_the_time_stamps() {
     let stamps = try_run_any(CITY, &SMALL_CITY).unwrap();
@@ -238,6 +276,11 @@ fn cli_error(sets: &[&str]) -> String {
 
 #[test]
 fn bad_view_cell_and_clock_keys_are_named() {
+    let e = cli_error(&["estimation.view_cells.pvc=\"nearest\""]);
+    assert!(
+        e.contains("key `estimation.view_cells.pvc`") && e.contains("expected `bound` or `point`"),
+        "{e}"
+    );
     let e = cli_error(&["estimation.view_cells.directions=0"]);
     assert!(
         e.contains("estimation.view_cells.directions") && e.contains("between 1 and 360"),

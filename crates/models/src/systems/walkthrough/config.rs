@@ -346,6 +346,34 @@ pub struct ViewCellEstimation {
     /// `vcs`: sample views rendered per cell and direction (their maximum
     /// is the estimate).
     pub samples: u32,
+    /// `pvc`: how each object's table entry is chosen (`bound` or `point`).
+    #[serde(skip_serializing_if = "PvcReading::is_default")]
+    pub pvc: PvcReading,
+}
+
+/// How per-view-cell estimation (`pvc`, paper 000 §5.2) picks each
+/// object's entry of its pos table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum PvcReading {
+    /// A bound over every view of the cell and heading sector: the largest
+    /// screen size the object can take from the cell, and the table's
+    /// largest entry up to that size over every direction it is seen from
+    /// (never below pos on any frame of the cell).
+    #[default]
+    Bound,
+    /// The paper's words: the point of the cell's boundary where the
+    /// object's bounding sphere appears largest in the frustum of the
+    /// direction (the sector's centre heading, the path's middle pitch),
+    /// and the table looked up there as pos would (size and direction of
+    /// that point). Found by searching a grid of points on the cell's faces.
+    Point,
+}
+
+impl PvcReading {
+    fn is_default(&self) -> bool {
+        *self == PvcReading::Bound
+    }
 }
 
 impl Default for ViewCellEstimation {
@@ -353,6 +381,7 @@ impl Default for ViewCellEstimation {
         ViewCellEstimation {
             directions: 8,
             samples: 16,
+            pvc: PvcReading::Bound,
         }
     }
 }

@@ -54,7 +54,7 @@ use crate::engine::{RngStreams, StreamRng};
 use crate::systems::error::SystemError;
 
 use super::camera::Pose;
-use super::config::{CameraConfig, ViewCellEstimation};
+use super::config::{CameraConfig, PvcReading, ViewCellEstimation};
 use super::culling::{Pvs, View, alpha_of_disk, disk_in_rect, project};
 use super::pos::PosTable;
 use super::render::Draw;
@@ -306,6 +306,62 @@ pub fn object_bound(
     })
 }
 
+/// Points per side of the grid searched on each face of a view cell
+/// ([`PvcReading::Point`]): 9 x 9 on each of the six faces of the cell's
+/// box (its square extruded over the path's eye heights).
+pub const BOUNDARY_GRID: usize = 9;
+
+/// The views [`PvcReading::Point`] searches for cell `key` and direction
+/// `bin`: the sector's centre heading and the path's middle pitch, from each
+/// point of a [`BOUNDARY_GRID`] grid on each face of the cell's box.
+pub fn boundary_views(
+    key: CellKey,
+    cell: f64,
+    bin: usize,
+    directions: u32,
+    nav: &Nav,
+    cam: &CameraConfig,
+) -> Vec<View> {
+    let (x0, y0) = (key.0 as f64 * cell, key.1 as f64 * cell);
+    let lo = [x0, y0, nav.z.0];
+    let hi = [x0 + cell, y0 + cell, nav.z.1];
+    let yaw = bin as f64 * TAU / directions.max(1) as f64;
+    let pitch = 0.5 * (nav.pitch.0 + nav.pitch.1);
+    let n = BOUNDARY_GRID;
+    let at = |a: usize, i: usize| lo[a] + (hi[a] - lo[a]) * i as f64 / (n - 1) as f64;
+    let mut views = Vec::with_capacity(6 * n * n);
+    for fixed in 0..3 {
+        let (a, b) = ((fixed + 1) % 3, (fixed + 2) % 3);
+        for side in [lo[fixed], hi[fixed]] {
+            for i in 0..n {
+                for j in 0..n {
+                    let mut eye = [0.0; 3];
+                    eye[fixed] = side;
+                    eye[a] = at(a, i);
+                    eye[b] = at(b, j);
+                    views.push(View::new(&Pose { eye, yaw, pitch }, cam));
+                }
+            }
+        }
+    }
+    views
+}
+
+/// The projection of `o` from the view where its bounding sphere appears
+/// largest in the frustum (largest clipped α) among `views`, or `None` when
+/// no view sees it.
+pub fn largest_point(
+    views: &[View],
+    o: &Object,
+    proto: &super::scene::Prototype,
+) -> Option<super::culling::Projection> {
+    views
+        .iter()
+        .filter(|v| v.sees_sphere(o.center, o.radius))
+        .map(|v| project(v, o, proto))
+        .max_by(|a, b| a.alpha.total_cmp(&b.alpha))
+}
+
 /// `metrics.estimation.view_cells`: the view-cell preprocess and its cost.
 #[derive(Debug, Clone, Serialize)]
 pub struct ViewCellSummary {
@@ -438,6 +494,13 @@ pub fn build(
         }
         if inp.want.1 {
             let t = std::time::Instant::now();
+            let point_views: Vec<Vec<View>> = if inp.cfg.pvc == PvcReading::Point {
+                (0..dirs as usize)
+                    .map(|bin| boundary_views(key, inp.cell, bin, dirs, &nav, inp.cam))
+                    .collect()
+            } else {
+                Vec::new()
+            };
             let mut row = vec![0.0; dirs as usize];
             for (bin, total) in row.iter_mut().enumerate() {
                 for &i in &set {
@@ -446,8 +509,18 @@ pub fn build(
                         continue;
                     };
                     sum.pvc_bounds += 1;
-                    if let Some(b) = object_bound(o, key, inp.cell, bin, dirs, &nav, &lens) {
-                        *total += tb.lookup_max(b.alpha, b.gamma, b.phi, &mut sum.pvc_table_reads);
+                    match inp.cfg.pvc {
+                        PvcReading::Bound => {
+                            if let Some(b) = object_bound(o, key, inp.cell, bin, dirs, &nav, &lens) {
+                                *total += tb.lookup_max(b.alpha, b.gamma, b.phi, &mut sum.pvc_table_reads);
+                            }
+                        }
+                        PvcReading::Point => {
+                            let views = &point_views[bin];
+                            if let Some(p) = largest_point(&views[..], o, &scene.protos[o.proto as usize]) {
+                                *total += tb.lookup(p.alpha, p.gamma, p.phi, &mut sum.pvc_table_reads);
+                            }
+                        }
                     }
                 }
             }
@@ -500,6 +573,63 @@ mod tests {
         assert_eq!(bin_of(TAU / 8.0 * 0.51, 8), 1);
         assert_eq!(bin_of(TAU - 0.01, 8), 0);
         assert_eq!(bin_of(3.0, 1), 0);
+    }
+
+    /// The paper's reading searches the cell's boundary: every eye on a
+    /// face of the cell's box, the sector's centre heading, the middle
+    /// pitch; the point it picks is the seeing view of largest α, inside
+    /// the bound, and an object behind every view is left out.
+    #[test]
+    fn the_point_reading_picks_the_largest_view_inside_the_bound() {
+        let cam = CameraConfig::default();
+        let lens = Lens::of(&cam);
+        let nav = Nav {
+            z: (1.5, 2.0),
+            pitch: (-0.05, 0.1),
+        };
+        let views = boundary_views((1, 2), 10.0, 2, 8, &nav, &cam);
+        assert_eq!(views.len(), 6 * BOUNDARY_GRID * BOUNDARY_GRID);
+        let on_face = |e: [f64; 3]| {
+            let inside = (10.0..=20.0).contains(&e[0]) && (20.0..=30.0).contains(&e[1]) && (1.5..=2.0).contains(&e[2]);
+            let face = [
+                e[0] == 10.0,
+                e[0] == 20.0,
+                e[1] == 20.0,
+                e[1] == 30.0,
+                e[2] == 1.5,
+                e[2] == 2.0,
+            ];
+            inside && face.iter().any(|&f| f)
+        };
+        assert!(views.iter().all(|v| on_face(v.eye)));
+        let proto = Prototype {
+            name: "box".into(),
+            size: [6.0, 4.0, 9.0],
+            levels: Vec::new(),
+            overdraw: 1.0,
+            size_sigma: 1.0,
+        };
+        // Sector 2 of 8 looks along +y: an object ahead is picked, one
+        // behind the cell is not.
+        let object = |c: [f64; 3]| Object {
+            proto: 0,
+            center: c,
+            radius: proto.radius(),
+            yaw: 0.4,
+            state: (0, 0, 0),
+            block: u32::MAX,
+        };
+        let ahead = object([16.0, 60.0, 4.5]);
+        let p = largest_point(&views, &ahead, &proto).expect("seen ahead");
+        let best = views
+            .iter()
+            .filter(|v| v.sees_sphere(ahead.center, ahead.radius))
+            .map(|v| project(v, &ahead, &proto).alpha)
+            .fold(0.0f64, f64::max);
+        assert_eq!(p.alpha, best);
+        let b = object_bound(&ahead, (1, 2), 10.0, 2, 8, &nav, &lens).unwrap();
+        assert!(p.disk_pixels <= b.pixels * (1.0 + 1e-9), "{p:?} {b:?}");
+        assert!(largest_point(&views, &object([16.0, -40.0, 4.5]), &proto).is_none());
     }
 
     /// Brute force: views sampled densely in the cell and direction never
