@@ -88,8 +88,7 @@ pub enum CalibrateError {
     },
 }
 
-/// The fewest rows [`fit`] fits a profile to.
-pub const MIN_ROWS: usize = 12;
+pub use super::device_profile::MIN_ROWS;
 
 /// Reads the rows of one CSV file (the one pass-CSV reader,
 /// [`super::passes::read_passes`]).

@@ -55,6 +55,10 @@ use serde::{Deserialize, Serialize};
 
 use super::coverage::{Coverage, WARP_QUADS};
 
+/// The fewest rows `rendersim calibrate` fits a profile to (and a
+/// profile's `fit.rows` may say).
+pub const MIN_ROWS: usize = 12;
+
 /// Largest cost a profile may give one unit of work (a pass, a draw, a
 /// vertex, a pixel): one second. Fitted costs are nanoseconds to
 /// microseconds; the bound keeps a prediction (costs times counts of up to
@@ -413,7 +417,7 @@ impl DeviceProfile {
     /// policy; 1 to [`MAX_SHADER_CORES`] shader cores; every cost finite and
     /// non-negative, the linear ones not all zero (such a profile predicts
     /// 0 ns for every pass), the overlap at most 1; standard errors only of costs, finite and non-negative;
-    /// at least [`super::calibrate::MIN_ROWS`] rows; the error statistics
+    /// at least [`MIN_ROWS`] rows; the error statistics
     /// finite, non-negative and ordered (median <= 90th percentile <=
     /// worst). The error is [`ProfileError::Invalid`] naming the key.
     pub fn validate(&self) -> Result<(), ProfileError> {
@@ -490,7 +494,7 @@ impl DeviceProfile {
             }
         }
         let f = &self.fit;
-        let min_rows = super::calibrate::MIN_ROWS;
+        let min_rows = MIN_ROWS;
         if f.rows < min_rows {
             return bad(
                 "fit.rows",

@@ -15,15 +15,15 @@
 //! five others), and within one process a slow spell of a few passes
 //! would fall on one condition's rounds if they ran back to back. Here the
 //! rounds run round 1 of every pass, then round 2, and the median of each
-//! pass's rounds is its time (see [`super::studies`]).
+//! pass's rounds is its time (see [`Gpu::measure_interleaved`]).
 
 use std::time::Instant;
 
 use serde::Serialize;
 
-use super::device::{Gpu, MeasureOptions, Measurement};
+use super::device::{Gpu, MeasureError, MeasureOptions, Measurement};
 use super::fit::median;
-use super::studies::{StudyError, interleaved, study_mesh};
+use crate::scene::generators::mesh_from_spec;
 use crate::scene::mesh::Mesh;
 
 /// The meshes of the design (specs as for `rendersim measure`).
@@ -139,6 +139,7 @@ pub fn design() -> Vec<(usize, MeasureOptions)> {
                         vs_loops,
                         fs_loops,
                         geometry_only,
+                        warmup: 1,
                         ..MeasureOptions::default()
                     },
                 ));
@@ -152,6 +153,7 @@ pub fn design() -> Vec<(usize, MeasureOptions)> {
                 MeasureOptions {
                     size,
                     draws,
+                    warmup: 1,
                     ..MeasureOptions::default()
                 },
             ));
@@ -160,16 +162,22 @@ pub fn design() -> Vec<(usize, MeasureOptions)> {
     v
 }
 
-/// Measures the design on `gpu`, `rounds` interleaved rounds.
-pub fn run_profile(gpu: &Gpu, rounds: u32) -> Result<ProfileStudy, StudyError> {
+/// A design mesh from its spec.
+fn design_mesh(spec: &str) -> Result<Mesh, MeasureError> {
+    mesh_from_spec(spec, std::path::Path::new(".")).map_err(|e| MeasureError::Option(format!("{spec}: {e}")))
+}
+
+/// Measures the design on `gpu`: each pass built once and warmed up once,
+/// then `rounds` interleaved rounds ([`Gpu::measure_interleaved`]).
+pub fn run_profile(gpu: &Gpu, rounds: u32) -> Result<ProfileStudy, MeasureError> {
     let t = Instant::now();
-    let meshes: Vec<Mesh> = MESHES.iter().map(|s| study_mesh(s)).collect::<Result<_, _>>()?;
+    let meshes: Vec<Mesh> = MESHES.iter().map(|s| design_mesh(s)).collect::<Result<_, _>>()?;
     let design = design();
     let conds: Vec<(&str, &Mesh, MeasureOptions)> = design
         .iter()
         .map(|(i, o)| (MESHES[*i], &meshes[*i], o.clone()))
         .collect();
-    let measured: Vec<Measurement> = interleaved(gpu, &conds, rounds)?;
+    let measured: Vec<Measurement> = gpu.measure_interleaved(&conds, rounds)?;
     let passes: Vec<ProfilePass> = measured
         .iter()
         .zip(&design)
@@ -245,7 +253,7 @@ mod tests {
         // Every mesh spec builds, and one pass writes a pass-CSV row (one
         // layer, no depth test: the CSV has no column for either).
         for m in MESHES {
-            study_mesh(m).unwrap();
+            design_mesh(m).unwrap();
         }
         assert!(d.iter().all(|(_, o)| o.layers == 1 && !o.depth_test));
     }

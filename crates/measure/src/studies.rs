@@ -34,7 +34,7 @@ pub enum StudyError {
 }
 
 /// A study's mesh from its spec.
-pub(crate) fn study_mesh(spec: &str) -> Result<Mesh, StudyError> {
+fn study_mesh(spec: &str) -> Result<Mesh, StudyError> {
     mesh_from_spec(spec, Path::new(".")).map_err(|e| StudyError::Mesh(e.to_string()))
 }
 
@@ -47,7 +47,7 @@ type Condition<'a> = (&'a str, &'a Mesh, MeasureOptions);
 /// built once and warmed up by one unrecorded pass ([`Gpu::measure_interleaved`]).
 /// Returns one measurement per condition whose `pass_times_ns` holds every
 /// round and whose `pass_time_ns` is their median.
-pub(crate) fn interleaved(gpu: &Gpu, conds: &[Condition], rounds: u32) -> Result<Vec<Measurement>, StudyError> {
+fn interleaved(gpu: &Gpu, conds: &[Condition], rounds: u32) -> Result<Vec<Measurement>, StudyError> {
     let conds: Vec<Condition> = conds
         .iter()
         .map(|(spec, mesh, opts)| {
