@@ -10,8 +10,10 @@ use anyhow::{Context, Result};
 use serde_json::json;
 
 use rendersim::measure::calibrate::{
-    CalibrateError, Fit, Invocations, LoadCache, MeshFolds, error_summary, fit, held_out_half, k_fold_by_mesh,
-    leave_one_out, leave_one_out_ns, linear_baseline_loo, read_rows_with_origins, row_load,
+    CalibrateError, Fit, Invocations, LoadCache, fit, read_rows_with_origins, row_load,
+};
+use rendersim::measure::cross_validation::{
+    MeshFolds, error_summary, held_out_half, k_fold_by_mesh, leave_one_out, leave_one_out_ns, linear_baseline_loo,
 };
 use rendersim::measure::device_predict::{DevicePass, predict_on_device};
 use rendersim::measure::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy, PassLoad, ProfileError};

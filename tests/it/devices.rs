@@ -6,9 +6,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use rendersim::measure::calibrate::{
-    Invocations, LoadCache, PassRow, error_summary, fit, held_out_half, k_fold_by_mesh, leave_one_out,
-    linear_baseline_loo, mesh_folds, read_rows, row_load,
+use rendersim::measure::calibrate::{Invocations, LoadCache, PassRow, fit, read_rows, row_load};
+use rendersim::measure::cross_validation::{
+    error_summary, held_out_half, k_fold_by_mesh, leave_one_out, linear_baseline_loo, mesh_folds,
 };
 use rendersim::measure::device_profile::{DeviceCosts, DeviceProfile};
 

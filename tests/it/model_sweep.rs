@@ -7,9 +7,8 @@
 use std::path::Path;
 use std::process::Command;
 
-use rendersim::measure::calibrate::{
-    Invocations, LoadCache, error_summary, leave_one_out, linear_baseline_loo, read_rows, row_load,
-};
+use rendersim::measure::calibrate::{Invocations, LoadCache, read_rows, row_load};
+use rendersim::measure::cross_validation::{error_summary, leave_one_out, linear_baseline_loo};
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_rendersim"))

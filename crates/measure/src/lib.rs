@@ -46,6 +46,7 @@ use rendersim_report::output;
 
 pub mod calibrate;
 pub mod coverage;
+pub mod cross_validation;
 pub mod device_predict;
 pub mod device_profile;
 pub mod estimation;

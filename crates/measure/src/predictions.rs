@@ -13,10 +13,8 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::calibrate::{
-    CalibrateError, Invocations, LoadCache, MeshFolds, error_summary, fit, k_fold_by_mesh, leave_one_out_ns,
-    linear_baseline_loo, row_load,
-};
+use super::calibrate::{CalibrateError, Invocations, LoadCache, fit, row_load};
+use super::cross_validation::{MeshFolds, error_summary, k_fold_by_mesh, leave_one_out_ns, linear_baseline_loo};
 use super::device_predict::{DevicePass, DevicePredictError, predict_on_device};
 use super::device_profile::{DeviceCosts, PassLoad};
 use super::device_profile::{DeviceInfo, DeviceProfile, FitAccuracy};
