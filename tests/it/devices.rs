@@ -354,6 +354,22 @@ fn the_held_out_half_fails_the_command_past_either_bound_and_keeps_the_profile()
         err.contains("median |error|") && err.contains("exceeds --holdout-max-median 0.001%; 90th percentile"),
         "{err}"
     );
+    // A bound that is not a finite percentage is refused before fitting:
+    // NaN or infinity would pass whatever the errors.
+    for (flag, bad) in [
+        ("--holdout-max-p90", "nan"),
+        ("--holdout-max-median", "inf"),
+        ("--holdout-max-p90", "-5"),
+    ] {
+        let arg = format!("{flag}={bad}");
+        let o = run(&[arg.as_str()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{flag} {bad}: {err}");
+        assert!(
+            err.contains(flag) && err.contains("a finite number at least 0"),
+            "{err}"
+        );
+    }
     // The bounds need --holdout.
     let o = bin()
         .arg("calibrate")

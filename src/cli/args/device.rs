@@ -10,7 +10,7 @@ use rendersim::components::vertex_cache::CachePolicy;
 
 use rendersim::measure::{DepthOrder, UnknownDepthOrder};
 
-use super::values::{Choice, Plain, Size, parse_size, parse_vertex_cache};
+use super::values::{Choice, Plain, Size, parse_max_median, parse_max_p90, parse_size, parse_vertex_cache};
 /// `rendersim measure`.
 #[derive(Args)]
 #[cfg_attr(not(feature = "wgpu"), allow(dead_code))] // read only with the `wgpu` feature
@@ -110,11 +110,11 @@ pub struct CalibrateArgs {
     pub holdout: bool,
     /// With --holdout: fail (exit status 1) when the held-out half's median
     /// |error| exceeds PCT percent (the profile is still written).
-    #[arg(long, value_name = "PCT", requires = "holdout")]
+    #[arg(long, value_name = "PCT", requires = "holdout", value_parser = Plain::new(parse_max_median))]
     pub holdout_max_median: Option<f64>,
     /// With --holdout: fail (exit status 1) when the held-out half's 90th
     /// percentile |error| exceeds PCT percent (the profile is still written).
-    #[arg(long, value_name = "PCT", requires = "holdout")]
+    #[arg(long, value_name = "PCT", requires = "holdout", value_parser = Plain::new(parse_max_p90))]
     pub holdout_max_p90: Option<f64>,
     /// Also write a Markdown report: every row measured against its
     /// leave-one-out prediction and against `predict`'s simulation, with

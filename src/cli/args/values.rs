@@ -43,6 +43,26 @@ pub(super) fn parse_vertex_cache(policy: &str) -> anyhow::Result<CachePolicy> {
         .map_err(|e| anyhow::anyhow!("--vertex-cache {policy:?}: {e}"))
 }
 
+/// `calibrate --holdout-max-median` and `--holdout-max-p90`: a bound in
+/// percent, a finite number at least 0 (NaN or infinity would make the
+/// check pass whatever the errors).
+fn parse_percent_bound(flag: &str, pct: &str) -> anyhow::Result<f64> {
+    match pct.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(anyhow::anyhow!(
+            "{flag} {pct:?}: expected a percentage, a finite number at least 0 (e.g. 30)"
+        )),
+    }
+}
+
+pub(super) fn parse_max_median(pct: &str) -> anyhow::Result<f64> {
+    parse_percent_bound("--holdout-max-median", pct)
+}
+
+pub(super) fn parse_max_p90(pct: &str) -> anyhow::Result<f64> {
+    parse_percent_bound("--holdout-max-p90", pct)
+}
+
 /// A usage error with `message` as its whole text (`error: ` before it),
 /// exit status 2.
 fn invalid_value(cmd: &clap::Command, message: String) -> clap::Error {
