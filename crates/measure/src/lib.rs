@@ -69,6 +69,8 @@ mod geometry;
 #[cfg(feature = "wgpu")]
 pub mod h1;
 #[cfg(feature = "wgpu")]
+mod measured_pass;
+#[cfg(feature = "wgpu")]
 pub mod profile_passes;
 #[cfg(feature = "wgpu")]
 pub mod studies;
