@@ -556,7 +556,7 @@ fn a_run_stopped_by_max_events_reports_the_frames_it_completed() {
 #[test]
 fn system_noise_experiment_prints_the_paper_constant_at_the_end() {
     let d = tempfile::tempdir().unwrap();
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/system-noise.toml");
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/figure3-system-noise.toml");
     let out = run_ok(&[
         "experiment",
         file.to_str().unwrap(),

@@ -223,7 +223,7 @@ fn the_readme_states_what_the_experiments_give() {
     );
     let c = |variation: &str| {
         value(
-            "system-noise",
+            "figure3-system-noise",
             &[("noise.enabled", "true"), ("variation.enabled", variation)],
             "c99_from_min",
         )
@@ -233,7 +233,7 @@ fn the_readme_states_what_the_experiments_give() {
         format!("{:.2} ms ({:.2} with variation", c("false"), c("true")),
     );
     let paper_timing = value(
-        "system-noise",
+        "figure3-system-noise",
         &[("noise.enabled", "true"), ("variation.enabled", "false")],
         "c99_paper_timing",
     );
@@ -243,7 +243,7 @@ fn the_readme_states_what_the_experiments_give() {
     );
     let t4 = |memory: &str, bytes: &str, column: &str| {
         value(
-            "table4-agp",
+            "table4-memory",
             &[
                 ("workload.groups.0.geometry_memory", memory),
                 ("workload.groups.0.vertex_bytes", bytes),
@@ -301,7 +301,7 @@ fn the_models_doc_states_what_the_geforce3_experiments_give() {
             ("workload.groups.0.vertex_bytes", bytes),
             ("workload.groups.0.geometry_upload", "1332800"),
         ];
-        value("table4-agp", &at, column)
+        value("table4-memory", &at, column)
     };
     let cell = |memory, bytes, paper: (f64, f64)| {
         let r = t4(memory, bytes, "metrics.gpu_time_ms.p50:mean");

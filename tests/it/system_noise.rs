@@ -6,14 +6,14 @@
 //! frame's time runs from its CPU start to its GPU end, and the density is
 //! two spikes 0.5 ms apart: 99% of frames within 0.5 ms of the fastest,
 //! against the paper's 1.52 ms. Timed present to present
-//! (`MsBetweenPresents`, what `experiments/system-noise.toml` plots) a task
+//! (`MsBetweenPresents`, what `experiments/figure3-system-noise.toml` plots) a task
 //! that hides the wait for the previous frame's GPU tail adds a third
 //! spike, 0.5 ms below, and the width is 1.27 ms (docs/models.md,
 //! "Per-frame variation").
 
 use std::process::Command;
 
-/// The single view's 10,000 frames, as `experiments/system-noise.toml`
+/// The single view's 10,000 frames, as `experiments/figure3-system-noise.toml`
 /// runs them: each frame's time from its CPU start to its GPU end, and
 /// from present to present (ms).
 fn frames() -> (Vec<f64>, Vec<f64>) {
