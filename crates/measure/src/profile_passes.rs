@@ -61,11 +61,11 @@ pub struct ProfilePass {
     pub mesh: String,
     /// Target width and height.
     pub size: (u32, u32),
-    /// Vertex and fragment loops.
+    /// Vertex-shader loops.
     pub vs_loops: u32,
-    /// Fragment loops.
+    /// Fragment-shader loops.
     pub fs_loops: u32,
-    /// Geometry only.
+    /// Every vertex at one point (no fragments).
     pub geometry_only: bool,
     /// Draw calls.
     pub draws: u32,
