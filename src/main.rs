@@ -38,7 +38,8 @@ enum Cmd {
     /// Measure a mesh on a real adapter through wgpu (build with `--features wgpu`).
     Measure(MeasureArgs),
     /// Hypothesis studies against real measurements (build with `--features wgpu`):
-    /// h1 vertex reuse, h2 sum vs max, h3 draw order, h4 cost per vertex, or all.
+    /// h1 vertex reuse, h2 sum vs max, h3 draw order, h4 cost per vertex, or all;
+    /// estimation (paper 000 §5 on the device); profile (passes for `calibrate`).
     Study(StudyArgs),
     /// Fit a device profile (models/devices/NAME.toml) to measured passes (CSV).
     Calibrate(CalibrateArgs),
