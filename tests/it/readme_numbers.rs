@@ -352,3 +352,58 @@ fn the_models_doc_states_what_the_geforce3_experiments_give() {
         assert!(doc.contains(&text), "docs/models.md should say {text:?}");
     }
 }
+
+#[test]
+fn the_models_doc_states_what_the_view_cell_experiments_give() {
+    // docs/models.md, "View-cell estimators (§5.1-5.2, §7.3)": the pvc
+    // readings' table and vcs's convergence over the sample views.
+    let doc = std::fs::read_to_string(Path::new(ROOT).join("docs/models.md")).unwrap();
+    let pvc = |reading: &str, dirs: &str, timing: &str, column: &str| {
+        value(
+            "view-cells-pvc",
+            &[
+                ("estimation.timing", timing),
+                ("estimation.view_cells.pvc", reading),
+                ("estimation.view_cells.directions", dirs),
+            ],
+            &format!("metrics.estimation.pvc.{column}:mean"),
+        )
+    };
+    let cell = |reading: &str, dirs: &str| {
+        let mse = |t| pvc(reading, dirs, t, "mse_ms2");
+        let (clock, stamps) = (mse("cpu_clock"), mse("timestamps"));
+        let under = pvc(reading, dirs, "cpu_clock", "underestimated_fraction");
+        let share = if under == 0.0 {
+            "0".to_string()
+        } else {
+            format!("{:.0}%", 100.0 * under)
+        };
+        let two = |v: f64| if v < 10.0 { format!("{v:.2}") } else { format!("{v:.1}") };
+        format!("{} / {}, {share}", two(clock), two(stamps))
+    };
+    for dirs in ["8", "16", "32"] {
+        let text = format!("| {dirs} | {} | {} |", cell("bound", dirs), cell("point", dirs));
+        assert!(doc.contains(&text), "docs/models.md should say {text:?}");
+    }
+    let vcs = |n: &str, column: &str| {
+        value(
+            "view-cells",
+            &[
+                ("estimation.timing", "timestamps"),
+                ("estimation.view_cells.samples", n),
+            ],
+            &format!("metrics.estimation.vcs.{column}:mean"),
+        )
+    };
+    let ns = ["4", "16", "64", "256"];
+    let under: Vec<String> = ns
+        .iter()
+        .map(|n| format!("{:.0}", 1000.0 * vcs(n, "underestimated_fraction")))
+        .collect();
+    let mse: Vec<String> = ns.iter().map(|n| format!("{:.2}", vcs(n, "mse_ms2"))).collect();
+    let text = format!(
+        "underestimates {}, {}, {} and {} of 1000 frames (paper: 2) at mse {}, {},\n  {} and {} ms²",
+        under[0], under[1], under[2], under[3], mse[0], mse[1], mse[2], mse[3]
+    );
+    assert!(doc.contains(&text), "docs/models.md should say {text:?}");
+}

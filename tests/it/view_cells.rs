@@ -302,3 +302,41 @@ fn bad_view_cell_and_clock_keys_are_named() {
     let e = cli_error(&["estimation.view_cells.sample=3"]);
     assert!(e.contains("sample"), "{e}");
 }
+
+/// docs/models.md states §7.3's four figures from one run on the shipped
+/// city (the paper's readings and timing, 16 directions, 256 views): this
+/// is that run, and the doc must say what it gives.
+#[test]
+fn the_models_doc_states_the_four_section_7_3_figures_of_one_run() {
+    let run = try_run_any(
+        CITY,
+        &[
+            "run.frames=1000",
+            "camera.path=\"preset\"",
+            "scene.preset=\"city\"",
+            "estimation.estimators=[\"pos\", \"vcs\", \"pvc\"]",
+            "estimation.timing=\"cpu_clock\"",
+            "estimation.view_cells.samples=256",
+            "estimation.view_cells.directions=16",
+            "estimation.view_cells.pvc=\"point\"",
+        ],
+    )
+    .unwrap();
+    let s = run.summary();
+    let e = |k: &str, m: &str| num(s, &format!("metrics.estimation.{k}.{m}"));
+    let none = |k: &str| e(k, "underestimated_fraction") == 0.0;
+    assert!(
+        none("vcs") && none("pvc"),
+        "{} {}",
+        e("vcs", "underestimated_fraction"),
+        e("pvc", "underestimated_fraction")
+    );
+    let text = format!(
+        "vcs underestimates no frame at {:.2} ms² (paper:\n  2 frames, 0.64), pvc none at {:.2} ms² (paper: none, 2.33), pos {:.2}.",
+        e("vcs", "mse_ms2"),
+        e("pvc", "mse_ms2"),
+        e("pos", "mse_ms2")
+    );
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/models.md")).unwrap();
+    assert!(doc.contains(&text), "docs/models.md should say {text:?}");
+}
