@@ -71,11 +71,9 @@ pub fn study(args: StudyArgs) -> Result<()> {
     if args.single.is_some() || args.multi.is_some() || args.seed.is_some() || args.load_scale.is_some() {
         bail!("--single, --multi, --seed and --load-scale belong to `rendersim study estimation`");
     }
-    // The profile study's passes are short and many: 9 rounds keep the
-    // median's scatter on lavapipe below what the held-out check allows.
-    let default_repeats = if args.name == super::args::Study::Profile { 9 } else { 5 };
-    let (name, repeats, json) = (args.name.name(), args.repeats.unwrap_or(default_repeats), args.json);
+    let (name, json) = (args.name.name(), args.json);
     let names = studies::study_names(&name)?;
+    let repeats = args.repeats.unwrap_or_else(|| studies::default_rounds(&names));
     if repeats == 0 {
         bail!("--repeats must be at least 1");
     }

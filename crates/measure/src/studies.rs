@@ -242,6 +242,17 @@ pub fn run_h4(gpu: &Gpu, mut setup: H4Setup, rounds: u32) -> Result<H4, StudyErr
     Ok(h4::analyze(setup, rows, measure_seconds, t.elapsed().as_secs_f64()))
 }
 
+/// Timed rounds per measurement unless told otherwise: 5, and the profile
+/// study's own ([`super::profile_passes::DEFAULT_ROUNDS`]) when it is the
+/// only study named.
+pub fn default_rounds(names: &[&str]) -> u32 {
+    if names == ["profile"] {
+        super::profile_passes::DEFAULT_ROUNDS
+    } else {
+        5
+    }
+}
+
 /// A study name that is not one.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("unknown study {0:?} (available: h1, h2, h3, h4, all, estimation, profile)")]
