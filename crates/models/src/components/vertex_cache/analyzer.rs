@@ -10,12 +10,12 @@
 //! new group of `primgroup` triangles, first flushes the cache (the clock
 //! jumps by `cache + 1`, so every stamp is stale).
 //!
-//! Two loops give the same counts. The general one ([`run_span`]) is
+//! Two loops give the same counts. The general one (`run_span`) is
 //! meshoptimizer's, with the clock compared by wrapping subtraction as its
 //! C++ does, and the warp and group tests compiled only into the variants
 //! whose policy has them. Lists short enough that the clock cannot wrap
 //! (below about 4e9 / (2 cache + 5) triangles: all but the largest) run
-//! [`no_wrap`]'s loop, which costs a triangle fewer instructions (its
+//! `no_wrap`'s loop, which costs a triangle fewer instructions (its
 //! module says how). `cargo bench --bench vcache` compares them with
 //! meshoptimizer's C++ in the same process; `docs/models.md` has the
 //! figures.
