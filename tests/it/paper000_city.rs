@@ -97,3 +97,51 @@ fn table_3_front_to_back_falls_short_and_back_to_front_overshoots() {
     );
     assert!((0.25..0.30).contains(&b2f), "back to front {b2f}");
 }
+
+#[test]
+fn the_docs_state_what_table_3s_inverse_what_ifs_give() {
+    // docs/models.md, "Table 3 predicted": the two searches of
+    // experiments/table3-depth-order.toml (from its golden searches.csv,
+    // which the golden test holds to a fresh run), and the three orders at
+    // the vertex cost the front-to-back search finds.
+    let doc = std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/models.md")).unwrap();
+    let doc = doc.split_whitespace().collect::<Vec<_>>().join(" ");
+    let searches = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/golden/experiments/table3-depth-order/searches.csv"),
+    )
+    .unwrap();
+    let found = |name: &str| -> f64 {
+        let line = searches
+            .lines()
+            .find(|l| l.starts_with(&format!("{name},")))
+            .unwrap_or_else(|| panic!("no search {name}"));
+        line.split(',').nth(6).unwrap().parse().unwrap()
+    };
+    let fill = found("fragment-cost-for-back-to-front");
+    let vertex = found("vertex-cost-for-front-to-back");
+    let median = shipped_table("models/city-geforce3.toml")["workload"]["groups"][0]["triangle_pixels"]["median"]
+        .as_float()
+        .unwrap();
+    let at = |order: &str| {
+        gpu_ms(&[
+            format!("workload.groups.0.triangle_pixels.median={median}"),
+            "gpu.fragment.per_fragment=\"8123ps\"".into(),
+            format!("gpu.geometry.vertex_shader=\"{vertex}ps\""),
+            format!("workload.depth_order=\"{order}\""),
+        ])
+    };
+    let (normal, f2b, b2f) = (at("random"), at("front_to_back"), at("back_to_front"));
+    for text in [
+        format!("back to front would give 12.552 ms: {:.3} ns against", fill / 1000.0),
+        format!("front to back would give 9.143 ms: {:.3} ns against", vertex / 1000.0),
+        format!(
+            "the normal view takes {normal:.2} ms, front to back {f2b:.3} ms and back to front {b2f:.2} ms, \
+             changes of {:+.1}% and {:+.1}%",
+            100.0 * (f2b / normal - 1.0),
+            100.0 * (b2f / normal - 1.0)
+        ),
+    ] {
+        assert!(doc.contains(&text), "docs/models.md should say {text:?}");
+    }
+}
