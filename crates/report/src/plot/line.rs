@@ -162,6 +162,43 @@ fn coincide(a: &Prepared, b: &Prepared) -> bool {
             .all(|(p, q)| p.0 == q.0 && (p.1 - q.1).abs() <= 1e-9 * p.1.abs().max(q.1.abs()).max(1e-300))
 }
 
+/// Where series `b` runs on top of series `a` without coinciding with it
+/// everywhere: the x ranges (each a run of adjacent segments) of the
+/// segments of `b` whose two ends are also two consecutive points of `a`
+/// (same x, y within `tol`), so that `a` hides them. Empty when no
+/// segment is hidden.
+fn overlap(a: &Prepared, b: &Prepared, tol: f64) -> Vec<(f64, f64)> {
+    if a.reference || b.reference {
+        return Vec::new();
+    }
+    let same = |p: &(f64, f64), q: &(f64, f64)| p.0 == q.0 && (p.1 - q.1).abs() <= tol;
+    let mut ranges: Vec<(f64, f64)> = Vec::new();
+    for w in b.points.windows(2) {
+        if !a.points.windows(2).any(|v| same(&v[0], &w[0]) && same(&v[1], &w[1])) {
+            continue;
+        }
+        match ranges.last_mut() {
+            Some(last) if last.1 == w[0].0 => last.1 = w[1].0,
+            _ => ranges.push((w[0].0, w[1].0)),
+        }
+    }
+    ranges
+}
+
+/// A number for a note: at most four significant digits, no trailing zeros.
+fn short(x: f64) -> String {
+    if x != 0.0 && (x.abs() < 1e-3 || x.abs() >= 1e5) {
+        return format!("{x:.3e}");
+    }
+    let digits = (3 - x.abs().max(1e-300).log10().floor() as i32).clamp(0, 6) as usize;
+    let t = format!("{x:.digits$}");
+    if t.contains('.') {
+        t.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        t
+    }
+}
+
 /// For each series, the earlier series it coincides with, if any.
 fn coinciding(series: &[Prepared]) -> Vec<Option<usize>> {
     series
@@ -371,6 +408,44 @@ pub fn line_plot(base: &Path, plot: &LinePlot) -> Result<(), PlotError> {
             notes.push(format!("note: {} coincides with {} (drawn dashed)", name(i), name(j)));
         }
     }
+    // Series that share part of their curve: the hidden part is named. On
+    // the plot, "the same" is within 0.2% of the data's y span (under a
+    // pixel of the plotting area).
+    let twins = coinciding(&series);
+    let ys = series.iter().flat_map(|s| s.points.iter().map(|p| p.1));
+    let (y_lo, y_hi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| (lo.min(y), hi.max(y)));
+    let tol = if y_hi > y_lo { 2e-3 * (y_hi - y_lo) } else { 0.0 };
+    for i in 0..series.len() {
+        if twins[i].is_some() {
+            continue;
+        }
+        for j in 0..i {
+            let hidden = overlap(&series[j], &series[i], tol);
+            if !hidden.is_empty() {
+                let name = |k: usize| {
+                    let n = &series[k].name;
+                    if n.is_empty() {
+                        format!("series {}", k + 1)
+                    } else {
+                        n.clone()
+                    }
+                };
+                // Back from the axis's coordinate to the data's.
+                let data = |x: f64| if plot.log_x { 10f64.powf(x) } else { x };
+                let spans: Vec<String> = hidden
+                    .iter()
+                    .map(|&(lo, hi)| format!("{} to {}", short(data(lo)), short(data(hi))))
+                    .collect();
+                notes.push(format!(
+                    "note: {} lies on {} from x = {}",
+                    name(i),
+                    name(j),
+                    spans.join(" and from ")
+                ));
+                break;
+            }
+        }
+    }
     render_both(
         base,
         |r| draw(r, plot, &series, &notes),
@@ -499,6 +574,58 @@ mod tests {
         let svg = std::fs::read_to_string(base.with_extension("svg")).unwrap();
         assert!(
             svg.contains("four coincides with one (drawn dashed)"),
+            "the note is on the plot"
+        );
+    }
+
+    #[test]
+    fn series_sharing_part_of_their_curve_are_noted_with_the_range() {
+        let a = prepared("FIFO 1", &[(0.5, 1.0), (1.0, 1.0), (2.0, 0.8), (4.0, 0.5)]);
+        let b = prepared("FIFO 64", &[(0.5, 1.0), (1.0, 1.0), (2.0, 0.9), (4.0, 0.6)]);
+        let c = prepared("apart", &[(0.5, 0.1), (1.0, 0.2)]);
+        // One shared point is not a hidden segment.
+        let d = prepared("crossing", &[(0.5, 0.5), (1.0, 1.0), (2.0, 2.0)]);
+        assert_eq!(overlap(&a, &b, 1e-9), vec![(0.5, 1.0)]);
+        assert_eq!(overlap(&a, &c, 1e-9), vec![]);
+        assert_eq!(overlap(&a, &d, 1e-9), vec![]);
+        // Within the tolerance the rest is hidden too.
+        assert_eq!(overlap(&a, &b, 0.2), vec![(0.5, 4.0)]);
+        // Two runs apart are two ranges.
+        let e = prepared(
+            "apart in the middle",
+            &[(0.5, 1.0), (1.0, 1.0), (2.0, 0.2), (4.0, 0.5), (8.0, 0.5)],
+        );
+        let f = prepared(
+            "FIFO 1 longer",
+            &[(0.5, 1.0), (1.0, 1.0), (2.0, 0.8), (4.0, 0.5), (8.0, 0.5)],
+        );
+        assert_eq!(overlap(&f, &e, 1e-9), vec![(0.5, 1.0), (4.0, 8.0)]);
+        assert_eq!(
+            (short(0.5), short(1.0), short(12.25), short(1234.6), short(2e-5)),
+            (
+                "0.5".to_string(),
+                "1".to_string(),
+                "12.25".to_string(),
+                "1235".to_string(),
+                "2.000e-5".to_string()
+            )
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let base = dir.path().join("partial");
+        let series = |name: &str, last: f64| Series {
+            name: name.into(),
+            points: vec![(0.5, 1.0), (1.0, 1.0), (2.0, last)],
+            ci: None,
+        };
+        let plot = LinePlot {
+            title: "t".into(),
+            series: vec![series("FIFO 1", 0.8), series("FIFO 64", 0.9)],
+            ..LinePlot::default()
+        };
+        line_plot(&base, &plot).unwrap();
+        let svg = std::fs::read_to_string(base.with_extension("svg")).unwrap();
+        assert!(
+            svg.contains("FIFO 64 lies on FIFO 1 from x = 0.5 to 1"),
             "the note is on the plot"
         );
     }
