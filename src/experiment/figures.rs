@@ -69,9 +69,10 @@ pub(crate) fn draw(
             range,
             filter,
             marks,
+            marks_above_min,
         } => {
             let c = columns.iter().position(|k| k == column);
-            let values = points
+            let values: Vec<(String, Vec<f64>)> = points
                 .iter()
                 .filter(|p| p.matches(filter))
                 .map(|p| {
@@ -79,13 +80,14 @@ pub(crate) fn draw(
                     (p.plot_label(&exp.sweeps), v)
                 })
                 .collect();
+            let marks = histogram_marks(marks, marks_above_min, &values);
             let h = Histogram {
                 title: spec.title.clone(),
                 x_label: spec.x_label.clone(),
                 values,
                 bins: *bins,
                 range: *range,
-                marks: marks.clone(),
+                marks,
             };
             histogram(&base, &h)?;
             Ok(h.outside_range_notes())
@@ -342,4 +344,27 @@ fn x_categories(sweep: &Sweep) -> Vec<(f64, String)> {
     } else {
         Vec::new()
     }
+}
+
+/// A histogram's marks: those at a value, then those at a width above the
+/// lowest finite value plotted (over every group; with no values there is
+/// no minimum, and no such mark).
+pub(crate) fn histogram_marks(
+    at: &[crate::plot::Mark],
+    above_min: &[crate::plot::Mark],
+    values: &[(String, Vec<f64>)],
+) -> Vec<crate::plot::Mark> {
+    let lowest = values
+        .iter()
+        .flat_map(|(_, v)| v.iter().copied())
+        .filter(|v| v.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    let mut marks = at.to_vec();
+    if lowest.is_finite() {
+        marks.extend(above_min.iter().map(|m| crate::plot::Mark {
+            at: lowest + m.at,
+            label: m.label.clone(),
+        }));
+    }
+    marks
 }

@@ -85,6 +85,10 @@ pub enum PlotKind {
         filter: Vec<(String, toml::Value)>,
         /// Values marked with a labelled vertical line (the paper's numbers).
         marks: Vec<crate::plot::Mark>,
+        /// Marks at a width above the lowest value plotted (`at` holds the
+        /// width): a paper's constant measured from the minimum, such as
+        /// paper 000's c.
+        marks_above_min: Vec<crate::plot::Mark>,
     },
     /// Grouped bars: one group per `y` path (metric or derived name), one
     /// bar per point (those `filter` keeps) and one per `paper` entry.

@@ -252,13 +252,14 @@ impl Validator<'_> {
             None => Vec::new(),
         };
         let range = self.histogram_range(key, &p.range)?;
-        let marks = self.histogram_marks(key, &p.marks)?;
+        let (marks, marks_above_min) = self.histogram_marks(key, &p.marks)?;
         Ok(PlotKind::Histogram {
             column,
             bins: bins as usize,
             range,
             filter: f,
             marks,
+            marks_above_min,
         })
     }
 
@@ -284,30 +285,41 @@ impl Validator<'_> {
         })
     }
 
-    /// A histogram's `marks`: at most 16, each at a finite x with a label of 1 to 80 characters.
+    /// A histogram's `marks`: at most 16, each with a label of 1 to 80
+    /// characters and either a finite `at` or a finite, non-negative
+    /// `above_min` (returned apart, the width in `at`).
+    #[allow(clippy::type_complexity)]
     fn histogram_marks(
         &self,
         key: &str,
         raw: &Option<Vec<RawMark>>,
-    ) -> Result<Vec<crate::plot::Mark>, ExperimentError> {
-        let mut marks = Vec::new();
+    ) -> Result<(Vec<crate::plot::Mark>, Vec<crate::plot::Mark>), ExperimentError> {
+        let (mut marks, mut above) = (Vec::new(), Vec::new());
         for (i, m) in raw.iter().flatten().enumerate() {
             let mkey = format!("{key}.marks.{i}");
-            if !m.at.is_finite() {
-                return Err(self.err(format!("{mkey}.at"), "must be a finite number"));
-            }
             if m.label.trim().is_empty() || m.label.chars().count() > 80 {
                 return Err(self.err(format!("{mkey}.label"), "must be 1 to 80 characters"));
             }
             if i >= 16 {
                 return Err(self.err(format!("{key}.marks"), "at most 16 marks"));
             }
-            marks.push(crate::plot::Mark {
-                at: m.at,
-                label: m.label.clone(),
-            });
+            let label = m.label.clone();
+            match (m.at, m.above_min) {
+                (Some(at), None) if at.is_finite() => marks.push(crate::plot::Mark { at, label }),
+                (Some(_), None) => return Err(self.err(format!("{mkey}.at"), "must be a finite number")),
+                (None, Some(w)) if w.is_finite() && w >= 0.0 => above.push(crate::plot::Mark { at: w, label }),
+                (None, Some(_)) => {
+                    return Err(self.err(format!("{mkey}.above_min"), "must be a finite number, 0 or more"));
+                }
+                _ => {
+                    return Err(self.err(
+                        mkey,
+                        "needs `at` (a value) or `above_min` (a width above the lowest value plotted), not both",
+                    ));
+                }
+            }
         }
-        Ok(marks)
+        Ok((marks, above))
     }
 
     /// A scatter plot's x and y (one metric path each) and scales.

@@ -155,11 +155,13 @@ pub(super) struct RawPaperValue {
     pub(super) values: Option<Vec<f64>>,
 }
 
-/// A value marked on a histogram: `{ at = 337.0, label = "paper: best 337 ms" }`.
+/// A value marked on a histogram: `{ at = 337.0, label = "paper: best 337 ms" }`,
+/// or a width above the lowest value plotted: `{ above_min = 1.52, label = "..." }`.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawMark {
-    pub(super) at: f64,
+    pub(super) at: Option<f64>,
+    pub(super) above_min: Option<f64>,
     pub(super) label: String,
 }
 

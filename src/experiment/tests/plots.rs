@@ -99,6 +99,63 @@ fn histogram_marks_are_parsed_and_validated() {
 }
 
 #[test]
+fn histogram_marks_above_the_minimum_are_parsed_apart_and_validated() {
+    let hist = |extra: &str| {
+        format!("name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"FrameTime\"\n{extra}")
+    };
+    let exp = parse(&hist(
+        "marks = [{ at = 11.92, label = \"axis\" }, { above_min = 1.52, label = \"paper c\" }]\n",
+    ));
+    let PlotKind::Histogram {
+        marks, marks_above_min, ..
+    } = &exp.plots[0].kind
+    else {
+        panic!("a histogram")
+    };
+    assert_eq!(marks.iter().map(|m| m.at).collect::<Vec<_>>(), [11.92]);
+    assert_eq!(
+        marks_above_min
+            .iter()
+            .map(|m| (m.at, m.label.as_str()))
+            .collect::<Vec<_>>(),
+        [(1.52, "paper c")]
+    );
+    for (bad, want) in [
+        (
+            "marks = [{ above_min = -1, label = \"x\" }]\n",
+            "marks.0.above_min`: must be a finite number, 0 or more",
+        ),
+        ("marks = [{ above_min = nan, label = \"x\" }]\n", "marks.0.above_min"),
+        ("marks = [{ at = 1, above_min = 1, label = \"x\" }]\n", "not both"),
+        ("marks = [{ label = \"x\" }]\n", "needs `at` (a value) or `above_min`"),
+    ] {
+        let e = parse_err(&hist(bad));
+        assert!(e.contains(want), "{bad}: {e}");
+    }
+}
+
+#[test]
+fn marks_above_the_minimum_sit_at_the_lowest_value_plotted() {
+    use crate::experiment::figures::histogram_marks;
+    use crate::plot::Mark;
+    let mark = |at: f64, label: &str| Mark {
+        at,
+        label: label.into(),
+    };
+    let values = vec![
+        ("a".to_string(), vec![12.5, 12.1, f64::NAN]),
+        ("b".to_string(), vec![f64::NEG_INFINITY, 12.3, 14.0]),
+    ];
+    let got = histogram_marks(&[mark(11.92, "axis")], &[mark(1.52, "paper c")], &values);
+    assert_eq!(got.len(), 2);
+    assert_eq!((got[0].at, got[0].label.as_str()), (11.92, "axis"));
+    assert!((got[1].at - (12.1 + 1.52)).abs() < 1e-12 && got[1].label == "paper c");
+    // Nothing plotted: no minimum to measure from.
+    let none = histogram_marks(&[], &[mark(1.52, "paper c")], &[("a".into(), vec![f64::NAN])]);
+    assert!(none.is_empty());
+}
+
+#[test]
 fn histogram_range_is_parsed_and_validated() {
     let hist = |extra: &str| {
         format!("name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"FrameTime\"\n{extra}")

@@ -4,6 +4,7 @@ use std::path::Path;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::PlotError;
 use super::axis::{coord, format_number, omitted_note, ticks, widen};
@@ -184,6 +185,14 @@ struct Layout {
     grown: bool,
 }
 
+/// Whether mark `m`'s label is drawn left of its line: when, at about 7 px
+/// a character on a 900 px plot area, it would run past the right edge of
+/// the x range `x`.
+fn label_goes_left(m: &Mark, x: (f64, f64)) -> bool {
+    let chars = m.label.chars().count() as f64 + 1.0;
+    (m.at - x.0) / (x.1 - x.0) + chars * 7.0 / 900.0 > 1.0
+}
+
 /// Where mark `i`'s label is drawn: its height as a fraction of the plot
 /// area (stacked down from the top, below a legend band `band`).
 fn mark_label_y(i: usize, band: f64) -> f64 {
@@ -220,12 +229,17 @@ fn layout(h: &Histogram, b: &Binned) -> Layout {
                 }
             }
         }
-        // Mark labels: about 7 px per character right of the line.
+        // Mark labels: about 7 px per character right of the line (left of
+        // it near the right edge).
         for (i, m) in marks.iter().enumerate() {
             let y = mark_label_y(i, band);
             let chars = m.label.chars().count() as f64 + 1.0;
+            let side = if label_goes_left(m, x) { -1.0 } else { 1.0 };
             for k in 0..=8 {
-                occ.push(Occupied::point(fx(m.at) + k as f64 / 8.0 * chars * 7.0 / 900.0, y));
+                occ.push(Occupied::point(
+                    fx(m.at) + side * k as f64 / 8.0 * chars * 7.0 / 900.0,
+                    y,
+                ));
             }
         }
         occ
@@ -325,12 +339,16 @@ fn draw<DB: DrawingBackend>(
             ))
             .map_err(e)?;
         let y = ymax * mark_label_y(i, band);
+        // Right of the line, or left of it where the label would run past
+        // the plot's right edge.
+        let font = (FAMILY, LABEL_PX).into_font().color(&BLACK);
+        let (text, font) = if label_goes_left(m, l.x) {
+            (format!("{} ", m.label), font.pos(Pos::new(HPos::Right, VPos::Top)))
+        } else {
+            (format!(" {}", m.label), font)
+        };
         chart
-            .draw_series(std::iter::once(Text::new(
-                format!(" {}", m.label),
-                (m.at, y),
-                (FAMILY, LABEL_PX).into_font().color(&BLACK),
-            )))
+            .draw_series(std::iter::once(Text::new(text, (m.at, y), font)))
             .map_err(e)?;
     }
     if any_legend {
@@ -415,6 +433,17 @@ mod tests {
         )
         .unwrap();
         assert_plot_files(&base);
+    }
+
+    #[test]
+    fn a_mark_label_near_the_right_edge_goes_left_of_its_line() {
+        let m = |at: f64| Mark {
+            at,
+            label: "paper c = 1.52 ms above the lowest frame plotted".into(),
+        };
+        // 49 characters at about 7 px on a 900 px area: 38% of the width.
+        assert!(!label_goes_left(&m(12.0), (11.8, 14.1)));
+        assert!(label_goes_left(&m(13.5), (11.8, 14.1)));
     }
 
     #[test]
