@@ -46,6 +46,16 @@ impl CheckOutcome {
         (r != 0.0 && r.is_finite()).then(|| e / r.abs())
     }
 
+    /// The measured value over the expected one as report text, `0.946x`
+    /// (the paper's value beside the simulated one, as a ratio); empty for
+    /// a check against bounds, without a measurement, or against 0.
+    pub fn ratio_text(&self) -> String {
+        match (self.measured, self.expect) {
+            (Some(m), Some(e)) if e != 0.0 && (m / e).is_finite() => format!("{:.3}x", m / e),
+            _ => String::new(),
+        }
+    }
+
     /// The error as report text: `+0.5 (+0.68%)`, `0 (inside the bounds)`, or `n/a`.
     pub fn error_text(&self) -> String {
         match (self.error, self.relative_error()) {
@@ -180,6 +190,21 @@ mod tests {
         assert_eq!(o.tolerance_text, "±1%");
         assert!(!evaluate("m", "p", None, 1.0, Tolerance::Absolute(10.0)).passed);
         assert!(!evaluate("m", "p", Some(f64::NAN), 1.0, Tolerance::Absolute(10.0)).passed);
+    }
+
+    #[test]
+    fn the_ratio_is_measured_over_expected_where_there_is_one() {
+        let r = |m: Option<f64>, e: f64| evaluate("m", "p", m, e, Tolerance::Relative(0.1)).ratio_text();
+        assert_eq!(r(Some(9.573), 9.143), "1.047x");
+        assert_eq!(r(Some(1.0), 0.0), "");
+        assert_eq!(r(None, 1.0), "");
+        assert_eq!(r(Some(f64::NAN), 1.0), "");
+        let bound = Some(Bound {
+            path: "",
+            value: Some(1.0),
+        });
+        let b = evaluate_between("t", "p", Some(2.0), bound, None, Tolerance::Absolute(0.0));
+        assert_eq!(b.ratio_text(), "", "a bound is not a paper value");
     }
 
     #[test]

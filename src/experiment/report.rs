@@ -342,17 +342,18 @@ fn claims(s: &mut String, r: &ExperimentResult) {
         }
         let _ = writeln!(
             s,
-            "\n| claim | value | point | measured | expected | tolerance | error | verdict |\n|---|---|---|---|---|---|---|---|"
+            "\n| claim | value | point | measured | expected | measured / expected | tolerance | error | verdict |\n|---|---|---|---|---|---|---|---|---|"
         );
         for c in r.checks.iter().filter(|c| c.claim.is_some()) {
             let _ = writeln!(
                 s,
-                "| {} | `{}` | {} | {} | {} | {} | {} | {} |",
+                "| {} | `{}` | {} | {} | {} | {} | {} | {} | {} |",
                 cell(c.claim.as_deref().unwrap_or_default()),
                 c.path,
                 cell(&c.point),
                 c.measured.map(fmt_precise).unwrap_or_else(|| "n/a".into()),
                 cell(&c.expected_text),
+                c.ratio_text(),
                 c.tolerance_text,
                 cell(&c.error_text()),
                 if c.passed { "holds" } else { "does not hold" }
@@ -370,18 +371,19 @@ fn checks(s: &mut String, r: &ExperimentResult) {
             s,
             "## Checks\n\n{} of {} passed. `error` is measured minus expected (for bounds: the distance \
              beyond the bound, 0 inside), relative to the expected value or bound.\n\n\
-             | value | point | measured | expected | tolerance | error | result |\n|---|---|---|---|---|---|---|",
+             | value | point | measured | expected | measured / expected | tolerance | error | result |\n|---|---|---|---|---|---|---|---|",
             tests.len() - r.checks_failed,
             tests.len()
         );
         for c in tests {
             let _ = writeln!(
                 s,
-                "| `{}` | {} | {} | {} | {} | {} | {} |",
+                "| `{}` | {} | {} | {} | {} | {} | {} | {} |",
                 c.path,
                 cell(&c.point),
                 c.measured.map(fmt_precise).unwrap_or_else(|| "n/a".into()),
                 cell(&c.expected_text),
+                c.ratio_text(),
                 c.tolerance_text,
                 cell(&c.error_text()),
                 if c.passed { "PASS" } else { "**FAIL**" }
