@@ -6,7 +6,9 @@
 //! test, so a command added to the README gets a run here. `measure` and
 //! `study` need a build with `--features wgpu` and a Vulkan adapter; CI
 //! runs them in their own steps (scripts/test-all.sh), and they are only
-//! named here.
+//! named here. The commands the README's prose shows (`` `rendersim run
+//! models/fixed.toml --set workload.gpu=17ms` ``, ...) run too, as written
+//! where they can be.
 
 use std::path::Path;
 use std::process::Command;
@@ -231,4 +233,109 @@ fn every_command_the_readme_shows_runs() {
             "no README line starts {start:?}"
         );
     }
+}
+
+/// The README's prose commands: each `` `rendersim ...` `` span outside the
+/// fenced blocks with arguments past its subcommand (`` `rendersim vcache` ``
+/// alone names a command; it does not show one to run).
+fn readme_prose_commands() -> Vec<String> {
+    let readme = std::fs::read_to_string(Path::new(ROOT).join("README.md")).unwrap();
+    // Outside fences: the even-numbered parts between ``` marks.
+    let prose: String = readme.split("```").step_by(2).collect::<Vec<_>>().join("\n");
+    prose
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .map(|span| span.split_whitespace().collect::<Vec<_>>().join(" "))
+        .filter(|span| span.starts_with("rendersim ") && span.split(' ').count() >= 3)
+        .collect()
+}
+
+/// A word that stands for an input: `DIR`, `FILE`, `DIR/model.toml`,
+/// `experiments/NAME.toml` (a path part, before its extension, in capitals).
+fn placeholder(word: &str) -> bool {
+    word.split('/').any(|part| {
+        let stem = part.split('.').next().unwrap_or_default();
+        stem.len() >= 3 && stem.chars().all(|c| c.is_ascii_uppercase() || c == '_')
+    })
+}
+
+#[test]
+fn every_command_the_readmes_prose_shows_runs() {
+    // The prose's commands run as written (from the repository root; none
+    // writes a file), except those with a placeholder or a long run, which
+    // run in the concrete form given here (outputs in a temporary folder).
+    // A prose command with a placeholder and no form here fails the test.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap().to_string();
+    let forms: &[(&str, &[&[&str]])] = &[
+        // The hour at a thousandth of its length.
+        ("rendersim bench hour", &[&["bench", "hour", "--scale", "0.001"]]),
+        (
+            "rendersim run DIR/model.toml",
+            &[
+                &["run", "models/fixed.toml", "--frames", "20", "--out", "{out}/run"],
+                &["run", "{out}/run/model.toml", "--frames", "20"],
+            ],
+        ),
+        (
+            "rendersim experiment experiments/NAME.toml",
+            &[&[
+                "experiment",
+                "experiments/vsync-quantization.toml",
+                "--quiet",
+                "--out",
+                "{out}/named",
+            ]],
+        ),
+        (
+            "rendersim experiment FILE --quiet",
+            &[&[
+                "experiment",
+                "experiments/vsync-quantization.toml",
+                "--quiet",
+                "--out",
+                "{out}/exp",
+            ]],
+        ),
+    ];
+    let commands = readme_prose_commands();
+    assert!(
+        commands
+            .iter()
+            .any(|c| c == "rendersim run models/fixed.toml --set workload.gpu=17ms"),
+        "{commands:?}"
+    );
+    for command in &commands {
+        let runs: Vec<Vec<String>> = match forms.iter().find(|(c, _)| c == command) {
+            Some((_, runs)) => runs
+                .iter()
+                .map(|r| r.iter().map(|a| a.replace("{out}", &out)).collect())
+                .collect(),
+            None => {
+                let words: Vec<String> = command.split(' ').skip(1).map(str::to_string).collect();
+                assert!(
+                    !words.iter().any(|w| placeholder(w)),
+                    "README prose command with a placeholder and no concrete form here: {command}"
+                );
+                vec![words]
+            }
+        };
+        for args in runs {
+            let o = Command::new(env!("CARGO_BIN_EXE_rendersim"))
+                .current_dir(ROOT)
+                .args(&args)
+                .output()
+                .unwrap();
+            assert!(
+                o.status.success(),
+                "README: {command}\nran: rendersim {}\nexit {:?}: {}",
+                args.join(" "),
+                o.status.code(),
+                String::from_utf8_lossy(&o.stderr)
+            );
+        }
+    }
+    assert!(placeholder("DIR/model.toml") && placeholder("FILE") && placeholder("experiments/NAME.toml"));
+    assert!(!placeholder("models/fixed.toml") && !placeholder("workload.gpu=17ms") && !placeholder("--quiet"));
 }
