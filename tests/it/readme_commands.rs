@@ -210,18 +210,7 @@ fn every_command_the_readme_shows_runs() {
             .unwrap_or_else(|| panic!("README command not run by this test: {line}"));
         let Some(args) = case.1 else { continue };
         let args: Vec<String> = args.iter().map(|a| a.replace("{out}", out)).collect();
-        let o = Command::new(env!("CARGO_BIN_EXE_rendersim"))
-            .current_dir(ROOT)
-            .args(&args)
-            .output()
-            .unwrap();
-        assert!(
-            o.status.success(),
-            "README: {line}\nran: rendersim {}\nexit {:?}: {}",
-            args.join(" "),
-            o.status.code(),
-            String::from_utf8_lossy(&o.stderr)
-        );
+        runs_ok(line, &args);
         ran += 1;
     }
     assert!(ran >= 15, "{ran}");
@@ -233,6 +222,23 @@ fn every_command_the_readme_shows_runs() {
             "no README line starts {start:?}"
         );
     }
+}
+
+/// Runs `rendersim ARGS` from the repository root; it must exit 0 (the
+/// failure names the README's `line`, what ran and its error output).
+fn runs_ok(line: &str, args: &[String]) {
+    let o = Command::new(env!("CARGO_BIN_EXE_rendersim"))
+        .current_dir(ROOT)
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "README: {line}\nran: rendersim {}\nexit {:?}: {}",
+        args.join(" "),
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr)
+    );
 }
 
 /// The README's prose commands: each `` `rendersim ...` `` span outside the
@@ -322,18 +328,7 @@ fn every_command_the_readmes_prose_shows_runs() {
             }
         };
         for args in runs {
-            let o = Command::new(env!("CARGO_BIN_EXE_rendersim"))
-                .current_dir(ROOT)
-                .args(&args)
-                .output()
-                .unwrap();
-            assert!(
-                o.status.success(),
-                "README: {command}\nran: rendersim {}\nexit {:?}: {}",
-                args.join(" "),
-                o.status.code(),
-                String::from_utf8_lossy(&o.stderr)
-            );
+            runs_ok(command, &args);
         }
     }
     assert!(placeholder("DIR/model.toml") && placeholder("FILE") && placeholder("experiments/NAME.toml"));

@@ -185,6 +185,14 @@ fn overlap(a: &Prepared, b: &Prepared, tol: f64) -> Vec<(f64, f64)> {
     ranges
 }
 
+/// Series `k`'s name in a note ("series k+1" when it has none).
+fn series_name(series: &[Prepared], k: usize) -> String {
+    match series[k].name.as_str() {
+        "" => format!("series {}", k + 1),
+        n => n.to_string(),
+    }
+}
+
 /// A number for a note: at most four significant digits, no trailing zeros.
 fn short(x: f64) -> String {
     if x != 0.0 && (x.abs() < 1e-3 || x.abs() >= 1e5) {
@@ -395,16 +403,9 @@ pub fn line_plot(base: &Path, plot: &LinePlot) -> Result<(), PlotError> {
     if series.iter().all(|s| s.points.is_empty()) {
         notes.push("note: no data".into());
     }
+    let name = |k: usize| series_name(&series, k);
     for (i, twin) in coinciding(&series).into_iter().enumerate() {
         if let Some(j) = twin {
-            let name = |k: usize| {
-                let n = &series[k].name;
-                if n.is_empty() {
-                    format!("series {}", k + 1)
-                } else {
-                    n.clone()
-                }
-            };
             notes.push(format!("note: {} coincides with {} (drawn dashed)", name(i), name(j)));
         }
     }
@@ -422,14 +423,6 @@ pub fn line_plot(base: &Path, plot: &LinePlot) -> Result<(), PlotError> {
         for j in 0..i {
             let hidden = overlap(&series[j], &series[i], tol);
             if !hidden.is_empty() {
-                let name = |k: usize| {
-                    let n = &series[k].name;
-                    if n.is_empty() {
-                        format!("series {}", k + 1)
-                    } else {
-                        n.clone()
-                    }
-                };
                 // Back from the axis's coordinate to the data's.
                 let data = |x: f64| if plot.log_x { 10f64.powf(x) } else { x };
                 let spans: Vec<String> = hidden
@@ -558,24 +551,31 @@ mod tests {
         let b = prepared("four shaders", &[(1.0, 2.0), (2.0, 3.0 + 1e-12)]);
         let c = prepared("other", &[(1.0, 2.0), (2.0, 3.5)]);
         assert_eq!(coinciding(&[a, b, c]), vec![None, Some(0), None]);
-        let dir = tempfile::tempdir().unwrap();
-        let base = dir.path().join("twins");
-        let series = |name: &str, y: f64| Series {
-            name: name.into(),
-            points: vec![(1.0, 1.0), (2.0, y)],
-            ci: None,
-        };
-        let plot = LinePlot {
-            title: "t".into(),
-            series: vec![series("one", 2.0), series("four", 2.0)],
-            ..LinePlot::default()
-        };
-        line_plot(&base, &plot).unwrap();
-        let svg = std::fs::read_to_string(base.with_extension("svg")).unwrap();
+        let svg = drawn(&[("one", &[(1.0, 1.0), (2.0, 2.0)]), ("four", &[(1.0, 1.0), (2.0, 2.0)])]);
         assert!(
             svg.contains("four coincides with one (drawn dashed)"),
             "the note is on the plot"
         );
+    }
+
+    /// The SVG of a line plot of these named series.
+    fn drawn(series: &[(&str, &[(f64, f64)])]) -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let base = dir.path().join("drawn");
+        let plot = LinePlot {
+            title: "t".into(),
+            series: series
+                .iter()
+                .map(|(name, points)| Series {
+                    name: name.to_string(),
+                    points: points.to_vec(),
+                    ci: None,
+                })
+                .collect(),
+            ..LinePlot::default()
+        };
+        line_plot(&base, &plot).unwrap();
+        std::fs::read_to_string(base.with_extension("svg")).unwrap()
     }
 
     #[test]
@@ -610,20 +610,10 @@ mod tests {
                 "2.000e-5".to_string()
             )
         );
-        let dir = tempfile::tempdir().unwrap();
-        let base = dir.path().join("partial");
-        let series = |name: &str, last: f64| Series {
-            name: name.into(),
-            points: vec![(0.5, 1.0), (1.0, 1.0), (2.0, last)],
-            ci: None,
-        };
-        let plot = LinePlot {
-            title: "t".into(),
-            series: vec![series("FIFO 1", 0.8), series("FIFO 64", 0.9)],
-            ..LinePlot::default()
-        };
-        line_plot(&base, &plot).unwrap();
-        let svg = std::fs::read_to_string(base.with_extension("svg")).unwrap();
+        let svg = drawn(&[
+            ("FIFO 1", &[(0.5, 1.0), (1.0, 1.0), (2.0, 0.8)]),
+            ("FIFO 64", &[(0.5, 1.0), (1.0, 1.0), (2.0, 0.9)]),
+        ]);
         assert!(
             svg.contains("FIFO 64 lies on FIFO 1 from x = 0.5 to 1"),
             "the note is on the plot"
