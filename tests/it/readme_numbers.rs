@@ -288,6 +288,8 @@ fn the_models_doc_states_what_the_geforce3_experiments_give() {
     // docs/models.md, "Paper 000 on the GeForce3": Table 1 on the split
     // pipeline, Table 3's two predictions and Table 4's parallel cells.
     let doc = std::fs::read_to_string(Path::new(ROOT).join("docs/models.md")).unwrap();
+    // The text with its line breaks as spaces, for sentences the docs wrap.
+    let flat = doc.split_whitespace().collect::<Vec<_>>().join(" ");
     let t1s = [
         ("gpu.geometry.vertex_shader", "79636ps"),
         ("gpu.fragment.per_fragment", "8123ps"),
@@ -336,7 +338,6 @@ fn the_models_doc_states_what_the_geforce3_experiments_give() {
             )
         },
     ] {
-        let flat = doc.split_whitespace().collect::<Vec<_>>().join(" ");
         assert!(
             doc.contains(&text) || flat.contains(&text),
             "docs/models.md should say {text:?}"

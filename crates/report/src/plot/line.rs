@@ -404,15 +404,15 @@ pub fn line_plot(base: &Path, plot: &LinePlot) -> Result<(), PlotError> {
         notes.push("note: no data".into());
     }
     let name = |k: usize| series_name(&series, k);
-    for (i, twin) in coinciding(&series).into_iter().enumerate() {
-        if let Some(j) = twin {
+    let twins = coinciding(&series);
+    for (i, twin) in twins.iter().enumerate() {
+        if let &Some(j) = twin {
             notes.push(format!("note: {} coincides with {} (drawn dashed)", name(i), name(j)));
         }
     }
     // Series that share part of their curve: the hidden part is named. On
     // the plot, "the same" is within 0.2% of the data's y span (under a
     // pixel of the plotting area).
-    let twins = coinciding(&series);
     let ys = series.iter().flat_map(|s| s.points.iter().map(|p| p.1));
     let (y_lo, y_hi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| (lo.min(y), hi.max(y)));
     let tol = if y_hi > y_lo { 2e-3 * (y_hi - y_lo) } else { 0.0 };

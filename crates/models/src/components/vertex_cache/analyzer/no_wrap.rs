@@ -28,6 +28,26 @@ use super::{Counts, OutOfRange, Policy};
 /// them). Tests use small blocks so that every boundary is crossed.
 const CHECKED: usize = if cfg!(test) { 5 } else { 1024 };
 
+/// `$portable(x)` compiled with AVX2 where the processor has it (one
+/// runtime check), as written otherwise: the body of a slice scan that
+/// the compiler vectorises.
+macro_rules! avx2_or_portable {
+    ($portable:ident, $x:expr, $out:ty) => {{
+        #[cfg(target_arch = "x86_64")]
+        {
+            #[target_feature(enable = "avx2")]
+            fn avx2(x: &[u32]) -> $out {
+                $portable(x)
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the processor has AVX2, checked just above.
+                return unsafe { avx2($x) };
+            }
+        }
+        $portable($x)
+    }};
+}
+
 /// The largest of `x` (0 when empty): AVX2's unsigned maximum where the
 /// processor has it, the portable loop otherwise.
 fn largest(x: &[u32]) -> u32 {
@@ -35,18 +55,7 @@ fn largest(x: &[u32]) -> u32 {
     fn portable(x: &[u32]) -> u32 {
         x.iter().copied().fold(0, u32::max)
     }
-    #[cfg(target_arch = "x86_64")]
-    {
-        #[target_feature(enable = "avx2")]
-        fn avx2(x: &[u32]) -> u32 {
-            portable(x)
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the processor has AVX2, checked just above.
-            return unsafe { avx2(x) };
-        }
-    }
-    portable(x)
+    avx2_or_portable!(portable, x, u32)
 }
 
 /// How many of `stamps` are not zero: the unique vertices (a stamp is the
@@ -60,18 +69,7 @@ pub(super) fn stamped(stamps: &[u32]) -> u64 {
             .map(|c| u64::from(c.iter().map(|&s| u32::from(s != 0)).sum::<u32>()))
             .sum()
     }
-    #[cfg(target_arch = "x86_64")]
-    {
-        #[target_feature(enable = "avx2")]
-        fn avx2(x: &[u32]) -> u64 {
-            portable(x)
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the processor has AVX2, checked just above.
-            return unsafe { avx2(stamps) };
-        }
-    }
-    portable(stamps)
+    avx2_or_portable!(portable, stamps, u64)
 }
 
 /// Whether a list of `triangles` can be run by [`run`]: the most its clock
