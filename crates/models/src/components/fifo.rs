@@ -122,6 +122,7 @@ impl<T> BoundedFifo<T> {
     }
 
     /// The oldest entry, without taking it.
+    #[inline]
     pub fn front(&self) -> Option<&T> {
         self.items.front().map(|(t, _)| t)
     }
@@ -198,6 +199,7 @@ impl<T> Ring<T> {
         item
     }
 
+    #[inline]
     fn front(&self) -> Option<&T> {
         if self.len == 0 {
             return None;

@@ -61,7 +61,7 @@ impl<const N: usize> StateClock<N> {
 
     /// Moves to `state` at `now`; returns the time spent in the old state
     /// (zero if the state does not change, in which case nothing happens).
-    #[inline]
+    #[inline(always)]
     pub fn set(&mut self, now: Time, state: usize) -> Duration {
         if state == self.state {
             return Duration::ZERO;

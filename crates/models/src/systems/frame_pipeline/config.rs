@@ -491,6 +491,7 @@ impl FragmentConfig {
     }
 
     /// Whether a draw's fragments wait for all of its geometry.
+    #[inline]
     pub fn binned(&self) -> bool {
         self.binning == Binning::Draw
     }
