@@ -35,7 +35,7 @@ macro_rules! order_by_picoseconds {
         impl PartialOrd for $t {
             #[inline(always)]
             fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-                Some(self.0.cmp(&other.0))
+                Some(self.cmp(other))
             }
             #[inline(always)]
             fn lt(&self, other: &Self) -> bool {
