@@ -74,7 +74,7 @@ pub enum TimelineError {
     Trace(String),
 }
 
-/// Tracks of the frame pipeline's trace (see `accounting::PipelineTrace`).
+/// Tracks of the frame pipeline's trace (see `pipeline_trace::PipelineTrace`).
 const CPU: u32 = 1;
 const FRONT: u32 = 2;
 const GEOMETRY: u32 = 3;

@@ -39,6 +39,7 @@ mod front_end;
 mod geometry_stage;
 mod links;
 pub mod model;
+pub mod pipeline_trace;
 mod quiet;
 pub mod records;
 pub mod report;

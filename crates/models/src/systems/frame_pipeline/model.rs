@@ -7,7 +7,7 @@
 //! through the command buffer; idle time when it is full or empty) and paper
 //! 004 §4.2 (vsync and double buffering). Each unit is a struct of its own
 //! that owns its state and the transitions that change it: the CPU thread
-//! (`cpu_thread.rs`), the front end (`front_end.rs`), the geometry and
+//! (`cpu_thread/`), the front end (`front_end.rs`), the geometry and
 //! fragment stages (`geometry_stage.rs`, `fragment_stage.rs`) and the
 //! display (`display.rs`); the FIFOs, the shader pool and the swap chain
 //! between them are the `Links` (`links.rs`), passed to the units'

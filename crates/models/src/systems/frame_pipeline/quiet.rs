@@ -30,7 +30,7 @@
 //! directly in their common case ([`FrontEnd::handoff_fast`](super::front_end::FrontEnd::handoff_fast): the held draw
 //! goes to geometry, the next draw command's front-end job starts), and the CPU's
 //! accounting is skipped when the CPU took no step. The CPU's own common
-//! instants have the same kind of direct path in `cpu_thread.rs`
+//! instants have the same kind of direct path in `cpu_thread/mod.rs`
 //! ([`CpuThread::draw_done_fast`](super::cpu_thread::CpuThread::draw_done_fast), [`CpuThread::step_alone`](super::cpu_thread::CpuThread::step_alone)). A traced run takes none
 //! of these short cuts, which is what the trace-equivalence test compares
 //! against.

@@ -9,14 +9,16 @@
 //! GPU times) and every transition that changes it; the command FIFO, the
 //! count of completed frames and the records come in an [`Env`].
 
-use crate::components::distribution::Dist;
-use crate::components::frame_pacing::{GpuForecast, limited, paced_start};
 use crate::components::preemptible::{Preemptible, Wake};
 use crate::engine::{Duration, Scheduler, StreamRng, Time};
 use crate::systems::error::SystemError;
 
+mod fixed_work;
+mod pacing;
+
+pub use fixed_work::FixedWork;
+
 use super::bus_copy::BusCopy;
-use super::config::FramesWorkload;
 use super::events::Ev;
 use super::links::{Command, Env, command_count, command_weight, draw_batch_weight};
 use super::records::FrameRecord;
@@ -53,82 +55,6 @@ pub enum CpuPhase {
     InPresent,
     /// All frames submitted.
     Finished,
-}
-
-/// A fixed workload's CPU and GPU time per frame: drawn from distributions
-/// by the CPU thread (the GPU's when it issues the frame's one command), or
-/// given frame by frame (a replayed capture, `kind = "frames"`).
-#[derive(Debug)]
-pub enum FixedWork {
-    /// Drawn each frame (`kind = "fixed"`).
-    Drawn {
-        /// CPU time.
-        cpu: Dist<Duration>,
-        /// GPU time.
-        gpu: Dist<Duration>,
-        /// Stream for the CPU part.
-        cpu_rng: StreamRng,
-        /// Stream for the GPU part.
-        gpu_rng: StreamRng,
-    },
-    /// Given frame by frame (`kind = "frames"`; every list holds at least
-    /// `run.frames` entries, checked by the model's validation).
-    PerFrame(FramesWorkload),
-}
-
-impl FixedWork {
-    /// CPU time after the frame's clear is pushed, before its GPU work is
-    /// (none for a frame given frame by frame: its GPU work, clear
-    /// included, is submitted together, [`FixedWork::before_clear`]).
-    fn before_submit(&mut self) -> Duration {
-        match self {
-            FixedWork::Drawn { cpu, cpu_rng, .. } => Duration::from_ps_f64(cpu.sample(cpu_rng)),
-            FixedWork::PerFrame(_) => Duration::ZERO,
-        }
-    }
-
-    /// CPU time of frame `f` before its clear is pushed (a frame given frame
-    /// by frame: its work up to the GPU submission).
-    fn before_clear(&self, f: u64) -> Duration {
-        match self {
-            FixedWork::Drawn { .. } => Duration::ZERO,
-            FixedWork::PerFrame(w) => w.submit[f as usize],
-        }
-    }
-
-    /// GPU time of frame `f`.
-    fn gpu(&mut self, f: u64) -> Duration {
-        match self {
-            FixedWork::Drawn { gpu, gpu_rng, .. } => Duration::from_ps_f64(gpu.sample(gpu_rng)),
-            FixedWork::PerFrame(w) => w.gpu[f as usize],
-        }
-    }
-
-    /// CPU time of frame `f` after its GPU work is submitted, up to its
-    /// present (none for a drawn workload).
-    fn after_submit(&self, f: u64) -> Duration {
-        match self {
-            FixedWork::Drawn { .. } => Duration::ZERO,
-            FixedWork::PerFrame(w) => Duration(w.cpu[f as usize].0.saturating_sub(w.submit[f as usize].0)),
-        }
-    }
-
-    /// When frame `f` may begin: the previous frame's present plus the time
-    /// in its present call, or the workload's start for frame 0 (`None`: at
-    /// once, as for a drawn workload).
-    fn begins_at(&self, f: u64, records: &[FrameRecord]) -> Option<Time> {
-        let FixedWork::PerFrame(w) = self else {
-            return None;
-        };
-        let at = match f {
-            0 => Time::ZERO.0.saturating_add(w.start.0),
-            _ => records[f as usize - 1]
-                .present
-                .0
-                .saturating_add(w.present[f as usize - 1].0),
-        };
-        Some(Time(at))
-    }
 }
 
 /// How a CPU event that only the CPU thread moved ended (the short cuts
@@ -298,81 +224,6 @@ impl CpuThread {
     #[inline(always)]
     pub(super) fn schedule_wake(s: &mut Scheduler<Ev>, w: Wake) {
         schedule(s, w);
-    }
-
-    /// Whether the low-latency pacer holds the thread (it waits for the GPU
-    /// to drain, not for a limiter's interval).
-    #[inline(always)]
-    pub(super) fn paced_for_gpu(&self) -> bool {
-        self.phase == CpuPhase::PaceStart && self.pace_for_gpu
-    }
-
-    /// The [`Ev::PaceWake`] event: the held frame starts, or presents.
-    pub(super) fn pace_wake(&mut self) {
-        self.pace_go = true;
-        self.phase = self.pace_resume;
-    }
-
-    /// The time the frame about to start must wait for (`[pacing]`: a
-    /// start-measured limiter, the low-latency pacer; the later wins), if
-    /// later than `now`.
-    fn start_wait(&mut self, now: Time, env: &Env) -> Option<Time> {
-        let p = &env.cfg.pacing;
-        if p.is_off() || self.frame == 0 {
-            return None;
-        }
-        let prev = &env.records[self.frame as usize - 1];
-        let mut t = now;
-        if let Some(interval) = p.start_limit() {
-            t = t.max(limited(Some(prev.start), interval).unwrap_or(now));
-        }
-        self.pace_for_gpu = false;
-        if p.low_latency {
-            // Times the accounting has closed: busy time is attributed to a
-            // frame at the end of the instant that moves past it, so a
-            // frame finished at `now` (or the CPU's frame just presented)
-            // is read from the frame before it.
-            let completed = env.links.frames_completed as usize;
-            let closed = |i: usize| env.records.get(i).filter(|r| r.gpu_end.is_some_and(|e| e < now));
-            let gpu_frame = (1..=2)
-                .filter_map(|back| completed.checked_sub(back).and_then(closed))
-                .map(|r| Duration(r.gpu_busy))
-                .next();
-            let f = self.frame as usize;
-            let cpu_frame = match f {
-                1 => Some(prev.present.since(prev.start)),
-                _ => Some(Duration(env.records[f - 2].cpu_busy)),
-            };
-            let forecast = GpuForecast {
-                in_flight: self.frame - env.links.frames_completed,
-                oldest_gpu_start: env.records.get(completed).and_then(|r| r.gpu_start),
-                gpu_frame,
-                cpu_frame,
-            };
-            let paced = paced_start(now, forecast);
-            if paced > t {
-                t = paced;
-                self.pace_for_gpu = true;
-            }
-        }
-        (t > now).then_some(t)
-    }
-
-    /// The time the current operation, if it is the swap, must wait for
-    /// under a present-measured limiter: the previous present plus the
-    /// interval, less the swap's own work, if later than `now`.
-    fn present_wait(&mut self, now: Time, env: &Env) -> Option<Time> {
-        let interval = env.cfg.pacing.present_limit()?;
-        if !matches!(self.op_at(self.op), Op::Swap) || self.frame == 0 {
-            return None;
-        }
-        if std::mem::take(&mut self.pace_go) {
-            return None;
-        }
-        let target = limited(Some(env.records[self.frame as usize - 1].present), interval)?;
-        let swap = self.op_work(Op::Swap, env);
-        let t = Time(target.0.saturating_sub(swap.0));
-        (t > now).then_some(t)
     }
 
     /// The [`Ev::ZeroTimeFrame`] event: the waiting frame may start.

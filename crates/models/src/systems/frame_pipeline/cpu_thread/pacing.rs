@@ -1,0 +1,87 @@
+//! The CPU thread held before a frame starts or presents (`[pacing]`): a
+//! frame limiter measured from the frame's start or from its present, and
+//! the low-latency pacer, which starts a frame as late as the GPU's
+//! forecast allows ([`crate::components::frame_pacing`]).
+
+use crate::components::frame_pacing::{GpuForecast, limited, paced_start};
+use crate::engine::{Duration, Time};
+
+use super::super::links::Env;
+use super::{CpuPhase, CpuThread, Op};
+
+impl CpuThread {
+    /// Whether the low-latency pacer holds the thread (it waits for the GPU
+    /// to drain, not for a limiter's interval).
+    #[inline(always)]
+    pub(in crate::systems::frame_pipeline) fn paced_for_gpu(&self) -> bool {
+        self.phase == CpuPhase::PaceStart && self.pace_for_gpu
+    }
+
+    /// The [`Ev::PaceWake`] event: the held frame starts, or presents.
+    pub(in crate::systems::frame_pipeline) fn pace_wake(&mut self) {
+        self.pace_go = true;
+        self.phase = self.pace_resume;
+    }
+
+    /// The time the frame about to start must wait for (`[pacing]`: a
+    /// start-measured limiter, the low-latency pacer; the later wins), if
+    /// later than `now`.
+    pub(super) fn start_wait(&mut self, now: Time, env: &Env) -> Option<Time> {
+        let p = &env.cfg.pacing;
+        if p.is_off() || self.frame == 0 {
+            return None;
+        }
+        let prev = &env.records[self.frame as usize - 1];
+        let mut t = now;
+        if let Some(interval) = p.start_limit() {
+            t = t.max(limited(Some(prev.start), interval).unwrap_or(now));
+        }
+        self.pace_for_gpu = false;
+        if p.low_latency {
+            // Times the accounting has closed: busy time is attributed to a
+            // frame at the end of the instant that moves past it, so a
+            // frame finished at `now` (or the CPU's frame just presented)
+            // is read from the frame before it.
+            let completed = env.links.frames_completed as usize;
+            let closed = |i: usize| env.records.get(i).filter(|r| r.gpu_end.is_some_and(|e| e < now));
+            let gpu_frame = (1..=2)
+                .filter_map(|back| completed.checked_sub(back).and_then(closed))
+                .map(|r| Duration(r.gpu_busy))
+                .next();
+            let f = self.frame as usize;
+            let cpu_frame = match f {
+                1 => Some(prev.present.since(prev.start)),
+                _ => Some(Duration(env.records[f - 2].cpu_busy)),
+            };
+            let forecast = GpuForecast {
+                in_flight: self.frame - env.links.frames_completed,
+                oldest_gpu_start: env.records.get(completed).and_then(|r| r.gpu_start),
+                gpu_frame,
+                cpu_frame,
+            };
+            let paced = paced_start(now, forecast);
+            if paced > t {
+                t = paced;
+                self.pace_for_gpu = true;
+            }
+        }
+        (t > now).then_some(t)
+    }
+
+    /// The time the current operation, if it is the swap, must wait for
+    /// under a present-measured limiter: the previous present plus the
+    /// interval, less the swap's own work, if later than `now`.
+    pub(super) fn present_wait(&mut self, now: Time, env: &Env) -> Option<Time> {
+        let interval = env.cfg.pacing.present_limit()?;
+        if !matches!(self.op_at(self.op), Op::Swap) || self.frame == 0 {
+            return None;
+        }
+        if std::mem::take(&mut self.pace_go) {
+            return None;
+        }
+        let target = limited(Some(env.records[self.frame as usize - 1].present), interval)?;
+        let swap = self.op_work(Op::Swap, env);
+        let t = Time(target.0.saturating_sub(swap.0));
+        (t > now).then_some(t)
+    }
+}
