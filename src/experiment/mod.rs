@@ -41,7 +41,7 @@ mod tables;
 mod tests;
 
 pub use check::{Bound, CheckOutcome, evaluate_between};
-pub use derived::{interval_width, quantile_width_from_min, ratio, relative_error, speedup};
+pub use derived::{interval_width, largest_bin_share, modes, quantile_width_from_min, ratio, relative_error, speedup};
 pub use dotted::{MetricPathError, json_number, json_path};
 pub use error::ExperimentError;
 pub use report::add_provenance;

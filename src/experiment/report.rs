@@ -255,6 +255,17 @@ fn derived(s: &mut String, exp: &Experiment, r: &ExperimentResult, keys: &[&str]
                     "{}% quantile minus minimum of per-frame `{column}` (pooled over replications)",
                     level * 100.0
                 ),
+                DerivedKind::Modes {
+                    column,
+                    bin,
+                    prominence,
+                } => format!(
+                    "modes of per-frame `{column}` (pooled over replications) in bins of {bin}: local maxima standing at least {}% of the tallest bin above the lowest bin towards any taller one",
+                    prominence * 100.0
+                ),
+                DerivedKind::LargestBinShare { column, bin } => {
+                    format!("share of per-frame `{column}` (pooled over replications) in its fullest bin of {bin}")
+                }
                 DerivedKind::RelativeError { path, reference } => format!(
                     "|mean `{path}` − reference| / |reference|, reference at {}",
                     filter_text(reference)

@@ -243,6 +243,39 @@ fn bad_experiment_files() {
 
     let e = parse_err("name = \"x\"\n[[derived]]\nname = \"d\"\nkind = \"interval_width\"\ncolumn = \"FrameTime\"\n");
     assert!(e.contains("needs `level`"), "{e}");
+    // The histogram's shape: a bin width is required, finite and positive;
+    // the prominence is a share in (0, 1] and only for modes.
+    let derived = |rest: &str| {
+        parse_err(&format!(
+            "name = \"x\"\n[[derived]]\nname = \"d\"\ncolumn = \"FrameTime\"\n{rest}"
+        ))
+    };
+    let e = derived("kind = \"modes\"\n");
+    assert!(
+        e.contains("derived[0] (d)") && e.contains("kind `modes` needs `bin`"),
+        "{e}"
+    );
+    for bad in ["0.0", "-0.08", "nan", "inf"] {
+        let e = derived(&format!("kind = \"largest_bin_share\"\nbin = {bad}\n"));
+        assert!(
+            e.contains("derived[0] (d).bin") && e.contains("must be finite and > 0"),
+            "{bad}: {e}"
+        );
+    }
+    for bad in ["0.0", "1.5", "nan"] {
+        let e = derived(&format!("kind = \"modes\"\nbin = 0.08\nprominence = {bad}\n"));
+        assert!(
+            e.contains("derived[0] (d).prominence") && e.contains("must be in (0, 1]"),
+            "{bad}: {e}"
+        );
+    }
+    let e = derived("kind = \"largest_bin_share\"\nbin = 0.08\nprominence = 0.2\n");
+    assert!(
+        e.contains("derived[0] (d).prominence") && e.contains("only to kind `modes`"),
+        "{e}"
+    );
+    let e = parse_err("name = \"x\"\n[[derived]]\nname = \"d\"\nkind = \"modes\"\nbin = 0.08\n");
+    assert!(e.contains("kind `modes` needs `column`"), "{e}");
 
     let e = parse_err("name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = \"oops\"\n");
     assert!(e.contains("experiments/bad.toml") && e.contains("values"), "{e}");

@@ -173,6 +173,28 @@ pub enum DerivedKind {
         /// Coverage, in `(0, 1]`.
         level: f64,
     },
+    /// The modes of the pooled frame `column`'s histogram (bins of width
+    /// `bin` from the smallest value): the local maxima that stand at
+    /// least `prominence` times the tallest bin above the lowest bin
+    /// between them and any taller bin (their topographic prominence), so
+    /// that counting noise on a smooth curve is not a mode.
+    Modes {
+        /// Frame column.
+        column: String,
+        /// Bin width, in the column's unit.
+        bin: f64,
+        /// Least prominence, a share of the tallest bin, in `(0, 1]`.
+        prominence: f64,
+    },
+    /// The share of the pooled frame `column`'s values in its fullest bin
+    /// of width `bin` (bins from the smallest value): near 1 for a spike,
+    /// small for a smooth density.
+    LargestBinShare {
+        /// Frame column.
+        column: String,
+        /// Bin width, in the column's unit.
+        bin: f64,
+    },
     /// `|v - v_ref| / |v_ref|` for the replication mean `v` of `path`, where
     /// `v_ref` is taken at the point that differs only in the `reference` keys.
     RelativeError {
@@ -325,7 +347,10 @@ impl Experiment {
         }
         for d in &self.derived {
             match &d.kind {
-                DerivedKind::IntervalWidth { column, .. } | DerivedKind::QuantileWidthFromMin { column, .. } => {
+                DerivedKind::IntervalWidth { column, .. }
+                | DerivedKind::QuantileWidthFromMin { column, .. }
+                | DerivedKind::Modes { column, .. }
+                | DerivedKind::LargestBinShare { column, .. } => {
                     cols.insert(column.clone());
                 }
                 _ => {}

@@ -113,6 +113,36 @@ impl Validator<'_> {
                         level,
                     }
                 }
+                "modes" | "largest_bin_share" => {
+                    let bin = d
+                        .bin
+                        .ok_or_else(|| self.err(&key, format!("kind `{}` needs `bin`", d.kind)))?;
+                    if !(bin.is_finite() && bin > 0.0) {
+                        return Err(self.err(format!("{key}.bin"), format!("must be finite and > 0, got {bin}")));
+                    }
+                    if d.kind == "modes" {
+                        let prominence = d.prominence.unwrap_or(0.1);
+                        if !(prominence > 0.0 && prominence <= 1.0) {
+                            return Err(self.err(
+                                format!("{key}.prominence"),
+                                format!("must be in (0, 1], got {prominence}"),
+                            ));
+                        }
+                        DerivedKind::Modes {
+                            column: need_column()?,
+                            bin,
+                            prominence,
+                        }
+                    } else {
+                        if d.prominence.is_some() {
+                            return Err(self.err(format!("{key}.prominence"), "applies only to kind `modes`"));
+                        }
+                        DerivedKind::LargestBinShare {
+                            column: need_column()?,
+                            bin,
+                        }
+                    }
+                }
                 "relative_error" => DerivedKind::RelativeError {
                     path: need_path()?,
                     reference: need_ref()?,
@@ -129,7 +159,7 @@ impl Validator<'_> {
                     return Err(self.err(
                         format!("{key}.kind"),
                         format!(
-                            "unknown kind `{other}` (expected interval_width, quantile_width_from_min, relative_error, ratio or speedup)"
+                            "unknown kind `{other}` (expected interval_width, quantile_width_from_min, modes, largest_bin_share, relative_error, ratio or speedup)"
                         ),
                     ));
                 }

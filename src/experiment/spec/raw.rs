@@ -172,6 +172,10 @@ pub(super) struct RawDerived {
     pub(super) kind: String,
     pub(super) column: Option<String>,
     pub(super) level: Option<f64>,
+    /// Histogram bin width, in the column's unit (`modes`, `largest_bin_share`).
+    pub(super) bin: Option<f64>,
+    /// `modes`: the least prominence of a mode, as a share of the tallest bin.
+    pub(super) prominence: Option<f64>,
     pub(super) path: Option<String>,
     pub(super) reference: Option<toml::Table>,
     /// Text for plots (legends, axes); the name by default.
