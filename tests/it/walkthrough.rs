@@ -381,7 +381,7 @@ fn immediate_with_vsync_on_does_not_wait_for_the_vertical_blank() {
 }
 
 #[test]
-fn the_forest_on_the_geforce3_is_table_6s_forest_and_its_search_is_what_the_readme_says() {
+fn the_forest_on_the_geforce3_is_table_6s_forest_and_its_searches_are_what_the_readme_says() {
     use rendersim::config::{ModelSource, Overrides, prepare};
     use rendersim::systems::run_model;
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -427,6 +427,32 @@ fn the_forest_on_the_geforce3_is_table_6s_forest_and_its_search_is_what_the_read
             found / 1246.0
         ),
         format!("{:.2} / {:.2} / {:.2} / {:.2}", at[0], at[1], at[2], at[4]),
+    ] {
+        assert!(row.contains(&text), "the README's row should say {text:?}: {row}");
+    }
+    // The second search: the clock overhead at which the city's pos reaches
+    // the paper's, and the city's heuristics there (walk fits).
+    let line = searches
+        .lines()
+        .find(|l| l.starts_with("city-clock-overhead-for-pos,"))
+        .expect("the second search's row");
+    let overhead: f64 = line.split(',').nth(6).unwrap().parse().unwrap();
+    let at = mse(&run(
+        "models/walkthrough-city-geforce3.toml",
+        &[
+            "estimation.timing=\"cpu_clock\"".into(),
+            "estimation.fit_views=\"walk\"".into(),
+            format!("estimation.clock_overhead=\"{overhead}us\""),
+        ],
+    ));
+    assert!((at[4] / 1.41 - 1.0).abs() < 0.01, "pos {} at {overhead} us", at[4]);
+    let row = readme
+        .lines()
+        .find(|l| l.contains("Table 6, city, the CPU clock's overhead at which pos reaches"))
+        .expect("the README's row");
+    for text in [
+        format!("{overhead:.1} us a reading (20 us shipped)"),
+        format!("{:.2} / {:.2} / {:.2} / {:.2}", at[0], at[1], at[2], at[3]),
     ] {
         assert!(row.contains(&text), "the README's row should say {text:?}: {row}");
     }
