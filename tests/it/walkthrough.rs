@@ -405,21 +405,27 @@ fn the_forest_on_the_geforce3_is_table_6s_forest_and_its_searches_are_what_the_r
     // test holds to a fresh run) and the forest's five values there, as the
     // README's row gives them.
     let searches = std::fs::read_to_string(root.join("tests/golden/experiments/table6/searches.csv")).unwrap();
-    let line = searches
-        .lines()
-        .find(|l| l.starts_with("forest-fragment-cost-for-h4,"))
-        .expect("the search's row");
-    let found: f64 = line.split(',').nth(6).unwrap().parse().unwrap();
+    let found_by = |search: &str| -> f64 {
+        let line = searches
+            .lines()
+            .find(|l| l.starts_with(&format!("{search},")))
+            .unwrap_or_else(|| panic!("no search {search}"));
+        line.split(',').nth(6).unwrap().parse().unwrap()
+    };
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let row_with = |text: &str| -> &str {
+        readme
+            .lines()
+            .find(|l| l.contains(text))
+            .unwrap_or_else(|| panic!("the README has no row with {text:?}"))
+    };
+    let found = found_by("forest-fragment-cost-for-h4");
     let at = mse(&run(
         "models/walkthrough-forest-geforce3.toml",
         &[timing, format!("gpu.fragment.per_fragment=\"{found}ps\"")],
     ));
     assert!((at[3] / 20.5 - 1.0).abs() < 0.01, "h4 {} at {found} ps", at[3]);
-    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
-    let row = readme
-        .lines()
-        .find(|l| l.contains("Table 6, forest, the fragment cost at which h4 reaches"))
-        .expect("the README's row");
+    let row = row_with("Table 6, forest, the fragment cost at which h4 reaches");
     for text in [
         format!(
             "{} ps a fragment ({:.1}x the simple shader's 1,246)",
@@ -432,11 +438,7 @@ fn the_forest_on_the_geforce3_is_table_6s_forest_and_its_searches_are_what_the_r
     }
     // The second search: the clock overhead at which the city's pos reaches
     // the paper's, and the city's heuristics there (walk fits).
-    let line = searches
-        .lines()
-        .find(|l| l.starts_with("city-clock-overhead-for-pos,"))
-        .expect("the second search's row");
-    let overhead: f64 = line.split(',').nth(6).unwrap().parse().unwrap();
+    let overhead = found_by("city-clock-overhead-for-pos");
     let at = mse(&run(
         "models/walkthrough-city-geforce3.toml",
         &[
@@ -446,10 +448,7 @@ fn the_forest_on_the_geforce3_is_table_6s_forest_and_its_searches_are_what_the_r
         ],
     ));
     assert!((at[4] / 1.41 - 1.0).abs() < 0.01, "pos {} at {overhead} us", at[4]);
-    let row = readme
-        .lines()
-        .find(|l| l.contains("Table 6, city, the CPU clock's overhead at which pos reaches"))
-        .expect("the README's row");
+    let row = row_with("Table 6, city, the CPU clock's overhead at which pos reaches");
     for text in [
         format!("{overhead:.1} us a reading (20 us shipped)"),
         format!("{:.2} / {:.2} / {:.2} / {:.2}", at[0], at[1], at[2], at[3]),
