@@ -15,6 +15,7 @@
 //! claims and searches, and the outputs are documented in
 //! `docs/experiments.md`; every shipped `experiments/*.toml` is an example.
 
+mod beside_paper;
 mod check;
 pub mod cost;
 mod derived;

@@ -88,6 +88,7 @@ pub(crate) fn render(exp: &Experiment, r: &ExperimentResult) -> String {
     results(&mut s, exp, r, &keys);
     derived(&mut s, exp, r, &keys);
     sensitivity(&mut s, exp, r);
+    super::beside_paper::section(&mut s, exp, r);
     claims(&mut s, r);
     checks(&mut s, r);
     timing(&mut s, r);

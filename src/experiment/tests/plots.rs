@@ -401,6 +401,18 @@ fn bar_plots_group_by_path_and_put_the_paper_beside() {
     assert_eq!((y.len(), *log_y, filter.len(), paper.len()), (2, true, 1, 1));
     let dir = tempfile::tempdir().unwrap();
     run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap();
+    // report.md says the paper's values beside the simulated ones, with the
+    // ratio, and how the points agree with them: the fake's interval at
+    // 10 ms is one refresh, 16.667 ms, against 16.7; its kind is 1 against 1.
+    let report = read(dir.path(), "report.md");
+    for row in [
+        "## Beside the paper",
+        "| workload.gpu=10ms, display.buffers=2 | display interval (ms) | 16.67 | 16.70 | 0.998x |",
+        "| workload.gpu=10ms, display.buffers=2 | metrics.fixed_kind | 1.000 | 1.000 | 1.000x |",
+        "| all points | 2 | 2 | 0.999x |",
+    ] {
+        assert!(report.contains(row), "report.md should have {row:?}:\n{report}");
+    }
     let svg = read(dir.path(), "bars.svg");
     // Two kept points, simulated, and the paper's entry named after its point.
     assert_eq!(svg.matches("(simulated)").count(), 2, "{svg}");
