@@ -32,18 +32,26 @@ pub(crate) fn draw(
             filter,
             y_bounds,
             paper,
+            levels,
         } => {
             let xi = exp.sweeps.iter().position(|s| &s.key == x).unwrap_or(0);
             let groups = line_groups(points, xi, filter);
             let mut series = Vec::new();
-            for path in y {
+            for (k, path) in y.iter().enumerate() {
                 let is_derived = exp.derived.iter().any(|d| &d.name == path);
+                // The path's published level, named in the legend.
+                let level = levels.get(k).copied();
                 for (_, members) in &groups {
                     let (pts, ci) = series_points(exp, points, results, xi, path, members);
+                    let name = series_name(exp, points, xi, filter, path, y.len() > 1, members);
                     series.push(Series {
-                        name: series_name(exp, points, xi, filter, path, y.len() > 1, members),
+                        name: match level {
+                            Some(v) => format!("{name} (dashed: {} {v})", spec.paper_label),
+                            None => name,
+                        },
                         points: pts,
                         ci: (!is_derived).then_some(ci),
+                        level,
                     });
                 }
             }

@@ -70,6 +70,9 @@ pub enum PlotKind {
         /// `paper`: published values, each at the points its `where`
         /// selects (it fixes the x key), drawn as crosses.
         paper: Vec<PaperValue>,
+        /// `paper_levels`: one published value per `y` path, independent
+        /// of x (empty: none), each a dashed line in its series' colour.
+        levels: Vec<f64>,
     },
     /// Per-frame values of `column`, pooled over the replications of each
     /// point, one group per point (optionally only the points matching `filter`).

@@ -53,10 +53,10 @@ impl Validator<'_> {
                 return Err(self.err(format!("{key}.paper"), "only line and bar plots take `paper`"));
             }
             let paper_label = match p.paper_label.take() {
-                Some(_) if p.paper.is_none() => {
+                Some(_) if p.paper.is_none() && p.paper_levels.is_none() => {
                     return Err(self.err(
                         format!("{key}.paper_label"),
-                        "names the `paper` values; give `paper` too",
+                        "names the `paper` values; give `paper` or `paper_levels` too",
                     ));
                 }
                 Some(l) if l.trim().is_empty() || l.chars().count() > 60 => {
@@ -65,6 +65,9 @@ impl Validator<'_> {
                 Some(l) => l,
                 None => "paper".to_string(),
             };
+            if p.paper_levels.is_some() && !matches!(kind, PlotKind::Line { .. }) {
+                return Err(self.err(format!("{key}.paper_levels"), "only line plots take `paper_levels`"));
+            }
             if p.y_bounds.is_some() && !matches!(kind, PlotKind::Line { .. }) {
                 return Err(self.err(format!("{key}.y_bounds"), "only line plots take `y_bounds`"));
             }
@@ -129,6 +132,20 @@ impl Validator<'_> {
             },
         };
         let paper = self.paper_values(p, key, sweeps, &x)?;
+        let levels = match p.paper_levels.clone() {
+            None => Vec::new(),
+            Some(v) if v.len() == y.len() && v.iter().all(|l| l.is_finite() && !(p.log_y && *l <= 0.0)) => v,
+            Some(v) => {
+                return Err(self.err(
+                    format!("{key}.paper_levels"),
+                    format!(
+                        "needs {} finite numbers, one per `y` path{}; got {v:?}",
+                        y.len(),
+                        if p.log_y { ", each above 0 on a log axis" } else { "" }
+                    ),
+                ));
+            }
+        };
         Ok(PlotKind::Line {
             x,
             y,
@@ -137,6 +154,7 @@ impl Validator<'_> {
             filter: f,
             y_bounds,
             paper,
+            levels,
         })
     }
 

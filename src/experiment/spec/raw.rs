@@ -142,6 +142,9 @@ pub(super) struct RawPlot {
     pub(super) paper: Option<Vec<RawPaperValue>>,
     /// What the `paper` values are called on the plot (default "paper").
     pub(super) paper_label: Option<String>,
+    /// Line plots: one published value per `y` path, independent of x,
+    /// drawn as a dashed line in that series' colour.
+    pub(super) paper_levels: Option<Vec<f64>>,
 }
 
 /// A published value on a line plot, `{ where = { KEY = VALUE, ... }, value = 4.969 }`,

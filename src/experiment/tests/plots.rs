@@ -372,7 +372,7 @@ fn paper_values_are_drawn_as_crosses_at_their_points() {
     assert_eq!(named.plots[0].paper_label, "measured");
     assert_eq!(parse(&line("")).plots[0].paper_label, "paper");
     for (bad, want) in [
-        ("paper_label = \"measured\"\n", "give `paper` too"),
+        ("paper_label = \"measured\"\n", "give `paper` or `paper_levels` too"),
         ("paper = []\npaper_label = \" \"\n", "1 to 60 characters"),
     ] {
         let e = parse_err(&line(bad));
@@ -464,4 +464,66 @@ fn derived_values_are_named_on_plots_by_their_label() {
         e.contains("derived[0] (r).label") && e.contains("must not be empty"),
         "{e}"
     );
+}
+
+#[test]
+fn a_line_plots_paper_levels_are_one_per_path_drawn_dashed_and_named() {
+    // The display interval's published level, 16.7 ms, drawn across the
+    // plot in its series' colour and named in the legend.
+    let text = format!(
+        "{BASIC}\n[[plot]]\nfile = \"levels\"\nkind = \"line\"\nx = \"workload.gpu\"\n\
+         y = [\"metrics.display_interval_ms.mean\"]\nwhere = {{ \"display.buffers\" = 2 }}\n\
+         paper_levels = [16.7]\npaper_label = \"measured\"\n"
+    );
+    let exp = parse(&text);
+    let PlotKind::Line { levels, .. } = &exp.plots[1].kind else {
+        panic!("not a line plot")
+    };
+    assert_eq!(levels, &vec![16.7]);
+    let dir = tempfile::tempdir().unwrap();
+    run_experiment(&exp, &base_model(), &Fake::default(), dir.path(), false).unwrap();
+    let svg = read(dir.path(), "levels.svg");
+    assert!(svg.contains("(dashed: measured 16.7)"), "{svg}");
+    // The same plot without the level: no dashed line, no such name.
+    let plain = parse(&text.replace("paper_levels = [16.7]\npaper_label = \"measured\"\n", ""));
+    let dir2 = tempfile::tempdir().unwrap();
+    run_experiment(&plain, &base_model(), &Fake::default(), dir2.path(), false).unwrap();
+    let without = read(dir2.path(), "levels.svg");
+    assert!(!without.contains("dashed"));
+    // plotters draws a dashed line as short segments: many more paths.
+    let segments =
+        |svg: &str| svg.matches("<polyline").count() + svg.matches("<line").count() + svg.matches("<path").count();
+    assert!(
+        segments(&svg) > segments(&without) + 10,
+        "the level is drawn dashed: {} against {} segments",
+        segments(&svg),
+        segments(&without)
+    );
+    // One finite number per `y` path (above 0 on a log axis), on line plots only.
+    let line = |extra: &str| {
+        format!(
+            "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[plot]]\nfile = \"p\"\nkind = \"line\"\nx = \"a\"\n\
+             y = [\"m\", \"n\"]\n{extra}"
+        )
+    };
+    for (bad, want) in [
+        (
+            "paper_levels = [1.0]\n",
+            "needs 2 finite numbers, one per `y` path; got [1.0]",
+        ),
+        ("paper_levels = []\n", "needs 2 finite numbers"),
+        ("paper_levels = [1.0, nan]\n", "needs 2 finite numbers"),
+        (
+            "log_y = true\npaper_levels = [1.0, 0.0]\n",
+            "each above 0 on a log axis",
+        ),
+    ] {
+        let e = parse_err(&line(bad));
+        assert!(e.contains("plot[0] (p).paper_levels") && e.contains(want), "{bad}: {e}");
+    }
+    assert_eq!(parse(&line("paper_levels = [1.0, -2.0]\n")).plots.len(), 1);
+    let e = parse_err(
+        "name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"FrameTime\"\npaper_levels = [1.0]\n",
+    );
+    assert!(e.contains("only line plots take `paper_levels`"), "{e}");
 }

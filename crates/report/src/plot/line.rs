@@ -22,6 +22,11 @@ pub struct Series {
     /// Optional `(low, high)` interval per point, same length as `points`,
     /// drawn as vertical error bars.
     pub ci: Option<Vec<(f64, f64)>>,
+    /// A published value for this series (a paper's number, independent of
+    /// x): a thin dashed horizontal line in the series' colour across the
+    /// plot. Not drawn where the y axis cannot show it (not finite, or not
+    /// positive on a logarithmic axis; counted in the omitted note).
+    pub level: Option<f64>,
 }
 
 /// A line plot description.
@@ -89,6 +94,8 @@ struct Prepared {
     points: Vec<(f64, f64)>,
     /// `(x, low, y, high)` per point that has an interval.
     bars: Vec<(f64, f64, f64, f64)>,
+    /// The series' published level, in axis coordinates.
+    level: Option<f64>,
 }
 
 /// Cuts every interval at `bounds` (the values the quantity can take), so
@@ -119,9 +126,15 @@ fn prepare(plot: &LinePlot) -> (Vec<Prepared>, usize) {
             }
         }
         rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let level = s.level.and_then(|v| {
+            let a = to_axis(v, plot.log_y);
+            dropped += usize::from(a.is_none());
+            a
+        });
         out.push(Prepared {
             name: s.name.clone(),
             reference: false,
+            level,
             points: rows.iter().map(|r| (r.0, r.1)).collect(),
             bars: rows
                 .iter()
@@ -144,6 +157,7 @@ fn prepare(plot: &LinePlot) -> (Vec<Prepared>, usize) {
                 reference: true,
                 points: pts,
                 bars: Vec::new(),
+                level: None,
             });
         }
     }
@@ -257,6 +271,11 @@ fn occupied(series: &[Prepared], xr: (f64, f64), yr: (f64, f64)) -> Vec<Occupied
                 y1: (b.3 - yr.0) / h,
             });
         }
+        if let Some(l) = s.level {
+            for k in 0..=20 {
+                samples.push(at(xr.0 + w * k as f64 / 20.0, l));
+            }
+        }
     }
     samples
 }
@@ -275,6 +294,7 @@ fn draw<DB: DrawingBackend>(
             .iter()
             .map(|p| p.1)
             .chain(s.bars.iter().flat_map(|b| [b.1, b.3]))
+            .chain(s.level)
     }));
     // Integer x data (frame counts, buffer counts, ...) gets whole-number ticks.
     let x_integer = all_integers(plot.series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
@@ -345,6 +365,11 @@ fn draw<DB: DrawingBackend>(
             continue;
         }
         let c = color(i);
+        if let Some(l) = s.level {
+            chart
+                .draw_series(DashedLineSeries::new([(xr.0, l), (xr.1, l)], 10, 6, c.stroke_width(1)))
+                .map_err(e)?;
+        }
         // A series drawn exactly over an earlier one is dashed, with open
         // square markers, so that both stay visible (and a note says so).
         let line = if twins[i].is_some() {
@@ -457,7 +482,38 @@ mod tests {
             reference: false,
             points: points.to_vec(),
             bars: Vec::new(),
+            level: None,
         }
+    }
+
+    #[test]
+    fn a_series_level_is_kept_where_the_axis_can_show_it() {
+        let plot = |level, log_y| LinePlot {
+            series: vec![Series {
+                name: "h1".into(),
+                points: vec![(1.0, 1.0), (2.0, 2.0)],
+                ci: None,
+                level: Some(level),
+            }],
+            log_y,
+            ..Default::default()
+        };
+        let (s, dropped) = prepare(&plot(10.0, false));
+        assert_eq!((s[0].level, dropped), (Some(10.0), 0));
+        // On a log axis the level is in log10 units, and a level of 0
+        // cannot be shown: left out and counted.
+        let (s, _) = prepare(&plot(100.0, true));
+        assert_eq!(s[0].level, Some(2.0));
+        let (s, dropped) = prepare(&plot(0.0, true));
+        assert_eq!((s[0].level, dropped), (None, 1));
+        // A level far above the data is inside the drawn range: the
+        // legend's corner search sees the line.
+        let (s, _) = prepare(&plot(10.0, false));
+        let occ = occupied(&s, (0.0, 3.0), (0.0, 11.0));
+        assert!(
+            occ.iter().any(|o| (o.y0 - 10.0 / 11.0).abs() < 1e-9),
+            "the level's samples"
+        );
     }
 
     #[test]
@@ -467,6 +523,7 @@ mod tests {
             reference: false,
             points: vec![(1.0, 0.5), (2.0, 0.9)],
             bars: vec![(1.0, -0.4, 0.5, 1.6), (2.0, 0.8, 0.9, 1.0)],
+            level: None,
         }];
         bound_bars(&mut s, None);
         assert_eq!(s[0].bars[0], (1.0, -0.4, 0.5, 1.6));
@@ -538,6 +595,7 @@ mod tests {
                     name: s.name.clone(),
                     points: s.points.clone(),
                     ci: None,
+                    level: None,
                 })
                 .collect(),
             ..LinePlot::default()
@@ -570,6 +628,7 @@ mod tests {
                     name: name.to_string(),
                     points: points.to_vec(),
                     ci: None,
+                    level: None,
                 })
                 .collect(),
             ..LinePlot::default()
@@ -639,11 +698,13 @@ mod tests {
                 name: "a".into(),
                 points: vec![(1.0, 2.0), (2.0, 3.0), (3.0, 2.5)],
                 ci: Some(vec![(1.5, 2.5), (2.8, 3.2), (2.0, 3.0)]),
+                level: None,
             },
             Series {
                 name: "b".into(),
                 points: vec![(3.0, 1.0), (1.0, 1.5)],
                 ci: None,
+                level: None,
             },
         ]);
         line_plot(&base, &p).unwrap();
@@ -662,6 +723,7 @@ mod tests {
                     name: "s".into(),
                     points: vec![(1.0, 1.0)],
                     ci: None,
+                    level: None,
                 }]),
             ),
             (
@@ -670,6 +732,7 @@ mod tests {
                     name: "s".into(),
                     points: vec![(0.0, 0.0), (0.0, 0.0)],
                     ci: Some(vec![(0.0, 0.0)]),
+                    level: None,
                 }]),
             ),
             (
@@ -678,6 +741,7 @@ mod tests {
                     name: "s".into(),
                     points: vec![(f64::NAN, 1.0), (1.0, f64::INFINITY), (2.0, 2.0)],
                     ci: None,
+                    level: None,
                 }]),
             ),
             (
@@ -689,6 +753,7 @@ mod tests {
                         name: "s".into(),
                         points: vec![(0.0, 1.0), (10.0, 100.0), (1000.0, 0.1)],
                         ci: Some(vec![(-1.0, 2.0), (50.0, 150.0), (0.05, 0.2)]),
+                        level: None,
                     }])
                 },
             ),
@@ -714,6 +779,7 @@ mod tests {
                 name: "network".into(),
                 points: vec![(0.0, 300.0), (1.0, 400.0), (2.0, 500.0)],
                 ci: None,
+                level: None,
             }])
         };
         line_plot(&base, &p).unwrap();

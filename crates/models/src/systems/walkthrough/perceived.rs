@@ -153,6 +153,7 @@ pub fn figure6(src: &ModelSource, table: &toml::Table, around: u64, out: &Path) 
         name: name.to_string(),
         points: window.iter().map(|r| (r.index as f64, v(r))).collect(),
         ci: None,
+        level: None,
     };
     let title = match first {
         Some(i) => format!(
