@@ -9,9 +9,12 @@
 
 use std::fmt::Write as _;
 
-use super::report::fmt_num;
+use crate::stats::quantile::quantile;
+
+use super::derived::{ratio, sorted_finite};
+use super::report::{cell, fmt_num};
 use super::results::ExperimentResult;
-use super::spec::{Experiment, PlotKind};
+use super::spec::{Experiment, PaperValues, PlotKind};
 use super::sweep::{Point, expand_points};
 
 /// One published value beside the simulated one at one point.
@@ -31,8 +34,7 @@ impl Pair {
     /// Simulated over published, when both are finite and the published
     /// value is not zero.
     pub fn ratio(&self) -> Option<f64> {
-        let r = self.simulated? / self.paper;
-        (self.paper != 0.0 && r.is_finite()).then_some(r)
+        ratio(self.simulated?, self.paper)
     }
 }
 
@@ -41,10 +43,7 @@ impl Pair {
 /// order.
 pub(crate) fn pairs(exp: &Experiment, r: &ExperimentResult, points: &[Point]) -> Vec<Pair> {
     let mut out = Vec::new();
-    for plot in &exp.plots {
-        let PlotKind::Bars { y, paper, .. } = &plot.kind else {
-            continue;
-        };
+    for (y, paper) in bar_papers(exp) {
         for entry in paper {
             for p in points.iter().filter(|p| p.matches(&entry.filter)) {
                 let Some(res) = r.points.get(p.index) else {
@@ -64,6 +63,14 @@ pub(crate) fn pairs(exp: &Experiment, r: &ExperimentResult, points: &[Point]) ->
     out
 }
 
+/// Every bar plot's `y` paths and published values.
+fn bar_papers(exp: &Experiment) -> impl Iterator<Item = (&[String], &[PaperValues])> {
+    exp.plots.iter().filter_map(|p| match &p.kind {
+        PlotKind::Bars { y, paper, .. } => Some((y.as_slice(), paper.as_slice())),
+        _ => None,
+    })
+}
+
 /// How a group of pairs agrees with the paper: the pairs with a ratio, how
 /// many of them lie within a factor of 2, and the median ratio.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -78,21 +85,11 @@ pub(crate) struct Agreement {
 
 /// The agreement of `ratios`, `None` when there are none.
 pub(crate) fn agreement(ratios: &[f64]) -> Option<Agreement> {
-    let mut r: Vec<f64> = ratios.iter().copied().filter(|v| v.is_finite()).collect();
-    if r.is_empty() {
-        return None;
-    }
-    r.sort_by(f64::total_cmp);
-    let n = r.len();
-    let median = if n % 2 == 1 {
-        r[n / 2]
-    } else {
-        0.5 * (r[n / 2 - 1] + r[n / 2])
-    };
+    let r = sorted_finite(ratios)?;
     Some(Agreement {
-        compared: n,
+        compared: r.len(),
         within_2x: r.iter().filter(|v| (0.5..=2.0).contains(*v)).count(),
-        median,
+        median: quantile(&r, 0.5),
     })
 }
 
@@ -112,22 +109,16 @@ pub(crate) fn section(s: &mut String, exp: &Experiment, r: &ExperimentResult) {
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} |",
-            r.points[q.point].label.replace('|', "\\|"),
-            exp.label_of(&q.path).replace('|', "\\|"),
+            cell(&r.points[q.point].label),
+            cell(&exp.label_of(&q.path)),
             q.simulated.map(fmt_num).unwrap_or_else(|| "n/a".into()),
             fmt_num(q.paper),
             q.ratio().map(|v| format!("{v:.3}x")).unwrap_or_else(|| "n/a".into()),
         );
     }
     // Groups: the points' assignments less the keys the `where`s fix.
-    let fixed: Vec<&str> = exp
-        .plots
-        .iter()
-        .filter_map(|p| match &p.kind {
-            PlotKind::Bars { paper, .. } => Some(paper),
-            _ => None,
-        })
-        .flatten()
+    let fixed: Vec<&str> = bar_papers(exp)
+        .flat_map(|(_, paper)| paper)
         .flat_map(|e| e.filter.iter().map(|(k, _)| k.as_str()))
         .collect();
     let group_of = |i: usize| -> String {
@@ -146,10 +137,10 @@ pub(crate) fn section(s: &mut String, exp: &Experiment, r: &ExperimentResult) {
     let mut groups: Vec<(String, Vec<f64>)> = Vec::new();
     for q in &pairs {
         let g = group_of(q.point);
-        let ratio = q.ratio();
+        let qr = q.ratio();
         match groups.iter_mut().find(|(name, _)| *name == g) {
-            Some((_, v)) => v.extend(ratio),
-            None => groups.push((g, ratio.into_iter().collect())),
+            Some((_, v)) => v.extend(qr),
+            None => groups.push((g, qr.into_iter().collect())),
         }
     }
     let _ = writeln!(
@@ -162,14 +153,14 @@ pub(crate) fn section(s: &mut String, exp: &Experiment, r: &ExperimentResult) {
                 let _ = writeln!(
                     s,
                     "| {} | {} | {} | {:.3}x |",
-                    g.replace('|', "\\|"),
+                    cell(g),
                     a.compared,
                     a.within_2x,
                     a.median
                 );
             }
             None => {
-                let _ = writeln!(s, "| {} | 0 | | |", g.replace('|', "\\|"));
+                let _ = writeln!(s, "| {} | 0 | | |", cell(g));
             }
         }
     }

@@ -132,7 +132,7 @@ pub fn speedup(wall: f64, reference_wall: f64) -> Option<f64> {
         .then_some(reference_wall / wall)
 }
 
-fn sorted_finite(values: &[f64]) -> Option<Vec<f64>> {
+pub(crate) fn sorted_finite(values: &[f64]) -> Option<Vec<f64>> {
     let mut s: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
     if s.is_empty() {
         return None;

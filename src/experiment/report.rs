@@ -67,7 +67,7 @@ fn filter_text(f: &[(String, toml::Value)]) -> String {
 }
 
 /// Escape `|` so text fits in a Markdown table cell.
-fn cell(s: &str) -> String {
+pub(crate) fn cell(s: &str) -> String {
     s.replace('|', "\\|")
 }
 
