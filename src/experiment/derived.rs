@@ -166,6 +166,19 @@ pub(crate) struct DerivedInputs<'a> {
     pub frame_columns: &'a [String],
 }
 
+/// A derived value taken on one point's frames (`values`: its column,
+/// pooled over the point's runs); `None` for the kinds taken between
+/// points, and where the value is undefined (no finite values).
+pub(crate) fn of_frames(kind: &DerivedKind, values: &[f64]) -> Option<f64> {
+    match kind {
+        DerivedKind::IntervalWidth { level, .. } => interval_width(values, *level),
+        DerivedKind::QuantileWidthFromMin { level, .. } => quantile_width_from_min(values, *level),
+        DerivedKind::Modes { bin, prominence, .. } => modes(values, *bin, *prominence),
+        DerivedKind::LargestBinShare { bin, .. } => largest_bin_share(values, *bin),
+        DerivedKind::RelativeError { .. } | DerivedKind::Ratio { .. } | DerivedKind::Speedup { .. } => None,
+    }
+}
+
 /// Every derived value of every point, in `exp.derived` order.
 pub(crate) fn compute(exp: &Experiment, inp: &DerivedInputs<'_>) -> Vec<Vec<Option<f64>>> {
     let mean = |pi: usize, path: &str| -> Option<f64> {
@@ -186,16 +199,10 @@ pub(crate) fn compute(exp: &Experiment, inp: &DerivedInputs<'_>) -> Vec<Vec<Opti
             exp.derived
                 .iter()
                 .map(|d| match &d.kind {
-                    DerivedKind::IntervalWidth { column: c, level } => interval_width(column(p.index, c), *level),
-                    DerivedKind::QuantileWidthFromMin { column: c, level } => {
-                        quantile_width_from_min(column(p.index, c), *level)
-                    }
-                    DerivedKind::Modes {
-                        column: c,
-                        bin,
-                        prominence,
-                    } => modes(column(p.index, c), *bin, *prominence),
-                    DerivedKind::LargestBinShare { column: c, bin } => largest_bin_share(column(p.index, c), *bin),
+                    DerivedKind::IntervalWidth { column: c, .. }
+                    | DerivedKind::QuantileWidthFromMin { column: c, .. }
+                    | DerivedKind::Modes { column: c, .. }
+                    | DerivedKind::LargestBinShare { column: c, .. } => of_frames(&d.kind, column(p.index, c)),
                     DerivedKind::RelativeError { path, reference } => {
                         let r = reference_point(exp, p, reference)?;
                         relative_error(mean(p.index, path)?, mean(r, path)?)

@@ -45,6 +45,10 @@ pub enum SearchError {
     /// The metric is `null` in the run summary.
     #[error("`{0}` is not a number in the run summary")]
     NotANumber(String),
+    /// The derived value of a frame column is undefined for a run (its
+    /// column is missing or holds no finite value).
+    #[error("the derived value `{0}` is undefined for a run of the search (its frame column is missing or empty)")]
+    NoFrameValue(String),
 }
 use super::sweep::format_range_number;
 
@@ -65,8 +69,12 @@ pub struct Search {
     pub format: Option<String>,
     /// Write the value as an integer (rounded), for counts.
     pub integer: bool,
-    /// Metric path into the run summary.
+    /// Metric path into the run summary, or the name of a derived value of
+    /// a frame column.
     pub path: String,
+    /// Set when `path` names a derived value of a frame column: how it is
+    /// computed from each run's frames (the experiment's validation sets it).
+    pub frame_value: Option<crate::experiment::spec::DerivedKind>,
     /// What the target is.
     pub target: Target,
     /// Overrides for this search, after the experiment's `[set]`.
@@ -202,6 +210,7 @@ pub(crate) fn validate(
         format: raw.format,
         integer: raw.integer,
         path: raw.path,
+        frame_value: None,
         target,
         set: flatten(&raw.set),
         tolerance,
@@ -240,8 +249,18 @@ impl Search {
             .iter()
             .map(|(k, _)| (k.clone(), format!("[[search]] {:?}, which sets {k}", self.name)))
             .collect();
-        let out = runner.run_noted(&model, seed, false, &origins)?;
-        json_number(&out.summary, path)?.ok_or_else(|| SearchError::NotANumber(path.to_string()))
+        let frame_value = self.frame_value.as_ref().filter(|_| path == self.path);
+        let out = runner.run_noted(&model, seed, frame_value.is_some(), &origins)?;
+        match frame_value {
+            Some(kind) => {
+                let column = kind
+                    .frame_column()
+                    .and_then(|c| out.frames.as_ref()?.column(c))
+                    .unwrap_or_default();
+                super::derived::of_frames(kind, &column).ok_or_else(|| SearchError::NoFrameValue(path.to_string()))
+            }
+            None => json_number(&out.summary, path)?.ok_or_else(|| SearchError::NotANumber(path.to_string())),
+        }
     }
 
     /// Runs the search from `base` (the experiment's model with its `[set]`).
@@ -387,10 +406,11 @@ mod tests {
     use super::*;
     use crate::experiment::runner::RunOutput;
 
-    /// metric = 3 x + 1 (x read from `k`, a float or "<x>us").
+    /// metric = 3 x + 1 (x read from `k`, a float or "<x>us"); asked for
+    /// frames, a column `T` of 101 values evenly from 0 to x.
     struct Linear;
     impl Runner for Linear {
-        fn run(&self, model: &toml::Table, _seed: u64, _f: bool) -> Result<RunOutput, RunError> {
+        fn run(&self, model: &toml::Table, _seed: u64, want_frames: bool) -> Result<RunOutput, RunError> {
             let x = match model.get("k") {
                 Some(toml::Value::Float(f)) => *f,
                 Some(toml::Value::String(s)) => s
@@ -401,9 +421,13 @@ mod tests {
                 _ => 0.0,
             };
             let scale = model.get("scale").and_then(|v| v.as_float()).unwrap_or(1.0);
+            let frames = want_frames.then(|| crate::experiment::runner::FrameTable {
+                columns: vec!["T".into()],
+                rows: (0..=100).map(|i| vec![x * f64::from(i) / 100.0]).collect(),
+            });
             Ok(RunOutput {
                 summary: serde_json::json!({"metrics": {"y": scale * (3.0 * x + 1.0)}}),
-                frames: None,
+                frames,
             })
         }
     }
@@ -418,6 +442,7 @@ mod tests {
             format: format.map(String::from),
             integer: false,
             path: "metrics.y".into(),
+            frame_value: None,
             target,
             set: vec![],
             tolerance: 1e-9,
@@ -474,5 +499,28 @@ mod tests {
         assert_eq!(r.value, None);
         assert!(!r.converged);
         assert_eq!(r.at_ends, (1.0, 31.0));
+    }
+
+    #[test]
+    fn a_search_can_aim_at_a_derived_value_of_a_frame_column() {
+        // The width of column T above its minimum (all of it: level 1) is
+        // x, so x = 4 reaches 4; each run of the search asks for frames.
+        let mut s = search(Target::Value(4.0), None);
+        s.path = "t_width".into();
+        s.frame_value = Some(crate::experiment::spec::DerivedKind::QuantileWidthFromMin {
+            column: "T".into(),
+            level: 1.0,
+        });
+        let r = s.run(&Linear, &toml::Table::new(), 1).unwrap();
+        assert!(r.converged, "{r:?}");
+        assert!((r.value.unwrap() - 4.0).abs() < 1e-6, "{r:?}");
+        assert_eq!(r.at_ends, (0.0, 10.0));
+        // A column the runs do not have: an error naming the value, not a panic.
+        s.frame_value = Some(crate::experiment::spec::DerivedKind::QuantileWidthFromMin {
+            column: "U".into(),
+            level: 1.0,
+        });
+        let e = s.run(&Linear, &toml::Table::new(), 1).unwrap_err().to_string();
+        assert!(e.contains("`t_width`") && e.contains("undefined"), "{e}");
     }
 }

@@ -598,3 +598,33 @@ fn point_model_applies_set_then_sweep() {
 mod checks;
 mod plots;
 mod sample;
+
+#[test]
+fn a_search_aims_at_a_summary_metric_or_a_frame_columns_derived_value_only() {
+    let with = |derived: &str, path: &str| {
+        format!(
+            "{BASIC}\n{derived}\n[[search]]\nname = \"s\"\nvary = \"workload.gpu\"\nfrom = 1\nto = 2\npath = \"{path}\"\ntarget = 1.0\n"
+        )
+    };
+    // A ratio is taken between points: no meaning for one run.
+    let e = parse_err(&with(
+        "[[derived]]\nname = \"r\"\nkind = \"ratio\"\npath = \"metrics.display_interval_ms.mean\"\nreference = { \"display.buffers\" = 2 }",
+        "r",
+    ));
+    assert!(
+        e.contains("search[0].path") && e.contains("`r` is a derived value taken between points"),
+        "{e}"
+    );
+    // A derived value of a frame column is computed from each run's frames.
+    let exp = parse(&with(
+        "[[derived]]\nname = \"w\"\nkind = \"interval_width\"\ncolumn = \"FrameTime\"\nlevel = 0.9",
+        "w",
+    ));
+    assert!(matches!(
+        exp.searches[0].frame_value,
+        Some(DerivedKind::IntervalWidth { ref column, .. }) if column == "FrameTime"
+    ));
+    // Any other path stays a summary path.
+    let exp = parse(&with("", "metrics.frame_time_ms.mean"));
+    assert_eq!(exp.searches[0].frame_value, None);
+}

@@ -226,6 +226,25 @@ pub enum DerivedKind {
     },
 }
 
+impl DerivedKind {
+    /// The frame column this value is computed from, for the kinds taken
+    /// on one point's frames (not between points).
+    pub fn frame_column(&self) -> Option<&str> {
+        match self {
+            DerivedKind::IntervalWidth { column, .. }
+            | DerivedKind::QuantileWidthFromMin { column, .. }
+            | DerivedKind::Modes { column, .. }
+            | DerivedKind::LargestBinShare { column, .. } => Some(column),
+            DerivedKind::RelativeError { .. } | DerivedKind::Ratio { .. } | DerivedKind::Speedup { .. } => None,
+        }
+    }
+
+    /// Whether the value is taken on one point's frames.
+    pub fn is_of_a_frame_column(&self) -> bool {
+        self.frame_column().is_some()
+    }
+}
+
 /// A value computed per point after all runs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Derived {
@@ -349,14 +368,8 @@ impl Experiment {
             }
         }
         for d in &self.derived {
-            match &d.kind {
-                DerivedKind::IntervalWidth { column, .. }
-                | DerivedKind::QuantileWidthFromMin { column, .. }
-                | DerivedKind::Modes { column, .. }
-                | DerivedKind::LargestBinShare { column, .. } => {
-                    cols.insert(column.clone());
-                }
-                _ => {}
+            if let Some(column) = d.kind.frame_column() {
+                cols.insert(column.to_string());
             }
         }
         cols.into_iter().collect()

@@ -266,9 +266,17 @@ impl Validator<'_> {
     }
 
     /// The `[[search]]`es, each under its own name.
+    ///
+    /// A search's `path` may name a derived value of a frame column
+    /// (`interval_width`, `quantile_width_from_min`, `modes`,
+    /// `largest_bin_share`): each run of the search then keeps its frames
+    /// and the value is computed from them, as for a point. A derived value
+    /// taken between points (`ratio` and the like) has no meaning for one
+    /// run and is refused.
     pub(super) fn searches(
         &self,
         raw: Vec<crate::experiment::inverse::RawSearch>,
+        derived: &[super::Derived],
     ) -> Result<Vec<crate::experiment::inverse::Search>, ExperimentError> {
         let mut searches = Vec::new();
         for (i, r) in raw.into_iter().enumerate() {
@@ -277,8 +285,22 @@ impl Validator<'_> {
                 flatten("", t, &mut v);
                 v
             };
-            let sp = crate::experiment::inverse::validate(r, flat)
+            let mut sp = crate::experiment::inverse::validate(r, flat)
                 .map_err(|(k, m)| self.err(format!("search[{i}].{k}"), m))?;
+            if let Some(d) = derived.iter().find(|d| d.name == sp.path) {
+                if !d.kind.is_of_a_frame_column() {
+                    return Err(self.err(
+                        format!("search[{i}].path"),
+                        format!(
+                            "`{}` is a derived value taken between points; a search reaches a summary metric \
+                             or a derived value of a frame column (interval_width, quantile_width_from_min, \
+                             modes, largest_bin_share)",
+                            sp.path
+                        ),
+                    ));
+                }
+                sp.frame_value = Some(d.kind.clone());
+            }
             if searches
                 .iter()
                 .any(|o: &crate::experiment::inverse::Search| o.name == sp.name)

@@ -211,7 +211,7 @@ impl Validator<'_> {
         let derived = self.derived(raw.derived, &sweeps, &metrics)?;
         let plots = self.plots(raw.plot, &sweeps, &metrics, &raw.name)?;
         let checks = self.checks(raw.check, &sweeps)?;
-        let searches = self.searches(raw.search)?;
+        let searches = self.searches(raw.search, &derived)?;
 
         Ok(Experiment {
             source: self.file.to_path_buf(),
