@@ -13,10 +13,15 @@ const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 /// The rows of an experiment's golden points.csv, as column -> text.
 fn points(experiment: &str) -> Vec<HashMap<String, String>> {
+    golden_csv(experiment, "points.csv")
+}
+
+/// The rows of one of an experiment's golden CSV files, as column -> text.
+fn golden_csv(experiment: &str, file: &str) -> Vec<HashMap<String, String>> {
     let path = Path::new(ROOT)
         .join("tests/golden/experiments")
         .join(experiment)
-        .join("points.csv");
+        .join(file);
     let mut r = csv::Reader::from_path(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let header: Vec<String> = r.headers().unwrap().iter().map(str::to_string).collect();
     r.records()
@@ -492,20 +497,7 @@ fn figure3s_variation_is_its_search_s_value() {
     // The experiment's `[set]` gives the variation points the median its
     // own search finds (to two decimals): re-searching with other
     // constants and not updating `[set]` fails here.
-    let rows = {
-        let path = Path::new(ROOT).join("tests/golden/experiments/figure3-system-noise/searches.csv");
-        let mut r = csv::Reader::from_path(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let header: Vec<String> = r.headers().unwrap().iter().map(str::to_string).collect();
-        r.records()
-            .map(|row| {
-                header
-                    .iter()
-                    .cloned()
-                    .zip(row.unwrap().iter().map(str::to_string))
-                    .collect()
-            })
-            .collect::<Vec<HashMap<String, String>>>()
-    };
+    let rows = golden_csv("figure3-system-noise", "searches.csv");
     let found = rows
         .iter()
         .find(|r| r["search"] == "variation-for-c")
