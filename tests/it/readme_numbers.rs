@@ -130,8 +130,30 @@ fn the_readme_states_what_the_experiments_give() {
         "Table 1, 4th cell, split GeForce3",
         format!("{split:.3} ms ({:+.1}%)", 100.0 * (split / 11.856 - 1.0)),
     );
-    let order = |o: &str| value("table3-depth-order", &[("workload.depth_order", o)], GPU);
+    let order = |o: &str| {
+        value(
+            "table3-depth-order",
+            &[("workload.depth_complexity", "2.5"), ("workload.depth_order", o)],
+            GPU,
+        )
+    };
     let normal = order("random");
+    let what_if = |o: &str| {
+        let v = value(
+            "table3-depth-order",
+            &[("workload.depth_complexity", "1.8"), ("workload.depth_order", o)],
+            "time_vs_normal",
+        );
+        format!("{:+.1}%", 100.0 * (v - 1.0))
+    };
+    expect(
+        "Table 3, back to front",
+        format!(
+            "at depth complexity 1.8 (2.5 shipped, the paper gives none) both changes are within 25% ({}, {})",
+            what_if("front_to_back"),
+            what_if("back_to_front")
+        ),
+    );
     for (result, o) in [
         ("Table 3, front to back", "front_to_back"),
         ("Table 3, back to front", "back_to_front"),
@@ -345,7 +367,7 @@ fn the_readme_states_what_the_experiments_give() {
         "Table 4, Test 4 parallel",
         format!("{city:.3} ms ({:+.1}%)", 100.0 * (city / 14.167 - 1.0)),
     );
-    assert_eq!(checked, 23);
+    assert_eq!(checked, 24);
 }
 
 #[test]
@@ -360,7 +382,13 @@ fn the_models_doc_states_what_the_geforce3_experiments_give() {
         ("gpu.fragment.per_fragment", "8123ps"),
     ];
     let split = value("table1-split", &t1s, GPU);
-    let order = |o: &str| value("table3-depth-order", &[("workload.depth_order", o)], GPU);
+    let order = |o: &str| {
+        value(
+            "table3-depth-order",
+            &[("workload.depth_complexity", "2.5"), ("workload.depth_order", o)],
+            GPU,
+        )
+    };
     // "AGP memory and copies": Table 4's parallel cells.
     let t4 = |memory: &str, bytes: &str, column: &str| {
         let at = [
@@ -376,7 +404,24 @@ fn the_models_doc_states_what_the_geforce3_experiments_give() {
         let pct = |v: f64, p: f64| format!("{:+.1}%", 100.0 * (v / p - 1.0));
         format!("{r:.3} ({}) / {c:.3} ({})", pct(r, paper.0), pct(c, paper.1))
     };
+    // Table 3's inverse what-if over the depth complexity: each order's
+    // change at d, as "-12.3% / +20.3% at 2.0".
+    let change = |d: &str, o: &str| {
+        let v = value(
+            "table3-depth-order",
+            &[("workload.depth_complexity", d), ("workload.depth_order", o)],
+            "time_vs_normal",
+        );
+        format!("{:+.1}%", 100.0 * (v - 1.0))
+    };
+    let at = |d: &str| format!("{} / {}", change(d, "front_to_back"), change(d, "back_to_front"));
     for text in [
+        format!(
+            "change by {} at 2.0, {} at 1.8 and {} at 1.6",
+            at("2"),
+            at("1.8"),
+            at("1.6")
+        ),
         format!("fourth cell comes out at {split:.3} ms"),
         format!("| front to back | 9.143 | {:.3} |", order("front_to_back")),
         format!("| back to front | 12.552 | {:.3} |", order("back_to_front")),
