@@ -2,9 +2,54 @@
 //! fewest drawn things (points and line samples, histogram bars, labels of
 //! marked values), every plot kind using the same rule; when every corner
 //! covers something, the caller grows the y axis by the legend's height so
-//! that the top band is free.
+//! that the top band is free. A line plot's legend of more than
+//! [`IN_PLOT_ENTRIES`] entries goes to a panel beside the plot instead
+//! ([`panel_width`], [`fit_text`], shared with the scatter plot's panel of
+//! labels).
 
-use plotters::prelude::SeriesLabelPosition;
+use plotters::coord::Shift;
+use plotters::prelude::{DrawingArea, DrawingAreaErrorKind, DrawingBackend, SeriesLabelPosition, TextStyle};
+
+/// A line plot's legend with more entries than this goes to a panel beside
+/// the plot: a box that tall would cover most of the plot area, and the
+/// corner search ([`corner`], its height capped by [`legend_height`])
+/// would not see it.
+pub(crate) const IN_PLOT_ENTRIES: usize = 8;
+
+/// Width of a panel beside a plot that lists `rows` at `font`, each after
+/// `lead` pixels of swatch or number: the widest row, at most two fifths
+/// of `area`'s width (longer rows are shortened by [`fit_text`]).
+pub(crate) fn panel_width<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    rows: &[String],
+    font: &TextStyle,
+    lead: i32,
+) -> i32 {
+    let widest = rows
+        .iter()
+        .filter_map(|r| area.estimate_text_size(r, font).ok())
+        .map(|(w, _)| w as i32)
+        .max()
+        .unwrap_or(0);
+    (widest + lead + 8).min(area.dim_in_pixel().0 as i32 * 2 / 5)
+}
+
+/// `text`, shortened with an ellipsis until it is at most `max_w` pixels
+/// wide at `font` (never below four characters).
+pub(crate) fn fit_text<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    font: &TextStyle,
+    max_w: i32,
+) -> Result<String, DrawingAreaErrorKind<DB::ErrorType>> {
+    let mut text = text.to_string();
+    while text.chars().count() > 4 && area.estimate_text_size(&text, font)?.0 as i32 > max_w {
+        text.pop();
+        text.pop();
+        text.push('…');
+    }
+    Ok(text)
+}
 
 /// Something drawn, in plot-area fractions (`0..1` left to right, bottom to
 /// top): a vertical extent at one x (a point is `y0 == y1`; a histogram bar

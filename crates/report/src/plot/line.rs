@@ -306,10 +306,12 @@ fn draw<DB: DrawingBackend>(
         ticks(xr.0, xr.1, plot.log_x, x_integer)
     };
     // The legend goes to a corner free of data; when every corner has some,
-    // the y axis grows by the legend's height so that the top is free.
+    // the y axis grows by the legend's height so that the top is free. A
+    // legend of many entries goes to a panel beside the plot instead.
     let entries = series.iter().filter(|s| !s.name.is_empty()).count();
+    let beside = entries > legend::IN_PLOT_ENTRIES;
     let (mut legend, covered) = legend_corner(series, xr, yr, entries);
-    if covered > 0 {
+    if covered > 0 && !beside {
         let (bw, bh) = legend_box(series, entries);
         if plot.y_bounds.is_some_and(|(lo, hi)| lo < hi) {
             // A bounded quantity (a fraction) keeps its axis: the legend
@@ -330,8 +332,28 @@ fn draw<DB: DrawingBackend>(
         }
     }
     let yt = ticks(yr.0, yr.1, plot.log_y, false);
-    let mut chart = ChartBuilder::on(root)
-        .caption(&plot.title, (FAMILY, TITLE_PX))
+    let names: Vec<String> = series
+        .iter()
+        .filter(|s| !s.name.is_empty())
+        .map(|s| s.name.clone())
+        .collect();
+    let panel_w = if beside {
+        legend::panel_width(root, &names, &legend_font(), SWATCH_PX)
+    } else {
+        0
+    };
+    // With a panel the title spans the whole image, above plot and panel.
+    let body = if beside {
+        root.titled(&plot.title, (FAMILY, TITLE_PX)).map_err(e)?
+    } else {
+        root.clone()
+    };
+    let (area, panel) = body.split_horizontally(body.dim_in_pixel().0 as i32 - panel_w);
+    let mut builder = ChartBuilder::on(&area);
+    if !beside {
+        builder.caption(&plot.title, (FAMILY, TITLE_PX));
+    }
+    let mut chart = builder
         .margin(20)
         .margin_bottom(20 + 16 * notes.len() as u32)
         .x_label_area_size(55)
@@ -407,7 +429,9 @@ fn draw<DB: DrawingBackend>(
             )
             .map_err(e)?;
     }
-    if any_legend {
+    if any_legend && beside {
+        draw_legend_beside(&panel, series, &twins).map_err(e)?;
+    } else if any_legend {
         chart
             .configure_series_labels()
             .label_font((FAMILY, TICK_PX))
@@ -418,6 +442,53 @@ fn draw<DB: DrawingBackend>(
             .map_err(e)?;
     }
     draw_notes(root, notes)
+}
+
+/// Width of a legend row's swatch (line, dash or cross) and its gap.
+const SWATCH_PX: i32 = 32;
+
+fn legend_font() -> TextStyle<'static> {
+    (FAMILY, TICK_PX).into_font().into()
+}
+
+/// The legend as a column in `panel`, beside the plot: each named series'
+/// swatch as the plot draws it (a cross for published values, a dashed
+/// line for one drawn over another, a line otherwise) and its name,
+/// shortened to fit; what the panel cannot hold is counted in a last row.
+fn draw_legend_beside<DB: DrawingBackend>(
+    panel: &DrawingArea<DB, Shift>,
+    series: &[Prepared],
+    twins: &[Option<usize>],
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    use plotters::style::text_anchor::{HPos, Pos, VPos};
+    let font = legend_font().pos(Pos::new(HPos::Left, VPos::Center));
+    let (w, h) = panel.dim_in_pixel();
+    let (w, h) = (w as i32, h as i32);
+    // A row per entry, from the plot area's top (the panel starts below
+    // the title).
+    let (top, row) = (30, 20);
+    let named: Vec<usize> = (0..series.len()).filter(|&i| !series[i].name.is_empty()).collect();
+    let fits = ((h - top - 20) / row).max(1) as usize;
+    let shown = if named.len() > fits { fits - 1 } else { named.len() };
+    for (n, &i) in named.iter().take(shown).enumerate() {
+        let y = top + row * n as i32;
+        let c = color(i);
+        if series[i].reference {
+            panel.draw(&Cross::new((14, y), 6, BLACK.stroke_width(2)))?;
+        } else if twins[i].is_some() {
+            panel.draw(&PathElement::new(vec![(4, y), (10, y)], c.stroke_width(2)))?;
+            panel.draw(&PathElement::new(vec![(16, y), (24, y)], c.stroke_width(2)))?;
+        } else {
+            panel.draw(&PathElement::new(vec![(4, y), (24, y)], c.stroke_width(2)))?;
+        }
+        let text = legend::fit_text(panel, &series[i].name, &font, w - SWATCH_PX - 4)?;
+        panel.draw_text(&text, &font, (SWATCH_PX, y))?;
+    }
+    if shown < named.len() {
+        let y = top + row * shown as i32;
+        panel.draw_text(&format!("… and {} more", named.len() - shown), &font, (SWATCH_PX, y))?;
+    }
+    Ok(())
 }
 
 /// Write `plot` to `<base>.svg` and `<base>.png`.
@@ -709,6 +780,46 @@ mod tests {
         ]);
         line_plot(&base, &p).unwrap();
         assert_plot_files(&base);
+    }
+
+    #[test]
+    fn a_legend_of_many_entries_goes_beside_the_plot() {
+        // Horizontal lines across the plot, each named at length. Up to
+        // `IN_PLOT_ENTRIES` the legend sits in a corner of the plot area, and
+        // the first line runs to the image's right margin; one more entry and
+        // the legend is a panel beside the plot, which narrows the plot area
+        // by the panel's width: the first colour then ends at its swatch,
+        // far from the right edge.
+        let dir = tempfile::tempdir().unwrap();
+        let rightmost_of_first_colour = |n: usize| {
+            let base = dir.path().join(format!("lines{n}"));
+            let series: Vec<Series> = (0..n)
+                .map(|k| Series {
+                    name: format!("series number {k} with a long name"),
+                    points: vec![(0.0, k as f64), (10.0, k as f64)],
+                    ci: None,
+                    level: None,
+                })
+                .collect();
+            line_plot(&base, &plot(series)).unwrap();
+            assert_plot_files(&base);
+            let file = std::fs::File::open(base.with_extension("png")).unwrap();
+            let mut reader = png::Decoder::new(std::io::BufReader::new(file)).read_info().unwrap();
+            let mut buf = vec![0; reader.output_buffer_size()];
+            let info = reader.next_frame(&mut buf).unwrap();
+            assert_eq!(info.color_type, png::ColorType::Rgb);
+            let (w, c) = (info.width as usize, color(0));
+            buf.chunks_exact(3)
+                .enumerate()
+                .filter(|(_, p)| (p[0], p[1], p[2]) == (c.0, c.1, c.2))
+                .map(|(i, _)| i % w)
+                .max()
+                .unwrap()
+        };
+        let corner = rightmost_of_first_colour(legend::IN_PLOT_ENTRIES);
+        let beside = rightmost_of_first_colour(legend::IN_PLOT_ENTRIES + 1);
+        assert!(corner > 950, "{corner}");
+        assert!(beside + 150 < corner, "{beside} against {corner}");
     }
 
     #[test]

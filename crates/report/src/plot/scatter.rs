@@ -163,14 +163,7 @@ fn label_font() -> TextStyle<'static> {
 
 /// Width of the side panel listing labels that found no free spot.
 fn panel_width<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, rows: &[String]) -> i32 {
-    let font = label_font();
-    let widest = rows
-        .iter()
-        .filter_map(|r| area.estimate_text_size(r, &font).ok())
-        .map(|(w, _)| w as i32)
-        .max()
-        .unwrap_or(0);
-    (widest + 34).min(area.dim_in_pixel().0 as i32 * 2 / 5)
+    super::legend::panel_width(area, rows, &label_font(), 26)
 }
 
 /// The text of panel row `n` (1-based) for `label`.
@@ -321,13 +314,8 @@ fn draw_panel<DB: DrawingBackend>(
         let i = pts[k].0;
         let y = top + row_h * n as i32 + row_h / 2;
         panel.draw(&Circle::new((16, y), 5, color(i).filled()))?;
-        let mut text = panel_row(n + 1, &s.points[i].label);
         // Shorten what the panel cannot hold.
-        while text.chars().count() > 4 && panel.estimate_text_size(&text, &font)?.0 as i32 > w - 30 {
-            text.pop();
-            text.pop();
-            text.push('…');
-        }
+        let text = super::legend::fit_text(panel, &panel_row(n + 1, &s.points[i].label), &font, w - 30)?;
         panel.draw_text(&text, &font, (26, y))?;
     }
     if shown < dropped.len() {
