@@ -280,6 +280,44 @@ fn occupied(series: &[Prepared], xr: (f64, f64), yr: (f64, f64)) -> Vec<Occupied
     samples
 }
 
+/// Where the legend goes: a corner free of data; when every corner has
+/// some, the y axis (`yr`) grows by the legend's height so that the top is
+/// free, or, for a bounded quantity, the middle of an edge if that covers
+/// fewer points. With `beside` (a legend of many entries, drawn in a panel
+/// next to the plot) the corner is unused and the axis kept.
+fn place_legend(
+    plot: &LinePlot,
+    series: &[Prepared],
+    xr: (f64, f64),
+    yr: &mut (f64, f64),
+    entries: usize,
+    beside: bool,
+) -> SeriesLabelPosition {
+    let (mut legend, covered) = legend_corner(series, xr, *yr, entries);
+    if covered == 0 || beside {
+        return legend;
+    }
+    let (bw, bh) = legend_box(series, entries);
+    if plot.y_bounds.is_some_and(|(lo, hi)| lo < hi) {
+        // A bounded quantity (a fraction) keeps its axis: the legend goes
+        // to the middle of an edge if that covers fewer points.
+        let (m, n) = legend::middle(&occupied(series, xr, *yr), bw, bh);
+        if n < covered {
+            legend = m;
+        }
+    } else {
+        *yr = legend::grow(*yr, bh);
+        // The top band is free now: the upper corner the box fits best.
+        let occ = occupied(series, xr, *yr);
+        legend = if legend::covered(&occ, true, true, bw, bh) < legend::covered(&occ, false, true, bw, bh) {
+            SeriesLabelPosition::UpperLeft
+        } else {
+            SeriesLabelPosition::UpperRight
+        };
+    }
+    legend
+}
+
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     plot: &LinePlot,
@@ -305,32 +343,9 @@ fn draw<DB: DrawingBackend>(
     } else {
         ticks(xr.0, xr.1, plot.log_x, x_integer)
     };
-    // The legend goes to a corner free of data; when every corner has some,
-    // the y axis grows by the legend's height so that the top is free. A
-    // legend of many entries goes to a panel beside the plot instead.
     let entries = series.iter().filter(|s| !s.name.is_empty()).count();
     let beside = entries > legend::IN_PLOT_ENTRIES;
-    let (mut legend, covered) = legend_corner(series, xr, yr, entries);
-    if covered > 0 && !beside {
-        let (bw, bh) = legend_box(series, entries);
-        if plot.y_bounds.is_some_and(|(lo, hi)| lo < hi) {
-            // A bounded quantity (a fraction) keeps its axis: the legend
-            // goes to the middle of an edge if that covers fewer points.
-            let (m, n) = legend::middle(&occupied(series, xr, yr), bw, bh);
-            if n < covered {
-                legend = m;
-            }
-        } else {
-            yr = legend::grow(yr, bh);
-            // The top band is free now: the upper corner the box fits best.
-            let occ = occupied(series, xr, yr);
-            legend = if legend::covered(&occ, true, true, bw, bh) < legend::covered(&occ, false, true, bw, bh) {
-                SeriesLabelPosition::UpperLeft
-            } else {
-                SeriesLabelPosition::UpperRight
-            };
-        }
-    }
+    let legend = place_legend(plot, series, xr, &mut yr, entries, beside);
     let yt = ticks(yr.0, yr.1, plot.log_y, false);
     let names: Vec<String> = series
         .iter()
