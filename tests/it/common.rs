@@ -24,6 +24,15 @@ pub fn try_run_any(text: &str, sets: &[&str]) -> Result<SystemRun, String> {
     run_model(&m.source, &m.table, None).map_err(|e| e.to_string())
 }
 
+/// Runs a shipped model file (its path from the repository root, so that
+/// its `hardware` file resolves) with `--set` patches; panics on failure.
+pub fn run_shipped<S: AsRef<str>>(rel: &str, sets: &[S]) -> SystemRun {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+    let src = ModelSource::from_file(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let m = prepare(src, &Overrides::with_sets(sets)).unwrap_or_else(|e| panic!("{rel}: {e}"));
+    run_model(&m.source, &m.table, None).unwrap_or_else(|e| panic!("{rel}: {e}"))
+}
+
 /// The summary of a run of any system; panics with the error on failure.
 pub fn summary_of(text: &str, sets: &[&str]) -> Value {
     try_run_any(text, sets)

@@ -309,9 +309,6 @@ fn bad_view_cell_and_clock_keys_are_named() {
 /// gives.
 #[test]
 fn the_models_doc_states_the_four_section_7_3_figures_of_one_run() {
-    use rendersim::config::{ModelSource, Overrides, prepare};
-    use rendersim::systems::run_model;
-    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/walkthrough-city-geforce3.toml");
     let sets = [
         "run.frames=1000",
         "camera.path=\"preset\"",
@@ -322,8 +319,7 @@ fn the_models_doc_states_the_four_section_7_3_figures_of_one_run() {
         "estimation.view_cells.directions=16",
         "estimation.view_cells.pvc=\"point\"",
     ];
-    let m = prepare(ModelSource::from_file(&file).unwrap(), &Overrides::with_sets(&sets)).unwrap();
-    let run = run_model(&m.source, &m.table, None).unwrap();
+    let run = crate::common::run_shipped("models/walkthrough-city-geforce3.toml", &sets);
     let s = run.summary();
     let e = |k: &str, m: &str| num(s, &format!("metrics.estimation.{k}.{m}"));
     let none = |k: &str| e(k, "underestimated_fraction") == 0.0;

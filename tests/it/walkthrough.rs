@@ -382,14 +382,8 @@ fn immediate_with_vsync_on_does_not_wait_for_the_vertical_blank() {
 
 #[test]
 fn the_forest_on_the_geforce3_is_table_6s_forest_and_its_searches_are_what_the_readme_says() {
-    use rendersim::config::{ModelSource, Overrides, prepare};
-    use rendersim::systems::run_model;
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let run = |file: &str, sets: &[String]| -> Value {
-        let src = ModelSource::from_file(&root.join(file)).unwrap();
-        let m = prepare(src, &Overrides::with_sets(sets)).unwrap();
-        run_model(&m.source, &m.table, None).unwrap().summary().clone()
-    };
+    let run = |file: &str, sets: &[String]| -> Value { crate::common::run_shipped(file, sets).summary().clone() };
     let mse = |s: &Value| ["h1", "h2", "h3", "h4", "pos"].map(|h| num(s, &format!("metrics.estimation.{h}.mse_ms2")));
     // experiments/table6.toml runs the city file with the forest preset:
     // the same as the shipped forest file, whose only other difference is

@@ -238,11 +238,6 @@ impl DerivedKind {
             DerivedKind::RelativeError { .. } | DerivedKind::Ratio { .. } | DerivedKind::Speedup { .. } => None,
         }
     }
-
-    /// Whether the value is taken on one point's frames.
-    pub fn is_of_a_frame_column(&self) -> bool {
-        self.frame_column().is_some()
-    }
 }
 
 /// A value computed per point after all runs.

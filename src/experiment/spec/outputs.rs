@@ -288,7 +288,7 @@ impl Validator<'_> {
             let mut sp = crate::experiment::inverse::validate(r, flat)
                 .map_err(|(k, m)| self.err(format!("search[{i}].{k}"), m))?;
             if let Some(d) = derived.iter().find(|d| d.name == sp.path) {
-                if !d.kind.is_of_a_frame_column() {
+                if d.kind.frame_column().is_none() {
                     return Err(self.err(
                         format!("search[{i}].path"),
                         format!(

@@ -347,12 +347,12 @@ fn draw<DB: DrawingBackend>(
     let beside = entries > legend::IN_PLOT_ENTRIES;
     let legend = place_legend(plot, series, xr, &mut yr, entries, beside);
     let yt = ticks(yr.0, yr.1, plot.log_y, false);
-    let names: Vec<String> = series
-        .iter()
-        .filter(|s| !s.name.is_empty())
-        .map(|s| s.name.clone())
-        .collect();
     let panel_w = if beside {
+        let names: Vec<String> = series
+            .iter()
+            .filter(|s| !s.name.is_empty())
+            .map(|s| s.name.clone())
+            .collect();
         legend::panel_width(root, &names, &legend_font(), SWATCH_PX)
     } else {
         0
