@@ -36,9 +36,9 @@ use super::{Counts, OutOfRange, Policy};
 
 /// Triangles checked at a time before the loop runs over them unchecked
 /// (3 KiB of indices, prefetched while the block before runs and still in
-/// the first-level cache when the loop reads them; 256 was a little faster
-/// than 1024 on every case of the benchmark). Tests use small blocks so
-/// that every boundary is crossed.
+/// the first-level cache when the loop reads them; 1024 measured within the
+/// noise of 256, with 12 KiB a block to hold there). Tests use small blocks
+/// so that every boundary is crossed.
 const CHECKED: usize = if cfg!(test) { 5 } else { 256 };
 
 /// `$portable(x)` compiled with AVX2 where the processor has it (one
