@@ -38,6 +38,7 @@ mod readback;
 mod readme_commands;
 mod readme_numbers;
 mod replay;
+mod replay_real;
 mod replay_round_trip;
 mod shards;
 mod shared_bus;

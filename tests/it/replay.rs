@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use rendersim::components::swap_chain::Composition;
-use rendersim::studies::replay::{ReplayOptions, fit_refresh, replay};
+use rendersim::studies::replay::{ReplayOptions, replay};
 
 fn capture(i: usize) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/fixtures/presentmon/test_case_{i}.csv"))
@@ -265,21 +265,6 @@ fn the_replay_system_runs_a_what_if_from_a_model_file_as_the_command_does() {
 }
 
 #[test]
-fn the_refresh_fit_recovers_a_period_and_phase_from_skipped_refreshes() {
-    let p = 16.683;
-    let screen: Vec<f64> = [0u32, 1, 2, 4, 5, 8, 9, 10, 13]
-        .iter()
-        .map(|&k| 3.2 + p * f64::from(k))
-        .collect();
-    let (period, phase) = fit_refresh(&screen).unwrap();
-    assert!(
-        (period - p).abs() < 1e-9 && (phase - 3.2).abs() < 1e-9,
-        "{period} {phase}"
-    );
-    assert!(fit_refresh(&[1.0]).is_none());
-}
-
-#[test]
 fn cli_prints_json_writes_its_folder_and_names_what_is_wrong() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("r");
@@ -407,7 +392,9 @@ fn assumptions_patch_the_replay_as_captured_and_their_errors_name_the_option() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["replay"]["assume"], serde_json::json!(["display.buffers=2"]));
-    assert_eq!(v["replay"]["refresh_from"], "fitted");
+    assert_eq!(v["replay"]["refresh_from"], "compositor");
+    assert_eq!(v["replay"]["display"]["refresh"]["from"], "compositor");
+    assert_eq!(v["replay"]["display"]["flips"], "on_grid");
     // The as-captured model is the one with the assumption, not a what-if.
     let model = std::fs::read_to_string(out.join("model.toml")).unwrap();
     assert!(model.contains("buffers = 2"), "{model}");
@@ -450,15 +437,31 @@ fn assumptions_patch_the_replay_as_captured_and_their_errors_name_the_option() {
 }
 
 #[test]
-fn a_tearing_capture_keeps_the_base_refresh_and_starts_at_its_first_cpu_start() {
-    // Tearing (`immediate`): screen times follow the GPU, so no refresh is
-    // fitted; the run starts at the first CPU start.
+fn a_tearing_swap_chain_takes_the_refresh_the_rest_of_the_capture_shows_and_alone_the_base_one() {
+    // Tearing (`immediate`): screen times follow the GPU. The other swap
+    // chains' composed frames still show the panel's vertical blanks.
     let dir = tempfile::tempdir().unwrap();
     let text = std::fs::read_to_string(capture(0))
         .unwrap()
         .replace(",1,0,0,Hardware: Legacy Flip,", ",0,0,1,Hardware: Legacy Flip,");
     let path = dir.path().join("tearing.csv");
-    std::fs::write(&path, text).unwrap();
+    std::fs::write(&path, &text).unwrap();
+    let r = replay(&path, &ReplayOptions::default()).unwrap();
+    assert_eq!(r.summary.model_present_mode, "immediate");
+    assert_eq!(
+        serde_json::to_value(r.summary.refresh_from).unwrap(),
+        serde_json::json!("display_changes")
+    );
+    assert!((r.summary.refresh_hz - 59.95).abs() < 0.05, "{}", r.summary.refresh_hz);
+    // Alone, nothing lies on a grid: the base model's 60 Hz, and the run
+    // starts at the first CPU start.
+    let alone: String = text
+        .lines()
+        .enumerate()
+        .filter(|(i, l)| *i == 0 || l.starts_with("dwm.exe,1268,0x224B280A1C0"))
+        .map(|(_, l)| format!("{l}\n"))
+        .collect();
+    std::fs::write(&path, alone).unwrap();
     let r = replay(&path, &ReplayOptions::default()).unwrap();
     assert_eq!(r.summary.model_present_mode, "immediate");
     assert_eq!(

@@ -42,7 +42,7 @@ pub mod results;
 mod setup;
 pub mod system;
 
-pub use refresh::{fit_phase, fit_refresh};
+pub use refresh::fit_phase;
 pub use results::{
     Agreement, ErrorStats, RefreshFrom, Replay, ReplayErrors, ReplayFrame, ReplaySummary, ReplayedFrames, WhatIf,
 };
@@ -280,6 +280,9 @@ pub fn replay_capture(
         },
         refresh_hz: 1000.0 / s.period,
         refresh_from: s.refresh_from,
+        display: s.display.clone(),
+        capture_notes: capture.notes.clone(),
+        capture_metadata: capture.metadata.clone(),
         assume: opts.assume.clone(),
         measured_displayed: frames.iter().filter(|f| f.displayed).count(),
         predicted_displayed: frames.iter().filter(|f| f.predicted_displayed).count(),

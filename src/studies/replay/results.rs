@@ -6,6 +6,7 @@
 use serde::Serialize;
 
 use super::display_stats::{DisplayStats, FrameTimes};
+use crate::capture::display::{DisplayInference, RefreshEvidence};
 use crate::capture::presentmon::Columns;
 use crate::components::swap_chain::Composition;
 use crate::stats::quantile::quantile;
@@ -87,10 +88,23 @@ pub struct ReplaySummary {
     pub model_composition: Composition,
     /// The refresh rate of the replay as captured.
     pub refresh_hz: f64,
-    /// Where it comes from: `fitted` to the displayed frames, `assumed`
-    /// (`--assume display.refresh=...`), or the base model's `default` (a
-    /// tearing capture, whose screen times lie off any refresh grid).
+    /// Where it comes from: the `compositor`'s presents, `display_changes`
+    /// at vertical blanks pooled across swap chains, the swap chain's own
+    /// `unsynced_flips`, `assumed` (`--assume display.refresh=...`), or the
+    /// base model's `default` (nothing in the capture on a refresh grid).
     pub refresh_from: RefreshFrom,
+    /// The display inferred from the whole capture: refresh, monitors, how
+    /// this swap chain's flips reached the screen, a variable-refresh
+    /// window, every swap chain's path (`capture::display`).
+    pub display: DisplayInference,
+    /// What the reader had to undo in the capture (ragged rows, values no
+    /// time can have, rows out of order, a restarted clock), one line each.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub capture_notes: Vec<String>,
+    /// What the capture says of itself (CapFrameX's header lines, OCAT's
+    /// and FrameView's system columns).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub capture_metadata: Vec<(String, String)>,
     /// The assumptions (`--assume` patches) the replay as captured made.
     pub assume: Vec<String>,
     /// Frames displayed in the capture.
@@ -170,12 +184,30 @@ impl ReplayFrame {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RefreshFrom {
-    /// Fitted to the displayed frames' screen times.
-    Fitted,
+    /// The compositor's presents on the swap chain's monitor
+    /// ([`RefreshEvidence::Compositor`]).
+    Compositor,
+    /// Display changes at vertical blanks, pooled across the capture's
+    /// swap chains ([`RefreshEvidence::DisplayChanges`]).
+    DisplayChanges,
+    /// The swap chain's own flips at sync interval 0
+    /// ([`RefreshEvidence::UnsyncedFlips`]).
+    UnsyncedFlips,
     /// Given with `--assume display.refresh=...`.
     Assumed,
-    /// The base model's (a tearing capture).
+    /// The base model's: nothing in the capture lies on a refresh grid
+    /// (a tearing swap chain alone).
     Default,
+}
+
+impl From<RefreshEvidence> for RefreshFrom {
+    fn from(e: RefreshEvidence) -> RefreshFrom {
+        match e {
+            RefreshEvidence::Compositor => RefreshFrom::Compositor,
+            RefreshEvidence::DisplayChanges => RefreshFrom::DisplayChanges,
+            RefreshEvidence::UnsyncedFlips => RefreshFrom::UnsyncedFlips,
+        }
+    }
 }
 
 /// A replayed run's frames as PresentMon writes them: the records, the

@@ -4,13 +4,14 @@
 //! the assumptions (`--assume`) patched on, before any what-if. The module
 //! documentation of `replay` says how a captured frame becomes the model's.
 
+use crate::capture::display::{DisplayInference, Flips, fit_grid, infer_display};
 use crate::capture::presentmon::{Capture, CaptureError, Present};
 use crate::config::patch::set_dotted;
 use crate::config::{ModelSource, apply_patches};
 use crate::systems::frame_pipeline::FramePipelineConfig;
 use crate::systems::frame_pipeline::records::ChainInfo;
 
-use super::{REPLAY_MODEL, RefreshFrom, ReplayError, ReplayOptions, fit_phase, fit_refresh};
+use super::{REPLAY_MODEL, RefreshFrom, ReplayError, ReplayOptions, fit_phase};
 
 /// The model's present mode, vsync and composition for a captured present.
 /// A hardware flip (`Hardware: Legacy Flip`, `Hardware: Independent Flip`,
@@ -18,9 +19,14 @@ use super::{REPLAY_MODEL, RefreshFrom, ReplayError, ReplayOptions, fit_phase, fi
 /// `Composed: ...` present is shown by the compositor one refresh later.
 /// Sync interval 1 or more is `fifo`; 0 is `mailbox`, or `immediate` when
 /// the present allows tearing on a hardware flip (the compositor never
-/// tears); a composed present without a sync interval (-1, PresentMon's
-/// value for a blit) is `fifo`.
-fn model_mode(p: &Present, file: &str) -> Result<(&'static str, bool, bool), CaptureError> {
+/// tears). A composed present without a sync interval (-1, PresentMon's
+/// value for a blit, D3D9's among them) says nothing of waiting: a swap
+/// chain whose frames the compositor skipped (`dropped_share` of its
+/// frames never shown, over 5%) did not wait for a vertical blank and is
+/// `mailbox` (CS:GO's blits at 119 presents a second on a 60 Hz panel);
+/// one that showed its frames is `fifo` (PresentMon's test app, its
+/// frames queued three refreshes deep).
+fn model_mode(p: &Present, dropped_share: f64, file: &str) -> Result<(&'static str, bool, bool), CaptureError> {
     let mode = p.present_mode.as_str();
     let composed = mode.starts_with("Composed");
     if !composed && !mode.starts_with("Hardware") {
@@ -36,6 +42,7 @@ fn model_mode(p: &Present, file: &str) -> Result<(&'static str, bool, bool), Cap
     }
     let sync = p.sync_interval.unwrap_or(1);
     Ok(match (sync, p.allows_tearing, composed) {
+        (s, _, true) if s < 0 && dropped_share > 0.05 => ("mailbox", true, true),
         (s, _, true) if s != 0 => ("fifo", true, true),
         (_, _, true) => ("mailbox", true, true),
         (s, _, false) if s >= 1 => ("fifo", true, false),
@@ -57,16 +64,18 @@ fn ps(ms: f64) -> toml::Value {
 /// The capture's swap chain made ready to simulate: the base model with the
 /// captured frames, refresh and present mode and the assumptions, before
 /// any what-if.
-pub(super) struct Setup<'a> {
-    pub(super) rows: Vec<&'a Present>,
+pub(super) struct Setup {
+    pub(super) rows: Vec<Present>,
     /// The present mode most frames use, and the model's for it.
-    pub(super) common: &'a Present,
+    pub(super) common: Present,
     pub(super) mode: &'static str,
     /// Whether the compositor shows its frames (a `Composed: ...` mode).
     pub(super) composed: bool,
     /// The refresh period of the replay as captured, ms, and where it comes from.
     pub(super) period: f64,
     pub(super) refresh_from: RefreshFrom,
+    /// The display inferred from the whole capture.
+    pub(super) display: DisplayInference,
     /// The capture's time of the model's time zero, ps.
     pub(super) origin_ps: i64,
     /// The capture's swap chain, for the replayed frames.
@@ -77,7 +86,7 @@ pub(super) struct Setup<'a> {
     pub(super) table: toml::Table,
 }
 
-impl Setup<'_> {
+impl Setup {
     /// The capture's time of the model's time zero, ms.
     pub(super) fn origin(&self) -> f64 {
         self.origin_ps as f64 / 1e9
@@ -91,7 +100,7 @@ fn assumes(assume: &[String], key: &str) -> bool {
         .any(|a| a.split_once('=').is_some_and(|(k, _)| k.trim() == key))
 }
 
-pub(super) fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Setup<'a>, ReplayError> {
+pub(super) fn setup(capture: &Capture, opts: &ReplayOptions) -> Result<Setup, ReplayError> {
     let (chain, rows) = capture.select(opts.app.as_deref(), opts.swap_chain.as_deref())?;
     let file = capture.file.as_str();
     // The mode most of its frames use (a swap chain may switch, e.g. from
@@ -99,9 +108,20 @@ pub(super) fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Se
     let common = rows
         .iter()
         .find(|p| p.present_mode == chain.present_mode)
-        .copied()
-        .unwrap_or(rows[0]);
-    let (mode, vsync, composed) = model_mode(common, file)?;
+        .unwrap_or(&rows[0])
+        .clone();
+    let dropped_share = rows.iter().filter(|p| !p.displayed()).count() as f64 / rows.len() as f64;
+    let (mode, vsync, composed) = model_mode(&common, dropped_share, file)?;
+    let display = infer_display(capture, &rows[0]);
+    // A flip at sync interval 0 off every grid the capture shows, that may
+    // not tear, was shown by a variable-refresh panel; one that may tear
+    // is `immediate` whatever its `Hardware:` mode says.
+    let mode = if display.flips == Flips::Tearing {
+        "immediate"
+    } else {
+        mode
+    };
+    let vsync = vsync && mode != "immediate";
 
     // The base model with the assumptions (they may give the refresh).
     let mut src = ModelSource::from_text("the replay model (models/replay.toml)", REPLAY_MODEL);
@@ -114,23 +134,7 @@ pub(super) fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Se
     let generation_ms = |i: usize| assumed_cfg.frame_generation.cost_before_present(i as u64).as_ms_f64();
     let given_period = assumes(&opts.assume, "display.refresh").then_some(model_period);
 
-    let screen: Vec<f64> = rows.iter().filter_map(|p| p.screen_time()).collect();
-    let (period, phase, refresh_from) = match (mode, given_period) {
-        // Tearing: screen times follow the GPU, not a refresh grid.
-        ("immediate", Some(p)) => (p, None, RefreshFrom::Assumed),
-        ("immediate", None) => (model_period, None, RefreshFrom::Default),
-        (_, Some(p)) => (p, Some(fit_phase(&screen, p)), RefreshFrom::Assumed),
-        (_, None) => {
-            let (p, ph) = fit_refresh(&screen).ok_or_else(|| CaptureError::Row {
-                file: file.to_string(),
-                line: rows[0].line,
-                message: "the refresh period cannot be inferred: no two displayed frames are more than 1 ms \
-                          apart (give it: --assume display.refresh=...)"
-                    .into(),
-            })?;
-            (p, Some(ph), RefreshFrom::Fitted)
-        }
-    };
+    let (period, phase, refresh_from) = refresh(&rows, &display, given_period, model_period, mode);
     // The run starts at a vertical blank at or before the first CPU start
     // (in whole picoseconds, so a capture written by rendersim lands
     // exactly on its own grid); with tearing, at the first CPU start.
@@ -145,36 +149,16 @@ pub(super) fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Se
     };
     let lead_ps = toml::Value::String(format!("{}ps", c0_ps - origin_ps));
 
-    let list = |f: &dyn Fn(usize, &Present) -> f64| {
-        toml::Value::Array(rows.iter().enumerate().map(|(i, p)| ps(f(i, p))).collect())
-    };
-    let mut sets: Vec<(&str, toml::Value)> = vec![
-        ("run.frames", toml::Value::Integer(rows.len() as i64)),
-        ("workload.start", lead_ps),
-        ("workload.cpu", list(&|_, p| p.cpu_busy)),
-        (
-            "workload.submit",
-            list(&|_, p| p.gpu_latency.unwrap_or(p.cpu_busy).clamp(0.0, p.cpu_busy)),
-        ),
-        (
-            "workload.gpu",
-            list(&|i, p| (p.gpu_busy.or(p.render_complete).unwrap_or(0.0) - generation_ms(i)).max(0.0)),
-        ),
-        ("workload.present", list(&|_, p| p.cpu_wait)),
-    ];
-    if rows.iter().any(|p| p.gpu_latency.is_some() && p.gpu_time.is_some()) {
-        // The frame's GPU end after its CPU start, where the capture has it
-        // (0: no floor).
-        sets.push((
-            "workload.gpu_end",
-            list(&|_, p| match (p.gpu_latency, p.gpu_time) {
-                (Some(l), Some(t)) => l.max(0.0) + t,
-                _ => 0.0,
-            }),
-        ));
-    }
+    let vrr = display.vrr.as_ref().filter(|_| {
+        display.flips == Flips::VariableRefresh
+            && !opts.assume.iter().any(|a| {
+                a.split_once('=')
+                    .is_some_and(|(k, _)| k.trim().starts_with("display.vrr"))
+            })
+    });
+    let mut sets = workload(&rows, lead_ps, &generation_ms);
     // What the capture says of its display, unless assumed otherwise.
-    let display: [(&str, toml::Value); 4] = [
+    let display_keys: [(&str, toml::Value); 4] = [
         ("display.refresh", toml::Value::String(format!("{period_ps}ps"))),
         ("display.present_mode", toml::Value::String(mode.into())),
         ("display.vsync", toml::Value::Boolean(vsync)),
@@ -183,10 +167,15 @@ pub(super) fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Se
             toml::Value::String(if composed { "composed" } else { "independent" }.into()),
         ),
     ];
-    for (key, value) in display {
+    for (key, value) in display_keys {
         if !assumes(&opts.assume, key) {
             sets.push((key, value));
         }
+    }
+    if let Some(v) = vrr {
+        let rate = |hz: f64| toml::Value::String(format!("{}ps", to_ps(1000.0 / hz)));
+        sets.push(("display.vrr.min_refresh", rate(v.min_hz)));
+        sets.push(("display.vrr.max_refresh", rate(v.max_hz)));
     }
     for (key, value) in sets {
         set_dotted(&mut table, key, value).map_err(|e| CaptureError::Format {
@@ -210,12 +199,108 @@ pub(super) fn setup<'a>(capture: &'a Capture, opts: &ReplayOptions) -> Result<Se
         composed,
         period,
         refresh_from,
+        display,
         origin_ps,
         chain,
         whatif_option: opts.option_names().0,
         src,
         table,
     })
+}
+
+/// The replay's refresh period (ms), the phase of its vertical blanks (none
+/// for a tearing swap chain on no grid) and where they come from: the
+/// assumed period (`given`) on the inferred grid's phase where the two
+/// agree, else the phase fitted to this swap chain's screen times; else the
+/// inferred refresh; else, nothing on a grid by the inference's measure,
+/// the swap chain's own display changes however scattered (where it waits
+/// for blanks), or the base model's period (`model_period`).
+fn refresh(
+    rows: &[Present],
+    display: &DisplayInference,
+    given: Option<f64>,
+    model_period: f64,
+    mode: &str,
+) -> (f64, Option<f64>, RefreshFrom) {
+    let screen: Vec<f64> = rows.iter().filter_map(|p| p.screen_time()).collect();
+    match (given, &display.refresh) {
+        (Some(p), Some(r)) if (r.grid.period_ms / p - 1.0).abs() < 0.005 => {
+            (p, Some(r.grid.phase_ms), RefreshFrom::Assumed)
+        }
+        (Some(p), _) if mode == "immediate" => (p, None, RefreshFrom::Assumed),
+        (Some(p), _) => (p, Some(fit_phase(&screen, p)), RefreshFrom::Assumed),
+        (None, Some(r)) => (r.grid.period_ms, Some(r.grid.phase_ms), r.from.into()),
+        (None, None) => match fit_grid(&screen).filter(|_| mode != "immediate") {
+            Some(g) => (g.period_ms, Some(g.phase_ms), RefreshFrom::DisplayChanges),
+            None => (model_period, None, RefreshFrom::Default),
+        },
+    }
+}
+
+/// The captured frames as the model's per-frame workload (`kind =
+/// "frames"`), the first frame starting `lead` after the run's time zero;
+/// `generation_ms(i)`, an assumed frame generation's cost in frame `i`'s
+/// GPU time, is taken out of it.
+///
+/// The GPU's busy time per frame: PresentMon 2 measures it; PresentMon 1
+/// gives only when the GPU finished (present plus `MsUntilRenderComplete`),
+/// which includes the wait behind the frames before: a frame's work then
+/// runs from its present, or from the end of the frame before if that is
+/// later, to its completion, and the GPU does not finish it earlier than
+/// the capture says.
+fn workload(
+    rows: &[Present],
+    lead: toml::Value,
+    generation_ms: &dyn Fn(usize) -> f64,
+) -> Vec<(&'static str, toml::Value)> {
+    let from_completions = rows.iter().all(|p| p.gpu_busy.is_none());
+    let gpu_busy: Vec<f64> = if from_completions {
+        let mut last_done = f64::NEG_INFINITY;
+        rows.iter()
+            .map(|p| match p.render_complete {
+                Some(rc) => {
+                    let done = p.present + rc;
+                    let busy = (done - p.present.max(last_done)).max(0.0);
+                    last_done = last_done.max(done);
+                    busy
+                }
+                None => 0.0,
+            })
+            .collect()
+    } else {
+        rows.iter().map(|p| p.gpu_busy.unwrap_or(0.0)).collect()
+    };
+    let list = |f: &dyn Fn(usize, &Present) -> f64| {
+        toml::Value::Array(rows.iter().enumerate().map(|(i, p)| ps(f(i, p))).collect())
+    };
+    let mut sets: Vec<(&'static str, toml::Value)> = vec![
+        ("run.frames", toml::Value::Integer(rows.len() as i64)),
+        ("workload.start", lead),
+        ("workload.cpu", list(&|_, p| p.cpu_busy)),
+        (
+            "workload.submit",
+            list(&|_, p| p.gpu_latency.unwrap_or(p.cpu_busy).clamp(0.0, p.cpu_busy)),
+        ),
+        ("workload.gpu", list(&|i, _| (gpu_busy[i] - generation_ms(i)).max(0.0))),
+        ("workload.present", list(&|_, p| p.cpu_wait)),
+    ];
+    if from_completions {
+        sets.push((
+            "workload.gpu_end",
+            list(&|_, p| p.render_complete.map_or(0.0, |rc| p.cpu_busy + rc)),
+        ));
+    } else if rows.iter().any(|p| p.gpu_latency.is_some() && p.gpu_time.is_some()) {
+        // The frame's GPU end after its CPU start, where the capture has it
+        // (0: no floor).
+        sets.push((
+            "workload.gpu_end",
+            list(&|_, p| match (p.gpu_latency, p.gpu_time) {
+                (Some(l), Some(t)) => l.max(0.0) + t,
+                _ => 0.0,
+            }),
+        ));
+    }
+    sets
 }
 
 /// The frame-pipeline model of the set-up frames with `sets` patched on.
