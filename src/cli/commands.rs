@@ -483,9 +483,38 @@ struct ReplayJson<'a> {
     provenance: rendersim::output::provenance::Provenance,
 }
 
+/// Whether a file name is one a replay's validation report writes.
+fn is_report_file(name: &str) -> bool {
+    let chain = |rest: &str| {
+        let stem = rest.split('-').next().unwrap_or_default();
+        !stem.is_empty() && stem.bytes().all(|b| b.is_ascii_digit())
+    };
+    matches!(name, "report.md" | "chains.csv")
+        || name.strip_prefix("chain-").is_some_and(|rest| {
+            chain(rest) && (rest.ends_with(".csv") || rest.ends_with("-screen.png") || rest.ends_with("-screen.svg"))
+        })
+}
+
 /// `rendersim replay`: a PresentMon capture through the frame pipeline.
 pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
     use rendersim::studies::replay::{ReplayOptions, replay};
+    if let (Some(out), Some(report)) = (&args.out, &args.report)
+        && std::path::absolute(out).ok() == std::path::absolute(report).ok()
+    {
+        anyhow::bail!(
+            "--out and --report name the same folder {}: give each its own",
+            out.display()
+        );
+    }
+    let report_set = match &args.report {
+        Some(dir) => Some(ResultSet::begin_kind(
+            dir,
+            Some("replay --report"),
+            is_report_file,
+            args.force,
+        )?),
+        None => None,
+    };
     let set = match &args.out {
         Some(dir) => Some(ResultSet::begin_kind(
             dir,
@@ -503,6 +532,11 @@ pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
         from_tables: false,
     };
     let r = replay(&args.capture, &opts)?;
+    if let Some(set) = report_set {
+        let report = rendersim::studies::replay::validation::validate(&args.capture, &opts)?;
+        report.write(set.dir()).context("writing the validation report")?;
+        set.commit()?;
+    }
     let provenance = command_provenance();
     let json = serde_json::to_string_pretty(&ReplayJson {
         replay: &r.summary,

@@ -86,6 +86,8 @@ const CASES: &[Case] = &[
             "--json",
             "--out",
             "{out}/replay",
+            "--report",
+            "{out}/replay-report",
         ]),
     ),
     ("rendersim isolate", Some(&["isolate", "models/fixed.toml", "--json"])),

@@ -476,3 +476,74 @@ fn a_tearing_swap_chain_takes_the_refresh_the_rest_of_the_capture_shows_and_alon
         first.cpu_start
     );
 }
+
+#[test]
+fn the_validation_report_lists_every_swap_chain_with_its_accuracy_and_why_frames_disagree() {
+    let dir = tempfile::tempdir().unwrap();
+    let rep = dir.path().join("report");
+    let o = bin()
+        .args(["replay", capture(0).to_str().unwrap(), "--report"])
+        .arg(&rep)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let chains = std::fs::read_to_string(rep.join("chains.csv")).unwrap();
+    // A header and test_case_0's ten swap chains.
+    assert_eq!(chains.lines().count(), 11, "{chains}");
+    assert!(chains.lines().nth(1).unwrap().starts_with("0,\"dwm.exe\""), "{chains}");
+    let md = std::fs::read_to_string(rep.join("report.md")).unwrap();
+    assert!(md.contains("8 of 10 meet the accuracy targets"), "{md}");
+    // The independent flip that tears misses whole refreshes and lands off
+    // the grid; the reasons are counted and listed.
+    assert!(md.contains("1 refresh(es) earlier than measured"), "{md}");
+    assert!(md.contains("ms off the refresh grid"), "{md}");
+    assert!(md.contains("replaced in the queue before its refresh"), "{md}");
+    for i in 0..10 {
+        assert!(rep.join(format!("chain-{i}.csv")).is_file(), "chain-{i}.csv");
+        assert!(
+            rep.join(format!("chain-{i}-screen.png")).is_file(),
+            "chain-{i}-screen.png"
+        );
+    }
+    let c3 = std::fs::read_to_string(rep.join("chain-3.csv")).unwrap();
+    assert!(
+        c3.starts_with("Line,PresentTime,MsUntilDisplayed,ReplayedMsUntilDisplayed,Reason\n"),
+        "{c3}"
+    );
+    // --out and --report in one folder, and a report over another
+    // command's results, are refused.
+    let e = bin()
+        .args(["replay", capture(0).to_str().unwrap(), "--report"])
+        .arg(&rep)
+        .arg("--out")
+        .arg(&rep)
+        .output()
+        .unwrap();
+    assert_eq!(e.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&e.stderr).contains("--out and --report name the same folder"));
+    let out = dir.path().join("out");
+    assert!(
+        bin()
+            .args(["replay", capture(0).to_str().unwrap(), "--out"])
+            .arg(&out)
+            .output()
+            .unwrap()
+            .status
+            .success()
+    );
+    let e = bin()
+        .args(["replay", capture(0).to_str().unwrap(), "--report"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(e.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&e.stderr).contains("holds the results of `rendersim replay`"),
+        "{}",
+        String::from_utf8_lossy(&e.stderr)
+    );
+    assert!(
+        out.join("replay.json").is_file(),
+        "the other command's results are kept"
+    );
+}

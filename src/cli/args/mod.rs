@@ -424,6 +424,12 @@ pub struct ReplayArgs {
     /// what-if, whatif-frames.csv and whatif-model.toml into DIR.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Write a validation report of every swap chain of the capture into
+    /// DIR: report.md (accuracy, the inferred display, the frames where
+    /// measured and replayed disagree and why), chains.csv, and per swap
+    /// chain chain-N.csv and chain-N-screen.png.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
     /// Replace an --out folder that holds another command's results (an
     /// experiment's, a replay's); without it that is an error.
     #[arg(long)]

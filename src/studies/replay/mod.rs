@@ -41,6 +41,7 @@ pub mod report;
 pub mod results;
 mod setup;
 pub mod system;
+pub mod validation;
 
 pub use refresh::fit_phase;
 pub use results::{
@@ -322,6 +323,7 @@ pub fn replay_capture(
         whatif_model,
         replayed: replayed(captured.records, captured.generated),
         whatif_replayed,
+        unknown_fates: s.rows.iter().filter(|p| !p.fate_known).map(|p| p.line).collect(),
     })
 }
 

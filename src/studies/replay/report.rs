@@ -68,6 +68,10 @@ pub fn write_text(s: &ReplaySummary, w: &mut impl std::io::Write) -> std::io::Re
         },
         s.refresh_hz
     )?;
+    writeln!(w, "  display: {}", s.display.describe())?;
+    for note in &s.capture_notes {
+        writeln!(w, "  read: {note}")?;
+    }
     writeln!(
         w,
         "  displayed: measured {}, predicted {}; fates agree on {:.1}% of frames",

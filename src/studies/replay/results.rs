@@ -248,4 +248,7 @@ pub struct Replay {
     pub replayed: ReplayedFrames,
     /// The what-if's run, as PresentMon frames (with `--set` patches only).
     pub whatif_replayed: Option<ReplayedFrames>,
+    /// The lines of the frames whose fate the capture does not know
+    /// (`Dropped` neither 0 nor 1).
+    pub unknown_fates: Vec<u64>,
 }

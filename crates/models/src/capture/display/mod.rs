@@ -408,6 +408,54 @@ pub struct DisplayInference {
     pub chains: Vec<ChainDisplay>,
 }
 
+impl DisplayInference {
+    /// One line a person reads: the refresh and what it came from, the
+    /// monitors, and how the swap chain's flips reached the screen.
+    pub fn describe(&self) -> String {
+        let refresh = match &self.refresh {
+            None => "no refresh: nothing in the capture lies on a refresh grid".to_string(),
+            Some(r) => {
+                let from = match r.from {
+                    RefreshEvidence::Compositor => "the compositor's presents",
+                    RefreshEvidence::DisplayChanges => "display changes at vertical blanks",
+                    RefreshEvidence::UnsyncedFlips => "the swap chain's unsynced flips",
+                };
+                let mut t = format!("{:.3} Hz from {from} ({})", r.hz, r.chains.join(", "));
+                if let Some(a) = r.ambiguous_below_hz {
+                    t += &format!(
+                        "; ambiguous: the capture fits {a:.2} Hz, the slowest multiple of at least {MIN_PANEL_HZ} Hz taken"
+                    );
+                }
+                if let Some(f) = r.raised_from_hz {
+                    t += &format!("; raised from {f:.2} Hz by flips faster than it");
+                }
+                t
+            }
+        };
+        let flips = match (self.flips, &self.vrr) {
+            (Flips::VariableRefresh, Some(v)) => format!(
+                "a variable refresh, {:.0}-{:.0} Hz ({} the slowest assumed)",
+                v.min_hz,
+                v.max_hz,
+                if v.max_from_refresh {
+                    "the fastest the panel's,"
+                } else {
+                    "the fastest as fast as its flips,"
+                }
+            ),
+            (Flips::OnGrid, _) => "on the refresh grid".to_string(),
+            (Flips::Tearing, _) => "when ready, tearing".to_string(),
+            (Flips::VariableRefresh, None) | (Flips::Unknown, _) => "unknown".to_string(),
+        };
+        let monitors = match self.monitors {
+            0 => String::new(),
+            1 => "; 1 monitor".to_string(),
+            n => format!("; {n} monitors"),
+        };
+        format!("{refresh}{monitors}; flips {flips}")
+    }
+}
+
 /// A swap chain's identity within a capture.
 type Key<'a> = (&'a str, &'a str, &'a str);
 
