@@ -16,7 +16,7 @@
 //! - `build`: the vertex-cache reordering against its direct form, and the
 //!   scene build against the simulation of the models that build a mesh
 //!   ([`build`]).
-//! - `replay`: replaying a 10,000-frame PresentMon capture against reading
+//! - `replay`: replaying a 20,000-frame PresentMon capture against reading
 //!   its CSV alone ([`replay`]).
 //!
 //! The functions return the measurements; `rendersim bench` prints them.
@@ -70,7 +70,7 @@ pub enum Bench {
     Pixelflow,
     /// Scene building against simulation ([`build::build_bench`]).
     Build,
-    /// A 10,000-frame capture's replay against reading it ([`replay::replay_bench`]).
+    /// A 20,000-frame capture's replay against reading it ([`replay::replay_bench`]).
     Replay,
 }
 

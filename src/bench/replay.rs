@@ -1,4 +1,4 @@
-//! `rendersim bench replay`: replaying a 10,000-frame capture against
+//! `rendersim bench replay`: replaying a 20,000-frame capture against
 //! reading the same CSV alone (issue 26, "Accuracy and speed": well under a
 //! second).
 //!
@@ -83,10 +83,10 @@ pub fn synthetic_capture(frames: usize) -> String {
     s
 }
 
-/// The replay benchmark at `scale`: 10,000 frames at 1 (at least 200),
+/// The replay benchmark at `scale`: 20,000 frames at 1 (at least 200),
 /// `repeats` repetitions.
 pub fn replay_bench(scale: f64, repeats: usize) -> Result<ReplayBench, BenchError> {
-    let frames = ((10_000.0 * scale) as usize).max(200);
+    let frames = ((20_000.0 * scale) as usize).max(200);
     let text = synthetic_capture(frames);
     let reps = repeats.max(1);
     let (mut read, mut whole, mut sim) = (Vec::new(), Vec::new(), Vec::new());

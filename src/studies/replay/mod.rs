@@ -270,9 +270,9 @@ pub fn replay_capture(
         columns: capture.columns,
         frames: frames.len(),
         not_rendered: capture.not_rendered,
-        application: s.rows[0].application.clone(),
-        swapchain: s.rows[0].swap_chain.clone(),
-        present_mode: s.common.present_mode.clone(),
+        application: s.rows[0].application.to_string(),
+        swapchain: s.rows[0].swap_chain.to_string(),
+        present_mode: s.common.present_mode.to_string(),
         model_present_mode: s.mode.to_string(),
         model_composition: if s.composed {
             Composition::Composed

@@ -27,7 +27,7 @@ use super::{REPLAY_MODEL, RefreshFrom, ReplayError, ReplayOptions, fit_phase};
 /// one that showed its frames is `fifo` (PresentMon's test app, its
 /// frames queued three refreshes deep).
 fn model_mode(p: &Present, dropped_share: f64, file: &str) -> Result<(&'static str, bool, bool), CaptureError> {
-    let mode = p.present_mode.as_str();
+    let mode: &str = &p.present_mode;
     let composed = mode.starts_with("Composed");
     if !composed && !mode.starts_with("Hardware") {
         return Err(CaptureError::Row {
@@ -107,7 +107,7 @@ pub(super) fn setup(capture: &Capture, opts: &ReplayOptions) -> Result<Setup, Re
     // a composed to an independent flip after its first frame).
     let common = rows
         .iter()
-        .find(|p| p.present_mode == chain.present_mode)
+        .find(|p| *p.present_mode == *chain.present_mode)
         .unwrap_or(&rows[0])
         .clone();
     let dropped_share = rows.iter().filter(|p| !p.displayed()).count() as f64 / rows.len() as f64;
@@ -184,13 +184,13 @@ pub(super) fn setup(capture: &Capture, opts: &ReplayOptions) -> Result<Setup, Re
         })?;
     }
     let chain = ChainInfo {
-        application: common.application.clone(),
-        process_id: common.process_id.clone(),
-        swap_chain: common.swap_chain.clone(),
+        application: common.application.to_string(),
+        process_id: common.process_id.to_string(),
+        swap_chain: common.swap_chain.to_string(),
         runtime: "Other".into(),
         sync_interval: common.sync_interval.unwrap_or(1),
         allows_tearing: common.allows_tearing,
-        present_mode: common.present_mode.clone(),
+        present_mode: common.present_mode.to_string(),
     };
     Ok(Setup {
         rows,

@@ -84,7 +84,7 @@ pub enum Path {
 impl Path {
     /// The path of one present.
     pub fn of(p: &Present) -> Path {
-        let mode = p.present_mode.as_str();
+        let mode: &str = &p.present_mode;
         let hardware = mode.starts_with("Hardware");
         let tearing = hardware && p.sync_interval == Some(0) && p.allows_tearing;
         if p.application.eq_ignore_ascii_case("dwm.exe") && !tearing {
@@ -220,6 +220,16 @@ pub fn fit_grid(times: &[f64]) -> Option<Grid> {
     if d.len() < 3 {
         return None;
     }
+    // Candidates are scored on at most this many intervals, evenly strided
+    // (a 20,000-frame capture's choice does not need them all); the phase
+    // fit below takes every change.
+    const SCORED: usize = 2000;
+    let d: Vec<f64> = if d.len() > SCORED {
+        let step = d.len() as f64 / SCORED as f64;
+        (0..SCORED).map(|i| d[(i as f64 * step) as usize]).collect()
+    } else {
+        d
+    };
     let mut sorted = d.clone();
     sorted.sort_by(f64::total_cmp);
     let mut candidates: Vec<f64> = Vec::new();
@@ -255,13 +265,13 @@ pub fn fit_grid(times: &[f64]) -> Option<Grid> {
             (best_n - n) as f64 <= expected + 3.0 * expected.sqrt() + 1.0
         })
         .expect("the best candidate passes its own test");
-    Some(phase_fit(&t, period, d.len()))
+    Some(phase_fit(&t, period))
 }
 
 /// The grid of period about `period` through sorted times `t`: refresh
 /// counts accumulated interval by interval, then least squares of the
 /// times on the grid against their counts.
-fn phase_fit(t: &[f64], period: f64, n_intervals: usize) -> Grid {
+fn phase_fit(t: &[f64], period: f64) -> Grid {
     let mut counts = Vec::with_capacity(t.len());
     let mut k = 0.0;
     let mut last = t[0];
@@ -302,7 +312,7 @@ fn phase_fit(t: &[f64], period: f64, n_intervals: usize) -> Grid {
     Grid {
         period_ms: p,
         phase_ms: phase,
-        intervals: n_intervals,
+        intervals: d.len(),
         on_grid: fits(&d, p),
     }
 }

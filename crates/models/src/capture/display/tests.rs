@@ -47,7 +47,7 @@ fn shown<'a>(
 }
 
 fn target(c: &Capture, app: &str) -> DisplayInference {
-    let p = c.presents.iter().find(|p| p.application == app).unwrap();
+    let p = c.presents.iter().find(|p| &*p.application == app).unwrap();
     infer_display(c, p)
 }
 

@@ -78,6 +78,8 @@ pub(super) struct Cells<'a> {
     header: &'a Header,
     /// Values no time can have, read as missing: the count and the first.
     impossible: std::cell::RefCell<(usize, Option<Impossible>)>,
+    /// The text cells read so far (names, addresses, modes), each kept once.
+    strings: std::cell::RefCell<std::collections::HashSet<std::sync::Arc<str>>>,
 }
 
 impl<'a> Cells<'a> {
@@ -86,7 +88,20 @@ impl<'a> Cells<'a> {
             file,
             header,
             impossible: Default::default(),
+            strings: Default::default(),
         }
+    }
+
+    /// A text cell, shared with every equal one read before (a capture
+    /// repeats its few names and modes on every row).
+    pub(super) fn intern(&self, text: &str) -> std::sync::Arc<str> {
+        let mut strings = self.strings.borrow_mut();
+        if let Some(s) = strings.get(text) {
+            return s.clone();
+        }
+        let s: std::sync::Arc<str> = text.into();
+        strings.insert(s.clone());
+        s
     }
 
     /// Adds the values read as missing to `notes`.

@@ -9,8 +9,6 @@
 //! `//key=value` lines). Names match without regard to case or spaces at
 //! either end.
 
-use std::collections::HashMap;
-
 /// A column the reader uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub(super) enum Col {
@@ -52,6 +50,9 @@ pub(super) enum Col {
     ClickToPhoton,
     RenderQueueDepth,
 }
+
+/// How many [`Col`]s there are.
+const COLS: usize = Col::RenderQueueDepth as usize + 1;
 
 /// Each column's names, the preferred first.
 const NAMES: &[(Col, &[&str])] = &[
@@ -127,7 +128,8 @@ fn fold(name: &str) -> String {
 
 /// The header's columns by what they hold.
 pub(super) struct Header {
-    index: HashMap<Col, usize>,
+    /// Where each column is, by [`Col`]'s discriminant (a lookup per cell).
+    index: [Option<usize>; COLS],
     /// The header as written.
     pub(super) names: Vec<String>,
 }
@@ -136,11 +138,9 @@ impl Header {
     /// Maps a header row (each column taken at its first occurrence).
     pub(super) fn new(cells: &csv::StringRecord) -> Header {
         let folded: Vec<String> = cells.iter().map(fold).collect();
-        let mut index = HashMap::new();
+        let mut index = [None; COLS];
         for (col, names) in NAMES {
-            if let Some(i) = names.iter().find_map(|n| folded.iter().position(|h| *h == fold(n))) {
-                index.insert(*col, i);
-            }
+            index[*col as usize] = names.iter().find_map(|n| folded.iter().position(|h| *h == fold(n)));
         }
         Header {
             index,
@@ -150,12 +150,12 @@ impl Header {
 
     /// Where a column is.
     pub(super) fn get(&self, col: Col) -> Option<usize> {
-        self.index.get(&col).copied()
+        self.index[col as usize]
     }
 
     /// Whether the header has a column.
     pub(super) fn has(&self, col: Col) -> bool {
-        self.index.contains_key(&col)
+        self.get(col).is_some()
     }
 
     /// The column's name as the header writes it (else its preferred name).

@@ -61,6 +61,7 @@ pub mod columns;
 
 use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
 use self::cells::{Cells, Notes};
 use self::columns::{Col, Header, SYSTEM_COLUMNS};
@@ -132,19 +133,19 @@ pub struct Present {
     /// Line in the file.
     pub line: u64,
     /// Process name.
-    pub application: String,
+    pub application: Arc<str>,
     /// Process id (as written).
-    pub process_id: String,
+    pub process_id: Arc<str>,
     /// Swap chain (as written, e.g. `0x224B280A1C0`).
-    pub swap_chain: String,
+    pub swap_chain: Arc<str>,
     /// `PresentMode` as written (`Hardware: Legacy Flip`, `Composed: Flip`, ...).
-    pub present_mode: String,
+    pub present_mode: Arc<str>,
     /// `SyncInterval` (absent in some captures).
     pub sync_interval: Option<i64>,
     /// `AllowsTearing`.
     pub allows_tearing: bool,
     /// `FrameType` as written (empty where the capture has none).
-    pub frame_type: String,
+    pub frame_type: Arc<str>,
     /// When the CPU started the frame.
     pub cpu_start: f64,
     /// When the present call started.
@@ -369,9 +370,9 @@ impl Capture {
         for p in &self.presents {
             let i = *index.entry(p.chain()).or_insert_with(|| {
                 order.push(SwapChainInfo {
-                    application: p.application.clone(),
-                    process_id: p.process_id.clone(),
-                    swap_chain: p.swap_chain.clone(),
+                    application: p.application.to_string(),
+                    process_id: p.process_id.to_string(),
+                    swap_chain: p.swap_chain.to_string(),
                     present_mode: String::new(),
                     frames: 0,
                 });
@@ -379,7 +380,7 @@ impl Capture {
                 order.len() - 1
             });
             order[i].frames += 1;
-            *modes[i].entry(p.present_mode.as_str()).or_default() += 1;
+            *modes[i].entry(&p.present_mode).or_default() += 1;
         }
         for (s, m) in order.iter_mut().zip(&modes) {
             let mut m: Vec<(&&str, &usize)> = m.iter().collect();
@@ -593,7 +594,7 @@ fn read_row(
             _ => None,
         },
     };
-    let text = |col: Col| cell.text(rec, col).unwrap_or_default().to_string();
+    let text = |col: Col| cell.intern(cell.text(rec, col).unwrap_or_default());
     let present = Present {
         line,
         application: text(Col::Application),
@@ -669,16 +670,25 @@ fn one_recording(rows: Vec<Row>, notes: &mut Notes) -> Vec<Row> {
 /// filled in (the previous present call's end, the first frame's
 /// `MsBetweenPresents` before its present).
 fn in_time_order(rows: Vec<Row>, columns: Columns, notes: &mut Notes) -> Vec<Present> {
-    let mut by_chain: HashMap<(String, String, String), Vec<usize>> = HashMap::new();
-    for (i, r) in rows.iter().enumerate() {
-        let (a, b, c) = r.present.chain();
-        by_chain.entry((a.into(), b.into(), c.into())).or_default().push(i);
+    // Each row's swap chain, numbered in order of first appearance.
+    let mut ids: HashMap<(&str, &str, &str), usize> = HashMap::new();
+    let chain_of: Vec<usize> = rows
+        .iter()
+        .map(|r| {
+            let n = ids.len();
+            *ids.entry(r.present.chain()).or_insert(n)
+        })
+        .collect();
+    let mut by_chain: Vec<Vec<usize>> = vec![Vec::new(); ids.len()];
+    drop(ids);
+    for (i, &c) in chain_of.iter().enumerate() {
+        by_chain[c].push(i);
     }
     // Slot i of the output takes the present that belongs there once its
     // swap chain's rows are sorted (the slots a swap chain fills stay its own).
     let mut slot: Vec<usize> = (0..rows.len()).collect();
     let mut out_of_order = 0;
-    for idx in by_chain.values() {
+    for idx in &by_chain {
         let mut sorted = idx.clone();
         sorted.sort_by(|&a, &b| {
             rows[a]
@@ -706,15 +716,16 @@ fn in_time_order(rows: Vec<Row>, columns: Columns, notes: &mut Notes) -> Vec<Pre
         })
         .collect();
     if columns == Columns::V1 {
-        let mut prev: HashMap<(String, String, String), (f64, f64)> = HashMap::new();
-        for (p, between) in &mut out {
-            let (a, b, c) = p.chain();
-            let k = (a.to_string(), b.to_string(), c.to_string());
-            let start = match prev.get(&k) {
-                Some(&(pp, w)) => pp + w,
+        // The previous present and its time in the present call, per chain
+        // (slot s holds a row of the chain of the row first at s).
+        let mut prev: Vec<Option<(f64, f64)>> = vec![None; by_chain.len()];
+        for (s, (p, between)) in out.iter_mut().enumerate() {
+            let c = chain_of[s];
+            let start = match prev[c] {
+                Some((pp, w)) => pp + w,
                 None => p.present - *between,
             };
-            prev.insert(k, (p.present, p.cpu_wait));
+            prev[c] = Some((p.present, p.cpu_wait));
             p.cpu_start = start.min(p.present);
             p.cpu_busy = (p.present - p.cpu_start).max(0.0);
         }
