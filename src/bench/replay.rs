@@ -120,7 +120,7 @@ mod tests {
 
     #[test]
     fn the_synthetic_capture_replays_as_it_was_generated() {
-        let b = replay_bench(0.02, 2).unwrap();
+        let b = replay_bench(0.01, 2).unwrap();
         assert_eq!(b.ratio.n, 2);
         assert_eq!(b.frames, 200);
         assert!(b.agreement > 0.99, "{}", b.agreement);
