@@ -22,35 +22,7 @@ use super::links::Links;
 use super::pipeline_trace::{PipelineTrace, Track};
 use super::records::FrameRecord;
 
-/// CPU states.
-pub const CPU_STATES: [&str; 8] = [
-    "work",
-    "system task",
-    "wait: command FIFO full",
-    "wait: frames in flight",
-    "idle",
-    "wait: pacing before a frame",
-    "wait: frame limiter before present",
-    "wait: in the present call",
-];
-/// GPU front-end states.
-pub const FRONT_STATES: [&str; 6] = [
-    "busy",
-    "starved",
-    "wait: swap image",
-    "wait: pipeline drain",
-    "wait: geometry",
-    "system task",
-];
-/// The front end's state (index into [`FRONT_STATES`]) while a draw waits
-/// for the geometry stage.
-pub const FRONT_WAIT_GEOMETRY: usize = 4;
-/// Geometry-stage states.
-pub const GEOM_STATES: [&str; 3] = ["busy", "blocked: triangle FIFO full", "idle"];
-/// Fragment-stage states.
-pub const FRAG_STATES: [&str; 2] = ["busy", "idle"];
-/// Bottleneck units.
-pub const BOTTLENECKS: [&str; 6] = ["cpu", "system", "gpu_front_end", "geometry", "fragment", "display"];
+use super::unit_states::FRONT_WAIT_GEOMETRY;
 
 /// Clocks and per-frame attribution.
 #[derive(Debug)]
@@ -169,7 +141,7 @@ fn attribute_cpu(records: &mut [FrameRecord], old: usize, spent: u64, frame: u64
     }
 }
 
-/// The CPU state (index into [`CPU_STATES`]) of a phase outside system tasks.
+/// The CPU state (index into [`CPU_STATES`](super::unit_states::CPU_STATES)) of a phase outside system tasks.
 #[inline]
 fn cpu_state_of(p: CpuPhase) -> usize {
     // A table, not a match: the phase changes from event to event, and a
@@ -192,7 +164,7 @@ fn cpu_state_of(p: CpuPhase) -> usize {
     OF[p as usize] as usize
 }
 
-/// The front-end state (index into [`FRONT_STATES`]) of a phase outside
+/// The front-end state (index into [`FRONT_STATES`](super::unit_states::FRONT_STATES)) of a phase outside
 /// system tasks.
 #[inline]
 fn front_state_of(p: FrontPhase) -> usize {
@@ -491,7 +463,7 @@ fn front_mode(u: Units<'_>) -> Mode {
     }
 }
 
-/// The CPU's state (index into [`CPU_STATES`]).
+/// The CPU's state (index into [`CPU_STATES`](super::unit_states::CPU_STATES)).
 #[inline]
 fn cpu_state(cpu: &CpuThread) -> usize {
     if cpu.in_system() { 1 } else { cpu_state_of(cpu.phase()) }

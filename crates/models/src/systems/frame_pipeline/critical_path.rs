@@ -26,7 +26,7 @@
 //!
 //! Each unit carries the blame vector of the critical path to its latest
 //! instant (six numbers: the time charged to each of
-//! [`BOTTLENECKS`](super::accounting::BOTTLENECKS)). When a unit works, its
+//! [`BOTTLENECKS`](super::unit_states::BOTTLENECKS)). When a unit works, its
 //! own path grows by the time it worked; when it waits, its path is the
 //! path of the unit it waits for, up to the instant the wait ends (that unit
 //! is what ended it).
@@ -56,7 +56,7 @@ use std::collections::VecDeque;
 use crate::engine::{Duration, Time};
 
 /// What time is charged to, in the order of
-/// [`BOTTLENECKS`](super::accounting::BOTTLENECKS).
+/// [`BOTTLENECKS`](super::unit_states::BOTTLENECKS).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Blame {
     /// The CPU thread.

@@ -13,7 +13,8 @@
 //! triangle sizes and their random stream) and its transitions; the
 //! triangle FIFO and the shader pool come in an [`Env`], the fragment stage
 //! it feeds as an argument. [`geometry_cost`] is the one formula of the
-//! stage's time, used per mesh by the workload and per triangle here.
+//! stage's time, used per mesh by the workload and per triangle here
+//! (its own file, below both).
 
 use crate::components::shader_pool::Stream;
 use crate::components::shared_bus::SharedBus;
@@ -22,9 +23,10 @@ use crate::scene::config::SizeOrder;
 use crate::systems::error::SystemError;
 
 use super::closed_form::DrawTimes;
-use super::config::{Fidelity, GeometryConfig};
+use super::config::Fidelity;
 use super::events::Ev;
 use super::fragment_stage::FragmentStage;
+use super::geometry_cost::geometry_cost;
 use super::links::{Env, FragWork};
 use super::workload::{MeshInfo, closed_times, ordered_sizes};
 
@@ -50,56 +52,6 @@ fn fetch_bound(total: Duration, shader: Duration, fetch: Duration, unified: bool
     } else {
         total.max(fetch)
     }
-}
-
-/// The geometry stage's time for some work: its vertex-shader part and the
-/// whole (the rest is index fetch and triangle setup).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct GeometryCost {
-    /// Vertex shading.
-    pub shader: Duration,
-    /// Index fetch, vertex shading and triangle setup.
-    pub total: Duration,
-}
-
-impl GeometryCost {
-    /// The fixed-function part (index fetch and triangle setup).
-    #[inline(always)]
-    pub fn fixed(&self) -> Duration {
-        Duration(self.total.0 - self.shader.0)
-    }
-}
-
-/// Which part of [`geometry_cost`] left the 64-bit picosecond range.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CostOverflow {
-    /// A cost times its count.
-    Product,
-    /// A sum of costs.
-    Sum,
-}
-
-/// The geometry stage's time for `transformed` vertices shaded (those the
-/// post-transform cache missed), `indices` indices fetched and `triangles`
-/// triangles set up, from the model's per-vertex, per-index and
-/// per-triangle costs (`gpu.geometry`). The first part to overflow is
-/// reported, in the order: shading, fetch, fetch + shading, setup, total.
-#[inline]
-pub fn geometry_cost(
-    geo: &GeometryConfig,
-    transformed: u64,
-    indices: u64,
-    triangles: u64,
-) -> Result<GeometryCost, CostOverflow> {
-    let shader = geo
-        .vertex_shader
-        .checked_mul(transformed)
-        .ok_or(CostOverflow::Product)?;
-    let fetch = geo.index_fetch.checked_mul(indices).ok_or(CostOverflow::Product)?;
-    let fetched = fetch.checked_add(shader).ok_or(CostOverflow::Sum)?;
-    let setup = geo.triangle_setup.checked_mul(triangles).ok_or(CostOverflow::Product)?;
-    let total = fetched.checked_add(setup).ok_or(CostOverflow::Sum)?;
-    Ok(GeometryCost { shader, total })
 }
 
 /// A draw in the geometry stage.

@@ -26,6 +26,7 @@
 //! timeline) live above it, in the `rendersim` crate's `studies`.
 
 pub mod accounting;
+mod analytic;
 mod bus_copy;
 pub mod checked;
 pub mod closed_form;
@@ -36,6 +37,7 @@ mod display;
 mod events;
 mod fragment_stage;
 mod front_end;
+mod geometry_cost;
 mod geometry_stage;
 mod links;
 pub mod model;
@@ -46,6 +48,7 @@ pub mod report;
 pub mod run;
 pub mod summary;
 pub mod system;
+pub mod unit_states;
 pub mod validate;
 pub mod workload;
 

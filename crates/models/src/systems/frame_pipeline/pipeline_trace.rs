@@ -7,8 +7,8 @@
 use crate::engine::{Duration, Time};
 use crate::output::trace::{FlowStep, TraceDetail, TraceWriter};
 
-use super::accounting::{CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES};
 use super::records::FrameRecord;
+use super::unit_states::{CPU_STATES, FRAG_STATES, FRONT_STATES, GEOM_STATES};
 
 /// Trace tracks (their track numbers in the trace are these plus one).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -6,9 +6,9 @@
 use crate::components::swap_chain::PresentMode;
 use crate::engine::PS_PER_MS;
 
+use super::analytic::AnalyticTerms;
 use super::config::{FramePipelineConfig, WorkloadConfig};
 use super::records::FrameRecord;
-use super::summary::AnalyticTerms;
 use crate::systems::error::{SystemError, invalid as bad};
 
 /// Checks values serde cannot (ranges, distributions); run through
@@ -521,76 +521,8 @@ pub(super) fn check_events(
 
 #[cfg(test)]
 mod tests {
-    use super::super::summary::analytic_terms;
-    use super::super::workload::compile_scene;
     use super::*;
     use crate::config::{Overrides, deserialize, load_model};
-
-    /// The estimate against the events of real runs: every shipped
-    /// frame-pipeline model (a few frames), and the default model with
-    /// heavy system tasks on either unit, at draw fidelity, without vsync,
-    /// binned and unified.
-    #[test]
-    fn the_event_estimate_is_a_lower_bound_of_real_runs() {
-        let root = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
-        let mut cases: Vec<(std::path::PathBuf, Vec<&str>)> = Vec::new();
-        let mut models: Vec<_> = std::fs::read_dir(root.join("models"))
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-            .collect();
-        models.sort();
-        for m in models {
-            cases.push((m, vec![]));
-        }
-        let default = root.join("models/default.toml");
-        for sets in [
-            vec!["noise.periodic.0.duration=\"28ms\"", "noise.periodic.0.jitter=\"0ms\""],
-            vec!["noise.periodic.0.target=\"gpu\"", "noise.periodic.0.duration=\"25ms\""],
-            vec!["fidelity=\"draw\""],
-            vec!["display.vsync=false"],
-            vec!["gpu.fragment.binning=\"draw\""],
-            vec!["gpu.architecture=\"unified\""],
-        ] {
-            cases.push((default.clone(), sets));
-        }
-        let mut checked = 0;
-        for (path, sets) in cases {
-            // A workload given frame by frame runs the frames it lists.
-            let listed = std::fs::read_to_string(&path).unwrap().contains("kind = \"frames\"");
-            let o = Overrides {
-                sets: sets.iter().map(|s| s.to_string()).collect(),
-                frames: (!listed).then_some(12),
-                ..Overrides::default()
-            };
-            let m = load_model(Some(&path), &o).unwrap();
-            if m.table
-                .get("system")
-                .and_then(|s| s.as_str())
-                .unwrap_or("frame_pipeline")
-                != "frame_pipeline"
-            {
-                continue;
-            }
-            let cfg: FramePipelineConfig = deserialize(&m.table, &m.source).unwrap();
-            let scene = match &cfg.workload {
-                WorkloadConfig::Scene(sc) => Some(compile_scene(&cfg, sc, &m.source.base_dir).unwrap()),
-                WorkloadConfig::Fixed(_) | WorkloadConfig::Frames(_) => None,
-            };
-            let a = analytic_terms(&cfg, scene.as_ref());
-            let parts = estimate_events(&cfg, &a, scene.as_ref().map(|s| s.stats.triangles));
-            let estimate: f64 = parts.iter().map(|p| p.2).sum();
-            let run = super::super::run::run_pipeline(cfg, &m.source.base_dir, None).unwrap();
-            let events = run.stats.events as f64;
-            assert!(
-                estimate <= events && estimate > 0.0,
-                "{} {sets:?}: estimate {estimate} ({parts:?}) > {events} events",
-                path.display()
-            );
-            checked += 1;
-        }
-        assert!(checked >= 13, "{checked}");
-    }
 
     #[test]
     fn system_tasks_must_leave_a_share_of_their_unit() {

@@ -17,7 +17,7 @@ use crate::scene::states::{StateNumbering, group_states_error, scene_groups};
 
 use super::closed_form::{DrawTimes, draw_times, draw_times_unified, ordered_draw_total};
 use super::config::{Fidelity, FramePipelineConfig};
-use super::geometry_stage::{CostOverflow, geometry_cost};
+use super::geometry_cost::{CostOverflow, geometry_cost};
 
 /// Errors while building the workload.
 #[derive(Debug, thiserror::Error)]
