@@ -208,7 +208,7 @@ impl Accounting {
         };
         let geom_state = if u.geom.busy() {
             0
-        } else if u.geom.holds_triangle() {
+        } else if u.links.held_triangle.is_some() {
             1
         } else {
             2
@@ -495,7 +495,7 @@ fn path_modes(u: Units<'_>) -> Modes {
         None => (
             if u.geom.busy() {
                 Mode::work(Blame::Geometry)
-            } else if u.geom.holds_triangle() {
+            } else if u.links.held_triangle.is_some() {
                 Mode::wait(Unit::Fragment)
             } else {
                 Mode::wait(Unit::Front)

@@ -7,15 +7,15 @@
 //! ([`super::closed_form`]), which the geometry stage starts.
 //!
 //! [`FragmentStage`] owns whether the stage is busy and its transitions;
-//! the triangle FIFO and the shader pool come in an [`Env`], the geometry
-//! stage it frees as an argument.
+//! the triangle FIFO, the link's slot for a held triangle and the shader
+//! pool come in an [`Env`]. It never calls the geometry stage: freeing a
+//! held triangle, it says so, and the step lets geometry go on.
 
 use crate::components::shader_pool::{ShaderPool, Stream};
 use crate::engine::{Scheduler, Time};
 use crate::systems::error::SystemError;
 
 use super::events::Ev;
-use super::geometry_stage::GeometryStage;
 use super::links::{Env, FragWork};
 
 /// The fragment stage.
@@ -59,29 +59,29 @@ impl FragmentStage {
     }
 
     /// `triangle` fidelity: a triangle is shaded. The next one comes from
-    /// the triangle FIFO; a triangle `geom` held back by a full FIFO goes
-    /// in (or straight here), and the geometry stage goes on.
+    /// the triangle FIFO; a triangle held back by a full FIFO (the link's
+    /// slot) goes in, or straight here. Returns whether it freed one (the
+    /// geometry stage, blocked on it, goes on).
     #[inline(always)]
     pub(super) fn triangle_done(
         &mut self,
         now: Time,
         env: &mut Env,
-        geom: &mut GeometryStage,
         s: &mut Scheduler<Ev>,
-    ) -> Result<(), SystemError> {
+    ) -> Result<bool, SystemError> {
         self.busy = false;
         let links = &mut env.links;
         if let Some(f) = links.triangles.pop() {
             self.start(now, f, &mut links.shaders, s)?;
         }
-        if let Some(f) = geom.take_held() {
-            if self.busy {
-                links.triangles.push(f, 1);
-            } else {
-                self.start(now, f, &mut links.shaders, s)?;
-            }
-            geom.next_triangle(now, env, s)?;
+        let Some(f) = links.held_triangle.take() else {
+            return Ok(false);
+        };
+        if self.busy {
+            links.triangles.push(f, 1);
+        } else {
+            self.start(now, f, &mut links.shaders, s)?;
         }
-        Ok(())
+        Ok(true)
     }
 }

@@ -188,7 +188,11 @@ impl FrontEnd {
                 }
                 FrontPhase::WaitDrain => {
                     // No triangle anywhere between the front end and the fragment output.
-                    if !(down.geom.drained() && env.links.triangles.is_empty() && !down.frag.busy()) {
+                    if !(down.geom.drained()
+                        && env.links.held_triangle.is_none()
+                        && env.links.triangles.is_empty()
+                        && !down.frag.busy())
+                    {
                         return Ok(progressed);
                     }
                     // With frame generation, the interpolation before the
@@ -234,7 +238,9 @@ impl FrontEnd {
                             continue;
                         }
                         self.set_up = false;
-                        down.geom.start_draw(now, draw, env, down.frag, s)?;
+                        if down.geom.start_draw(now, draw, env, s)? {
+                            down.frag.set_closed_busy(true);
+                        }
                     }
                     self.phase = FrontPhase::Idle;
                 }
@@ -485,7 +491,9 @@ impl FrontEnd {
             Some(_) => return Ok(false),
         };
         // The geometry stage takes the held draw (`GeometryStage::start_draw`).
-        geom.start_closed_draw(draw, triangles, t, frag, env.traced, s)?;
+        if geom.start_closed_draw(draw, triangles, t, env.traced, s)? {
+            frag.set_closed_busy(true);
+        }
         self.phase = FrontPhase::Idle;
         // The front end takes the next draw command (`begin`, `job`).
         if let Some((work, commands)) = next

@@ -9,10 +9,12 @@
 //! geometry.
 //!
 //! [`GeometryStage`] owns the stage's state (the draw it holds, the
-//! triangle held back by a full FIFO, the running closed form, the
-//! triangle sizes and their random stream) and its transitions; the
-//! triangle FIFO and the shader pool come in an [`Env`], the fragment stage
-//! it feeds as an argument. [`geometry_cost`] is the one formula of the
+//! running closed form, the triangle sizes and their random stream) and
+//! its transitions; the triangle FIFO, its slot for a triangle held back
+//! by a full FIFO and the shader pool come in an [`Env`]. It never calls
+//! the fragment stage: a finished triangle is handed back to the step
+//! ([`Handoff`]), which starts the fragments, and a closed-form draw says
+//! when the fragment stage is busy. [`geometry_cost`] is the one formula of the
 //! stage's time, used per mesh by the workload and per triangle here
 //! (its own file, below both).
 
@@ -25,7 +27,6 @@ use crate::systems::error::SystemError;
 use super::closed_form::DrawTimes;
 use super::config::Fidelity;
 use super::events::Ev;
-use super::fragment_stage::FragmentStage;
 use super::geometry_cost::geometry_cost;
 use super::links::{Env, FragWork};
 use super::workload::{MeshInfo, closed_times, ordered_sizes};
@@ -52,6 +53,22 @@ fn fetch_bound(total: Duration, shader: Duration, fetch: Duration, unified: bool
     } else {
         total.max(fetch)
     }
+}
+
+/// Where a triangle the geometry stage finished goes (the step acts on it,
+/// in this order: the fragments start, then the stage takes its next
+/// triangle).
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Handoff {
+    /// Straight to the idle fragment stage; the stage goes on.
+    Fragment(FragWork),
+    /// Into the triangle FIFO (or its bins); the stage goes on.
+    Queued,
+    /// Into the link's slot past a full FIFO: the stage blocks until the
+    /// fragment stage frees it.
+    Held,
+    /// No draw (nothing left the stage).
+    NoDraw,
 }
 
 /// A draw in the geometry stage.
@@ -83,7 +100,6 @@ pub struct GeometryStage {
     /// `draw` fidelity: when the running draw ends (its [`Ev::DrawDone`]).
     done_at: Option<Time>,
     /// A finished triangle's fragment work that found the triangle FIFO full.
-    held: Option<FragWork>,
     /// The running draw's triangle sizes when its group sorts them
     /// (`size_order`), in drawing order; empty otherwise.
     sizes: Vec<f64>,
@@ -102,7 +118,6 @@ impl GeometryStage {
             split: None,
             fragment_limited: None,
             done_at: None,
-            held: None,
             sizes: Vec::new(),
             pixel_rng,
             pixel_rng_start,
@@ -113,12 +128,6 @@ impl GeometryStage {
     #[inline(always)]
     pub(super) fn busy(&self) -> bool {
         self.busy
-    }
-
-    /// Whether a finished triangle waits for room in the triangle FIFO.
-    #[inline(always)]
-    pub(super) fn holds_triangle(&self) -> bool {
-        self.held.is_some()
     }
 
     /// Whether it holds a draw.
@@ -144,11 +153,11 @@ impl GeometryStage {
         self.done_at
     }
 
-    /// Whether no triangle is in the stage (the triangle FIFO and the
-    /// fragment stage are the caller's to check).
+    /// Whether no triangle is in the stage (the triangle link, its held
+    /// slot included, and the fragment stage are the caller's to check).
     #[inline]
     pub(super) fn drained(&self) -> bool {
-        self.draw.is_none() && self.held.is_none() && !self.busy
+        self.draw.is_none() && !self.busy
     }
 
     /// A new frame begins (its clear): a static view's triangles get the
@@ -160,17 +169,17 @@ impl GeometryStage {
         }
     }
 
-    /// Takes `draw` from the front end.
+    /// Takes `draw` from the front end. Returns whether the fragment stage
+    /// is busy from now (`draw` fidelity: the draw's closed form spans it).
     pub(super) fn start_draw(
         &mut self,
         now: Time,
         draw: u32,
         env: &mut Env,
-        frag: &mut FragmentStage,
         s: &mut Scheduler<Ev>,
-    ) -> Result<(), SystemError> {
+    ) -> Result<bool, SystemError> {
         let Some(sc) = &env.scene else {
-            return Ok(());
+            return Ok(false);
         };
         let d = &sc.draws[draw as usize];
         let mesh = &sc.meshes[d.mesh as usize];
@@ -200,7 +209,8 @@ impl GeometryStage {
                     triangles,
                     fetch,
                 });
-                self.next_triangle(now, env, s)
+                self.next_triangle(now, env, s)?;
+                Ok(false)
             }
             Fidelity::Draw => {
                 let g = &sc.groups[d.group as usize];
@@ -212,23 +222,23 @@ impl GeometryStage {
                     }
                     None => closed_times(&env.cfg, mesh, g),
                 };
-                self.start_closed_draw(draw, triangles, t, frag, env.traced, s)
+                self.start_closed_draw(draw, triangles, t, env.traced, s)
             }
         }
     }
 
     /// `draw` fidelity: takes `draw` (`triangles` triangles), whose closed
-    /// form `t` spans this stage and `frag`.
+    /// form `t` spans this stage and the fragment stage. Returns whether
+    /// the fragment stage is busy from now.
     #[inline(always)]
     pub(super) fn start_closed_draw(
         &mut self,
         draw: u32,
         triangles: u64,
         t: DrawTimes,
-        frag: &mut FragmentStage,
         traced: bool,
         s: &mut Scheduler<Ev>,
-    ) -> Result<(), SystemError> {
+    ) -> Result<bool, SystemError> {
         self.draw = Some(ActiveDraw {
             draw,
             next: 0,
@@ -241,24 +251,18 @@ impl GeometryStage {
             // T <= G + F, so the GPU is busy throughout. Without a trace the
             // split is credited at the end (one event).
             self.busy = true;
-            frag.set_closed_busy(true);
             self.split = Some((t.geometry, t.fragment, t.total));
             self.done_at = Some(s.after(t.total, Ev::DrawDone, "draw")?);
-            return Ok(());
+            return Ok(true);
         }
-        self.closed_draw_traced(t, frag, s)
+        self.closed_draw_traced(t, s)
     }
 
     /// [`GeometryStage::start_closed_draw`] with a trace: the geometry
     /// part's end and the fragment part's start are events of their own, so
     /// the trace shows each stage's span.
     #[inline(never)]
-    fn closed_draw_traced(
-        &mut self,
-        t: DrawTimes,
-        frag: &mut FragmentStage,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<(), SystemError> {
+    fn closed_draw_traced(&mut self, t: DrawTimes, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
         if t.geometry.0 > 0 {
             self.busy = true;
             s.after(t.geometry, Ev::DrawGeometry, "draw geometry")?;
@@ -266,11 +270,9 @@ impl GeometryStage {
         let frag_start = t.total.saturating_sub(t.fragment);
         if frag_start.0 > 0 {
             s.after(frag_start, Ev::DrawFragmentStart, "draw fragment start")?;
-        } else {
-            frag.set_closed_busy(true);
         }
         self.done_at = Some(s.after(t.total, Ev::DrawDone, "draw")?);
-        Ok(())
+        Ok(frag_start.0 == 0)
     }
 
     /// `draw` fidelity with a trace: the running draw's geometry part ended.
@@ -278,14 +280,14 @@ impl GeometryStage {
         self.busy = false;
     }
 
-    /// `draw` fidelity: the draw's last fragment is done; both stages are
-    /// free. Returns the draw's (geometry, fragment, total) times when they
-    /// are yet to be credited to the stage clocks (no trace).
+    /// `draw` fidelity: the draw's last fragment is done; this stage is
+    /// free (the fragment stage is the caller's to free). Returns the
+    /// draw's (geometry, fragment, total) times when they are yet to be
+    /// credited to the stage clocks (no trace).
     #[inline]
-    pub(super) fn draw_done(&mut self, frag: &mut FragmentStage) -> Option<(Duration, Duration, Duration)> {
+    pub(super) fn draw_done(&mut self) -> Option<(Duration, Duration, Duration)> {
         let split = self.split.take();
         self.busy = false;
-        frag.set_closed_busy(false);
         self.draw = None;
         self.fragment_limited = None;
         self.done_at = None;
@@ -337,24 +339,20 @@ impl GeometryStage {
     }
 
     /// `triangle` fidelity: a triangle left the stage; its fragment work
-    /// goes to `frag`, or into the triangle FIFO, or is held while the FIFO
-    /// is full (the stage blocks).
+    /// goes to the fragment stage (idle unless `frag_busy`), into the
+    /// triangle FIFO, or into the link's slot past a full FIFO (the stage
+    /// blocks). The step starts the fragments and lets the stage go on
+    /// ([`Handoff`]).
     #[inline(always)]
-    pub(super) fn triangle_done(
-        &mut self,
-        now: Time,
-        env: &mut Env,
-        frag: &mut FragmentStage,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<(), SystemError> {
+    pub(super) fn triangle_done(&mut self, env: &mut Env, frag_busy: bool) -> Result<Handoff, SystemError> {
         self.busy = false;
         let Some(a) = self.draw.as_mut() else {
-            return Ok(());
+            return Ok(Handoff::NoDraw);
         };
         a.next += 1;
         let (next, last, draw) = (a.next, a.next >= a.triangles, a.draw);
         let Some(sc) = &env.scene else {
-            return Ok(());
+            return Ok(Handoff::NoDraw);
         };
         let g = &sc.groups[sc.draws[draw as usize].group as usize];
         let px = match self.sizes.get((next - 1) as usize) {
@@ -374,29 +372,25 @@ impl GeometryStage {
             }
         };
         let fifo = &mut links.triangles;
-        if env.cfg.gpu.fragment.binned() {
+        Ok(if env.cfg.gpu.fragment.binned() {
             // Sort-middle: bin the triangle; the draw's last triangle opens the bins.
             fifo.push(f, 1);
             if last
-                && !frag.busy()
+                && !frag_busy
                 && let Some(first) = fifo.pop()
             {
-                frag.start(now, first, &mut links.shaders, s)?;
+                Handoff::Fragment(first)
+            } else {
+                Handoff::Queued
             }
-        } else if !frag.busy() && fifo.is_empty() {
-            frag.start(now, f, &mut links.shaders, s)?;
+        } else if !frag_busy && fifo.is_empty() {
+            Handoff::Fragment(f)
         } else if fifo.len() < fifo.capacity() as usize {
             fifo.push(f, 1);
+            Handoff::Queued
         } else {
-            self.held = Some(f);
-            return Ok(());
-        }
-        self.next_triangle(now, env, s)
-    }
-
-    /// Takes the triangle held back by a full triangle FIFO, if any.
-    #[inline]
-    pub(super) fn take_held(&mut self) -> Option<FragWork> {
-        self.held.take()
+            links.held_triangle = Some(f);
+            Handoff::Held
+        })
     }
 }

@@ -69,6 +69,10 @@ pub struct Links {
     pub(super) commands: BoundedFifo<Command>,
     /// The triangle FIFO (geometry -> fragment); with binning, the draw's bins.
     pub(super) triangles: BoundedFifo<FragWork>,
+    /// The triangle link's slot past the FIFO: a triangle the geometry
+    /// stage finished while the FIFO was full (the stage blocks until the
+    /// fragment stage takes it from here).
+    pub(super) held_triangle: Option<FragWork>,
     /// The unified architecture's shader-core pool (`None`: split).
     pub(super) shaders: Option<ShaderPool>,
     /// The swap chain (front end -> display).

@@ -32,7 +32,7 @@ use super::cpu_thread::{Alone, CpuThread, FixedWork};
 use super::display::Display;
 use super::fragment_stage::FragmentStage;
 use super::front_end::{Downstream, FrontEnd};
-use super::geometry_stage::GeometryStage;
+use super::geometry_stage::{GeometryStage, Handoff};
 use super::links::{Env, Links};
 use super::workload::SceneProgram;
 
@@ -176,6 +176,7 @@ impl FramePipeline {
             chain: SwapChain::new(cfg.display.buffers, mode),
             frames_completed: 0,
             bus: SharedBus::new(cfg.bus.bandwidth.bytes_per_ps()),
+            held_triangle: None,
             bus_changed: false,
         };
         Ok(FramePipeline {
@@ -269,7 +270,7 @@ impl FramePipeline {
             self.front.describe(),
             self.geom.draw(),
             self.geom.busy(),
-            self.geom.holds_triangle(),
+            self.env.links.held_triangle.is_some(),
             self.frag.busy(),
             self.env.links.frames_completed,
             self.env.links.chain.queued()
@@ -449,18 +450,31 @@ impl Model for FramePipeline {
             }
             Ev::GeomTriangle { tag } => {
                 if self.env.links.shader_completes(now, Stream::Vertex, tag) {
-                    self.geom.triangle_done(now, &mut self.env, &mut self.frag, s)?;
+                    // A finished triangle goes to the fragment stage, the
+                    // triangle FIFO or the link's slot past it.
+                    match self.geom.triangle_done(&mut self.env, self.frag.busy())? {
+                        Handoff::Fragment(f) => {
+                            self.frag.start(now, f, &mut self.env.links.shaders, s)?;
+                            self.geom.next_triangle(now, &mut self.env, s)?;
+                        }
+                        Handoff::Queued => self.geom.next_triangle(now, &mut self.env, s)?,
+                        Handoff::Held | Handoff::NoDraw => {}
+                    }
                 }
             }
             Ev::FragTriangle { tag } => {
                 if self.env.links.shader_completes(now, Stream::Fragment, tag) {
-                    self.frag.triangle_done(now, &mut self.env, &mut self.geom, s)?;
+                    // A held triangle freed into the FIFO: geometry goes on.
+                    if self.frag.triangle_done(now, &mut self.env, s)? {
+                        self.geom.next_triangle(now, &mut self.env, s)?;
+                    }
                 }
             }
             Ev::DrawGeometry => self.geom.closed_geometry_done(),
             Ev::DrawFragmentStart => self.frag.set_closed_busy(true),
             Ev::DrawDone => {
-                if let Some(split) = self.geom.draw_done(&mut self.frag) {
+                self.frag.set_closed_busy(false);
+                if let Some(split) = self.geom.draw_done() {
                     self.acct.credit_draw_split(split);
                 }
                 // The draw's vertex fetch from AGP memory (if any) ends.
