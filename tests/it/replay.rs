@@ -491,6 +491,14 @@ fn the_validation_report_lists_every_swap_chain_with_its_accuracy_and_why_frames
     // A header and test_case_0's ten swap chains.
     assert_eq!(chains.lines().count(), 11, "{chains}");
     assert!(chains.lines().nth(1).unwrap().starts_with("0,\"dwm.exe\""), "{chains}");
+    assert!(
+        chains.starts_with("chain,application,")
+            && chains
+                .lines()
+                .next()
+                .unwrap()
+                .contains(",gpu_done_to_screen_refreshes_median,")
+    );
     let md = std::fs::read_to_string(rep.join("report.md")).unwrap();
     assert!(md.contains("8 of 10 meet the accuracy targets"), "{md}");
     // The independent flip that tears misses whole refreshes and lands off
@@ -498,6 +506,10 @@ fn the_validation_report_lists_every_swap_chain_with_its_accuracy_and_why_frames
     assert!(md.contains("1 refresh(es) earlier than measured"), "{md}");
     assert!(md.contains("ms off the refresh grid"), "{md}");
     assert!(md.contains("replaced in the queue before its refresh"), "{md}");
+    assert!(
+        md.contains("Measured, from the GPU finishing a shown frame to the frame on screen: "),
+        "{md}"
+    );
     for i in 0..10 {
         assert!(rep.join(format!("chain-{i}.csv")).is_file(), "chain-{i}.csv");
         assert!(

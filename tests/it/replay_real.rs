@@ -15,6 +15,7 @@ use std::path::PathBuf;
 
 use rendersim::capture::display::Flips;
 use rendersim::capture::presentmon::Capture;
+use rendersim::studies::replay::validation::validate;
 use rendersim::studies::replay::{ReplayOptions, replay};
 
 /// The shared captures' folder (beside the checkout, as CI lays it).
@@ -281,4 +282,21 @@ fn every_shared_swap_chain_of_100_frames_infers_its_display_and_those_that_met_t
         }
     }
     eprintln!("{table}{met} of {} swap chains meet the targets", CHAINS.len());
+}
+
+#[test]
+fn the_compositor_s_delay_differs_by_machine_as_the_report_measures_it() {
+    // From the GPU finishing a composed frame to the frame on screen, in
+    // refreshes (docs/replay.md, "Real captures"): two and a half on the
+    // FrameView machine (Cyberpunk 2077 at 120 Hz), one and a fifth on
+    // CapFrameX's (Resident Evil 2's GDI copies at 120 Hz).
+    let dir = shared();
+    for (file, lo, hi) in [
+        ("whatif/cyberpunk-1080p-unlimited.csv", 2.44, 2.54),
+        ("games/capframex-re2-composed-copy-120hz.csv", 1.15, 1.25),
+    ] {
+        let report = validate(&dir.join(file), &ReplayOptions::default()).unwrap();
+        let [_, median, _] = report.chains[0].gpu_done_to_screen_refreshes().unwrap();
+        assert!((lo..=hi).contains(&median), "{file}: {median}");
+    }
 }

@@ -108,6 +108,27 @@ pub struct ChainReport {
 }
 
 impl ChainReport {
+    /// Measured, from the GPU finishing each shown frame (present plus
+    /// `MsRenderPresentLatency` or `MsUntilRenderComplete`) to the frame on
+    /// screen, in refreshes: the 10th percentile, the median and the 90th
+    /// (`None` without such frames). On a composed swap chain this is the
+    /// compositor's delay as the capture shows it.
+    pub fn gpu_done_to_screen_refreshes(&self) -> Option<[f64; 3]> {
+        let r = self.replay.as_ref().ok()?;
+        let period = 1000.0 / r.summary.refresh_hz;
+        let mut lag: Vec<f64> = r
+            .frames
+            .iter()
+            .filter_map(|f| Some((f.until_displayed.0? - f.render_complete.0?) / period))
+            .collect();
+        if lag.is_empty() {
+            return None;
+        }
+        lag.sort_by(f64::total_cmp);
+        let q = |x: f64| crate::stats::quantile::quantile(&lag, x);
+        Some([q(0.1), q(0.5), q(0.9)])
+    }
+
     /// Whether the swap chain meets the accuracy targets.
     pub fn meets_targets(&self) -> bool {
         let Ok(r) = &self.replay else { return false };
@@ -193,7 +214,7 @@ pub fn disagreements(r: &Replay) -> Vec<Disagreement> {
 }
 
 /// The columns of `chains.csv`.
-pub const CHAIN_COLUMNS: [&str; 15] = [
+pub const CHAIN_COLUMNS: [&str; 16] = [
     "chain",
     "application",
     "process_id",
@@ -208,6 +229,7 @@ pub const CHAIN_COLUMNS: [&str; 15] = [
     "until_displayed_median_ms",
     "until_displayed_p90_ms",
     "render_complete_median_ms",
+    "gpu_done_to_screen_refreshes_median",
     "meets_targets",
 ];
 
@@ -241,7 +263,7 @@ impl ValidationReport {
         );
         let opt = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
         match &c.replay {
-            Err(_) => format!("{head},,,,,,,,,false\n"),
+            Err(_) => format!("{head},,,,,,,,,,false\n"),
             Ok(r) => {
                 let s = &r.summary;
                 let refresh_from = serde_json::to_value(s.refresh_from)
@@ -249,13 +271,14 @@ impl ValidationReport {
                 let flips = serde_json::to_value(s.display.flips)
                     .map_or(String::new(), |v| v.as_str().unwrap_or_default().to_string());
                 format!(
-                    "{head},{},{},{refresh_from},{flips},{},{},{},{},{}\n",
+                    "{head},{},{},{refresh_from},{flips},{},{},{},{},{},{}\n",
                     s.model_present_mode,
                     s.refresh_hz,
                     s.agreement.displayed,
                     opt(s.error_ms.until_displayed.median),
                     opt(s.error_ms.until_displayed.p90),
                     opt(s.error_ms.render_complete.median),
+                    opt(c.gpu_done_to_screen_refreshes().map(|q| q[1])),
                     c.meets_targets()
                 )
             }
@@ -381,6 +404,16 @@ fn chain_section(i: usize, ch: &ChainReport) -> String {
         ch.chain.present_mode,
         r.summary.display.describe()
     );
+    if let Some([lo, mid, hi]) = ch.gpu_done_to_screen_refreshes() {
+        md += &format!(
+            "Measured, from the GPU finishing a shown frame to the frame on screen: {mid:.2} refreshes at the median ({lo:.2}-{hi:.2}, 10th-90th percentile){}.\n\n",
+            if r.summary.model_composition.is_independent() {
+                ""
+            } else {
+                "; the replay's compositor takes one refresh after the first vertical blank"
+            }
+        );
+    }
     md += &format!("![measured and replayed time until displayed](chain-{i}-screen.png)\n\n");
     if ch.disagreements.is_empty() {
         md += "Every frame agrees (fate, and time until displayed within 0.5 ms).\n";
