@@ -169,7 +169,8 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         say!("{}", serde_json::to_string_pretty(&v)?);
         return check_holdout(args, half.map(|h| h.0));
     }
-    print!("{}", calibration_text(&calibration, &args.out)?);
+    let text = calibration_text(&calibration, &args.out)?;
+    super::progress::print_line(text.trim_end_matches('\n'));
     check_holdout(args, half.map(|h| h.0))
 }
 

@@ -80,6 +80,20 @@ impl Drop for Activity {
     }
 }
 
+/// Writes `line` and a newline to standard output; where it cannot be
+/// written (a full disk, a closed or broken pipe), says so on standard
+/// error and exits with status 2 instead of panicking (everything the
+/// command writes to files is written before it prints).
+pub(crate) fn print_line(line: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = writeln!(out, "{line}").and_then(|()| out.flush()) {
+        drop(out);
+        eprintln!("error: cannot write to standard output: {e}");
+        std::process::exit(2);
+    }
+}
+
 /// Runs `f` (a print) with the spinner, if one is drawn, off the screen.
 pub(crate) fn suspend<R>(f: impl FnOnce() -> R) -> R {
     let bar = BAR.lock().unwrap_or_else(|e| e.into_inner());
@@ -94,7 +108,7 @@ macro_rules! say {
     ($($arg:tt)*) => {
         {
             let line = format!($($arg)*);
-            $crate::cli::progress::suspend(|| println!("{line}"))
+            $crate::cli::progress::suspend(|| $crate::cli::progress::print_line(&line))
         }
     };
 }

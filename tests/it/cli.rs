@@ -1517,3 +1517,29 @@ fn isolate_lengthens_a_run_too_short_to_judge() {
     let v: serde_json::Value = serde_json::from_str(&run_ok(&["isolate", m, "--json"])).unwrap();
     assert_eq!((v["frames"].as_u64(), v.get("note")), (Some(4), None), "{v}");
 }
+
+#[test]
+fn standard_output_that_cannot_be_written_is_an_error_not_a_panic() {
+    // issue 60 item 3: a full disk behind standard output.
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        return; // no /dev/full on this system
+    };
+    for args in [
+        &["run", "--json"][..],
+        &["run"][..],
+        &["replay", "tests/fixtures/presentmon/test_case_1.csv"][..],
+    ] {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(args)
+            .stdout(full.try_clone().unwrap())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("No space left on device") && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+    }
+}

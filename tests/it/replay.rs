@@ -559,3 +559,23 @@ fn the_validation_report_lists_every_swap_chain_with_its_accuracy_and_why_frames
         "the other command's results are kept"
     );
 }
+
+#[test]
+fn a_what_if_that_ends_early_writes_its_folder_without_a_panic() {
+    // issue 60 item 4: the what-if's frames end before the capture's.
+    let dir = tempfile::tempdir().unwrap();
+    for (i, set) in ["run.frames=5", "run.until=\"300ms\""].iter().enumerate() {
+        let out = dir.path().join(format!("r{i}"));
+        let o = bin()
+            .args(["replay", capture(0).to_str().unwrap(), "--set", set, "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success() && !err.contains("panicked"), "{set}: {err}");
+        let cmp = std::fs::read_to_string(out.join("comparison.csv")).unwrap();
+        // A header and the replayed swap chain's 197 frames.
+        assert_eq!(cmp.lines().count(), 198, "{set}");
+        assert!(out.join("whatif-frames.csv").is_file());
+    }
+}

@@ -389,13 +389,20 @@ impl Replay {
                     v(f.render_complete.1),
                     err,
                 ];
-                if let Some(w) = self.whatif_frames.as_ref().map(|w| &w[i]) {
-                    row.extend([
-                        w.predicted_present,
-                        f64::from(u8::from(w.predicted_displayed)),
-                        v(w.until_displayed.1),
-                        v(w.between_display_change.1),
-                    ]);
+                // A what-if that ends early (`run.frames`, `run.until`)
+                // has no values for the frames after its last.
+                if let Some(wf) = self.whatif_frames.as_ref() {
+                    match wf.get(i) {
+                        Some(w) => {
+                            row.extend([
+                                w.predicted_present,
+                                f64::from(u8::from(w.predicted_displayed)),
+                                v(w.until_displayed.1),
+                                v(w.between_display_change.1),
+                            ]);
+                        }
+                        None => row.extend([f64::NAN; WHATIF_COLUMNS.len()]),
+                    }
                 }
                 row
             })
