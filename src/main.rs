@@ -14,10 +14,21 @@ use cli::args::{
 };
 use cli::commands::{self, ChecksFailed};
 
+/// `--version`: the package's version and the git revision it was built
+/// from (`-dirty` where tracked files differed), as the provenance beside
+/// every result names it.
+fn version() -> &'static str {
+    static VERSION: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    VERSION.get_or_init(|| match option_env!("RENDERSIM_GIT_REVISION") {
+        Some(rev) => format!("{} ({rev})", env!("CARGO_PKG_VERSION")),
+        None => env!("CARGO_PKG_VERSION").to_string(),
+    })
+}
+
 #[derive(Parser)]
 #[command(
     name = "rendersim",
-    version,
+    version = version(),
     about = "Discrete-event simulator of GPU rendering pipelines and latency"
 )]
 struct Cli {

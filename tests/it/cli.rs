@@ -1543,3 +1543,18 @@ fn standard_output_that_cannot_be_written_is_an_error_not_a_panic() {
         );
     }
 }
+
+#[test]
+fn version_names_the_git_revision_it_was_built_from() {
+    // issue 58: `--version` gives what the provenance beside results gives.
+    let o = bin().arg("--version").output().unwrap();
+    assert!(o.status.success());
+    let out = String::from_utf8(o.stdout).unwrap();
+    assert!(
+        out.starts_with(concat!("rendersim ", env!("CARGO_PKG_VERSION"))),
+        "{out}"
+    );
+    if let Some(rev) = option_env!("RENDERSIM_GIT_REVISION") {
+        assert!(out.trim_end().ends_with(&format!("({rev})")), "{out}");
+    }
+}
