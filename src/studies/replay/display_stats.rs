@@ -33,7 +33,7 @@ pub struct Percentiles {
 }
 
 impl Percentiles {
-    fn of(mut v: Vec<f64>) -> Percentiles {
+    pub(super) fn of(mut v: Vec<f64>) -> Percentiles {
         v.sort_by(f64::total_cmp);
         let q = |x: f64| (!v.is_empty()).then(|| quantile(&v, x));
         Percentiles {

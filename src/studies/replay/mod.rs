@@ -45,7 +45,8 @@ pub mod validation;
 
 pub use refresh::fit_phase;
 pub use results::{
-    Agreement, ErrorStats, RefreshFrom, Replay, ReplayErrors, ReplayFrame, ReplaySummary, ReplayedFrames, WhatIf,
+    Agreement, ErrorStats, InputLatency, RefreshFrom, Replay, ReplayErrors, ReplayFrame, ReplaySummary, ReplayedFrames,
+    WhatIf,
 };
 
 use std::path::Path;
@@ -297,6 +298,7 @@ pub fn replay_capture(
             present: ErrorStats::of(frames.iter().map(|f| (Some(f.predicted_present), Some(f.present)))),
         },
         measured: DisplayStats::of(&measured, s.period),
+        measured_input_latency: results::InputLatency::of(&s.rows),
         whatif: WhatIf {
             sets: opts.sets.clone(),
             stats: whatif.as_ref().map_or_else(|| as_captured.clone(), Simulated::stats),

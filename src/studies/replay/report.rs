@@ -96,6 +96,21 @@ pub fn write_text(s: &ReplaySummary, w: &mut impl std::io::Write) -> std::io::Re
     )?;
     writeln!(w, "  |error| ms, present time            {}", stat(&s.error_ms.present))?;
     display_figures(s, w)?;
+    let l = &s.measured_input_latency;
+    for (name, p) in [
+        ("PC latency (MsPCLatency)", &l.pc_latency_ms),
+        ("all input to photon", &l.all_input_to_photon_ms),
+        ("click to photon", &l.click_to_photon_ms),
+    ] {
+        if let Some(p) = p
+            && let (Some(m), Some(p90)) = (p.median, p.p90)
+        {
+            writeln!(
+                w,
+                "  measured {name}: median {m:.2} ms, p90 {p90:.2} ms (not predicted yet)"
+            )?;
+        }
+    }
     writeln!(
         w,
         "  {:.4} s wall ({:.4} s simulating)",

@@ -5,7 +5,7 @@
 
 use serde::Serialize;
 
-use super::display_stats::{DisplayStats, FrameTimes};
+use super::display_stats::{DisplayStats, FrameTimes, Percentiles};
 use crate::capture::display::{DisplayInference, RefreshEvidence};
 use crate::capture::presentmon::Columns;
 use crate::components::swap_chain::Composition;
@@ -117,6 +117,10 @@ pub struct ReplaySummary {
     pub error_ms: ReplayErrors,
     /// The capture's own frames, measured.
     pub measured: DisplayStats,
+    /// The latencies from input the capture measured (left out of the JSON
+    /// where it has none).
+    #[serde(skip_serializing_if = "InputLatency::is_empty")]
+    pub measured_input_latency: InputLatency,
     /// The frames replayed as captured.
     pub as_captured: DisplayStats,
     /// The frames replayed with the what-if's patches.
@@ -125,6 +129,44 @@ pub struct ReplaySummary {
     pub simulate_seconds: f64,
     /// Wall time of the whole replay (reading the capture included), seconds.
     pub wall_seconds: f64,
+}
+
+/// The latencies a capture measured from input (where it has them, over
+/// the replayed swap chain's frames), ms: NVIDIA Reflex's PC latency
+/// (`MsPCLatency`: the game sampling input to the frame on screen) and
+/// PresentMon's input-to-photon latencies. Measured only: the replay does
+/// not predict them yet (issue 56).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct InputLatency {
+    /// `MsPCLatency`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pc_latency_ms: Option<Percentiles>,
+    /// `MsAllInputToPhotonLatency`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub all_input_to_photon_ms: Option<Percentiles>,
+    /// `MsClickToPhotonLatency`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub click_to_photon_ms: Option<Percentiles>,
+}
+
+impl InputLatency {
+    /// The percentiles of each latency over `rows` (none where no row has it).
+    pub(super) fn of(rows: &[crate::capture::presentmon::Present]) -> InputLatency {
+        let of = |f: &dyn Fn(&crate::capture::presentmon::Present) -> Option<f64>| {
+            let v: Vec<f64> = rows.iter().filter_map(f).collect();
+            (!v.is_empty()).then(|| Percentiles::of(v))
+        };
+        InputLatency {
+            pc_latency_ms: of(&|p| p.pc_latency),
+            all_input_to_photon_ms: of(&|p| p.all_input_to_photon),
+            click_to_photon_ms: of(&|p| p.click_to_photon),
+        }
+    }
+
+    /// Whether the capture has none of them.
+    pub fn is_empty(&self) -> bool {
+        self.pc_latency_ms.is_none() && self.all_input_to_photon_ms.is_none() && self.click_to_photon_ms.is_none()
+    }
 }
 
 /// A what-if's patches and what the display shows under them.
