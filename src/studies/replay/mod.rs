@@ -270,7 +270,7 @@ pub fn replay_capture(
         capture: capture.file.clone(),
         columns: capture.columns,
         frames: frames.len(),
-        not_rendered: capture.not_rendered,
+        not_rendered: capture.not_rendered(),
         application: s.rows[0].application.to_string(),
         swapchain: s.rows[0].swap_chain.to_string(),
         present_mode: s.common.present_mode.to_string(),

@@ -55,17 +55,12 @@ pub fn write_text(s: &ReplaySummary, w: &mut impl std::io::Write) -> std::io::Re
     writeln!(w, "replay of {} ({:?} columns)", s.capture, s.columns)?;
     writeln!(
         w,
-        "  swap chain {} of {}: {} frames, {} (model: {}{}), refresh {:.3} Hz",
+        "  swap chain {} of {}: {} frames, {} (model: {}), refresh {:.3} Hz",
         s.swapchain,
         s.application,
         s.frames,
         s.present_mode,
-        s.model_present_mode,
-        if s.model_composition.is_independent() {
-            ""
-        } else {
-            ", composed"
-        },
+        s.model_label(),
         s.refresh_hz
     )?;
     writeln!(w, "  display: {}", s.display.describe())?;

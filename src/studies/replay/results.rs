@@ -242,6 +242,27 @@ pub enum RefreshFrom {
     Default,
 }
 
+impl ReplaySummary {
+    /// The model's present mode as a person reads it: `mailbox`, or
+    /// `mailbox, composed` where the compositor shows the frames.
+    pub fn model_label(&self) -> String {
+        if self.model_composition.is_independent() {
+            self.model_present_mode.clone()
+        } else {
+            format!("{}, composed", self.model_present_mode)
+        }
+    }
+}
+
+/// The name a unit-like enum has in the JSON (`display_changes`,
+/// `variable_refresh`), for text and tables.
+pub fn json_name(v: impl Serialize) -> String {
+    serde_json::to_value(v)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default()
+}
+
 impl From<RefreshEvidence> for RefreshFrom {
     fn from(e: RefreshEvidence) -> RefreshFrom {
         match e {

@@ -93,11 +93,15 @@ impl Setup {
     }
 }
 
-/// Whether the assumptions (`--assume K=V` patches) set `key`.
+/// Whether the assumptions (`--assume K=V` patches) set `key`, or, with
+/// `key` ending in `.`, a key under it.
 fn assumes(assume: &[String], key: &str) -> bool {
-    assume
-        .iter()
-        .any(|a| a.split_once('=').is_some_and(|(k, _)| k.trim() == key))
+    assume.iter().any(|a| {
+        a.split_once('=').is_some_and(|(k, _)| {
+            let k = k.trim();
+            k == key || (key.ends_with('.') && k.starts_with(key)) || format!("{k}.") == key
+        })
+    })
 }
 
 pub(super) fn setup(capture: &Capture, opts: &ReplayOptions) -> Result<Setup, ReplayError> {
@@ -149,13 +153,10 @@ pub(super) fn setup(capture: &Capture, opts: &ReplayOptions) -> Result<Setup, Re
     };
     let lead_ps = toml::Value::String(format!("{}ps", c0_ps - origin_ps));
 
-    let vrr = display.vrr.as_ref().filter(|_| {
-        display.flips == Flips::VariableRefresh
-            && !opts.assume.iter().any(|a| {
-                a.split_once('=')
-                    .is_some_and(|(k, _)| k.trim().starts_with("display.vrr"))
-            })
-    });
+    let vrr = display
+        .vrr
+        .as_ref()
+        .filter(|_| display.flips == Flips::VariableRefresh && !assumes(&opts.assume, "display.vrr."));
     let mut sets = workload(&rows, lead_ps, &generation_ms);
     // What the capture says of its display, unless assumed otherwise.
     let display_keys: [(&str, toml::Value); 4] = [

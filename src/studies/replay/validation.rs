@@ -17,6 +17,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
+use super::results::json_name;
 use super::{Replay, ReplayError, ReplayOptions, replay_capture};
 use crate::capture::presentmon::{Capture, SwapChainInfo};
 
@@ -266,14 +267,12 @@ impl ValidationReport {
             Err(_) => format!("{head},,,,,,,,,,false\n"),
             Ok(r) => {
                 let s = &r.summary;
-                let refresh_from = serde_json::to_value(s.refresh_from)
-                    .map_or(String::new(), |v| v.as_str().unwrap_or_default().to_string());
-                let flips = serde_json::to_value(s.display.flips)
-                    .map_or(String::new(), |v| v.as_str().unwrap_or_default().to_string());
                 format!(
-                    "{head},{},{},{refresh_from},{flips},{},{},{},{},{},{}\n",
+                    "{head},{},{},{},{},{},{},{},{},{},{}\n",
                     s.model_present_mode,
                     s.refresh_hz,
+                    json_name(s.refresh_from),
+                    json_name(s.display.flips),
                     s.agreement.displayed,
                     opt(s.error_ms.until_displayed.median),
                     opt(s.error_ms.until_displayed.p90),
@@ -367,24 +366,13 @@ fn chain_line(i: usize, ch: &ChainReport) -> String {
             let e = &s.error_ms;
             let f = |x: Option<f64>| x.map_or("-".into(), |v| format!("{v:.3}"));
             format!(
-                "| {i} | {name} | {} | {} | {}{} | {:.2} Hz ({}) | {} | {:.1}% | {} / {} | {} | {} |\n",
+                "| {i} | {name} | {} | {} | {} | {:.2} Hz ({}) | {} | {:.1}% | {} / {} | {} | {} |\n",
                 s.frames,
                 s.present_mode,
-                s.model_present_mode,
-                if s.model_composition.is_independent() {
-                    ""
-                } else {
-                    ", composed"
-                },
+                s.model_label(),
                 s.refresh_hz,
-                serde_json::to_value(s.refresh_from)
-                    .ok()
-                    .and_then(|v| v.as_str().map(str::to_string))
-                    .unwrap_or_default(),
-                serde_json::to_value(s.display.flips)
-                    .ok()
-                    .and_then(|v| v.as_str().map(str::to_string))
-                    .unwrap_or_default(),
+                json_name(s.refresh_from),
+                json_name(s.display.flips),
                 100.0 * s.agreement.displayed,
                 f(e.until_displayed.median),
                 f(e.until_displayed.p90),

@@ -262,7 +262,7 @@ fn generated_frames_are_kept_apart_and_a_restarted_clock_keeps_the_longest_recor
         text += &format!("g.exe,1,0x1,Hardware: Independent Flip,{kind},{t},4.0,1.0,3.0\n");
     }
     let c = Capture::parse("g.csv", text.as_bytes()).unwrap();
-    assert_eq!((c.presents.len(), c.generated.len(), c.not_rendered), (3, 2, 2));
+    assert_eq!((c.presents.len(), c.generated.len(), c.not_rendered()), (3, 2, 2));
     assert!(c.generated.iter().all(|g| !g.rendered()));
     // The clock goes back 50 s at line 4: two recordings, the longer read.
     let mut text = format!("{head}\n");
