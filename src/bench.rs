@@ -23,7 +23,9 @@
 
 use std::time::Instant;
 
-use crate::config::{ConfigError, ModelSource, Overrides, load_model};
+use crate::config::{ConfigError, ModelSource, Overrides, deserialize, load_model};
+use crate::systems::frame_pipeline::summary::PipelineSummary;
+use crate::systems::frame_pipeline::{FramePipelineConfig, run_pipeline};
 use crate::systems::{SimError, run_model};
 
 pub mod build;
@@ -107,11 +109,12 @@ pub fn check_scale(scale: f64) -> Result<(), BenchError> {
     }
 }
 
-fn run_default_with(sets: &[&str]) -> Result<(serde_json::Value, f64), BenchError> {
+fn run_default_with(sets: &[&str]) -> Result<(PipelineSummary, f64), BenchError> {
     let m = load_model(None, &Overrides::with_sets(sets))?;
     let start = Instant::now();
-    let r = run_model(&m.source, &m.table, None)?;
-    Ok((r.summary().clone(), start.elapsed().as_secs_f64()))
+    let cfg: FramePipelineConfig = deserialize(&m.table, &m.source)?;
+    let r = run_pipeline(cfg, &m.source.base_dir, None).map_err(|e| SimError::of(&m.source, e))?;
+    Ok((r.results, start.elapsed().as_secs_f64()))
 }
 
 /// One frame at both fidelities, each figure over the repeats.
@@ -161,20 +164,20 @@ pub fn pipeline(w: u32, repeats: usize) -> Result<PipelineBench, BenchError> {
     tri.push("fidelity=\"triangle\"");
     let mut draw: Vec<&str> = common.to_vec();
     draw.push("fidelity=\"draw\"");
-    let sim = |s: &serde_json::Value| s["simulate_seconds"].as_f64().unwrap_or(f64::NAN);
     let (mut tw, mut dw, mut ts, mut ds) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let (mut s_tri, mut s_draw) = (serde_json::Value::Null, serde_json::Value::Null);
+    let (mut s_tri, mut s_draw) = (None, None);
     for _ in 0..repeats.max(1) {
         let (s, w) = run_default_with(&tri)?;
         tw.push(w);
-        ts.push(sim(&s));
-        s_tri = s;
+        ts.push(s.simulate_seconds);
+        s_tri = Some(s);
         let (s, w) = run_default_with(&draw)?;
         dw.push(w);
-        ds.push(sim(&s));
-        s_draw = s;
+        ds.push(s.simulate_seconds);
+        s_draw = Some(s);
     }
-    let ft = |s: &serde_json::Value| s["metrics"]["gpu_time_ms"]["mean"].as_f64().unwrap_or(f64::NAN);
+    let events = |s: &Option<PipelineSummary>| s.as_ref().map_or(0, |s| s.events.total);
+    let ft = |s: &Option<PipelineSummary>| s.as_ref().and_then(|s| s.metrics.gpu_time_ms.mean).unwrap_or(f64::NAN);
     Ok(PipelineBench {
         width: w,
         triangles: 2 * w as u64 * w as u64,
@@ -185,8 +188,8 @@ pub fn pipeline(w: u32, repeats: usize) -> Result<PipelineBench, BenchError> {
         draw_simulate_s: Spread::of(&ds),
         speedup: paired_ratio(&tw, &dw),
         simulate_speedup: paired_ratio(&ts, &ds),
-        triangle_events: s_tri["events"]["total"].as_u64().unwrap_or(0),
-        draw_events: s_draw["events"]["total"].as_u64().unwrap_or(0),
+        triangle_events: events(&s_tri),
+        draw_events: events(&s_draw),
         triangle_gpu_ms: ft(&s_tri),
         draw_gpu_ms: ft(&s_draw),
     })
@@ -333,10 +336,10 @@ pub fn hour_bench(scale: f64, repeats: usize) -> Result<HourBench, BenchError> {
         let after = bare_rate(KernelWork::Hold, 1_000, yardstick_events);
         let yardstick = 0.5 * (before + after);
         before = after;
-        simulated = s["simulated_seconds"].as_f64().unwrap_or(0.0);
-        events = s["events"]["total"].as_u64().unwrap_or(0);
+        simulated = s.simulated_seconds;
+        events = s.events.total;
         wall.push(wall_s);
-        rate.push(s["events_per_second"].as_f64().unwrap_or(0.0));
+        rate.push(s.events_per_second);
         yard.push(yardstick);
         m_events.push(wall_s * yardstick / 1e6);
     }

@@ -257,10 +257,10 @@ pub fn isolate(cfg: &FramePipelineConfig, base_dir: &Path, options: IsolateOptio
                 reduced(&base, name, factor)
             };
             let r = run_pipeline(c, base_dir, None)?;
-            let m = &r.summary["metrics"];
+            let m = &r.results.metrics;
             Ok((
-                m["frame_time_ms"]["mean"].as_f64().unwrap_or(0.0),
-                m["display_interval_ms"]["mean"].as_f64().unwrap_or(0.0),
+                m.frame_time_ms.mean.unwrap_or(0.0),
+                m.display_interval_ms.mean.unwrap_or(0.0),
             ))
         })
         .collect::<Result<_, SystemError>>()?;

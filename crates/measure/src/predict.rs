@@ -126,11 +126,9 @@ pub fn simulate_pass(m: &PassModel) -> Result<PassPrediction, PredictError> {
     let Ok(r) = run.downcast::<crate::systems::frame_pipeline::PipelineRun>() else {
         return Err(PredictError::Missing("a frame-pipeline run"));
     };
-    let gpu_ms = r.summary["metrics"]["gpu_time_ms"]["mean"]
-        .as_f64()
-        .ok_or(PredictError::Missing("metrics.gpu_time_ms.mean"))?;
-    let transformed_vertices = r.summary["scene"]["transformed_vertices"]
-        .as_u64()
+    let gpu_ms = (r.results.metrics.gpu_time_ms.mean).ok_or(PredictError::Missing("metrics.gpu_time_ms.mean"))?;
+    let transformed_vertices = (r.results.scene.as_ref())
+        .map(|s| s.transformed_vertices)
         .ok_or(PredictError::Missing("scene.transformed_vertices"))?;
     Ok(PassPrediction {
         gpu_ms,

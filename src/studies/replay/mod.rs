@@ -52,12 +52,12 @@ pub use results::{
 use std::path::Path;
 
 use self::display_stats::{DisplayStats, FrameTimes};
-use self::setup::{Setup, model_of, setup};
+use self::setup::{Setup, fill_frames, frames_into, model_of, setup};
 use crate::capture::presentmon::{Capture, CaptureError};
 use crate::components::swap_chain::Composition;
 use crate::config::{ModelSource, invalid};
 use crate::systems::error::SystemError;
-use crate::systems::frame_pipeline::config::FramesWorkload;
+use crate::systems::frame_pipeline::config::{FramesWorkload, WorkloadConfig};
 use crate::systems::frame_pipeline::records::{FrameRecord, GeneratedRecord};
 use crate::systems::frame_pipeline::{FramePipelineConfig, run_pipeline};
 
@@ -160,13 +160,18 @@ impl Simulated {
 pub fn replay_model(path: &Path, opts: &ReplayOptions) -> Result<(ModelSource, toml::Table), ReplayError> {
     let capture = Capture::read(path)?;
     let s = setup(&capture, opts)?;
-    model_of(&s, &opts.sets)
+    let (src, mut table) = model_of(&s, &opts.sets)?;
+    frames_into(&mut table, &s.frames);
+    Ok((src, table))
 }
 
 /// One simulation of the set-up frames with `sets` patched on.
 fn simulate(s: &Setup, sets: &[String]) -> Result<Simulated, ReplayError> {
     let (src, table) = model_of(s, sets)?;
-    let cfg = FramePipelineConfig::from_table(&table, &src)?;
+    let mut cfg = FramePipelineConfig::from_table(&table, &src)?;
+    if let WorkloadConfig::Frames(w) = &mut cfg.workload {
+        fill_frames(w, &s.frames);
+    }
     let sim = std::time::Instant::now();
     // A value the model cannot use is blamed on the option that gave it.
     let run = run_pipeline(cfg, &src.base_dir, None).map_err(|e| match e {
@@ -214,7 +219,7 @@ fn simulate(s: &Setup, sets: &[String]) -> Result<Simulated, ReplayError> {
         });
     }
     let mut model = run.config;
-    if let crate::systems::frame_pipeline::config::WorkloadConfig::Frames(w) = &mut model.workload {
+    if let WorkloadConfig::Frames(w) = &mut model.workload {
         *w = FramesWorkload {
             cpu: vec![],
             submit: vec![],
@@ -224,8 +229,8 @@ fn simulate(s: &Setup, sets: &[String]) -> Result<Simulated, ReplayError> {
             start: w.start,
         };
     }
-    let repeated_refreshes = run.summary["metrics"]["repeated_refreshes"].as_u64().unwrap_or(0);
-    let torn_per_second = run.summary["metrics"]["tearing"]["torn_per_second"].as_f64();
+    let repeated_refreshes = run.results.metrics.repeated_refreshes;
+    let torn_per_second = run.results.metrics.tearing.as_ref().map(|t| t.torn_per_second);
     Ok(Simulated {
         frames,
         model,

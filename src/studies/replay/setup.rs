@@ -8,7 +8,9 @@ use crate::capture::display::{DisplayInference, Flips, fit_grid, infer_display};
 use crate::capture::presentmon::{Capture, CaptureError, Present};
 use crate::config::patch::set_dotted;
 use crate::config::{ModelSource, apply_patches};
+use crate::engine::Duration;
 use crate::systems::frame_pipeline::FramePipelineConfig;
+use crate::systems::frame_pipeline::config::FramesWorkload;
 use crate::systems::frame_pipeline::records::ChainInfo;
 
 use super::{REPLAY_MODEL, RefreshFrom, ReplayError, ReplayOptions, fit_phase};
@@ -57,8 +59,10 @@ fn to_ps(ms: f64) -> i64 {
     (ms * 1e9).round() as i64
 }
 
-fn ps(ms: f64) -> toml::Value {
-    toml::Value::String(format!("{}ps", to_ps(ms.max(0.0))))
+/// A capture's non-negative milliseconds as the model's duration (a
+/// negative or missing time is none).
+fn duration(ms: f64) -> Duration {
+    Duration(to_ps(ms.max(0.0)).max(0) as u64)
 }
 
 /// The capture's swap chain made ready to simulate: the base model with the
@@ -83,7 +87,11 @@ pub(super) struct Setup {
     /// What errors call the what-if's patches.
     pub(super) whatif_option: &'static str,
     pub(super) src: ModelSource,
+    /// The model's table without the captured frames' lists (empty), which
+    /// [`Setup::frames`] holds typed.
     pub(super) table: toml::Table,
+    /// The captured frames as the model's per-frame workload.
+    pub(super) frames: FramesWorkload,
 }
 
 impl Setup {
@@ -151,13 +159,21 @@ pub(super) fn setup(capture: &Capture, opts: &ReplayOptions) -> Result<Setup, Re
         }
         None => c0_ps,
     };
-    let lead_ps = toml::Value::String(format!("{}ps", c0_ps - origin_ps));
 
     let vrr = display
         .vrr
         .as_ref()
         .filter(|_| display.flips == Flips::VariableRefresh && !assumes(&opts.assume, "display.vrr."));
-    let mut sets = workload(&rows, lead_ps, &generation_ms);
+    let frames = workload(&rows, Duration((c0_ps - origin_ps).max(0) as u64), &generation_ms);
+    let mut sets: Vec<(&str, toml::Value)> = vec![
+        ("run.frames", toml::Value::Integer(rows.len() as i64)),
+        ("workload.start", toml::Value::String(format!("{}ps", frames.start.0))),
+    ];
+    // The lists are the typed `frames`, not TOML text (a what-if that
+    // patches one keeps its own).
+    for (key, _) in frames.lists() {
+        sets.push((key, toml::Value::Array(Vec::new())));
+    }
     // What the capture says of its display, unless assumed otherwise.
     let display_keys: [(&str, toml::Value); 4] = [
         ("display.refresh", toml::Value::String(format!("{period_ps}ps"))),
@@ -206,6 +222,7 @@ pub(super) fn setup(capture: &Capture, opts: &ReplayOptions) -> Result<Setup, Re
         whatif_option: opts.option_names().0,
         src,
         table,
+        frames,
     })
 }
 
@@ -239,7 +256,7 @@ fn refresh(
 }
 
 /// The captured frames as the model's per-frame workload (`kind =
-/// "frames"`), the first frame starting `lead` after the run's time zero;
+/// "frames"`), the first frame starting `start` after the run's time zero;
 /// `generation_ms(i)`, an assumed frame generation's cost in frame `i`'s
 /// GPU time, is taken out of it.
 ///
@@ -249,11 +266,7 @@ fn refresh(
 /// runs from its present, or from the end of the frame before if that is
 /// later, to its completion, and the GPU does not finish it earlier than
 /// the capture says.
-fn workload(
-    rows: &[Present],
-    lead: toml::Value,
-    generation_ms: &dyn Fn(usize) -> f64,
-) -> Vec<(&'static str, toml::Value)> {
+fn workload(rows: &[Present], start: Duration, generation_ms: &dyn Fn(usize) -> f64) -> FramesWorkload {
     let from_completions = rows.iter().all(|p| p.gpu_busy.is_none());
     let gpu_busy: Vec<f64> = if from_completions {
         let mut last_done = f64::NEG_INFINITY;
@@ -271,37 +284,72 @@ fn workload(
     } else {
         rows.iter().map(|p| p.gpu_busy.unwrap_or(0.0)).collect()
     };
-    let list = |f: &dyn Fn(usize, &Present) -> f64| {
-        toml::Value::Array(rows.iter().enumerate().map(|(i, p)| ps(f(i, p))).collect())
+    let list = |f: &dyn Fn(usize, &Present) -> f64| -> Vec<Duration> {
+        rows.iter().enumerate().map(|(i, p)| duration(f(i, p))).collect()
     };
-    let mut sets: Vec<(&'static str, toml::Value)> = vec![
-        ("run.frames", toml::Value::Integer(rows.len() as i64)),
-        ("workload.start", lead),
-        ("workload.cpu", list(&|_, p| p.cpu_busy)),
-        (
-            "workload.submit",
-            list(&|_, p| p.gpu_latency.unwrap_or(p.cpu_busy).clamp(0.0, p.cpu_busy)),
-        ),
-        ("workload.gpu", list(&|i, _| (gpu_busy[i] - generation_ms(i)).max(0.0))),
-        ("workload.present", list(&|_, p| p.cpu_wait)),
-    ];
-    if from_completions {
-        sets.push((
-            "workload.gpu_end",
-            list(&|_, p| p.render_complete.map_or(0.0, |rc| p.cpu_busy + rc)),
-        ));
+    let gpu_end = if from_completions {
+        list(&|_, p| p.render_complete.map_or(0.0, |rc| p.cpu_busy + rc))
     } else if rows.iter().any(|p| p.gpu_latency.is_some() && p.gpu_time.is_some()) {
         // The frame's GPU end after its CPU start, where the capture has it
         // (0: no floor).
-        sets.push((
-            "workload.gpu_end",
-            list(&|_, p| match (p.gpu_latency, p.gpu_time) {
-                (Some(l), Some(t)) => l.max(0.0) + t,
-                _ => 0.0,
-            }),
-        ));
+        list(&|_, p| match (p.gpu_latency, p.gpu_time) {
+            (Some(l), Some(t)) => l.max(0.0) + t,
+            _ => 0.0,
+        })
+    } else {
+        Vec::new()
+    };
+    FramesWorkload {
+        cpu: list(&|_, p| p.cpu_busy),
+        submit: list(&|_, p| p.gpu_latency.unwrap_or(p.cpu_busy).clamp(0.0, p.cpu_busy)),
+        gpu: list(&|i, _| (gpu_busy[i] - generation_ms(i)).max(0.0)),
+        present: list(&|_, p| p.cpu_wait),
+        gpu_end,
+        start,
     }
-    sets
+}
+
+/// `workload`'s lists that a patch left empty, filled with the captured
+/// frames' (a what-if that gives a list keeps it).
+pub(super) fn fill_frames(w: &mut FramesWorkload, captured: &FramesWorkload) {
+    for (list, from) in [
+        (&mut w.cpu, &captured.cpu),
+        (&mut w.submit, &captured.submit),
+        (&mut w.gpu, &captured.gpu),
+        (&mut w.present, &captured.present),
+        (&mut w.gpu_end, &captured.gpu_end),
+    ] {
+        if list.is_empty() {
+            list.clone_from(from);
+        }
+    }
+}
+
+/// The captured frames' lists written into a model `table` where it holds
+/// none (a model file of the replay, which `rendersim timeline` runs).
+pub(super) fn frames_into(table: &mut toml::Table, frames: &FramesWorkload) {
+    let Some(toml::Value::Table(w)) = table.get_mut("workload") else {
+        return;
+    };
+    let text = |list: &[Duration]| {
+        toml::Value::Array(list.iter().map(|d| toml::Value::String(format!("{}ps", d.0))).collect())
+    };
+    for (key, list) in [
+        ("cpu", &frames.cpu),
+        ("submit", &frames.submit),
+        ("gpu", &frames.gpu),
+        ("present", &frames.present),
+        ("gpu_end", &frames.gpu_end),
+    ] {
+        let empty = match w.get(key) {
+            None => true,
+            Some(toml::Value::Array(a)) => a.is_empty(),
+            Some(_) => false,
+        };
+        if empty && !list.is_empty() {
+            w.insert(key.to_string(), text(list));
+        }
+    }
 }
 
 /// The frame-pipeline model of the set-up frames with `sets` patched on.

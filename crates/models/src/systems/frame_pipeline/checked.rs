@@ -4,12 +4,13 @@
 //! `validate.rs` that needs only the model (ranges, distributions, the
 //! display, the architecture, the noise's share, the scene's sizes, the
 //! memory the results would take) runs in [`CheckedPipeline::new`], the
-//! only way to make one. The pipeline ([`super::model::FramePipeline::new`])
-//! and the walkthrough's one-frame runs ([`super::run::simulate_program`])
-//! take a `CheckedPipeline`, so no code below can meet an unchecked model
-//! or needs to check it again. What depends on the compiled scene (the
-//! clock's range over the run, the number of events) is checked once, in
-//! [`super::run::run_pipeline`], after the scene is built.
+//! only way to make one. It is the first half of the pipeline's plan
+//! ([`super::plan::PipelinePlan::new`], which then compiles the scene and
+//! bounds the clock's range and the count of events); the walkthrough keeps
+//! one checked model and moves it to each of its one-frame runs
+//! ([`CheckedPipeline::for_run_at`], then
+//! [`super::plan::PipelinePlan::with_program`]), so no code below can meet
+//! an unchecked model or needs to check it again.
 
 use crate::engine::Duration;
 use crate::systems::error::SystemError;

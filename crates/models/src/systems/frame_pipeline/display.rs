@@ -28,11 +28,15 @@ use crate::systems::error::SystemError;
 
 use super::critical_path::CriticalPath;
 use super::events::Ev;
+use super::plan::DisplaySpec;
 use super::records::{FrameRecord, GeneratedRecord};
 
 /// The display.
 #[derive(Debug)]
 pub struct Display {
+    /// The swap chain the front end presents into (its present mode
+    /// resolved once, by the plan).
+    chain: SwapChain,
     refresh: Duration,
     /// From a flip to the frame on screen (one refresh when composed).
     compositor_delay: Duration,
@@ -97,30 +101,44 @@ impl Display {
     /// `vrr`: a variable-refresh window (then `refresh` is its shortest
     /// period); `scan`: the scan-out an `immediate` flip tears;
     /// `generation`: whether frames are generated between rendered ones.
-    pub(super) fn new(
-        (refresh, compositor_delay, vrr, scan): (Duration, Duration, Option<VrrWindow>, Option<ScanOut>),
-        generation: bool,
-        frames_total: u64,
-        warmup_frames: u64,
-    ) -> Self {
+    pub(super) fn new(spec: &DisplaySpec) -> Self {
         Display {
-            refresh,
-            compositor_delay,
-            frames_total,
-            warmup_frames,
+            chain: SwapChain::new(spec.buffers, spec.mode),
+            refresh: spec.refresh,
+            compositor_delay: spec.compositor_delay,
+            frames_total: spec.frames_total,
+            warmup_frames: spec.warmup_frames,
             vblanks: 0,
             repeated_refreshes: 0,
             refresh_mark: None,
             last_display: None,
             resolved: 0,
-            vrr: vrr.map(|window| Vrr {
+            vrr: spec.vrr.map(|window| Vrr {
                 window,
                 scan_start: None,
                 tag: 0,
             }),
-            scan,
-            generation: generation.then(Generation::default),
+            scan: spec.scan,
+            generation: spec.generation.then(Generation::default),
         }
+    }
+
+    /// The front end takes a free swap-chain image for a frame it clears
+    /// (false: none is free, it waits).
+    #[inline(always)]
+    pub(super) fn acquire(&mut self) -> bool {
+        self.chain.acquire()
+    }
+
+    /// Frames presented and waiting to be shown.
+    pub(super) fn queued(&self) -> usize {
+        self.chain.queued()
+    }
+
+    /// The present mode the display follows (`immediate` without vsync).
+    #[inline]
+    pub(super) fn mode(&self) -> PresentMode {
+        self.chain.mode()
     }
 
     /// What frame generation did (`None` when it is off).
@@ -151,14 +169,13 @@ impl Display {
         now: Time,
         frame: u64,
         previous_end: Option<Time>,
-        chain: &mut SwapChain,
         records: &mut [FrameRecord],
         path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
         match (&self.generation, previous_end) {
-            (Some(_), Some(prev)) => self.present_generating(now, frame, prev, chain, records, path, s),
-            _ => self.present(now, frame, chain, records, path, s),
+            (Some(_), Some(prev)) => self.present_generating(now, frame, prev, records, path, s),
+            _ => self.present(now, frame, records, path, s),
         }
     }
 
@@ -171,17 +188,16 @@ impl Display {
         now: Time,
         frame: u64,
         prev: Time,
-        chain: &mut SwapChain,
         records: &mut [FrameRecord],
         path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
         let held = self.generation.as_mut().and_then(|g| g.held.take());
         if let Some((h, _)) = held {
-            self.present(now, h, chain, records, path, s)?;
+            self.present(now, h, records, path, s)?;
         }
         let g = self.generation.as_mut().expect("generation is on");
-        if chain.acquire() {
+        if self.chain.acquire() {
             g.frames.push(GeneratedRecord {
                 before: frame,
                 present: now,
@@ -189,7 +205,7 @@ impl Display {
                 dropped: false,
                 tear_line: None,
             });
-            self.present(now, generated_id(frame), chain, records, path, s)?;
+            self.present(now, generated_id(frame), records, path, s)?;
         } else {
             g.skipped.push(frame);
         }
@@ -208,7 +224,6 @@ impl Display {
         &mut self,
         now: Time,
         tag: u32,
-        chain: &mut SwapChain,
         records: &mut [FrameRecord],
         path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
@@ -217,15 +232,15 @@ impl Display {
             return Ok(());
         };
         match g.held.take() {
-            Some((frame, _)) => self.present(now, frame, chain, records, path, s),
+            Some((frame, _)) => self.present(now, frame, records, path, s),
             None => Ok(()),
         }
     }
 
     /// Whether the display refreshes at fixed vertical blanks from time
     /// zero (vsync without variable refresh).
-    pub(super) fn fixed_vblanks(&self, mode: PresentMode) -> bool {
-        mode != PresentMode::Immediate && self.vrr.is_none()
+    pub(super) fn fixed_vblanks(&self) -> bool {
+        self.mode() != PresentMode::Immediate && self.vrr.is_none()
     }
 
     /// The refresh period.
@@ -268,7 +283,6 @@ impl Display {
         &mut self,
         now: Time,
         frame: u64,
-        chain: &mut SwapChain,
         records: &mut [FrameRecord],
         path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
@@ -276,14 +290,14 @@ impl Display {
         if generated_before(frame).is_none() {
             path.presented(frame);
         }
-        let flip = chain.present(frame);
-        self.apply_flip(now, flip, chain.mode(), records, path);
+        let flip = self.chain.present(frame);
+        self.apply_flip(now, flip, self.chain.mode(), records, path);
         if let Some(v) = &self.vrr {
             let idle = v
                 .scan_start
                 .is_none_or(|t| now.0 >= t.0.saturating_add(v.window.shortest.0));
             if idle {
-                self.scan_out(now, chain, records, path, s)?;
+                self.scan_out(now, records, path, s)?;
             }
         }
         Ok(())
@@ -364,23 +378,23 @@ impl Display {
         &mut self,
         now: Time,
         tag: u32,
-        chain: &mut SwapChain,
         records: &mut [FrameRecord],
         path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
+        let queued = self.chain.queued();
         let Some(v) = &mut self.vrr else {
-            return self.fixed_vblank(now, chain, records, path, s);
+            return self.fixed_vblank(now, records, path, s);
         };
         if tag != v.tag {
             return Ok(());
         }
         let start = v.scan_start.expect("a variable-refresh event follows a scan-out");
         let deadline = Time(start.0.saturating_add(v.window.longest.0));
-        if chain.queued() > 0 || now >= deadline {
+        if queued > 0 || now >= deadline {
             // A frame waits for this scan-out's end, or the old image must
             // be refreshed (scanned out again).
-            return self.scan_out(now, chain, records, path, s);
+            return self.scan_out(now, records, path, s);
         }
         // The scan-out ended with nothing to show: the panel waits, up to
         // the slowest refresh's deadline.
@@ -393,12 +407,11 @@ impl Display {
     fn fixed_vblank(
         &mut self,
         now: Time,
-        chain: &mut SwapChain,
         records: &mut [FrameRecord],
         path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
-        self.refresh_now(now, chain, records, path);
+        self.refresh_now(now, records, path);
         if !self.done() {
             s.after(
                 self.refresh,
@@ -414,12 +427,11 @@ impl Display {
     fn scan_out(
         &mut self,
         now: Time,
-        chain: &mut SwapChain,
         records: &mut [FrameRecord],
         path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
-        self.refresh_now(now, chain, records, path);
+        self.refresh_now(now, records, path);
         let done = self.done();
         let v = self.vrr.as_mut().expect("a variable-refresh panel");
         v.scan_start = Some(now);
@@ -437,12 +449,12 @@ impl Display {
 
     /// A refresh at `now`: the swap chain flips its oldest queued frame, if
     /// any; one with nothing new repeats the image on screen.
-    fn refresh_now(&mut self, now: Time, chain: &mut SwapChain, records: &mut [FrameRecord], path: &mut CriticalPath) {
+    fn refresh_now(&mut self, now: Time, records: &mut [FrameRecord], path: &mut CriticalPath) {
         self.vblanks += 1;
-        let flip = chain.vblank();
+        let flip = self.chain.vblank();
         if flip.shown.is_none() && self.last_display.is_some() {
             self.repeated_refreshes += 1;
         }
-        self.apply_flip(now, flip, chain.mode(), records, path);
+        self.apply_flip(now, flip, self.chain.mode(), records, path);
     }
 }

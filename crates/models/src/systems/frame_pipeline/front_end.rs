@@ -181,7 +181,7 @@ impl FrontEnd {
                     self.phase = self.begin(now, c, env, down, s)?;
                 }
                 FrontPhase::WaitImage => {
-                    if !env.links.chain.acquire() {
+                    if !down.display.acquire() {
                         return Ok(progressed);
                     }
                     self.phase = self.start_clear(now, self.cmd, env, down, s)?;
@@ -283,7 +283,7 @@ impl FrontEnd {
         let cmd_cost = env.cfg.gpu.command;
         match c {
             Command::Clear { .. } => {
-                if env.links.chain.acquire() {
+                if down.display.acquire() {
                     self.start_clear(now, c, env, down, s)
                 } else {
                     Ok(FrontPhase::WaitImage)
@@ -397,15 +397,8 @@ impl FrontEnd {
                     Some(p) if env.cfg.frame_generation.enabled => env.records[p as usize].gpu_end,
                     _ => None,
                 };
-                down.display.present_rendered(
-                    now,
-                    frame,
-                    previous_end,
-                    &mut env.links.chain,
-                    &mut env.records,
-                    down.path,
-                    s,
-                )?;
+                down.display
+                    .present_rendered(now, frame, previous_end, &mut env.records, down.path, s)?;
                 FrontPhase::Idle
             }
             Command::Clear { .. } | Command::Fixed { .. } => FrontPhase::Idle,

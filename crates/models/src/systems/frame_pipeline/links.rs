@@ -14,7 +14,6 @@
 use crate::components::fifo::{BoundedFifo, FifoUnit};
 use crate::components::shader_pool::{ShaderPool, Stream};
 use crate::components::shared_bus::SharedBus;
-use crate::components::swap_chain::SwapChain;
 use crate::engine::{Duration, Scheduler, Time};
 use crate::systems::error::SystemError;
 
@@ -75,8 +74,6 @@ pub struct Links {
     pub(super) held_triangle: Option<FragWork>,
     /// The unified architecture's shader-core pool (`None`: split).
     pub(super) shaders: Option<ShaderPool>,
-    /// The swap chain (front end -> display).
-    pub(super) chain: SwapChain,
     /// Frames whose swap the GPU finished (what the CPU's
     /// `cpu.max_frames_ahead` counts against).
     pub(super) frames_completed: u64,
@@ -118,7 +115,9 @@ impl Links {
     #[inline(never)]
     fn settle_pool(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         if let Some(pool) = &mut self.shaders {
-            for d in pool.settle(now)?.iter() {
+            // Over the two streams' slots, not `Changes::iter` (which the
+            // compiler does not always inline here).
+            for d in pool.settle(now)?.0.into_iter().flatten() {
                 s.at(
                     d.at,
                     match d.stream {

@@ -18,7 +18,8 @@
 //! - `critical_path`: bottleneck attribution along the critical path;
 //! - `records`: per-frame records and the PresentMon-style table;
 //! - `report`: the human-readable report of a run;
-//! - `run`: build and run a model;
+//! - `plan`: the one fallible step, from a parsed model to what runs;
+//! - `run`: run a plan;
 //! - `validate`: what a model is refused for before it runs;
 //! - `summary`: the run's summary (`summary.json`).
 //!
@@ -42,6 +43,7 @@ mod geometry_stage;
 mod links;
 pub mod model;
 pub mod pipeline_trace;
+mod plan;
 mod quiet;
 pub mod records;
 pub mod report;
@@ -55,4 +57,5 @@ pub mod workload;
 pub use checked::CheckedPipeline;
 pub use config::{Fidelity, FramePipelineConfig};
 pub use model::FramePipeline;
+pub use plan::PipelinePlan;
 pub use run::{PipelineRun, run_pipeline};

@@ -18,23 +18,22 @@
 //! (`accounting.rs`, which reads the units through an immutable view).
 
 use crate::components::fifo::BoundedFifo;
-use crate::components::noise::{Arrivals, NoiseSource, NoiseTarget};
+use crate::components::noise::{NoiseSource, NoiseTarget};
 use crate::components::shader_pool::{ShaderPool, Stream};
 use crate::components::shared_bus::SharedBus;
-use crate::components::swap_chain::{PresentMode, SwapChain};
+use crate::components::swap_chain::PresentMode;
 use crate::engine::{Control, Model, RngStreams, Scheduler, Time};
 use crate::systems::error::SystemError;
 
 use super::accounting::{Accounting, Units, units_of};
-use super::checked::CheckedPipeline;
-use super::config::{Fidelity, FramePipelineConfig, WorkloadConfig};
-use super::cpu_thread::{Alone, CpuThread, FixedWork};
+use super::config::{Fidelity, WorkloadConfig};
+use super::cpu_thread::{Alone, CpuThread};
 use super::display::Display;
 use super::fragment_stage::FragmentStage;
 use super::front_end::{Downstream, FrontEnd};
 use super::geometry_stage::{GeometryStage, Handoff};
 use super::links::{Env, Links};
-use super::workload::SceneProgram;
+use super::plan::{PipelinePlan, PlannedWork};
 
 pub use super::cpu_thread::CpuPhase;
 pub use super::events::Ev;
@@ -70,84 +69,21 @@ macro_rules! downstream {
     };
 }
 
-/// The model's noise sources (system tasks), periodic then random.
-fn noise_sources(cfg: &FramePipelineConfig, streams: &RngStreams) -> Result<Vec<NoiseSource>, SystemError> {
-    let mut noise = Vec::new();
-    if !cfg.noise.enabled {
-        return Ok(noise);
-    }
-    for (i, p) in cfg.noise.periodic.iter().enumerate().filter(|(_, p)| p.enabled) {
-        let src = NoiseSource::new(
-            p.name.clone(),
-            p.target,
-            Arrivals::Periodic {
-                period: p.period,
-                phase: p.phase,
-                jitter: p.jitter,
-            },
-            p.duration.clone(),
-            streams.stream(&format!("noise.{}", p.name)),
-        )
-        .map_err(|e| SystemError::Invalid {
-            key: format!("noise.periodic.{i}"),
-            message: e.to_string(),
-        })?;
-        noise.push(src);
-    }
-    for (i, r) in cfg.noise.random.iter().enumerate().filter(|(_, r)| r.enabled) {
-        let src = NoiseSource::new(
-            r.name.clone(),
-            r.target,
-            Arrivals::Poisson {
-                mean_gap: r.rate.period,
-            },
-            r.duration.clone(),
-            streams.stream(&format!("noise.{}", r.name)),
-        )
-        .map_err(|e| SystemError::Invalid {
-            key: format!("noise.random.{i}"),
-            message: e.to_string(),
-        })?;
-        noise.push(src);
-    }
-    Ok(noise)
-}
-
 impl FramePipeline {
-    /// Builds the system from a checked model and its compiled workload.
-    pub fn new(
-        checked: CheckedPipeline,
-        scene: Option<SceneProgram>,
-        trace: Option<crate::output::trace::TraceWriter>,
-    ) -> Result<Self, SystemError> {
-        let cfg = checked.into_config();
+    /// Builds the units from a plan (which cannot fail: [`PipelinePlan::new`]
+    /// refused every model they could not run).
+    pub fn new(plan: PipelinePlan, trace: Option<crate::output::trace::TraceWriter>) -> Self {
+        let (cfg, work, noise, display) = plan.into_parts();
         let streams = RngStreams::new(cfg.run.seed);
-        let (fixed, scene) = match (&cfg.workload, scene) {
-            (WorkloadConfig::Fixed(f), _) => (
-                Some(FixedWork::Drawn {
-                    cpu: f.cpu.clone(),
-                    gpu: f.gpu.clone(),
-                    cpu_rng: streams.stream("workload.cpu"),
-                    gpu_rng: streams.stream("workload.gpu"),
-                }),
-                None,
-            ),
-            (WorkloadConfig::Frames(f), _) => (Some(FixedWork::PerFrame(f.clone())), None),
-            (WorkloadConfig::Scene(_), Some(s)) => (None, Some(s)),
-            (WorkloadConfig::Scene(_), None) => {
-                return Err(SystemError::Invalid {
-                    key: "workload".into(),
-                    message: "scene not compiled".into(),
-                });
-            }
+        let (fixed, scene) = match work {
+            PlannedWork::Fixed(f) => (Some(f), None),
+            PlannedWork::Scene(s) => (None, Some(s)),
         };
-        let noise = noise_sources(&cfg, &streams)?;
         // Only a trace of the units' states needs the events' traced paths
         // (a `frame`-detail trace is written from the records at the end).
         let traced = trace
             .as_ref()
             .is_some_and(|t| t.detail() != crate::output::trace::TraceDetail::Frame);
-        let mode = cfg.display.effective_mode();
         let frames_total = cfg.run.frames;
         let body = match &scene {
             None => (1, false),
@@ -173,33 +109,22 @@ impl FramePipeline {
                 Fidelity::Triangle => cfg.gpu.pool().map(|(n, p)| ShaderPool::new(n, p)),
                 Fidelity::Draw => None,
             },
-            chain: SwapChain::new(cfg.display.buffers, mode),
             frames_completed: 0,
             bus: SharedBus::new(cfg.bus.bandwidth.bytes_per_ps()),
             held_triangle: None,
             bus_changed: false,
         };
-        Ok(FramePipeline {
+        FramePipeline {
             cpu: CpuThread::new(frames_total, body, cpu_rngs, fixed, zero_time_after),
             front: FrontEnd::new(streams.stream("variation.gpu")),
             geom: GeometryStage::new(streams.stream("fragment.pixels"), pixel_rng_start),
             frag: FragmentStage::default(),
-            display: Display::new(
-                (
-                    cfg.display.shortest_period(),
-                    cfg.display.compositor_delay(),
-                    cfg.display.vrr_window(),
-                    cfg.display.scan_out(),
-                ),
-                cfg.frame_generation.enabled,
-                frames_total,
-                cfg.run.warmup_frames,
-            ),
+            display: Display::new(&display),
             frames_total,
             noise,
             acct: Accounting::new(
                 trace,
-                (mode != PresentMode::Immediate).then_some(cfg.display.shortest_period()),
+                (display.mode != PresentMode::Immediate).then_some(display.refresh),
             ),
             env: Env {
                 links,
@@ -208,7 +133,7 @@ impl FramePipeline {
                 traced,
                 cfg,
             },
-        })
+        }
     }
 
     /// Schedules the first events. Call once before running.
@@ -216,7 +141,7 @@ impl FramePipeline {
         if self.frames_total == 0 {
             return Ok(());
         }
-        if self.display.fixed_vblanks(self.env.links.chain.mode()) {
+        if self.display.fixed_vblanks() {
             s.at(Time::ZERO, Ev::Vblank { tag: 0 });
         }
         for i in 0..self.noise.len() {
@@ -273,7 +198,7 @@ impl FramePipeline {
             self.env.links.held_triangle.is_some(),
             self.frag.busy(),
             self.env.links.frames_completed,
-            self.env.links.chain.queued()
+            self.display.queued()
         )
     }
 
@@ -421,8 +346,7 @@ impl FramePipeline {
             Ev::GpuHoldEnd => self.front.hold_ends(),
             Ev::HeldPresent { tag } => {
                 let path = &mut self.acct.path;
-                self.display
-                    .held_present(now, tag, &mut self.env.links.chain, &mut self.env.records, path, s)?;
+                self.display.held_present(now, tag, &mut self.env.records, path, s)?;
             }
             _ => unreachable!("not a wait's end: {ev:?}"),
         }
@@ -486,8 +410,7 @@ impl Model for FramePipeline {
             }
             Ev::Vblank { tag } => {
                 let path = &mut self.acct.path;
-                self.display
-                    .vblank(now, tag, &mut self.env.links.chain, &mut self.env.records, path, s)?;
+                self.display.vblank(now, tag, &mut self.env.records, path, s)?;
             }
             Ev::NoiseArrive { source } => self.noise_arrive(now, source, s)?,
             Ev::NoiseEnd { target } => self.noise_end(now, target, s)?,

@@ -227,7 +227,7 @@ pub(super) fn summarize(
     let dropped = m.env.records.iter().skip(warm).filter(|r| r.dropped).count();
     let (mark_vblanks, mark_repeated, mark_time) =
         m.display.refresh_mark().unwrap_or((0, 0, crate::engine::Time::ZERO));
-    let refreshes = if m.env.links.chain.mode() == crate::components::swap_chain::PresentMode::Immediate {
+    let refreshes = if m.display.mode() == crate::components::swap_chain::PresentMode::Immediate {
         end.0 / m.display.refresh().0 - mark_time.0 / m.display.refresh().0
     } else {
         m.display.vblanks() - mark_vblanks

@@ -32,6 +32,16 @@ pub enum WorkloadError {
     },
 }
 
+impl From<WorkloadError> for crate::systems::error::SystemError {
+    /// A scene that cannot be compiled is a model value the system cannot
+    /// use, blamed on its key.
+    fn from(e: WorkloadError) -> Self {
+        match e {
+            WorkloadError::Invalid { key, message } => Self::Invalid { key, message },
+        }
+    }
+}
+
 fn invalid(key: impl Into<String>, message: impl Into<String>) -> WorkloadError {
     WorkloadError::Invalid {
         key: key.into(),

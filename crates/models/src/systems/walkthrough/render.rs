@@ -3,7 +3,7 @@
 //! run (CPU thread, command FIFO, GPU front end, geometry and fragment work
 //! on the configured architecture, system-task noise, swap), built with
 //! the pipeline's own workload code (`build_program`) and simulated by its
-//! event model (`simulate_program`). Nothing of the GPU model is copied.
+//! event model (`PipelinePlan::with_program`). Nothing of the GPU model is copied.
 //!
 //! Each frame is run on its own, from an idle pipeline, and timed from the
 //! CPU's start to the GPU's last work: the frame's rendering time RT, as
@@ -18,12 +18,11 @@ use crate::components::distribution::Dist;
 use crate::engine::{Duration, RngStreams, StreamRng};
 use crate::scene::config::{SceneWorkload, StateOrder, View};
 use crate::systems::error::SystemError;
-use crate::systems::frame_pipeline::CheckedPipeline;
 use crate::systems::frame_pipeline::config::{FramePipelineConfig, RunConfig, WorkloadConfig};
-use crate::systems::frame_pipeline::run::simulate_program;
 use crate::systems::frame_pipeline::workload::{
-    GroupInfo, Instance, MeshInfo, Misses, WorkloadError, build_program, early_z_pass, fragment_costs, timed_mesh,
+    GroupInfo, Instance, MeshInfo, Misses, build_program, early_z_pass, fragment_costs, timed_mesh,
 };
+use crate::systems::frame_pipeline::{CheckedPipeline, PipelinePlan};
 
 use super::config::WalkthroughConfig;
 use super::scene::Scene;
@@ -66,12 +65,6 @@ pub struct Renderer {
     shade: f64,
     fixed: f64,
     pass: f64,
-}
-
-fn workload_error(e: WorkloadError) -> SystemError {
-    match e {
-        WorkloadError::Invalid { key, message } => SystemError::Invalid { key, message },
-    }
 }
 
 impl Renderer {
@@ -130,10 +123,11 @@ impl Renderer {
                     geometry_time: Duration::ZERO,
                     geometry_shader: Duration::ZERO,
                 };
-                levels.push(
-                    timed_mesh(template.config(), info, &format!("scene ({} level {l})", p.name))
-                        .map_err(workload_error)?,
-                );
+                levels.push(timed_mesh(
+                    template.config(),
+                    info,
+                    &format!("scene ({} level {l})", p.name),
+                )?);
             }
             meshes.push(levels);
         }
@@ -204,9 +198,9 @@ impl Renderer {
                 upload: 0,
             });
         }
-        let program = build_program(cfg, meshes, groups, &objects, self.pass).map_err(workload_error)?;
+        let program = build_program(cfg, meshes, groups, &objects, self.pass)?;
         let cpu_submit = program.draws.iter().fold(0u64, |t, d| t.saturating_add(d.cpu.0));
-        let (stats, records) = simulate_program(checked, program)?;
+        let (stats, records) = PipelinePlan::with_program(checked, program)?.simulate()?;
         let r = records.first().ok_or_else(|| SystemError::Unfinished {
             at: stats.end_time,
             missing: "the frame was drawn".into(),
