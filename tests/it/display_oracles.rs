@@ -1,5 +1,6 @@
 //! Display and latency oracles: vsync quantization with double and triple
-//! buffering (paper 004 §4.2), mailbox, immediate, and render-ahead latency.
+//! buffering (paper 004 §4.2), mailbox, FIFO latest ready, immediate, and
+//! render-ahead latency.
 
 use crate::common;
 use common::{FIXED, metric, run};
@@ -63,6 +64,87 @@ fn mailbox_drops_frames_produced_faster_than_refresh() {
     );
     assert_eq!(metric(&f, "metrics.dropped_frames"), 0.0);
     assert!((metric(&f, "metrics.frame_time_ms.mean") - REFRESH_MS).abs() < 0.01);
+}
+
+/// Vulkan's `fifo_latest_ready` (VK_KHR_present_mode_fifo_latest_ready):
+/// frames queue as in FIFO and each vertical blank shows the newest one
+/// ready, releasing the older ones. With two images only one frame can
+/// queue, so it is FIFO exactly; with four and a GPU three times faster than
+/// the refresh, every vertical blank shows the newest frame finished before
+/// it, every dropped frame was overtaken before its vertical blank, and the
+/// GPU waits for images that mailbox would have freed at once.
+#[test]
+fn fifo_latest_ready_shows_the_newest_ready_frame_at_each_vertical_blank() {
+    let latest = "display.present_mode=\"fifo_latest_ready\"";
+    let timeline = |r: &rendersim::systems::frame_pipeline::PipelineRun| {
+        r.records
+            .iter()
+            .map(|f| (f.gpu_end, f.displayed, f.dropped))
+            .collect::<Vec<_>>()
+    };
+    let two = ["display.buffers=2", "workload.gpu=\"5ms\"", "workload.cpu=\"1ms\""];
+    assert_eq!(
+        timeline(&run(FIXED, &[&two[..], &[latest]].concat())),
+        timeline(&run(FIXED, &two)),
+        "two images: fifo_latest_ready is fifo"
+    );
+
+    let four = [
+        "display.buffers=4",
+        "workload.gpu=\"5ms\"",
+        "workload.cpu=\"1ms\"",
+        latest,
+    ];
+    let r = run(FIXED, &four);
+    let shown: Vec<(u64, u64)> = r
+        .records
+        .iter()
+        .filter_map(|f| f.displayed.map(|t| (t.0, f.index)))
+        .collect();
+    assert!(shown.len() > 100, "{}", shown.len());
+    let done = |i: u64| r.records[i as usize].gpu_end.expect("every frame finished").0;
+    for &(t, f) in &shown {
+        assert!(done(f) <= t, "frame {f} shown before it was done");
+        // No later frame was ready at this vertical blank.
+        if let Some(next) = r.records.get(f as usize + 1) {
+            assert!(
+                next.gpu_end.unwrap().0 >= t,
+                "frame {} was newer than {f} at {t}",
+                f + 1
+            );
+        }
+    }
+    let mut dropped = 0;
+    for d in r.records.iter().filter(|f| f.dropped) {
+        dropped += 1;
+        let end = d.gpu_end.unwrap().0;
+        let (_, f) = shown
+            .iter()
+            .find(|&&(t, _)| t >= end)
+            .expect("a vertical blank after it");
+        assert!(*f > d.index, "frame {} dropped but nothing newer was shown", d.index);
+    }
+    assert!(dropped > 100, "{dropped}");
+    // Every refresh shows a new frame; the display never repeats one.
+    assert_eq!(metric(&r, "metrics.repeated_refreshes"), 0.0);
+    // Mailbox frees a replaced frame's image at once, so its GPU never
+    // waits (5 ms a frame); here the images come back only at a vertical
+    // blank, and the GPU waits for them.
+    let mailbox = run(
+        FIXED,
+        &[
+            "display.buffers=4",
+            "workload.gpu=\"5ms\"",
+            "workload.cpu=\"1ms\"",
+            "display.present_mode=\"mailbox\"",
+        ],
+    );
+    let (ft_latest, ft_mailbox) = (
+        metric(&r, "metrics.frame_time_ms.mean"),
+        metric(&mailbox, "metrics.frame_time_ms.mean"),
+    );
+    assert!((ft_mailbox - 5.0).abs() < 0.01, "{ft_mailbox}");
+    assert!(ft_latest > ft_mailbox + 0.2, "{ft_latest} vs {ft_mailbox}");
 }
 
 #[test]

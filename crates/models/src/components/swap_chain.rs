@@ -7,6 +7,13 @@
 //!   the GPU waits for a free image (classic double/triple buffering).
 //! - `mailbox`: a newly presented frame replaces a queued one (the replaced
 //!   frame is dropped and its image freed); each vertical blank shows it.
+//! - `fifo_latest_ready` (Vulkan's `VK_PRESENT_MODE_FIFO_LATEST_READY_KHR`,
+//!   from `VK_EXT_present_mode_fifo_latest_ready`): presented frames queue
+//!   as in `fifo`, and each vertical blank dequeues them in order up to the
+//!   newest one that is ready, shows it and releases the older ones unshown.
+//!   Unlike `mailbox`, images are freed only at a vertical blank, several
+//!   at once (every presented frame is ready here: a frame is presented
+//!   when the GPU finished it).
 //! - `immediate` (or vsync off): a presented frame is shown at once, tearing
 //!   the picture where the scan-out is (`display.blanking`, the share of a
 //!   refresh in vertical blanking: [`crate::components::tearing`]).
@@ -56,6 +63,9 @@ pub enum PresentMode {
     Mailbox,
     /// Shown at once, no waiting for vertical blank.
     Immediate,
+    /// Queue; each vertical blank shows the newest queued frame and drops
+    /// the older ones.
+    FifoLatestReady,
 }
 
 /// Who shows a flipped frame (see the module docs).
@@ -143,8 +153,8 @@ impl DisplayConfig {
         }
     }
 
-    /// Whether presented frames wait for a vertical blank (`fifo` or
-    /// `mailbox` with vsync on).
+    /// Whether presented frames wait for a vertical blank (any mode but
+    /// `immediate`, with vsync on).
     pub fn waits_for_vblank(&self) -> bool {
         self.effective_mode() != PresentMode::Immediate
     }
@@ -226,7 +236,7 @@ impl DisplayConfig {
             return Err((
                 "display.composition",
                 "a composed frame is shown by the desktop compositor at a vertical blank: \
-                 `composed` needs `display.vsync = true` and `present_mode` `fifo` or `mailbox`"
+                 `composed` needs `display.vsync = true` and `present_mode` `fifo`, `mailbox` or `fifo_latest_ready`"
                     .to_string(),
             ));
         }
@@ -271,7 +281,7 @@ impl DisplayConfig {
                 "display.vrr",
                 "a variable-refresh panel shows each frame at a scan-out start; with vsync off frames above \
                  its range would tear, which is not modelled: `display.vrr` needs `display.vsync = true` and \
-                 `present_mode` `fifo` or `mailbox`"
+                 `present_mode` `fifo`, `mailbox` or `fifo_latest_ready`"
                     .to_string(),
             ));
         }
@@ -332,6 +342,22 @@ pub type FrameId = u64;
 /// assert!(mailbox.acquire());
 /// assert_eq!(mailbox.present(1).dropped, Some(0)); // never shown
 /// assert_eq!(mailbox.vblank().shown, Some(1));
+///
+/// // FIFO latest ready with four images: frames queue as in FIFO, and the
+/// // vertical blank releases the older ones and shows the newest.
+/// let mut latest = SwapChain::new(4, PresentMode::FifoLatestReady);
+/// for f in 0..3 {
+///     assert!(latest.acquire());
+///     latest.present(f);
+/// }
+/// assert!(!latest.acquire()); // every image is queued or on screen
+/// assert_eq!(latest.release_stale(), Some(0));
+/// assert_eq!(latest.release_stale(), Some(1));
+/// assert_eq!(latest.release_stale(), None);
+/// assert_eq!(latest.vblank().shown, Some(2));
+/// // Three images come back at once: the two released and the old front.
+/// assert!(latest.acquire() && latest.acquire() && latest.acquire());
+/// assert!(!latest.acquire());
 /// ```
 #[derive(Debug, Clone)]
 pub struct SwapChain {
@@ -403,7 +429,7 @@ impl SwapChain {
                     freed: true,
                 }
             }
-            PresentMode::Fifo => {
+            PresentMode::Fifo | PresentMode::FifoLatestReady => {
                 self.queued.push_back(frame);
                 Flip::default()
             }
@@ -422,12 +448,30 @@ impl SwapChain {
         }
     }
 
+    /// At a vertical blank in `fifo_latest_ready`, before [`SwapChain::vblank`]:
+    /// the oldest queued frame, released unshown and its image freed, while
+    /// a newer one is queued (`None`: nothing more to release; always in the
+    /// other modes). Call it until it gives `None`.
+    #[inline]
+    pub fn release_stale(&mut self) -> Option<FrameId> {
+        if self.mode != PresentMode::FifoLatestReady || self.queued.len() < 2 {
+            return None;
+        }
+        self.free += 1;
+        self.queued.pop_front()
+    }
+
     /// A vertical blank: the oldest queued frame (if any) becomes the front
-    /// buffer and the old front image is freed.
+    /// buffer and the old front image is freed (in `fifo_latest_ready`,
+    /// after [`SwapChain::release_stale`], the newest).
     pub fn vblank(&mut self) -> Flip {
         if self.mode == PresentMode::Immediate {
             return Flip::default();
         }
+        debug_assert!(
+            self.mode != PresentMode::FifoLatestReady || self.queued.len() <= 1,
+            "fifo_latest_ready: release the stale frames before the vertical blank"
+        );
         match self.queued.pop_front() {
             Some(f) => {
                 self.front = Some(f);

@@ -451,6 +451,15 @@ impl Display {
     /// any; one with nothing new repeats the image on screen.
     fn refresh_now(&mut self, now: Time, records: &mut [FrameRecord], path: &mut CriticalPath) {
         self.vblanks += 1;
+        // `fifo_latest_ready`: the frames a newer one overtook leave unshown.
+        while let Some(stale) = self.chain.release_stale() {
+            let drop = Flip {
+                shown: None,
+                dropped: Some(stale),
+                freed: true,
+            };
+            self.apply_flip(now, drop, self.chain.mode(), records, path);
+        }
         let flip = self.chain.vblank();
         if flip.shown.is_none() && self.last_display.is_some() {
             self.repeated_refreshes += 1;

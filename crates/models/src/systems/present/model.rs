@@ -238,6 +238,15 @@ impl Model for Present {
             }
             Ev::Vblank => {
                 self.vblanks += 1;
+                // `fifo_latest_ready`: the frames a newer one overtook leave unshown.
+                while let Some(stale) = self.chain.release_stale() {
+                    let drop = Flip {
+                        shown: None,
+                        dropped: Some(stale),
+                        freed: true,
+                    };
+                    self.apply(now, drop);
+                }
                 let flip = self.chain.vblank();
                 if flip.shown.is_none() && self.on_screen.is_some() {
                     self.repeated += 1;
