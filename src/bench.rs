@@ -24,7 +24,7 @@
 use std::time::Instant;
 
 use crate::config::{ConfigError, ModelSource, Overrides, deserialize, load_model};
-use crate::systems::frame_pipeline::summary::PipelineSummary;
+use crate::systems::frame_pipeline::PipelineSummary;
 use crate::systems::frame_pipeline::{FramePipelineConfig, run_pipeline};
 use crate::systems::{SimError, run_model};
 

@@ -8,7 +8,7 @@
 //! frame-pipeline run its replay makes (as captured, or under the file's
 //! what-if): the capture's frames on the pipeline's lanes.
 //!
-//! The picture is built from the run's own trace ([`crate::systems::frame_pipeline::accounting`]),
+//! The picture is built from the run's own trace (the frame pipeline's accounting),
 //! kept as merged spans while the run makes it ([`crate::output::span_collector`]): the CPU's
 //! and the display's spans carry their frame; GPU work is given the frame
 //! whose GPU interval (its clear to its swap, [`crate::systems::frame_pipeline::records`]) contains

@@ -21,6 +21,7 @@ use super::events::Ev;
 use super::fragment_stage::FragmentStage;
 use super::geometry_stage::GeometryStage;
 use super::links::{Command, Env, command_count};
+use super::unit_specs::FrontSpec;
 
 /// What the GPU front end is doing (its command is its own, see
 /// `FrontEnd::describe`).
@@ -69,6 +70,8 @@ pub struct FrontEnd {
     /// Whether the held draw's stalling state setup has run
     /// (`gpu.state_change_stalls`).
     set_up: bool,
+    /// What it reads of the model.
+    spec: FrontSpec,
 }
 
 #[inline(always)]
@@ -79,9 +82,10 @@ fn schedule(s: &mut Scheduler<Ev>, w: Wake) {
 }
 
 impl FrontEnd {
-    /// An idle front end; `variation_rng`: the `variation.gpu` stream.
-    pub(super) fn new(variation_rng: StreamRng) -> Self {
+    /// An idle front end of `spec`; `variation_rng`: the `variation.gpu` stream.
+    pub(super) fn new(spec: FrontSpec, variation_rng: StreamRng) -> Self {
         FrontEnd {
+            spec,
             work: Preemptible::new(),
             phase: FrontPhase::Idle,
             cmd: Command::Clear { frame: 0 },
@@ -91,6 +95,12 @@ impl FrontEnd {
             executed: 0,
             set_up: false,
         }
+    }
+
+    /// Whether the fragments are binned (sort-middle).
+    #[inline(always)]
+    pub(super) fn binned(&self) -> bool {
+        self.spec.binned
     }
 
     /// The phase.
@@ -197,17 +207,14 @@ impl FrontEnd {
                     }
                     // With frame generation, the interpolation before the
                     // frame's present is GPU work of its swap.
-                    let generate = match self.cmd {
-                        Command::Swap { frame } if env.cfg.frame_generation.enabled => {
-                            env.cfg.frame_generation.cost_before_present(frame)
-                        }
+                    let generate = match (self.cmd, &self.spec.frame_generation) {
+                        (Command::Swap { frame }, Some(g)) => g.cost_before_present(frame),
                         _ => Duration::ZERO,
                     };
-                    let work = env
-                        .cfg
-                        .gpu
+                    let work = self
+                        .spec
                         .swap
-                        .saturating_add(env.cfg.gpu.command)
+                        .saturating_add(self.spec.command)
                         .saturating_add(generate);
                     if let Some(t) = self.held_until(env, work)
                         && t > now
@@ -220,8 +227,7 @@ impl FrontEnd {
                 }
                 FrontPhase::Handoff => {
                     // Binning: the next draw's geometry waits for the bins to drain.
-                    let bins_busy =
-                        env.cfg.gpu.fragment.binned() && (down.frag.busy() || !env.links.triangles.is_empty());
+                    let bins_busy = self.spec.binned && (down.frag.busy() || !env.links.triangles.is_empty());
                     if down.geom.has_draw() || bins_busy {
                         return Ok(progressed);
                     }
@@ -255,11 +261,8 @@ impl FrontEnd {
     /// frame began); `None` for every other workload.
     #[inline(never)]
     fn held_until(&self, env: &Env, work: Duration) -> Option<Time> {
-        let crate::systems::frame_pipeline::config::WorkloadConfig::Frames(w) = &env.cfg.workload else {
-            return None;
-        };
         let f = self.frame? as usize;
-        let end = w.gpu_end.get(f)?;
+        let end = self.spec.gpu_end.get(f)?;
         Some(Time(
             env.records[f].begun.0.saturating_add(end.0).saturating_sub(work.0),
         ))
@@ -280,7 +283,7 @@ impl FrontEnd {
         down: &mut Downstream<'_>,
         s: &mut Scheduler<Ev>,
     ) -> Result<FrontPhase, SystemError> {
-        let cmd_cost = env.cfg.gpu.command;
+        let cmd_cost = self.spec.command;
         match c {
             Command::Clear { .. } => {
                 if down.display.acquire() {
@@ -317,9 +320,9 @@ impl FrontEnd {
             down.geom.new_frame();
             env.records[frame as usize].gpu_start = Some(now);
         }
-        let mut work = env.cfg.gpu.clear.saturating_add(env.cfg.gpu.command);
+        let mut work = self.spec.clear.saturating_add(self.spec.command);
         // Per-frame variation (config `variation.gpu`), drawn only when given.
-        if let (Command::Clear { .. }, Some(v)) = (c, env.cfg.variation.gpu()) {
+        if let (Command::Clear { .. }, Some(v)) = (c, &self.spec.variation) {
             work = work.saturating_add(Duration::from_ps_f64(v.sample(&mut self.variation_rng)));
         }
         self.job(now, c, work, env, down, s)
@@ -394,7 +397,7 @@ impl FrontEnd {
                 env.records[frame as usize].gpu_end = Some(now);
                 self.frame = None;
                 let previous_end = match frame.checked_sub(1) {
-                    Some(p) if env.cfg.frame_generation.enabled => env.records[p as usize].gpu_end,
+                    Some(p) if self.spec.frame_generation.is_some() => env.records[p as usize].gpu_end,
                     _ => None,
                 };
                 down.display

@@ -29,6 +29,7 @@ use super::config::Fidelity;
 use super::events::Ev;
 use super::geometry_cost::geometry_cost;
 use super::links::{Env, FragWork};
+use super::unit_specs::GeometrySpec;
 use super::workload::{MeshInfo, closed_times, ordered_sizes};
 
 /// `mesh` as a draw from AGP memory sees it at the bus's share now: its
@@ -106,13 +107,16 @@ pub struct GeometryStage {
     pixel_rng: StreamRng,
     /// The size stream's state at the start, restored every frame for a static view.
     pixel_rng_start: Option<StreamRng>,
+    /// What it reads of the model.
+    spec: GeometrySpec,
 }
 
 impl GeometryStage {
     /// An idle stage drawing triangle sizes from `pixel_rng`, restarted at
     /// every frame from `pixel_rng_start` when given (a static view).
-    pub(super) fn new(pixel_rng: StreamRng, pixel_rng_start: Option<StreamRng>) -> Self {
+    pub(super) fn new(spec: GeometrySpec, pixel_rng: StreamRng, pixel_rng_start: Option<StreamRng>) -> Self {
         GeometryStage {
+            spec,
             draw: None,
             busy: false,
             split: None,
@@ -195,7 +199,7 @@ impl GeometryStage {
             };
             env.links.bus_changed |= env.links.bus.set_fetch(ask);
         }
-        match env.cfg.fidelity {
+        match self.spec.fidelity {
             Fidelity::Triangle => {
                 let g = &sc.groups[d.group as usize];
                 if g.order == SizeOrder::Random {
@@ -217,10 +221,10 @@ impl GeometryStage {
                 let t = match d.closed {
                     Some(t) => t,
                     None if fetch > 0.0 => {
-                        let m = agp_mesh(mesh, fetch, &env.links.bus, env.cfg.gpu.pool().is_some());
-                        closed_times(&env.cfg, &m, g)
+                        let m = agp_mesh(mesh, fetch, &env.links.bus, self.spec.closed.unified());
+                        closed_times(&self.spec.closed, &m, g)
                     }
-                    None => closed_times(&env.cfg, mesh, g),
+                    None => closed_times(&self.spec.closed, mesh, g),
                 };
                 self.start_closed_draw(draw, triangles, t, env.traced, s)
             }
@@ -313,7 +317,7 @@ impl GeometryStage {
         let indices = if mesh.indices > 0 { 3 } else { 0 };
         // Checked: a huge per-vertex cost times the vertices must not wrap.
         let mut cost =
-            geometry_cost(&env.cfg.gpu.geometry, tv, indices, 1).map_err(|_| crate::engine::TimeError::Overflow {
+            geometry_cost(&self.spec.costs, tv, indices, 1).map_err(|_| crate::engine::TimeError::Overflow {
                 context: "computing the geometry time of a triangle (gpu.geometry costs)".into(),
                 at: now,
                 by: Duration(u64::MAX),
@@ -372,7 +376,7 @@ impl GeometryStage {
             }
         };
         let fifo = &mut links.triangles;
-        Ok(if env.cfg.gpu.fragment.binned() {
+        Ok(if self.spec.binned {
             // Sort-middle: bin the triangle; the draw's last triangle opens the bins.
             fifo.push(f, 1);
             if last

@@ -17,7 +17,6 @@ use crate::components::shared_bus::SharedBus;
 use crate::engine::{Duration, Scheduler, Time};
 use crate::systems::error::SystemError;
 
-use super::config::FramePipelineConfig;
 use super::events::Ev;
 use super::records::FrameRecord;
 use super::workload::{DrawItem, SceneProgram};
@@ -131,14 +130,13 @@ impl Links {
     }
 }
 
-/// What a unit's transition reads and writes besides its own state: the
-/// model, the scene, the links, the per-frame records, and whether a trace
+/// What a unit's transition reads and writes besides its own state and spec:
+/// the scene, the links, the per-frame records, and whether a trace
 /// is written (which turns the short cuts off). The pipeline owns it as one
 /// field, so a transition gets it as one reference and no struct of
 /// references is built per event.
 #[derive(Debug)]
 pub(super) struct Env {
-    pub(super) cfg: FramePipelineConfig,
     /// The compiled scene (`None`: a fixed workload, which the CPU thread holds).
     pub(super) scene: Option<SceneProgram>,
     pub(super) links: Links,
@@ -153,19 +151,6 @@ pub(super) fn draw_batch_weight(unit: FifoUnit, d: &DrawItem) -> u64 {
     match unit {
         FifoUnit::Entries => u64::from(d.commands),
         FifoUnit::Bytes => d.bytes,
-    }
-}
-
-/// The weight of a command in the FIFO's unit.
-pub(super) fn command_weight(cfg: &FramePipelineConfig, scene: &Option<SceneProgram>, c: &Command) -> u64 {
-    let unit = cfg.command_fifo.unit;
-    let b = &cfg.command_fifo.bytes;
-    match (unit, c) {
-        (_, Command::Draw { draw, .. }) if let Some(s) = scene => draw_batch_weight(unit, &s.draws[*draw as usize]),
-        (FifoUnit::Entries, _) => 1,
-        (FifoUnit::Bytes, Command::Clear { .. }) => b.clear.0,
-        (FifoUnit::Bytes, Command::Swap { .. }) => b.swap.0,
-        (FifoUnit::Bytes, Command::Fixed { .. } | Command::Draw { .. }) => b.draw.0,
     }
 }
 

@@ -19,21 +19,27 @@
 //! - `records`: per-frame records and the PresentMon-style table;
 //! - `report`: the human-readable report of a run;
 //! - `plan`: the one fallible step, from a parsed model to what runs;
+//! - `unit_specs`: what each unit reads of the model, taken out once;
 //! - `run`: run a plan;
 //! - `validate`: what a model is refused for before it runs;
 //! - `summary`: the run's summary (`summary.json`).
 //!
+//! Outside it, the frame pipeline is its model file ([`config`]), the plan
+//! ([`PipelinePlan`]), the run ([`run_pipeline`], [`PipelineRun`]) and the
+//! typed results ([`PipelineSummary`], [`records`]); the units, links,
+//! accounting and checks are private to it.
+//!
 //! Studies that run this system whole (isolation, Table 1, the Figure 4
 //! timeline) live above it, in the `rendersim` crate's `studies`.
 
-pub mod accounting;
+mod accounting;
 mod analytic;
 mod bus_copy;
-pub mod checked;
-pub mod closed_form;
+mod checked;
+mod closed_form;
 pub mod config;
 mod cpu_thread;
-pub mod critical_path;
+mod critical_path;
 mod display;
 mod events;
 mod fragment_stage;
@@ -41,17 +47,18 @@ mod front_end;
 mod geometry_cost;
 mod geometry_stage;
 mod links;
-pub mod model;
-pub mod pipeline_trace;
+mod model;
+mod pipeline_trace;
 mod plan;
 mod quiet;
 pub mod records;
-pub mod report;
+mod report;
 pub mod run;
-pub mod summary;
+mod summary;
 pub mod system;
-pub mod unit_states;
-pub mod validate;
+mod unit_specs;
+mod unit_states;
+mod validate;
 pub mod workload;
 
 pub use checked::CheckedPipeline;
@@ -59,3 +66,4 @@ pub use config::{Fidelity, FramePipelineConfig};
 pub use model::FramePipeline;
 pub use plan::PipelinePlan;
 pub use run::{PipelineRun, run_pipeline};
+pub use summary::PipelineSummary;

@@ -26,7 +26,7 @@ use crate::engine::{Control, Model, RngStreams, Scheduler, Time};
 use crate::systems::error::SystemError;
 
 use super::accounting::{Accounting, Units, units_of};
-use super::config::{Fidelity, WorkloadConfig};
+use super::config::{Fidelity, FramePipelineConfig, WorkloadConfig};
 use super::cpu_thread::{Alone, CpuThread};
 use super::display::Display;
 use super::fragment_stage::FragmentStage;
@@ -34,12 +34,10 @@ use super::front_end::{Downstream, FrontEnd};
 use super::geometry_stage::{GeometryStage, Handoff};
 use super::links::{Env, Links};
 use super::plan::{PipelinePlan, PlannedWork};
+use super::unit_specs::unit_specs;
 
-pub use super::cpu_thread::CpuPhase;
 pub use super::events::Ev;
 pub use super::front_end::FrontPhase;
-pub use super::geometry_stage::ActiveDraw;
-pub use super::links::{Command, FragWork};
 
 /// The frame pipeline: its units, the links between them, the noise
 /// sources, the per-frame records and the accounting.
@@ -47,6 +45,9 @@ pub struct FramePipeline {
     /// The model, the scene, the links, the records and the trace flag that
     /// the units' transitions get.
     pub(super) env: Env,
+    /// The checked model, kept to summarise the run and write `model.toml`
+    /// (the units hold their specs).
+    pub(super) cfg: FramePipelineConfig,
     pub(super) frames_total: u64,
     pub(super) cpu: CpuThread,
     pub(super) front: FrontEnd,
@@ -114,10 +115,11 @@ impl FramePipeline {
             held_triangle: None,
             bus_changed: false,
         };
+        let (cpu_spec, front_spec, geometry_spec) = unit_specs(&cfg);
         FramePipeline {
-            cpu: CpuThread::new(frames_total, body, cpu_rngs, fixed, zero_time_after),
-            front: FrontEnd::new(streams.stream("variation.gpu")),
-            geom: GeometryStage::new(streams.stream("fragment.pixels"), pixel_rng_start),
+            cpu: CpuThread::new(cpu_spec, frames_total, body, cpu_rngs, fixed, zero_time_after),
+            front: FrontEnd::new(front_spec, streams.stream("variation.gpu")),
+            geom: GeometryStage::new(geometry_spec, streams.stream("fragment.pixels"), pixel_rng_start),
             frag: FragmentStage::default(),
             display: Display::new(&display),
             frames_total,
@@ -131,8 +133,8 @@ impl FramePipeline {
                 scene,
                 records: Vec::with_capacity(frames_total.min(1 << 16) as usize),
                 traced,
-                cfg,
             },
+            cfg,
         }
     }
 
@@ -154,7 +156,7 @@ impl FramePipeline {
 
     /// The fidelity.
     pub fn fidelity(&self) -> Fidelity {
-        self.env.cfg.fidelity
+        self.cfg.fidelity
     }
 
     /// Commands pushed by the CPU and commands executed by the GPU.

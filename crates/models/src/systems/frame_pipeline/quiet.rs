@@ -91,10 +91,7 @@ impl FramePipeline {
     /// written.
     #[inline]
     pub(super) fn draw_done_alone(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<bool, SystemError> {
-        if self.front.phase() != FrontPhase::Handoff
-            || self.env.traced
-            || self.front.in_system()
-            || self.env.cfg.gpu.fragment.binned()
+        if self.front.phase() != FrontPhase::Handoff || self.env.traced || self.front.in_system() || self.front.binned()
         {
             return Ok(false);
         }

@@ -102,8 +102,8 @@ fn model_run(model: &mut FramePipeline) -> Result<RunStats, SystemError> {
     let mut sched = Scheduler::new();
     model.start(&mut sched)?;
     let limits = Limits {
-        until: model.env.cfg.run.until.map(|d| Time(d.0)),
-        max_events: model.env.cfg.run.max_events,
+        until: model.cfg.run.until.map(|d| Time(d.0)),
+        max_events: model.cfg.run.max_events,
     };
     let stats = run(model, &mut sched, limits)?;
     model.catch_up(&sched)?;
@@ -165,7 +165,7 @@ fn finish(
         commands,
         records,
         generated,
-        config: model.env.cfg,
+        config: model.cfg,
     })
 }
 

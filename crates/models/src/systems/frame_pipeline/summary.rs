@@ -208,7 +208,7 @@ pub(super) fn summarize(
 ) -> PipelineSummary {
     let end = stats.end_time;
     let elapsed = end.0.max(1) as f64;
-    let warm = m.env.cfg.run.warmup_frames as usize;
+    let warm = m.cfg.run.warmup_frames as usize;
     let rows = metric_rows(&m.env.records);
     let col = |i: usize| -> Dist { Dist::of_finite(&rows.iter().skip(warm).map(|r| r[i]).collect::<Vec<f64>>()) };
     let cpu = m.acct.cpu.totals_at(end);
@@ -236,13 +236,13 @@ pub(super) fn summarize(
     let (issued, executed) = m.command_counts();
     PipelineSummary {
         system: "frame_pipeline",
-        description: m.env.cfg.description.clone(),
-        fidelity: m.env.cfg.fidelity,
-        seed: m.env.cfg.run.seed,
+        description: m.cfg.description.clone(),
+        fidelity: m.cfg.fidelity,
+        seed: m.cfg.run.seed,
         frames: m.env.records.len(),
         frames_simulated: m.env.records.len(),
-        frames_requested: m.env.cfg.run.frames,
-        warmup_frames: m.env.cfg.run.warmup_frames,
+        frames_requested: m.cfg.run.frames,
+        warmup_frames: m.cfg.run.warmup_frames,
         events: EventCounts::of(stats),
         wall_seconds: build_seconds + stats.wall_seconds,
         build_seconds,
@@ -283,8 +283,8 @@ pub(super) fn summarize(
                 // The pacing states only where `[pacing]` is on, the present
                 // call only for a workload given frame by frame.
                 cpu: {
-                    let pacing = !m.env.cfg.pacing.is_off();
-                    let frames = matches!(m.env.cfg.workload, WorkloadConfig::Frames(_));
+                    let pacing = !m.cfg.pacing.is_off();
+                    let frames = matches!(m.cfg.workload, WorkloadConfig::Frames(_));
                     let shown = |i: usize| i < 5 || (pacing && i < 7) || (frames && i == 7);
                     CPU_STATES
                         .iter()
@@ -353,7 +353,7 @@ fn copy_stats(m: &FramePipeline, warm: usize) -> Option<Dist> {
 /// frames), generated ones too, over `span_ps`; `None` when flips wait for
 /// a vertical blank.
 fn tearing_stats(m: &FramePipeline, warm: usize, span_ps: u64) -> Option<TearingStats> {
-    m.env.cfg.display.scan_out()?;
+    m.cfg.display.scan_out()?;
     let generated = m.display.generation().map_or(&[][..], |g| g.frames);
     let lines: Vec<f64> = m
         .env

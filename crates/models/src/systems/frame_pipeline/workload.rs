@@ -256,14 +256,40 @@ fn add(a: Duration, b: Duration, key: &str) -> Result<Duration, WorkloadError> {
         .ok_or_else(|| invalid(key, "sum of costs overflows the 64-bit picosecond range"))
 }
 
-/// The closed-form times of one draw of mesh `m` in group `g` (the `draw`
-/// fidelity), for the model's architecture.
-pub fn closed_times(cfg: &FramePipelineConfig, m: &MeshInfo, g: &GroupInfo) -> DrawTimes {
-    let depth = cfg.gpu.fragment.depth();
-    if g.order != SizeOrder::Random {
-        return ordered_closed_times(cfg, m, g);
+/// What a draw's closed-form times depend on besides the draw: the triangle
+/// FIFO's depth, whether the shaders are one unified pool, and the seed of
+/// the sorted sizes' sample.
+#[derive(Debug, Clone, Copy)]
+pub struct ClosedForm {
+    depth: Option<u32>,
+    unified: bool,
+    seed: u64,
+}
+
+impl ClosedForm {
+    /// The closed form's terms of `cfg`.
+    pub fn of(cfg: &FramePipelineConfig) -> Self {
+        ClosedForm {
+            depth: cfg.gpu.fragment.depth(),
+            unified: cfg.gpu.pool().is_some(),
+            seed: cfg.run.seed,
+        }
     }
-    if cfg.gpu.pool().is_none() {
+
+    /// Whether the shaders are one unified pool.
+    pub fn unified(&self) -> bool {
+        self.unified
+    }
+}
+
+/// The closed-form times of one draw of mesh `m` in group `g` (the `draw`
+/// fidelity), for the model's architecture (`form`).
+pub fn closed_times(form: &ClosedForm, m: &MeshInfo, g: &GroupInfo) -> DrawTimes {
+    let depth = form.depth;
+    if g.order != SizeOrder::Random {
+        return ordered_closed_times(form, m, g);
+    }
+    if !form.unified {
         return draw_times(m.triangles, m.geometry_time, &g.pixels, g.cost_per_pixel(), depth);
     }
     draw_times_unified(
@@ -295,12 +321,12 @@ pub fn ordered_sizes(g: &GroupInfo, n: u64, rng: &mut crate::engine::StreamRng, 
 /// own stream, so the same for every draw of the mesh), pushed through the
 /// exact pipeline recursion ([`ordered_draw_total`]); on the unified pool
 /// at least the draw's shader work.
-fn ordered_closed_times(cfg: &FramePipelineConfig, m: &MeshInfo, g: &GroupInfo) -> DrawTimes {
+fn ordered_closed_times(form: &ClosedForm, m: &MeshInfo, g: &GroupInfo) -> DrawTimes {
     let n = m.triangles;
-    let mut rng = crate::engine::RngStreams::new(cfg.run.seed).stream("fragment.pixels.ordered");
+    let mut rng = crate::engine::RngStreams::new(form.seed).stream("fragment.pixels.ordered");
     let mut sizes = Vec::new();
     ordered_sizes(g, n, &mut rng, &mut sizes);
-    let unified = cfg.gpu.pool().is_some();
+    let unified = form.unified;
     let g_fixed = m.geometry_time.saturating_sub(m.geometry_shader);
     let per_triangle = if unified {
         m.geometry_shader.max(g_fixed).0 as f64 / n.max(1) as f64
@@ -313,7 +339,7 @@ fn ordered_closed_times(cfg: &FramePipelineConfig, m: &MeshInfo, g: &GroupInfo) 
         g.cost_per_pixel()
     };
     let fragment: Vec<f64> = sizes.iter().map(|px| px * per_pixel).collect();
-    let mut total = ordered_draw_total(per_triangle, &fragment, cfg.gpu.fragment.depth());
+    let mut total = ordered_draw_total(per_triangle, &fragment, form.depth);
     if unified {
         let shader = m.geometry_shader.0 as f64 + sizes.iter().sum::<f64>() * g.shade_per_pixel;
         total = total.max(shader);
@@ -483,6 +509,7 @@ pub fn build_program(
             .any(|o| groups[o.group as usize].fetch_bytes_per_vertex > 0.0);
     // Closed forms per (mesh, group): computed once, only at `draw` fidelity.
     let mut closed_cache: HashMap<(u32, u32), DrawTimes> = HashMap::new();
+    let form = ClosedForm::of(cfg);
     for o in objects {
         let Instance {
             group,
@@ -564,7 +591,7 @@ pub fn build_program(
         let closed = (cfg.fidelity == Fidelity::Draw && fetch == 0.0).then(|| {
             *closed_cache
                 .entry((mesh, group))
-                .or_insert_with(|| closed_times(cfg, m, &groups[group as usize]))
+                .or_insert_with(|| closed_times(&form, m, &groups[group as usize]))
         });
         draws.push(DrawItem {
             group,

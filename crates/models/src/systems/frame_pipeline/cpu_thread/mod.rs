@@ -20,8 +20,9 @@ pub use fixed_work::FixedWork;
 
 use super::bus_copy::BusCopy;
 use super::events::Ev;
-use super::links::{Command, Env, command_count, command_weight, draw_batch_weight};
+use super::links::{Command, Env, command_count, draw_batch_weight};
 use super::records::FrameRecord;
+use super::unit_specs::CpuSpec;
 
 /// What the CPU thread is doing. The phases carry no data (the command
 /// to push is the thread's own), so a phase is one byte, written and read
@@ -121,6 +122,8 @@ pub struct CpuThread {
     pace_for_gpu: bool,
     /// Whether the workload is given frame by frame (`kind = "frames"`).
     per_frame: bool,
+    /// What it reads of the model.
+    spec: CpuSpec,
     /// The current draw's copy over a shared bus, while it runs
     /// ([`super::bus_copy`]).
     copy: Option<BusCopy>,
@@ -138,6 +141,7 @@ impl CpuThread {
     /// operations between clear and swap (`scene_body`: a scene's draws);
     /// `zero_time_after`: see [`Ev::ZeroTimeFrame`].
     pub(super) fn new(
+        spec: CpuSpec,
         frames_total: u64,
         (body_ops, scene_body): (u32, bool),
         rngs: [StreamRng; 2],
@@ -167,6 +171,7 @@ impl CpuThread {
             pace_resume: CpuPhase::NextFrame,
             pace_for_gpu: false,
             copy: None,
+            spec,
         }
     }
 
@@ -250,13 +255,13 @@ impl CpuThread {
     }
 
     fn op_work(&mut self, op: Op, env: &Env) -> Duration {
-        let c = &env.cfg.cpu;
+        let c = &self.spec;
         match op {
             Op::Input => c.input_sampling,
             Op::NonRender => {
                 let work = Duration::from_ps_f64(c.non_render.sample(&mut self.non_render_rng));
                 // Per-frame variation (config `variation.cpu`), drawn only when given.
-                let work = match &env.cfg.variation.cpu() {
+                let work = match &c.variation {
                     Some(v) => work.saturating_add(Duration::from_ps_f64(v.sample(&mut self.variation_rng))),
                     None => work,
                 };
@@ -307,7 +312,7 @@ impl CpuThread {
     #[inline]
     fn push_phase(&mut self, c: Command, env: &Env) -> CpuPhase {
         self.cmd = c;
-        self.cmd_weight = command_weight(&env.cfg, &env.scene, &c);
+        self.cmd_weight = self.spec.weights.of(&env.scene, &c);
         CpuPhase::Push
     }
 
@@ -438,7 +443,7 @@ impl CpuThread {
             return Ok(None);
         };
         let d = &sc.draws[k as usize];
-        let weight = draw_batch_weight(env.cfg.command_fifo.unit, d);
+        let weight = draw_batch_weight(self.spec.weights.unit, d);
         let cmd = Command::Draw {
             frame: self.frame,
             draw: k,
@@ -480,7 +485,7 @@ impl CpuThread {
         };
         let next = match sc.draws.get(k as usize + 1) {
             Some(n) => n.cpu,
-            None => env.cfg.cpu.swap,
+            None => self.spec.swap,
         };
         let fifo = &mut env.links.commands;
         if next.0 == 0 || fifo.used().saturating_add(weight) > fifo.capacity() {
@@ -527,7 +532,7 @@ impl CpuThread {
     /// CPU, not yet completed by the GPU): the thread may not start another.
     #[inline(always)]
     fn frames_ahead_full(&self, env: &Env) -> bool {
-        self.frame - env.links.frames_completed >= u64::from(env.cfg.cpu.max_frames_ahead)
+        self.frame - env.links.frames_completed >= u64::from(self.spec.max_frames_ahead)
     }
 
     /// [`CpuThread::step`] from a phase that may move.

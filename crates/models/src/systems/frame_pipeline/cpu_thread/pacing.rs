@@ -27,7 +27,7 @@ impl CpuThread {
     /// start-measured limiter, the low-latency pacer; the later wins), if
     /// later than `now`.
     pub(super) fn start_wait(&mut self, now: Time, env: &Env) -> Option<Time> {
-        let p = &env.cfg.pacing;
+        let p = &self.spec.pacing;
         if p.is_off() || self.frame == 0 {
             return None;
         }
@@ -72,7 +72,7 @@ impl CpuThread {
     /// under a present-measured limiter: the previous present plus the
     /// interval, less the swap's own work, if later than `now`.
     pub(super) fn present_wait(&mut self, now: Time, env: &Env) -> Option<Time> {
-        let interval = env.cfg.pacing.present_limit()?;
+        let interval = self.spec.pacing.present_limit()?;
         if !matches!(self.op_at(self.op), Op::Swap) || self.frame == 0 {
             return None;
         }
