@@ -6,6 +6,35 @@
 //! (plot axes and `where` filters name sweep keys and sweep values, names are
 //! unique, exactly one of `values`/`range`, ...) and reports the offending
 //! entry as e.g. `sweep[1]` or `plot[0] (interval).x`.
+//!
+//! ```
+//! use std::path::Path;
+//! use rendersim::experiment::parse_experiment;
+//!
+//! // Display latency against frames in flight, on the fixed-work model
+//! // (`model` is relative to the experiment file).
+//! let text = r#"
+//! name = "frames-ahead"
+//! model = "../models/fixed.toml"
+//! replications = 2
+//!
+//! [[sweep]]
+//! key = "cpu.max_frames_ahead"
+//! values = [1, 2, 3]
+//!
+//! [[metric]]
+//! path = "metrics.display_latency_ms.mean"
+//! label = "mean display latency (ms)"
+//! "#;
+//! let file = Path::new("experiments/frames-ahead.toml");
+//! let e = parse_experiment(text, file).unwrap();
+//! assert_eq!(e.sweeps[0].values.len(), 3);
+//! assert_eq!(e.seeds().len(), 2);
+//!
+//! // A misspelt key is refused with its name and line.
+//! let err = parse_experiment(&text.replace("replications", "replicates"), file).unwrap_err();
+//! assert!(err.to_string().contains("replicates"), "{err}");
+//! ```
 
 use std::collections::BTreeSet;
 use std::path::PathBuf;

@@ -4,6 +4,32 @@
 //! count, shortening the warm-up when it would not leave a frame to measure.
 //! Every key set this way is noted on the [`ModelSource`], so an error in
 //! its value names the option rather than a line of the file.
+//!
+//! ```
+//! use std::path::Path;
+//! use rendersim_models::config::{Overrides, deserialize, load_model};
+//! use rendersim_models::systems::frame_pipeline::FramePipelineConfig;
+//!
+//! // A model file with two `--set`s, the seed and the frame count.
+//! let overrides = Overrides {
+//!     sets: vec!["display.buffers=3".into(), "cpu.max_frames_ahead=1".into()],
+//!     seed: Some(7),
+//!     frames: Some(50),
+//! };
+//! let m = load_model(Some(Path::new("../../models/fixed.toml")), &overrides).unwrap();
+//! let cfg: FramePipelineConfig = deserialize(&m.table, &m.source).unwrap();
+//! assert_eq!((cfg.display.buffers, cfg.cpu.max_frames_ahead), (3, 1));
+//! assert_eq!((cfg.run.seed, cfg.run.frames), (7, 50));
+//!
+//! // A misspelt key is refused where it came from: the option, not a line.
+//! let m = load_model(None, &Overrides::with_sets(&["display.bufers=3"])).unwrap();
+//! let e = deserialize::<FramePipelineConfig>(&m.table, &m.source).unwrap_err().to_string();
+//! assert!(e.contains("--set display.bufers=3"), "{e}");
+//!
+//! // A file that is not there says so, with its path.
+//! let e = load_model(Some(Path::new("no-such-model.toml")), &Overrides::default()).unwrap_err();
+//! assert!(e.to_string().contains("no-such-model.toml"), "{e}");
+//! ```
 
 use std::path::Path;
 

@@ -67,6 +67,28 @@ pub struct ClockTotals {
 
 /// Checks, builds and runs the model ([`PipelinePlan::new`], then
 /// [`PipelinePlan::run`]).
+///
+/// ```
+/// use std::path::Path;
+/// use rendersim_models::config::{Overrides, deserialize, load_model};
+/// use rendersim_models::systems::frame_pipeline::{FramePipelineConfig, run_pipeline};
+///
+/// // Paper 004's vsync quantisation: a 17 ms GPU frame (`fixed.toml`) on a
+/// // 60 Hz display with double buffering misses every other refresh and
+/// // is shown at 30 Hz.
+/// let sets = ["run.frames=60", "run.warmup_frames=10"];
+/// let m = load_model(Some(Path::new("../../models/fixed.toml")), &Overrides::with_sets(&sets)).unwrap();
+/// let mut cfg: FramePipelineConfig = deserialize(&m.table, &m.source).unwrap();
+/// let run = run_pipeline(cfg.clone(), Path::new("../../models"), None).unwrap();
+/// let interval = run.results.metrics.display_interval_ms.mean.unwrap();
+/// assert!((interval - 33.333).abs() < 0.01, "{interval}");
+///
+/// // With vsync off the same frames are shown as the GPU finishes them.
+/// cfg.display.vsync = false;
+/// let run = run_pipeline(cfg, Path::new("../../models"), None).unwrap();
+/// let interval = run.results.metrics.display_interval_ms.mean.unwrap();
+/// assert!((interval - 17.0).abs() < 0.01, "{interval}");
+/// ```
 pub fn run_pipeline(
     cfg: FramePipelineConfig,
     base_dir: &Path,
