@@ -196,7 +196,7 @@ impl CriticalPath {
     /// frames it presented, the display's path follows a shown frame, and
     /// the path of every unit whose mode changes is carried to `now` under
     /// the old modes; then the new modes hold.
-    #[inline]
+    #[inline(always)]
     pub fn update(&mut self, now: Time, modes: Modes) {
         if modes == self.modes && !self.pending {
             return;
@@ -204,6 +204,7 @@ impl CriticalPath {
         self.update_changed(now, modes);
     }
 
+    #[inline(never)]
     fn update_changed(&mut self, now: Time, modes: Modes) {
         if self.pending {
             self.display_events(now);

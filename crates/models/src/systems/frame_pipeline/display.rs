@@ -17,8 +17,11 @@
 //!
 //! [`Display`] owns the display's counters (vertical blanks, repeated
 //! refreshes, the mark where refresh metrics start after warm-up, frames
-//! shown or dropped) and its transitions; the swap chain, the records and
-//! the critical path it reports presents and shows to are arguments.
+//! shown or dropped), the swap chain and its transitions; the records are
+//! an argument. What it did at an instant that the critical path observes
+//! (the rendered frames presented, the frame shown) it keeps as
+//! [`DisplayNews`], which the accounting takes after the instant's steps:
+//! the display never writes the critical path.
 
 use crate::components::frame_generation::{generated_before, generated_id, held_present};
 use crate::components::swap_chain::{Flip, PresentMode, SwapChain, VrrWindow};
@@ -26,7 +29,6 @@ use crate::components::tearing::ScanOut;
 use crate::engine::{Duration, Scheduler, Time};
 use crate::systems::error::SystemError;
 
-use super::critical_path::CriticalPath;
 use super::events::Ev;
 use super::plan::DisplaySpec;
 use super::records::{FrameRecord, GeneratedRecord};
@@ -56,6 +58,19 @@ pub struct Display {
     scan: Option<ScanOut>,
     /// Frame generation's state, when it is on.
     generation: Option<Generation>,
+    /// What it did at the current instant, for the critical path.
+    news: DisplayNews,
+}
+
+/// What the display did at the current instant that the critical path
+/// observes ([`super::critical_path::CriticalPath::presented`] and
+/// `shown`).
+#[derive(Debug, Default)]
+pub(super) struct DisplayNews {
+    /// The rendered frames presented, in order.
+    pub(super) presented: Vec<u64>,
+    /// The last frame shown.
+    pub(super) shown: Option<u64>,
 }
 
 /// Frame generation at the display: the rendered frame held back, the
@@ -120,6 +135,7 @@ impl Display {
             }),
             scan: spec.scan,
             generation: spec.generation.then(Generation::default),
+            news: DisplayNews::default(),
         }
     }
 
@@ -150,6 +166,17 @@ impl Display {
         })
     }
 
+    /// Whether it presented or showed a frame at the current instant.
+    #[inline(always)]
+    pub(super) fn has_news(&self) -> bool {
+        self.news.shown.is_some() || !self.news.presented.is_empty()
+    }
+
+    /// What it did at the current instant, for the critical path to take.
+    pub(super) fn news_mut(&mut self) -> &mut DisplayNews {
+        &mut self.news
+    }
+
     /// The generated frames, taken out at the end of a run.
     pub(super) fn take_generated(&mut self) -> Vec<GeneratedRecord> {
         self.generation
@@ -170,12 +197,11 @@ impl Display {
         frame: u64,
         previous_end: Option<Time>,
         records: &mut [FrameRecord],
-        path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
         match (&self.generation, previous_end) {
-            (Some(_), Some(prev)) => self.present_generating(now, frame, prev, records, path, s),
-            _ => self.present(now, frame, records, path, s),
+            (Some(_), Some(prev)) => self.present_generating(now, frame, prev, records, s),
+            _ => self.present(now, frame, records, s),
         }
     }
 
@@ -189,12 +215,11 @@ impl Display {
         frame: u64,
         prev: Time,
         records: &mut [FrameRecord],
-        path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
         let held = self.generation.as_mut().and_then(|g| g.held.take());
         if let Some((h, _)) = held {
-            self.present(now, h, records, path, s)?;
+            self.present(now, h, records, s)?;
         }
         let g = self.generation.as_mut().expect("generation is on");
         if self.chain.acquire() {
@@ -205,7 +230,7 @@ impl Display {
                 dropped: false,
                 tear_line: None,
             });
-            self.present(now, generated_id(frame), records, path, s)?;
+            self.present(now, generated_id(frame), records, s)?;
         } else {
             g.skipped.push(frame);
         }
@@ -225,14 +250,13 @@ impl Display {
         now: Time,
         tag: u32,
         records: &mut [FrameRecord],
-        path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
         let Some(g) = self.generation.as_mut().filter(|g| g.tag == tag) else {
             return Ok(());
         };
         match g.held.take() {
-            Some((frame, _)) => self.present(now, frame, records, path, s),
+            Some((frame, _)) => self.present(now, frame, records, s),
             None => Ok(()),
         }
     }
@@ -284,33 +308,25 @@ impl Display {
         now: Time,
         frame: u64,
         records: &mut [FrameRecord],
-        path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
         if generated_before(frame).is_none() {
-            path.presented(frame);
+            self.news.presented.push(frame);
         }
         let flip = self.chain.present(frame);
-        self.apply_flip(now, flip, self.chain.mode(), records, path);
+        self.apply_flip(now, flip, self.chain.mode(), records);
         if let Some(v) = &self.vrr {
             let idle = v
                 .scan_start
                 .is_none_or(|t| now.0 >= t.0.saturating_add(v.window.shortest.0));
             if idle {
-                self.scan_out(now, records, path, s)?;
+                self.scan_out(now, records, s)?;
             }
         }
         Ok(())
     }
 
-    fn apply_flip(
-        &mut self,
-        now: Time,
-        flip: Flip,
-        mode: PresentMode,
-        records: &mut [FrameRecord],
-        path: &mut CriticalPath,
-    ) {
+    fn apply_flip(&mut self, now: Time, flip: Flip, mode: PresentMode, records: &mut [FrameRecord]) {
         if let Some(d) = flip.dropped {
             match self.generated_mut(d) {
                 Some(g) => g.dropped = true,
@@ -338,7 +354,7 @@ impl Display {
             if let Some(scan) = &self.scan {
                 records[f as usize].tear_line = scan.tear_line(now);
             }
-            path.shown(f);
+            self.news.shown = Some(f);
             self.last_display = Some(now);
             self.resolved += 1;
             let warm = self.warmup_frames;
@@ -379,12 +395,11 @@ impl Display {
         now: Time,
         tag: u32,
         records: &mut [FrameRecord],
-        path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
         let queued = self.chain.queued();
         let Some(v) = &mut self.vrr else {
-            return self.fixed_vblank(now, records, path, s);
+            return self.fixed_vblank(now, records, s);
         };
         if tag != v.tag {
             return Ok(());
@@ -394,7 +409,7 @@ impl Display {
         if queued > 0 || now >= deadline {
             // A frame waits for this scan-out's end, or the old image must
             // be refreshed (scanned out again).
-            return self.scan_out(now, records, path, s);
+            return self.scan_out(now, records, s);
         }
         // The scan-out ended with nothing to show: the panel waits, up to
         // the slowest refresh's deadline.
@@ -408,10 +423,9 @@ impl Display {
         &mut self,
         now: Time,
         records: &mut [FrameRecord],
-        path: &mut CriticalPath,
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
-        self.refresh_now(now, records, path);
+        self.refresh_now(now, records);
         if !self.done() {
             s.after(
                 self.refresh,
@@ -424,14 +438,8 @@ impl Display {
 
     /// A variable-refresh panel starts a scan-out now (of the oldest queued
     /// frame, or again of the image on screen); its end is the next event.
-    fn scan_out(
-        &mut self,
-        now: Time,
-        records: &mut [FrameRecord],
-        path: &mut CriticalPath,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<(), SystemError> {
-        self.refresh_now(now, records, path);
+    fn scan_out(&mut self, now: Time, records: &mut [FrameRecord], s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+        self.refresh_now(now, records);
         let done = self.done();
         let v = self.vrr.as_mut().expect("a variable-refresh panel");
         v.scan_start = Some(now);
@@ -449,7 +457,7 @@ impl Display {
 
     /// A refresh at `now`: the swap chain flips its oldest queued frame, if
     /// any; one with nothing new repeats the image on screen.
-    fn refresh_now(&mut self, now: Time, records: &mut [FrameRecord], path: &mut CriticalPath) {
+    fn refresh_now(&mut self, now: Time, records: &mut [FrameRecord]) {
         self.vblanks += 1;
         // `fifo_latest_ready`: the frames a newer one overtook leave unshown.
         while let Some(stale) = self.chain.release_stale() {
@@ -458,12 +466,12 @@ impl Display {
                 dropped: Some(stale),
                 freed: true,
             };
-            self.apply_flip(now, drop, self.chain.mode(), records, path);
+            self.apply_flip(now, drop, self.chain.mode(), records);
         }
         let flip = self.chain.vblank();
         if flip.shown.is_none() && self.last_display.is_some() {
             self.repeated_refreshes += 1;
         }
-        self.apply_flip(now, flip, self.chain.mode(), records, path);
+        self.apply_flip(now, flip, self.chain.mode(), records);
     }
 }

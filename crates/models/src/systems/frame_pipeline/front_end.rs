@@ -7,15 +7,13 @@
 //!
 //! [`FrontEnd`] owns the front end's state (its phase, the command it
 //! holds, the frame it is on, its quiet completion, its random stream) and
-//! its transitions; the FIFOs and the swap chain come in an [`Env`], and
-//! the units downstream of it (geometry, fragment, display, and the
-//! critical path the display reports to) in a [`Downstream`].
+//! its transitions; the FIFOs come in an [`Env`], and the units downstream
+//! of it (geometry, fragment, display) in a [`Downstream`].
 
 use crate::components::preemptible::{Preemptible, Wake};
 use crate::engine::{Duration, Scheduler, Slot, StreamRng, Time};
 use crate::systems::error::SystemError;
 
-use super::critical_path::CriticalPath;
 use super::display::Display;
 use super::events::Ev;
 use super::fragment_stage::FragmentStage;
@@ -48,7 +46,6 @@ pub(super) struct Downstream<'a> {
     pub(super) geom: &'a mut GeometryStage,
     pub(super) frag: &'a mut FragmentStage,
     pub(super) display: &'a mut Display,
-    pub(super) path: &'a mut CriticalPath,
 }
 
 /// The GPU front end.
@@ -401,7 +398,7 @@ impl FrontEnd {
                     _ => None,
                 };
                 down.display
-                    .present_rendered(now, frame, previous_end, &mut env.records, down.path, s)?;
+                    .present_rendered(now, frame, previous_end, &mut env.records, s)?;
                 FrontPhase::Idle
             }
             Command::Clear { .. } | Command::Fixed { .. } => FrontPhase::Idle,

@@ -65,7 +65,6 @@ macro_rules! downstream {
             geom: &mut $p.geom,
             frag: &mut $p.frag,
             display: &mut $p.display,
-            path: &mut $p.acct.path,
         }
     };
 }
@@ -254,7 +253,9 @@ impl FramePipeline {
                 return Ok(());
             }
             let mut down = downstream!(self);
-            if !self.front.step(now, &mut self.env, &mut down, s)? {
+            let progressed = self.front.step(now, &mut self.env, &mut down, s)?;
+            self.observe_display();
+            if !progressed {
                 return Ok(());
             }
         }
@@ -264,6 +265,29 @@ impl FramePipeline {
     /// an immutable view.
     pub(super) fn account(&mut self, now: Time) {
         self.acct.account(now, units_of!(self), &mut self.env.records);
+    }
+
+    /// The critical path takes what the display did (the frames presented,
+    /// the frame shown), right after each step that can present or show:
+    /// it observes the display's results; the display does not write it.
+    #[inline(always)]
+    fn observe_display(&mut self) {
+        if self.display.has_news() {
+            self.take_display_news();
+        }
+    }
+
+    /// [`FramePipeline::observe_display`] with news.
+    #[cold]
+    #[inline(never)]
+    fn take_display_news(&mut self) {
+        let news = self.display.news_mut();
+        for f in news.presented.drain(..) {
+            self.acct.path.presented(f);
+        }
+        if let Some(f) = news.shown.take() {
+            self.acct.path.shown(f);
+        }
     }
 
     /// The CPU thread's operation finished (its event, not stale): the
@@ -295,6 +319,10 @@ impl FramePipeline {
     /// The accounting an instant that only the CPU thread moved leaves.
     #[inline(always)]
     fn account_cpu_alone(&mut self, now: Time, a: Alone) {
+        debug_assert!(
+            !self.display.has_news(),
+            "a CPU-only instant presented or showed a frame"
+        );
         if a == Alone::Blocked {
             self.acct.account_cpu_alone(now, &self.cpu, &mut self.env.records);
         }
@@ -347,8 +375,8 @@ impl FramePipeline {
             Ev::PresentReturn => self.cpu.present_returned(),
             Ev::GpuHoldEnd => self.front.hold_ends(),
             Ev::HeldPresent { tag } => {
-                let path = &mut self.acct.path;
-                self.display.held_present(now, tag, &mut self.env.records, path, s)?;
+                self.display.held_present(now, tag, &mut self.env.records, s)?;
+                self.observe_display();
             }
             _ => unreachable!("not a wait's end: {ev:?}"),
         }
@@ -372,6 +400,7 @@ impl Model for FramePipeline {
                 if self.front.complete(tag) {
                     let mut down = downstream!(self);
                     self.front.command_done(now, &mut self.env, &mut down, s)?;
+                    self.observe_display();
                 }
             }
             Ev::GeomTriangle { tag } => {
@@ -411,8 +440,8 @@ impl Model for FramePipeline {
                 }
             }
             Ev::Vblank { tag } => {
-                let path = &mut self.acct.path;
-                self.display.vblank(now, tag, &mut self.env.records, path, s)?;
+                self.display.vblank(now, tag, &mut self.env.records, s)?;
+                self.observe_display();
             }
             Ev::NoiseArrive { source } => self.noise_arrive(now, source, s)?,
             Ev::NoiseEnd { target } => self.noise_end(now, target, s)?,

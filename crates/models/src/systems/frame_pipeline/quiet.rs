@@ -109,6 +109,10 @@ impl FramePipeline {
             true
         };
         if self.front.frame() == gpu_frame && self.geom.busy() && self.cpu.frame() == self.acct.cpu_frame() {
+            debug_assert!(
+                !self.display.has_news(),
+                "a draw's hand-off presented or showed a frame"
+            );
             self.acct
                 .account_draw_handoff(now, cpu_moved, units_of!(self), &mut self.env.records);
         } else {
