@@ -395,6 +395,12 @@ impl SwapChain {
         self.mode
     }
 
+    /// Whether an image is free for [`SwapChain::acquire`] to take.
+    #[inline]
+    pub fn can_acquire(&self) -> bool {
+        self.free > 0
+    }
+
     /// Takes a free image to render into; false if none is free.
     #[inline]
     pub fn acquire(&mut self) -> bool {

@@ -146,6 +146,12 @@ impl Display {
         self.chain.acquire()
     }
 
+    /// Whether a swap-chain image is free for [`Display::acquire`].
+    #[inline]
+    pub(super) fn can_acquire(&self) -> bool {
+        self.chain.can_acquire()
+    }
+
     /// Frames presented and waiting to be shown.
     pub(super) fn queued(&self) -> usize {
         self.chain.queued()

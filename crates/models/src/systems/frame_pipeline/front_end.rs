@@ -7,8 +7,13 @@
 //!
 //! [`FrontEnd`] owns the front end's state (its phase, the command it
 //! holds, the frame it is on, its quiet completion, its random stream) and
-//! its transitions; the FIFOs come in an [`Env`], and the units downstream
-//! of it (geometry, fragment, display) in a [`Downstream`].
+//! its transitions; the FIFOs come in an [`Env`]. It reads the units
+//! downstream of it (geometry, fragment, display) through a read-only
+//! [`Downstream`] and changes none of them: what it asks of them (an
+//! image, a draw taken, a frame presented) is a [`FrontOut`] that the
+//! pipeline's step carries out (`FramePipeline::downstream`). Only the
+//! `draw`-fidelity short cut [`FrontEnd::handoff_fast`] still starts the
+//! geometry stage's draw itself.
 
 use crate::components::preemptible::{Preemptible, Wake};
 use crate::engine::{Duration, Scheduler, Slot, StreamRng, Time};
@@ -40,12 +45,39 @@ pub enum FrontPhase {
     HoldFrame,
 }
 
-/// The units a front-end step can reach: the draws it hands on, the drain
-/// it waits for, the frames it presents.
+/// What a front-end step reads of the units downstream of it: whether the
+/// geometry stage takes a draw and when its draw ends, whether the
+/// pipeline drained, whether a swap-chain image is free. It changes none of
+/// them: what it asks of them is a [`FrontOut`].
 pub(super) struct Downstream<'a> {
-    pub(super) geom: &'a mut GeometryStage,
-    pub(super) frag: &'a mut FragmentStage,
-    pub(super) display: &'a mut Display,
+    pub(super) geom: &'a GeometryStage,
+    pub(super) frag: &'a FragmentStage,
+    pub(super) display: &'a Display,
+}
+
+/// What a front-end transition asks of the units downstream of it, in the
+/// order the pipeline's step applies it before the front end goes on: take
+/// a swap-chain image, start a frame in the geometry stage, hand it a draw,
+/// present a finished frame to the display.
+#[derive(Debug, Default, Clone, Copy)]
+pub(super) struct FrontOut {
+    /// A swap-chain image for the frame it clears (one is free).
+    pub(super) acquire: bool,
+    /// A frame begins (the geometry stage restarts a static view's sizes).
+    pub(super) new_frame: bool,
+    /// A draw for the geometry stage, which is free to take it.
+    pub(super) draw: Option<u32>,
+    /// A finished frame to present, with the frame before's GPU end under
+    /// frame generation.
+    pub(super) present: Option<(u64, Option<Time>)>,
+}
+
+/// How a [`FrontEnd::step`] ended.
+pub(super) enum FrontStep {
+    /// It cannot go on now; whether it changed anything.
+    Rest(bool),
+    /// It asks something of the units downstream; it goes on once that is done.
+    Out(FrontOut),
 }
 
 /// The GPU front end.
@@ -69,6 +101,10 @@ pub struct FrontEnd {
     set_up: bool,
     /// What it reads of the model.
     spec: FrontSpec,
+    /// What its last transitions ask of the units downstream (`has_out`:
+    /// anything), taken by the step.
+    out: FrontOut,
+    has_out: bool,
 }
 
 #[inline(always)]
@@ -83,6 +119,8 @@ impl FrontEnd {
     pub(super) fn new(spec: FrontSpec, variation_rng: StreamRng) -> Self {
         FrontEnd {
             spec,
+            out: FrontOut::default(),
+            has_out: false,
             work: Preemptible::new(),
             phase: FrontPhase::Idle,
             cmd: Command::Clear { frame: 0 },
@@ -167,30 +205,36 @@ impl FrontEnd {
         schedule(s, w);
     }
 
-    /// Advances the front end as far as it can go now. Returns whether
-    /// anything changed.
+    /// Advances the front end as far as it can go now, or until a
+    /// transition asks something of the units downstream
+    /// ([`FrontStep::Out`]: the pipeline's step does it and steps the front
+    /// end again).
     pub(super) fn step(
         &mut self,
         now: Time,
         env: &mut Env,
-        down: &mut Downstream<'_>,
+        down: &Downstream<'_>,
         s: &mut Scheduler<Ev>,
-    ) -> Result<bool, SystemError> {
+    ) -> Result<FrontStep, SystemError> {
         let mut progressed = false;
         loop {
+            if self.has_out {
+                return Ok(FrontStep::Out(self.take_out()));
+            }
             match self.phase {
                 FrontPhase::Idle => {
                     let Some(c) = env.links.commands.pop() else {
-                        return Ok(progressed);
+                        return Ok(FrontStep::Rest(progressed));
                     };
                     self.executed += command_count(&env.scene, &c);
                     self.cmd = c;
                     self.phase = self.begin(now, c, env, down, s)?;
                 }
                 FrontPhase::WaitImage => {
-                    if !down.display.acquire() {
-                        return Ok(progressed);
+                    if !down.display.can_acquire() {
+                        return Ok(FrontStep::Rest(progressed));
                     }
+                    self.emit().acquire = true;
                     self.phase = self.start_clear(now, self.cmd, env, down, s)?;
                 }
                 FrontPhase::WaitDrain => {
@@ -200,7 +244,7 @@ impl FrontEnd {
                         && env.links.triangles.is_empty()
                         && !down.frag.busy())
                     {
-                        return Ok(progressed);
+                        return Ok(FrontStep::Rest(progressed));
                     }
                     // With frame generation, the interpolation before the
                     // frame's present is GPU work of its swap.
@@ -218,7 +262,7 @@ impl FrontEnd {
                     {
                         s.at(t, Ev::GpuHoldEnd);
                         self.phase = FrontPhase::HoldFrame;
-                        return Ok(true);
+                        return Ok(FrontStep::Rest(true));
                     }
                     self.phase = self.job(now, self.cmd, work, env, down, s)?;
                 }
@@ -226,7 +270,7 @@ impl FrontEnd {
                     // Binning: the next draw's geometry waits for the bins to drain.
                     let bins_busy = self.spec.binned && (down.frag.busy() || !env.links.triangles.is_empty());
                     if down.geom.has_draw() || bins_busy {
-                        return Ok(progressed);
+                        return Ok(FrontStep::Rest(progressed));
                     }
                     if let Command::Draw { draw, .. } = self.cmd {
                         // A stalling state setup runs now that the stage is free.
@@ -241,13 +285,12 @@ impl FrontEnd {
                             continue;
                         }
                         self.set_up = false;
-                        if down.geom.start_draw(now, draw, env, s)? {
-                            down.frag.set_closed_busy(true);
-                        }
+                        // The geometry stage takes the draw (the step hands it on).
+                        self.emit().draw = Some(draw);
                     }
                     self.phase = FrontPhase::Idle;
                 }
-                FrontPhase::Running | FrontPhase::HoldFrame => return Ok(progressed),
+                FrontPhase::Running | FrontPhase::HoldFrame => return Ok(FrontStep::Rest(progressed)),
             }
             progressed = true;
         }
@@ -277,13 +320,14 @@ impl FrontEnd {
         now: Time,
         c: Command,
         env: &mut Env,
-        down: &mut Downstream<'_>,
+        down: &Downstream<'_>,
         s: &mut Scheduler<Ev>,
     ) -> Result<FrontPhase, SystemError> {
         let cmd_cost = self.spec.command;
         match c {
             Command::Clear { .. } => {
-                if down.display.acquire() {
+                if down.display.can_acquire() {
+                    self.emit().acquire = true;
                     self.start_clear(now, c, env, down, s)
                 } else {
                     Ok(FrontPhase::WaitImage)
@@ -309,12 +353,12 @@ impl FrontEnd {
         now: Time,
         c: Command,
         env: &mut Env,
-        down: &mut Downstream<'_>,
+        down: &Downstream<'_>,
         s: &mut Scheduler<Ev>,
     ) -> Result<FrontPhase, SystemError> {
         if let Command::Clear { frame } = c {
             self.frame = Some(frame);
-            down.geom.new_frame();
+            self.emit().new_frame = true;
             env.records[frame as usize].gpu_start = Some(now);
         }
         let mut work = self.spec.clear.saturating_add(self.spec.command);
@@ -333,14 +377,14 @@ impl FrontEnd {
         c: Command,
         work: Duration,
         env: &mut Env,
-        down: &mut Downstream<'_>,
+        down: &Downstream<'_>,
         s: &mut Scheduler<Ev>,
     ) -> Result<FrontPhase, SystemError> {
         if work.0 > 0 || self.work.in_system() {
             self.start_job(now, c, work, down.geom.done_at(), s)?;
             return Ok(FrontPhase::Running);
         }
-        self.after(now, c, env, down, s)
+        Ok(self.after(now, c, env))
     }
 
     /// Starts the job of `work` for `c`; its completion is an event, or
@@ -365,28 +409,31 @@ impl FrontEnd {
     }
 
     /// The running command's work finished (its event).
-    pub(super) fn command_done(
-        &mut self,
-        now: Time,
-        env: &mut Env,
-        down: &mut Downstream<'_>,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<(), SystemError> {
+    /// What it asks of the units downstream is returned (a frame to
+    /// present, after a swap).
+    pub(super) fn command_done(&mut self, now: Time, env: &mut Env) -> FrontOut {
         if let FrontPhase::Running = self.phase {
-            self.phase = self.after(now, self.cmd, env, down, s)?;
+            self.phase = self.after(now, self.cmd, env);
         }
-        Ok(())
+        self.take_out()
     }
 
-    fn after(
-        &mut self,
-        now: Time,
-        c: Command,
-        env: &mut Env,
-        down: &mut Downstream<'_>,
-        s: &mut Scheduler<Ev>,
-    ) -> Result<FrontPhase, SystemError> {
-        Ok(match c {
+    /// A transition's requests of the units downstream, to be filled in.
+    #[inline(always)]
+    fn emit(&mut self) -> &mut FrontOut {
+        self.has_out = true;
+        &mut self.out
+    }
+
+    /// The requests made since the last time, taken.
+    #[inline(always)]
+    fn take_out(&mut self) -> FrontOut {
+        self.has_out = false;
+        std::mem::take(&mut self.out)
+    }
+
+    fn after(&mut self, now: Time, c: Command, env: &mut Env) -> FrontPhase {
+        match c {
             Command::Draw { .. } => FrontPhase::Handoff,
             Command::Swap { frame } => {
                 // The frame is complete: present it.
@@ -397,12 +444,11 @@ impl FrontEnd {
                     Some(p) if self.spec.frame_generation.is_some() => env.records[p as usize].gpu_end,
                     _ => None,
                 };
-                down.display
-                    .present_rendered(now, frame, previous_end, &mut env.records, s)?;
+                self.emit().present = Some((frame, previous_end));
                 FrontPhase::Idle
             }
             Command::Clear { .. } | Command::Fixed { .. } => FrontPhase::Idle,
-        })
+        }
     }
 
     /// The quiet completion whose turn came before the event being handled

@@ -9,13 +9,17 @@
 //! that owns its state and the transitions that change it: the CPU thread
 //! (`cpu_thread/`), the front end (`front_end.rs`), the geometry and
 //! fragment stages (`geometry_stage.rs`, `fragment_stage.rs`) and the
-//! display (`display.rs`); the FIFOs, the shader pool and the swap chain
-//! between them are the `Links` (`links.rs`), passed to the units'
-//! methods; the events they schedule are [`Ev`] (`events.rs`).
-//! [`FramePipeline`] holds the units, dispatches each event to the
-//! unit it concerns, then lets the units take their steps in the order the
-//! data flows (`FramePipeline::settle`) and has the instant accounted
-//! (`accounting.rs`, which reads the units through an immutable view).
+//! display (`display.rs`, which owns the swap chain); each holds its spec
+//! (`unit_specs.rs`). The FIFOs, the shader pool and the bus between them
+//! are the `Links` (`links.rs`), passed to the units' methods; the events
+//! they schedule are [`Ev`] (`events.rs`). [`FramePipeline`] holds the
+//! units, dispatches each event to the unit it concerns, then lets the
+//! units take their steps in the order the data flows
+//! (`FramePipeline::settle_units`: CPU -> command FIFO -> front end ->
+//! geometry | swap chain and display, the front end's requests carried out
+//! by `FramePipeline::downstream`) and has the instant accounted
+//! (`accounting.rs`, which reads the units through an immutable view; the
+//! critical path takes the display's news after the step that made it).
 
 use crate::components::fifo::BoundedFifo;
 use crate::components::noise::{NoiseSource, NoiseTarget};
@@ -30,7 +34,7 @@ use super::config::{Fidelity, FramePipelineConfig, WorkloadConfig};
 use super::cpu_thread::{Alone, CpuThread};
 use super::display::Display;
 use super::fragment_stage::FragmentStage;
-use super::front_end::{Downstream, FrontEnd};
+use super::front_end::{Downstream, FrontEnd, FrontOut, FrontStep};
 use super::geometry_stage::{GeometryStage, Handoff};
 use super::links::{Env, Links};
 use super::plan::{PipelinePlan, PlannedWork};
@@ -62,9 +66,9 @@ pub struct FramePipeline {
 macro_rules! downstream {
     ($p:ident) => {
         Downstream {
-            geom: &mut $p.geom,
-            frag: &mut $p.frag,
-            display: &mut $p.display,
+            geom: &$p.geom,
+            frag: &$p.frag,
+            display: &$p.display,
         }
     };
 }
@@ -243,22 +247,63 @@ impl FramePipeline {
         self.cpu.bus_changed(now, &mut self.env, s)
     }
 
-    /// [`FramePipeline::settle`]'s steps of the units.
+    /// [`FramePipeline::settle`]'s steps of the units, in the order of a
+    /// frame's data flow: the CPU thread pushes into the command FIFO; the
+    /// front end takes from it and asks the units downstream of it
+    /// ([`FramePipeline::downstream`]) to take an image, a draw or a frame.
     fn settle_units(&mut self, now: Time, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
         loop {
+            // CPU thread -> command FIFO.
             self.cpu.step(now, &mut self.env, s)?;
-            // A front end at rest takes no step (most events find it so):
-            // its downstream units are not even gathered.
+            // A front end at rest takes no step (most events find it so).
             if self.front.at_rest(&self.geom) {
                 return Ok(());
             }
-            let mut down = downstream!(self);
-            let progressed = self.front.step(now, &mut self.env, &mut down, s)?;
-            self.observe_display();
+            // Command FIFO -> front end -> geometry | swap chain and display.
+            let mut progressed = false;
+            loop {
+                match self.front.step(now, &mut self.env, &downstream!(self), s)? {
+                    FrontStep::Rest(p) => {
+                        progressed |= p;
+                        break;
+                    }
+                    FrontStep::Out(out) => {
+                        progressed = true;
+                        self.downstream(now, out, s)?;
+                    }
+                }
+            }
             if !progressed {
                 return Ok(());
             }
         }
+    }
+
+    /// What the front end asked of the units downstream of it, done in the
+    /// order of the data flow: a swap-chain image taken for the frame it
+    /// clears, the frame begun in the geometry stage, a draw handed to the
+    /// geometry stage (which feeds the fragment stage), a finished frame
+    /// presented to the display (whose news the critical path takes).
+    #[inline(always)]
+    fn downstream(&mut self, now: Time, out: FrontOut, s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+        if out.acquire {
+            let took = self.display.acquire();
+            debug_assert!(took, "the front end saw a free image");
+        }
+        if out.new_frame {
+            self.geom.new_frame();
+        }
+        if let Some(draw) = out.draw
+            && self.geom.start_draw(now, draw, &mut self.env, s)?
+        {
+            self.frag.set_closed_busy(true);
+        }
+        if let Some((frame, previous_end)) = out.present {
+            self.display
+                .present_rendered(now, frame, previous_end, &mut self.env.records, s)?;
+            self.observe_display();
+        }
+        Ok(())
     }
 
     /// Accounts the instant `now` in full: every unit's state, read through
@@ -398,9 +443,8 @@ impl Model for FramePipeline {
             }
             Ev::FrontDone { tag } => {
                 if self.front.complete(tag) {
-                    let mut down = downstream!(self);
-                    self.front.command_done(now, &mut self.env, &mut down, s)?;
-                    self.observe_display();
+                    let out = self.front.command_done(now, &mut self.env);
+                    self.downstream(now, out, s)?;
                 }
             }
             Ev::GeomTriangle { tag } => {
