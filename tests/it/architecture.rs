@@ -9,7 +9,9 @@
 //!   folder, `name/`);
 //! - no function runs over 150 lines (issue 27);
 //! - the frame pipeline's files import in no circle but those listed to
-//!   take apart (issue 55).
+//!   take apart (issue 55);
+//! - the frame pipeline's units read their specs, never the raw model: their
+//!   files' code does not name `FramePipelineConfig` (issue 55).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -640,6 +642,50 @@ fn no_import_circle_among_the_frame_pipelines_files_but_those_listed_to_take_apa
         "the frame pipeline's import circles changed: a new one must be taken apart (a file named by two \
          others moves below both), and one taken apart leaves KNOWN_PIPELINE_CIRCLES"
     );
+}
+
+/// The frame pipeline's units and the links between them: each holds
+/// its spec (`unit_specs.rs`, the display's `DisplaySpec`).
+const PIPELINE_UNIT_FILES: &[&str] = &[
+    "cpu_thread/mod.rs",
+    "cpu_thread/pacing.rs",
+    "cpu_thread/fixed_work.rs",
+    "front_end.rs",
+    "geometry_stage.rs",
+    "fragment_stage.rs",
+    "display.rs",
+    "links.rs",
+    "bus_copy.rs",
+    "quiet.rs",
+];
+
+/// The lines of `text`'s code (strings and comments left out) that name `name`.
+fn code_lines_naming(text: &str, name: &str) -> Vec<usize> {
+    let mut strip = Strip::default();
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| strip.code(l).contains(name))
+        .map(|(i, _)| i + 1)
+        .collect()
+}
+
+#[test]
+fn the_pipelines_units_never_name_the_raw_model() {
+    let dir = root().join("crates/models/src/systems/frame_pipeline");
+    let mut found = Vec::new();
+    for f in PIPELINE_UNIT_FILES {
+        let text = std::fs::read_to_string(dir.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+        for line in code_lines_naming(&text, "FramePipelineConfig") {
+            found.push(format!("{f}:{line}"));
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "a unit names the raw model (give it what it reads in its spec, unit_specs.rs): {found:?}"
+    );
+    // The check reads code, not the docs that name the type.
+    let text = "/// Not `FramePipelineConfig`.\nfn f(c: &FramePipelineConfig) {}\n";
+    assert_eq!(code_lines_naming(text, "FramePipelineConfig"), [2]);
 }
 
 #[test]
