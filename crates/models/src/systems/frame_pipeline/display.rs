@@ -23,7 +23,7 @@
 //! [`DisplayNews`], which the accounting takes after the instant's steps:
 //! the display never writes the critical path.
 
-use crate::components::frame_generation::{generated_before, generated_id, held_present};
+use crate::components::frame_generation::{FrameGenerationConfig, generated_before, generated_id, held_present};
 use crate::components::swap_chain::{Flip, PresentMode, SwapChain, VrrWindow};
 use crate::components::tearing::ScanOut;
 use crate::engine::{Duration, Scheduler, Time};
@@ -77,6 +77,8 @@ pub(super) struct DisplayNews {
 /// generated frames, and those discarded for want of an image.
 #[derive(Debug, Default)]
 struct Generation {
+    /// Its keys (`[frame_generation]`: the GPU time of an interpolation).
+    config: FrameGenerationConfig,
     /// The rendered frame held back, and when it goes out.
     held: Option<(u64, Time)>,
     /// The tag of the one [`Ev::HeldPresent`] event that is not stale.
@@ -134,7 +136,10 @@ impl Display {
                 tag: 0,
             }),
             scan: spec.scan,
-            generation: spec.generation.then(Generation::default),
+            generation: spec.generation.clone().map(|config| Generation {
+                config,
+                ..Generation::default()
+            }),
             news: DisplayNews::default(),
         }
     }
@@ -190,9 +195,18 @@ impl Display {
             .map_or_else(Vec::new, |g| std::mem::take(&mut g.frames))
     }
 
-    /// The GPU finished rendered frame `frame` at `now` (`previous_end`: the
-    /// frame before's GPU end). Without frame generation, or for frame 0, it
-    /// is presented now. With it, a frame held back before is presented
+    /// The GPU time frame generation adds before rendered frame `frame`'s
+    /// present: its interpolation (none for frame 0, or without frame
+    /// generation). The front end runs it as part of the frame's swap.
+    #[inline]
+    pub(super) fn generation_cost(&self, frame: u64) -> Duration {
+        self.generation
+            .as_ref()
+            .map_or(Duration::ZERO, |g| g.config.cost_before_present(frame))
+    }
+
+    /// The GPU finished rendered frame `frame` at `now`. Without frame
+    /// generation, or for frame 0, it is presented now. With it, a frame held back before is presented
     /// first; the generated frame is presented now (when a swap-chain image
     /// is free for it), and `frame` is held back half a rendered interval
     /// ([`Ev::HeldPresent`]).
@@ -201,13 +215,17 @@ impl Display {
         &mut self,
         now: Time,
         frame: u64,
-        previous_end: Option<Time>,
         records: &mut [FrameRecord],
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
-        match (&self.generation, previous_end) {
-            (Some(_), Some(prev)) => self.present_generating(now, frame, prev, records, s),
-            _ => self.present(now, frame, records, s),
+        // With frame generation, the frame before's GPU end paces the hold-back.
+        let previous_end = match (&self.generation, frame.checked_sub(1)) {
+            (Some(_), Some(p)) => records[p as usize].gpu_end,
+            _ => None,
+        };
+        match previous_end {
+            Some(prev) => self.present_generating(now, frame, prev, records, s),
+            None => self.present(now, frame, records, s),
         }
     }
 

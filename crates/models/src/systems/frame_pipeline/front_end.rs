@@ -67,9 +67,8 @@ pub(super) struct FrontOut {
     pub(super) new_frame: bool,
     /// A draw for the geometry stage, which is free to take it.
     pub(super) draw: Option<u32>,
-    /// A finished frame to present, with the frame before's GPU end under
-    /// frame generation.
-    pub(super) present: Option<(u64, Option<Time>)>,
+    /// A finished frame to present.
+    pub(super) present: Option<u64>,
 }
 
 /// How a [`FrontEnd::step`] ended.
@@ -248,8 +247,8 @@ impl FrontEnd {
                     }
                     // With frame generation, the interpolation before the
                     // frame's present is GPU work of its swap.
-                    let generate = match (self.cmd, &self.spec.frame_generation) {
-                        (Command::Swap { frame }, Some(g)) => g.cost_before_present(frame),
+                    let generate = match self.cmd {
+                        Command::Swap { frame } => down.display.generation_cost(frame),
                         _ => Duration::ZERO,
                     };
                     let work = self
@@ -440,11 +439,7 @@ impl FrontEnd {
                 env.links.frames_completed += 1;
                 env.records[frame as usize].gpu_end = Some(now);
                 self.frame = None;
-                let previous_end = match frame.checked_sub(1) {
-                    Some(p) if self.spec.frame_generation.is_some() => env.records[p as usize].gpu_end,
-                    _ => None,
-                };
-                self.emit().present = Some((frame, previous_end));
+                self.emit().present = Some(frame);
                 FrontPhase::Idle
             }
             Command::Clear { .. } | Command::Fixed { .. } => FrontPhase::Idle,

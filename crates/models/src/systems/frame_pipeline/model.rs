@@ -298,9 +298,8 @@ impl FramePipeline {
         {
             self.frag.set_closed_busy(true);
         }
-        if let Some((frame, previous_end)) = out.present {
-            self.display
-                .present_rendered(now, frame, previous_end, &mut self.env.records, s)?;
+        if let Some(frame) = out.present {
+            self.display.present_rendered(now, frame, &mut self.env.records, s)?;
             self.observe_display();
         }
         Ok(())

@@ -35,6 +35,7 @@
 
 use std::path::Path;
 
+use crate::components::frame_generation::FrameGenerationConfig;
 use crate::components::noise::{Arrivals, NoiseSource};
 use crate::components::swap_chain::{PresentMode, VrrWindow};
 use crate::components::tearing::ScanOut;
@@ -61,7 +62,7 @@ pub(super) enum PlannedWork {
 /// What the display is built from: its swap chain (images, and the present
 /// mode resolved once: `immediate` without vsync), its refresh, the
 /// compositor's delay, the variable-refresh window, the scan-out a tearing
-/// flip lands in, and whether frame generation presents between frames.
+/// flip lands in, and frame generation when it presents between frames.
 #[derive(Debug, Clone)]
 pub(super) struct DisplaySpec {
     pub(super) mode: PresentMode,
@@ -71,7 +72,7 @@ pub(super) struct DisplaySpec {
     pub(super) compositor_delay: Duration,
     pub(super) vrr: Option<VrrWindow>,
     pub(super) scan: Option<ScanOut>,
-    pub(super) generation: bool,
+    pub(super) generation: Option<FrameGenerationConfig>,
     pub(super) frames_total: u64,
     pub(super) warmup_frames: u64,
 }
@@ -86,7 +87,7 @@ impl DisplaySpec {
             compositor_delay: d.compositor_delay(),
             vrr: d.vrr_window(),
             scan: d.scan_out(),
-            generation: cfg.frame_generation.enabled,
+            generation: cfg.frame_generation.enabled.then(|| cfg.frame_generation.clone()),
             frames_total: cfg.run.frames,
             warmup_frames: cfg.run.warmup_frames,
         }

@@ -1,14 +1,13 @@
 //! What each unit reads of the model, taken out of the checked model once by
 //! the plan ([`super::plan::PipelinePlan`]): the CPU thread's costs, pacing
-//! and command weights; the front end's command costs, per-frame variation,
-//! frame generation and replayed GPU ends; the geometry stage's costs and
-//! closed forms. A unit holds its spec and never sees the raw model
+//! and command weights; the front end's command costs, per-frame variation
+//! and replayed GPU ends; the geometry stage's costs and closed forms (the
+//! display's, with frame generation, is the plan's `DisplaySpec`). A unit holds its spec and never sees the raw model
 //! ([`super::config::FramePipelineConfig`], which the run keeps only to
 //! summarise and write `model.toml`).
 
 use crate::components::distribution::Dist;
 use crate::components::fifo::FifoUnit;
-use crate::components::frame_generation::FrameGenerationConfig;
 use crate::components::frame_pacing::PacingConfig;
 use crate::engine::Duration;
 
@@ -62,8 +61,8 @@ impl CommandWeights {
     }
 }
 
-/// The GPU front end's spec (`[gpu]` command costs, `variation.gpu`,
-/// `[frame_generation]`, a replay's measured GPU ends).
+/// The GPU front end's spec (`[gpu]` command costs, `variation.gpu`, a
+/// replay's measured GPU ends; frame generation's cost is the display's).
 #[derive(Debug, Clone)]
 pub(super) struct FrontSpec {
     /// Processing cost of every command.
@@ -73,8 +72,6 @@ pub(super) struct FrontSpec {
     pub(super) swap: Duration,
     /// Per-frame variation added to the clear (`variation.gpu`).
     pub(super) variation: Option<Dist<Duration>>,
-    /// Frame generation, when enabled.
-    pub(super) frame_generation: Option<FrameGenerationConfig>,
     /// Sort-middle binning: a draw's geometry waits for the bins to drain.
     pub(super) binned: bool,
     /// A replayed frame's measured GPU end after it began
@@ -118,7 +115,6 @@ pub(super) fn unit_specs(cfg: &FramePipelineConfig) -> (CpuSpec, FrontSpec, Geom
         clear: cfg.gpu.clear,
         swap: cfg.gpu.swap,
         variation: cfg.variation.gpu().cloned(),
-        frame_generation: cfg.frame_generation.enabled.then(|| cfg.frame_generation.clone()),
         binned: cfg.gpu.fragment.binned(),
         gpu_end: match &cfg.workload {
             WorkloadConfig::Frames(w) => w.gpu_end.clone(),
