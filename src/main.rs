@@ -34,6 +34,9 @@ fn version() -> &'static str {
 struct Cli {
     #[command(subcommand)]
     cmd: Cmd,
+    /// Largest input file to read, in bytes, for every kind of input (default 64 MiB for models, experiments, profiles, instance and shard files; 4 GiB for captures, measurement CSVs, meshes and sequences; or RENDERSIM_MAX_INPUT_BYTES)
+    #[arg(long, global = true, value_name = "BYTES", value_parser = clap::value_parser!(u64).range(1..))]
+    max_input_bytes: Option<u64>,
 }
 
 #[derive(Subcommand)]
@@ -84,6 +87,9 @@ fn main() -> ExitCode {
     // outputs being written; finished outputs are never touched.
     rendersim::output::cleanup::remove_on_signals();
     let cli = Cli::parse();
+    if let Some(bytes) = cli.max_input_bytes {
+        rendersim::limits::set_max_input_bytes(bytes);
+    }
     // A spinner on a terminal once a command has worked for two seconds
     // (`experiment` draws its own bar over its runs).
     let _activity = (!matches!(cli.cmd, Cmd::Experiment(_))).then(|| cli::progress::Activity::start(activity_label()));

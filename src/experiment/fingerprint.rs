@@ -18,9 +18,11 @@ pub fn sha256_hex(data: &[u8]) -> String {
 /// files a model sweep names) or the
 /// outputs (a plot, a check) changes it.
 pub fn experiment_fingerprint(exp: &Experiment, base_model: &toml::Table) -> Result<String, ExperimentError> {
-    let text = std::fs::read(&exp.source).map_err(|source| ExperimentError::Io {
-        path: exp.source.clone(),
-        source,
+    let text = crate::limits::read_input(&exp.source, crate::limits::InputKind::Text).map_err(|source| {
+        ExperimentError::Io {
+            path: exp.source.clone(),
+            source,
+        }
     })?;
     let mut data = text;
     data.push(0);

@@ -48,7 +48,7 @@ impl SimRunner {
             ExperimentModel::File(p) => (
                 p.display().to_string(),
                 p.parent().map(Path::to_path_buf).unwrap_or_default(),
-                std::fs::read_to_string(p).unwrap_or_default(),
+                crate::limits::read_input_string(p, crate::limits::InputKind::Text).unwrap_or_default(),
             ),
         };
         SimRunner {

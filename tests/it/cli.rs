@@ -228,6 +228,65 @@ fn malformed_files_are_reported_with_their_names() {
     assert!(e.contains("missing.obj"), "{e}");
 }
 
+/// Input files are read only when regular and only up to their size limit
+/// (issue 60 item 1): `/dev/zero` as a model, as a model's hardware file
+/// and behind an `.obj` name, a FIFO that would block, and a model over a
+/// limit set by the option and by the environment, each exit 2 at once
+/// with the file and the reason.
+#[cfg(unix)]
+#[test]
+fn inputs_that_are_endless_blocking_or_too_large_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let err = run_err(&["run", "/dev/zero"]);
+    assert!(err.contains("/dev/zero") && err.contains("not a regular file"), "{err}");
+    let hw = write(
+        d.path(),
+        "hw.toml",
+        "system = \"frame_pipeline\"\nhardware = \"/dev/zero\"\n[workload]\nkind = \"fixed\"\n",
+    );
+    let err = run_err(&["run", &hw]);
+    assert!(
+        err.contains("key `hardware`") && err.contains("not a regular file"),
+        "{err}"
+    );
+    let obj = d.path().join("zero.obj");
+    std::os::unix::fs::symlink("/dev/zero", &obj).unwrap();
+    let err = run_err(&["vcache", "--policy", "fifo:16", obj.to_str().unwrap()]);
+    assert!(err.contains("zero.obj") && err.contains("not a regular file"), "{err}");
+    let fifo = d.path().join("fifo.toml");
+    assert!(
+        std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success(),
+        "mkfifo"
+    );
+    let err = run_err(&["run", fifo.to_str().unwrap()]);
+    assert!(err.contains("fifo.toml") && err.contains("not a regular file"), "{err}");
+    let m = write(d.path(), "m.toml", SMALL);
+    let err = run_err(&["run", &m, "--max-input-bytes", "10"]);
+    assert!(
+        err.contains("m.toml") && err.contains("more than the 10 bytes"),
+        "{err}"
+    );
+    let o = bin()
+        .args(["run", &m])
+        .env("RENDERSIM_MAX_INPUT_BYTES", "20")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("more than the 20 bytes"), "{err}");
+    // Raised by the option above the environment's limit, the model runs.
+    let o = bin()
+        .args(["run", &m, "--max-input-bytes", "1000000"])
+        .env("RENDERSIM_MAX_INPUT_BYTES", "20")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 #[test]
 fn a_failed_run_keeps_earlier_results() {
     let d = tempfile::tempdir().unwrap();

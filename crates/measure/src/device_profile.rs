@@ -393,9 +393,11 @@ impl DeviceCosts {
 impl DeviceProfile {
     /// Reads and validates a profile file.
     pub fn read(path: &Path) -> Result<DeviceProfile, ProfileError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ProfileError::Io {
-            path: path.to_path_buf(),
-            source,
+        let text = crate::limits::read_input_string(path, crate::limits::InputKind::Text).map_err(|source| {
+            ProfileError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
         })?;
         Self::parse(&text, path)
     }

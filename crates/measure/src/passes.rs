@@ -393,7 +393,7 @@ pub fn read_passes(path: &Path) -> Result<Vec<PassRow>, PassCsvError> {
 /// [`read_passes`], each row with its 1-based line in the file (for errors
 /// found later, such as a mesh file that cannot be built).
 pub fn read_passes_with_lines(path: &Path) -> Result<Vec<(PassRow, u64)>, PassCsvError> {
-    let file = std::fs::File::open(path).map_err(io("reading", path))?;
+    let file = crate::limits::open_input(path, crate::limits::InputKind::Data).map_err(io("reading", path))?;
     read_passes_lines_from(file, path)
 }
 

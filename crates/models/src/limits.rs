@@ -305,3 +305,120 @@ mod tests {
         assert!(m.contains("b: 1.037e7 s") && m.contains("213 days"), "{m}");
     }
 }
+
+/// The kinds of input file, each with its own size limit
+/// ([`max_input_bytes`]): text a person writes (models, experiment files,
+/// device profiles, LOD instance files, shard files), and data a tool or a
+/// measurement wrote (captures, measurement CSVs, meshes, state sequences).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InputKind {
+    /// A model, an experiment, a device profile, an instance or shard file.
+    Text,
+    /// A capture, a measurement CSV, a mesh (`.obj`, `.idx`), a sequence.
+    Data,
+}
+
+/// Default size limit of a [`InputKind::Text`] input file: 64 MiB.
+pub const MAX_TEXT_INPUT_BYTES: u64 = 64 << 20;
+
+/// Default size limit of a [`InputKind::Data`] input file: 4 GiB.
+pub const MAX_DATA_INPUT_BYTES: u64 = 4 << 30;
+
+/// The environment variable that sets one size limit, in bytes, for every
+/// input file (the command line's `--max-input-bytes` sets it too).
+pub const MAX_INPUT_BYTES_VAR: &str = "RENDERSIM_MAX_INPUT_BYTES";
+
+/// The limit the command line's `--max-input-bytes` set (0: none).
+static MAX_INPUT_OVERRIDE: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Sets one size limit, in bytes (at least 1), for every input file this
+/// process reads (the command line's `--max-input-bytes`); it wins over
+/// [`MAX_INPUT_BYTES_VAR`].
+pub fn set_max_input_bytes(bytes: u64) {
+    MAX_INPUT_OVERRIDE.store(bytes.max(1), std::sync::atomic::Ordering::Relaxed);
+}
+
+/// The size limit of an input file of `kind`: the one
+/// [`set_max_input_bytes`] set, else [`MAX_INPUT_BYTES_VAR`] when set to a
+/// number, else the kind's default.
+pub fn max_input_bytes(kind: InputKind) -> u64 {
+    let set = MAX_INPUT_OVERRIDE.load(std::sync::atomic::Ordering::Relaxed);
+    if set > 0 {
+        return set;
+    }
+    if let Some(n) = std::env::var(MAX_INPUT_BYTES_VAR)
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+    {
+        return n;
+    }
+    match kind {
+        InputKind::Text => MAX_TEXT_INPUT_BYTES,
+        InputKind::Data => MAX_DATA_INPUT_BYTES,
+    }
+}
+
+fn too_large(size: u64, kind: InputKind) -> std::io::Error {
+    let limit = max_input_bytes(kind);
+    let what = match kind {
+        InputKind::Text => "a model, experiment, profile or instance file",
+        InputKind::Data => "a capture, measurement, mesh or sequence file",
+    };
+    std::io::Error::new(
+        std::io::ErrorKind::InvalidData,
+        format!(
+            "the file is {}, more than the {} {what} may be (set {MAX_INPUT_BYTES_VAR} or --max-input-bytes to raise it)",
+            show_bytes(size),
+            show_bytes(limit)
+        ),
+    )
+}
+
+/// Opens an input file of `kind` for reading, refusing what is not a
+/// regular file (a device such as `/dev/zero`, a FIFO, a socket: they can
+/// be endless or block) and a file over its size limit. The reader stops
+/// one byte past the limit, so a file that grows while read is caught by
+/// [`read_input`]. A folder is left to the caller's own message (opening
+/// one fails, or reading it does).
+///
+/// ```
+/// use rendersim_models::limits::{InputKind, read_input};
+/// let e = read_input(std::path::Path::new("/dev/zero"), InputKind::Text).unwrap_err();
+/// assert!(e.to_string().contains("not a regular file"), "{e}");
+/// ```
+pub fn open_input(path: &std::path::Path, kind: InputKind) -> std::io::Result<std::io::Take<std::fs::File>> {
+    use std::io::Read;
+    // Checked before opening: opening a FIFO blocks until a writer comes.
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() && !meta.is_dir() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file (a device, FIFO or socket): input is read from files",
+        ));
+    }
+    let limit = max_input_bytes(kind);
+    if meta.is_file() && meta.len() > limit {
+        return Err(too_large(meta.len(), kind));
+    }
+    Ok(std::fs::File::open(path)?.take(limit.saturating_add(1)))
+}
+
+/// Reads an input file of `kind` whole ([`open_input`]'s checks, and the
+/// size limit again on what was read).
+pub fn read_input(path: &std::path::Path, kind: InputKind) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut r = open_input(path, kind)?;
+    let mut bytes = Vec::new();
+    r.read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > max_input_bytes(kind) {
+        return Err(too_large(bytes.len() as u64, kind));
+    }
+    Ok(bytes)
+}
+
+/// [`read_input`] as UTF-8 text (invalid UTF-8 is an
+/// [`std::io::ErrorKind::InvalidData`] error, as `fs::read_to_string` gives).
+pub fn read_input_string(path: &std::path::Path, kind: InputKind) -> std::io::Result<String> {
+    String::from_utf8(read_input(path, kind)?)
+        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "stream did not contain valid UTF-8"))
+}

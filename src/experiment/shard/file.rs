@@ -165,10 +165,11 @@ pub(super) fn shard_error(file: &Path, message: impl Into<String>) -> Experiment
 }
 
 pub(super) fn read_shard(path: &Path) -> Result<ShardFile, ExperimentError> {
-    let text = std::fs::read(path).map_err(|source| ExperimentError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text =
+        crate::limits::read_input(path, crate::limits::InputKind::Text).map_err(|source| ExperimentError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
     let file: ShardFile =
         serde_json::from_slice(&text).map_err(|e| shard_error(path, format!("not a readable shard file ({e})")))?;
     if file.format != SHARD_FORMAT {

@@ -469,7 +469,7 @@ impl Experiment {
     /// that an error in such a value names the experiment file instead of
     /// the model file (see [`crate::config::ModelSource::overrides`]).
     pub fn value_origins(&self) -> Vec<(String, String)> {
-        let text = std::fs::read_to_string(&self.source).unwrap_or_default();
+        let text = crate::limits::read_input_string(&self.source, crate::limits::InputKind::Text).unwrap_or_default();
         let file = self.source.display().to_string();
         let src = crate::config::ModelSource::from_text(&file, &text);
         let at = |key: &str| match src.line_of(key) {

@@ -11,9 +11,11 @@ use crate::experiment::sweep::expand_range;
 
 /// Read and validate the experiment file at `path`.
 pub fn load_experiment(path: &Path) -> Result<Experiment, ExperimentError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ExperimentError::Io {
-        path: path.to_path_buf(),
-        source,
+    let text = crate::limits::read_input_string(path, crate::limits::InputKind::Text).map_err(|source| {
+        ExperimentError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
     })?;
     parse_experiment(&text, path)
 }
@@ -153,8 +155,9 @@ impl Validator<'_> {
                 return Err(self.err(
                     "model",
                     format!(
-                        "model file {:?} not found (looked for {}; paths are relative to the experiment file)",
+                        "model file {:?} {} (looked for {}; paths are relative to the experiment file)",
                         raw.model,
+                        missing_or_not_a_file(&path),
                         path.display()
                     ),
                 ));
@@ -293,7 +296,8 @@ impl Validator<'_> {
                 return Err(self.err(
                     format!("{key}.values"),
                     format!(
-                        "model file {name:?} not found (looked for {}; paths are relative to the experiment file)",
+                        "model file {name:?} {} (looked for {}; paths are relative to the experiment file)",
+                        missing_or_not_a_file(&dir.join(name)),
                         dir.join(name).display()
                     ),
                 ));
@@ -401,5 +405,15 @@ impl Validator<'_> {
             scramble: s.scramble.unwrap_or(true),
             params,
         })
+    }
+}
+
+/// Why `path`, which is not a regular file, cannot be a model: it is not
+/// there, or it is a folder, a device, a FIFO or a socket.
+fn missing_or_not_a_file(path: &Path) -> &'static str {
+    match std::fs::metadata(path) {
+        Err(_) => "not found",
+        Ok(m) if m.is_dir() => "is a folder, not a file",
+        Ok(_) => "is not a regular file (a device, FIFO or socket)",
     }
 }

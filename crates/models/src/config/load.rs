@@ -78,9 +78,11 @@ pub enum ConfigError {
 impl ModelSource {
     /// Reads a model file.
     pub fn from_file(path: &Path) -> Result<ModelSource, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
-            path: path.display().to_string(),
-            source,
+        let text = crate::limits::read_input_string(path, crate::limits::InputKind::Text).map_err(|source| {
+            ConfigError::Io {
+                path: path.display().to_string(),
+                source,
+            }
         })?;
         Ok(ModelSource {
             name: path.display().to_string(),

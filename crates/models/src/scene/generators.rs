@@ -250,7 +250,7 @@ fn random(t: u64, v: u32, seed: u64, name: &str) -> Mesh {
 /// Loads an OBJ file's faces as one triangle list, keeping the file's vertex
 /// numbering where faces reference positions only (see [`super::obj`]).
 fn load_obj(path: &Path, name: &str) -> Result<Mesh, MeshError> {
-    let file = std::fs::File::open(path).map_err(|source| MeshError::Io {
+    let file = crate::limits::open_input(path, crate::limits::InputKind::Data).map_err(|source| MeshError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -264,10 +264,11 @@ fn load_obj(path: &Path, name: &str) -> Result<Mesh, MeshError> {
 
 /// Loads whitespace-separated triangle-list indices (`#` starts a comment).
 fn load_idx(path: &Path, name: &str) -> Result<Mesh, MeshError> {
-    let text = std::fs::read_to_string(path).map_err(|source| MeshError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text =
+        crate::limits::read_input_string(path, crate::limits::InputKind::Data).map_err(|source| MeshError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
     let mut indices = Vec::new();
     for (n, line) in text.lines().enumerate() {
         let content = line.split('#').next().unwrap_or("");

@@ -256,10 +256,11 @@ struct Row {
 impl Capture {
     /// Reads a capture from `path`.
     pub fn read(path: &Path) -> Result<Capture, CaptureError> {
-        let bytes = std::fs::read(path).map_err(|source| CaptureError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let bytes =
+            crate::limits::read_input(path, crate::limits::InputKind::Data).map_err(|source| CaptureError::Io {
+                path: path.display().to_string(),
+                source,
+            })?;
         Capture::parse(&path.display().to_string(), &bytes)
     }
 

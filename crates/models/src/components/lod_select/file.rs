@@ -157,8 +157,8 @@ fn build(raw: RawInstance) -> Result<Instance, (String, LodSelectError)> {
 /// Reads and parses an instance file: JSON when its name ends in `.json`,
 /// TOML otherwise. Errors name the file, the key and (TOML) its line.
 pub fn read_instance(path: &std::path::Path) -> Result<Instance, LodSelectError> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| LodSelectError::File(format!("reading {}: {e}", path.display())))?;
+    let text = crate::limits::read_input_string(path, crate::limits::InputKind::Text)
+        .map_err(|e| LodSelectError::File(format!("reading {}: {e}", path.display())))?;
     let file = path.display().to_string();
     if path.extension().is_some_and(|e| e == "json") {
         parse_json(&text, &file)

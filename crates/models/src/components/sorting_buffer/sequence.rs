@@ -162,8 +162,8 @@ pub fn sequence_from_spec(spec: &str, base: &Path) -> Result<Vec<StateId>, SortB
             "{spec} is a folder; give a file of state ids, lru-worst:M or random:N:D:S:SEED"
         )));
     }
-    let bytes =
-        std::fs::read(&path).map_err(|e| SortBufferError::Source(format!("reading sequence file {spec}: {e}")))?;
+    let bytes = crate::limits::read_input(&path, crate::limits::InputKind::Data)
+        .map_err(|e| SortBufferError::Source(format!("reading sequence file {spec}: {e}")))?;
     let text = String::from_utf8(bytes).map_err(|e| {
         SortBufferError::Source(format!(
             "{spec}: not UTF-8 text (byte {})",
