@@ -188,7 +188,7 @@ pub struct VcacheArgs {
 /// `rendersim bench`.
 #[derive(Args)]
 pub struct BenchArgs {
-    /// Which: kernel, pipeline, hour, pixelflow, build, all.
+    /// Which: kernel, pipeline, hour, pixelflow, build, replay, all.
     #[arg(default_value = "all", value_parser = Choice::<BenchTarget>::new(unknown_bench))]
     pub which: BenchTarget,
     /// Scale the work down (0.01 .. 1) for a quick check.

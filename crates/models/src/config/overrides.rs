@@ -117,8 +117,9 @@ impl Overrides {
                 .unwrap_or(0);
             if f > 0 && warm as u64 >= f {
                 notes.push(format!(
-                    "run.warmup_frames = {warm} is not less than --frames {f}; using {} warm-up frames",
-                    f / 10
+                    "run.warmup_frames = {warm} is not less than --frames {f}; using {} warm-up frame{}",
+                    f / 10,
+                    if f / 10 == 1 { "" } else { "s" }
                 ));
                 set_noted(
                     src,
@@ -198,6 +199,16 @@ mod tests {
         );
         assert_eq!(m.source.override_of("run.seed"), Some("--seed 3"));
         assert_eq!(m.source.override_of("run.frames"), Some("--frames 20"));
+        // One warm-up frame is one frame.
+        let src = ModelSource::from_text("m.toml", "[run]\nwarmup_frames = 60\n");
+        let one = Overrides {
+            frames: Some(10),
+            ..Overrides::default()
+        };
+        assert_eq!(
+            prepare(src, &one).unwrap().notes,
+            ["run.warmup_frames = 60 is not less than --frames 10; using 1 warm-up frame"]
+        );
         let e = prepare(
             ModelSource::embedded_default(),
             &Overrides {
