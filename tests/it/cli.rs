@@ -287,6 +287,30 @@ fn inputs_that_are_endless_blocking_or_too_large_are_refused() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
+/// Errors that blamed the wrong thing (issue 60 item 9): an empty sortbuf
+/// sequence said "` is a folder`"; a uniform distribution's bounds were
+/// raw picoseconds; a wrong `--set run.frames` was dropped unchecked when
+/// `--frames` replaced it.
+#[test]
+fn errors_name_what_the_user_wrote() {
+    let err = run_err(&["sortbuf", "", "--buffer", "4"]);
+    assert!(err.contains("the sequence is empty"), "{err}");
+    let d = tempfile::tempdir().unwrap();
+    let m = write(d.path(), "m.toml", SMALL);
+    let err = run_err(&[
+        "run",
+        &m,
+        "--set",
+        "workload.cpu={kind=\"uniform\", min=\"30ms\", max=\"22ms\"}",
+    ]);
+    assert!(err.contains("`min` (30ms) must not exceed `max` (22ms)"), "{err}");
+    let err = run_err(&["run", &m, "--set", "run.frames=\"abc\"", "--frames", "5"]);
+    assert!(
+        err.contains("--set run.frames=\"abc\"") && err.contains("whole number"),
+        "{err}"
+    );
+}
+
 #[test]
 fn a_failed_run_keeps_earlier_results() {
     let d = tempfile::tempdir().unwrap();

@@ -34,6 +34,10 @@ pub trait Quantity: Copy + fmt::Debug + PartialEq + Serialize + for<'de> Deseria
     fn to_f64(self) -> f64;
     /// The quantity for a value in its base unit.
     fn from_f64(x: f64) -> Self;
+    /// A value as a model file writes it (with its unit), for messages.
+    fn show(self) -> String {
+        format!("{}", self.to_f64())
+    }
 }
 
 impl Quantity for f64 {
@@ -53,6 +57,9 @@ impl Quantity for crate::engine::Duration {
     }
     fn from_f64(x: f64) -> Self {
         crate::engine::Duration::from_ps_f64(x)
+    }
+    fn show(self) -> String {
+        self.to_string()
     }
 }
 
@@ -166,10 +173,10 @@ pub enum DistError {
     MinAboveMax {
         /// Path prefix inside a mixture ("" at the top level).
         prefix: String,
-        /// The lower bound.
-        min: f64,
-        /// The upper bound.
-        max: f64,
+        /// The lower bound, as a model file writes it (`30ms`).
+        min: String,
+        /// The upper bound, as a model file writes it.
+        max: String,
     },
     /// A mixture without parts.
     #[error("distribution parameter `{prefix}parts` must not be empty")]
@@ -232,8 +239,8 @@ impl<V: Quantity> Dist<V> {
                 if lo > hi {
                     return Err(DistError::MinAboveMax {
                         prefix: prefix.to_string(),
-                        min: lo,
-                        max: hi,
+                        min: min.show(),
+                        max: max.show(),
                     });
                 }
                 Ok(())

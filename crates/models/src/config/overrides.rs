@@ -99,6 +99,23 @@ impl Overrides {
         for s in &self.sets {
             set_noted(src, table, s, format!("--set {s}"))?;
         }
+        // A `--set` of a key that `--seed` or `--frames` then replaces is
+        // still checked: a wrong value is an error, not silently dropped.
+        for (key, given) in [("seed", self.seed.is_some()), ("frames", self.frames.is_some())] {
+            let value = table.get("run").and_then(|r| r.get(key));
+            if given
+                && let Some(v) = value
+                && v.as_integer().is_none_or(|n| n < 0)
+                && let Some(option) = src.override_of(&format!("run.{key}"))
+            {
+                return Err(ConfigError::Override {
+                    option: option.to_string(),
+                    reason: format!(
+                        "run.{key} must be a whole number >= 0, got {v} (--{key} replaces it, but a wrong value is still an error)"
+                    ),
+                });
+            }
+        }
         if let Some(seed) = self.seed {
             if seed > i64::MAX as u64 {
                 return Err(ConfigError::Override {
@@ -199,6 +216,17 @@ mod tests {
         );
         assert_eq!(m.source.override_of("run.seed"), Some("--seed 3"));
         assert_eq!(m.source.override_of("run.frames"), Some("--frames 20"));
+        // A wrong `--set` of a key `--frames` replaces is still an error.
+        let bad = Overrides {
+            sets: vec!["run.frames=\"abc\"".into()],
+            frames: Some(5),
+            ..Overrides::default()
+        };
+        let e = prepare(ModelSource::embedded_default(), &bad).unwrap_err().to_string();
+        assert!(
+            e.contains("--set run.frames=\"abc\"") && e.contains("whole number"),
+            "{e}"
+        );
         // One warm-up frame is one frame.
         let src = ModelSource::from_text("m.toml", "[run]\nwarmup_frames = 60\n");
         let one = Overrides {

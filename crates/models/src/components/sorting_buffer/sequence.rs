@@ -154,6 +154,11 @@ pub fn sequence_from_spec(spec: &str, base: &Path) -> Result<Vec<StateId>, SortB
         })?;
         return lru_worst(m);
     }
+    if spec.trim().is_empty() {
+        return Err(SortBufferError::Source(
+            "the sequence is empty: give a file of state ids, lru-worst:M or random:N:D:S:SEED".into(),
+        ));
+    }
     let path = base.join(spec);
     let meta =
         std::fs::metadata(&path).map_err(|e| SortBufferError::Source(format!("reading sequence file {spec}: {e}")))?;
