@@ -130,15 +130,7 @@ fn fifo_latest_ready_shows_the_newest_ready_frame_at_each_vertical_blank() {
     // Mailbox frees a replaced frame's image at once, so its GPU never
     // waits (5 ms a frame); here the images come back only at a vertical
     // blank, and the GPU waits for them.
-    let mailbox = run(
-        FIXED,
-        &[
-            "display.buffers=4",
-            "workload.gpu=\"5ms\"",
-            "workload.cpu=\"1ms\"",
-            "display.present_mode=\"mailbox\"",
-        ],
-    );
+    let mailbox = run(FIXED, &[&four[..3], &["display.present_mode=\"mailbox\""]].concat());
     let (ft_latest, ft_mailbox) = (
         metric(&r, "metrics.frame_time_ms.mean"),
         metric(&mailbox, "metrics.frame_time_ms.mean"),

@@ -38,7 +38,6 @@ use super::front_end::{Downstream, FrontEnd, FrontOut, FrontStep};
 use super::geometry_stage::{GeometryStage, Handoff};
 use super::links::{Env, Links};
 use super::plan::{PipelinePlan, PlannedWork};
-use super::unit_specs::unit_specs;
 
 pub use super::events::Ev;
 pub use super::front_end::FrontPhase;
@@ -77,7 +76,7 @@ impl FramePipeline {
     /// Builds the units from a plan (which cannot fail: [`PipelinePlan::new`]
     /// refused every model they could not run).
     pub fn new(plan: PipelinePlan, trace: Option<crate::output::trace::TraceWriter>) -> Self {
-        let (cfg, work, noise, display) = plan.into_parts();
+        let (cfg, work, noise, display, units) = plan.into_parts();
         let streams = RngStreams::new(cfg.run.seed);
         let (fixed, scene) = match work {
             PlannedWork::Fixed(f) => (Some(f), None),
@@ -118,11 +117,10 @@ impl FramePipeline {
             held_triangle: None,
             bus_changed: false,
         };
-        let (cpu_spec, front_spec, geometry_spec) = unit_specs(&cfg);
         FramePipeline {
-            cpu: CpuThread::new(cpu_spec, frames_total, body, cpu_rngs, fixed, zero_time_after),
-            front: FrontEnd::new(front_spec, streams.stream("variation.gpu")),
-            geom: GeometryStage::new(geometry_spec, streams.stream("fragment.pixels"), pixel_rng_start),
+            cpu: CpuThread::new(units.cpu, frames_total, body, cpu_rngs, fixed, zero_time_after),
+            front: FrontEnd::new(units.front, streams.stream("variation.gpu")),
+            geom: GeometryStage::new(units.geometry, streams.stream("fragment.pixels"), pixel_rng_start),
             frag: FragmentStage::default(),
             display: Display::new(&display),
             frames_total,

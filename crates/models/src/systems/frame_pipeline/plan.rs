@@ -46,6 +46,7 @@ use super::analytic::{AnalyticTerms, analytic_terms};
 use super::checked::CheckedPipeline;
 use super::config::{FramePipelineConfig, WorkloadConfig};
 use super::cpu_thread::FixedWork;
+use super::unit_specs::{UnitSpecs, unit_specs};
 use super::validate::{check_events, check_time_range};
 use super::workload::{SceneProgram, compile_scene};
 
@@ -104,6 +105,8 @@ pub struct PipelinePlan {
     pub(super) work: PlannedWork,
     pub(super) noise: Vec<NoiseSource>,
     pub(super) display: DisplaySpec,
+    /// The other units' specs.
+    units: UnitSpecs,
     analytic: Option<AnalyticTerms>,
     /// Seconds the plan took (the run adds the units' building).
     pub(super) build_seconds: f64,
@@ -162,6 +165,7 @@ impl PipelinePlan {
         let noise = noise_sources(cfg, &streams)?;
         Ok(PipelinePlan {
             display: DisplaySpec::of(cfg),
+            units: unit_specs(cfg),
             checked,
             work,
             noise,
@@ -186,9 +190,23 @@ impl PipelinePlan {
     }
 
     /// The plan taken apart for the units: the model, the work, the system
-    /// tasks and the display's spec.
-    pub(super) fn into_parts(self) -> (FramePipelineConfig, PlannedWork, Vec<NoiseSource>, DisplaySpec) {
-        (self.checked.into_config(), self.work, self.noise, self.display)
+    /// tasks, the display's spec and the other units' specs.
+    pub(super) fn into_parts(
+        self,
+    ) -> (
+        FramePipelineConfig,
+        PlannedWork,
+        Vec<NoiseSource>,
+        DisplaySpec,
+        UnitSpecs,
+    ) {
+        (
+            self.checked.into_config(),
+            self.work,
+            self.noise,
+            self.display,
+            self.units,
+        )
     }
 }
 

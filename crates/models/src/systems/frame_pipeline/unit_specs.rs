@@ -92,8 +92,17 @@ pub(super) struct GeometrySpec {
     pub(super) closed: ClosedForm,
 }
 
-/// The three units' specs of a checked model.
-pub(super) fn unit_specs(cfg: &FramePipelineConfig) -> (CpuSpec, FrontSpec, GeometrySpec) {
+/// The CPU thread's, the front end's and the geometry stage's specs (the
+/// display's is the plan's `DisplaySpec`).
+#[derive(Debug, Clone)]
+pub(super) struct UnitSpecs {
+    pub(super) cpu: CpuSpec,
+    pub(super) front: FrontSpec,
+    pub(super) geometry: GeometrySpec,
+}
+
+/// The units' specs of a checked model.
+pub(super) fn unit_specs(cfg: &FramePipelineConfig) -> UnitSpecs {
     let bytes = &cfg.command_fifo.bytes;
     let cpu = CpuSpec {
         input_sampling: cfg.cpu.input_sampling,
@@ -127,5 +136,5 @@ pub(super) fn unit_specs(cfg: &FramePipelineConfig) -> (CpuSpec, FrontSpec, Geom
         binned: cfg.gpu.fragment.binned(),
         closed: ClosedForm::of(cfg),
     };
-    (cpu, front, geometry)
+    UnitSpecs { cpu, front, geometry }
 }
