@@ -229,3 +229,103 @@ fn a_composed_display_needs_a_vertical_blank() {
         .expect_err("composed without vsync is refused");
     assert!(e.contains("display.composition") && e.contains("vsync"), "{e}");
 }
+
+#[test]
+fn the_compositor_takes_the_newest_ready_frame_at_its_wake_and_shows_it_refreshes_later() {
+    // `[display.compositor]`: frames are taken at the compositor's wake, a
+    // set time after each vertical blank, and seen `refreshes` blanks after
+    // the blank before that wake. An independent replay of that rule over
+    // the run's own GPU ends must give every frame's fate and screen time:
+    // `fifo` takes the oldest queued frame at each wake, `mailbox` and
+    // `fifo_latest_ready` the newest (the older ones are dropped).
+    let t = (1e12f64 / 60.0).round() as u64;
+    let wake = 3_300_000_000u64; // 3.3 ms
+    for mode in ["fifo", "mailbox", "fifo_latest_ready"] {
+        let r = run(
+            FIXED,
+            &[
+                "workload.gpu=\"6.1ms\"",
+                "workload.cpu=\"2ms\"",
+                "display.buffers=3",
+                &format!("display.present_mode=\"{mode}\""),
+                "display.composition=\"composed\"",
+                "display.compositor.wake=\"3.3ms\"",
+                "display.compositor.refreshes=2",
+                "run.frames=300",
+            ],
+        );
+        let ends: Vec<u64> = r.records.iter().map(|f| f.gpu_end.expect("rendered").0).collect();
+        assert!(ends.windows(2).all(|w| w[0] < w[1]));
+        let mut expected: Vec<Option<u64>> = vec![None; ends.len()];
+        let (mut next, mut k) = (0usize, 0u64);
+        while next < ends.len() {
+            let w = k * t + wake;
+            let ready = ends[next..].iter().take_while(|&&e| e <= w).count();
+            if ready > 0 {
+                let take = if mode == "fifo" { next } else { next + ready - 1 };
+                expected[take] = Some((k + 2) * t);
+                next = take + 1;
+            }
+            k += 1;
+        }
+        let mut dropped = 0;
+        for (f, e) in r.records.iter().zip(&expected) {
+            assert_eq!(f.displayed.map(|d| d.0), *e, "{mode}: frame {}", f.index);
+            assert_eq!(f.dropped, e.is_none(), "{mode}: frame {}", f.index);
+            dropped += usize::from(f.dropped);
+        }
+        if mode == "fifo" {
+            assert_eq!(dropped, 0);
+        } else {
+            assert!(
+                dropped > 50,
+                "{mode}: a 6.1 ms frame on a 60 Hz compositor drops most: {dropped}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_compositor_s_default_timing_is_a_wake_at_the_blank_and_one_refresh() {
+    // Left out, `[display.compositor]` is `wake = 0`, `refreshes = 1`; one
+    // refresh more moves every screen time by one refresh and nothing else.
+    let base = [
+        "display.composition=\"composed\"",
+        "display.buffers=3",
+        "run.frames=240",
+    ];
+    let plain = run(FIXED, &base);
+    let mut given = base.to_vec();
+    given.extend(["display.compositor.wake=\"0ms\"", "display.compositor.refreshes=1"]);
+    assert_eq!(run(FIXED, &given).records, plain.records);
+    let mut later = base.to_vec();
+    later.push("display.compositor.refreshes=3");
+    let later = run(FIXED, &later);
+    let t = (1e12f64 / 60.0).round() as u64;
+    for (a, b) in plain.records.iter().zip(&later.records) {
+        assert_eq!(a.gpu_end, b.gpu_end);
+        assert_eq!(b.displayed.map(|d| d.0), a.displayed.map(|d| d.0 + 2 * t));
+    }
+}
+
+#[test]
+fn a_compositor_s_timing_is_checked() {
+    for (sets, says) in [
+        (&["display.compositor.wake=\"1ms\""][..], "display.compositor"),
+        (
+            &["display.composition=\"composed\"", "display.compositor.wake=\"17ms\""][..],
+            "must be below one refresh",
+        ),
+        (
+            &["display.composition=\"composed\"", "display.compositor.refreshes=0"][..],
+            "must be 1 to 16",
+        ),
+        (
+            &["display.composition=\"composed\"", "display.compositor.delay=2"][..],
+            "delay",
+        ),
+    ] {
+        let e = common::try_run(FIXED, sets).expect_err("refused");
+        assert!(e.contains(says), "{sets:?}: {e}");
+    }
+}

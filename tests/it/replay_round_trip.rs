@@ -131,12 +131,40 @@ fn every_shipped_frame_pipeline_model_replays_exactly_from_its_frames_csv() {
 #[test]
 fn present_modes_composition_pacing_variable_refresh_and_frame_generation_replay_exactly() {
     let fixed = repo().join("models/fixed.toml");
-    let cases: [(&[&str], &[&str]); 10] = [
+    let cases: [(&[&str], &[&str]); 12] = [
         (&["display.present_mode=\"mailbox\"", "display.buffers=3"], &[]),
         // Composed, every frame of this GPU-bound model is shown two refreshes
         // after the one before: its screen times fit 30 Hz as well as 60 Hz,
         // so the capture cannot tell the refresh, and the test gives it.
         (&["display.composition=\"composed\""], &["display.refresh=\"60Hz\""]),
+        // The compositor's timing, not assumed: inferred from the frames,
+        // from their screen times and (mailbox, skipping) their fates.
+        (
+            &[
+                "display.composition=\"composed\"",
+                "display.present_mode=\"mailbox\"",
+                "display.buffers=3",
+                "workload.gpu=\"6ms\"",
+                "workload.cpu=\"2ms\"",
+                "display.compositor.wake=\"2.5ms\"",
+                "display.compositor.refreshes=2",
+            ],
+            &[],
+        ),
+        (
+            &[
+                "display.composition=\"composed\"",
+                "display.buffers=3",
+                // Slower than the refresh, so frames are ready at every
+                // phase; a GPU faster than the refresh would wait for the
+                // images the compositor frees at its wake, every frame ready
+                // at one phase, and the wake would not show (docs/replay.md).
+                "workload.gpu=\"20.3ms\"",
+                "display.compositor.wake=\"5ms\"",
+                "display.compositor.refreshes=3",
+            ],
+            &[],
+        ),
         (&["display.vsync=false", "workload.gpu=\"9ms\""], &[]),
         (&["cpu.max_frames_ahead=1", "workload.cpu=\"4ms\""], &[]),
         (&["pacing.low_latency=true", "display.vsync=false"], &[]),

@@ -30,8 +30,8 @@
 //! `Hardware: Independent Flip`, ...) are `fifo` at a sync interval of 1 or
 //! more, `immediate` at 0 with tearing allowed, and `mailbox` at 0 without.
 //! `Composed: ...` modes are the same with `display.composition =
-//! "composed"` (the desktop compositor shows the frame one refresh after
-//! its flip); a composed present without a sync interval (-1, a blit) is
+//! "composed"` and the compositor's wake and refreshes inferred from the
+//! swap chain's frames (`capture::display::infer_compositor`); a composed present without a sync interval (-1, a blit) is
 //! `fifo`.
 
 pub mod config;

@@ -18,7 +18,8 @@ use super::{REPLAY_MODEL, RefreshFrom, ReplayError, ReplayOptions, fit_phase};
 /// The model's present mode, vsync and composition for a captured present.
 /// A hardware flip (`Hardware: Legacy Flip`, `Hardware: Independent Flip`,
 /// `Hardware Composed: Independent Flip`) is an independent flip; a
-/// `Composed: ...` present is shown by the compositor one refresh later.
+/// `Composed: ...` present is shown by the compositor (its timing inferred
+/// from the swap chain's frames, [`crate::capture::display::infer_compositor`]).
 /// Sync interval 1 or more is `fifo`; 0 is `mailbox`, or `immediate` when
 /// the present allows tearing on a hardware flip (the compositor never
 /// tears). A composed present without a sync interval (-1, PresentMon's
@@ -188,6 +189,21 @@ pub(super) fn setup(capture: &Capture, opts: &ReplayOptions) -> Result<Setup, Re
         if !assumes(&opts.assume, key) {
             sets.push((key, value));
         }
+    }
+    // The compositor's timing inferred from the swap chain's composed frames.
+    if let Some(c) = display
+        .compositor
+        .as_ref()
+        .filter(|_| composed && !assumes(&opts.assume, "display.compositor."))
+    {
+        sets.push((
+            "display.compositor.wake",
+            toml::Value::String(format!("{}ps", to_ps(c.wake_ms).clamp(0, period_ps - 1))),
+        ));
+        sets.push((
+            "display.compositor.refreshes",
+            toml::Value::Integer(i64::from(c.refreshes)),
+        ));
     }
     if let Some(v) = vrr {
         let rate = |hz: f64| toml::Value::String(format!("{}ps", to_ps(1000.0 / hz)));

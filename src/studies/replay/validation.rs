@@ -215,7 +215,7 @@ pub fn disagreements(r: &Replay) -> Vec<Disagreement> {
 }
 
 /// The columns of `chains.csv`.
-pub const CHAIN_COLUMNS: [&str; 16] = [
+pub const CHAIN_COLUMNS: [&str; 18] = [
     "chain",
     "application",
     "process_id",
@@ -231,6 +231,8 @@ pub const CHAIN_COLUMNS: [&str; 16] = [
     "until_displayed_p90_ms",
     "render_complete_median_ms",
     "gpu_done_to_screen_refreshes_median",
+    "compositor_wake_ms",
+    "compositor_refreshes",
     "meets_targets",
 ];
 
@@ -264,11 +266,11 @@ impl ValidationReport {
         );
         let opt = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
         match &c.replay {
-            Err(_) => format!("{head},,,,,,,,,,false\n"),
+            Err(_) => format!("{head},,,,,,,,,,,,false\n"),
             Ok(r) => {
                 let s = &r.summary;
                 format!(
-                    "{head},{},{},{},{},{},{},{},{},{},{}\n",
+                    "{head},{},{},{},{},{},{},{},{},{},{},{},{}\n",
                     s.model_present_mode,
                     s.refresh_hz,
                     json_name(s.refresh_from),
@@ -278,6 +280,8 @@ impl ValidationReport {
                     opt(s.error_ms.until_displayed.p90),
                     opt(s.error_ms.render_complete.median),
                     opt(c.gpu_done_to_screen_refreshes().map(|q| q[1])),
+                    opt(s.display.compositor.as_ref().map(|k| k.wake_ms)),
+                    opt(s.display.compositor.as_ref().map(|k| f64::from(k.refreshes))),
                     c.meets_targets()
                 )
             }
@@ -395,10 +399,13 @@ fn chain_section(i: usize, ch: &ChainReport) -> String {
     if let Some([lo, mid, hi]) = ch.gpu_done_to_screen_refreshes() {
         md += &format!(
             "Measured, from the GPU finishing a shown frame to the frame on screen: {mid:.2} refreshes at the median ({lo:.2}-{hi:.2}, 10th-90th percentile){}.\n\n",
-            if r.summary.model_composition.is_independent() {
-                ""
-            } else {
-                "; the replay's compositor takes one refresh after the first vertical blank"
+            match (&r.summary.display.compositor, r.summary.model_composition.is_independent()) {
+                (_, true) => String::new(),
+                (Some(c), false) => format!(
+                    "; the replay's compositor, inferred from these frames, takes the newest ready frame {:.2} ms after each vertical blank and shows it {} blank(s) after the one before",
+                    c.wake_ms, c.refreshes
+                ),
+                (None, false) => "; the replay's compositor takes each frame at the vertical blank and shows it one refresh later (too few frames to infer its timing)".to_string(),
             }
         );
     }

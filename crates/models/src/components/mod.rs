@@ -1,8 +1,9 @@
 //! Reusable parts that systems compose: distributions, vertex caches, bounded
-//! FIFOs, swap chains, tearing, frame pacing (limiters, low-latency pacers), frame generation,
+//! FIFOs, swap chains, the desktop compositor, tearing, frame pacing (limiters, low-latency pacers), frame generation,
 //! system-task noise, preemptible processors, a unified shader-core pool, a
 //! bus shared by copies and vertex fetch, and state-time accounting.
 
+pub mod compositor;
 pub mod distribution;
 pub mod fifo;
 pub mod frame_generation;

@@ -25,11 +25,14 @@
 //! (a hardware flip: PresentMon's `Hardware: Legacy Flip` and `Hardware:
 //! Independent Flip`) shows it at the flip. `composed` (the desktop
 //! compositor, PresentMon's `Composed: Flip` and `Composed: Copy with GPU
-//! GDI`) takes the frame at the flip's vertical blank and shows its next
-//! composition one refresh later: one refresh of compositor latency on every
-//! frame, no change in which frames are shown or when images are freed (the
-//! compositor copies or holds its own surface). That is the rule the shared
-//! PresentMon captures follow (docs/replay.md, "Composition").
+//! GDI`) takes the newest ready frame when it wakes after a vertical blank
+//! and shows its composition some refreshes later
+//! ([`crate::components::compositor`], `[display.compositor]`; by default
+//! it wakes at the blank and is seen one refresh later). The swap chain's
+//! images are taken and freed at the compositor's wake instead of the
+//! vertical blank (the compositor holds the frame it took, or its own copy).
+//! docs/replay.md, "Composition", says how the shared PresentMon captures
+//! follow it.
 //!
 //! `vrr` makes the panel's refresh variable (adaptive sync: VESA
 //! Adaptive-Sync, AMD FreeSync, NVIDIA G-Sync, HDMI 2.1 VRR). The panel has
@@ -51,6 +54,7 @@ use std::collections::VecDeque;
 
 use serde::{Deserialize, Serialize};
 
+use crate::components::compositor::CompositorConfig;
 use crate::config::Rate;
 
 /// How presented frames reach the screen.
@@ -104,6 +108,12 @@ pub struct DisplayConfig {
     /// default) or the desktop compositor one refresh later (`composed`).
     #[serde(skip_serializing_if = "Composition::is_independent")]
     pub composition: Composition,
+    /// When a composed display's compositor takes frames and when they
+    /// are seen (`[display.compositor]`; only with `composition =
+    /// "composed"`). Left out: it wakes at the vertical blank and is seen
+    /// one refresh later.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compositor: Option<CompositorConfig>,
     /// Variable refresh (see the module docs); `None`, the default, is a
     /// fixed refresh.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -195,13 +205,29 @@ impl DisplayConfig {
         (!self.waits_for_vblank()).then(|| crate::components::tearing::ScanOut::new(self.refresh.period, self.blanking))
     }
 
-    /// Time from a flip to the frame on screen: one refresh when composed,
-    /// none for a hardware flip.
-    pub fn compositor_delay(&self) -> crate::engine::Duration {
+    /// The compositor's timing when composed (`None` for a hardware flip):
+    /// `[display.compositor]`, or its defaults.
+    pub fn compositor_timing(&self) -> Option<CompositorConfig> {
         match self.composition {
-            Composition::Independent => crate::engine::Duration::ZERO,
-            Composition::Composed => self.refresh.period,
+            Composition::Independent => None,
+            Composition::Composed => Some(self.compositor.unwrap_or_default()),
         }
+    }
+
+    /// When the swap chain's frames are taken after each vertical blank:
+    /// at the blank for a hardware flip, at the compositor's wake when
+    /// composed.
+    pub fn latch_phase(&self) -> crate::engine::Duration {
+        self.compositor_timing()
+            .map_or(crate::engine::Duration::ZERO, |c| c.wake)
+    }
+
+    /// Time from a frame's being taken to its being on screen: none for a
+    /// hardware flip; when composed, the compositor's delay from its wake
+    /// ([`CompositorConfig::delay`]; one refresh by default).
+    pub fn compositor_delay(&self) -> crate::engine::Duration {
+        self.compositor_timing()
+            .map_or(crate::engine::Duration::ZERO, |c| c.delay(self.refresh.period))
     }
 
     /// Checks the display every system can run: a refresh period of at
@@ -239,6 +265,17 @@ impl DisplayConfig {
                  `composed` needs `display.vsync = true` and `present_mode` `fifo`, `mailbox` or `fifo_latest_ready`"
                     .to_string(),
             ));
+        }
+        if let Some(c) = &self.compositor {
+            if self.composition.is_independent() {
+                return Err((
+                    "display.compositor",
+                    "the compositor's timing applies to a composed display: set `display.composition = \"composed\"` \
+                     or leave `[display.compositor]` out"
+                        .to_string(),
+                ));
+            }
+            c.check(self.refresh.period)?;
         }
         Ok(())
     }
@@ -305,6 +342,7 @@ impl Default for DisplayConfig {
             buffers: 2,
             present_mode: PresentMode::Fifo,
             composition: Composition::Independent,
+            compositor: None,
             vrr: None,
             blanking: crate::components::tearing::DEFAULT_BLANKING,
         }

@@ -30,8 +30,10 @@
 
 use serde::Serialize;
 
+mod compositor;
 mod grid;
 
+pub use self::compositor::{CompositorInference, infer_compositor};
 use self::grid::intervals;
 pub use self::grid::{Grid, fit_grid, tolerance};
 use super::presentmon::{Capture, Present};
@@ -195,6 +197,10 @@ pub struct DisplayInference {
     pub vrr: Option<VrrInference>,
     /// Every swap chain of the capture, most frames first.
     pub chains: Vec<ChainDisplay>,
+    /// The compositor's timing, inferred from the replayed swap chain's
+    /// composed frames (`None` for a hardware flip, or too few frames).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compositor: Option<CompositorInference>,
 }
 
 impl DisplayInference {
@@ -241,7 +247,11 @@ impl DisplayInference {
             1 => "; 1 monitor".to_string(),
             n => format!("; {n} monitors"),
         };
-        format!("{refresh}{monitors}; flips {flips}")
+        let compositor = self
+            .compositor
+            .as_ref()
+            .map_or(String::new(), |c| format!("; {}", c.describe()));
+        format!("{refresh}{monitors}; flips {flips}{compositor}")
     }
 }
 
@@ -332,12 +342,23 @@ pub fn infer_display(capture: &Capture, target: &Present) -> DisplayInference {
         })
         .collect();
     listing.sort_by_key(|c| std::cmp::Reverse(c.frames));
+    let compositor = grid
+        .filter(|_| dominant_path(&chains.rows[ti]) == Path::Composed)
+        .and_then(|g| {
+            let own: Vec<&Present> = (0..chains.keys.len())
+                .filter(|&i| dominant_path(&chains.rows[i]) == Path::Compositor)
+                .flat_map(|i| chains.rows[i].iter().copied())
+                .filter(|p| p.screen_time().is_some_and(|t| g.holds(t)))
+                .collect();
+            infer_compositor(&chains.rows[ti], &g, &own)
+        });
     DisplayInference {
         refresh,
         monitors: monitors.len(),
         flips,
         vrr,
         chains: listing,
+        compositor,
     }
 }
 

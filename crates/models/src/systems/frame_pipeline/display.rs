@@ -1,9 +1,10 @@
 //! The display (paper 004 §4.2): frames the front end presents into the
 //! swap chain are shown at a vertical blank (`fifo`, `mailbox`) or at once
 //! (`immediate` / vsync off); repeated refreshes and dropped frames are
-//! counted. A composed display (`display.composition = "composed"`) shows
-//! each flipped frame one refresh later, through the desktop compositor
-//! ([`crate::components::swap_chain::Composition`]). A variable-refresh
+//! counted. A composed display (`display.composition = "composed"`) is
+//! served by the desktop compositor ([`crate::components::compositor`]):
+//! the swap chain's frames are taken at its wake, a set time after each
+//! vertical blank, instead of at the blank, and are seen its delay later. A variable-refresh
 //! display (`display.vrr`) has no fixed vertical blank: a flipped frame
 //! starts a scan-out at once when the panel is idle, or when the scan-out
 //! under way ends; a panel that got no new frame within its slowest period
@@ -40,7 +41,11 @@ pub struct Display {
     /// resolved once, by the plan).
     chain: SwapChain,
     refresh: Duration,
-    /// From a flip to the frame on screen (one refresh when composed).
+    /// When the swap chain's frames are taken after each vertical blank
+    /// (the compositor's wake when composed).
+    latch_phase: Duration,
+    /// From a frame's being taken to its being on screen (the compositor's
+    /// delay when composed).
     compositor_delay: Duration,
     frames_total: u64,
     warmup_frames: u64,
@@ -122,6 +127,7 @@ impl Display {
         Display {
             chain: SwapChain::new(spec.buffers, spec.mode),
             refresh: spec.refresh,
+            latch_phase: spec.latch_phase,
             compositor_delay: spec.compositor_delay,
             frames_total: spec.frames_total,
             warmup_frames: spec.warmup_frames,
@@ -291,6 +297,12 @@ impl Display {
         self.mode() != PresentMode::Immediate && self.vrr.is_none()
     }
 
+    /// When the first fixed refresh takes the swap chain's frames: at time
+    /// zero, a vertical blank, or the compositor's first wake after it.
+    pub(super) fn first_latch(&self) -> Time {
+        Time(self.latch_phase.0)
+    }
+
     /// The refresh period.
     pub(super) fn refresh(&self) -> Duration {
         self.refresh
@@ -410,7 +422,8 @@ impl Display {
         }
     }
 
-    /// A vertical blank (fixed refresh), or the display event of a
+    /// A vertical blank (fixed refresh; when composed, the compositor's wake
+    /// that follows each blank), or the display event of a
     /// variable-refresh panel tagged `tag`: the end of a scan-out or the
     /// deadline of the slowest refresh. A stale tag (the panel started a
     /// scan-out at a present since) does nothing.

@@ -41,7 +41,8 @@ pub enum Ev {
     DrawFragmentStart,
     /// A draw ended (`draw` fidelity).
     DrawDone,
-    /// Vertical blank; with variable refresh, the end of a scan-out or the
+    /// Vertical blank (when composed, the compositor's wake after it, where
+    /// it takes the newest ready frame); with variable refresh, the end of a scan-out or the
     /// slowest refresh's deadline (the tag tells the one pending event from
     /// stale ones; always 0 at a fixed refresh).
     Vblank {

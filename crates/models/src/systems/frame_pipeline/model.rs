@@ -145,7 +145,7 @@ impl FramePipeline {
             return Ok(());
         }
         if self.display.fixed_vblanks() {
-            s.at(Time::ZERO, Ev::Vblank { tag: 0 });
+            s.at(self.display.first_latch(), Ev::Vblank { tag: 0 });
         }
         for i in 0..self.noise.len() {
             let t = self.noise[i].next_arrival(Time::ZERO)?;

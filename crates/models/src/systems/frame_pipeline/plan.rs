@@ -61,8 +61,8 @@ pub(super) enum PlannedWork {
 }
 
 /// What the display is built from: its swap chain (images, and the present
-/// mode resolved once: `immediate` without vsync), its refresh, the
-/// compositor's delay, the variable-refresh window, the scan-out a tearing
+/// mode resolved once: `immediate` without vsync), its refresh, when
+/// frames are taken after each vertical blank and the compositor's delay, the variable-refresh window, the scan-out a tearing
 /// flip lands in, and frame generation when it presents between frames.
 #[derive(Debug, Clone)]
 pub(super) struct DisplaySpec {
@@ -70,6 +70,10 @@ pub(super) struct DisplaySpec {
     pub(super) buffers: u32,
     /// The refresh period (the shortest, on a variable-refresh panel).
     pub(super) refresh: Duration,
+    /// When the swap chain's frames are taken after each vertical blank
+    /// (the compositor's wake when composed; else at the blank).
+    pub(super) latch_phase: Duration,
+    /// From a frame's being taken to its being on screen.
     pub(super) compositor_delay: Duration,
     pub(super) vrr: Option<VrrWindow>,
     pub(super) scan: Option<ScanOut>,
@@ -85,6 +89,7 @@ impl DisplaySpec {
             mode: d.effective_mode(),
             buffers: d.buffers,
             refresh: d.shortest_period(),
+            latch_phase: d.latch_phase(),
             compositor_delay: d.compositor_delay(),
             vrr: d.vrr_window(),
             scan: d.scan_out(),

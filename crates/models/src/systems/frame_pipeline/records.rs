@@ -48,7 +48,7 @@ use crate::components::swap_chain::{DisplayConfig, PresentMode};
 use crate::engine::{PS_PER_MS, Time};
 
 /// One frame's timeline.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct FrameRecord {
     /// Frame index.
     pub index: u64,
