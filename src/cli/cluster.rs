@@ -137,8 +137,8 @@ fn slurm(args: &ExperimentArgs, exp: &Experiment, out: &Path, ours: impl Fn(&str
     if !args.submit {
         say!(
             "submit with: jid=$(sbatch --parsable {}) && sbatch --dependency=afterany:${{jid%%;*}} {}",
-            job.display(),
-            merge.display()
+            rendersim::experiment::shell_quote(&job.to_string_lossy()),
+            rendersim::experiment::shell_quote(&merge.to_string_lossy())
         );
         return Ok(());
     }

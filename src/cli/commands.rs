@@ -405,8 +405,9 @@ pub fn bench(args: BenchArgs) -> Result<()> {
 /// `rendersim timeline`: the picture of paper 000 Figure 4 for a few frames.
 pub fn timeline(args: TimelineArgs) -> Result<()> {
     use rendersim::studies::timeline::{TimelineOptions, timeline_of};
-    // The extension is checked before simulating.
+    // The extension and the place are checked before simulating.
     rendersim::plot::ImageFormat::of(&args.out)?;
+    rendersim::output::result_set::check_outside_sets(&args.out)?;
     let model = load_model(
         args.model.as_deref(),
         &rendersim::config::Overrides::with_sets(&args.sets),
@@ -442,6 +443,7 @@ pub fn sortbuf(args: super::args::SortbufArgs) -> Result<()> {
 pub fn perceived_speed(args: super::args::PerceivedSpeedArgs) -> Result<()> {
     use rendersim::systems::walkthrough::perceived::figure6;
     rendersim::plot::ImageFormat::of(&args.out)?;
+    rendersim::output::result_set::check_outside_sets(&args.out)?;
     let model = load_model(
         Some(args.model.as_path()),
         &rendersim::config::Overrides::with_sets(&args.sets),

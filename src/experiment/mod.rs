@@ -51,7 +51,7 @@ pub use run::{point_model, run_experiment};
 pub use runner::{FrameTable, RunError, RunOutput, Runner};
 pub use shard::{SHARD_FORMAT, SHARDS_DIR, ShardId, ShardIdError, ShardOutcome, merge_shards, run_shard};
 pub use sim_runner::SimRunner;
-pub use slurm::{SlurmError, SlurmOptions, SlurmScripts, sbatch, slurm_scripts};
+pub use slurm::{SlurmError, SlurmOptions, SlurmScripts, sbatch, shell_quote, slurm_scripts};
 pub use spec::{
     BoundRef, Check, Derived, DerivedKind, Expect, Experiment, Metric, ModelSource, PlotKind, PlotSpec, Tolerance,
     load_experiment, parse_experiment,

@@ -85,8 +85,13 @@ pub enum SlurmError {
     },
 }
 
-/// `s` quoted for a POSIX shell.
-fn shell_quote(s: &str) -> String {
+/// `s` quoted for a POSIX shell (a command line a user pastes, such as
+/// the `submit with:` line, runs nothing a folder name holds).
+///
+/// ```
+/// assert_eq!(rendersim::experiment::shell_quote("/x/a$(id)'b"), r"'/x/a$(id)'\''b'");
+/// ```
+pub fn shell_quote(s: &str) -> String {
     format!("'{}'", s.replace('\'', r"'\''"))
 }
 

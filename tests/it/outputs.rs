@@ -810,3 +810,47 @@ fn run_replay_and_experiment_outputs_say_where_they_came_from() {
             .starts_with("# Written by rendersim ")
     );
 }
+
+#[test]
+fn no_command_writes_inside_another_command_s_result_set() {
+    // Issue 60 item 2: any output path inside a folder holding a set's
+    // marker is refused (exit 2, naming the set and its kind) before any
+    // work, whatever command writes it; the set stays byte for byte. A
+    // command's own --out still takes a trace inside it.
+    let d = tempfile::tempdir().unwrap();
+    let m = model(d.path());
+    let set = d.path().join("set");
+    ok(bin().args(["run", &m, "--out", set.to_str().unwrap()]));
+    let before = snapshot(&set);
+    let inside = |name: &str| set.join(name).display().to_string();
+    let capture = repo_file("tests/fixtures/presentmon/test_case_0.csv");
+    for args in [
+        vec!["run", &m, "--trace", &inside("summary.json")],
+        vec!["run", &m, "--trace", &inside("new-trace.json")],
+        vec!["run", &m, "--out", &inside("nested")],
+        vec!["timeline", &m, "--frames", "3", "--out", &inside("t.svg")],
+        vec!["replay", &capture, "--report", &inside("report")],
+        vec!["replay", &capture, "--out", &inside("replayed")],
+    ] {
+        let e = err(bin().args(&args));
+        assert!(
+            e.contains("is inside") && e.contains("a result set of `rendersim run`"),
+            "{args:?}: {e}"
+        );
+        assert_eq!(snapshot(&set), before, "{args:?} changed the set");
+    }
+    ok(bin().args([
+        "run",
+        &m,
+        "--out",
+        set.to_str().unwrap(),
+        "--trace",
+        &inside("trace.json"),
+    ]));
+    assert!(set.join("trace.json").is_file());
+}
+
+/// A file of the repository, as a path string.
+fn repo_file(rel: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(rel).display().to_string()
+}

@@ -492,3 +492,33 @@ fn edited_shard_files_are_refused_and_redone() {
     assert_eq!(values(&now), values(&texts[1]));
     assert_eq!(values(&now).len(), 4);
 }
+
+#[cfg(unix)]
+#[test]
+fn the_printed_submit_line_runs_nothing_a_folder_name_holds() {
+    // Issue 60 item 10: the `submit with:` line quotes the scripts' paths,
+    // so pasting it for an --out like `a$(touch${IFS}pwned)` runs only sbatch.
+    use std::os::unix::fs::PermissionsExt;
+    let d = tempfile::tempdir().unwrap();
+    let exp = experiment(d.path());
+    let out = d.path().join("a$(touch${IFS}pwned)");
+    let said = ok(&["experiment", s(&exp), "--out", s(&out), "--slurm", "--shards", "2"]);
+    let line = said
+        .lines()
+        .find_map(|l| l.strip_prefix("submit with: "))
+        .unwrap_or_else(|| panic!("no submit line in {said}"));
+    let stub = d.path().join("bin");
+    std::fs::create_dir(&stub).unwrap();
+    let sbatch = stub.join("sbatch");
+    std::fs::write(&sbatch, "#!/bin/sh\necho 7\n").unwrap();
+    std::fs::set_permissions(&sbatch, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let path = format!("{}:{}", stub.display(), std::env::var("PATH").unwrap_or_default());
+    let st = std::process::Command::new("sh")
+        .args(["-c", line])
+        .current_dir(d.path())
+        .env("PATH", path)
+        .status()
+        .unwrap();
+    assert!(st.success(), "{line}");
+    assert!(!d.path().join("pwned").exists(), "the line ran the folder name: {line}");
+}

@@ -82,6 +82,20 @@ pub enum OutputError {
         /// The set's file it names.
         name: String,
     },
+    /// An output inside a result set another command wrote.
+    #[error(
+        "{path} is inside {set}, a result set of `rendersim {kind}`: a file written there would be lost when \
+         that set is written again, or mixed into it; write it outside the folder (a command writes only into \
+         its own set, its --out)"
+    )]
+    InsideSet {
+        /// The path given.
+        path: PathBuf,
+        /// The set's folder.
+        set: PathBuf,
+        /// The kind of set (the command that wrote it).
+        kind: String,
+    },
     /// Two files of one command name the same place.
     #[error("{second} {path} names the same file as {first}; give each its own file")]
     SameFile {

@@ -152,6 +152,7 @@ pub fn destination(path: &Path) -> Result<Destination, OutputError> {
         // /dev/stdout): written in place, never replaced.
         return Ok(Destination::InPlace(path.to_path_buf()));
     }
+    super::result_set::check_outside_sets(&target)?;
     match found {
         Ok(_) => Ok(Destination::Replace(target)),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Destination::Replace(target)),

@@ -72,6 +72,44 @@ fn marker_text(kind: Option<&str>) -> String {
     t
 }
 
+/// The result sets this process claimed ([`claim_folder`]): it writes into
+/// them piece by piece, so [`check_outside_sets`] lets it.
+static CLAIMED: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Refuses an output at `path` that lies inside a result set (a folder
+/// holding [`MARKER`], at any depth above `path`) other than one this
+/// process claimed: a file written there would be lost to, or mixed into,
+/// the set of the command that wrote it (`run --trace DIR/summary.json`
+/// over a run's folder, `timeline --out` into an experiment's). A
+/// command's own set is written through [`ResultSet::place`] instead.
+///
+/// ```
+/// use rendersim_report::output::result_set::{ResultSet, check_outside_sets};
+///
+/// let parent = tempfile::tempdir().unwrap();
+/// let out = parent.path().join("results");
+/// ResultSet::begin(&out, |_| false).unwrap().commit().unwrap();
+/// assert!(check_outside_sets(&out.join("trace.json")).is_err());
+/// assert!(check_outside_sets(&parent.path().join("trace.json")).is_ok());
+/// ```
+pub fn check_outside_sets(path: &Path) -> Result<(), OutputError> {
+    if path.as_os_str() == "-" || path.starts_with("/dev") || path.starts_with("/proc") {
+        return Ok(());
+    }
+    let real = real_path(path);
+    let claimed = CLAIMED.lock().map(|c| c.clone()).unwrap_or_default();
+    for folder in real.ancestors().skip(1) {
+        if folder.join(MARKER).is_file() && !claimed.iter().any(|c| c == folder) {
+            return Err(OutputError::InsideSet {
+                path: path.to_path_buf(),
+                set: folder.to_path_buf(),
+                kind: marker_kind(folder).unwrap_or_else(|| "rendersim".into()),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// The kind a set's marker names (`None`: none, as markers before kinds).
 fn marker_kind(target: &Path) -> Option<String> {
     let text = std::fs::read_to_string(target.join(MARKER)).ok()?;
@@ -265,6 +303,7 @@ impl ResultSet {
         force: bool,
     ) -> Result<Self, OutputError> {
         let target = absolute_folder(&resolve_links(target)?)?;
+        check_outside_sets(&target)?;
         check_replaceable(&target, &legacy)?;
         if target.join(MARKER).is_file() {
             check_kind(&target, kind, force)?;
@@ -398,12 +437,17 @@ pub fn claim_folder(
     force: bool,
 ) -> Result<PathBuf, OutputError> {
     let target = absolute_folder(&resolve_links(target)?)?;
+    check_outside_sets(&target)?;
     check_replaceable(&target, &legacy)?;
     std::fs::create_dir_all(&target).map_err(OutputError::io("creating folder", &target))?;
     let marker = target.join(MARKER);
     if marker.is_file() {
         check_kind(&target, kind, force)?;
-    } else {
+    }
+    if let Ok(mut c) = CLAIMED.lock() {
+        c.push(super::files::real_path(&target));
+    }
+    if !marker.is_file() {
         super::files::write_output(&marker, |w| w.write_all(marker_text(kind).as_bytes()))?;
     }
     Ok(target)

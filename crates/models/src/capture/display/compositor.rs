@@ -111,10 +111,10 @@ fn explain(frames: &[Composed], grid: &Grid, wake: f64, fates: bool) -> (usize, 
             *c += 1;
         }
     }
-    let (n, most) = counts
-        .iter()
-        .enumerate()
-        .fold((0i64, 0usize), |best, (l, &c)| if c > best.1 { (l as i64, c) } else { best });
+    let (n, most) = counts.iter().enumerate().fold(
+        (0i64, 0usize),
+        |best, (l, &c)| if c > best.1 { (l as i64, c) } else { best },
+    );
     let right_fates = if fates {
         frames
             .windows(2)
@@ -129,7 +129,7 @@ fn explain(frames: &[Composed], grid: &Grid, wake: f64, fates: bool) -> (usize, 
 /// Infers the compositor's timing from the composed frames among `rows`
 /// (one swap chain's presents, in order) on the refresh `grid`;
 /// `compositor` are the compositor's own presents on that monitor, for the
-/// report. `None` with fewer than [`MIN_FRAMES`] shown frames that say
+/// report. `None` with fewer than 20 shown frames that say
 /// when their GPU work ended.
 pub fn infer_compositor(rows: &[&Present], grid: &Grid, compositor: &[&Present]) -> Option<CompositorInference> {
     let t = grid.period_ms;
