@@ -533,7 +533,10 @@ pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
         assume: args.assume.clone(),
         from_tables: false,
     };
-    let r = replay(&args.capture, &opts)?;
+    let mut r = replay(&args.capture, &opts)?;
+    if let Some(measured) = &args.compare {
+        r.summary.compare = Some(rendersim::studies::replay::compare::compare(&r, measured)?);
+    }
     if let Some(set) = report_set {
         let report = rendersim::studies::replay::validation::validate(&args.capture, &opts)?;
         report.write(set.dir()).context("writing the validation report")?;

@@ -40,6 +40,7 @@ mod readme_numbers;
 mod replay;
 mod replay_real;
 mod replay_round_trip;
+mod replay_whatif_pairs;
 mod shards;
 mod shared_bus;
 mod sortbuf;

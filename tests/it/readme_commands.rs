@@ -83,6 +83,8 @@ const CASES: &[Case] = &[
             "display.buffers=2",
             "--set",
             "cpu.max_frames_ahead=1",
+            "--compare",
+            "tests/fixtures/presentmon/test_case_0.csv",
             "--json",
             "--out",
             "{out}/replay",

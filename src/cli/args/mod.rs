@@ -416,6 +416,12 @@ pub struct ReplayArgs {
     /// display.refresh (repeatable).
     #[arg(long = "assume", value_name = "KEY=VALUE")]
     pub assume: Vec<String>,
+    /// A capture of the same game measured under the what-if's setting:
+    /// its figures (fps, displayed fps, display change, until displayed,
+    /// display latency, PC latency medians) are put beside the prediction
+    /// (`replay.compare`).
+    #[arg(long, value_name = "MEASURED.csv")]
+    pub compare: Option<PathBuf>,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,

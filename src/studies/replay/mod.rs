@@ -34,6 +34,7 @@
 //! swap chain's frames (`capture::display::infer_compositor`); a composed present without a sync interval (-1, a blit) is
 //! `fifo`.
 
+pub mod compare;
 pub mod config;
 pub mod display_stats;
 pub mod refresh;
@@ -309,6 +310,7 @@ pub fn replay_capture(
             stats: whatif.as_ref().map_or_else(|| as_captured.clone(), Simulated::stats),
         },
         as_captured,
+        compare: None,
         simulate_seconds,
         wall_seconds: wall.elapsed().as_secs_f64(),
     };

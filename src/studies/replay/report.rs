@@ -106,9 +106,33 @@ pub fn write_text(s: &ReplaySummary, w: &mut impl std::io::Write) -> std::io::Re
             )?;
         }
     }
+    if let Some(c) = &s.compare {
+        compare_table(c, w)?;
+    }
     writeln!(
         w,
         "  {:.4} s wall ({:.4} s simulating)",
         s.wall_seconds, s.simulate_seconds
     )
+}
+
+/// The `--compare` table: each figure predicted, measured and their ratio.
+fn compare_table(c: &super::compare::Comparison, w: &mut impl std::io::Write) -> std::io::Result<()> {
+    writeln!(
+        w,
+        "  compared with {} ({} {}, {} frames):",
+        c.capture, c.application, c.swapchain, c.frames
+    )?;
+    writeln!(w, "  {:<28} {:>10} {:>10} {:>7}", "", "predicted", "measured", "ratio")?;
+    let v = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:.2}"));
+    for (name, m) in c.rows() {
+        writeln!(
+            w,
+            "  {name:<28} {:>10} {:>10} {:>7}",
+            v(m.predicted),
+            v(m.measured),
+            m.ratio.map_or("-".to_string(), |r| format!("{r:.3}"))
+        )?;
+    }
+    writeln!(w, "  PC latency predicted with {}", c.pc_latency_assumption)
 }

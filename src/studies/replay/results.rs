@@ -125,6 +125,10 @@ pub struct ReplaySummary {
     pub as_captured: DisplayStats,
     /// The frames replayed with the what-if's patches.
     pub whatif: WhatIf,
+    /// The what-if (or the replay as captured) beside a capture measured
+    /// under its setting (`--compare`; [`super::compare`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compare: Option<super::compare::Comparison>,
     /// Wall time of the simulations alone (both, with a what-if), seconds.
     pub simulate_seconds: f64,
     /// Wall time of the whole replay (reading the capture included), seconds.
