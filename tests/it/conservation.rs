@@ -26,6 +26,8 @@ struct Params {
     groups: u64,
     grid: u32,
     seed: u64,
+    /// A frame limiter's place (`None`: no `[pacing]`).
+    pacing: Option<&'static str>,
 }
 
 fn params() -> impl Strategy<Value = Params> {
@@ -47,13 +49,23 @@ fn params() -> impl Strategy<Value = Params> {
             any::<bool>(),
             any::<bool>(),
         ),
-        (1u64..5, 1u32..12, 0u64..i64::MAX as u64),
+        (
+            1u64..5,
+            1u32..12,
+            0u64..i64::MAX as u64,
+            prop_oneof![
+                Just(None),
+                Just(Some("start")),
+                Just(Some("present")),
+                Just(Some("submit"))
+            ],
+        ),
     )
         .prop_map(
             |(
                 (scene, fidelity, cpu_us, gpu_us, fifo, bytes, depth),
                 (buffers, mode, vsync, ahead, noise, gpu_noise),
-                (groups, grid, seed),
+                (groups, grid, seed, pacing),
             )| Params {
                 scene,
                 fidelity,
@@ -71,6 +83,7 @@ fn params() -> impl Strategy<Value = Params> {
                 groups,
                 grid,
                 seed,
+                pacing,
             },
         )
 }
@@ -149,7 +162,10 @@ name = "driver"
 target = "{target}"
 rate = "300Hz"
 duration = {{ kind = "pareto", scale = "20us", shape = 2.5 }}
-{workload}"#,
+{workload}{pacing}"#,
+        pacing = p.pacing.map_or(String::new(), |place| format!(
+            "[pacing]\nlimit = \"150Hz\"\nlimit_from = \"{place}\"\n"
+        )),
         fid = p.fidelity,
         seed = p.seed,
         cpu = p.cpu_us,
@@ -191,9 +207,17 @@ proptest! {
         }
         // Per frame: busy + wait = frame time, exactly; the timeline is ordered.
         prop_assert_eq!(r.records.len(), 12);
+        // A limiter's wait before a frame belongs to no frame (the frame
+        // starts when it ends): over the run, every CPU picosecond from the
+        // first start to the last present is a frame's or that wait's.
+        let first_to_last = r.records.last().unwrap().present.0 - r.records[0].start.0;
+        let framed: u64 = r.records.iter().map(|f| f.cpu_busy + f.cpu_wait).sum();
+        prop_assert_eq!(framed + c.cpu[5], first_to_last);
         for (i, f) in r.records.iter().enumerate() {
             let end = r.records.get(i + 1).map(|n| n.start).unwrap_or(f.present);
-            prop_assert_eq!(f.cpu_busy + f.cpu_wait, end.0 - f.start.0, "frame {}", i);
+            if p.pacing != Some("start") {
+                prop_assert_eq!(f.cpu_busy + f.cpu_wait, end.0 - f.start.0, "frame {}", i);
+            }
             prop_assert!(f.start <= f.input && f.input <= f.present);
             let (gs, ge) = (f.gpu_start.unwrap(), f.gpu_end.unwrap());
             prop_assert!(f.input <= gs && gs <= ge);

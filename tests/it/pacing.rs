@@ -91,3 +91,38 @@ fn bad_pacing_keys_name_the_key() {
         assert!(e.contains(needle), "{set}: {e}");
     }
 }
+
+#[test]
+fn where_a_limiter_waits_decides_the_latency() {
+    // 2 ms of CPU, 5 ms of GPU, a 50 Hz limit, vsync off (a frame is shown
+    // when it is presented and its GPU work is done). Every frame after the
+    // first, closed form, display latency (input to screen):
+    // - the game's limiter before the frame (`start`): CPU + GPU = 7 ms;
+    // - in the present call (`present`): the interval, 20 ms (the GPU work
+    //   went out before the wait and finished during it);
+    // - the GPU driver's (`submit`): the wait holds the frame's GPU work,
+    //   so the interval plus the GPU time, 25 ms.
+    for (place, expected_ms) in [("start", 7.0), ("present", 20.0), ("submit", 25.0)] {
+        let from = format!("pacing.limit_from=\"{place}\"");
+        let r = run(
+            FIXED,
+            &[
+                "workload.cpu=\"2ms\"",
+                "workload.gpu=\"5ms\"",
+                "display.vsync=false",
+                "pacing.limit=\"50Hz\"",
+                &from,
+                "run.frames=40",
+                "run.warmup_frames=1",
+            ],
+        );
+        for f in r.records.iter().skip(1) {
+            let lat = f.displayed.unwrap().since(f.input).as_ms_f64();
+            assert!((lat - expected_ms).abs() < 1e-9, "{place}: frame {}: {lat} ms", f.index);
+        }
+        for w in r.records[1..].windows(2) {
+            let iv = w[1].displayed.unwrap().since(w[0].displayed.unwrap()).as_ms_f64();
+            assert!((iv - 20.0).abs() < 1e-9, "{place}: frame {}: {iv} ms apart", w[1].index);
+        }
+    }
+}

@@ -131,7 +131,7 @@ fn every_shipped_frame_pipeline_model_replays_exactly_from_its_frames_csv() {
 #[test]
 fn present_modes_composition_pacing_variable_refresh_and_frame_generation_replay_exactly() {
     let fixed = repo().join("models/fixed.toml");
-    let cases: [(&[&str], &[&str]); 12] = [
+    let cases: [(&[&str], &[&str]); 13] = [
         (&["display.present_mode=\"mailbox\"", "display.buffers=3"], &[]),
         // Composed, every frame of this GPU-bound model is shown two refreshes
         // after the one before: its screen times fit 30 Hz as well as 60 Hz,
@@ -169,6 +169,7 @@ fn present_modes_composition_pacing_variable_refresh_and_frame_generation_replay
         (&["cpu.max_frames_ahead=1", "workload.cpu=\"4ms\""], &[]),
         (&["pacing.low_latency=true", "display.vsync=false"], &[]),
         (&["pacing.limit=\"40Hz\"", "pacing.limit_from=\"present\""], &[]),
+        (&["pacing.limit=\"40Hz\"", "pacing.limit_from=\"submit\""], &[]),
         (&["pacing.limit=\"50Hz\"", "display.refresh=\"144Hz\""], &[]),
         (
             &["display.refresh=\"144Hz\"", "display.vrr.min_refresh=\"48Hz\""],

@@ -7,10 +7,18 @@
 //!   frames are at least one target interval apart. Measured from the CPU's
 //!   start (`limit_from = "start"`, as in-game limiters and RTSS's default do)
 //!   frame n starts no earlier than frame n-1's start plus the interval;
-//!   measured from the present (`limit_from = "present"`, as a driver-side
-//!   limiter that holds the present call does) frame n's present comes no
-//!   earlier than frame n-1's plus the interval, the wait falling just before
-//!   the present.
+//!   measured from the present (`limit_from = "present"`, a limiter that
+//!   holds the present call) frame n's present comes no earlier than frame
+//!   n-1's plus the interval, the wait falling just before the present;
+//!   measured from the GPU submission (`limit_from = "submit"`, the GPU
+//!   driver's cap: NVIDIA's Max Frame Rate, AMD's Frame Rate Target
+//!   Control, which hold the frame in the driver before its work reaches
+//!   the GPU) frame n's first GPU command goes no earlier than frame n-1's
+//!   plus the interval: the CPU thread waits at its submission, and the
+//!   GPU gets the frame's work only after the wait, so the frame reaches
+//!   the screen a GPU frame after the wait ends (the shared FrameView
+//!   captures of Alan Wake 2 under the driver's cap: present to screen is
+//!   the GPU time; docs/replay.md).
 //! - **Low-latency pacer** (`pacing.low_latency = true`; NVIDIA Reflex, AMD
 //!   Anti-Lag, LatencyFleX and DXVK's low-latency frame pacer all aim at it):
 //!   the CPU starts a frame late, so that its GPU work arrives just as the GPU
@@ -39,6 +47,9 @@ pub enum LimitFrom {
     Start,
     /// From one present to the next: the wait is just before the present.
     Present,
+    /// From one GPU submission to the next (the GPU driver's cap): the wait
+    /// is just before the frame's first GPU command.
+    Submit,
 }
 
 impl LimitFrom {
@@ -82,6 +93,14 @@ impl PacingConfig {
         self.limit
             .as_ref()
             .filter(|_| self.limit_from == LimitFrom::Present)
+            .map(|r| r.period)
+    }
+
+    /// The limiter's interval when it is measured from the GPU submission.
+    pub fn submit_limit(&self) -> Option<Duration> {
+        self.limit
+            .as_ref()
+            .filter(|_| self.limit_from == LimitFrom::Submit)
             .map(|r| r.period)
     }
 }

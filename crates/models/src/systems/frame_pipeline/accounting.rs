@@ -28,7 +28,7 @@ use super::unit_states::FRONT_WAIT_GEOMETRY;
 #[derive(Debug)]
 pub struct Accounting {
     /// CPU clock.
-    pub cpu: StateClock<8>,
+    pub cpu: StateClock<9>,
     /// Front-end clock.
     pub front: StateClock<6>,
     /// Geometry clock.
@@ -135,7 +135,7 @@ fn attribute_cpu(records: &mut [FrameRecord], old: usize, spent: u64, frame: u64
             0 | 1 => r.cpu_busy += spent,
             // Pacing before a frame (5) is between frames: the frame
             // starts when it ends.
-            2 | 3 | 6 | 7 => r.cpu_wait += spent,
+            2 | 3 | 6 | 7 | 8 => r.cpu_wait += spent,
             _ => {}
         }
     }
@@ -146,8 +146,8 @@ fn attribute_cpu(records: &mut [FrameRecord], old: usize, spent: u64, frame: u64
 fn cpu_state_of(p: CpuPhase) -> usize {
     // A table, not a match: the phase changes from event to event, and a
     // jump table's indirect branch would often be mispredicted.
-    const OF: [u8; 11] = {
-        let mut of = [0u8; 11];
+    const OF: [u8; 12] = {
+        let mut of = [0u8; 12];
         of[CpuPhase::NextFrame as usize] = 0;
         of[CpuPhase::WaitFrames as usize] = 3;
         of[CpuPhase::Ready as usize] = 0;
@@ -159,6 +159,7 @@ fn cpu_state_of(p: CpuPhase) -> usize {
         of[CpuPhase::PaceStart as usize] = 5;
         of[CpuPhase::PacePresent as usize] = 6;
         of[CpuPhase::InPresent as usize] = 7;
+        of[CpuPhase::PaceSubmit as usize] = 8;
         of
     };
     OF[p as usize] as usize

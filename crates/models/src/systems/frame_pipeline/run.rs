@@ -50,7 +50,7 @@ pub struct PipelineRun {
 #[derive(Debug, Clone)]
 pub struct ClockTotals {
     /// CPU: work, system, wait FIFO, wait frames, idle.
-    pub cpu: [u64; 8],
+    pub cpu: [u64; 9],
     /// Front end states.
     pub front: [u64; 6],
     /// Geometry: busy, blocked, idle.

@@ -285,7 +285,7 @@ pub(super) fn summarize(
                 cpu: {
                     let pacing = !m.cfg.pacing.is_off();
                     let frames = matches!(m.cfg.workload, WorkloadConfig::Frames(_));
-                    let shown = |i: usize| i < 5 || (pacing && i < 7) || (frames && i == 7);
+                    let shown = |i: usize| i < 5 || (pacing && (i < 7 || i == 8)) || (frames && i == 7);
                     CPU_STATES
                         .iter()
                         .zip(cpu)

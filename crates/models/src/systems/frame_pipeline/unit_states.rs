@@ -5,7 +5,7 @@
 //! trace name what it counted.
 
 /// CPU states.
-pub const CPU_STATES: [&str; 8] = [
+pub const CPU_STATES: [&str; 9] = [
     "work",
     "system task",
     "wait: command FIFO full",
@@ -14,6 +14,7 @@ pub const CPU_STATES: [&str; 8] = [
     "wait: pacing before a frame",
     "wait: frame limiter before present",
     "wait: in the present call",
+    "wait: frame limiter before GPU submission",
 ];
 /// GPU front-end states.
 pub const FRONT_STATES: [&str; 6] = [

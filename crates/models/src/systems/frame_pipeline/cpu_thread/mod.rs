@@ -56,6 +56,10 @@ pub enum CpuPhase {
     InPresent,
     /// All frames submitted.
     Finished,
+    /// Held by a submission-measured frame limiter (the GPU driver's cap,
+    /// `pacing.limit_from = "submit"`) before the frame's first GPU
+    /// command; [`Ev::PaceWake`] ends it.
+    PaceSubmit,
 }
 
 /// How a CPU event that only the CPU thread moved ended (the short cuts
@@ -120,6 +124,8 @@ pub struct CpuThread {
     pace_resume: CpuPhase,
     /// Whether the low-latency pacer (not a limiter) set the start wait.
     pace_for_gpu: bool,
+    /// When the last frame's first GPU command (its clear) started.
+    last_submit: Option<Time>,
     /// Whether the workload is given frame by frame (`kind = "frames"`).
     per_frame: bool,
     /// What it reads of the model.
@@ -170,6 +176,7 @@ impl CpuThread {
             pace_go: false,
             pace_resume: CpuPhase::NextFrame,
             pace_for_gpu: false,
+            last_submit: None,
             copy: None,
             spec,
         }
@@ -515,6 +522,7 @@ impl CpuThread {
             | CpuPhase::ZeroTimeWait
             | CpuPhase::PaceStart
             | CpuPhase::PacePresent
+            | CpuPhase::PaceSubmit
             | CpuPhase::InPresent
             | CpuPhase::Finished => return Ok(false),
             CpuPhase::WaitFrames if self.frames_ahead_full(env) => {
@@ -555,11 +563,19 @@ impl CpuThread {
                     }
                 }
                 CpuPhase::Ready => {
-                    if let Some(t) = self.present_wait(now, env) {
+                    if let Some(t) = self.op_wait(now, env) {
                         s.at(t, Ev::PaceWake);
                         self.pace_resume = CpuPhase::Ready;
-                        self.phase = CpuPhase::PacePresent;
+                        self.phase = match self.op_at(self.op) {
+                            Op::Clear => CpuPhase::PaceSubmit,
+                            _ => CpuPhase::PacePresent,
+                        };
                         return Ok(true);
+                    }
+                    if let Op::Clear = self.op_at(self.op) {
+                        // The frame's first GPU command starts now (a
+                        // submission-measured limiter counts from here).
+                        self.last_submit = Some(now);
                     }
                     let work = self.op_work(self.op_at(self.op), env);
                     // A draw with nothing but its copy still runs (for no
@@ -597,6 +613,7 @@ impl CpuThread {
                 | CpuPhase::ZeroTimeWait
                 | CpuPhase::PaceStart
                 | CpuPhase::PacePresent
+                | CpuPhase::PaceSubmit
                 | CpuPhase::InPresent
                 | CpuPhase::Finished => return Ok(progressed),
             }

@@ -1,5 +1,6 @@
-//! The CPU thread held before a frame starts or presents (`[pacing]`): a
-//! frame limiter measured from the frame's start or from its present, and
+//! The CPU thread held before a frame starts, submits or presents
+//! (`[pacing]`): a frame limiter measured from the frame's start, its GPU
+//! submission or its present, and
 //! the low-latency pacer, which starts a frame as late as the GPU's
 //! forecast allows ([`crate::components::frame_pacing`]).
 
@@ -68,20 +69,28 @@ impl CpuThread {
         (t > now).then_some(t)
     }
 
-    /// The time the current operation, if it is the swap, must wait for
-    /// under a present-measured limiter: the previous present plus the
-    /// interval, less the swap's own work, if later than `now`.
-    pub(super) fn present_wait(&mut self, now: Time, env: &Env) -> Option<Time> {
-        let interval = self.spec.pacing.present_limit()?;
-        if !matches!(self.op_at(self.op), Op::Swap) || self.frame == 0 {
-            return None;
-        }
+    /// The time the current operation must wait for under a limiter placed
+    /// inside the frame, if later than `now`: the swap under a
+    /// present-measured limiter (the previous present plus the interval,
+    /// less the swap's own work); the clear, the frame's first GPU command,
+    /// under a submission-measured one (the previous frame's clear plus
+    /// the interval, less the clear's work).
+    pub(super) fn op_wait(&mut self, now: Time, env: &Env) -> Option<Time> {
+        let op = self.op_at(self.op);
+        let (interval, previous) = match op {
+            Op::Swap => (
+                self.spec.pacing.present_limit()?,
+                env.records.get((self.frame as usize).checked_sub(1)?)?.present,
+            ),
+            Op::Clear => (self.spec.pacing.submit_limit()?, self.last_submit?),
+            _ => return None,
+        };
         if std::mem::take(&mut self.pace_go) {
             return None;
         }
-        let target = limited(Some(env.records[self.frame as usize - 1].present), interval)?;
-        let swap = self.op_work(Op::Swap, env);
-        let t = Time(target.0.saturating_sub(swap.0));
+        let target = limited(Some(previous), interval)?;
+        let work = self.op_work(op, env);
+        let t = Time(target.0.saturating_sub(work.0));
         (t > now).then_some(t)
     }
 }
