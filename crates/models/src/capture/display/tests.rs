@@ -114,7 +114,7 @@ fn two_monitors_each_with_its_compositor_swap_chain_and_the_app_on_its_own() {
         p144,
         3.3,
     ));
-    let game: Vec<u32> = (0..300).map(|i| 2 * i + (i % 3)).collect();
+    let game: Vec<u32> = (0..300).map(|i| 2 * i + u32::from(i % 3 == 0)).collect();
     rows.extend(shown("game.exe", "0x1", "Composed: Flip", 1, &game, p144, 3.3));
     rows.sort_by(|a, b| a.5.total_cmp(&b.5));
     let c = capture(&rows);

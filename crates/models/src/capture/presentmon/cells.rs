@@ -80,7 +80,13 @@ pub(super) struct Cells<'a> {
     impossible: std::cell::RefCell<(usize, Option<Impossible>)>,
     /// The text cells read so far (names, addresses, modes), each kept once.
     strings: std::cell::RefCell<std::collections::HashSet<std::sync::Arc<str>>>,
+    /// Subtracted from every QPC stamp read (the earliest, where stamps
+    /// are too large for milliseconds as `f64`; else 0).
+    qpc_base: std::cell::Cell<i64>,
 }
+
+/// QPC stamps above this many ticks are counted from the earliest one.
+const QPC_EXACT: i64 = 1 << 52;
 
 impl<'a> Cells<'a> {
     pub(super) fn new(file: &'a str, header: &'a Header) -> Cells<'a> {
@@ -89,7 +95,30 @@ impl<'a> Cells<'a> {
             header,
             impossible: Default::default(),
             strings: Default::default(),
+            qpc_base: std::cell::Cell::new(0),
         }
+    }
+
+    /// Counts QPC stamps from the earliest one when any is above
+    /// [`QPC_EXACT`] (true then); a negative stamp is an error.
+    pub(super) fn set_qpc_base(&self, raw: &[(u64, csv::StringRecord)]) -> Result<bool, CaptureError> {
+        let mut least: Option<i64> = None;
+        let mut large = false;
+        for (line, rec) in raw {
+            for col in [Col::TimeInQpc, Col::CpuStartQpc] {
+                if let Some(v) = self.text(rec, col).and_then(|t| t.parse::<i64>().ok()) {
+                    if v < 0 {
+                        return Err(self.bad(*line, col, format!("{v} is negative: a QPC stamp counts ticks")));
+                    }
+                    large |= v > QPC_EXACT;
+                    least = Some(least.map_or(v, |l| l.min(v)));
+                }
+            }
+        }
+        if large {
+            self.qpc_base.set(least.unwrap_or(0));
+        }
+        Ok(large)
     }
 
     /// A text cell, shared with every equal one read before (a capture
@@ -136,6 +165,15 @@ impl<'a> Cells<'a> {
         };
         if t.is_empty() || t.eq_ignore_ascii_case("NA") {
             return Ok(None);
+        }
+        if matches!(col, Col::TimeInQpc | Col::CpuStartQpc) {
+            // Ticks, exactly (an `f64` holds whole numbers only to 2^53).
+            if let Ok(v) = t.parse::<i64>() {
+                if v < 0 {
+                    return Err(self.bad(line, col, format!("{v} is negative: a QPC stamp counts ticks")));
+                }
+                return Ok(Some((v - self.qpc_base.get()) as f64));
+            }
         }
         match t.parse::<f64>() {
             Ok(v) if v.is_finite() && v.abs() <= MAX_MS => Ok(Some(v)),

@@ -148,6 +148,23 @@ impl Header {
         }
     }
 
+    /// A column the header names twice (by one name or two of its names):
+    /// the name as written and the two fields (1-based).
+    pub(super) fn repeated(&self) -> Option<(String, usize, usize)> {
+        let folded: Vec<String> = self.names.iter().map(|n| fold(n)).collect();
+        for (_, names) in NAMES {
+            let mut at = folded
+                .iter()
+                .enumerate()
+                .filter(|(_, h)| names.iter().any(|n| **h == fold(n)))
+                .map(|(i, _)| i);
+            if let (Some(a), Some(b)) = (at.next(), at.next()) {
+                return Some((self.names[b].clone(), a + 1, b + 1));
+            }
+        }
+        None
+    }
+
     /// Where a column is.
     pub(super) fn get(&self, col: Col) -> Option<usize> {
         self.index[col as usize]

@@ -270,6 +270,12 @@ impl Capture {
             file: file.to_string(),
             message,
         };
+        let mut notes = Notes::default();
+        let decoded = from_utf16(bytes).map_err(format)?;
+        if decoded.is_some() {
+            notes.push("read as UTF-16 text (converted; PresentMon and FrameView write UTF-8)".into());
+        }
+        let bytes = decoded.as_deref().unwrap_or(bytes);
         let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
         let (metadata, skipped, body) = leading_comments(bytes);
         let mut rdr = csv::ReaderBuilder::new()
@@ -283,8 +289,13 @@ impl Capture {
             None => return Err(format("empty: no header".into())),
         };
         let header = Header::new(&header_rec);
+        if let Some((name, a, b)) = header.repeated() {
+            return Err(format(format!(
+                "the header names `{name}` twice (fields {a} and {b}): which one holds the values is not known; \
+                 remove or rename one"
+            )));
+        }
         let columns = column_set(file, &header)?;
-        let mut notes = Notes::default();
         let mut meta = metadata;
         let mut raw = Vec::new();
         for rec in records {
@@ -319,8 +330,16 @@ impl Capture {
         if raw.is_empty() {
             return Err(format("no presents: the capture has a header and no rows".into()));
         }
+        repeated_rows(file, &raw)?;
         system_metadata(&header, &raw, &mut meta);
         let cell = Cells::new(file, &header);
+        if cell.set_qpc_base(&raw)? {
+            notes.push(
+                "QPC stamps above 2^52 ticks: times are counted from the earliest stamp (as milliseconds \
+                 since boot they would lose precision)"
+                    .into(),
+            );
+        }
         let qpc_per_ms = match (columns, header.has(Col::TimeInQpc), header.has(Col::CpuStartQpc)) {
             (Columns::V2, true, true) => match qpc_rate(&cell, &raw)? {
                 Some(r) => Some(r),
@@ -467,6 +486,17 @@ impl Capture {
                 r.cpu_start = before;
                 r.cpu_busy = (r.present - before).max(0.0);
             }
+        }
+        if rows.iter().all(|p| p.present == rows[0].present) {
+            return Err(row_err(
+                rows[0].line,
+                format!(
+                    "all {} presents of swap chain {} are at one instant ({} ms): a replay needs time between frames",
+                    rows.len(),
+                    pick.swap_chain,
+                    rows[0].present
+                ),
+            ));
         }
         if rows.iter().filter(|p| p.displayed()).count() < 2 {
             return Err(row_err(
@@ -635,6 +665,49 @@ fn read_row(
 }
 
 /// The column set a header uses, checked for the columns a replay needs.
+/// A capture's bytes as UTF-8 when they are UTF-16 (a byte-order mark
+/// `FF FE` or `FE FF`, or, without one, a first line whose every other
+/// byte is zero); `None` for anything else (read as UTF-8).
+fn from_utf16(bytes: &[u8]) -> Result<Option<Vec<u8>>, String> {
+    let (little, body) = match bytes {
+        [0xFF, 0xFE, rest @ ..] => (true, rest),
+        [0xFE, 0xFF, rest @ ..] => (false, rest),
+        [a, 0, b, 0, ..] if *a != 0 && *b != 0 => (true, bytes),
+        [0, a, 0, b, ..] if *a != 0 && *b != 0 => (false, bytes),
+        _ => return Ok(None),
+    };
+    let units: Vec<u16> = body
+        .chunks(2)
+        .map(|c| match (c, little) {
+            ([lo, hi], true) => u16::from_le_bytes([*lo, *hi]),
+            ([hi, lo], false) => u16::from_be_bytes([*hi, *lo]),
+            _ => 0xFFFD,
+        })
+        .collect();
+    String::from_utf16(&units)
+        .map(|t| Some(t.into_bytes()))
+        .map_err(|_| "the file looks like UTF-16 text (by its first bytes) but is not valid UTF-16".to_string())
+}
+
+/// Refuses a capture that holds a row twice, field for field (a file
+/// written twice into one, which would count every frame twice).
+fn repeated_rows(file: &str, raw: &[(u64, csv::StringRecord)]) -> Result<(), CaptureError> {
+    let mut seen: HashMap<Vec<&str>, u64> = HashMap::with_capacity(raw.len());
+    for (line, rec) in raw {
+        if let Some(first) = seen.insert(rec.iter().collect(), *line) {
+            return Err(CaptureError::Row {
+                file: file.to_string(),
+                line: *line,
+                message: format!(
+                    "repeats line {first} field for field: the capture holds rows twice (written twice into one \
+                     file?), which would count its frames twice; remove the copies"
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 fn column_set(file: &str, header: &Header) -> Result<Columns, CaptureError> {
     let fmt = |message: String| CaptureError::Format {
         file: file.to_string(),

@@ -273,3 +273,97 @@ fn generated_frames_are_kept_apart_and_a_restarted_clock_keeps_the_longest_recor
     assert_eq!(c.presents.iter().map(|p| p.line).collect::<Vec<_>>(), [4, 5, 6]);
     assert!(c.notes.join(" ").contains("line 4 goes back 50.0 s"), "{:?}", c.notes);
 }
+
+/// A capture of `n` frames 16.667 ms apart, QPC at 10 MHz from `base`.
+fn frames_from(base: u64, n: u64) -> String {
+    (0..n)
+        .map(|i| {
+            let start = base + i * 166_670;
+            let at = start + 50_000;
+            format!("a.exe,1,0x1,Hardware: Legacy Flip,1,0,{at},{start},5.0,0.1,0.5,2.0,0.1,3.0,NA\n")
+        })
+        .collect()
+}
+
+#[test]
+fn qpc_stamps_near_2_pow_62_keep_their_precision_and_negative_ones_are_refused() {
+    // As `f64` milliseconds since boot, stamps near 2^62 ticks keep only
+    // about 0.1 ms (the refresh fitted 60.21 Hz instead of 59.95): they are
+    // counted from the earliest stamp, exactly, and the note says so.
+    let base = 1u64 << 62;
+    let c = Capture::parse("t.csv", format!("{HEAD}{}", frames_from(base, 50)).as_bytes()).unwrap();
+    assert!(c.notes.iter().any(|n| n.contains("2^52")), "{:?}", c.notes);
+    assert_eq!(c.qpc_per_ms, Some(10_000.0));
+    for w in c.presents.windows(2) {
+        assert!(
+            (w[1].present - w[0].present - 16.667).abs() < 1e-9,
+            "{}",
+            w[1].present - w[0].present
+        );
+    }
+    // Ordinary stamps stay milliseconds since boot.
+    let c = Capture::parse("t.csv", format!("{HEAD}{}", frames_from(10_000_000, 3)).as_bytes()).unwrap();
+    assert!((c.presents[0].cpu_start - 1000.0).abs() < 1e-9);
+    let text = format!("{HEAD}{}", frames_from(0, 2)).replace(",0,5.0,", ",-7,5.0,");
+    let e = Capture::parse("t.csv", text.as_bytes()).unwrap_err().to_string();
+    assert!(
+        e.contains("t.csv:2:") && e.contains("CPUStartQPC") && e.contains("negative"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_header_naming_a_column_twice_is_refused() {
+    let head = HEAD.replace("MsCPUWait", "MsCPUBusy");
+    let e = Capture::parse("t.csv", format!("{head}{}", frames_from(0, 3)).as_bytes())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`MsCPUBusy` twice") && e.contains("fields 9 and 10"), "{e}");
+    // Two names of one column (PresentMon 1.7's lower case beside the capitalised) too.
+    let head = HEAD.replace("MsBetweenDisplayChange", "msCPUBusy");
+    let e = Capture::parse("t.csv", format!("{head}{}", frames_from(0, 3)).as_bytes())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("twice"), "{e}");
+}
+
+#[test]
+fn rows_written_twice_are_refused_not_counted_twice() {
+    let rows = frames_from(0, 4);
+    let e = Capture::parse("t.csv", format!("{HEAD}{rows}{rows}").as_bytes())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("t.csv:6:") && e.contains("repeats line 2"), "{e}");
+}
+
+#[test]
+fn frames_all_at_one_instant_are_refused() {
+    let one: String = (0..3)
+        .map(|i| {
+            format!(
+                "a.exe,1,0x1,Hardware: Legacy Flip,1,0,500,0,5.0,0.1,0.5,2.0,0.1,{}.0,NA\n",
+                3 + i
+            )
+        })
+        .collect();
+    let c = Capture::parse("t.csv", format!("{HEAD}{one}").as_bytes()).unwrap();
+    let e = c.select(None, None).unwrap_err().to_string();
+    assert!(e.contains("at one instant"), "{e}");
+}
+
+#[test]
+fn utf16_captures_are_read_as_their_writer_meant() {
+    let text = format!("{HEAD}{}", frames_from(0, 3));
+    let utf8 = Capture::parse("t.csv", text.as_bytes()).unwrap();
+    let le: Vec<u8> = [0xFF, 0xFE]
+        .into_iter()
+        .chain(text.encode_utf16().flat_map(u16::to_le_bytes))
+        .collect();
+    let be: Vec<u8> = text.encode_utf16().flat_map(u16::to_be_bytes).collect();
+    for bytes in [le, be] {
+        let c = Capture::parse("t.csv", &bytes).unwrap();
+        assert_eq!(c.presents.len(), 3);
+        assert_eq!(c.presents[2].present, utf8.presents[2].present);
+        assert!(c.notes.iter().any(|n| n.contains("UTF-16")), "{:?}", c.notes);
+    }
+}
