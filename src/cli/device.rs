@@ -407,10 +407,27 @@ pub fn predict(args: &PredictArgs) -> Result<()> {
     let measured = if args.measure { Some(measure_pass(args)?) } else { None };
     // The comparison: measured pass time and wall time of measuring
     // (opening the adapter, warm-ups, repeats) against the simulation's.
+    // A profile of another device predicts that device, not this one: the
+    // error then compares two devices, and says so.
+    let other_device = measured
+        .as_ref()
+        .filter(|(_, _, adapter)| !profile.device.matches_adapter(adapter))
+        .map(|(_, _, adapter)| {
+            format!(
+                "the profile {} is for the device `{}`, and the pass was measured on `{adapter}`: the error compares \
+                 two devices; calibrate a profile for this adapter (`rendersim calibrate`) to predict it",
+                args.device.display(),
+                profile.device.name
+            )
+        });
+    if let Some(w) = &other_device {
+        eprintln!("warning: {w}");
+    }
     let comparison = measured.as_ref().map(|(ns, wall, adapter)| {
         json!({"adapter": adapter, "pass_time_ns": ns, "error_pct": rel_error_pct(p.pass_time_ns, *ns),
             "measure_wall_seconds": wall, "simulate_wall_seconds": p.sim_wall_seconds,
-            "speedup": wall / p.sim_wall_seconds.max(1e-9)})
+            "speedup": wall / p.sim_wall_seconds.max(1e-9),
+            "same_device": other_device.is_none(), "warning": other_device})
     });
     if args.json {
         let v = json!({

@@ -515,3 +515,35 @@ fn interleaved_rounds_keep_every_round_and_pool_one_row_per_pass() {
     let rows = gpu.measured_passes().rows;
     assert_eq!(rows.len(), 3);
 }
+
+#[test]
+fn predict_measure_says_when_the_profile_is_for_another_device() {
+    // Issue 58: the H200's profile measured against this machine's adapter
+    // (lavapipe in CI) printed "-97.6%" as if it were the profile's error.
+    let h200 = concat!(env!("CARGO_MANIFEST_DIR"), "/models/devices/nvidia-h200.toml");
+    let Some(o) = rendersim(&[
+        "predict",
+        "grid:8x8",
+        "--size",
+        "64x64",
+        "--device",
+        h200,
+        "--measure",
+        "--json",
+    ]) else {
+        return;
+    };
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let adapter = v["measured"]["adapter"].as_str().unwrap().to_lowercase();
+    if adapter.contains("h200") {
+        return; // on the profile's own device there is nothing to say
+    }
+    assert_eq!(v["measured"]["same_device"], false);
+    assert!(
+        err.contains("warning: the profile") && err.contains("nvidia-h200"),
+        "{err}"
+    );
+    assert!(v["measured"]["warning"].as_str().unwrap().contains("two devices"));
+}

@@ -122,6 +122,32 @@ pub struct DeviceInfo {
     pub shader_cores: u32,
 }
 
+impl DeviceInfo {
+    /// Whether an adapter of this name is the profile's device: every word
+    /// of the profile's short name (letters and digits, any case) is a word
+    /// of the adapter's name.
+    ///
+    /// ```
+    /// use rendersim_measure::device_profile::DeviceInfo;
+    ///
+    /// let h200 = DeviceInfo { name: "nvidia-h200".into(), vertex_cache: "nvidia".into(), shader_cores: 132 };
+    /// assert!(h200.matches_adapter("NVIDIA H200"));
+    /// assert!(!h200.matches_adapter("llvmpipe (LLVM 15.0.7, 256 bits)"));
+    /// ```
+    pub fn matches_adapter(&self, adapter: &str) -> bool {
+        let words = |s: &str| -> Vec<String> {
+            s.to_lowercase()
+                .split(|c: char| !c.is_ascii_alphanumeric())
+                .filter(|w| !w.is_empty())
+                .map(str::to_string)
+                .collect()
+        };
+        let have = words(adapter);
+        let want = words(&self.name);
+        !want.is_empty() && want.iter().all(|w| have.contains(w))
+    }
+}
+
 /// How well the fit reproduces its rows, relative errors in percent.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
