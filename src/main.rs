@@ -37,6 +37,9 @@ struct Cli {
     /// Largest input file to read, in bytes, for every kind of input (default 64 MiB for models, experiments, profiles, instance and shard files; 4 GiB for captures, measurement CSVs, meshes and sequences; or RENDERSIM_MAX_INPUT_BYTES)
     #[arg(long, global = true, value_name = "BYTES", value_parser = clap::value_parser!(u64).range(1..))]
     max_input_bytes: Option<u64>,
+    /// Write every wall time (seconds building and simulating, events a second, an experiment's wall time) as 0, so that two result sets of one command compare byte for byte (as SOURCE_DATE_EPOCH does, which also fixes the date)
+    #[arg(long, global = true)]
+    no_timing: bool,
 }
 
 #[derive(Subcommand)]
@@ -89,6 +92,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     if let Some(bytes) = cli.max_input_bytes {
         rendersim::limits::set_max_input_bytes(bytes);
+    }
+    if cli.no_timing {
+        // SAFETY: at start-up, before any other thread exists.
+        unsafe { std::env::set_var("RENDERSIM_NO_TIMING", "1") };
     }
     // A spinner on a terminal once a command has worked for two seconds
     // (`experiment` draws its own bar over its runs).

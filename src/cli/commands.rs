@@ -108,7 +108,9 @@ pub fn run(args: RunArgs) -> Result<()> {
     run.summary_mut()["provenance"] = serde_json::to_value(&provenance)?;
     if let Some(set) = &set {
         let dir = set.dir();
-        let summary = serde_json::to_string_pretty(run.summary())?;
+        let mut summary = run.summary().clone();
+        rendersim::output::timing::fix_wall_times(&mut summary);
+        let summary = serde_json::to_string_pretty(&summary)?;
         std::fs::write(dir.join("summary.json"), summary).context("writing summary.json")?;
         let mut frames = std::io::BufWriter::new(std::fs::File::create(dir.join("frames.csv"))?);
         run.write_frames_csv(&mut frames).context("writing frames.csv")?;
@@ -129,7 +131,9 @@ pub fn run(args: RunArgs) -> Result<()> {
         set.commit()?;
     }
     if args.json {
-        let text = serde_json::to_string_pretty(run.summary())?;
+        let mut summary = run.summary().clone();
+        rendersim::output::timing::fix_wall_times(&mut summary);
+        let text = serde_json::to_string_pretty(&summary)?;
         if trace_on_stdout {
             esay!("{text}");
         } else {
@@ -543,10 +547,12 @@ pub fn replay(args: super::args::ReplayArgs) -> Result<()> {
         set.commit()?;
     }
     let provenance = command_provenance();
-    let json = serde_json::to_string_pretty(&ReplayJson {
+    let mut json = serde_json::to_value(ReplayJson {
         replay: &r.summary,
         provenance: provenance.clone(),
     })?;
+    rendersim::output::timing::fix_wall_times(&mut json);
+    let json = serde_json::to_string_pretty(&json)?;
     if let Some(set) = set {
         let dir = set.dir();
         std::fs::write(dir.join("replay.json"), &json).context("writing replay.json")?;

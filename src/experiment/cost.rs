@@ -3,8 +3,13 @@
 //! compared with.
 
 /// CPU time (user + system) this process has used so far, in seconds, or
-/// `None` where the system does not say (`getrusage(RUSAGE_SELF)` on Unix).
+/// `None` where the system does not say (`getrusage(RUSAGE_SELF)` on Unix);
+/// 0 when wall times are fixed ([`crate::output::timing::timing_fixed`]).
 pub fn process_cpu_seconds() -> Option<f64> {
+    process_cpu_seconds_measured().map(crate::output::timing::wall)
+}
+
+fn process_cpu_seconds_measured() -> Option<f64> {
     #[cfg(unix)]
     {
         // SAFETY: `usage` is a plain C struct that getrusage fills in.
@@ -23,12 +28,15 @@ pub fn process_cpu_seconds() -> Option<f64> {
     }
 }
 
-/// Seconds since the Unix epoch (0 if the clock is before it).
+/// Seconds since the Unix epoch (0 if the clock is before it, and when
+/// wall times are fixed: [`crate::output::timing::timing_fixed`]).
 pub fn unix_seconds() -> f64 {
-    std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_secs_f64())
-        .unwrap_or(0.0)
+    crate::output::timing::wall(
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_secs_f64())
+            .unwrap_or(0.0),
+    )
 }
 
 #[cfg(test)]

@@ -408,6 +408,12 @@ fn checks(s: &mut String, r: &ExperimentResult) {
 /// `## Timing`: wall and CPU times.
 fn timing(s: &mut String, r: &ExperimentResult) {
     let _ = writeln!(s, "## Timing\n");
+    if crate::output::timing::timing_fixed() {
+        let _ = writeln!(
+            s,
+            "Wall and CPU times are written as 0 (`SOURCE_DATE_EPOCH` or `--no-timing`: outputs comparable byte for byte).\n"
+        );
+    }
     match &r.shards {
         None => {
             let _ = writeln!(s, "- experiment wall time: {:.3} s", r.wall_seconds);

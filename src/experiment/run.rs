@@ -220,7 +220,7 @@ pub(crate) fn finish(
         sensitivity,
     };
     match timing {
-        Timing::Single(started) => result.wall_seconds = started.elapsed().as_secs_f64(),
+        Timing::Single(started) => result.wall_seconds = crate::output::timing::wall(started.elapsed().as_secs_f64()),
         Timing::Shards(cost) => {
             result.wall_seconds = cost.array_wall_seconds;
             result.shards = Some(cost);
@@ -489,7 +489,7 @@ fn run_job(
         Some(src) => runner.run_from(src, model, seed, want_frames),
     }
     .map_err(|e| fail(e.to_string()))?;
-    let measured = t0.elapsed().as_secs_f64();
+    let measured = crate::output::timing::wall(t0.elapsed().as_secs_f64());
     let wall_seconds = match json_number(&out.summary, "wall_seconds") {
         Ok(Some(w)) => w,
         _ => measured,

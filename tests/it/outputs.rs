@@ -854,3 +854,95 @@ fn no_command_writes_inside_another_command_s_result_set() {
 fn repo_file(rel: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel).display().to_string()
 }
+
+/// Every file under `dir` (relative name, bytes), sorted.
+fn tree_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p.strip_prefix(dir).unwrap().display().to_string();
+                out.push((rel, std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn result_sets_of_one_command_compare_byte_for_byte_under_source_date_epoch_or_no_timing() {
+    // Issue 60 item 11: a run's, an experiment's and a replay's folders,
+    // written twice by the same command, are the same bytes when wall
+    // times are fixed (SOURCE_DATE_EPOCH, or --no-timing, which also dates
+    // the provenance 1970-01-01); the wall times are written as 0.
+    let d = tempfile::tempdir().unwrap();
+    let m = model(d.path());
+    let exp = d.path().join("e.toml");
+    std::fs::write(
+        &exp,
+        format!(
+            "name = \"p\"\nmodel = {m:?}\nreplications = 2\n[set]\n\"run.frames\" = 10\n\
+             [[sweep]]\nkey = \"workload.gpu\"\nvalues = [\"5ms\", \"9ms\"]\n\
+             [[metric]]\npath = \"metrics.frame_time_ms.mean\"\n"
+        ),
+    )
+    .unwrap();
+    let capture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/presentmon/test_case_0.csv");
+    let out = d.path().join("out");
+    let commands: [Vec<&str>; 3] = [
+        vec!["run", &m, "--out", out.to_str().unwrap()],
+        vec![
+            "experiment",
+            exp.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        vec![
+            "replay",
+            capture.to_str().unwrap(),
+            "--set",
+            "cpu.max_frames_ahead=1",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    ];
+    for fixed in [&["--no-timing"][..], &[][..]] {
+        for args in &commands {
+            let once = || {
+                let mut c = bin();
+                c.args(fixed).args(args).arg("--force");
+                if fixed.is_empty() {
+                    c.env("SOURCE_DATE_EPOCH", "1796386922");
+                } else {
+                    c.env_remove("SOURCE_DATE_EPOCH");
+                }
+                ok(&mut c);
+                tree_bytes(&out)
+            };
+            let (a, b) = (once(), once());
+            assert_eq!(
+                a.iter().map(|f| &f.0).collect::<Vec<_>>(),
+                b.iter().map(|f| &f.0).collect::<Vec<_>>()
+            );
+            for ((name, x), (_, y)) in a.iter().zip(&b) {
+                assert!(x == y, "{fixed:?} {}: {name} differs", args[0]);
+            }
+            let text: String = a.iter().map(|(_, x)| String::from_utf8_lossy(x).to_string()).collect();
+            if args[0] != "experiment" {
+                assert!(text.contains("\"wall_seconds\": 0.0"), "{fixed:?} {}", args[0]);
+            }
+            let date = if fixed.is_empty() {
+                "2026-12-04T"
+            } else {
+                "1970-01-01T00:00:00Z"
+            };
+            assert!(text.contains(date), "{fixed:?} {}: no {date}", args[0]);
+        }
+    }
+}

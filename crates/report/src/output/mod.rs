@@ -26,6 +26,7 @@ pub mod result_set;
 pub mod span_collector;
 pub mod table;
 pub mod text;
+pub mod timing;
 pub mod trace;
 
 pub use error::OutputError;

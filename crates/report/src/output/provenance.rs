@@ -28,12 +28,18 @@ pub struct Provenance {
 
 impl Provenance {
     /// A record dated now (or at `SOURCE_DATE_EPOCH` when that is set to a
-    /// whole number of seconds).
+    /// whole number of seconds; at 0, 1970-01-01, under `--no-timing`
+    /// without it, so that outputs compare byte for byte:
+    /// [`super::timing`]).
     pub fn now(program: impl Into<String>, git_revision: Option<String>, command: Vec<String>) -> Self {
+        let no_timing = std::env::var_os("RENDERSIM_NO_TIMING").is_some_and(|v| !v.is_empty());
         let secs = std::env::var("SOURCE_DATE_EPOCH")
             .ok()
             .and_then(|s| s.trim().parse::<i64>().ok())
             .unwrap_or_else(|| {
+                if no_timing {
+                    return 0;
+                }
                 SystemTime::now()
                     .duration_since(UNIX_EPOCH)
                     .map_or(0, |d| d.as_secs() as i64)
