@@ -72,6 +72,16 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         .join(", ");
     let of_inputs = |e: CalibrateError| anyhow::Error::new(e).context(format!("the passes of {inputs}"));
     let f = fit(&fit_loads, &y).map_err(of_inputs)?;
+    let undetermined = (!f.undetermined.is_empty()).then(|| {
+        format!(
+            "these passes do not determine {} (no pass exercises a cost, or it moves with the others): such a \
+             cost is whatever the fit left; measure passes that vary it",
+            f.undetermined.join(", ")
+        )
+    });
+    if let Some(u) = &undetermined {
+        eprintln!("warning: {u}");
+    }
     let fit_seconds = start.elapsed().as_secs_f64();
     let fitted: Vec<f64> = fit_loads.iter().map(|l| f.costs.cost(l).pass_ns).collect();
     let errors: Vec<f64> = fitted.iter().zip(&y).map(|(p, m)| rel_error_pct(*p, *m)).collect();
@@ -133,6 +143,9 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
             "K-fold by mesh ({} folds over {} meshes, each fold's meshes held out whole): median {m:.1}%, 90th percentile {p:.1}%, worst {w:.1}%.",
             k.folds, k.meshes
         ));
+    }
+    if let Some(u) = &undetermined {
+        header.push(format!("Not determined: {u}."));
     }
     header.push("Cost formula and keys: docs/models.md (Device profiles). Regenerate with the command in docs/measurements/README.md.".into());
     if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {

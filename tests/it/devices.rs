@@ -494,3 +494,62 @@ fn the_h200_profile_predicts_study_h2() {
     assert!((held_out - 0.935).abs() < 0.002, "{held_out}");
     assert!(f.costs.shared_core_overlap > 0.05, "{:?}", f.costs);
 }
+
+#[test]
+fn calibrate_refuses_repeated_passes_and_names_the_costs_its_passes_cannot_determine() {
+    // Issue 60 item 7: twenty copies of one pass (plus one other) passed the
+    // 12-row minimum and gave a profile predicting 0 ms, without a word.
+    let d = tempfile::tempdir().unwrap();
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/measurements/llvmpipe-mesa-22.3.6-profile-passes.csv");
+    let text = std::fs::read_to_string(&src).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let rows: Vec<&str> = lines.collect();
+    let copies = d.path().join("copies.csv");
+    let mut t = format!("{header}\n{}\n", rows[1]);
+    for _ in 0..20 {
+        t += &format!("{}\n", rows[0]);
+    }
+    std::fs::write(&copies, t).unwrap();
+    let out = d.path().join("p.toml");
+    let o = bin()
+        .args(["calibrate", copies.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("21 rows hold 2 distinct pass(es)") && e.contains("at least 12"),
+        "{e}"
+    );
+    assert!(!out.exists());
+    // Passes without shader loops cannot tell the loop costs: calibrated,
+    // with a warning and a line in the profile naming them.
+    let header_cols: Vec<&str> = header.split(',').collect();
+    let col = |name: &str| header_cols.iter().position(|c| *c == name).unwrap();
+    let (vs, fs) = (col("vs_loops"), col("fs_loops"));
+    let plain: Vec<&str> = rows
+        .iter()
+        .filter(|r| {
+            let f: Vec<&str> = r.split(',').collect();
+            f[vs] == "0" && f[fs] == "0"
+        })
+        .copied()
+        .collect();
+    assert!(plain.len() >= 12, "{}", plain.len());
+    let no_loops = d.path().join("no-loops.csv");
+    std::fs::write(&no_loops, format!("{header}\n{}\n", plain.join("\n"))).unwrap();
+    let o = bin()
+        .args(["calibrate", no_loops.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{e}");
+    assert!(
+        e.contains("warning: these passes do not determine") && e.contains("fragment_per_loop_ns"),
+        "{e}"
+    );
+    let profile = std::fs::read_to_string(&out).unwrap();
+    assert!(profile.contains("# Not determined:") && profile.contains("vertex_lane_per_loop_ns"));
+    assert!(!profile.contains("Not determined: these passes do not determine pass_overhead_ns"));
+}

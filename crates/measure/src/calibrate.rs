@@ -39,6 +39,17 @@ pub enum CalibrateError {
     /// Not enough rows to fit the costs.
     #[error("{0} rows are too few to fit a device profile (at least {MIN_ROWS})")]
     TooFewRows(usize),
+    /// The rows repeat too few distinct passes to fit the costs.
+    #[error(
+        "the {rows} rows hold {distinct} distinct pass(es) (a pass measured again, with the same mesh, size, loops \
+         and draws, is one pass); a fit of the profile's costs needs at least {MIN_ROWS} distinct passes"
+    )]
+    TooFewDistinct {
+        /// Rows given.
+        rows: usize,
+        /// Distinct passes among them.
+        distinct: usize,
+    },
     /// Cross-validation by mesh needs two meshes at least.
     #[error("cross-validation by mesh needs passes of at least 2 distinct meshes; these have {0}")]
     TooFewMeshes(usize),
@@ -319,6 +330,65 @@ pub struct Fit {
     pub std_errors: Vec<(String, f64)>,
     /// Sum of squared relative errors.
     pub objective: f64,
+    /// The costs these passes cannot determine ([`undetermined_costs`]):
+    /// their values are whatever the fit left.
+    pub undetermined: Vec<&'static str>,
+}
+
+/// The linear costs (keys as in a profile) that `loads` cannot determine:
+/// a cost whose column of the design is zero on every pass (nothing
+/// measured exercises it), or a combination of the columns before it (it
+/// cannot be told apart from them), by Gaussian elimination over the
+/// columns scaled to their largest value.
+///
+/// ```
+/// use rendersim_measure::calibrate::undetermined_costs;
+///
+/// // No passes: nothing is determined.
+/// assert_eq!(undetermined_costs(&[]).len(), rendersim_measure::device_profile::COSTS);
+/// ```
+pub fn undetermined_costs(loads: &[PassLoad]) -> Vec<&'static str> {
+    let draws_vary = loads.iter().any(|l| l.draws != loads[0].draws);
+    let mut a: Vec<[f64; Q]> = loads.iter().map(|l| design(l, 0, 0.0, draws_vary)).collect();
+    let keys = DeviceCosts::default().entries();
+    let mut free = Vec::new();
+    let mut next = 0;
+    for j in 0..P {
+        let scale = a.iter().map(|r| r[j].abs()).fold(0.0, f64::max);
+        if scale > 0.0 {
+            a.iter_mut().for_each(|r| r[j] /= scale);
+        }
+        let best = (next..a.len()).max_by(|&x, &y| a[x][j].abs().total_cmp(&a[y][j].abs()));
+        match best.filter(|&r| a[r][j].abs() > 1e-9) {
+            None => free.push(keys[j].0),
+            Some(r) => {
+                a.swap(r, next);
+                let pivot = a[next];
+                for row in a.iter_mut().skip(next + 1) {
+                    let f = row[j] / pivot[j];
+                    if f != 0.0 {
+                        for (x, p) in row.iter_mut().zip(&pivot) {
+                            *x -= f * p;
+                        }
+                    }
+                }
+                next += 1;
+            }
+        }
+    }
+    free
+}
+
+/// Passes among `loads` that differ in what the fit sees of them.
+fn distinct_passes(loads: &[PassLoad]) -> usize {
+    let draws_vary = loads.iter().any(|l| l.draws != loads[0].draws);
+    let mut rows: Vec<Vec<u64>> = loads
+        .iter()
+        .map(|l| design(l, 0, 0.0, draws_vary).iter().map(|x| x.to_bits()).collect())
+        .collect();
+    rows.sort_unstable();
+    rows.dedup();
+    rows.len()
 }
 
 /// Design row: the load's regressors with the clear term (side 2) or the
@@ -540,6 +610,13 @@ pub fn fit(loads: &[PassLoad], y: &[f64]) -> Result<Fit, CalibrateError> {
     if loads.len() < MIN_ROWS {
         return Err(CalibrateError::TooFewRows(loads.len()));
     }
+    let distinct = distinct_passes(loads);
+    if distinct < MIN_ROWS {
+        return Err(CalibrateError::TooFewDistinct {
+            rows: loads.len(),
+            distinct,
+        });
+    }
     if let Some((row, &value)) = y.iter().enumerate().find(|(_, t)| !t.is_finite() || **t <= 0.0) {
         return Err(CalibrateError::BadTime { row, value });
     }
@@ -575,6 +652,7 @@ pub fn fit(loads: &[PassLoad], y: &[f64]) -> Result<Fit, CalibrateError> {
             .map(|((k, _), s)| (k.to_string(), s))
             .collect(),
         objective,
+        undetermined: undetermined_costs(loads),
     })
 }
 
