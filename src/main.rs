@@ -74,6 +74,13 @@ enum Cmd {
     Sortbuf(cli::args::SortbufArgs),
     /// Perceived movement speed per displayed refresh around a walkthrough's first frame skip (paper 000 Figure 6).
     PerceivedSpeed(cli::args::PerceivedSpeedArgs),
+    /// Print a shell's completion script: `rendersim completions bash > /etc/bash_completion.d/rendersim` (or zsh, fish, elvish, powershell).
+    Completions {
+        /// The shell.
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff): `rendersim man > rendersim.1; man ./rendersim.1`.
+    Man,
 }
 
 fn main() -> ExitCode {
@@ -115,6 +122,8 @@ fn main() -> ExitCode {
         Cmd::LodSelect(a) => commands::lod_select(a),
         Cmd::Sortbuf(a) => commands::sortbuf(a),
         Cmd::PerceivedSpeed(a) => commands::perceived_speed(a),
+        Cmd::Completions { shell } => completions(shell),
+        Cmd::Man => man_page(),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -151,6 +160,34 @@ fn quiet_vulkan_device_select() {
         // SAFETY: called at start-up, before any other thread exists.
         unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
     }
+}
+
+/// `rendersim completions SHELL`: the completion script clap_complete
+/// writes from the command line's own definition, on standard output.
+fn completions(shell: clap_complete::Shell) -> anyhow::Result<()> {
+    use clap::CommandFactory;
+    let mut out = Vec::new();
+    clap_complete::generate(shell, &mut Cli::command(), "rendersim", &mut out);
+    print_bytes(&out)
+}
+
+/// `rendersim man`: the man page clap_mangen writes from the command
+/// line's own definition (the commands and global options; each command's
+/// options are in its `--help`), on standard output.
+fn man_page() -> anyhow::Result<()> {
+    use clap::CommandFactory;
+    let mut out = Vec::new();
+    clap_mangen::Man::new(Cli::command()).render(&mut out)?;
+    print_bytes(&out)
+}
+
+/// Writes `bytes` to standard output (a full disk is an error, not a panic).
+fn print_bytes(bytes: &[u8]) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut o = std::io::stdout().lock();
+    o.write_all(bytes)
+        .and_then(|()| o.flush())
+        .map_err(|e| anyhow::anyhow!("cannot write to standard output: {e}"))
 }
 
 /// What the spinner says: the command line, shortened to fit a terminal.

@@ -1641,3 +1641,32 @@ fn version_names_the_git_revision_it_was_built_from() {
         assert!(out.trim_end().ends_with(&format!("({rev})")), "{out}");
     }
 }
+
+#[test]
+fn completions_and_the_man_page_come_from_the_command_line_itself() {
+    // Issue 58 item 2: clap's own generators, so every command is in them.
+    for shell in ["bash", "zsh", "fish", "elvish", "powershell"] {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+            .args(["completions", shell])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{shell}");
+        let text = String::from_utf8_lossy(&o.stdout);
+        for cmd in ["replay", "experiment", "perceived-speed", "compare", "no-timing"] {
+            assert!(text.contains(cmd), "{shell}: no {cmd}");
+        }
+    }
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+        .arg("man")
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let page = String::from_utf8_lossy(&o.stdout);
+    assert!(page.contains(".TH rendersim 1") && page.contains("replay"), "{page}");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
+        .args(["completions", "tcsh"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("possible values: bash"));
+}

@@ -196,6 +196,8 @@ const CASES: &[Case] = &[
             "--quiet",
         ]),
     ),
+    ("rendersim completions bash", Some(&["completions", "bash"])),
+    ("rendersim man", Some(&["man"])),
 ];
 
 #[test]
