@@ -112,46 +112,74 @@ pub struct ExperimentResult {
 }
 
 impl ExperimentResult {
-    /// A short plain-text table: one line per point with each metric's mean
-    /// and half-width, then the derived values (`[[derived]]`: the numbers
-    /// an experiment is usually run for) one line per point where any is
-    /// defined, then the check tally.
+    /// The most points whose means [`ExperimentResult::table`] lists one
+    /// line each; more are in `points.csv` and `report.md`.
+    pub const POINT_LINES: usize = 12;
+
+    /// What `rendersim experiment` prints at the end (issue 58 item 3: the
+    /// answer, not a line per point): each point's means when there are at
+    /// most [`Self::POINT_LINES`] points (else where they are), the
+    /// checks' tally with each failed check measured against expected, the
+    /// claims' verdicts, the Sobol' indices and the searches' values.
     pub fn table(&self, exp: &Experiment) -> String {
         let mut out = String::new();
-        for p in &self.points {
-            let cells: Vec<String> = exp
-                .metrics
+        if self.points.len() <= Self::POINT_LINES {
+            for p in &self.points {
+                let cells: Vec<String> = exp
+                    .metrics
+                    .iter()
+                    .map(|m| match p.stat(&m.path) {
+                        Some(c) => format!("{} = {}", m.label, report::mean_pm(c)),
+                        None => format!("{} = n/a", m.label),
+                    })
+                    .collect();
+                out.push_str(&format!("{}: {}\n", p.label, cells.join("; ")));
+            }
+            let derived: Vec<String> = self
+                .points
                 .iter()
-                .map(|m| match p.stat(&m.path) {
-                    Some(c) => format!("{} = {}", m.label, report::mean_pm(c)),
-                    None => format!("{} = n/a", m.label),
+                .filter_map(|p| {
+                    let cells: Vec<String> = p
+                        .derived
+                        .iter()
+                        .filter_map(|(name, v)| v.map(|v| format!("{name} = {}", report::fmt_num(v))))
+                        .collect();
+                    (!cells.is_empty()).then(|| format!("  {}: {}\n", p.label, cells.join("; ")))
                 })
                 .collect();
-            out.push_str(&format!("{}: {}\n", p.label, cells.join("; ")));
+            if !derived.is_empty() {
+                out.push_str("derived values:\n");
+                derived.iter().for_each(|l| out.push_str(l));
+            }
+        } else {
+            out.push_str(&format!(
+                "{} points: each point's means are in points.csv, the runs in runs.csv, the plots and tables in report.md\n",
+                self.points.len()
+            ));
         }
-        let derived: Vec<String> = self
-            .points
-            .iter()
-            .filter_map(|p| {
-                let cells: Vec<String> = p
-                    .derived
-                    .iter()
-                    .filter_map(|(name, v)| v.map(|v| format!("{name} = {}", report::fmt_num(v))))
-                    .collect();
-                (!cells.is_empty()).then(|| format!("  {}: {}\n", p.label, cells.join("; ")))
-            })
-            .collect();
-        if !derived.is_empty() {
-            out.push_str("derived values:\n");
-            derived.iter().for_each(|l| out.push_str(l));
-        }
-        let tests = self.checks.iter().filter(|c| c.claim.is_none()).count();
-        if tests > 0 {
+        let tests: Vec<&CheckOutcome> = self.checks.iter().filter(|c| c.claim.is_none()).collect();
+        if !tests.is_empty() {
             out.push_str(&format!(
                 "checks: {} passed, {} failed\n",
-                tests - self.checks_failed,
+                tests.len() - self.checks_failed,
                 self.checks_failed
             ));
+            const FAILED_LINES: usize = 10;
+            let failed: Vec<&&CheckOutcome> = tests.iter().filter(|c| !c.passed).collect();
+            for c in failed.iter().take(FAILED_LINES) {
+                out.push_str(&format!(
+                    "  FAILED {} at {}: measured {}, expected {} ({}), error {}\n",
+                    c.path,
+                    c.point,
+                    c.measured.map_or("n/a".into(), report::fmt_num),
+                    c.expected_text,
+                    c.tolerance_text,
+                    c.error_text()
+                ));
+            }
+            if failed.len() > FAILED_LINES {
+                out.push_str(&format!("  ... and {} more (report.md)\n", failed.len() - FAILED_LINES));
+            }
         }
         for (claim, holds, total) in self.claims() {
             let verdict = match holds {
@@ -160,6 +188,46 @@ impl ExperimentResult {
                 h => format!("HOLDS IN PART ({h} of {total})"),
             };
             out.push_str(&format!("claim {verdict}: {claim}\n"));
+        }
+        for s in &self.sensitivity {
+            let Some(indices) = &s.indices else {
+                out.push_str(&format!(
+                    "Sobol' indices of {}: n/a (the metric does not vary)\n",
+                    s.label
+                ));
+                continue;
+            };
+            out.push_str(&format!(
+                "Sobol' indices of {} (first order S1, total ST, bootstrap 95% intervals):\n",
+                s.label
+            ));
+            for (key, i) in indices {
+                out.push_str(&format!(
+                    "  {key}: S1 {:.3} [{:.3}, {:.3}], ST {:.3} [{:.3}, {:.3}]\n",
+                    i.first, i.first_ci.0, i.first_ci.1, i.total, i.total_ci.0, i.total_ci.1
+                ));
+            }
+        }
+        for r in &self.searches {
+            out.push_str(&match r.value {
+                Some(v) => format!(
+                    "search {}: {} = {} gives {} = {}\n",
+                    r.name,
+                    r.vary,
+                    report::fmt_num(v),
+                    r.path,
+                    report::fmt_num(r.target)
+                ),
+                None => format!(
+                    "search {}: {} does not reach {} = {} over its bracket ({} to {})\n",
+                    r.name,
+                    r.vary,
+                    r.path,
+                    report::fmt_num(r.target),
+                    report::fmt_num(r.at_ends.0),
+                    report::fmt_num(r.at_ends.1)
+                ),
+            });
         }
         out
     }

@@ -1670,3 +1670,28 @@ fn completions_and_the_man_page_come_from_the_command_line_itself() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("possible values: bash"));
 }
+
+#[test]
+fn an_experiment_ends_with_its_answer_not_a_line_per_point() {
+    // Issue 58 item 3's target: latency-sensitivity (2,048 points) prints at
+    // most 30 lines, and they hold the Sobol' indices.
+    let d = tempfile::tempdir().unwrap();
+    let o = bin()
+        .args(["experiment", "experiments/latency-sensitivity.toml", "--out"])
+        .arg(d.path().join("ls"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.lines().count() <= 30, "{} lines:\n{text}", text.lines().count());
+    assert!(text.contains("Sobol' indices of mean display latency (ms)"), "{text}");
+    assert!(
+        text.contains("cpu.max_frames_ahead: S1 ") && text.contains(", ST "),
+        "{text}"
+    );
+    assert!(
+        text.contains("2048 points: each point's means are in points.csv"),
+        "{text}"
+    );
+}
