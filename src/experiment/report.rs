@@ -330,7 +330,12 @@ fn sensitivity(s: &mut String, exp: &Experiment, r: &ExperimentResult) {
                     fmt_num(i.total_ci.1)
                 );
             }
-            let _ = writeln!(s, "\n![Sobol' indices of {}]({f}.svg)\n", sens.label, f = sens.plot);
+            let _ = writeln!(
+                s,
+                "\n![{}]({f}.svg)\n",
+                super::sobol::indices_title(&sens.label),
+                f = sens.plot
+            );
         }
     }
 }

@@ -192,14 +192,14 @@ impl ExperimentResult {
         for s in &self.sensitivity {
             let Some(indices) = &s.indices else {
                 out.push_str(&format!(
-                    "Sobol' indices of {}: n/a (the metric does not vary)\n",
-                    s.label
+                    "{}: n/a (the metric does not vary)\n",
+                    super::sobol::indices_title(&s.label)
                 ));
                 continue;
             };
             out.push_str(&format!(
-                "Sobol' indices of {} (first order S1, total ST, bootstrap 95% intervals):\n",
-                s.label
+                "{}, first order S1 and total ST with bootstrap 95% intervals:\n",
+                super::sobol::indices_title(&s.label)
             ));
             for (key, i) in indices {
                 out.push_str(&format!(

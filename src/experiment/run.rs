@@ -386,7 +386,7 @@ fn write_sensitivity(
             tint_of_previous: false,
         };
         let chart = crate::plot::BarChart {
-            title: format!("Sobol' indices of {}", s.label),
+            title: super::sobol::indices_title(&s.label),
             y_label: "index (share of the output variance)".into(),
             categories: indices.iter().map(|(k, _)| k.clone()).collect(),
             series: vec![

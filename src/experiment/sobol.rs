@@ -235,6 +235,23 @@ pub struct Sensitivity {
     pub plot: String,
 }
 
+/// The name of the indices of a metric labelled `label`: a unit the label
+/// ends with (`mean display latency (ms)`) is the metric's, not the
+/// indices' (shares of its variance, without a unit), and is said so.
+///
+/// ```
+/// use rendersim::experiment::sobol::indices_title;
+///
+/// assert_eq!(indices_title("mean display latency (ms)"), "Sobol' indices of mean display latency (a metric in ms)");
+/// assert_eq!(indices_title("repeated refresh fraction"), "Sobol' indices of repeated refresh fraction");
+/// ```
+pub fn indices_title(label: &str) -> String {
+    match label.trim_end().strip_suffix(')').and_then(|l| l.rsplit_once(" (")) {
+        Some((name, unit)) if !unit.contains('(') => format!("Sobol' indices of {name} (a metric in {unit})"),
+        _ => format!("Sobol' indices of {label}"),
+    }
+}
+
 /// Sobol' indices of every `[[metric]]` of `exp` from the replication means
 /// of its points (empty unless `exp` samples with `method = "sobol"`).
 pub(crate) fn analyse(exp: &super::spec::Experiment, results: &[super::results::PointResult]) -> Vec<Sensitivity> {

@@ -1685,7 +1685,10 @@ fn an_experiment_ends_with_its_answer_not_a_line_per_point() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.lines().count() <= 30, "{} lines:\n{text}", text.lines().count());
-    assert!(text.contains("Sobol' indices of mean display latency (ms)"), "{text}");
+    assert!(
+        text.contains("Sobol' indices of mean display latency (a metric in ms)"),
+        "{text}"
+    );
     assert!(
         text.contains("cpu.max_frames_ahead: S1 ") && text.contains(", ST "),
         "{text}"
