@@ -235,19 +235,30 @@ pub fn experiment(args: ExperimentArgs) -> Result<()> {
     };
     add_report_provenance(set.dir())?;
     set.commit()?;
+    if args.json {
+        say!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "experiment": result,
+                "out": out.display().to_string(),
+            }))?
+        );
+    }
     // --quiet: the final line alone (with the checks' and claims' tally).
-    if !args.quiet {
+    if !args.quiet && !args.json {
         say!("{}", result.table(&exp));
     }
-    say!(
-        "experiment {:?}: {} points{}, {:.2} s wall ({:.2} s of simulation); results in {}",
-        exp.name,
-        result.points.len(),
-        result.tally(),
-        result.wall_seconds,
-        result.sim_wall_seconds,
-        out.display()
-    );
+    if !args.json {
+        say!(
+            "experiment {:?}: {} points{}, {:.2} s wall ({:.2} s of simulation); results in {}",
+            exp.name,
+            result.points.len(),
+            result.tally(),
+            result.wall_seconds,
+            result.sim_wall_seconds,
+            out.display()
+        );
+    }
     if result.checks_failed > 0 {
         return Err(ChecksFailed {
             failed: result.checks_failed,
@@ -382,26 +393,58 @@ pub fn bench(args: BenchArgs) -> Result<()> {
     let (scale, n) = (args.scale, args.repeats);
     bench::check_scale(scale)?;
     bench::check_repeats(n)?;
+    // With --json, every result goes into one object printed at the end.
+    let mut json = serde_json::Map::new();
+    let mut show = |name: &str, text: String, value: serde_json::Value| {
+        if args.json {
+            json.insert(name.to_string(), value);
+        } else {
+            say!("{text}");
+        }
+    };
     for b in Vec::<Bench>::from(args.which) {
         match b {
-            Bench::Pixelflow => say!("{}", print::pixelflow_bench(&bench::pixelflow_bench(scale, n)?)),
+            Bench::Pixelflow => {
+                let r = bench::pixelflow_bench(scale, n)?;
+                show("pixelflow", print::pixelflow_bench(&r), serde_json::to_value(&r)?);
+            }
             Bench::Kernel => {
                 let mut cases = Vec::new();
                 for (work, pop) in KERNEL_CASES {
                     let k = bench::kernel_case(work, pop, bench::kernel_events(pop, scale, n), n);
-                    say!("{}", print::kernel_bench(&k));
+                    if !args.json {
+                        say!("{}", print::kernel_bench(&k));
+                    }
                     cases.push(k);
                 }
                 if let Some(path) = &args.plot {
                     bench::plot_kernel(&cases, path)?;
-                    say!("kernel scaling plot (the lines above): {}", path.display());
+                    if !args.json {
+                        say!("kernel scaling plot (the lines above): {}", path.display());
+                    }
                 }
+                show("kernel", String::new(), serde_json::to_value(&cases)?);
             }
-            Bench::Pipeline => say!("{}", print::pipeline_bench(&bench::pipeline_bench(scale, n)?)),
-            Bench::Hour => say!("{}", print::hour_bench(&bench::hour_bench(scale, n)?)),
-            Bench::Build => say!("{}", print::build_bench(&bench::build::build_bench(scale, n)?)),
-            Bench::Replay => say!("{}", print::replay_bench(&bench::replay::replay_bench(scale, n)?)),
+            Bench::Pipeline => {
+                let r = bench::pipeline_bench(scale, n)?;
+                show("pipeline", print::pipeline_bench(&r), serde_json::to_value(&r)?);
+            }
+            Bench::Hour => {
+                let r = bench::hour_bench(scale, n)?;
+                show("hour", print::hour_bench(&r), serde_json::to_value(&r)?);
+            }
+            Bench::Build => {
+                let r = bench::build::build_bench(scale, n)?;
+                show("build", print::build_bench(&r), serde_json::to_value(&r)?);
+            }
+            Bench::Replay => {
+                let r = bench::replay::replay_bench(scale, n)?;
+                show("replay", print::replay_bench(&r), serde_json::to_value(&r)?);
+            }
         }
+    }
+    if args.json {
+        say!("{}", serde_json::to_string_pretty(&json)?);
     }
     Ok(())
 }

@@ -1698,3 +1698,29 @@ fn an_experiment_ends_with_its_answer_not_a_line_per_point() {
         "{text}"
     );
 }
+
+#[test]
+fn bench_and_experiment_print_json_when_asked() {
+    // Issue 58 item 3: --json on bench and experiment (calibrate had it).
+    let o = bin()
+        .args(["bench", "pipeline", "--scale", "0.01", "--repeats", "1", "--json"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["pipeline"].is_object(), "{v}");
+    let d = tempfile::tempdir().unwrap();
+    let o = bin()
+        .args(["experiment", "experiments/render-ahead.toml", "--json", "--out"])
+        .arg(d.path().join("ra"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["experiment"]["name"], "render-ahead");
+    assert_eq!(v["experiment"]["points"].as_array().unwrap().len(), 20);
+    assert_eq!(v["experiment"]["checks_failed"], 0);
+    assert!(v["out"].as_str().unwrap().ends_with("ra"));
+}

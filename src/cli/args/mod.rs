@@ -115,6 +115,10 @@ pub struct ExperimentArgs {
     /// With --slurm: submit both scripts with sbatch and print the job ids.
     #[arg(long, requires = "slurm")]
     pub submit: bool,
+    /// Print the result as JSON (points, checks, claims, Sobol' indices,
+    /// searches, wall times, and where the files are) instead of the text.
+    #[arg(long, conflicts_with_all = ["shard", "merge", "slurm"])]
+    pub json: bool,
 }
 
 /// `rendersim isolate`.
@@ -205,6 +209,10 @@ pub struct BenchArgs {
     /// the lines print (medians, bars from minimum to maximum).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
+    /// Print every benchmark's measurements as one JSON object (keyed by
+    /// benchmark) at the end instead of a line each.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// The benchmarks of `rendersim bench`.
