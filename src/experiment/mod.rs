@@ -45,7 +45,7 @@ pub use check::{Bound, CheckOutcome, evaluate_between};
 pub use derived::{interval_width, largest_bin_share, modes, quantile_width_from_min, ratio, relative_error, speedup};
 pub use dotted::{MetricPathError, json_number, json_path};
 pub use error::ExperimentError;
-pub use report::add_provenance;
+pub use report::{add_provenance, lexically_normal};
 pub use results::{ExperimentResult, PathStat, PointResult, RunRecord, ShardCost};
 pub use run::{point_model, run_experiment};
 pub use runner::{FrameTable, RunError, RunOutput, Runner};

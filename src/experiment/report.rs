@@ -121,13 +121,39 @@ fn key_cells(p: &PointResult) -> Vec<String> {
     }
 }
 
+/// `p` with `name/..` pairs and `.` parts taken out, without asking the
+/// file system (`experiments/../models/fixed.toml` is `models/fixed.toml`;
+/// a leading `..` stays).
+///
+/// ```
+/// use std::path::Path;
+/// use rendersim::experiment::lexically_normal;
+///
+/// assert_eq!(lexically_normal(Path::new("experiments/../models/./fixed.toml")), Path::new("models/fixed.toml"));
+/// assert_eq!(lexically_normal(Path::new("../shared/a.csv")), Path::new("../shared/a.csv"));
+/// ```
+pub fn lexically_normal(p: &std::path::Path) -> std::path::PathBuf {
+    use std::path::Component;
+    let mut out: Vec<Component<'_>> = Vec::new();
+    for c in p.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    out.iter().collect()
+}
+
 /// `## Setup`: the model, replications, confidence, points, fixed settings
 /// and sweeps.
 fn setup(s: &mut String, exp: &Experiment, r: &ExperimentResult) {
     let _ = writeln!(s, "## Setup\n");
     let model = match &exp.model {
         ModelSource::Default => "the embedded default model".to_string(),
-        ModelSource::File(p) => format!("`{}`", p.display()),
+        ModelSource::File(p) => format!("`{}`", lexically_normal(p).display()),
     };
     let _ = writeln!(s, "- model: {model}");
     let seeds = exp.seeds();

@@ -1723,4 +1723,8 @@ fn bench_and_experiment_print_json_when_asked() {
     assert_eq!(v["experiment"]["points"].as_array().unwrap().len(), 20);
     assert_eq!(v["experiment"]["checks_failed"], 0);
     assert!(v["out"].as_str().unwrap().ends_with("ra"));
+    // The report names the model as a reader finds it (issue 58 item 4: it
+    // said `experiments/../models/fixed.toml`).
+    let report = std::fs::read_to_string(d.path().join("ra/report.md")).unwrap();
+    assert!(report.contains("- model: `models/fixed.toml`"), "{report}");
 }
