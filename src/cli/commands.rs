@@ -106,12 +106,15 @@ pub fn run(args: RunArgs) -> Result<()> {
     run.summary_mut()["model"] = json!(src.name);
     let provenance = command_provenance();
     run.summary_mut()["provenance"] = serde_json::to_value(&provenance)?;
-    if let Some(set) = &set {
-        let dir = set.dir();
+    // The summary as written (summary.json, --json): wall times fixed when asked.
+    let summary_text = {
         let mut summary = run.summary().clone();
         rendersim::output::timing::fix_wall_times(&mut summary);
-        let summary = serde_json::to_string_pretty(&summary)?;
-        std::fs::write(dir.join("summary.json"), summary).context("writing summary.json")?;
+        serde_json::to_string_pretty(&summary)?
+    };
+    if let Some(set) = &set {
+        let dir = set.dir();
+        std::fs::write(dir.join("summary.json"), &summary_text).context("writing summary.json")?;
         let mut frames = std::io::BufWriter::new(std::fs::File::create(dir.join("frames.csv"))?);
         run.write_frames_csv(&mut frames).context("writing frames.csv")?;
         frames.flush().context("writing frames.csv")?;
@@ -131,13 +134,10 @@ pub fn run(args: RunArgs) -> Result<()> {
         set.commit()?;
     }
     if args.json {
-        let mut summary = run.summary().clone();
-        rendersim::output::timing::fix_wall_times(&mut summary);
-        let text = serde_json::to_string_pretty(&summary)?;
         if trace_on_stdout {
-            esay!("{text}");
+            esay!("{summary_text}");
         } else {
-            say!("{text}");
+            say!("{summary_text}");
         }
     } else if !trace_on_stdout {
         super::progress::suspend(|| run.write_report(&mut std::io::stdout().lock()))?;

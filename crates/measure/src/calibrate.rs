@@ -348,8 +348,7 @@ pub struct Fit {
 /// assert_eq!(undetermined_costs(&[]).len(), rendersim_measure::device_profile::COSTS);
 /// ```
 pub fn undetermined_costs(loads: &[PassLoad]) -> Vec<&'static str> {
-    let draws_vary = loads.iter().any(|l| l.draws != loads[0].draws);
-    let mut a: Vec<[f64; Q]> = loads.iter().map(|l| design(l, 0, 0.0, draws_vary)).collect();
+    let mut a = plain_design(loads);
     let keys = DeviceCosts::default().entries();
     let mut free = Vec::new();
     let mut next = 0;
@@ -379,12 +378,18 @@ pub fn undetermined_costs(loads: &[PassLoad]) -> Vec<&'static str> {
     free
 }
 
+/// The design rows of `loads` with both sides of `max(clear, geometry)`
+/// and no overlap: every column a pass exercises.
+fn plain_design(loads: &[PassLoad]) -> Vec<[f64; Q]> {
+    let draws_vary = loads.iter().any(|l| l.draws != loads[0].draws);
+    loads.iter().map(|l| design(l, 0, 0.0, draws_vary)).collect()
+}
+
 /// Passes among `loads` that differ in what the fit sees of them.
 fn distinct_passes(loads: &[PassLoad]) -> usize {
-    let draws_vary = loads.iter().any(|l| l.draws != loads[0].draws);
-    let mut rows: Vec<Vec<u64>> = loads
+    let mut rows: Vec<Vec<u64>> = plain_design(loads)
         .iter()
-        .map(|l| design(l, 0, 0.0, draws_vary).iter().map(|x| x.to_bits()).collect())
+        .map(|r| r.iter().map(|x| x.to_bits()).collect())
         .collect();
     rows.sort_unstable();
     rows.dedup();

@@ -167,11 +167,9 @@ impl<'a> Cells<'a> {
             return Ok(None);
         }
         if matches!(col, Col::TimeInQpc | Col::CpuStartQpc) {
-            // Ticks, exactly (an `f64` holds whole numbers only to 2^53).
+            // Ticks, exactly (an `f64` holds whole numbers only to 2^53);
+            // negative ones were refused by `set_qpc_base`.
             if let Ok(v) = t.parse::<i64>() {
-                if v < 0 {
-                    return Err(self.bad(line, col, format!("{v} is negative: a QPC stamp counts ticks")));
-                }
                 return Ok(Some((v - self.qpc_base.get()) as f64));
             }
         }
