@@ -147,6 +147,14 @@ impl Figures {
 
 /// The frames the replay predicts (the what-if's, or as captured without
 /// one), generated frames included.
+///
+/// With frame generation the capture lists the presents of its present
+/// thread: a rendered frame's present is the thread's (its GPU end plus
+/// its hold-back), not the game's call, and PresentMon's CPU start of
+/// every present, generated or rendered, is the end of the present before
+/// it. A generated frame's PC latency is measured from the input of the
+/// rendered frame it precedes (FrameView's: the pairs of `MsPCLatency` one
+/// display change apart in the DLSS captures).
 fn predicted(r: &Replay) -> Vec<Frame> {
     let (frames, replayed) = match (&r.whatif_frames, &r.whatif_replayed) {
         (Some(f), Some(rp)) => (f, rp),
@@ -154,6 +162,13 @@ fn predicted(r: &Replay) -> Vec<Frame> {
     };
     let origin = replayed.origin_ps as f64 / 1e9;
     let at = |t: crate::engine::Time| origin + t.as_ms_f64();
+    let mut thread_present: Vec<Option<f64>> = vec![None; frames.len()];
+    for &(f, hold) in &replayed.hold_backs {
+        let end = replayed.records.get(f as usize).and_then(|rec| rec.gpu_end);
+        if let (Some(slot), Some(end)) = (thread_present.get_mut(f as usize), end) {
+            *slot = Some(at(end) + hold.as_ms_f64());
+        }
+    }
     let mut out: Vec<Frame> = frames
         .iter()
         .zip(&replayed.records)
@@ -175,19 +190,29 @@ fn predicted(r: &Replay) -> Vec<Frame> {
                 };
                 Frame {
                     cpu_start: Some(cpu_start),
-                    present: f.predicted_present,
+                    present: thread_present[i].unwrap_or(f.predicted_present),
                     screen,
                     pc_latency: screen.map(|s| s - at(rec.input)),
                 }
             },
         )
         .collect();
-    out.extend(replayed.generated.iter().map(|g| Frame {
-        cpu_start: None,
-        present: at(g.present),
-        screen: g.displayed.map(at),
-        pc_latency: None,
+    out.extend(replayed.generated.iter().map(|g| {
+        let screen = g.displayed.map(at);
+        let input = replayed.records.get(g.before as usize).map(|rec| at(rec.input));
+        Frame {
+            cpu_start: None,
+            present: at(g.present),
+            screen,
+            pc_latency: screen.zip(input).map(|(s, i)| s - i),
+        }
     }));
+    if !replayed.hold_backs.is_empty() {
+        out.sort_by(|a, b| a.present.total_cmp(&b.present));
+        for i in 1..out.len() {
+            out[i].cpu_start = Some(out[i - 1].present);
+        }
+    }
     out
 }
 

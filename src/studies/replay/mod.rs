@@ -123,6 +123,8 @@ struct Simulated {
     records: Vec<FrameRecord>,
     /// The frames frame generation made.
     generated: Vec<GeneratedRecord>,
+    /// Frame generation's hold-backs of the rendered frames.
+    hold_backs: Vec<(u64, crate::engine::Duration)>,
     /// The simulation's wall time, s.
     seconds: f64,
     /// The refreshes that repeated an image, as the display counted them.
@@ -237,6 +239,7 @@ fn simulate(s: &Setup, sets: &[String]) -> Result<Simulated, ReplayError> {
         model,
         records: run.records,
         generated: run.generated,
+        hold_backs: run.hold_backs,
         origin,
         seconds,
         repeated_refreshes,
@@ -314,14 +317,19 @@ pub fn replay_capture(
         simulate_seconds,
         wall_seconds: wall.elapsed().as_secs_f64(),
     };
-    let replayed = |records: Vec<FrameRecord>, generated: Vec<GeneratedRecord>| ReplayedFrames {
+    let replayed = |records: Vec<FrameRecord>, generated: Vec<GeneratedRecord>, hold_backs| ReplayedFrames {
         records,
         generated,
+        hold_backs,
         chain: s.chain.clone(),
         origin_ps: s.origin_ps,
     };
     let (whatif_frames, whatif_model, whatif_replayed) = match whatif {
-        Some(w) => (Some(w.frames), Some(w.model), Some(replayed(w.records, w.generated))),
+        Some(w) => (
+            Some(w.frames),
+            Some(w.model),
+            Some(replayed(w.records, w.generated, w.hold_backs)),
+        ),
         None => (None, None, None),
     };
     Ok(Replay {
@@ -330,7 +338,7 @@ pub fn replay_capture(
         model: captured.model,
         whatif_frames,
         whatif_model,
-        replayed: replayed(captured.records, captured.generated),
+        replayed: replayed(captured.records, captured.generated, captured.hold_backs),
         whatif_replayed,
         unknown_fates: s.rows.iter().filter(|p| !p.fate_known).map(|p| p.line).collect(),
     })

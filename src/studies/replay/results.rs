@@ -285,6 +285,9 @@ pub struct ReplayedFrames {
     pub records: Vec<FrameRecord>,
     /// The frames a what-if's frame generation made.
     pub generated: Vec<GeneratedRecord>,
+    /// With frame generation, per rendered frame its present thread
+    /// presented: (frame, from its GPU end to that present).
+    pub hold_backs: Vec<(u64, crate::engine::Duration)>,
     /// The capture's swap chain.
     pub chain: ChainInfo,
     /// The capture's clock at the run's time zero, ps.

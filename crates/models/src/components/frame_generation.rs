@@ -3,48 +3,95 @@
 //! GPU makes a third, interpolated from both, and the display shows it
 //! before the newer rendered frame, doubling the frames shown.
 //!
-//! The interpolated frame needs the newer rendered frame, so that frame is
-//! held back: when rendered frame `n` is done, the GPU first interpolates
-//! (`frame_generation.cost` of GPU time, which delays the next frame's
-//! rendering like any GPU work), presents the generated frame, and presents
-//! frame `n` half a rendered interval later, so that generated and
-//! rendered frames reach the display evenly spaced (the frame pacing these
-//! implementations do). The rendered interval is the one just measured:
-//! `n`'s GPU end (interpolation included) less `n - 1`'s. A held frame is
-//! presented at once when the next rendered frame is done first (frames
-//! are never reordered). Frame 0 has no predecessor and is presented as it
-//! is.
+//! The model follows the frame-pacing rules AMD publishes for FSR 3's
+//! frame-interpolation swap chain (FidelityFX SDK, "Frame Pacing in FSR3"
+//! and "Frame Interpolation Swapchain": a proxy swap chain with a present
+//! thread of its own), which the DLSS captures in
+//! `../shared/measurements/presentmon/whatif` also show (presents evenly
+//! spaced at twice the rendered rate, the game unthrottled by the display):
+//!
+//! - **The game renders into the proxy's images**, `display.buffers` of
+//!   them. A rendered frame keeps its image until it has been copied into
+//!   the real swap chain (its present) and the next frame's interpolation,
+//!   which reads it, is done ([`PresentThread`]).
+//! - **Interpolation is GPU work of the newer frame** (`cost`): when
+//!   rendered frame `n >= 1` is done, the generated frame between `n - 1`
+//!   and `n` is ready, and so is `n`.
+//! - **A present thread paces the presents**: it presents the generated
+//!   frame, then the rendered one, each no sooner than a present delta
+//!   after the previous present. The delta aims at half the rendered frame
+//!   time, a moving average of the last `pacing_frames` intervals between
+//!   rendered frames' GPU ends (seven in FSR 3), so that generated and
+//!   rendered frames reach the display evenly spaced and one slow frame
+//!   does not upset the pacing; it is shortened by `pacing_variance_factor`
+//!   times the intervals' spread and by `pacing_margin` (FSR 3's frame
+//!   pacing tuning: "target delta = average frame time - variance x
+//!   variance factor - safety margin", defaults 0.1 and 0.1 ms; we read
+//!   its variance as the standard deviation of the halved intervals). The
+//!   shortening is what drains a backlog: paced at exactly half the
+//!   rendered interval the thread would keep any queue it once had, and
+//!   the game, short of proxy images behind it, would slow to match.
+//! - **It holds back only the newest frame's pair**: frames still waiting
+//!   when a newer rendered frame is done go out at once, so the thread
+//!   cannot build a queue that would slow the game behind it.
+//! - **Each present takes an image of the real swap chain** (the display's,
+//!   in its present mode): with none free, the present thread waits for
+//!   one, and the game, short of proxy images, waits behind it. So with
+//!   vsync on (`fifo`) the rendered rate falls to half the refresh, as the
+//!   FSR 3 documentation says; on a composed or `mailbox` chain a newer
+//!   frame replaces a queued one (dropped, counted).
 //!
 //! What it costs is latency: every rendered frame reaches the screen
-//! `cost` plus half an interval later than it would have, and a GPU-bound
-//! game renders fewer frames (the interpolation takes GPU time). What it
-//! gives is twice the frames shown. A generated frame is rendered into a
-//! swap-chain image like any other: with no free image when it is ready, it
-//! is discarded (counted), so frame generation needs at least three images
-//! to show anything.
+//! `cost` plus about half a rendered interval later than it would have,
+//! and a GPU-bound game renders fewer frames (the interpolation takes GPU
+//! time). What it gives is twice the frames shown.
 //!
 //! ```
-//! use rendersim_models::components::frame_generation::held_present;
-//! use rendersim_engine::Time;
+//! use rendersim_models::components::frame_generation::{FrameGenerationConfig, PresentThread, Next, generated_id};
+//! use rendersim_engine::{Duration, Time};
 //!
-//! // Rendered frames done every 18 ms: the newer one goes out 9 ms after
-//! // its generated predecessor.
-//! let at = held_present(Time(36_000_000_000), Time(18_000_000_000));
-//! assert_eq!(at, Time(45_000_000_000));
+//! let ms = |m: u64| Time(m * 1_000_000_000);
+//! // Two proxy images; a moving average over 7 frames, no shortening.
+//! let config = FrameGenerationConfig {
+//!     pacing_margin: Duration::ZERO,
+//!     ..FrameGenerationConfig::default()
+//! };
+//! let mut t = PresentThread::new(2, &config);
+//! assert!(t.acquire());
+//! t.rendered(0, ms(18)); // frame 0: nothing to interpolate from
+//! assert_eq!(t.next(ms(18)), Some(Next::Now(0)));
+//! t.presented(ms(18));
+//! assert!(t.acquire());
+//! t.rendered(1, ms(36)); // frame 1: 18 ms later; the delta is 9 ms
+//! assert_eq!(t.next(ms(36)), Some(Next::Now(generated_id(1))));
+//! t.presented(ms(36));
+//! assert_eq!(t.next(ms(36)), Some(Next::At(ms(45))));
+//! assert_eq!(t.next(ms(45)), Some(Next::Now(1)));
 //! ```
+
+use std::collections::VecDeque;
 
 use serde::{Deserialize, Serialize};
 
 use crate::engine::{Duration, Time};
 
 /// A model file's `[frame_generation]` (left out of written models when off).
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FrameGenerationConfig {
     /// One generated frame before every rendered frame after the first.
     pub enabled: bool,
     /// GPU time to interpolate one frame.
     pub cost: Duration,
+    /// Rendered frames whose intervals the present pacing averages (FSR 3:
+    /// seven).
+    pub pacing_frames: u32,
+    /// How much sooner than half the average rendered interval the present
+    /// thread presents (FSR 3's `safetyMarginInMs`, 0.1 ms).
+    pub pacing_margin: Duration,
+    /// Times the spread of the halved rendered intervals the present delta
+    /// is shortened by (FSR 3's `varianceFactor`, 0.1; 0 to 1).
+    pub pacing_variance_factor: f64,
 }
 
 impl Default for FrameGenerationConfig {
@@ -52,9 +99,15 @@ impl Default for FrameGenerationConfig {
         FrameGenerationConfig {
             enabled: false,
             cost: Duration::ms(1),
+            pacing_frames: 7,
+            pacing_margin: Duration::us(100),
+            pacing_variance_factor: 0.1,
         }
     }
 }
+
+/// The most rendered intervals the present pacing may average.
+pub const MAX_PACING_FRAMES: u32 = 120;
 
 impl FrameGenerationConfig {
     /// Whether frame generation is off (the default).
@@ -71,13 +124,172 @@ impl FrameGenerationConfig {
             Duration::ZERO
         }
     }
+
+    /// Refuses a pacing window outside 1..=[`MAX_PACING_FRAMES`]: the key
+    /// and why.
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        if !(1..=MAX_PACING_FRAMES).contains(&self.pacing_frames) {
+            return Err((
+                "frame_generation.pacing_frames",
+                format!(
+                    "must be 1 to {MAX_PACING_FRAMES} rendered frames (got {})",
+                    self.pacing_frames
+                ),
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.pacing_variance_factor) {
+            return Err((
+                "frame_generation.pacing_variance_factor",
+                format!("must be 0 to 1 (got {})", self.pacing_variance_factor),
+            ));
+        }
+        Ok(())
+    }
 }
 
-/// When a rendered frame done at `done` (its interpolation included) is
-/// presented after the generated frame shown before it: half the rendered
-/// interval (`done - previous_done`) later.
-pub fn held_present(done: Time, previous_done: Time) -> Time {
-    Time(done.0.saturating_add(done.0.saturating_sub(previous_done.0) / 2))
+/// What the present thread does next.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Next {
+    /// Present this frame (swap-chain id) now, if the real swap chain has
+    /// a free image.
+    Now(u64),
+    /// The next present is due at this time.
+    At(Time),
+}
+
+/// Frame generation's proxy swap chain and present thread: the images the
+/// game renders into, the frames waiting to be presented in order, and the
+/// present pacing (see the module's documentation).
+#[derive(Debug, Clone)]
+pub struct PresentThread {
+    /// Proxy images free for the game to render into.
+    free: u32,
+    /// Rendered frames holding a proxy image: (frame, copied into the real
+    /// swap chain, a newer frame's interpolation done).
+    held: VecDeque<(u64, bool, bool)>,
+    /// Frames ready, in present order: (swap-chain id, ready).
+    queue: VecDeque<(u64, Time)>,
+    /// The last rendered frame's GPU end.
+    last_done: Option<Time>,
+    /// The last present.
+    last_present: Option<Time>,
+    /// The last `window` intervals between rendered frames' GPU ends, ps.
+    intervals: VecDeque<u64>,
+    window: usize,
+    /// Shortening of the delta: a fixed margin, and a factor of the
+    /// spread.
+    margin: Duration,
+    variance_factor: f64,
+}
+
+impl PresentThread {
+    /// A present thread whose proxy has `images` images, pacing as
+    /// `config` says.
+    pub fn new(images: u32, config: &FrameGenerationConfig) -> Self {
+        PresentThread {
+            free: images,
+            held: VecDeque::new(),
+            queue: VecDeque::new(),
+            last_done: None,
+            last_present: None,
+            intervals: VecDeque::new(),
+            window: config.pacing_frames.max(1) as usize,
+            margin: config.pacing_margin,
+            variance_factor: config.pacing_variance_factor,
+        }
+    }
+
+    /// Whether a proxy image is free for the game.
+    pub fn can_acquire(&self) -> bool {
+        self.free > 0
+    }
+
+    /// The game takes a proxy image to render into; false if none is free.
+    pub fn acquire(&mut self) -> bool {
+        if self.free > 0 {
+            self.free -= 1;
+            true
+        } else {
+            false
+        }
+    }
+
+    /// The present delta: half the moving average of the rendered
+    /// intervals, less the variance factor times their (halved) standard
+    /// deviation and the margin, never below zero (zero before the second
+    /// rendered frame).
+    pub fn delta(&self) -> Duration {
+        let n = self.intervals.len();
+        if n == 0 {
+            return Duration::ZERO;
+        }
+        let half: Vec<f64> = self.intervals.iter().map(|&i| i as f64 / 2.0).collect();
+        let mean = half.iter().sum::<f64>() / n as f64;
+        let var = half.iter().map(|h| (h - mean) * (h - mean)).sum::<f64>() / n as f64;
+        let target = mean - self.variance_factor * var.sqrt() - self.margin.0 as f64;
+        Duration(target.max(0.0).round() as u64)
+    }
+
+    /// Rendered frame `frame` is done at `done` (its interpolation
+    /// included): the generated frame before it (none for frame 0) and the
+    /// frame itself join the queue, the interval joins the average, and
+    /// the older frames' images, no longer an interpolation's source, are
+    /// freed once copied.
+    pub fn rendered(&mut self, frame: u64, done: Time) {
+        if let Some(last) = self.last_done {
+            self.intervals.push_back(done.0.saturating_sub(last.0));
+            if self.intervals.len() > self.window {
+                self.intervals.pop_front();
+            }
+        }
+        self.last_done = Some(done);
+        for h in &mut self.held {
+            h.2 = true;
+        }
+        self.held.push_back((frame, false, false));
+        self.release();
+        if frame > 0 {
+            self.queue.push_back((generated_id(frame), done));
+        }
+        self.queue.push_back((frame, done));
+    }
+
+    /// What to do next at `now` (`None`: nothing is waiting). A frame is
+    /// due a present delta after the last present, or at once when a newer
+    /// rendered frame is already done: the thread never holds more than
+    /// the newest frame's pair back, so a backlog (after a hitch that
+    /// lengthened the average) cannot outlast the next frame.
+    pub fn next(&self, now: Time) -> Option<Next> {
+        let &(id, ready) = self.queue.front()?;
+        let superseded = self.last_done.is_some_and(|done| ready < done);
+        let due = match self.last_present {
+            Some(last) if !superseded => ready.max(Time(last.0.saturating_add(self.delta().0))),
+            _ => ready,
+        };
+        Some(if due > now { Next::At(due) } else { Next::Now(id) })
+    }
+
+    /// The queue's first frame was presented at `now` (after
+    /// [`Next::Now`]): its id and when it was ready.
+    pub fn presented(&mut self, now: Time) -> Option<(u64, Time)> {
+        let (id, ready) = self.queue.pop_front()?;
+        self.last_present = Some(now);
+        if generated_before(id).is_none()
+            && let Some(h) = self.held.iter_mut().find(|h| h.0 == id)
+        {
+            h.1 = true;
+        }
+        self.release();
+        Some((id, ready))
+    }
+
+    /// Frees the images of the oldest frames both copied and superseded.
+    fn release(&mut self) {
+        while self.held.front().is_some_and(|h| h.1 && h.2) {
+            self.held.pop_front();
+            self.free += 1;
+        }
+    }
 }
 
 /// The swap-chain id of the frame generated before rendered frame `n`
@@ -104,17 +316,74 @@ mod tests {
     use super::*;
 
     #[test]
-    fn ids_and_the_held_present() {
+    fn ids_and_costs() {
         assert_eq!(generated_before(generated_id(7)), Some(7));
         assert_eq!(generated_before(7), None);
-        assert_eq!(held_present(Time(30), Time(10)), Time(40));
-        assert_eq!(held_present(Time(10), Time(10)), Time(10));
         let c = FrameGenerationConfig {
             enabled: true,
             cost: Duration(5),
+            ..FrameGenerationConfig::default()
         };
         assert_eq!(c.cost_before_present(0), Duration::ZERO);
         assert_eq!(c.cost_before_present(1), Duration(5));
         assert!(FrameGenerationConfig::default().is_off());
+        assert!(c.check().is_ok());
+        let bad = FrameGenerationConfig {
+            pacing_frames: 0,
+            ..c.clone()
+        };
+        assert_eq!(bad.check().unwrap_err().0, "frame_generation.pacing_frames");
+        let bad = FrameGenerationConfig {
+            pacing_variance_factor: 1.5,
+            ..c
+        };
+        assert_eq!(bad.check().unwrap_err().0, "frame_generation.pacing_variance_factor");
+    }
+
+    fn exact(window: u32) -> FrameGenerationConfig {
+        FrameGenerationConfig {
+            pacing_frames: window,
+            pacing_margin: Duration::ZERO,
+            pacing_variance_factor: 0.0,
+            ..FrameGenerationConfig::default()
+        }
+    }
+
+    #[test]
+    fn the_delta_is_half_the_moving_average_less_the_spread_and_margin() {
+        let run = |config: &FrameGenerationConfig| {
+            let mut t = PresentThread::new(8, config);
+            for (f, at) in [(0, 0), (1, 10), (2, 30), (3, 60)] {
+                assert!(t.acquire());
+                t.rendered(f, Time(at));
+            }
+            t.delta()
+        };
+        // The last two intervals, 20 and 30: half their mean.
+        assert_eq!(run(&exact(2)), Duration(13));
+        // Halved, 10 and 15: spread 2.5; a factor of 0.4 takes 1, a margin 2.
+        let shortened = FrameGenerationConfig {
+            pacing_variance_factor: 0.4,
+            pacing_margin: Duration(2),
+            ..exact(2)
+        };
+        assert_eq!(run(&shortened), Duration(10));
+    }
+
+    #[test]
+    fn an_image_is_freed_once_copied_and_no_longer_a_source() {
+        let mut t = PresentThread::new(2, &exact(7));
+        assert!(t.acquire() && t.acquire() && !t.acquire());
+        t.rendered(0, Time(10));
+        t.presented(Time(10));
+        // Frame 0 is copied but still the next interpolation's source.
+        assert!(!t.can_acquire());
+        t.rendered(1, Time(20));
+        assert!(t.can_acquire(), "frame 1's interpolation is done");
+        assert_eq!(t.next(Time(20)), Some(Next::Now(generated_id(1))));
+        t.presented(Time(20));
+        assert_eq!(t.next(Time(20)), Some(Next::At(Time(25))));
+        assert_eq!(t.presented(Time(25)), Some((1, Time(20))));
+        assert_eq!(t.next(Time(25)), None);
     }
 }

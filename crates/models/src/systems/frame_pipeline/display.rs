@@ -12,9 +12,10 @@
 //! frame flipped at once (`immediate`) tears the picture where the scan-out
 //! is ([`crate::components::tearing`]): its record keeps the tear line.
 //! With frame generation (`[frame_generation]`,
-//! [`crate::components::frame_generation`]) a rendered frame after the
-//! first is preceded by a generated one and held back half a rendered
-//! interval ([`Display::present_rendered`]).
+//! [`crate::components::frame_generation`]) the game renders into the
+//! proxy's images, and a present thread presents a generated frame before
+//! each rendered one after the first, paced half a rendered interval
+//! apart, each into an image of this swap chain ([`Display::present_rendered`]).
 //!
 //! [`Display`] owns the display's counters (vertical blanks, repeated
 //! refreshes, the mark where refresh metrics start after warm-up, frames
@@ -24,7 +25,7 @@
 //! [`DisplayNews`], which the accounting takes after the instant's steps:
 //! the display never writes the critical path.
 
-use crate::components::frame_generation::{FrameGenerationConfig, generated_before, generated_id, held_present};
+use crate::components::frame_generation::{FrameGenerationConfig, Next, PresentThread, generated_before};
 use crate::components::swap_chain::{Flip, PresentMode, SwapChain, VrrWindow};
 use crate::components::tearing::ScanOut;
 use crate::engine::{Duration, Scheduler, Time};
@@ -78,21 +79,22 @@ pub(super) struct DisplayNews {
     pub(super) shown: Option<u64>,
 }
 
-/// Frame generation at the display: the rendered frame held back, the
-/// generated frames, and those discarded for want of an image.
-#[derive(Debug, Default)]
+/// Frame generation at the display: its present thread (the proxy's
+/// images, the frames waiting, the pacing), the generated frames and the
+/// rendered frames' hold-backs.
+#[derive(Debug)]
 struct Generation {
     /// Its keys (`[frame_generation]`: the GPU time of an interpolation).
     config: FrameGenerationConfig,
-    /// The rendered frame held back, and when it goes out.
-    held: Option<(u64, Time)>,
-    /// The tag of the one [`Ev::HeldPresent`] event that is not stale.
+    /// The proxy swap chain and its present thread.
+    thread: PresentThread,
+    /// The tag of the one [`Ev::HeldPresent`] event that is not stale, and
+    /// when it is due.
     tag: u32,
+    due: Option<Time>,
     /// The frames generated and presented, in order.
     frames: Vec<GeneratedRecord>,
-    /// Generated frames discarded: no swap-chain image was free.
-    skipped: Vec<u64>,
-    /// Per rendered frame held back: (frame, GPU end to its present).
+    /// Per rendered frame presented: (frame, GPU end to its present).
     hold_backs: Vec<(u64, Duration)>,
 }
 
@@ -101,9 +103,7 @@ struct Generation {
 pub struct GenerationView<'a> {
     /// The generated frames presented.
     pub frames: &'a [GeneratedRecord],
-    /// The rendered frames whose generated frame was discarded (no image).
-    pub skipped: &'a [u64],
-    /// (frame, hold-back) per rendered frame held back.
+    /// (frame, hold-back) per rendered frame presented.
     pub hold_backs: &'a [(u64, Duration)],
 }
 
@@ -143,24 +143,35 @@ impl Display {
             }),
             scan: spec.scan,
             generation: spec.generation.clone().map(|config| Generation {
+                thread: PresentThread::new(spec.buffers, &config),
                 config,
-                ..Generation::default()
+                tag: 0,
+                due: None,
+                frames: Vec::new(),
+                hold_backs: Vec::new(),
             }),
             news: DisplayNews::default(),
         }
     }
 
     /// The front end takes a free swap-chain image for a frame it clears
-    /// (false: none is free, it waits).
+    /// (false: none is free, it waits): with frame generation, an image of
+    /// its proxy.
     #[inline(always)]
     pub(super) fn acquire(&mut self) -> bool {
-        self.chain.acquire()
+        match &mut self.generation {
+            None => self.chain.acquire(),
+            Some(g) => g.thread.acquire(),
+        }
     }
 
     /// Whether a swap-chain image is free for [`Display::acquire`].
     #[inline]
     pub(super) fn can_acquire(&self) -> bool {
-        self.chain.can_acquire()
+        match &self.generation {
+            None => self.chain.can_acquire(),
+            Some(g) => g.thread.can_acquire(),
+        }
     }
 
     /// Frames presented and waiting to be shown.
@@ -178,7 +189,6 @@ impl Display {
     pub(super) fn generation(&self) -> Option<GenerationView<'_>> {
         self.generation.as_ref().map(|g| GenerationView {
             frames: &g.frames,
-            skipped: &g.skipped,
             hold_backs: &g.hold_backs,
         })
     }
@@ -201,6 +211,14 @@ impl Display {
             .map_or_else(Vec::new, |g| std::mem::take(&mut g.frames))
     }
 
+    /// The rendered frames' hold-backs (GPU end to present), taken out at
+    /// the end of a run.
+    pub(super) fn take_hold_backs(&mut self) -> Vec<(u64, Duration)> {
+        self.generation
+            .as_mut()
+            .map_or_else(Vec::new, |g| std::mem::take(&mut g.hold_backs))
+    }
+
     /// The GPU time frame generation adds before rendered frame `frame`'s
     /// present: its interpolation (none for frame 0, or without frame
     /// generation). The front end runs it as part of the frame's swap.
@@ -212,11 +230,9 @@ impl Display {
     }
 
     /// The GPU finished rendered frame `frame` at `now`. Without frame
-    /// generation, or for frame 0, it is presented now. With it, a frame held back before is presented
-    /// first; the generated frame is presented now (when a swap-chain image
-    /// is free for it), and `frame` is held back half a rendered interval
-    /// ([`Ev::HeldPresent`]).
-    #[allow(clippy::too_many_arguments)]
+    /// generation it is presented now. With it, the frame (and the one
+    /// generated before it, for frames after the first) joins the present
+    /// thread's queue, which presents what is due ([`Display::pump`]).
     pub(super) fn present_rendered(
         &mut self,
         now: Time,
@@ -224,57 +240,58 @@ impl Display {
         records: &mut [FrameRecord],
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
-        // With frame generation, the frame before's GPU end paces the hold-back.
-        let previous_end = match (&self.generation, frame.checked_sub(1)) {
-            (Some(_), Some(p)) => records[p as usize].gpu_end,
-            _ => None,
-        };
-        match previous_end {
-            Some(prev) => self.present_generating(now, frame, prev, records, s),
+        match &mut self.generation {
             None => self.present(now, frame, records, s),
+            Some(g) => {
+                g.thread.rendered(frame, now);
+                self.pump(now, records, s)
+            }
         }
     }
 
-    /// [`Display::present_rendered`] with frame generation, for a frame
-    /// after the first (out of line: most runs never come here).
+    /// Frame generation's present thread presents every frame due by
+    /// `now` for which this swap chain has a free image, in order; the
+    /// next one due later gets its [`Ev::HeldPresent`] event. A frame
+    /// waiting for an image goes out at the refresh that frees one.
     #[inline(never)]
-    #[allow(clippy::too_many_arguments)]
-    fn present_generating(
-        &mut self,
-        now: Time,
-        frame: u64,
-        prev: Time,
-        records: &mut [FrameRecord],
-        s: &mut Scheduler<Ev>,
-    ) -> Result<(), SystemError> {
-        let held = self.generation.as_mut().and_then(|g| g.held.take());
-        if let Some((h, _)) = held {
-            self.present(now, h, records, s)?;
+    fn pump(&mut self, now: Time, records: &mut [FrameRecord], s: &mut Scheduler<Ev>) -> Result<(), SystemError> {
+        loop {
+            let Some(g) = self.generation.as_mut() else {
+                return Ok(());
+            };
+            match g.thread.next(now) {
+                None => return Ok(()),
+                Some(Next::At(due)) => {
+                    if g.due != Some(due) {
+                        g.due = Some(due);
+                        g.tag = g.tag.wrapping_add(1);
+                        s.at(due, Ev::HeldPresent { tag: g.tag });
+                    }
+                    return Ok(());
+                }
+                Some(Next::Now(_)) => {
+                    if !self.chain.acquire() {
+                        return Ok(());
+                    }
+                    let (id, ready) = g.thread.presented(now).expect("a frame is due");
+                    match generated_before(id) {
+                        Some(before) => g.frames.push(GeneratedRecord {
+                            before,
+                            present: now,
+                            displayed: None,
+                            dropped: false,
+                            tear_line: None,
+                        }),
+                        None => g.hold_backs.push((id, now.since(ready))),
+                    }
+                    self.present(now, id, records, s)?;
+                }
+            }
         }
-        let g = self.generation.as_mut().expect("generation is on");
-        if self.chain.acquire() {
-            g.frames.push(GeneratedRecord {
-                before: frame,
-                present: now,
-                displayed: None,
-                dropped: false,
-                tear_line: None,
-            });
-            self.present(now, generated_id(frame), records, s)?;
-        } else {
-            g.skipped.push(frame);
-        }
-        let g = self.generation.as_mut().expect("generation is on");
-        let at = held_present(now, prev);
-        g.hold_backs.push((frame, at.since(now)));
-        g.held = Some((frame, at));
-        g.tag = g.tag.wrapping_add(1);
-        s.at(at, Ev::HeldPresent { tag: g.tag });
-        Ok(())
     }
 
-    /// The [`Ev::HeldPresent`] event tagged `tag`: the held rendered frame
-    /// goes out (a stale tag, whose frame went out early, does nothing).
+    /// The [`Ev::HeldPresent`] event tagged `tag`: the present thread's
+    /// next present is due (a stale tag does nothing).
     pub(super) fn held_present(
         &mut self,
         now: Time,
@@ -285,10 +302,8 @@ impl Display {
         let Some(g) = self.generation.as_mut().filter(|g| g.tag == tag) else {
             return Ok(());
         };
-        match g.held.take() {
-            Some((frame, _)) => self.present(now, frame, records, s),
-            None => Ok(()),
-        }
+        g.due = None;
+        self.pump(now, records, s)
     }
 
     /// Whether the display refreshes at fixed vertical blanks from time
@@ -446,7 +461,8 @@ impl Display {
         if queued > 0 || now >= deadline {
             // A frame waits for this scan-out's end, or the old image must
             // be refreshed (scanned out again).
-            return self.scan_out(now, records, s);
+            self.scan_out(now, records, s)?;
+            return self.after_refresh(now, records, s);
         }
         // The scan-out ended with nothing to show: the panel waits, up to
         // the slowest refresh's deadline.
@@ -463,6 +479,7 @@ impl Display {
         s: &mut Scheduler<Ev>,
     ) -> Result<(), SystemError> {
         self.refresh_now(now, records);
+        self.after_refresh(now, records, s)?;
         if !self.done() {
             s.after(
                 self.refresh,
@@ -510,5 +527,19 @@ impl Display {
             self.repeated_refreshes += 1;
         }
         self.apply_flip(now, flip, self.chain.mode(), records);
+    }
+
+    /// After a refresh: frame generation's present thread may have waited
+    /// for the image it freed.
+    fn after_refresh(
+        &mut self,
+        now: Time,
+        records: &mut [FrameRecord],
+        s: &mut Scheduler<Ev>,
+    ) -> Result<(), SystemError> {
+        if self.generation.is_some() {
+            self.pump(now, records, s)?;
+        }
+        Ok(())
     }
 }

@@ -60,9 +60,9 @@ pub fn write_report(s: &Value, w: &mut dyn Write) -> io::Result<()> {
     if g.is_object() {
         writeln!(
             w,
-            "  frame generation: {} generated frames shown ({} discarded, no image), {} frames shown per second ({} rendered), hold-back mean {} ms",
+            "  frame generation: {} generated frames shown ({} replaced unshown), {} frames shown per second ({} rendered), hold-back mean {} ms",
             g["generated_shown"],
-            g["skipped"],
+            g["generated_dropped"],
             fixed(f(&g["displayed_fps"]), 1),
             fixed(f(&g["rendered_fps"]), 1),
             fixed(f(&g["hold_back_ms"]["mean"]), 3)

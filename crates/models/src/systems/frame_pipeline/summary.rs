@@ -141,9 +141,8 @@ pub struct GenerationStats {
     pub generated_frames: usize,
     /// Of them, shown.
     pub generated_shown: usize,
-    /// Generated frames discarded: no swap-chain image was free when they
-    /// were ready.
-    pub skipped: usize,
+    /// Of them, replaced by a newer frame before they were shown.
+    pub generated_dropped: usize,
     /// Frames shown a second, rendered and generated, from the first frame
     /// shown after the warm-up to the end of the run.
     pub displayed_fps: f64,
@@ -328,7 +327,7 @@ fn generation_stats(m: &FramePipeline, warm: usize, displayed: usize, span_ps: u
     Some(GenerationStats {
         generated_frames: frames.len(),
         generated_shown: shown,
-        skipped: g.skipped.iter().filter(|f| after(**f)).count(),
+        generated_dropped: frames.iter().filter(|x| x.dropped).count(),
         displayed_fps: per_s(displayed + shown),
         rendered_fps: per_s(displayed),
         hold_back_ms: Dist::of_finite(&holds),

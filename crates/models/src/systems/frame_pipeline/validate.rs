@@ -21,6 +21,9 @@ pub(super) fn validate(cfg: &FramePipelineConfig) -> Result<(), SystemError> {
         ));
     }
     cfg.display.check().map_err(|(key, message)| bad(key, message))?;
+    cfg.frame_generation
+        .check()
+        .map_err(|(key, message)| bad(key, message))?;
     cfg.gpu
         .check_architecture()
         .map_err(|(key, message)| bad(key, message))?;
