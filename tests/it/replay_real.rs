@@ -344,17 +344,29 @@ fn the_compositor_s_timing_is_inferred_from_each_capture_and_explains_its_frames
 
 #[test]
 fn the_input_latencies_a_capture_measured_are_reported_beside_the_replay() {
-    // FrameView's MsPCLatency (issue 56 item 3 reads it; the prediction is
-    // still to come): Alan Wake 2 under the driver's 30 fps cap, The Talos
-    // Principle 2 under its own 60 fps limit.
+    // FrameView's MsPCLatency (issue 56 item 3): Alan Wake 2 under the
+    // driver's 30 fps cap, The Talos Principle 2 under its own 60 fps
+    // limit; and where each game samples input, which the predicted PC
+    // latency keeps in frames: its median less PresentMon's display
+    // latency (screen less the previous present's end), over the median
+    // interval between presents (figures worked out from the files
+    // outside rendersim).
     let dir = shared();
-    for (file, median) in [
-        ("whatif/alanwake2-1080p-dlaa-drivercap30.csv", 65.90),
-        ("whatif/talos2-1080p-cap60.csv", 22.68),
+    for (file, median, lead_ms, lead_frames) in [
+        ("whatif/alanwake2-1080p-dlaa-drivercap30.csv", 65.90, 21.674, 0.650),
+        ("whatif/talos2-1080p-cap60.csv", 22.68, -0.684, -0.041),
+        ("whatif/cyberpunk-1080p-unlimited.csv", 47.45, 8.27, 0.907),
+        ("whatif/alanwake2-1080p-dlaa-unlimited.csv", 28.04, 11.00, 1.283),
+        ("whatif/talos2-1080p-unlimited.csv", 28.85, 14.09, 1.984),
     ] {
         let r = replay(&dir.join(file), &ReplayOptions::default()).unwrap();
         let pc = r.summary.measured_input_latency.pc_latency_ms.unwrap();
         assert!((pc.median.unwrap() - median).abs() < 0.01, "{file}: {pc:?}");
+        let lead = r.summary.measured_input_latency.input_lead.unwrap();
+        assert!(
+            (lead.ms - lead_ms).abs() < 0.01 && (lead.frames - lead_frames).abs() < 0.01,
+            "{file}: {lead:?}"
+        );
     }
     // PresentMon's test capture has none: the JSON leaves the key out.
     let r = replay(&dir.join("test_case_0.csv"), &ReplayOptions::default()).unwrap();

@@ -13,24 +13,29 @@
 //!
 //! PC latency (NVIDIA Reflex's: the game sampling input to the frame on
 //! screen) is measured where the capture has `MsPCLatency`. The replay
-//! predicts it from where its model samples input: at each frame's CPU
-//! start (PresentMon's: the end of the previous present call), after any
-//! wait a pacer or a limiter placed there ([`PC_LATENCY_ASSUMPTION`]). A
-//! game that samples input earlier (a simulation thread a frame ahead of
-//! its render thread) has a longer PC latency than predicted: that is a
-//! finding of the comparison, not a constant fitted to it.
+//! predicts it from where the game samples input, which the replayed
+//! capture shows when it has `MsPCLatency` itself: so many of the game's
+//! frames before PresentMon's CPU start (the end of the previous present
+//! call; [`super::results::InputLead`]), kept in frames under the what-if;
+//! without it, at each frame's start after any wait a pacer or a limiter
+//! placed there ([`PC_LATENCY_ASSUMPTION`]). Where a limiter sits relative
+//! to the game's input (before it, as The Talos Principle 2's does, or
+//! after) is the engine's and is not in a capture: that is a finding of
+//! the comparison, not a constant fitted to it.
 
 use std::path::Path;
 
 use serde::Serialize;
 
-use super::{Replay, ReplayError, ReplayFrame};
+use super::{Replay, ReplayError};
 use crate::capture::presentmon::{Capture, Present};
 use crate::stats::quantile::quantile;
 
 /// Where the replay's model samples input, which its PC latency assumes.
-pub const PC_LATENCY_ASSUMPTION: &str = "input sampled at each frame's CPU start (PresentMon's: the end of the \
-                                         previous present call), after any wait a pacer or limiter puts there";
+pub const PC_LATENCY_ASSUMPTION: &str = "input sampled as many of the game's frames before PresentMon's CPU start \
+                                         (the end of the previous present call) as the replayed capture's \
+                                         MsPCLatency shows (replay.measured_input_latency.input_lead); without \
+                                         it, at each frame's start after any wait a pacer or limiter puts there";
 
 /// One figure, predicted and measured.
 #[derive(Debug, Clone, Copy, Serialize, PartialEq)]
@@ -169,37 +174,43 @@ fn predicted(r: &Replay) -> Vec<Frame> {
             *slot = Some(at(end) + hold.as_ms_f64());
         }
     }
-    let mut out: Vec<Frame> = frames
-        .iter()
-        .zip(&replayed.records)
-        .enumerate()
-        .map(
-            |(i, (f, rec)): (
-                usize,
-                (&ReplayFrame, &crate::systems::frame_pipeline::records::FrameRecord),
-            )| {
-                let screen = f.until_displayed.1.map(|u| f.predicted_present + u);
-                // PresentMon's CPU start is the end of the previous present
-                // call (it cannot see a limiter's sleep after it): the
-                // previous frame's predicted present plus its present call as
-                // captured, unless the model began the frame earlier.
-                let begun = f.cpu_start.1;
-                let cpu_start = match i.checked_sub(1).map(|j| &frames[j]) {
-                    Some(prev) => begun.min(prev.predicted_present + (f.cpu_start.0 - prev.present).max(0.0)),
-                    None => begun,
-                };
-                Frame {
-                    cpu_start: Some(cpu_start),
-                    present: thread_present[i].unwrap_or(f.predicted_present),
-                    screen,
-                    pc_latency: screen.map(|s| s - at(rec.input)),
-                }
-            },
-        )
-        .collect();
+    let generating = !replayed.hold_backs.is_empty();
+    // Where the game samples input: as many of its own frames ahead of
+    // the frame's start as the capture measured (`None`: at the model's
+    // input, the frame's start after any pacing wait).
+    let lead = r.summary.measured_input_latency.input_lead.map(|l| l.frames);
+    let mut inputs: Vec<f64> = Vec::with_capacity(frames.len());
+    let mut out: Vec<Frame> = Vec::with_capacity(frames.len() + replayed.generated.len());
+    for (i, (f, rec)) in frames.iter().zip(&replayed.records).enumerate() {
+        let screen = f.until_displayed.1.map(|u| f.predicted_present + u);
+        // PresentMon's CPU start is the end of the previous present
+        // call (it cannot see a limiter's sleep after it): the
+        // previous frame's predicted present plus its present call as
+        // captured, unless the model began the frame earlier.
+        let begun = f.cpu_start.1;
+        let prev = i.checked_sub(1).map(|j| &frames[j]);
+        let cpu_start = match prev {
+            Some(prev) => begun.min(prev.predicted_present + (f.cpu_start.0 - prev.present).max(0.0)),
+            None => begun,
+        };
+        let input = match (lead, prev) {
+            // With frame generation the presents are the present
+            // thread's: the game's own frames are paced by their starts.
+            (Some(k), Some(prev)) if generating => begun - k * (begun - prev.cpu_start.1),
+            (Some(k), Some(prev)) => cpu_start - k * (f.predicted_present - prev.predicted_present),
+            _ => at(rec.input),
+        };
+        inputs.push(input);
+        out.push(Frame {
+            cpu_start: Some(cpu_start),
+            present: thread_present[i].unwrap_or(f.predicted_present),
+            screen,
+            pc_latency: screen.map(|s| s - input),
+        });
+    }
     out.extend(replayed.generated.iter().map(|g| {
         let screen = g.displayed.map(at);
-        let input = replayed.records.get(g.before as usize).map(|rec| at(rec.input));
+        let input = inputs.get(g.before as usize).copied();
         Frame {
             cpu_start: None,
             present: at(g.present),
@@ -207,7 +218,7 @@ fn predicted(r: &Replay) -> Vec<Frame> {
             pc_latency: screen.zip(input).map(|(s, i)| s - i),
         }
     }));
-    if !replayed.hold_backs.is_empty() {
+    if generating {
         out.sort_by(|a, b| a.present.total_cmp(&b.present));
         for i in 1..out.len() {
             out[i].cpu_start = Some(out[i - 1].present);

@@ -100,11 +100,15 @@ pub fn write_text(s: &ReplaySummary, w: &mut impl std::io::Write) -> std::io::Re
         if let Some(p) = p
             && let (Some(m), Some(p90)) = (p.median, p.p90)
         {
-            writeln!(
-                w,
-                "  measured {name}: median {m:.2} ms, p90 {p90:.2} ms (not predicted yet)"
-            )?;
+            writeln!(w, "  measured {name}: median {m:.2} ms, p90 {p90:.2} ms")?;
         }
+    }
+    if let Some(lead) = &l.input_lead {
+        writeln!(
+            w,
+            "  input sampled {:.2} ms before PresentMon's CPU start (median over {} frames): {:.2} frames of {:.2} ms, which the predicted PC latency keeps",
+            lead.ms, lead.measured_over, lead.frames, lead.interval_ms
+        )?;
     }
     if let Some(c) = &s.compare {
         compare_table(c, w)?;

@@ -138,8 +138,9 @@ pub struct ReplaySummary {
 /// The latencies a capture measured from input (where it has them, over
 /// the replayed swap chain's frames), ms: NVIDIA Reflex's PC latency
 /// (`MsPCLatency`: the game sampling input to the frame on screen) and
-/// PresentMon's input-to-photon latencies. Measured only: the replay does
-/// not predict them yet (issue 56).
+/// PresentMon's input-to-photon latencies, as the capture measured them,
+/// and where the game sampled input ([`InputLead`]), which the replay's
+/// predicted PC latency takes from it.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct InputLatency {
     /// `MsPCLatency`.
@@ -151,6 +152,61 @@ pub struct InputLatency {
     /// `MsClickToPhotonLatency`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub click_to_photon_ms: Option<Percentiles>,
+    /// How long before PresentMon's CPU start the game sampled input (from
+    /// `MsPCLatency`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub input_lead: Option<InputLead>,
+}
+
+/// How far ahead of the frame PresentMon sees the game samples input: a
+/// game's simulation (where NVIDIA Reflex's PC latency starts) runs ahead
+/// of the thread that submits and presents the frame, in most engines by
+/// about a frame. Over the frames with `MsPCLatency`, the lead is PC
+/// latency less the display latency PresentMon measures (screen less its
+/// CPU start, the end of the previous present call); the replay counts it
+/// in frames (the median lead over the median interval between presents),
+/// so that under a what-if that changes the frame rate the game still
+/// samples input that many of its own frames ahead.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct InputLead {
+    /// The median lead, ms.
+    pub ms: f64,
+    /// The median interval between presents, ms.
+    pub interval_ms: f64,
+    /// The lead in frames: `ms / interval_ms`.
+    pub frames: f64,
+    /// Frames it was measured over.
+    pub measured_over: usize,
+}
+
+impl InputLead {
+    /// The lead over `rows` (one swap chain, in present order), or `None`
+    /// without a frame that has PC latency, a display and a predecessor.
+    pub fn of(rows: &[crate::capture::presentmon::Present]) -> Option<InputLead> {
+        let mut leads = Vec::new();
+        let mut intervals = Vec::new();
+        for w in rows.windows(2) {
+            let (prev, p) = (&w[0], &w[1]);
+            intervals.push(p.present - prev.present);
+            if let (Some(pcl), Some(screen)) = (p.pc_latency, p.screen_time()) {
+                leads.push(pcl - (screen - p.cpu_start));
+            }
+        }
+        let median = |mut v: Vec<f64>| {
+            v.retain(|x| x.is_finite());
+            v.sort_by(f64::total_cmp);
+            (!v.is_empty()).then(|| crate::stats::quantile::quantile(&v, 0.5))
+        };
+        let measured_over = leads.len();
+        let ms = median(leads)?;
+        let interval_ms = median(intervals).filter(|i| *i > 0.0)?;
+        Some(InputLead {
+            ms,
+            interval_ms,
+            frames: ms / interval_ms,
+            measured_over,
+        })
+    }
 }
 
 impl InputLatency {
@@ -164,6 +220,7 @@ impl InputLatency {
             pc_latency_ms: of(&|p| p.pc_latency),
             all_input_to_photon_ms: of(&|p| p.all_input_to_photon),
             click_to_photon_ms: of(&|p| p.click_to_photon),
+            input_lead: InputLead::of(rows),
         }
     }
 
