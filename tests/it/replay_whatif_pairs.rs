@@ -182,3 +182,41 @@ fn compare_names_a_missing_capture_and_one_without_the_game() {
     assert!((fps["ratio"].as_f64().unwrap() - ratio).abs() < 1e-12);
     assert!(c["pc_latency_ms_median"]["measured"].is_null());
 }
+
+#[test]
+fn the_pairs_experiment_replays_each_pair_under_its_scenario_s_own_keys() {
+    // experiments/replay-whatif-pairs.toml sweeps one replay model per
+    // pair (experiments/replay-whatif/pairs/): each names the base and the
+    // measured capture of PAIRS and the scenario's keys, no others.
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("experiments/replay-whatif/pairs");
+    let sc = scenarios();
+    let game = |base: &str| base.split('-').next().unwrap().to_string();
+    let mut seen = 0;
+    for (base, scenario, measured) in PAIRS {
+        let file = root.join(format!("{}-{scenario}.toml", game(base)));
+        let text = std::fs::read_to_string(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        let m: rendersim::studies::replay::config::ReplayConfig = toml::from_str(&text).unwrap();
+        assert!(m.capture.ends_with(format!("{base}.csv")), "{}", file.display());
+        assert!(
+            m.compare.unwrap().ends_with(format!("{measured}.csv")),
+            "{}",
+            file.display()
+        );
+        let mut keys = rendersim::studies::replay::config::whatif_sets(&m.whatif);
+        let mut want: Vec<String> = sc[scenario]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_str().unwrap().replace(' ', ""))
+            .collect();
+        keys.sort();
+        want.sort();
+        assert_eq!(keys, want, "{}", file.display());
+        seen += 1;
+    }
+    assert_eq!(
+        seen,
+        std::fs::read_dir(&root).unwrap().count(),
+        "a pair model without a pair"
+    );
+}

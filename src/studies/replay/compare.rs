@@ -9,7 +9,9 @@
 //! display changes per second (generated frames included, as a capture
 //! without `FrameType` lists them), the median interval between display
 //! changes, the median time from a present to its display, the median
-//! display latency (CPU start to the screen), and the median PC latency.
+//! display latency (CPU start to the screen), the median PC latency, and
+//! the frame time (the interval between presents) at its median and 99th
+//! percentile.
 //!
 //! PC latency (NVIDIA Reflex's: the game sampling input to the frame on
 //! screen) is measured where the capture has `MsPCLatency`. The replay
@@ -85,13 +87,17 @@ pub struct Comparison {
     pub display_latency_ms_median: Compared,
     /// Median PC latency, ms (measured: `MsPCLatency`).
     pub pc_latency_ms_median: Compared,
+    /// Frame time (the interval between presents), median, ms.
+    pub frame_time_ms_p50: Compared,
+    /// Frame time, 99th percentile, ms.
+    pub frame_time_ms_p99: Compared,
     /// Where the prediction samples input.
     pub pc_latency_assumption: &'static str,
 }
 
 impl Comparison {
     /// The figures in order, with a name a person reads.
-    pub fn rows(&self) -> [(&'static str, &Compared); 6] {
+    pub fn rows(&self) -> [(&'static str, &Compared); 8] {
         [
             ("fps (presents/s)", &self.fps),
             ("displayed fps", &self.displayed_fps),
@@ -99,6 +105,8 @@ impl Comparison {
             ("until displayed median ms", &self.until_displayed_ms_median),
             ("display latency median ms", &self.display_latency_ms_median),
             ("PC latency median ms", &self.pc_latency_ms_median),
+            ("frame time median ms", &self.frame_time_ms_p50),
+            ("frame time p99 ms", &self.frame_time_ms_p99),
         ]
     }
 }
@@ -119,6 +127,8 @@ struct Figures {
     until_displayed: Option<f64>,
     display_latency: Option<f64>,
     pc_latency: Option<f64>,
+    frame_time_p50: Option<f64>,
+    frame_time_p99: Option<f64>,
 }
 
 fn median(mut v: Vec<f64>) -> Option<f64> {
@@ -139,7 +149,14 @@ impl Figures {
     fn of(frames: &[Frame]) -> Figures {
         let mut screens: Vec<f64> = frames.iter().filter_map(|f| f.screen).collect();
         screens.sort_by(f64::total_cmp);
+        let mut presents: Vec<f64> = frames.iter().map(|f| f.present).filter(|x| x.is_finite()).collect();
+        presents.sort_by(f64::total_cmp);
+        let mut intervals: Vec<f64> = presents.windows(2).map(|w| w[1] - w[0]).collect();
+        intervals.sort_by(f64::total_cmp);
+        let q = |p: f64| (!intervals.is_empty()).then(|| quantile(&intervals, p));
         Figures {
+            frame_time_p50: q(0.5),
+            frame_time_p99: q(0.99),
             fps: rate(frames.iter().map(|f| f.present).collect()),
             displayed_fps: rate(screens.clone()),
             display_change: median(screens.windows(2).map(|w| w[1] - w[0]).collect()),
@@ -272,6 +289,8 @@ pub fn compare(r: &Replay, path: &Path) -> Result<Comparison, ReplayError> {
         until_displayed_ms_median: Compared::of(p.until_displayed, m.until_displayed),
         display_latency_ms_median: Compared::of(p.display_latency, m.display_latency),
         pc_latency_ms_median: Compared::of(p.pc_latency, m.pc_latency),
+        frame_time_ms_p50: Compared::of(p.frame_time_p50, m.frame_time_p50),
+        frame_time_ms_p99: Compared::of(p.frame_time_p99, m.frame_time_p99),
         pc_latency_assumption: PC_LATENCY_ASSUMPTION,
     })
 }

@@ -10,6 +10,9 @@
 //! [assume]                      # optional: what the capture does not say (patches on
 //! display.buffers = 2           # the as-captured model, before the what-if)
 //!
+//! compare = "measured.csv"     # optional: a capture measured under the what-if,
+//!                               # its figures beside the prediction (`replay.compare`)
+//!
 //! [whatif]                      # patches on models/replay.toml (none: as captured)
 //! cpu.max_frames_ahead = 1
 //! display.present_mode = "mailbox"
@@ -41,6 +44,11 @@ pub struct ReplayConfig {
     /// the replay as captured, nested as in a model file.
     #[serde(default, skip_serializing_if = "toml::Table::is_empty")]
     pub assume: toml::Table,
+    /// A capture of the same game measured under the what-if's setting,
+    /// relative to the model file: its figures go beside the prediction
+    /// (`replay.compare`, as `rendersim replay --compare` gives them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compare: Option<PathBuf>,
     /// The what-if: keys of the replay's frame-pipeline model
     /// (models/replay.toml) and their values, nested as in a model file.
     #[serde(default)]

@@ -1,6 +1,8 @@
 //! The `replay` system ([`crate::systems::STUDIES`]): a capture replayed as
 //! captured and under the model file's what-if, so an experiment can sweep
-//! what-ifs on one capture (experiments/replay-whatif.toml). Its summary is
+//! what-ifs on one capture (experiments/replay-whatif.toml), and, with
+//! `compare`, put a capture measured under the what-if beside it
+//! (experiments/replay-whatif-pairs.toml). Its summary is
 //! the replay's (`replay.*`, the keys `rendersim replay --json` prints), its
 //! table the frames of the run the model describes, as PresentMon writes
 //! them (`frames.csv`: the what-if's run, or the replay as captured without
@@ -66,7 +68,14 @@ impl SystemModel for ReplaySystem {
             assume: whatif_sets(&cfg.assume),
             from_tables: true,
         };
-        let replay = replay(&base_dir.join(&cfg.capture), &opts).map_err(blame)?;
+        let mut replay = replay(&base_dir.join(&cfg.capture), &opts).map_err(blame)?;
+        if let Some(measured) = &cfg.compare {
+            let c = super::compare::compare(&replay, &base_dir.join(measured)).map_err(|e| match e {
+                ReplayError::Capture(e) => invalid("compare", e.to_string()),
+                e => blame(e),
+            })?;
+            replay.summary.compare = Some(c);
+        }
         let s = &replay.summary;
         let summary = Summary {
             system: "replay",
@@ -119,6 +128,7 @@ impl Outcome for ReplayRun {
     fn resolved_model(&self, base_dir: &Path) -> String {
         let mut cfg = self.config.clone();
         cfg.capture = base_dir.join(&cfg.capture);
+        cfg.compare = cfg.compare.map(|c| base_dir.join(c));
         resolved_toml(&cfg)
     }
 
