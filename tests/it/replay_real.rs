@@ -156,9 +156,9 @@ const CHAINS: &[Chain] = &[
     c(
         "whatif/alanwake2-1080p-dlaa-drivercap30.csv",
         None,
-        Some(60.0),
+        Some(120.0),
         Flips::VariableRefresh,
-        false,
+        true,
     ),
     c(
         "whatif/alanwake2-1080p-dlaa-drivercap60.csv",

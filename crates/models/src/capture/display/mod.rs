@@ -26,7 +26,9 @@
 //! more changes than chance would must be taken instead). Where even the
 //! pooled changes leave the rate below any panel's
 //! ([`MIN_PANEL_HZ`]), the panel's rate is taken as the slowest whole
-//! multiple at or above it, and the inference says it was ambiguous.
+//! multiple at or above it that puts every display change at a vertical
+//! blank on its grid (a few composed frames three refreshes apart tell 120
+//! Hz from 60), and the inference says it was ambiguous.
 
 use serde::Serialize;
 
@@ -217,9 +219,16 @@ impl DisplayInference {
                 };
                 let mut t = format!("{:.3} Hz from {from} ({})", r.hz, r.chains.join(", "));
                 if let Some(a) = r.ambiguous_below_hz {
-                    t += &format!(
-                        "; ambiguous: the capture fits {a:.2} Hz, the slowest multiple of at least {MIN_PANEL_HZ} Hz taken"
-                    );
+                    let floor = (MIN_PANEL_HZ / a).ceil();
+                    if (r.hz / a).round() > floor {
+                        t += &format!(
+                            "; ambiguous: the capture fits {a:.2} Hz, the multiple of it that its display changes at vertical blanks fit taken"
+                        );
+                    } else {
+                        t += &format!(
+                            "; ambiguous: the capture fits {a:.2} Hz, the slowest multiple of at least {MIN_PANEL_HZ} Hz taken"
+                        );
+                    }
                 }
                 if let Some(f) = r.raised_from_hz {
                     t += &format!("; raised from {f:.2} Hz by flips faster than it");
@@ -303,6 +312,57 @@ impl<'a> Chains<'a> {
     }
 }
 
+/// The fastest panel rate taken: beyond it a finer grid fits too much by
+/// chance to be evidence.
+pub const MAX_PANEL_HZ: f64 = 360.0;
+
+/// Refresh rates panels are sold with (Hz): a finer grid is taken only at
+/// one of them (within 1%), so that a stray interval a grid fits by chance
+/// does not make a 150 Hz or 210 Hz panel.
+pub const PANEL_RATES_HZ: [f64; 16] = [
+    50.0, 60.0, 75.0, 85.0, 90.0, 100.0, 120.0, 144.0, 165.0, 170.0, 180.0, 200.0, 240.0, 280.0, 300.0, 360.0,
+];
+
+/// The intervals between display changes at vertical blanks (the
+/// compositor's presents, composed frames, synced flips), per swap chain.
+fn blank_intervals(chains: &Chains<'_>) -> Vec<f64> {
+    (0..chains.keys.len())
+        .flat_map(|i| intervals(&chains.screen(i, &Path::on_blanks)))
+        .collect()
+}
+
+/// How many refreshes of the panel a grid of `period_ms` (slower than
+/// [`MIN_PANEL_HZ`]) spans. A game capped at 30 fps on a 120 Hz panel
+/// changes the display every 33.3 ms, which 60 Hz fits too; a few composed
+/// frames 25 ms apart (three refreshes) can only be 120 Hz. So: the
+/// slowest multiple at or above the floor, unless a finer one at a panel's
+/// rate ([`PANEL_RATES_HZ`]) puts more of the display changes at vertical blanks
+/// (`blank`, within [`tolerance`]) than chance would: more than its share
+/// of the misfits left (twice the tolerance over the period) plus half a
+/// change.
+fn panel_multiple(period_ms: f64, blank: &[f64]) -> f64 {
+    let floor = (MIN_PANEL_HZ * period_ms / 1000.0).ceil().max(1.0);
+    let misfits = |p: f64| {
+        blank
+            .iter()
+            .filter(|d| (*d - (*d / p).round() * p).abs() > tolerance(p))
+            .count() as f64
+    };
+    let (mut best, mut best_misfits) = (floor, misfits(period_ms / floor));
+    let mut k = floor + 1.0;
+    while 1000.0 * k / period_ms <= MAX_PANEL_HZ && best_misfits > 0.0 {
+        let p = period_ms / k;
+        let hz = 1000.0 / p;
+        let sold = PANEL_RATES_HZ.iter().any(|r| (hz / r - 1.0).abs() <= 0.01);
+        let m = misfits(p);
+        if sold && best_misfits - m > best_misfits * 2.0 * tolerance(p) / p + 0.5 {
+            (best, best_misfits) = (k, m);
+        }
+        k += 1.0;
+    }
+    best
+}
+
 /// Whether a grid holds enough of the changes it was fitted to to count.
 fn is_grid(g: &Grid) -> bool {
     g.on_grid as f64 >= ON_GRID * g.intervals as f64
@@ -322,7 +382,7 @@ pub fn infer_display(capture: &Capture, target: &Present) -> DisplayInference {
     if let Some(r) = &mut refresh
         && r.hz < MIN_PANEL_HZ
     {
-        let k = (MIN_PANEL_HZ / r.hz).ceil();
+        let k = panel_multiple(r.grid.period_ms, &blank_intervals(&chains));
         r.ambiguous_below_hz = Some(r.hz);
         r.grid.period_ms /= k;
         r.hz = r.grid.hz();

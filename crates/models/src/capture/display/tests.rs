@@ -230,3 +230,21 @@ fn the_grid_recovers_period_and_phase_from_skipped_refreshes() {
     assert!(g.holds(3.2) && g.holds(3.2 + 100.0 * p), "{g:?}");
     assert_eq!((g.on_grid, g.intervals), (8, 8));
 }
+
+#[test]
+fn a_grid_below_any_panel_takes_the_multiple_its_blank_changes_fit() {
+    let p = 1000.0 / 30.0;
+    // A 30 fps game's changes alone: the slowest multiple at or above 48 Hz.
+    assert_eq!(panel_multiple(p, &[33.33, 33.34, 33.32, 66.67]), 2.0);
+    // A few composed frames 16.7 and 25 ms apart: 25 ms is three refreshes
+    // of 120 Hz and one and a half of 60 Hz; an outlier that fits no panel
+    // (64.76 ms) does not stop it.
+    assert_eq!(panel_multiple(p, &[33.33, 33.34, 16.71, 24.94, 64.76, 33.3]), 4.0);
+    // A stray interval (a hitch) that no panel's grid fits changes nothing.
+    // (One that a finer panel's grid fits by chance would: the evidence
+    // is a single interval, as in Alan Wake 2's capture under the driver's
+    // 30 fps cap.)
+    assert_eq!(panel_multiple(p, &[33.33, 33.34, 41.3, 33.3]), 2.0);
+    // Nothing to go on.
+    assert_eq!(panel_multiple(p, &[]), 2.0);
+}
