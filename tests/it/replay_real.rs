@@ -144,7 +144,7 @@ const CHAINS: &[Chain] = &[
         Some("dwm.exe"),
         Some(59.95),
         Flips::OnGrid,
-        false,
+        true,
     ),
     c(
         "games/presentmon-trivflip.csv",

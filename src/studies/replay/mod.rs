@@ -271,7 +271,15 @@ pub fn replay_capture(
     };
     let simulate_seconds = captured.seconds + whatif.as_ref().map_or(0.0, |w| w.seconds);
     let frames = &captured.frames;
-    let agree = frames.iter().filter(|f| f.displayed == f.predicted_displayed).count();
+    // Fates agree over the frames whose fate the capture knows.
+    let known: Vec<&ReplayFrame> = s
+        .rows
+        .iter()
+        .zip(frames)
+        .filter(|(p, _)| p.fate_known)
+        .map(|(_, f)| f)
+        .collect();
+    let agree = known.iter().filter(|f| f.displayed == f.predicted_displayed).count();
     let swap = |(m, p): (Option<f64>, Option<f64>)| (p, m);
     let measured: Vec<FrameTimes> = frames.iter().map(ReplayFrame::measured_times).collect();
     let as_captured = captured.stats();
@@ -298,7 +306,7 @@ pub fn replay_capture(
         measured_displayed: frames.iter().filter(|f| f.displayed).count(),
         predicted_displayed: frames.iter().filter(|f| f.predicted_displayed).count(),
         agreement: Agreement {
-            displayed: agree as f64 / frames.len().max(1) as f64,
+            displayed: agree as f64 / known.len().max(1) as f64,
         },
         error_ms: ReplayErrors {
             until_displayed: ErrorStats::of(frames.iter().map(|f| swap(f.until_displayed))),

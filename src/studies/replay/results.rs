@@ -57,7 +57,8 @@ pub struct ReplayErrors {
 /// Agreement of the frames' fates.
 #[derive(Debug, Clone, Serialize)]
 pub struct Agreement {
-    /// Fraction of frames whose displayed-or-dropped state matches.
+    /// Fraction of the frames whose fate the capture knows whose
+    /// displayed-or-dropped state matches.
     pub displayed: f64,
 }
 

@@ -17,6 +17,9 @@ pub(super) struct Notes {
     pub(super) repeated_headers: usize,
     pub(super) trailers: usize,
     pub(super) unknown_fates: usize,
+    /// Presents of a mode PresentMon could not tell that it followed no
+    /// further than the present call.
+    pub(super) untracked: usize,
     /// Values no time can have: the count, and the first one's line, column and text.
     pub(super) impossible: usize,
     pub(super) first_impossible: Option<Impossible>,
@@ -56,6 +59,13 @@ impl Notes {
             out.push(format!(
                 "{} frame(s) with a `Dropped` of neither 0 nor 1 (FrameView writes `Error`): read as not shown",
                 self.unknown_fates
+            ));
+        }
+        if self.untracked > 0 {
+            out.push(format!(
+                "{} present(s) of a mode PresentMon could not tell (`Other`) that it followed no further than the \
+                 present call (no render completion, no display; the trace began after them): fate unknown",
+                self.untracked
             ));
         }
         if let Some((line, col, text)) = &self.first_impossible {

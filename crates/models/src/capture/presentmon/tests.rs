@@ -367,3 +367,30 @@ fn utf16_captures_are_read_as_their_writer_meant() {
         assert!(c.notes.iter().any(|n| n.contains("UTF-16")), "{:?}", c.notes);
     }
 }
+
+#[test]
+fn a_present_presentmon_followed_no_further_than_its_call_has_no_fate() {
+    let head = "Application,ProcessID,SwapChainAddress,Runtime,SyncInterval,PresentFlags,Dropped,TimeInSeconds,MsInPresentAPI,MsBetweenPresents,AllowsTearing,PresentMode,MsUntilRenderComplete,MsUntilDisplayed,MsBetweenDisplayChange";
+    let row = |t: f64, dropped: &str, mode: &str, complete: f64, until: f64| {
+        format!("dwm.exe,1,0x1,DXGI,1,0,{dropped},{t},0.2,16.7,0,{mode},{complete},{until},0\n")
+    };
+    let text = format!(
+        "{head}\n{}{}{}{}",
+        // Untracked: mode unknown, dropped, no completion, no display.
+        row(1.0, "1", "Other", 0.0, 0.0),
+        // A mode unknown but a completion seen: dropped is a fate.
+        row(1.0167, "1", "Other", 2.0, 0.0),
+        // A known mode, dropped: a fate.
+        row(1.0333, "1", "Hardware: Legacy Flip", 0.0, 0.0),
+        row(1.05, "0", "Hardware: Legacy Flip", 1.0, 16.0),
+    );
+    let c = Capture::parse("t.csv", text.as_bytes()).unwrap();
+    let known: Vec<bool> = c.presents.iter().map(|p| p.fate_known).collect();
+    assert_eq!(known, [false, true, true, true]);
+    let notes = c.notes.join("\n");
+    assert!(
+        notes.contains("1 present(s) of a mode PresentMon could not tell"),
+        "{notes}"
+    );
+    assert!(!notes.contains("`Dropped` of neither"), "{notes}");
+}
