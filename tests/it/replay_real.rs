@@ -151,7 +151,7 @@ const CHAINS: &[Chain] = &[
         Some("TrivFlip12.exe"),
         Some(59.95),
         Flips::OnGrid,
-        false,
+        true,
     ),
     c(
         "whatif/alanwake2-1080p-dlaa-drivercap30.csv",

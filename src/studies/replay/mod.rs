@@ -37,6 +37,7 @@
 pub mod compare;
 pub mod config;
 pub mod display_stats;
+pub mod images;
 pub mod refresh;
 pub mod report;
 pub mod results;
@@ -262,8 +263,9 @@ pub fn replay_capture(
     opts: &ReplayOptions,
     wall: std::time::Instant,
 ) -> Result<Replay, ReplayError> {
-    let s = setup(capture, opts)?;
+    let mut s = setup(capture, opts)?;
     let captured = simulate(&s, &[])?;
+    let (captured, images) = images::infer_images(&mut s, &opts.assume, captured)?;
     let whatif = if opts.sets.is_empty() {
         None
     } else {
@@ -299,6 +301,7 @@ pub fn replay_capture(
         },
         refresh_hz: 1000.0 / s.period,
         refresh_from: s.refresh_from,
+        images,
         display: s.display.clone(),
         capture_notes: capture.notes.clone(),
         capture_metadata: capture.metadata.clone(),

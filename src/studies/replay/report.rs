@@ -64,6 +64,13 @@ pub fn write_text(s: &ReplaySummary, w: &mut impl std::io::Write) -> std::io::Re
         s.refresh_hz
     )?;
     writeln!(w, "  display: {}", s.display.describe())?;
+    if let Some(i) = &s.images {
+        writeln!(
+            w,
+            "  swap chain: {} images (its GPU finished frames as early as only {} allow; {} left them {:.2} ms late)",
+            i.buffers, i.buffers, i.instead_of, i.late_ms_instead
+        )?;
+    }
     for note in &s.capture_notes {
         writeln!(w, "  read: {note}")?;
     }

@@ -98,6 +98,10 @@ pub struct ReplaySummary {
     /// this swap chain's flips reached the screen, a variable-refresh
     /// window, every swap chain's path (`capture::display`).
     pub display: DisplayInference,
+    /// The swap chain's image count where its render completions showed
+    /// more than the replay's three ([`super::images`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub images: Option<super::images::ImagesInference>,
     /// What the reader had to undo in the capture (ragged rows, values no
     /// time can have, rows out of order, a restarted clock), one line each.
     #[serde(skip_serializing_if = "Vec::is_empty")]

@@ -104,7 +104,7 @@ impl Setup {
 
 /// Whether the assumptions (`--assume K=V` patches) set `key`, or, with
 /// `key` ending in `.`, a key under it.
-fn assumes(assume: &[String], key: &str) -> bool {
+pub(super) fn assumes(assume: &[String], key: &str) -> bool {
     assume.iter().any(|a| {
         a.split_once('=').is_some_and(|(k, _)| {
             let k = k.trim();
