@@ -1728,3 +1728,25 @@ fn bench_and_experiment_print_json_when_asked() {
     let report = std::fs::read_to_string(d.path().join("ra/report.md")).unwrap();
     assert!(report.contains("- model: `models/fixed.toml`"), "{report}");
 }
+
+#[test]
+fn seeds_past_what_a_model_holds_blame_the_experiment_s_base_seed() {
+    // Issue 60 item 9: the last seed of base_seed + replications - 1 past
+    // i64::MAX (a TOML integer's largest) blamed the model file's line.
+    let root = env!("CARGO_MANIFEST_DIR");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let e = run_err(&[
+        "experiment",
+        &format!("{root}/tests/fuzz-cases/seed-past-i64.toml"),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        e.contains("seed-past-i64.toml") && e.contains("base_seed") && e.contains("9223372036854775808"),
+        "{e}"
+    );
+    assert!(!e.contains("fixed.toml"), "{e}");
+    assert!(!out.exists(), "nothing written");
+}

@@ -141,6 +141,21 @@ impl Validator<'_> {
                 ),
             ));
         }
+        // Each run's seed is written into its model as a TOML integer,
+        // which holds at most i64::MAX.
+        let last_seed = raw.base_seed.checked_add(raw.replications as u64 - 1);
+        if last_seed.is_none_or(|s| s > i64::MAX as u64) {
+            return Err(self.err(
+                "base_seed",
+                format!(
+                    "{} with {} replications runs seeds up to {}, past the largest a model's run.seed can hold ({}): lower base_seed",
+                    raw.base_seed,
+                    raw.replications,
+                    last_seed.map_or_else(|| "beyond 2^64".to_string(), |s| s.to_string()),
+                    i64::MAX
+                ),
+            ));
+        }
         if !(raw.confidence > 0.0 && raw.confidence < 1.0) {
             return Err(self.err("confidence", format!("must be in (0, 1), got {}", raw.confidence)));
         }
