@@ -370,6 +370,67 @@ mod tests {
         assert_eq!(run(&shortened), Duration(10));
     }
 
+    proptest::proptest! {
+        /// Whatever the rendered frames' intervals and the pacing keys, the
+        /// thread presents every frame once, in order (each generated frame
+        /// just before its rendered one), never sooner than it is ready, at
+        /// times that never go back; at the end every proxy image is free but the last
+        /// frame's, the next interpolation's source.
+        #[test]
+        fn presents_every_frame_once_in_order(
+            gaps in proptest::collection::vec(1u64..50_000, 1..60),
+            window in 1u32..10,
+            factor in 0.0f64..1.0,
+            images in 2u32..5,
+        ) {
+            let config = FrameGenerationConfig {
+                enabled: true,
+                pacing_frames: window,
+                pacing_variance_factor: factor,
+                ..FrameGenerationConfig::default()
+            };
+            let mut t = PresentThread::new(images, &config);
+            let mut presented: Vec<(u64, Time)> = Vec::new();
+            let mut now = Time(0);
+            let mut frame = 0u64;
+            let drain = |t: &mut PresentThread, upto: Time, out: &mut Vec<(u64, Time)>| {
+                while let Some(next) = t.next(upto) {
+                    let at = match next {
+                        Next::Now(_) => upto,
+                        Next::At(due) if due <= upto => due,
+                        Next::At(_) => break,
+                    };
+                    let (id, ready) = t.presented(at).unwrap();
+                    proptest::prop_assert!(ready <= at);
+                    out.push((id, at));
+                }
+                Ok(())
+            };
+            for g in &gaps {
+                // The game renders the next frame when a proxy image is free.
+                if !t.acquire() {
+                    // Wait for the pending presents to free one.
+                    drain(&mut t, Time(u64::MAX / 4), &mut presented)?;
+                    proptest::prop_assert!(t.acquire() || frame == 0);
+                }
+                now = Time(now.0 + g);
+                drain(&mut t, now, &mut presented)?;
+                t.rendered(frame, now);
+                frame += 1;
+            }
+            drain(&mut t, Time(u64::MAX / 4), &mut presented)?;
+            let order: Vec<u64> = presented.iter().map(|p| p.0).collect();
+            let mut want = vec![0u64];
+            for n in 1..frame {
+                want.push(generated_id(n));
+                want.push(n);
+            }
+            proptest::prop_assert_eq!(order, want);
+            proptest::prop_assert!(presented.windows(2).all(|w| w[0].1 <= w[1].1));
+            proptest::prop_assert_eq!(t.free, images - 1);
+        }
+    }
+
     #[test]
     fn an_image_is_freed_once_copied_and_no_longer_a_source() {
         let mut t = PresentThread::new(2, &exact(7));
