@@ -73,8 +73,8 @@ pub enum Ev {
     /// The GPU reaches a replayed frame's measured end (`kind = "frames"`
     /// with `gpu_end` only): its swap may finish.
     GpuHoldEnd,
-    /// A rendered frame held back by frame generation goes to the swap
-    /// chain (the tag tells the one pending event from stale ones).
+    /// Frame generation's present thread's next present is due (the tag
+    /// tells the one pending event from stale ones).
     HeldPresent {
         /// Generation tag.
         tag: u32,
