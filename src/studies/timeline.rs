@@ -106,6 +106,19 @@ fn named_bars(spans: &[&ReadSpan]) -> Vec<Bar> {
         .collect()
 }
 
+/// The display lane from the frames shown, `(when, which)`: each on screen
+/// until the next one, the last until `end`.
+fn screen_bars(mut shown: Vec<(f64, Fill)>, end: f64) -> Vec<Bar> {
+    shown.sort_by(|a, b| a.0.total_cmp(&b.0));
+    (0..shown.len())
+        .map(|i| Bar {
+            start: shown[i].0,
+            end: shown.get(i + 1).map_or(end.max(shown[i].0), |n| n.0),
+            fill: shown[i].1,
+        })
+        .collect()
+}
+
 /// Bars of a GPU unit: its busy spans split by the frames' GPU intervals
 /// (`windows`: `(start ms, end ms, frame)`, ascending and disjoint); work
 /// outside every interval goes to the frame before it.
@@ -278,7 +291,23 @@ pub fn timeline_of(
         },
         Lane {
             name: "display".into(),
-            bars: named_bars(&on(DISPLAY)),
+            bars: if run.generated.is_empty() {
+                named_bars(&on(DISPLAY))
+            } else {
+                // Frame generation: every frame on screen until the next,
+                // the generated ones (`gN`, before frame N) among them.
+                let shown: Vec<(f64, Fill)> = run
+                    .records
+                    .iter()
+                    .filter_map(|r| Some((to_ms(r.displayed?), Fill::Frame(r.index))))
+                    .chain(
+                        run.generated
+                            .iter()
+                            .filter_map(|g| Some((to_ms(g.displayed?), Fill::Generated(g.before)))),
+                    )
+                    .collect();
+                screen_bars(shown, range.1)
+            },
             level: None,
         },
     ];
@@ -307,8 +336,13 @@ pub fn timeline_of(
             "refresh (vsync off: frames shown at once)".into()
         },
         notes: vec![format!(
-            "command FIFO fill in {unit}; work less than {MERGE_GAP_US} us apart drawn as one bar; {} Hz display",
-            crate::output::text::fixed(1000.0 / refresh_ms, 1)
+            "command FIFO fill in {unit}; work less than {MERGE_GAP_US} us apart drawn as one bar; {} Hz display{}",
+            crate::output::text::fixed(1000.0 / refresh_ms, 1),
+            if run.generated.is_empty() {
+                ""
+            } else {
+                "; gN: the frame generated before frame N"
+            }
         )],
     };
     Ok((timeline, run))
@@ -326,6 +360,27 @@ mod tests {
             start_us: a * 1000.0,
             end_us: b * 1000.0,
         }
+    }
+
+    #[test]
+    fn generated_frames_take_the_screen_between_rendered_ones() {
+        let bars = screen_bars(
+            vec![
+                (20.0, Fill::Frame(1)),
+                (2.0, Fill::Frame(0)),
+                (11.0, Fill::Generated(1)),
+            ],
+            25.0,
+        );
+        let got: Vec<(f64, f64, Fill)> = bars.iter().map(|b| (b.start, b.end, b.fill)).collect();
+        assert_eq!(
+            got,
+            vec![
+                (2.0, 11.0, Fill::Frame(0)),
+                (11.0, 20.0, Fill::Generated(1)),
+                (20.0, 25.0, Fill::Frame(1)),
+            ]
+        );
     }
 
     #[test]

@@ -26,6 +26,9 @@ use super::{HEIGHT, WIDTH};
 pub enum Fill {
     /// Work on frame `n` (coloured by `n`, labelled when wide enough).
     Frame(u64),
+    /// The frame generated before frame `n` (frame generation): in `n`'s
+    /// colour, lighter, labelled `gN`.
+    Generated(u64),
     /// A system task (dark grey).
     System,
     /// Waiting or blocked (light grey, thin).
@@ -223,7 +226,7 @@ fn draw_bars<DB: DrawingBackend>(
     px_per_x: f64,
 ) -> Result<(), String> {
     let clip = |v: f64| v.clamp(x0, x1);
-    for pass in [Fill::Wait, Fill::System, Fill::Frame(0)] {
+    for pass in [Fill::Wait, Fill::System, Fill::Generated(0), Fill::Frame(0)] {
         let bars = bars
             .iter()
             .filter(|b| std::mem::discriminant(&b.fill) == std::mem::discriminant(&pass) && b.end > x0 && b.start < x1);
@@ -234,6 +237,7 @@ fn draw_bars<DB: DrawingBackend>(
             };
             let style = match b.fill {
                 Fill::Frame(f) => color(f as usize).filled(),
+                Fill::Generated(f) => color(f as usize).mix(0.45).filled(),
                 Fill::System => SYSTEM.filled(),
                 Fill::Wait => WAIT.filled(),
             };
@@ -241,20 +245,24 @@ fn draw_bars<DB: DrawingBackend>(
             chart
                 .draw_series(std::iter::once(Rectangle::new([(s, lo), (end, hi)], style)))
                 .map_err(|e| e.to_string())?;
-            if let Fill::Frame(f) = b.fill {
-                let label = f.to_string();
-                if (end - s) * px_per_x >= 9.0 * label.len() as f64 + 4.0 {
-                    chart
-                        .draw_series(std::iter::once(Text::new(
-                            label,
-                            ((s + end) / 2.0, base + 0.5),
-                            (FAMILY, TICK_PX)
-                                .into_font()
-                                .color(&WHITE)
-                                .pos(Pos::new(HPos::Center, VPos::Center)),
-                        )))
-                        .map_err(|e| e.to_string())?;
-                }
+            let label = match b.fill {
+                Fill::Frame(f) => Some(f.to_string()),
+                Fill::Generated(f) => Some(format!("g{f}")),
+                _ => None,
+            };
+            if let Some(label) = label
+                && (end - s) * px_per_x >= 9.0 * label.len() as f64 + 4.0
+            {
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        label,
+                        ((s + end) / 2.0, base + 0.5),
+                        (FAMILY, TICK_PX)
+                            .into_font()
+                            .color(&WHITE)
+                            .pos(Pos::new(HPos::Center, VPos::Center)),
+                    )))
+                    .map_err(|e| e.to_string())?;
             }
         }
     }
