@@ -106,6 +106,23 @@ fn named_bars(spans: &[&ReadSpan]) -> Vec<Bar> {
         .collect()
 }
 
+/// The display lane of a run with frame generation: every frame on screen
+/// until the next, the generated ones (`gN`, before frame N) among them.
+fn generated_screen_bars(run: &crate::systems::frame_pipeline::PipelineRun, end: f64) -> Vec<Bar> {
+    let to_ms = |t: crate::engine::Time| t.0 as f64 / PS_PER_MS as f64;
+    let shown: Vec<(f64, Fill)> = run
+        .records
+        .iter()
+        .filter_map(|r| Some((to_ms(r.displayed?), Fill::Frame(r.index))))
+        .chain(
+            run.generated
+                .iter()
+                .filter_map(|g| Some((to_ms(g.displayed?), Fill::Generated(g.before)))),
+        )
+        .collect();
+    screen_bars(shown, end)
+}
+
 /// The display lane from the frames shown, `(when, which)`: each on screen
 /// until the next one, the last until `end`.
 fn screen_bars(mut shown: Vec<(f64, Fill)>, end: f64) -> Vec<Bar> {
@@ -294,19 +311,7 @@ pub fn timeline_of(
             bars: if run.generated.is_empty() {
                 named_bars(&on(DISPLAY))
             } else {
-                // Frame generation: every frame on screen until the next,
-                // the generated ones (`gN`, before frame N) among them.
-                let shown: Vec<(f64, Fill)> = run
-                    .records
-                    .iter()
-                    .filter_map(|r| Some((to_ms(r.displayed?), Fill::Frame(r.index))))
-                    .chain(
-                        run.generated
-                            .iter()
-                            .filter_map(|g| Some((to_ms(g.displayed?), Fill::Generated(g.before)))),
-                    )
-                    .collect();
-                screen_bars(shown, range.1)
+                generated_screen_bars(&run, range.1)
             },
             level: None,
         },
