@@ -131,7 +131,8 @@ struct Figures {
     frame_time_p99: Option<f64>,
 }
 
-fn median(mut v: Vec<f64>) -> Option<f64> {
+/// The median of the finite values of `v` (`None` without one).
+pub(super) fn median(mut v: Vec<f64>) -> Option<f64> {
     v.retain(|x| x.is_finite());
     v.sort_by(f64::total_cmp);
     (!v.is_empty()).then(|| quantile(&v, 0.5))

@@ -15,9 +15,9 @@
 
 use serde::Serialize;
 
+use super::compare::median;
 use super::setup::{Setup, assumes};
 use super::{ReplayError, Simulated, simulate};
-use crate::stats::quantile::quantile;
 
 /// Render completion later than measured by more than this (median, ms)
 /// says the replay's chain has too few images: the accuracy target's bound.
@@ -41,14 +41,12 @@ pub struct ImagesInference {
 /// The median of predicted less measured render completion, ms (`None`
 /// without a frame that has both).
 fn late_ms(sim: &Simulated) -> Option<f64> {
-    let mut d: Vec<f64> = sim
-        .frames
-        .iter()
-        .filter_map(|f| Some(f.render_complete.1? - f.render_complete.0?))
-        .filter(|x| x.is_finite())
-        .collect();
-    d.sort_by(f64::total_cmp);
-    (!d.is_empty()).then(|| quantile(&d, 0.5))
+    median(
+        sim.frames
+            .iter()
+            .filter_map(|f| Some(f.render_complete.1? - f.render_complete.0?))
+            .collect(),
+    )
 }
 
 /// The replay as captured with the image count its render completions

@@ -197,11 +197,7 @@ impl InputLead {
                 leads.push(pcl - (screen - p.cpu_start));
             }
         }
-        let median = |mut v: Vec<f64>| {
-            v.retain(|x| x.is_finite());
-            v.sort_by(f64::total_cmp);
-            (!v.is_empty()).then(|| crate::stats::quantile::quantile(&v, 0.5))
-        };
+        let median = super::compare::median;
         let measured_over = leads.len();
         let ms = median(leads)?;
         let interval_ms = median(intervals).filter(|i| *i > 0.0)?;

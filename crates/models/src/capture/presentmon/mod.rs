@@ -616,7 +616,7 @@ fn read_row(
     // Shown or not: `Dropped` where the capture has it (anything but 0 or
     // 1 is unknown), else whether the time until displayed exists.
     let dropped = cell.text(rec, Col::Dropped);
-    let mut fate_known = dropped.is_none_or(|d| d == "0" || d == "1" || d.is_empty());
+    let fate_known = dropped.is_none_or(|d| d == "0" || d == "1" || d.is_empty());
     let until_displayed = if dropped == Some("1") || !fate_known {
         None
     } else if header.has(Col::UntilDisplayed) {
@@ -633,22 +633,8 @@ fn read_row(
             _ => None,
         },
     };
-    // A present of a mode PresentMon could not tell (`Other`), marked
-    // dropped with neither a render completion nor a display: PresentMon
-    // followed it no further than the present call (PresentMon's test
-    // capture of TrivFlip opens with 40 of dwm.exe's: the trace began
-    // after their flips were set up), so its `Dropped` is no fate.
-    let mode = cell.text(rec, Col::PresentMode).unwrap_or_default();
-    let untracked = fate_known
-        && dropped == Some("1")
-        && (mode == "Other" || mode == "Unknown")
-        && render_complete.is_none_or(|r| r == 0.0);
-    if untracked {
-        fate_known = false;
-        notes.untracked += 1;
-    }
     let text = |col: Col| cell.intern(cell.text(rec, col).unwrap_or_default());
-    let present = Present {
+    let mut present = Present {
         line,
         application: text(Col::Application),
         process_id: text(Col::ProcessId),
@@ -674,8 +660,22 @@ fn read_row(
         click_to_photon: opt(Col::ClickToPhoton)?,
         render_queue_depth: opt(Col::RenderQueueDepth)?,
     };
-    if !fate_known && !untracked {
+    if !fate_known {
         notes.unknown_fates += 1;
+    }
+    // A present of a mode PresentMon could not tell (`Other`), marked
+    // dropped with neither a render completion nor a display: PresentMon
+    // followed it no further than the present call (PresentMon's test
+    // capture of TrivFlip opens with 40 of dwm.exe's: the trace began
+    // after their flips were set up), so its `Dropped` is no fate.
+    let mode: &str = &present.present_mode;
+    if fate_known
+        && dropped == Some("1")
+        && (mode == "Other" || mode == "Unknown")
+        && present.render_complete.is_none_or(|r| r == 0.0)
+    {
+        present.fate_known = false;
+        notes.untracked += 1;
     }
     Ok(Row { present, between })
 }
