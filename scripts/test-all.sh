@@ -84,6 +84,19 @@ step "Python package: built from source (pip install ./python) and its tests (py
 CARGO_TARGET_DIR="$root/target" .venv/bin/pip install --quiet --disable-pip-version-check ./python
 .venv/bin/pytest -q -p no:cacheprovider --basetemp "$ci_out/pytest" python/tests
 
+step "Browser: rendersim explore in headless Chromium (Debian's chromium and chromium-driver, driven by Selenium)"
+if [ ! -x /usr/bin/chromium ] || [ ! -x /usr/bin/chromedriver ]; then
+  if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
+    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium chromium-driver >/dev/null
+  else
+    echo "note: cannot install chromium and chromium-driver here (not root or no apt-get); the browser test skips itself"
+  fi
+fi
+.venv/bin/pip install --quiet --disable-pip-version-check -r tests/browser/requirements.txt
+# Screenshots into the CI folder; the test prints the redraw times.
+RENDERSIM_SCREENSHOTS="$ci_out/screenshots" .venv/bin/pytest -q -s -p no:cacheprovider -rs \
+  --basetemp "$ci_out/pytest-browser" tests/browser
+
 step "Studies H1-H4 on this machine's adapter (H1 must predict its validation meshes exactly)"
 if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
   # --require-exact: on lavapipe an inexact H1 is a regression, not a finding.

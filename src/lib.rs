@@ -13,7 +13,7 @@
 //!   simulated systems.
 //! - [`measure`] (`rendersim-measure`): real measurements through wgpu,
 //!   device profiles, calibration and predictions.
-//! - here: [`studies`] that run whole models (isolation, paper 000 Table 1,
+//! - here: [`explore`] (the page `rendersim explore` serves), [`studies`] that run whole models (isolation, paper 000 Table 1,
 //!   the Figure 4 timeline, device predictions), [`experiment`],
 //!   [`bench`](mod@bench), and the command-line tool (`src/main.rs`, `src/cli`).
 #![warn(missing_docs)]
@@ -25,6 +25,7 @@ pub use rendersim_report::{output, plot, stats};
 
 pub mod bench;
 pub mod experiment;
+pub mod explore;
 pub mod studies;
 pub mod systems;
 

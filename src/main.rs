@@ -66,6 +66,8 @@ enum Cmd {
     Bench(BenchArgs),
     /// Draw a few frames as a timeline (paper 000 Figure 4): one lane per unit, frames by colour, vertical blanks marked.
     Timeline(TimelineArgs),
+    /// Explore a model in the browser: a local page with its main knobs, lessons, and the timeline, latency and bottleneck redrawn on every change.
+    Explore(cli::args::ExploreArgs),
     /// Replay a PresentMon capture through the frame pipeline: predicted against measured display times (--set for a what-if).
     Replay(cli::args::ReplayArgs),
     /// Level-of-detail selection on one knapsack instance (paper 001, Funkhouser & Sequin): greedy, incremental, optimal.
@@ -93,10 +95,13 @@ fn main() -> ExitCode {
     }
     #[cfg(all(unix, feature = "wgpu"))]
     quiet_vulkan_device_select();
-    // An interrupt removes the temporary files and staging folders of
-    // outputs being written; finished outputs are never touched.
-    rendersim::output::cleanup::remove_on_signals();
     let cli = Cli::parse();
+    // An interrupt removes the temporary files and staging folders of
+    // outputs being written; finished outputs are never touched. `explore`
+    // writes no file and handles Ctrl-C itself (it stops serving).
+    if !matches!(cli.cmd, Cmd::Explore(_)) {
+        rendersim::output::cleanup::remove_on_signals();
+    }
     if let Some(bytes) = cli.max_input_bytes {
         rendersim::limits::set_max_input_bytes(bytes);
     }
@@ -106,7 +111,8 @@ fn main() -> ExitCode {
     }
     // A spinner on a terminal once a command has worked for two seconds
     // (`experiment` draws its own bar over its runs).
-    let _activity = (!matches!(cli.cmd, Cmd::Experiment(_))).then(|| cli::progress::Activity::start(activity_label()));
+    let _activity = (!matches!(cli.cmd, Cmd::Experiment(_) | Cmd::Explore(_)))
+        .then(|| cli::progress::Activity::start(activity_label()));
     let result = match cli.cmd {
         Cmd::Run(a) => commands::run(a),
         Cmd::Experiment(a) => commands::experiment(a),
@@ -119,6 +125,7 @@ fn main() -> ExitCode {
         Cmd::Bench(a) => commands::bench(a),
         Cmd::Timeline(a) => commands::timeline(a),
         Cmd::Replay(a) => commands::replay(a),
+        Cmd::Explore(a) => commands::explore(a),
         Cmd::LodSelect(a) => commands::lod_select(a),
         Cmd::Sortbuf(a) => commands::sortbuf(a),
         Cmd::PerceivedSpeed(a) => commands::perceived_speed(a),

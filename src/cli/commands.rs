@@ -476,6 +476,47 @@ pub fn timeline(args: TimelineArgs) -> Result<()> {
     Ok(())
 }
 
+/// `rendersim explore`: serves the page until Ctrl-C.
+pub fn explore(args: super::args::ExploreArgs) -> Result<()> {
+    use rendersim::explore::{page_run::Explorer, server};
+    let mut sets = args.sets.clone();
+    if !sets
+        .iter()
+        .any(|s| s.split('=').next().is_some_and(|k| k.trim() == "fidelity"))
+    {
+        sets.insert(0, "fidelity=\"draw\"".to_string());
+    }
+    let explorer = Explorer::new(args.model.as_deref(), sets, args.budget_events)?;
+    let ip = args
+        .listen
+        .unwrap_or(std::net::IpAddr::V4(std::net::Ipv4Addr::LOCALHOST));
+    let addr = std::net::SocketAddr::new(ip, args.port).to_string();
+    let name = explorer.name().to_string();
+    server::serve(explorer, &addr, |at| {
+        let url = format!("http://{at}/");
+        say!("rendersim explore: {name} at {url} (Ctrl-C stops)");
+        if args.open {
+            open_in_browser(&url);
+        }
+    })?;
+    say!("rendersim explore: stopped");
+    Ok(())
+}
+
+/// Opens `url` with the system's opener, or says how to open it.
+fn open_in_browser(url: &str) {
+    let opener = if cfg!(target_os = "macos") { "open" } else { "xdg-open" };
+    let started = std::process::Command::new(opener)
+        .arg(url)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn();
+    if started.is_err() {
+        esay!("note: --open: cannot start {opener}; open {url} in a browser");
+    }
+}
+
 /// `rendersim lod-select`.
 pub fn lod_select(args: super::args::LodSelectArgs) -> Result<()> {
     super::lod::lod_select(&args)

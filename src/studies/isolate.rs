@@ -237,6 +237,9 @@ pub fn isolate(cfg: &FramePipelineConfig, base_dir: &Path, options: IsolateOptio
     if let Some(f) = fidelity {
         base.fidelity = f;
     }
+    // A variable-refresh panel does not quantise frames within its range,
+    // and it needs vsync: it keeps it.
+    let keep_vsync = keep_vsync || base.display.vrr.is_some();
     if !keep_vsync {
         base.display.vsync = false;
     }

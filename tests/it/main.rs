@@ -14,6 +14,7 @@ mod determinism;
 mod devices;
 mod display_oracles;
 mod estimation;
+mod explore;
 mod extreme;
 mod forsyth;
 mod frame_generation;

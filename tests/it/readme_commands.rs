@@ -61,6 +61,9 @@ const CASES: &[Case] = &[
             "--quiet",
         ]),
     ),
+    // A server that runs until Ctrl-C: here its options are checked;
+    // `tests/it/explore.rs` serves it, asks it and stops it.
+    ("rendersim explore", Some(&["explore", "--help"])),
     (
         "rendersim timeline",
         Some(&[

@@ -132,7 +132,7 @@ pub struct IsolateArgs {
     /// Load factor for the reduced subsystem.
     #[arg(long, default_value_t = 0.5)]
     pub factor: f64,
-    /// Keep vsync on (by default it is switched off so quantization does not hide changes).
+    /// Keep vsync on (by default it is switched off so quantization does not hide changes; a VRR display keeps it, as VRR needs it).
     #[arg(long)]
     pub keep_vsync: bool,
     /// Reductions of the frame time within this fraction of the best reduction are reported as a tie.
@@ -368,6 +368,30 @@ mod tests {
             "--order: unknown depth order \"x\" (front_to_back, back_to_front, random)"
         );
     }
+}
+
+/// `rendersim explore`.
+#[derive(Args)]
+pub struct ExploreArgs {
+    /// Model file (TOML) of a frame pipeline; the embedded default model when omitted.
+    pub model: Option<PathBuf>,
+    /// The port to serve on (0: any free one; the address is printed).
+    #[arg(long, default_value_t = 8765)]
+    pub port: u16,
+    /// The address to listen on (default 127.0.0.1: this machine only).
+    #[arg(long, value_name = "ADDR")]
+    pub listen: Option<std::net::IpAddr>,
+    /// Open the page in the system's browser once it is served.
+    #[arg(long)]
+    pub open: bool,
+    /// Where the page starts: a model key set as --set does (repeatable).
+    /// Without a --set of `fidelity`, the page starts at `fidelity="draw"`.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+    /// Most events one run of the page may process (a run that needs more
+    /// is refused with a message, not shown cut short).
+    #[arg(long, value_name = "N", default_value_t = 50_000_000, value_parser = clap::value_parser!(u64).range(1..))]
+    pub budget_events: u64,
 }
 
 /// `rendersim timeline`.

@@ -10,7 +10,7 @@ use super::PlotError;
 use super::axis::{coord, format_number, omitted_note, ticks, widen};
 use super::font::{AXIS_PX, FAMILY, LABEL_PX, TICK_PX, TITLE_PX};
 use super::legend::{self, Occupied};
-use super::output::{draw_notes, render_both};
+use super::output::{Sink, draw_notes, render_to};
 use super::palette::color;
 
 /// A histogram description: each group gets its own colour; all groups share
@@ -366,13 +366,24 @@ fn draw<DB: DrawingBackend>(
 
 /// Write `h` to `<base>.svg` and `<base>.png`.
 pub fn histogram(base: &Path, h: &Histogram) -> Result<(), PlotError> {
+    histogram_to(Sink::Files(base), h)
+}
+
+/// `h` as one SVG document (what [`histogram`] writes to `<base>.svg`).
+pub fn histogram_svg(h: &Histogram) -> Result<String, PlotError> {
+    let mut out = String::new();
+    histogram_to(Sink::Svg(&mut out), h)?;
+    Ok(out)
+}
+
+fn histogram_to(sink: Sink<'_>, h: &Histogram) -> Result<(), PlotError> {
     let (binned, dropped) = bin(h);
     let mut notes: Vec<String> = omitted_note(dropped, false).into_iter().collect();
     notes.extend(h.outside_range_notes().into_iter().map(|n| format!("note: {n}")));
     if h.values.iter().all(|g| g.1.is_empty()) {
         notes.push("note: no data".into());
     }
-    render_both(base, |r| draw(r, h, &binned, &notes), |r| draw(r, h, &binned, &notes))
+    render_to(sink, |r| draw(r, h, &binned, &notes), |r| draw(r, h, &binned, &notes))
 }
 
 #[cfg(test)]

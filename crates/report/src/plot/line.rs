@@ -9,7 +9,7 @@ use super::PlotError;
 use super::axis::{Ticks, all_integers, coord, omitted_note, padded_range, ticks, to_axis};
 use super::font::{AXIS_PX, FAMILY, TICK_PX, TITLE_PX};
 use super::legend::{self, Occupied};
-use super::output::{draw_notes, render_both};
+use super::output::{Sink, draw_notes, render_to};
 use super::palette::color;
 
 /// One named series of a [`LinePlot`].
@@ -508,6 +508,17 @@ fn draw_legend_beside<DB: DrawingBackend>(
 
 /// Write `plot` to `<base>.svg` and `<base>.png`.
 pub fn line_plot(base: &Path, plot: &LinePlot) -> Result<(), PlotError> {
+    line_plot_to(Sink::Files(base), plot)
+}
+
+/// `plot` as one SVG document (what [`line_plot`] writes to `<base>.svg`).
+pub fn line_plot_svg(plot: &LinePlot) -> Result<String, PlotError> {
+    let mut out = String::new();
+    line_plot_to(Sink::Svg(&mut out), plot)?;
+    Ok(out)
+}
+
+fn line_plot_to(sink: Sink<'_>, plot: &LinePlot) -> Result<(), PlotError> {
     let (mut series, dropped) = prepare(plot);
     bound_bars(&mut series, plot.y_bounds);
     let mut notes: Vec<String> = omitted_note(dropped, plot.log_x || plot.log_y).into_iter().collect();
@@ -550,8 +561,8 @@ pub fn line_plot(base: &Path, plot: &LinePlot) -> Result<(), PlotError> {
             }
         }
     }
-    render_both(
-        base,
+    render_to(
+        sink,
         |r| draw(r, plot, &series, &notes),
         |r| draw(r, plot, &series, &notes),
     )

@@ -61,6 +61,52 @@ pub(crate) fn render_both(
     std::fs::write(&png_path, bytes).map_err(|source| PlotError::Io { path: png_path, source })
 }
 
+/// Where a picture goes: `<base>.svg` and `<base>.png` beside each other,
+/// or one SVG document kept in memory (a page that shows the picture,
+/// `rendersim explore`).
+pub(crate) enum Sink<'a> {
+    /// `<base>.svg` and `<base>.png`.
+    Files(&'a Path),
+    /// An SVG document, written into the string.
+    Svg(&'a mut String),
+}
+
+/// The name an in-memory picture goes by in errors.
+pub(crate) const IN_MEMORY: &str = "<svg in memory>";
+
+/// Draws one picture into an SVG document held in memory.
+pub(crate) fn render_svg(
+    out: &mut String,
+    svg: impl FnOnce(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
+) -> Result<(), PlotError> {
+    ensure_font()?;
+    let err = |message: String| PlotError::Draw {
+        path: PathBuf::from(IN_MEMORY),
+        message,
+    };
+    let mut s = String::new();
+    {
+        let root = SVGBackend::with_string(&mut s, (WIDTH, HEIGHT)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
+        svg(&root).map_err(err)?;
+        root.present().map_err(|e| err(e.to_string()))?;
+    }
+    *out = s;
+    Ok(())
+}
+
+/// [`render_both`] or [`render_svg`], by `sink`.
+pub(crate) fn render_to(
+    sink: Sink<'_>,
+    svg: impl FnOnce(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
+    png: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
+) -> Result<(), PlotError> {
+    match sink {
+        Sink::Files(base) => render_both(base, svg, png),
+        Sink::Svg(out) => render_svg(out, svg),
+    }
+}
+
 /// An RGB buffer of `width` x `height` pixels as PNG bytes.
 pub(crate) fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>, png::EncodingError> {
     let mut out = Vec::new();

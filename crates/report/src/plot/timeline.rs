@@ -329,6 +329,13 @@ fn draw_key<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Timeline, has
     Ok(())
 }
 
+/// `t` as one SVG document (what [`timeline`] writes to a `.svg` file).
+pub fn timeline_svg(t: &Timeline) -> Result<String, PlotError> {
+    let mut out = String::new();
+    super::output::render_svg(&mut out, |root| draw(root, t))?;
+    Ok(out)
+}
+
 /// Writes `t` to `path` as SVG or PNG, by the path's extension (see
 /// [`ImageFormat::of`]); the file is replaced atomically.
 pub fn timeline(path: &Path, t: &Timeline) -> Result<(), PlotError> {

@@ -164,6 +164,37 @@ pub(super) fn metric_rows(records: &[FrameRecord]) -> Vec<[f64; metric::N]> {
     rows
 }
 
+/// One frame's figures as the summary's statistics take them: what a view
+/// of a run draws frame by frame (`rendersim explore`).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct FrameFigures {
+    /// The frame's index.
+    pub index: u64,
+    /// Its slot start to the next frame's (ms): `metrics.frame_time_ms`.
+    pub frame_time_ms: f64,
+    /// Its display to the previous frame's display (ms), where both were
+    /// shown: `metrics.display_interval_ms`.
+    pub display_interval_ms: Option<f64>,
+    /// Input sampled to display (ms), where shown: `metrics.display_latency_ms`.
+    pub display_latency_ms: Option<f64>,
+}
+
+/// [`FrameFigures`] of every record, in order (warm-up frames included:
+/// the summary leaves out the first `run.warmup_frames`).
+pub fn frame_figures(records: &[FrameRecord]) -> Vec<FrameFigures> {
+    let some = |v: f64| (!v.is_nan()).then_some(v);
+    records
+        .iter()
+        .zip(metric_rows(records))
+        .map(|(r, row)| FrameFigures {
+            index: r.index,
+            frame_time_ms: row[metric::FRAME_TIME],
+            display_interval_ms: some(row[metric::DISPLAY_INTERVAL]),
+            display_latency_ms: some(row[metric::INPUT_LATENCY]),
+        })
+        .collect()
+}
+
 /// The swap chain the frames were presented on, as PresentMon names it
 /// (the text columns of `frames.csv`).
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -474,7 +474,8 @@ impl CpuThread {
     /// [`CpuPhase::Push`]; the thread is then [`CpuPhase::Running`]. Returns
     /// false, having changed nothing, when that is not all the step would
     /// do: the batch would fill the FIFO past its capacity (a rendezvous),
-    /// or the next operation has no work (it ends at once).
+    /// the next operation has no work (it ends at once), or it is the swap
+    /// and a limiter waits before the present.
     #[inline(always)]
     fn push_draw_start_next(
         &mut self,
@@ -492,6 +493,10 @@ impl CpuThread {
         };
         let next = match sc.draws.get(k as usize + 1) {
             Some(n) => n.cpu,
+            // The swap: a limiter that waits before the present holds it
+            // (`op_wait`, from `CpuPhase::Ready`), so that start is the
+            // general path's.
+            None if self.spec.pacing.present_limit().is_some() => return Ok(false),
             None => self.spec.swap,
         };
         let fifo = &mut env.links.commands;
