@@ -12,6 +12,8 @@
 //! - [`presets`]: the lessons (`docs/teaching.md`);
 //! - [`page_run`]: one redraw, from the `--set` list to typed results and
 //!   SVG views;
+//! - [`page_replay`]: a capture dropped on the page, replayed with the
+//!   page's display and pacing as the what-if;
 //! - [`server`]: the HTTP server (bounded runs, no file read, Ctrl-C).
 //!
 //! ```
@@ -33,6 +35,7 @@
 //! ```
 
 pub mod controls;
+pub mod page_replay;
 pub mod page_run;
 pub mod presets;
 pub mod server;

@@ -5,7 +5,9 @@ It opens the page, checks the timeline has a lane per unit and that the
 page's numbers are `rendersim run --json`'s for the command the page
 shows, takes paper 000 Table 1's lesson and moves the fragment-cost control
 until the verdict moves from geometry to fragment, checks that a bad value
-gets the model's message and that the address carries the state, and fails
+gets the model's message and that the address carries the state, drops a
+shared game capture on the page and checks the replay's agreement is shown
+and that a frame limiter becomes its what-if, and fails
 on any error in the browser's console. It prints the redraw times (from a
 change to the page drawn: median and worst; no limit is asserted) and saves
 screenshots into the test's temp folder (or RENDERSIM_SCREENSHOTS).
@@ -77,6 +79,20 @@ def wait_for(driver, state, timeout=60):
             return
         time.sleep(0.05)
     raise AssertionError(f"the page did not become {state!r}: {driver.find_element('id', 'status').text}")
+
+
+def wait_replay(driver, timeout=60):
+    """Waits until the dropped capture's replay is shown and none is pending."""
+    end = time.time() + timeout
+    while time.time() < end:
+        got = driver.execute_script(
+            "return [document.getElementById('replay-status').dataset.state, replaying.busy || replaying.pending]"
+        )
+        if got[0] in ("ready", "error") and not got[1]:
+            assert got[0] == "ready", driver.find_element("id", "replay-status").text
+            return
+        time.sleep(0.05)
+    raise AssertionError("the capture was not replayed: " + driver.find_element("id", "replay-status").text)
 
 
 def console_errors(driver, allowed=()):
@@ -173,6 +189,29 @@ def test_the_page_teaches_the_bottleneck_shift(served, browser, tmp_path):
     wait_for(d, "error")
     message = d.find_element("id", "error").text
     assert "gpu.fragment.per_fragment" in message, message
+    assert console_errors(d, allowed=["status of 422"]) == []
+
+    # A game capture dropped on the page (the shared CapFrameX capture of
+    # Resident Evil 2; the project's PresentMon test capture without it):
+    # the replay's agreement shown, then a 30 fps limit as its what-if.
+    shared = ROOT.parent / "shared" / "measurements" / "presentmon" / "games" / "capframex-re2-composed-copy-120hz.csv"
+    capture = shared if shared.exists() else ROOT / "tests" / "fixtures" / "presentmon" / "test_case_0.csv"
+    d.get(served)
+    wait_for(d, "ready")
+    d.find_element("id", "capture-file").send_keys(str(capture))
+    wait_replay(d)
+    status = d.find_element("id", "replay-status")
+    assert float(status.get_attribute("data-agreement")) > 0.95, status.text
+    assert "agrees on" in d.find_element("id", "replay-summary").text
+    d.find_element("id", "on-pacing.limit").click()
+    set_control(d, "pacing.limit", 30)
+    wait_for(d, "ready")
+    wait_replay(d)
+    assert "pacing.limit" in d.find_element("id", "replay-command").text
+    whatif_fps = d.find_element("css selector", "#replay-stats tbody tr td:nth-child(4)").text
+    assert float(whatif_fps) < 30.5, whatif_fps
+    d.execute_script("document.getElementById('capture').scrollIntoView()")
+    screenshot(d, tmp_path, "explore-replay")
     assert console_errors(d, allowed=["status of 422"]) == []
 
     print(

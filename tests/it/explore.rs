@@ -256,8 +256,21 @@ impl Served {
 
     /// `GET path` (or another `method`): the status and the body.
     fn ask(&self, method: &str, path: &str) -> (u16, String) {
+        self.send(method, path, None, &[])
+    }
+
+    /// A request with `body` (its length as `Content-Length`, or `length`
+    /// where given, for a body announced but not sent).
+    fn send(&self, method: &str, path: &str, length: Option<u64>, body: &[u8]) -> (u16, String) {
         let mut s = TcpStream::connect(&self.addr).unwrap();
-        write!(s, "{method} {path} HTTP/1.0\r\nHost: {}\r\n\r\n", self.addr).unwrap();
+        let length = length.unwrap_or(body.len() as u64);
+        write!(
+            s,
+            "{method} {path} HTTP/1.0\r\nHost: {}\r\nContent-Length: {length}\r\n\r\n",
+            self.addr
+        )
+        .unwrap();
+        s.write_all(body).unwrap();
         let mut text = String::new();
         s.read_to_string(&mut text).unwrap();
         let status = text.split(' ').nth(1).and_then(|c| c.parse().ok()).unwrap_or(0);
@@ -298,6 +311,43 @@ fn the_server_answers_bad_requests_with_a_message_and_stops_on_ctrl_c() {
     let (status, toml) = served.ask("GET", "/api/model.toml?set=display.buffers%3D3");
     assert_eq!(status, 200);
     assert!(toml.contains("buffers = 3"), "{toml}");
+    // A capture dropped on the page: replayed from the upload, the
+    // display's and pacing's controls as its what-if.
+    let capture = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/presentmon/test_case_0.csv"
+    ))
+    .unwrap();
+    let (status, body) = served.send(
+        "POST",
+        "/api/replay?file=test_case_0.csv&set=pacing.limit%3D%2230Hz%22",
+        None,
+        &capture,
+    );
+    assert_eq!(status, 200, "{body}");
+    let r: serde_json::Value = serde_json::from_str(&body).unwrap();
+    assert!(r["agreement"].as_f64().unwrap() > 0.95, "{}", r["agreement"]);
+    assert_eq!(
+        r["command"],
+        "rendersim replay test_case_0.csv --set 'pacing.limit=\"30Hz\"'"
+    );
+    assert!(
+        r["whatif"][1]["fps"].as_f64().unwrap() < 30.5,
+        "{}",
+        r["whatif"][1]["fps"]
+    );
+    // A scene's key is no replay's what-if; a file that is no capture, an
+    // empty one and one over the limit are refused with a message.
+    let (status, body) = served.send("POST", "/api/replay?set=cpu.per_object%3D%221us%22", None, &capture);
+    assert_eq!(status, 400, "{body}");
+    let (status, body) = served.send("POST", "/api/replay?file=notes.txt", None, b"hello,world\n1,2\n");
+    assert_eq!(status, 422, "{body}");
+    assert!(body.contains("notes.txt"), "{body}");
+    assert_eq!(served.send("POST", "/api/replay", None, b"").0, 400);
+    let (status, body) = served.send("POST", "/api/replay", Some(1 << 40), b"");
+    assert_eq!(status, 413, "{body}");
+    assert!(body.contains("64 MiB"), "{body}");
+    assert_eq!(served.ask("GET", "/api/replay").0, 405);
     // Still serving after all that; Ctrl-C (SIGINT) stops it with status 0.
     assert_eq!(
         served

@@ -4,7 +4,9 @@
 // plotting, the rest is text.
 "use strict";
 
-const state = { model: null, sets: [], busy: false, pending: false, changedAt: null };
+const state = { model: null, sets: [], busy: false, pending: false, changedAt: null, capture: null };
+// The keys a replay's what-if takes (src/explore/page_replay.rs, WHATIF_PREFIXES).
+const WHATIF = ["display.", "pacing.", "frame_generation.", "cpu.max_frames_ahead"];
 // Redraw times (ms from a change to the page drawn), read by the browser test.
 window.rendersimTimings = [];
 
@@ -200,6 +202,7 @@ async function redraw() {
   const q = query();
   history.replaceState(null, "", q ? "?" + q : location.pathname);
   $("model-toml").href = "/api/model.toml" + (q ? "?" + q : "");
+  if (state.capture) replay();
   if (state.busy) { state.pending = true; return; }
   state.busy = true;
   const asked = state.changedAt;
@@ -262,6 +265,84 @@ function draw(r) {
   $("status").dataset.state = "ready";
 }
 
+// The capture replayed with the what-if the controls give; one request at
+// a time, the newest state replayed after it.
+const replaying = { busy: false, pending: false };
+
+async function replay() {
+  if (replaying.busy) { replaying.pending = true; return; }
+  replaying.busy = true;
+  const status = $("replay-status");
+  status.textContent = `replaying ${state.capture.name}…`;
+  status.dataset.state = "loading";
+  const params = new URLSearchParams();
+  params.append("file", state.capture.name);
+  const app = $("capture-app").value.trim();
+  if (app) params.append("app", app);
+  for (const s of state.sets) if (WHATIF.some((p) => keyOf(s).startsWith(p))) params.append("set", s);
+  try {
+    const response = await fetch("/api/replay?" + params.toString(), { method: "POST", body: state.capture.bytes });
+    const body = await response.json();
+    if (!response.ok) {
+      status.textContent = body.error || response.statusText;
+      status.dataset.state = "error";
+    } else drawReplay(body);
+  } catch (err) {
+    status.textContent = "the server did not answer: " + err;
+    status.dataset.state = "error";
+  } finally {
+    replaying.busy = false;
+    if (replaying.pending) { replaying.pending = false; replay(); }
+  }
+}
+
+function pct(v) { return v === null || v === undefined ? "–" : (v * 100).toFixed(1) + "%"; }
+
+function drawReplay(r) {
+  const status = $("replay-status");
+  status.textContent = `${r.file}: ${r.application} (${r.swapchain}), ${r.frames} frames replayed`;
+  status.dataset.state = "ready";
+  status.dataset.agreement = String(r.agreement);
+  const sum = $("replay-summary").tBodies[0];
+  sum.textContent = "";
+  sum.appendChild(row(["displayed or dropped: replay agrees on", pct(r.agreement)]));
+  sum.appendChild(row(["present to screen, |error| median / p90",
+    `${fmt(r.until_displayed_error_ms[0])} / ${fmt(r.until_displayed_error_ms[1])} ms`]));
+  sum.appendChild(row(["present to GPU done, |error| median", `${fmt(r.render_complete_error_ms)} ms`]));
+  sum.appendChild(row(["display inferred", `${r.refresh_hz.toFixed(2)} Hz (from ${r.refresh_from}); ` +
+    `${r.present_mode[0]} replayed as ${r.present_mode[1]}`]));
+  for (const n of r.capture_notes) sum.appendChild(row(["note", n]));
+  const stats = $("replay-stats").tBodies[0];
+  stats.textContent = "";
+  const cols = [r.measured, r.as_captured, r.whatif[1]];
+  const line = (label, pick) => stats.appendChild(row([label, ...cols.map((c) => { const v = pick(c); return v === null || v === undefined ? "–" : fmt(v); })]));
+  line("presents a second", (c) => c.fps);
+  line("display changes a second", (c) => c.displayed_fps);
+  line("latency (CPU start to screen), median, ms", (c) => c.display_latency_ms.median);
+  line("latency, p90, ms", (c) => c.display_latency_ms.p90);
+  line("frames dropped", (c) => c.dropped);
+  $("replay-view").querySelector(".svg").innerHTML = r.view;
+  $("replay-command").textContent = r.command + (r.whatif[0].length ? "" : "    # no what-if: set a display or pacing control");
+}
+
+function setUpCapture() {
+  const load = async (file) => {
+    if (!file) return;
+    state.capture = { name: file.name, bytes: await file.arrayBuffer() };
+    replay();
+  };
+  $("capture-file").addEventListener("change", (e) => load(e.target.files[0]));
+  $("capture-app").addEventListener("change", () => { if (state.capture) replay(); });
+  const zone = $("drop-zone");
+  zone.addEventListener("dragover", (e) => { e.preventDefault(); zone.classList.add("over"); });
+  zone.addEventListener("dragleave", () => zone.classList.remove("over"));
+  zone.addEventListener("drop", (e) => {
+    e.preventDefault();
+    zone.classList.remove("over");
+    load(e.dataTransfer.files[0]);
+  });
+}
+
 async function init() {
   try {
     const response = await fetch("/api/model");
@@ -277,6 +358,7 @@ async function init() {
   state.sets = given.length ? given : state.model.start_sets.slice();
   buildControls();
   buildPresets();
+  setUpCapture();
   showValues();
   $("free-add").addEventListener("click", () => {
     const s = $("free-set").value.trim();
