@@ -209,6 +209,16 @@ pub const CONTROLS: &[Control] = &[
             step: 1.0,
         },
     ),
+    opt(
+        "display.vrr.max_refresh",
+        "VRR: highest refresh (default: refresh)",
+        "display",
+        Kind::Rate {
+            min: 48.0,
+            max: 360.0,
+            step: 1.0,
+        },
+    ),
     opt("pacing.limit", "frame limiter", "pacing", HZ),
     c(
         "pacing.limit_from",

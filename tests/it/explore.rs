@@ -137,6 +137,9 @@ fn every_control_is_taken_by_the_model_at_its_sliders_ends() {
             if a.starts_with("display.vrr") {
                 sets.push("display.refresh=\"360Hz\"".into());
             }
+            if a.starts_with("display.vrr.max_refresh") {
+                sets.push("display.vrr.min_refresh=\"20Hz\"".into());
+            }
             if a.starts_with("display.refresh") && a.contains("\"20Hz\"") {
                 sets.push("pacing.limit=\"20Hz\"".into());
             }

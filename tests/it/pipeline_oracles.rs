@@ -250,6 +250,38 @@ fn tracing_does_not_change_results_at_either_fidelity() {
             "noise.random.0.rate=\"300Hz\"",
             "command_fifo.capacity=8",
         ],
+        // Pacing and the display's other paths, traced and untraced alike.
+        // (A short cut both take once skipped the limiter before the
+        // present; tests/it/pacing.rs holds each place to its interval.)
+        &[
+            "display.vsync=false",
+            "pacing.limit=\"40Hz\"",
+            "pacing.limit_from=\"start\"",
+        ],
+        &[
+            "display.vsync=false",
+            "pacing.limit=\"40Hz\"",
+            "pacing.limit_from=\"present\"",
+        ],
+        &[
+            "display.vsync=false",
+            "pacing.limit=\"40Hz\"",
+            "pacing.limit_from=\"submit\"",
+        ],
+        &[
+            "pacing.limit=\"40Hz\"",
+            "pacing.limit_from=\"present\"",
+            "command_fifo.capacity=8",
+        ],
+        &["display.vsync=false", "pacing.low_latency=true"],
+        &[
+            "display.vsync=false",
+            "display.buffers=3",
+            "frame_generation.enabled=true",
+        ],
+        &["display.present_mode=\"fifo_latest_ready\"", "display.buffers=3"],
+        &["display.composition=\"composed\""],
+        &["display.refresh=\"144Hz\"", "display.vrr.min_refresh=\"48Hz\""],
     ];
     for (fid, extra) in [
         ("triangle", &[][..]),
