@@ -75,6 +75,10 @@ pub struct Control {
     /// Off unless given (`pacing.limit`): the page shows a switch, and
     /// without it the key is not set at all.
     pub optional: bool,
+    /// A scene's knob (per object, per draw, vertex and fragment costs,
+    /// the shader pool): left out for a fixed or replayed workload, whose
+    /// model still carries the key but never uses it.
+    pub scene_only: bool,
 }
 
 const fn c(key: &'static str, label: &'static str, group: &'static str, kind: Kind) -> Control {
@@ -84,16 +88,22 @@ const fn c(key: &'static str, label: &'static str, group: &'static str, kind: Ki
         group,
         kind,
         optional: false,
+        scene_only: false,
+    }
+}
+
+/// A scene's knob ([`Control::scene_only`]).
+const fn scene(key: &'static str, label: &'static str, group: &'static str, kind: Kind) -> Control {
+    Control {
+        scene_only: true,
+        ..c(key, label, group, kind)
     }
 }
 
 const fn opt(key: &'static str, label: &'static str, group: &'static str, kind: Kind) -> Control {
     Control {
-        key,
-        label,
-        group,
-        kind,
         optional: true,
+        ..c(key, label, group, kind)
     }
 }
 
@@ -134,8 +144,8 @@ const HZ: Kind = Kind::Rate {
 /// (CPU, command FIFO, GPU, display, pacing), then the run's own.
 pub const CONTROLS: &[Control] = &[
     c("cpu.non_render", "CPU work per frame", "CPU", ms(0.1, 50.0, 0.1)),
-    c("cpu.per_object", "CPU work per object", "CPU", us(0.0, 200.0, 1.0)),
-    c("cpu.per_draw", "CPU work per draw call", "CPU", us(0.0, 200.0, 1.0)),
+    scene("cpu.per_object", "CPU work per object", "CPU", us(0.0, 200.0, 1.0)),
+    scene("cpu.per_draw", "CPU work per draw call", "CPU", us(0.0, 200.0, 1.0)),
     c("workload.cpu", "CPU work per frame", "CPU", ms(0.0, 50.0, 0.1)),
     c(
         "cpu.max_frames_ahead",
@@ -149,7 +159,7 @@ pub const CONTROLS: &[Control] = &[
         "CPU",
         Kind::Int { min: 1, max: 4096 },
     ),
-    c(
+    scene(
         "gpu.architecture",
         "GPU architecture",
         "GPU",
@@ -157,8 +167,8 @@ pub const CONTROLS: &[Control] = &[
             options: &["unified", "split"],
         },
     ),
-    c("gpu.geometry.vertex_shader", "vertex cost", "GPU", ns(0.0, 500.0, 1.0)),
-    c("gpu.fragment.per_fragment", "fragment cost", "GPU", ns(0.0, 50.0, 0.1)),
+    scene("gpu.geometry.vertex_shader", "vertex cost", "GPU", ns(0.0, 500.0, 1.0)),
+    scene("gpu.fragment.per_fragment", "fragment cost", "GPU", ns(0.0, 50.0, 0.1)),
     c("workload.gpu", "GPU work per frame", "GPU", ms(0.0, 50.0, 0.1)),
     c(
         "workload.scale",
@@ -309,9 +319,14 @@ fn rate_hz(text: &str) -> Option<f64> {
 }
 
 /// The controls that apply to `resolved` (a model as `rendersim run`
-/// writes `model.toml`: every key it uses given), with their values.
-pub fn shown(resolved: &toml::Table) -> Vec<Shown> {
-    CONTROLS.iter().filter_map(|c| show(c, resolved)).collect()
+/// writes `model.toml`: every key it uses given), with their values;
+/// `scene`: whether its workload is a scene.
+pub fn shown(resolved: &toml::Table, scene: bool) -> Vec<Shown> {
+    CONTROLS
+        .iter()
+        .filter(|c| scene || !c.scene_only)
+        .filter_map(|c| show(c, resolved))
+        .collect()
 }
 
 fn show(c: &Control, resolved: &toml::Table) -> Option<Shown> {
@@ -398,7 +413,7 @@ mod tests {
         let t = resolved(
             "[cpu]\nnon_render = { kind = \"lognormal\", median = \"3ms\", sigma = 0.15 }\nper_object = \"5us\"\n[display]\nrefresh = \"60Hz\"\n",
         );
-        let s = shown(&t);
+        let s = shown(&t, true);
         let non_render = s.iter().find(|s| s.control.key == "cpu.non_render").unwrap();
         assert_eq!(non_render.set_key, "cpu.non_render.median");
         assert_eq!(non_render.value, serde_json::json!(3.0));

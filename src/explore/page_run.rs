@@ -19,7 +19,7 @@ use crate::engine::StopReason;
 use crate::plot::{BarChart, BarSeries, Histogram, LinePlot, Series};
 use crate::studies::isolate::{IsolateOptions, Isolation, isolate};
 use crate::studies::timeline::{TimelineOptions, timeline_of};
-use crate::systems::frame_pipeline::config::FramePipelineConfig;
+use crate::systems::frame_pipeline::config::{FramePipelineConfig, WorkloadConfig};
 use crate::systems::frame_pipeline::records::frame_figures;
 use crate::systems::frame_pipeline::{PipelineRun, PipelineSummary};
 
@@ -85,8 +85,10 @@ pub struct PageModel {
     pub start_sets: Vec<String>,
     /// The controls that apply, with the model's values (start sets applied).
     pub controls: Vec<Shown>,
-    /// The lessons.
-    pub presets: &'static [Preset],
+    /// The lessons this model takes: they are written for a scene (the
+    /// default model's), so a scene whose model takes each one's
+    /// assignments; none for a fixed or replayed workload.
+    pub presets: Vec<&'static Preset>,
     /// The event budget of one run.
     pub budget_events: u64,
 }
@@ -225,8 +227,20 @@ impl Explorer {
             model: self.source.name.clone(),
             description: cfg.description.clone(),
             start_sets: self.start_sets.clone(),
-            controls: shown(&resolved),
-            presets: PRESETS,
+            controls: shown(&resolved, matches!(cfg.workload, WorkloadConfig::Scene(_))),
+            presets: PRESETS
+                .iter()
+                .filter(|_| matches!(cfg.workload, WorkloadConfig::Scene(_)))
+                .filter(|p| {
+                    let sets: Vec<String> = self
+                        .start_sets
+                        .iter()
+                        .cloned()
+                        .chain(p.sets.iter().map(|s| s.to_string()))
+                        .collect();
+                    self.model_toml(&sets).is_ok()
+                })
+                .collect(),
             budget_events: self.budget_events,
         })
     }

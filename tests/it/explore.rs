@@ -126,6 +126,19 @@ fn every_control_is_taken_by_the_model_at_its_sliders_ends() {
     let keys: Vec<&str> = model.controls.iter().map(|c| c.control.key).collect();
     assert!(keys.contains(&"gpu.fragment.per_fragment") && !keys.contains(&"workload.gpu"));
     assert_eq!(model.controls.len(), CONTROLS.len() - 2);
+    assert_eq!(model.presets.len(), PRESETS.len());
+    // The fixed teaching model shows its own knobs, and only the lessons
+    // whose keys it has.
+    let fixed = concat!(env!("CARGO_MANIFEST_DIR"), "/models/fixed.toml");
+    let fixed = Explorer::new(Some(std::path::Path::new(fixed)), vec![DRAW.into()], 1_000_000).unwrap();
+    let m = fixed.page_model().unwrap();
+    let keys: Vec<&str> = m.controls.iter().map(|c| c.control.key).collect();
+    assert!(
+        keys.contains(&"workload.gpu") && !keys.contains(&"gpu.fragment.per_fragment"),
+        "{keys:?}"
+    );
+    assert!(m.presets.is_empty(), "the lessons are written for a scene");
+    fixed.run(&[DRAW.into(), "workload.gpu=\"20ms\"".into()], 4).unwrap();
     for shown in &model.controls {
         for a in ends(&shown.set_key, &shown.control.kind) {
             // Immediate presents need vsync off, VRR needs vsync on with a

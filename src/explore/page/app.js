@@ -170,6 +170,10 @@ function showValues() {
 
 function buildPresets() {
   const box = $("preset-buttons");
+  if (!state.model.presets.length) {
+    $("preset-text").textContent = "The lessons are written for a scene like the default model's: " +
+      "run `rendersim explore` without a model to take them.";
+  }
   for (const p of state.model.presets) {
     const b = document.createElement("button");
     b.type = "button";
