@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # A real Slurm on this one machine, for rendersim's job arrays:
-#   - installs Debian's slurm-wlm and munge if they are missing (apt-get, as root);
+#   - installs Debian's slurmctld, slurmd, slurm-client and munge if they are
+#     missing (apt-get as root, without recommended packages; their services
+#     neither started by the install nor enabled at boot);
 #   - starts munged (unless one runs already), slurmctld and slurmd with a
 #     minimal localhost slurm.conf written into a temp folder (no cgroups:
 #     proctrack/linuxproc, task/none);
@@ -18,12 +20,39 @@ bin=${RENDERSIM_BIN:-$root/target/release/rendersim}
 fail() { echo "slurm-test: FAILED: $*" >&2; exit 1; }
 [ -x "$bin" ] || fail "no rendersim binary at $bin (run cargo build --release first)"
 
+# What the test uses, and no more: the two daemons, the client commands and
+# munge, without the packages Debian recommends beside them (slurm-wlm's
+# plugin and -dev packages). The packages' own services are neither
+# started by their install (a policy-rc.d that says no, the one there put
+# back after) nor left enabled at boot: this script starts the daemons it
+# needs and stops them at the end.
+slurm_packages="slurmctld slurmd slurm-client munge"
 if ! command -v slurmctld >/dev/null 2>&1 || ! command -v slurmd >/dev/null 2>&1 || ! command -v munged >/dev/null 2>&1; then
   if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-    echo "installing slurm-wlm and munge"
-    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq slurm-wlm munge >/dev/null
+    echo "installing $slurm_packages (without recommended packages; their services not started or enabled at boot)"
+    policy=/usr/sbin/policy-rc.d
+    saved_policy=""
+    if [ -e "$policy" ]; then
+      saved_policy=$(mktemp)
+      cp -p "$policy" "$saved_policy"
+    fi
+    printf '#!/bin/sh\n# rendersim slurm-test: no service starts while its packages install\nexit 101\n' > "$policy"
+    chmod 755 "$policy"
+    installed=0
+    # shellcheck disable=SC2086
+    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $slurm_packages >/dev/null && installed=1
+    if [ -n "$saved_policy" ]; then mv "$saved_policy" "$policy"; else rm -f "$policy"; fi
+    [ "$installed" = 1 ] || fail "apt-get could not install $slurm_packages"
+    for svc in munge slurmctld slurmd; do
+      if command -v deb-systemd-helper >/dev/null 2>&1; then
+        deb-systemd-helper disable "$svc.service" >/dev/null 2>&1 || true
+      fi
+      if [ -x "/etc/init.d/$svc" ] && command -v update-rc.d >/dev/null 2>&1; then
+        update-rc.d "$svc" disable >/dev/null 2>&1 || true
+      fi
+    done
   else
-    fail "slurm-wlm and munge are not installed and cannot be installed here (needs root and apt-get)"
+    fail "slurmctld, slurmd and munge are not installed and cannot be installed here (needs root and apt-get)"
   fi
 fi
 [ "$(id -u)" = 0 ] || fail "slurmd must run as root here (SlurmdUser=root)"
