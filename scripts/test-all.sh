@@ -150,7 +150,7 @@ for f in experiments/*.toml; do
   "$RENDERSIM_BIN" experiment "$f" --out "$ci_out/$name" --quiet | tail -n 3
 done
 
-step "Notebooks (committed with their outputs; each executed again here)"
+step "Notebooks (committed with their outputs; each executed again here, printing the same text)"
 .venv/bin/python - notebooks/*.ipynb <<'PY'
 import json, sys
 for path in sys.argv[1:]:
@@ -160,10 +160,14 @@ for path in sys.argv[1:]:
         sys.exit(f"{path}: code cells {bare} have no outputs; run jupyter nbconvert --to notebook --execute --inplace {path}")
 print(f"{len(sys.argv) - 1} notebooks carry their outputs")
 PY
+# Executed again into the CI folder; the text each cell prints must be the
+# text committed (scripts/notebook-outputs.py: pictures aside).
+mkdir -p "$ci_out/notebooks"
 for nb in notebooks/*.ipynb; do
   [ -e "$nb" ] || continue
   echo "-- $nb"
-  .venv/bin/jupyter execute "$nb"
+  .venv/bin/jupyter nbconvert --log-level WARN --to notebook --execute --output-dir "$ci_out/notebooks" "$nb"
+  .venv/bin/python scripts/notebook-outputs.py "$nb" "$ci_out/notebooks/$(basename "$nb")"
 done
 
 step "Slurm: a 4-task job array and its merge on a one-machine Slurm, compared with one process"

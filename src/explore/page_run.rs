@@ -113,8 +113,13 @@ pub struct ClosedForm {
     pub label: &'static str,
     /// Paper 000 §4.1's per-frame term (ms).
     pub closed_form_ms: f64,
+    /// Its path in `rendersim run --json`'s summary.
+    pub closed_form_json: &'static str,
     /// The simulated counterpart (ms).
     pub simulated_ms: Option<f64>,
+    /// Where `rendersim run --json` gives it (a path, or how it is made
+    /// from one).
+    pub simulated_from: &'static str,
 }
 
 /// `isolate`'s verdict, as the page shows it.
@@ -489,22 +494,51 @@ fn numbers(r: &PipelineSummary) -> Vec<Number> {
 fn closed_form(r: &PipelineSummary) -> Vec<ClosedForm> {
     let m = &r.metrics;
     let a = &m.analytic;
-    let frames = r.frames.saturating_sub(r.warmup_frames as usize).max(1) as f64;
+    // A unit's time per state covers the whole run, warm-up included.
+    let frames = r.frames.max(1) as f64;
     let busy = |states: &std::collections::BTreeMap<String, f64>| states.get("busy").map(|b| b / frames);
-    let c = |label, closed_form_ms, simulated_ms| ClosedForm {
+    let c = |label, closed_form_ms, closed_form_json, simulated_ms, simulated_from| ClosedForm {
         label,
         closed_form_ms,
+        closed_form_json,
         simulated_ms,
+        simulated_from,
     };
     vec![
-        c("CPU work per frame", a.cpu_ms, m.cpu_busy_ms.mean),
-        c("geometry per frame", a.geometry_ms, busy(&m.states_ms.geometry)),
-        c("fragment per frame", a.fragment_ms, busy(&m.states_ms.fragment)),
-        c("GPU per frame (units added up)", a.gpu_sum_ms, m.gpu_busy_ms.mean),
+        c(
+            "CPU work per frame",
+            a.cpu_ms,
+            "metrics.analytic.cpu_ms",
+            m.cpu_busy_ms.mean,
+            "metrics.cpu_busy_ms.mean",
+        ),
+        c(
+            "geometry per frame",
+            a.geometry_ms,
+            "metrics.analytic.geometry_ms",
+            busy(&m.states_ms.geometry),
+            "metrics.states_ms.geometry.busy / frames_simulated",
+        ),
+        c(
+            "fragment per frame",
+            a.fragment_ms,
+            "metrics.analytic.fragment_ms",
+            busy(&m.states_ms.fragment),
+            "metrics.states_ms.fragment.busy / frames_simulated",
+        ),
+        c(
+            "GPU per frame (units added up)",
+            a.gpu_sum_ms,
+            "metrics.analytic.gpu_sum_ms",
+            m.gpu_busy_ms.mean,
+            "metrics.gpu_busy_ms.mean",
+        ),
         c(
             "frame time, lower bound (slowest unit)",
             a.frame_max_ms,
+            "metrics.analytic.frame_max_ms",
             m.frame_time_ms.mean,
+            "metrics.frame_time_ms.mean",
         ),
     ]
 }

@@ -225,6 +225,23 @@ fn the_pages_numbers_are_rendersim_runs() {
                 n.value
             );
         }
+        for c in &shown.closed_form {
+            assert!(
+                same(Some(c.closed_form_ms), at(&json, c.closed_form_json).as_f64()),
+                "{}",
+                c.label
+            );
+            let simulated = match c.simulated_from.split_once(" / ") {
+                None => at(&json, c.simulated_from).as_f64(),
+                Some((busy, by)) => at(&json, busy).as_f64().map(|b| b / at(&json, by).as_f64().unwrap()),
+            };
+            assert!(
+                same(c.simulated_ms, simulated),
+                "{}: {:?} {simulated:?}",
+                c.label,
+                c.simulated_ms
+            );
+        }
         for (unit, share) in &shown.shares {
             let cli = json["metrics"]["bottleneck"][unit].as_f64();
             assert!(same(Some(*share), cli), "{unit}: {share} {cli:?}");
