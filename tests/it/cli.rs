@@ -1750,3 +1750,48 @@ fn seeds_past_what_a_model_holds_blame_the_experiment_s_base_seed() {
     assert!(!e.contains("fixed.toml"), "{e}");
     assert!(!out.exists(), "nothing written");
 }
+
+/// Issue 60 item 5: a table written as an array was read field by
+/// position (`display = ["144Hz"]` set the refresh, `run = [1024]` ran 1024
+/// frames, a device profile's `device = [...]` loaded). Every loader now
+/// refuses it, naming the key.
+#[test]
+fn a_table_written_as_an_array_is_refused_naming_the_key() {
+    let fixed = concat!(env!("CARGO_MANIFEST_DIR"), "/models/fixed.toml");
+    for (set, key) in [
+        ("display=[\"144Hz\"]", "display"),
+        ("run=[1024]", "run"),
+        ("display.vrr=[\"48Hz\"]", "display.vrr"),
+        ("noise.periodic=[[\"x\"]]", "noise.periodic"),
+    ] {
+        let err = run_err(&["run", fixed, "--set", set]);
+        assert!(
+            err.contains(&format!("key `{key}")) && err.contains("expected a table"),
+            "{set}: {err}"
+        );
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let profile = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/models/devices/llvmpipe.toml"))
+        .unwrap()
+        .replace(
+            "[device]\nname = \"llvmpipe\"\nvertex_cache = \"lavapipe\"\nshader_cores = 132\n",
+            "device = [\"x\", \"lavapipe\", 4]\n",
+        );
+    assert!(
+        profile.contains("device = ["),
+        "the profile's [device] table was not replaced"
+    );
+    let p = write(dir.path(), "p.toml", &profile);
+    let err = run_err(&["predict", "grid:8x8", "--device", &p]);
+    assert!(err.contains("device") && err.contains("expected a table"), "{err}");
+    let e = write(
+        dir.path(),
+        "e.toml",
+        "name = \"e\"\nmodel = \"../m.toml\"\nreplications = 1\nmetric = [[\"a\", \"b\"]]\n",
+    );
+    let err = run_err(&["experiment", &e, "--out", &dir.path().join("o").display().to_string()]);
+    assert!(
+        !err.contains("RawMetric") && err.contains("metric") && err.contains("expected a table"),
+        "{err}"
+    );
+}

@@ -199,7 +199,8 @@ fn line_at(text: &str, offset: usize) -> usize {
 /// Deserializes `table` into `T`, turning serde's errors into
 /// [`ConfigError::Invalid`] with key path, line and suggestion.
 pub fn deserialize<T: DeserializeOwned>(table: &toml::Table, src: &ModelSource) -> Result<T, ConfigError> {
-    let de = table.clone();
+    // A table written as an array is refused, not read field by position.
+    let de = super::strict::Strict(table.clone());
     serde_path_to_error::deserialize::<_, T>(de).map_err(|e| {
         let mut path = dotted_path(&e.path().to_string());
         let message = e.inner().to_string();

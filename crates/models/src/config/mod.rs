@@ -5,6 +5,7 @@ pub mod hardware;
 pub mod load;
 pub mod overrides;
 pub mod patch;
+pub mod strict;
 pub mod units;
 
 pub use hardware::{HARDWARE_KEY, HARDWARE_SECTIONS};

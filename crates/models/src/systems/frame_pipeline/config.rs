@@ -721,7 +721,7 @@ impl<'de> Deserialize<'de> for WorkloadConfig {
             }
         };
         fn inner<T: serde::de::DeserializeOwned, E: Error>(t: toml::Table) -> Result<T, E> {
-            serde_path_to_error::deserialize::<_, T>(t).map_err(|e| {
+            serde_path_to_error::deserialize::<_, T>(crate::config::strict::Strict(t)).map_err(|e| {
                 let path = e.path().to_string();
                 let msg = e.inner().to_string();
                 let msg = msg.lines().next().unwrap_or_default().to_string();
