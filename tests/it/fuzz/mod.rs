@@ -54,6 +54,9 @@ struct Case {
     copy: Vec<(PathBuf, String)>,
     /// Files removed after the case (written outside the case's folder).
     cleanup: Vec<PathBuf>,
+    /// The input is wrong whatever the values (a table written as an
+    /// array): a result is a failure, only a clean error passes.
+    must_refuse: bool,
 }
 
 impl Case {
@@ -237,7 +240,8 @@ fn model_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
     let mut files = Vec::new();
     let mut blame = vec![key.clone(), key.rsplit('.').next().unwrap().to_string()];
     let mut what = String::new();
-    match rng.random_range(0..4) {
+    let mut must_refuse = false;
+    match rng.random_range(0..5) {
         // The value in a model file (written as TOML).
         0 => {
             let name = format!("case-{n}.toml");
@@ -274,6 +278,27 @@ fn model_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
             what = format!("{file} with the misspelt key {typo}");
             blame.push(typo);
         }
+        // The key's table written as an array of its values, as --set
+        // takes it (serde once read such arrays field by position).
+        4 if key.contains('.') && !key.split('.').any(|p| p.parse::<usize>().is_ok()) => {
+            let parent = key.rsplit_once('.').unwrap().0;
+            let mut t = table.clone();
+            let mut at = t.as_table_mut().unwrap();
+            for part in parent.split('.') {
+                at = at.get_mut(part).and_then(|v| v.as_table_mut()).unwrap();
+            }
+            let values: Vec<String> = at
+                .values()
+                .filter(|v| !v.is_table() && !v.is_array())
+                .map(|v| v.to_string())
+                .collect();
+            args.push(Path::new(ROOT).join(file).display().to_string());
+            args.push("--set".into());
+            args.push(format!("{parent}=[{}]", values.join(", ")));
+            blame.push(parent.to_string());
+            must_refuse = true;
+            what = format!("{file} with its table {parent} written as an array");
+        }
         // The value from --set.
         _ => {
             args.push(Path::new(ROOT).join(file).display().to_string());
@@ -299,6 +324,7 @@ fn model_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
         allow_null: vec![],
         copy: vec![],
         cleanup: vec![],
+        must_refuse,
     }
 }
 
@@ -367,6 +393,7 @@ fn mesh_case(rng: &mut Xoshiro256PlusPlus) -> Case {
         allow_null: vec![],
         copy: vec![],
         cleanup: vec![],
+        must_refuse: false,
     }
 }
 
@@ -446,6 +473,7 @@ fn experiment_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
         allow_null: vec![],
         copy: vec![],
         cleanup: vec![],
+        must_refuse: false,
     }
 }
 
@@ -520,6 +548,7 @@ fn judge(case: &Case, dir: &Path) -> Result<&'static str, String> {
         return Err(format!("panic or abort: {what}"));
     }
     match status.code() {
+        Some(0) if case.must_refuse => Err("taken, though the input is wrong whatever its values".into()),
         Some(0) => {
             if !case.json {
                 return Ok("ok");
@@ -636,6 +665,7 @@ fn regressions() -> Vec<Case> {
                 allow_null: vec![],
                 copy: vec![],
                 cleanup: vec![],
+                must_refuse: false,
             }
         })
         .collect()

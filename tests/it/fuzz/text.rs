@@ -471,5 +471,6 @@ pub fn case(rng: &mut Xoshiro256PlusPlus, n: usize, tree: &Tree) -> Case {
         } else {
             vec![path]
         },
+        must_refuse: false,
     }
 }
