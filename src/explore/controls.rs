@@ -368,9 +368,11 @@ fn in_unit(kind: &Kind, v: &toml::Value) -> Option<serde_json::Value> {
     })
 }
 
-/// The `--set` assignment a control writes for `value` (as the page sends
-/// it: a number in the control's unit, `true`/`false`, or a choice), or
-/// why the value is not of the control's kind.
+/// The `--set` assignment a control writes for `value` (a number in the
+/// control's unit, `true`/`false`, or a choice), or why the value is not of
+/// the control's kind. The page's `assignmentOf` (page/app.js) writes the
+/// same form; `tests/it/explore.rs` runs every control's slider ends
+/// through this one.
 pub fn assignment(c: &Control, set_key: &str, value: &str) -> Result<String, String> {
     let number = || {
         value

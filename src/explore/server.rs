@@ -322,7 +322,6 @@ fn answer(explorer: &Explorer, turns: &Turns, req: &Request) -> Answer {
         None => busy(),
         Some(_turn) => f().map_or_else(|e| Answer::of(&e), Answer::json),
     };
-    let to_json = |v: &dyn erased::Json| v.json().map_err(|e| PageError::View(e.to_string()));
     match path {
         "/" | "/index.html" => Answer::new(200, "text/html; charset=utf-8", INDEX_HTML),
         "/app.js" => Answer::new(200, "text/javascript; charset=utf-8", APP_JS),
@@ -354,16 +353,9 @@ fn answer(explorer: &Explorer, turns: &Turns, req: &Request) -> Answer {
     }
 }
 
-mod erased {
-    /// Serialisation behind a `dyn` (the routes' results are of several types).
-    pub trait Json {
-        fn json(&self) -> serde_json::Result<String>;
-    }
-    impl<T: serde::Serialize> Json for T {
-        fn json(&self) -> serde_json::Result<String> {
-            serde_json::to_string(self)
-        }
-    }
+/// A route's result as the JSON the page reads.
+fn to_json<T: serde::Serialize>(v: &T) -> Result<String, PageError> {
+    serde_json::to_string(v).map_err(|e| PageError::View(e.to_string()))
 }
 
 /// One connection: its request read, answered, and closed.

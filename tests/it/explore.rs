@@ -9,7 +9,7 @@ use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
 use std::process::{Child, Command, Stdio};
 
-use rendersim::explore::controls::{CONTROLS, Kind};
+use rendersim::explore::controls::{CONTROLS, Control, Kind, assignment};
 use rendersim::explore::page_run::{Explorer, PageResult};
 use rendersim::explore::presets::PRESETS;
 
@@ -104,18 +104,21 @@ fn each_lesson_shows_what_its_text_says() {
     assert!(number(&fg, LATENCY) > number(&off, LATENCY) + 2.0);
 }
 
-/// The assignments a control writes at its slider's ends (or each value).
-fn ends(key: &str, kind: &Kind) -> Vec<String> {
-    match *kind {
-        Kind::Duration { unit, min, max, .. } => {
-            vec![format!("{key}=\"{min}{unit}\""), format!("{key}=\"{max}{unit}\"")]
+/// The assignments a control writes at its slider's ends (or each value),
+/// in the form the page writes them (`controls::assignment`).
+fn ends(control: &Control, key: &str) -> Vec<String> {
+    let values: Vec<String> = match control.kind {
+        Kind::Duration { min, max, .. } | Kind::Rate { min, max, .. } | Kind::Float { min, max, .. } => {
+            vec![format!("{min:?}"), format!("{max:?}")]
         }
-        Kind::Rate { min, max, .. } => vec![format!("{key}=\"{min}Hz\""), format!("{key}=\"{max}Hz\"")],
-        Kind::Int { min, max } => vec![format!("{key}={min}"), format!("{key}={max}")],
-        Kind::Float { min, max, .. } => vec![format!("{key}={min:?}"), format!("{key}={max:?}")],
-        Kind::Bool => vec![format!("{key}=true"), format!("{key}=false")],
-        Kind::Choice { options } => options.iter().map(|o| format!("{key}=\"{o}\"")).collect(),
-    }
+        Kind::Int { min, max } => vec![min.to_string(), max.to_string()],
+        Kind::Bool => vec!["true".into(), "false".into()],
+        Kind::Choice { options } => options.iter().map(|o| o.to_string()).collect(),
+    };
+    values
+        .iter()
+        .map(|v| assignment(control, key, v).unwrap_or_else(|e| panic!("{e}")))
+        .collect()
 }
 
 #[test]
@@ -140,7 +143,7 @@ fn every_control_is_taken_by_the_model_at_its_sliders_ends() {
     assert!(m.presets.is_empty(), "the lessons are written for a scene");
     fixed.run(&[DRAW.into(), "workload.gpu=\"20ms\"".into()], 4).unwrap();
     for shown in &model.controls {
-        for a in ends(&shown.set_key, &shown.control.kind) {
+        for a in ends(&shown.control, &shown.set_key) {
             // Immediate presents need vsync off, VRR needs vsync on with a
             // panel faster than its floor: each end is tried where it can hold.
             let mut sets = vec![DRAW.to_string()];

@@ -11,7 +11,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use super::PlotError;
 use super::axis::{coord, ticks, to_axis, widen};
 use super::font::{AXIS_PX, FAMILY, TICK_PX, TITLE_PX};
-use super::output::{draw_notes, render_both, render_svg};
+use super::output::{Sink, draw_notes, render_to, svg_of};
 use super::palette::color;
 
 /// One series of a [`BarChart`]: a value per category.
@@ -190,14 +190,12 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &BarChart) -> Resu
 
 /// Write `c` to `<base>.svg` and `<base>.png`.
 pub fn bar_chart(base: &Path, c: &BarChart) -> Result<(), PlotError> {
-    render_both(base, |r| draw(r, c), |r| draw(r, c))
+    render_to(Sink::Files(base), |r| draw(r, c), |r| draw(r, c))
 }
 
 /// `c` as one SVG document (what [`bar_chart`] writes to `<base>.svg`).
 pub fn bar_chart_svg(c: &BarChart) -> Result<String, PlotError> {
-    let mut out = String::new();
-    render_svg(&mut out, |r| draw(r, c))?;
-    Ok(out)
+    svg_of(|sink| render_to(sink, |r| draw(r, c), |r| draw(r, c)))
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ use super::PlotError;
 use super::axis::{coord, format_number, omitted_note, ticks, widen};
 use super::font::{AXIS_PX, FAMILY, LABEL_PX, TICK_PX, TITLE_PX};
 use super::legend::{self, Occupied};
-use super::output::{Sink, draw_notes, render_to};
+use super::output::{Sink, draw_notes, render_to, svg_of};
 use super::palette::color;
 
 /// A histogram description: each group gets its own colour; all groups share
@@ -371,9 +371,7 @@ pub fn histogram(base: &Path, h: &Histogram) -> Result<(), PlotError> {
 
 /// `h` as one SVG document (what [`histogram`] writes to `<base>.svg`).
 pub fn histogram_svg(h: &Histogram) -> Result<String, PlotError> {
-    let mut out = String::new();
-    histogram_to(Sink::Svg(&mut out), h)?;
-    Ok(out)
+    svg_of(|sink| histogram_to(sink, h))
 }
 
 fn histogram_to(sink: Sink<'_>, h: &Histogram) -> Result<(), PlotError> {

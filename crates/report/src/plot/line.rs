@@ -9,7 +9,7 @@ use super::PlotError;
 use super::axis::{Ticks, all_integers, coord, omitted_note, padded_range, ticks, to_axis};
 use super::font::{AXIS_PX, FAMILY, TICK_PX, TITLE_PX};
 use super::legend::{self, Occupied};
-use super::output::{Sink, draw_notes, render_to};
+use super::output::{Sink, draw_notes, render_to, svg_of};
 use super::palette::color;
 
 /// One named series of a [`LinePlot`].
@@ -513,9 +513,7 @@ pub fn line_plot(base: &Path, plot: &LinePlot) -> Result<(), PlotError> {
 
 /// `plot` as one SVG document (what [`line_plot`] writes to `<base>.svg`).
 pub fn line_plot_svg(plot: &LinePlot) -> Result<String, PlotError> {
-    let mut out = String::new();
-    line_plot_to(Sink::Svg(&mut out), plot)?;
-    Ok(out)
+    svg_of(|sink| line_plot_to(sink, plot))
 }
 
 fn line_plot_to(sink: Sink<'_>, plot: &LinePlot) -> Result<(), PlotError> {

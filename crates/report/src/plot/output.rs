@@ -95,6 +95,14 @@ pub(crate) fn render_svg(
     Ok(())
 }
 
+/// The SVG document a plot's drawing into a [`Sink`] makes (the `_svg`
+/// twins of the plot functions).
+pub(crate) fn svg_of(draw: impl FnOnce(Sink<'_>) -> Result<(), PlotError>) -> Result<String, PlotError> {
+    let mut out = String::new();
+    draw(Sink::Svg(&mut out))?;
+    Ok(out)
+}
+
 /// [`render_both`] or [`render_svg`], by `sink`.
 pub(crate) fn render_to(
     sink: Sink<'_>,

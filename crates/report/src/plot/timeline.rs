@@ -348,12 +348,10 @@ pub fn timeline(path: &Path, t: &Timeline) -> Result<(), PlotError> {
     let bytes = match format {
         ImageFormat::Svg => {
             let mut s = String::new();
-            {
-                let root = SVGBackend::with_string(&mut s, (WIDTH, HEIGHT)).into_drawing_area();
-                root.fill(&WHITE).map_err(|e| draw_err(e.to_string()))?;
-                draw(&root, t).map_err(draw_err)?;
-                root.present().map_err(|e| draw_err(e.to_string()))?;
-            }
+            super::output::render_svg(&mut s, |root| draw(root, t)).map_err(|e| match e {
+                PlotError::Draw { message, .. } => draw_err(message),
+                e => e,
+            })?;
             s.into_bytes()
         }
         ImageFormat::Png => {
