@@ -282,3 +282,39 @@ fn a_trace_fifo_closed_by_its_reader_ends_with_an_error() {
         "{err}"
     );
 }
+
+#[test]
+fn a_walkthrough_whose_runs_cannot_finish_is_refused_before_its_preprocess() {
+    // Issue 60 item 6: every frame and preprocess render is a pipeline run of
+    // its own, so a swap of 10^6 s is about 6e7 vertical blanks per run over
+    // 10,000 fit renders (it ran for hours).
+    let model = root("models/walkthrough-city.toml");
+    refused(
+        &[
+            "run",
+            &model,
+            "--set",
+            "gpu.swap=\"1000000s\"",
+            "--set",
+            "run.frames=5",
+            "--json",
+        ],
+        &["key `gpu.swap`", "e11 events", "11377 preprocess renders", "1000000s", "for a walkthrough"],
+    );
+    // With pos alone (no fit), the pos tables' least renders count: a
+    // longer swap is refused the same way.
+    refused(
+        &[
+            "run",
+            &model,
+            "--set",
+            "gpu.swap=\"10000000s\"",
+            "--set",
+            "estimation.estimators=[\"pos\"]",
+            "--set",
+            "run.frames=5",
+            "--json",
+        ],
+        &["key `gpu.swap`", "pos"],
+    );
+}

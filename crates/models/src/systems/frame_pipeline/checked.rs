@@ -16,7 +16,7 @@ use crate::engine::Duration;
 use crate::systems::error::SystemError;
 
 use super::config::FramePipelineConfig;
-use super::validate::{check_memory, validate};
+use super::validate::{check_memory, estimate_events, validate};
 
 /// A [`FramePipelineConfig`] that passed every model check.
 #[derive(Debug, Clone)]
@@ -61,6 +61,17 @@ impl CheckedPipeline {
             });
         }
         CheckedPipeline { cfg }
+    }
+
+    /// A lower bound, in parts (the key to blame, what, how many), of the
+    /// events one run of this model needs whatever its scene draws: the
+    /// frames, and over the span the per-frame fixed costs alone take
+    /// (`cpu.clear`, `cpu.swap`, `gpu.clear`, `gpu.swap`, ...), the display's
+    /// refreshes and the system tasks. The walkthrough multiplies it by its
+    /// one-frame runs to refuse, before simulating, a walk that could not
+    /// finish.
+    pub fn events_floor(&self) -> Vec<crate::limits::EventPart> {
+        estimate_events(&self.cfg, &super::analytic::analytic_terms(&self.cfg, None), None)
     }
 }
 

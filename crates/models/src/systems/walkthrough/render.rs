@@ -222,6 +222,11 @@ impl Renderer {
         Ok((timing, stats.by_kind, stats.kind_names))
     }
 
+    /// The checked model each of its runs starts from.
+    pub fn model(&self) -> &CheckedPipeline {
+        &self.template
+    }
+
     /// The levels' mesh statistics of prototype `p`.
     pub fn levels(&self, p: u32) -> &[MeshInfo] {
         &self.meshes[p as usize]

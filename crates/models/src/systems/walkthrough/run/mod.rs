@@ -85,6 +85,14 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
         .iter()
         .map(|e| cfg.estimation.estimators.iter().any(|x| x == e))
         .collect();
+    super::validate::check_events(&super::validate::Runs::of(
+        &cfg,
+        &scene,
+        poses.len() as u64,
+        &wants,
+        exact.model(),
+        actual.model(),
+    ))?;
     let (policy, lod_est, algorithm) = super::lod::validate(&cfg.lod, &cfg.estimation.estimators)?;
     let Preprocess {
         empty,
