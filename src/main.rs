@@ -95,7 +95,10 @@ fn main() -> ExitCode {
     }
     #[cfg(all(unix, feature = "wgpu"))]
     quiet_vulkan_device_select();
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return parse_failure(e),
+    };
     // An interrupt removes the temporary files and staging folders of
     // outputs being written; finished outputs are never touched. `explore`
     // writes no file and handles Ctrl-C itself (it stops serving).
@@ -186,6 +189,31 @@ fn man_page() -> anyhow::Result<()> {
     let mut out = Vec::new();
     clap_mangen::Man::new(Cli::command()).render(&mut out)?;
     print_bytes(&out)
+}
+
+/// Ends a command line that did not parse, or that asked for `--help` or
+/// `--version`: the help and version go to standard output, where a full
+/// disk is an error (exit 2), as for every other output; clap's own
+/// printing would drop it and exit 0.
+fn parse_failure(e: clap::Error) -> ExitCode {
+    if e.use_stderr() {
+        let _ = e.print();
+        return ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2));
+    }
+    use std::io::IsTerminal;
+    let text = e.render();
+    let text = if std::io::stdout().is_terminal() {
+        text.ansi().to_string()
+    } else {
+        text.to_string()
+    };
+    match print_bytes(text.as_bytes()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {err}");
+            ExitCode::from(2)
+        }
+    }
 }
 
 /// Writes `bytes` to standard output (a full disk is an error, not a panic).

@@ -299,7 +299,13 @@ fn a_walkthrough_whose_runs_cannot_finish_is_refused_before_its_preprocess() {
             "run.frames=5",
             "--json",
         ],
-        &["key `gpu.swap`", "e11 events", "11377 preprocess renders", "1000000s", "for a walkthrough"],
+        &[
+            "key `gpu.swap`",
+            "e11 events",
+            "11377 preprocess renders",
+            "1000000s",
+            "for a walkthrough",
+        ],
     );
     // With pos alone (no fit), the pos tables' least renders count: a
     // longer swap is refused the same way.

@@ -1611,6 +1611,11 @@ fn standard_output_that_cannot_be_written_is_an_error_not_a_panic() {
         &["run", "--json"][..],
         &["run"][..],
         &["replay", "tests/fixtures/presentmon/test_case_1.csv"][..],
+        // The help and the version too (clap's own printing dropped them
+        // with exit 0).
+        &["--help"][..],
+        &["run", "--help"][..],
+        &["--version"][..],
     ] {
         let o = std::process::Command::new(env!("CARGO_BIN_EXE_rendersim"))
             .current_dir(env!("CARGO_MANIFEST_DIR"))

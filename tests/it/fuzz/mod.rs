@@ -1,7 +1,10 @@
 //! A seeded fuzz test of every input a user gives: model files, `--set`
 //! values, mesh specs with cache policies, and experiment files (leaf values
 //! changed, here), and text-level damage to every kind of file rendersim
-//! reads, shard files and measurement CSVs included ([`text`]).
+//! reads, shard files and measurement CSVs included ([`text`]), and
+//! mutations at the edges of the file system and the process: endless,
+//! huge and special input files, questionable captures, outputs inside
+//! another command's result set, a full standard output ([`edges`]).
 //!
 //! Each case runs the real binary under a memory cap (RLIMIT_AS) and a hang
 //! guard, and must end in one of two ways:
@@ -14,7 +17,8 @@
 //! signal, a hang, a null number) fails the test, and the case is printed
 //! as a command line to paste into `tests/fuzz-regressions.txt`, whose cases
 //! run first on every run. `RENDERSIM_FUZZ_CASES` (default 2,000 leaf-value
-//! cases), `RENDERSIM_FUZZ_TEXT_CASES` (default 1,000 text cases) and
+//! cases), `RENDERSIM_FUZZ_TEXT_CASES` (default 1,000 text cases),
+//! `RENDERSIM_FUZZ_EDGE_CASES` (default 400 edge cases) and
 //! `RENDERSIM_FUZZ_SEED` (default 1) choose the cases; the counts are
 //! printed, by command and by verdict. The hang guard (60 s, against runs that normally take well under
 //! a second) only catches hangs; it is not a speed check.
@@ -29,6 +33,7 @@ use rand::{Rng, SeedableRng, seq::IndexedRandom};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 
+mod edges;
 mod text;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
@@ -39,7 +44,7 @@ const HANG_GUARD: Duration = Duration::from_secs(60);
 
 /// One fuzz case: the arguments after `rendersim`, files it needs written
 /// first (name, text), and the words one of which a clean error must contain.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 struct Case {
     /// What was mutated (for a case whose input is a written file).
     what: String,
@@ -57,6 +62,18 @@ struct Case {
     /// The input is wrong whatever the values (a table written as an
     /// array): a result is a failure, only a clean error passes.
     must_refuse: bool,
+    /// Links made in the case's folder after the copies and files (target,
+    /// name): a name that stands for a device or a FIFO.
+    links: Vec<(PathBuf, String)>,
+    /// Standard output is `/dev/full` (a full disk).
+    stdout_full: bool,
+    /// A folder of the case's (another command's result set) that must be
+    /// the same, byte for byte, after the case.
+    guard: Option<String>,
+    /// On success, the same command on an equivalent input (a capture's
+    /// stamps shifted, another encoding): every number of the two JSON
+    /// summaries must agree to 1e-6, relative.
+    same_as: Option<Vec<String>>,
 }
 
 impl Case {
@@ -325,6 +342,7 @@ fn model_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
         copy: vec![],
         cleanup: vec![],
         must_refuse,
+        ..Case::default()
     }
 }
 
@@ -394,6 +412,7 @@ fn mesh_case(rng: &mut Xoshiro256PlusPlus) -> Case {
         copy: vec![],
         cleanup: vec![],
         must_refuse: false,
+        ..Case::default()
     }
 }
 
@@ -474,6 +493,7 @@ fn experiment_case(rng: &mut Xoshiro256PlusPlus, n: usize) -> Case {
         copy: vec![],
         cleanup: vec![],
         must_refuse: false,
+        ..Case::default()
     }
 }
 
@@ -485,12 +505,46 @@ fn judge(case: &Case, dir: &Path) -> Result<&'static str, String> {
     for (name, text) in &case.files {
         std::fs::write(dir.join(name), text).unwrap();
     }
+    for (target, name) in &case.links {
+        let link = dir.join(name);
+        let _ = std::fs::remove_file(&link);
+        std::os::unix::fs::symlink(target, &link).unwrap();
+    }
+    let before = case.guard.as_ref().map(|g| edges::snapshot(&dir.join(g)));
+    let verdict = run_case(case, dir, &case.args)?;
+    if let (Some(g), Some(before)) = (&case.guard, before)
+        && let Some(change) = edges::changed(&before, &edges::snapshot(&dir.join(g)))
+    {
+        return Err(format!("wrote inside another command's result set `{g}`: {change}"));
+    }
+    if let (Some(reference), ("ok", Some(out))) = (&case.same_as, &verdict) {
+        let (_, Some(expected)) = run_case(case, dir, reference)? else {
+            return Err("the reference command printed no JSON".into());
+        };
+        if let Some(diff) = edges::differ(&expected, out, "") {
+            return Err(format!(
+                "differs from the same input as written before the change: {diff}"
+            ));
+        }
+    }
+    Ok(verdict.0)
+}
+
+/// Runs `args` as `case` says (limits, standard output) in `dir`; on
+/// success with a JSON summary, returns it too.
+fn run_case(case: &Case, dir: &Path, args: &[String]) -> Result<(&'static str, Option<serde_json::Value>), String> {
+    // `ABS/` stands for the case's own folder, absolute.
+    let abs = format!("{}/", dir.display());
+    let args: Vec<String> = args.iter().map(|a| a.replace("ABS/", &abs)).collect();
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_rendersim"));
-    cmd.args(&case.args)
+    cmd.args(&args)
         .current_dir(dir)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
+    if case.stdout_full {
+        cmd.stdout(std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap());
+    }
     #[cfg(unix)]
     {
         use std::os::unix::process::CommandExt;
@@ -507,7 +561,10 @@ fn judge(case: &Case, dir: &Path) -> Result<&'static str, String> {
         }
     }
     let mut child = cmd.spawn().unwrap();
-    let mut out_pipe = child.stdout.take().unwrap();
+    let mut out_pipe: Box<dyn Read + Send> = match child.stdout.take() {
+        Some(p) => Box::new(p),
+        None => Box::new(std::io::empty()),
+    };
     let mut err_pipe = child.stderr.take().unwrap();
     let out_reader = std::thread::spawn(move || {
         let mut v = Vec::new();
@@ -551,14 +608,14 @@ fn judge(case: &Case, dir: &Path) -> Result<&'static str, String> {
         Some(0) if case.must_refuse => Err("taken, though the input is wrong whatever its values".into()),
         Some(0) => {
             if !case.json {
-                return Ok("ok");
+                return Ok(("ok", None));
             }
             let v: serde_json::Value =
                 serde_json::from_str(&stdout).map_err(|e| format!("success without a JSON summary ({e})"))?;
             if let Some(path) = null_number(&v, "", &case.allow_null) {
                 return Err(format!("null where a number belongs: `{path}`"));
             }
-            Ok("ok")
+            Ok(("ok", Some(v)))
         }
         Some(2) => {
             let first = stderr.lines().find(|l| l.starts_with("error:"));
@@ -571,13 +628,13 @@ fn judge(case: &Case, dir: &Path) -> Result<&'static str, String> {
                 .iter()
                 .any(|b| !b.is_empty() && lower.contains(&b.to_lowercase()))
             {
-                Ok("clean error")
+                Ok(("clean error", None))
             } else {
                 Err(format!("the error names none of {:?}: {}", case.blame, tail(&stderr)))
             }
         }
         // Failed checks of an experiment (its report says which).
-        Some(1) if case.args[0] == "experiment" => Ok("failed check"),
+        Some(1) if case.args[0] == "experiment" => Ok(("failed check", None)),
         Some(c) => Err(format!("exit status {c}: {}", tail(&stderr))),
         None => Err(format!("ended by a signal: {}", tail(&stderr))),
     }
@@ -616,6 +673,14 @@ fn copy_dir(from: &Path, to: &Path) {
             std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
         }
     }
+}
+
+/// Where a case comes from: the list made up front (regressions and
+/// leaf-value cases), or made where it runs from its own stream.
+enum Job {
+    Listed,
+    Text(usize),
+    Edge(usize),
 }
 
 /// Regression cases: one command line per line (after `rendersim`), split on
@@ -666,6 +731,7 @@ fn regressions() -> Vec<Case> {
                 copy: vec![],
                 cleanup: vec![],
                 must_refuse: false,
+                ..Case::default()
             }
         })
         .collect()
@@ -685,8 +751,14 @@ fn every_input_ends_in_a_result_or_a_clean_error() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1000);
+    let edge_count: usize = std::env::var("RENDERSIM_FUZZ_EDGE_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(400);
     let dir = tempfile::tempdir().unwrap();
-    let tree = text::prepare(dir.path(), Path::new(env!("CARGO_BIN_EXE_rendersim")));
+    let bin = Path::new(env!("CARGO_BIN_EXE_rendersim"));
+    let tree = text::prepare(dir.path(), bin);
+    let edges = edges::prepare(&tree.root, bin, &tree.shard_experiment, &tree.shard_out);
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let mut cases = regressions();
     let fixed = cases.len();
@@ -699,9 +771,10 @@ fn every_input_ends_in_a_result_or_a_clean_error() {
     }
     // Text cases are made where they run, each from its own stream (seed,
     // n): their inputs (5 MB strings among them) are never all in memory.
-    let jobs: Vec<Option<usize>> = (0..cases.len())
-        .map(|_| None)
-        .chain((0..text_count).map(Some))
+    let jobs: Vec<Job> = (0..cases.len())
+        .map(|_| Job::Listed)
+        .chain((0..text_count).map(Job::Text))
+        .chain((0..edge_count).map(Job::Edge))
         .collect();
     let counts: Mutex<std::collections::BTreeMap<String, usize>> = Mutex::default();
     let failures: Mutex<Vec<(String, String)>> = Mutex::default();
@@ -710,10 +783,15 @@ fn every_input_ends_in_a_result_or_a_clean_error() {
     jobs.par_iter().enumerate().for_each(|(i, job)| {
         let made;
         let case = match job {
-            None => &cases[i],
-            Some(n) => {
+            Job::Listed => &cases[i],
+            Job::Text(n) => {
                 let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ *n as u64);
                 made = text::case(&mut rng, *n, &tree);
+                &made
+            }
+            Job::Edge(n) => {
+                let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed.wrapping_mul(0xbf58_476d_1ce4_e5b9) ^ *n as u64);
+                made = edges::case(&mut rng, *n, &edges);
                 &made
             }
         };
@@ -729,7 +807,13 @@ fn every_input_ends_in_a_result_or_a_clean_error() {
         let kind = format!(
             "{}{mode}{} ",
             case.args[0],
-            if case.what.starts_with("text:") { " (text)" } else { "" }
+            if case.what.starts_with("text:") {
+                " (text)"
+            } else if case.what.starts_with("edge:") {
+                " (edge)"
+            } else {
+                ""
+            }
         );
         let t0 = Instant::now();
         let verdict = judge(case, &d);
@@ -761,7 +845,7 @@ fn every_input_ends_in_a_result_or_a_clean_error() {
     let counts = counts.into_inner().unwrap();
     let failures = failures.into_inner().unwrap();
     println!(
-        "fuzz: {} cases ({fixed} regression cases, {count} leaf-value and {text_count} text cases generated with seed {seed}) in {:.1} s",
+        "fuzz: {} cases ({fixed} regression cases, {count} leaf-value, {text_count} text and {edge_count} edge cases generated with seed {seed}) in {:.1} s",
         jobs.len(),
         started.elapsed().as_secs_f64()
     );

@@ -1,6 +1,7 @@
 //! Text-level mutations of every kind of file rendersim reads: model files,
 //! device profiles, experiment files, measurement CSVs, LOD instances,
-//! meshes (`.obj`, `.idx`) and shard files read back by `--merge`.
+//! meshes (`.obj`, `.idx`), PresentMon captures and shard files read back
+//! by `--merge`.
 //!
 //! Where the leaf-value cases (the parent module) change one value and keep
 //! the file well formed, these damage the text itself: lines dropped,
@@ -60,6 +61,8 @@ enum Kind {
     /// `rendersim experiment E --merge --out DIR` with one shard file of a
     /// finished split of E mutated.
     Shard,
+    /// `rendersim replay FILE --json`: a PresentMon capture.
+    Capture,
 }
 
 /// One starting file: where it lives in the tree, its text, and its kind.
@@ -75,11 +78,11 @@ struct Seed {
 
 /// The copied tree and the seeds.
 pub struct Tree {
-    root: PathBuf,
+    pub(super) root: PathBuf,
     seeds: Vec<Seed>,
     /// The sharded fixture experiment in the tree, and its finished split.
-    shard_experiment: PathBuf,
-    shard_out: PathBuf,
+    pub(super) shard_experiment: PathBuf,
+    pub(super) shard_out: PathBuf,
 }
 
 fn copy_tree(from: &Path, to: &Path) {
@@ -95,7 +98,7 @@ fn copy_tree(from: &Path, to: &Path) {
     }
 }
 
-const INSTANCE: &str = "budget = \"10ms\"\n\n[[objects]]\nname = \"near\"\nlevels = [{ cost = \"1ms\", benefit = 1.0 }, \
+pub(super) const INSTANCE: &str = "budget = \"10ms\"\n\n[[objects]]\nname = \"near\"\nlevels = [{ cost = \"1ms\", benefit = 1.0 }, \
 { cost = \"3ms\", benefit = 2.5 }]\n\n[[objects]]\nname = \"far\"\nlevels = [{ cost = \"2ms\", benefit = 0.5 }, \
 { cost = \"6ms\", benefit = 4.0 }]\n\n[[objects]]\nname = \"sky\"\nlevels = [{ cost = \"0.5ms\", benefit = 0.1 }]\n";
 
@@ -164,6 +167,11 @@ pub fn prepare(dir: &Path, bin: &Path) -> Tree {
         }
     }
     add(&root.join("instances"), "toml", INSTANCE.into(), Kind::Instance);
+    copy_tree(&src.join("tests/fixtures/presentmon"), &root.join("captures"));
+    for p in files(&root.join("captures"), "csv") {
+        let text = std::fs::read_to_string(&p).unwrap();
+        add(&root.join("captures"), "csv", text, Kind::Capture);
+    }
     add(&root.join("meshes"), "obj", OBJ.into(), Kind::Mesh);
     let idx: Vec<String> = (0..30u32)
         .flat_map(|i| [0, i + 1, i + 2])
@@ -423,6 +431,11 @@ pub fn case(rng: &mut Xoshiro256PlusPlus, n: usize, tree: &Tree) -> Case {
             allow_null.push("selection");
             vec!["lod-select".into(), p.clone(), "--json".into()]
         }
+        Kind::Capture => {
+            // A capture without tearing has no tear rate.
+            allow_null.push("torn_per_second");
+            vec!["replay".into(), p.clone(), "--json".into()]
+        }
         Kind::Mesh => vec![
             "vcache".into(),
             p.clone(),
@@ -472,5 +485,6 @@ pub fn case(rng: &mut Xoshiro256PlusPlus, n: usize, tree: &Tree) -> Case {
             vec![path]
         },
         must_refuse: false,
+        ..Case::default()
     }
 }

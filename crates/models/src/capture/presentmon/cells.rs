@@ -95,9 +95,6 @@ pub(super) struct Cells<'a> {
     qpc_base: std::cell::Cell<i64>,
 }
 
-/// QPC stamps above this many ticks are counted from the earliest one.
-const QPC_EXACT: i64 = 1 << 52;
-
 impl<'a> Cells<'a> {
     pub(super) fn new(file: &'a str, header: &'a Header) -> Cells<'a> {
         Cells {
@@ -109,26 +106,24 @@ impl<'a> Cells<'a> {
         }
     }
 
-    /// Counts QPC stamps from the earliest one when any is above
-    /// [`QPC_EXACT`] (true then); a negative stamp is an error.
-    pub(super) fn set_qpc_base(&self, raw: &[(u64, csv::StringRecord)]) -> Result<bool, CaptureError> {
+    /// Counts QPC stamps from the earliest one (exact in `f64` however
+    /// far from boot the capture was taken, and a replay of the same
+    /// frames the same wherever its clock stood); a negative stamp is an
+    /// error.
+    pub(super) fn set_qpc_base(&self, raw: &[(u64, csv::StringRecord)]) -> Result<(), CaptureError> {
         let mut least: Option<i64> = None;
-        let mut large = false;
         for (line, rec) in raw {
             for col in [Col::TimeInQpc, Col::CpuStartQpc] {
                 if let Some(v) = self.text(rec, col).and_then(|t| t.parse::<i64>().ok()) {
                     if v < 0 {
                         return Err(self.bad(*line, col, format!("{v} is negative: a QPC stamp counts ticks")));
                     }
-                    large |= v > QPC_EXACT;
                     least = Some(least.map_or(v, |l| l.min(v)));
                 }
             }
         }
-        if large {
-            self.qpc_base.set(least.unwrap_or(0));
-        }
-        Ok(large)
+        self.qpc_base.set(least.unwrap_or(0));
+        Ok(())
     }
 
     /// A text cell, shared with every equal one read before (a capture

@@ -335,13 +335,7 @@ impl Capture {
         repeated_rows(file, &raw)?;
         system_metadata(&header, &raw, &mut meta);
         let cell = Cells::new(file, &header);
-        if cell.set_qpc_base(&raw)? {
-            notes.push(
-                "QPC stamps above 2^52 ticks: times are counted from the earliest stamp (as milliseconds \
-                 since boot they would lose precision)"
-                    .into(),
-            );
-        }
+        cell.set_qpc_base(&raw)?;
         let qpc_per_ms = match (columns, header.has(Col::TimeInQpc), header.has(Col::CpuStartQpc)) {
             (Columns::V2, true, true) => match qpc_rate(&cell, &raw)? {
                 Some(r) => Some(r),

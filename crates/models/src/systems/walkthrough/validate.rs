@@ -154,9 +154,8 @@ impl<'a> Runs<'a> {
             for o in &scene.objects {
                 used[o.proto as usize] = true;
             }
-            let per_table = u64::from(p.gamma_steps.max(1)) * u64::from(p.phi_steps.max(1))
-                + u64::from(p.alpha_steps.max(2))
-                - 1;
+            let per_table =
+                u64::from(p.gamma_steps.max(1)) * u64::from(p.phi_steps.max(1)) + u64::from(p.alpha_steps.max(2)) - 1;
             used.iter().filter(|u| **u).count() as u64 * per_table
         } else {
             0
@@ -186,7 +185,12 @@ impl<'a> Runs<'a> {
         .expect("five costs");
         let mut parts: Vec<EventPart> = Vec::new();
         for (n, what, key, model) in [
-            (self.preprocess, "the preprocess's renders", "estimation.fit_samples", self.exact),
+            (
+                self.preprocess,
+                "the preprocess's renders",
+                "estimation.fit_samples",
+                self.exact,
+            ),
             (self.frames, "the frames", "run.frames", self.actual),
         ] {
             for (k, w, v) in model.events_floor() {
@@ -281,7 +285,10 @@ mod tests {
             let floor: f64 = runs.events_floor().0.iter().map(|p| p.2).sum();
             let run = run_walkthrough(cfg).unwrap();
             let events = run.summary["events"]["total"].as_f64().unwrap();
-            assert!(floor <= events, "{sets:?}: floor {floor} above the {events} events taken");
+            assert!(
+                floor <= events,
+                "{sets:?}: floor {floor} above the {events} events taken"
+            );
             eprintln!("{sets:?}: floor {floor:.0}, taken {events}");
         }
     }
