@@ -79,9 +79,10 @@ for ex in examples/*.rs crates/*/examples/*.rs; do
 done
 
 step "Python package: built from source (pip install ./python) and its tests (pytest)"
-# The package's Rust build shares the release build's target folder, so only
-# PyO3 and the crates whose features differ are compiled again.
-CARGO_TARGET_DIR="$root/target" .venv/bin/pip install --quiet --disable-pip-version-check ./python
+# The package's build backend (python/build_backend/rendersim_build.py)
+# shares the checkout's target folder, so the release build's crates are
+# reused: PyO3, the bindings and rendersim's own crates are compiled.
+.venv/bin/pip install --quiet --disable-pip-version-check ./python
 .venv/bin/pytest -q -p no:cacheprovider --basetemp "$ci_out/pytest" python/tests
 
 step "Browser: rendersim explore in headless Chromium (Debian's chromium and chromium-driver, driven by Selenium)"

@@ -1,7 +1,7 @@
 //! Every system the tool runs: the models' systems
 //! ([`rendersim_models::systems`], re-exported here whole) and the studies
 //! registered as systems ([`STUDIES`]). [`systems`], [`run_model`],
-//! [`traceless_system`] and [`tracing_systems`] here know both; the models'
+//! [`read_model`], [`traceless_system`] and [`tracing_systems`] here know both; the models'
 //! own functions of the same names, and [`SYSTEMS`], know only the models'
 //! systems (a study that runs a system cannot be below it).
 
@@ -36,6 +36,12 @@ pub fn systems() -> &'static [&'static dyn System] {
 /// ([`systems`]); see [`rendersim_models::systems::run_model`].
 pub fn run_model(src: &ModelSource, table: &toml::Table, trace: Option<TraceWriter>) -> Result<SystemRun, SimError> {
     run_among(systems(), src, table, trace)
+}
+
+/// Reads a model without running it, among every system; see
+/// [`rendersim_models::systems::read_model`]. Returns the system's name.
+pub fn read_model(src: &ModelSource, table: &toml::Table) -> Result<&'static str, SimError> {
+    read_among(systems(), src, table)
 }
 
 /// The name of the model's system when that system writes no trace events,

@@ -12,24 +12,31 @@ dicts and pandas DataFrames:
 >>> r.frames[["Frame", "MsUntilDisplayed"]].head()    # doctest: +SKIP
 
 Errors raise :class:`ModelError` (a ``ValueError``) with the command line's
-message and, where it names them, ``file``, ``line`` and ``key``.
+message in Python's terms and, where it names them, ``file``, ``line`` and
+``key``; :class:`SimulationError` for a run that failed while running; and
+``FileNotFoundError`` for a file that does not exist (``rendersim.errors``).
 """
 
 from __future__ import annotations
 
+import contextlib
 import io
 import json
 import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping, Optional, Sequence, Union
+from typing import Any, Iterator, Mapping, Optional, Sequence, Union
 
 from . import _native
-from ._native import ModelError
+from .errors import Error, ModelError, SimulationError, from_native
+from .model import Model, ModelLike, model_args
 
 __all__ = [
+    "Error",
     "ModelError",
+    "SimulationError",
+    "Model",
     "Run",
     "ExperimentResult",
     "ReplayResult",
@@ -47,6 +54,15 @@ __all__ = [
 __version__: str = _native.version()[0].split(" ", 1)[1]
 
 PathLike = Union[str, "os.PathLike[str]"]
+
+
+@contextlib.contextmanager
+def _native_errors() -> Iterator[None]:
+    """The native module's errors raised as Python's (``rendersim.errors``)."""
+    try:
+        yield
+    except _native.ModelError as e:
+        raise from_native(e) from None
 
 
 def to_toml(value: Any) -> str:
@@ -136,14 +152,15 @@ class Run:
 
 
 def run(
-    model: Optional[PathLike] = None,
+    model: ModelLike = None,
     set: Optional[Mapping[str, Any]] = None,
     seed: int = 1,
     frames: Optional[int] = None,
     sets: Sequence[str] = (),
 ) -> Run:
-    """Runs a model file (the embedded default model when ``model`` is
-    None) with ``set`` patches (``{"display.buffers": 3}``) and ``sets``
+    """Runs a model (a file, TOML text such as ``Run.model``, a dict of its
+    tables or a :class:`Model`; the embedded default model when ``model``
+    is None) with ``set`` patches (``{"display.buffers": 3}``) and ``sets``
     (``["display.buffers=3"]``, the command line's ``--set`` text), the
     master ``seed`` and, when given, ``frames`` frames.
 
@@ -152,8 +169,11 @@ def run(
         raise ModelError(f"seed: expected a whole number >= 0, got {seed!r}")
     if frames is not None and (not isinstance(frames, int) or frames < 0):
         raise ModelError(f"frames: expected a whole number >= 0, got {frames!r}")
-    command = _command("run", model=_path(model), set=dict(set or {}), sets=list(sets), seed=seed, frames=frames)
-    summary, csv, model_text, notes = _native.run(_path(model), _sets(set, sets), seed, frames, command)
+    path, text, own = model_args(model)
+    shown = repr(model) if isinstance(model, Model) else (path or ("<model text>" if text else None))
+    command = _command("run", model=shown, set=dict(set or {}), sets=list(sets), seed=seed, frames=frames)
+    with _native_errors():
+        summary, csv, model_text, notes = _native.run(path, text, own + _sets(set, sets), seed, frames, command)
     return Run(
         summary=json.loads(summary),
         frames=_csv(csv),
@@ -201,7 +221,8 @@ def experiment(
     import pandas as pd
 
     command = _command("experiment", path=_path(path), set=dict(set or {}), sets=list(sets), out=_path(out))
-    out_dir, result = _native.experiment(_path(path), _sets(set, sets), _path(out), bool(force), command)
+    with _native_errors():
+        out_dir, result = _native.experiment(_path(path), _sets(set, sets), _path(out), bool(force), command)
     res = json.loads(result)
     out_dir = Path(out_dir)
     files = [out_dir / f for f in res["files"]]
@@ -222,11 +243,12 @@ def vcache(mesh: str, policy: str) -> dict:
     ``grid:WxH``, ``random:T:V:SEED``, a ``.obj`` file, ...; ``policy``:
     ``fifo:32``, ``lru:16``, ``nvidia``, ...): triangles, indices, unique
     and transformed vertices, ACMR and ATVR."""
-    return json.loads(_native.vcache(str(mesh), str(policy)))
+    with _native_errors():
+        return json.loads(_native.vcache(str(mesh), str(policy)))
 
 
 def isolate(
-    model: Optional[PathLike] = None,
+    model: ModelLike = None,
     set: Optional[Mapping[str, Any]] = None,
     factor: float = 0.5,
     keep_vsync: bool = False,
@@ -241,11 +263,12 @@ def isolate(
     ``"model"`` (the model file's own). The dict has the keys of
     ``rendersim isolate --json``: ``frames`` each variant ran, and ``note``
     when a run too short to judge from was lengthened."""
-    return json.loads(
-        _native.isolate(
-            _path(model), _sets(set, sets), float(factor), bool(keep_vsync), float(tie_tolerance), str(fidelity)
+    path, text, own = model_args(model)
+    with _native_errors():
+        out = _native.isolate(
+            path, text, own + _sets(set, sets), float(factor), bool(keep_vsync), float(tie_tolerance), str(fidelity)
         )
-    )
+    return json.loads(out)
 
 
 @dataclass
@@ -274,9 +297,10 @@ def replay(
     """Replays a PresentMon CSV capture; ``set`` is a what-if on the
     display and CPU (``{"display.refresh": "120Hz"}``), ``assume`` what the
     capture does not say (``{"display.buffers": 3}``)."""
-    summary, comparison, frames, whatif = _native.replay(
-        _path(capture), app, swapchain, _sets(set, sets), _sets(assume, assumes)
-    )
+    with _native_errors():
+        summary, comparison, frames, whatif = _native.replay(
+            _path(capture), app, swapchain, _sets(set, sets), _sets(assume, assumes)
+        )
     return ReplayResult(
         summary=json.loads(summary),
         comparison=_csv(comparison),
@@ -287,7 +311,7 @@ def replay(
 
 def timeline(
     out: PathLike,
-    model: Optional[PathLike] = None,
+    model: ModelLike = None,
     set: Optional[Mapping[str, Any]] = None,
     frames: int = 6,
     first: int = 0,
@@ -297,7 +321,9 @@ def timeline(
     vertical blanks marked) for ``frames`` frames from frame ``first`` into
     ``out`` (``.png`` or ``.svg``), as ``rendersim timeline``; returns the
     frames and the time range drawn (ms)."""
-    f0, f1, t0, t1 = _native.timeline(_path(model), _sets(set, sets), int(first), int(frames), _path(out))
+    path, text, own = model_args(model)
+    with _native_errors():
+        f0, f1, t0, t1 = _native.timeline(path, text, own + _sets(set, sets), int(first), int(frames), _path(out))
     return {"out": Path(out), "frames": (f0, f1), "range_ms": (t0, t1)}
 
 
@@ -311,5 +337,6 @@ def perceived_speed(
     """Paper 000 Figure 6 from a walkthrough model: the perceived speed per
     displayed refresh around the first frame skip, drawn to ``out`` (its
     ``.png`` and ``.svg``), as ``rendersim perceived-speed``."""
-    skip, r0, r1, skips = _native.perceived_speed(_path(model), _sets(set, sets), int(around), _path(out))
+    with _native_errors():
+        skip, r0, r1, skips = _native.perceived_speed(_path(model), _sets(set, sets), int(around), _path(out))
     return {"out": Path(out), "first_skip": skip, "refreshes": (r0, r1), "skips": skips}

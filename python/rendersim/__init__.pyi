@@ -6,7 +6,11 @@ from typing import Any, Mapping, Optional, Sequence, Union
 
 import pandas as pd
 
-from ._native import ModelError as ModelError
+from .errors import Error as Error
+from .errors import ModelError as ModelError
+from .errors import SimulationError as SimulationError
+from .model import Model as Model
+from .model import ModelLike as ModelLike
 
 __version__: str
 PathLike = Union[str, os.PathLike[str]]
@@ -23,7 +27,7 @@ class Run:
     def save(self, out: PathLike) -> Path: ...
 
 def run(
-    model: Optional[PathLike] = None,
+    model: ModelLike = None,
     set: Optional[Mapping[str, Any]] = None,
     seed: int = 1,
     frames: Optional[int] = None,
@@ -49,7 +53,7 @@ def experiment(
 ) -> ExperimentResult: ...
 def vcache(mesh: str, policy: str) -> dict[str, Any]: ...
 def isolate(
-    model: Optional[PathLike] = None,
+    model: ModelLike = None,
     set: Optional[Mapping[str, Any]] = None,
     factor: float = 0.5,
     keep_vsync: bool = False,
@@ -75,7 +79,7 @@ def replay(
 ) -> ReplayResult: ...
 def timeline(
     out: PathLike,
-    model: Optional[PathLike] = None,
+    model: ModelLike = None,
     set: Optional[Mapping[str, Any]] = None,
     frames: int = 6,
     first: int = 0,

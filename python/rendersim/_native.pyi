@@ -6,22 +6,28 @@ class ModelError(ValueError):
     file: Optional[str]
     line: Optional[int]
     key: Optional[str]
+    kind: str  # "model", "missing" or "simulation"
+    filename: Optional[str]
 
 def run(
-    model: Optional[str], sets: list[str], seed: Optional[int], frames: Optional[int], command: list[str]
+    model: Optional[str], text: Optional[str], sets: list[str], seed: Optional[int], frames: Optional[int], command: list[str]
 ) -> tuple[str, str, str, list[str]]: ...
+def resolve(model: Optional[str], text: Optional[str], sets: list[str]) -> tuple[str, str, str, str]: ...
 def experiment(
     path: str, sets: list[str], out: Optional[str], force: bool, command: list[str]
 ) -> tuple[str, str]: ...
 def vcache(mesh: str, policy: str) -> str: ...
 def isolate(
-    model: Optional[str], sets: list[str], factor: float, keep_vsync: bool, tie_tolerance: float, fidelity: str
+    model: Optional[str],
+    text: Optional[str],
+    sets: list[str],
+    factor: float, keep_vsync: bool, tie_tolerance: float, fidelity: str
 ) -> str: ...
 def replay(
     capture: str, app: Optional[str], swapchain: Optional[str], sets: list[str], assume: list[str]
 ) -> tuple[str, str, str, str]: ...
 def timeline(
-    model: Optional[str], sets: list[str], first: int, frames: int, out: str
+    model: Optional[str], text: Optional[str], sets: list[str], first: int, frames: int, out: str
 ) -> tuple[int, int, float, float]: ...
 def perceived_speed(model: str, sets: list[str], around: int, out: str) -> tuple[Optional[int], int, int, int]: ...
 def version() -> tuple[str, Optional[str]]: ...

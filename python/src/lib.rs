@@ -3,9 +3,12 @@
 //! that the package turns into dicts and pandas DataFrames. The simulation
 //! runs with the GIL released, so Python threads go on meanwhile.
 //!
-//! Every error is raised as `rendersim.ModelError` (a `ValueError`) with the
-//! message the command line prints after `error: `, and `file`, `line` and
-//! `key` where the error names them.
+//! Every error is raised as `_native.ModelError` with the message the
+//! command line prints after `error: `, `file`, `line` and `key` where the
+//! error names them, and `kind`: `"model"`, `"missing"` (a file that does
+//! not exist; `filename` names it) or `"simulation"` (a run that failed
+//! while running). The package turns it into Python's own terms
+//! (`rendersim.errors`).
 
 use std::error::Error;
 use std::path::{Path, PathBuf};
@@ -14,7 +17,7 @@ use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use rendersim::config::{ConfigError, ModelSource, Overrides, load_model};
+use rendersim::config::{ConfigError, ModelSource, Overrides, PreparedModel, load_model, prepare};
 use rendersim::output::result_set::ResultSet;
 use rendersim::systems::run_model;
 
@@ -50,6 +53,7 @@ fn model_error(e: &(dyn Error + 'static)) -> PyErr {
         }
         cause = c.source();
     }
+    let (kind, filename) = kind_of(e);
     let msg = rendersim::error_line(e);
     Python::attach(|py| {
         let err = ModelError::new_err(msg);
@@ -57,8 +61,39 @@ fn model_error(e: &(dyn Error + 'static)) -> PyErr {
         let _ = v.setattr("file", file);
         let _ = v.setattr("line", line);
         let _ = v.setattr("key", key);
+        let _ = v.setattr("kind", kind);
+        let _ = v.setattr("filename", filename);
         err
     })
+}
+
+/// What kind of error `e` is for Python: a file that does not exist
+/// (`"missing"`, with its path where the error holds it), a run that failed
+/// while running (`"simulation"`), or anything else a model, a file or an
+/// argument is wrong in (`"model"`). A key whose value names a missing file
+/// (a model's `hardware = `) stays a model error: the key is what to change.
+fn kind_of(e: &(dyn Error + 'static)) -> (&'static str, Option<String>) {
+    use rendersim::systems::SimError;
+    let mut cause: Option<&(dyn Error + 'static)> = Some(e);
+    while let Some(c) = cause {
+        match config_error(c) {
+            Some(ConfigError::Io { path, source }) if source.kind() == std::io::ErrorKind::NotFound => {
+                return ("missing", Some(path.clone()));
+            }
+            Some(_) => return ("model", None),
+            None => {}
+        }
+        if matches!(c.downcast_ref::<SimError>(), Some(SimError::Run { .. })) {
+            return ("simulation", None);
+        }
+        if let Some(io) = c.downcast_ref::<std::io::Error>()
+            && io.kind() == std::io::ErrorKind::NotFound
+        {
+            return ("missing", None);
+        }
+        cause = c.source();
+    }
+    ("model", None)
 }
 
 /// The model-file error `c` is or wraps without a cause of its own (the
@@ -90,13 +125,43 @@ fn usage(msg: String) -> PyErr {
     model_error(&*Box::<dyn Error + Send + Sync>::from(msg))
 }
 
+/// The model a call names: TOML text (`text`, its relative paths read
+/// from the working folder), a file (`path`), or the embedded default;
+/// `overrides` applied.
+fn prepared(path: Option<PathBuf>, text: Option<String>, overrides: &Overrides) -> Result<PreparedModel, ConfigError> {
+    match text {
+        Some(t) => prepare(ModelSource::from_text("<model text>", &t), overrides),
+        None => load_model(path.as_deref(), overrides),
+    }
+}
+
+/// `rendersim.Model`'s view of a model: (name, system, the table as TOML,
+/// the table as JSON), with `sets` applied and the whole read as its
+/// system's config (a misspelt key is an error here, not at the run).
+#[pyfunction]
+#[pyo3(signature = (model, text, sets))]
+fn resolve(
+    model: Option<PathBuf>,
+    text: Option<String>,
+    sets: Vec<String>,
+) -> PyResult<(String, String, String, String)> {
+    let p = prepared(model, text, &Overrides::with_sets(&sets)).map_err(err)?;
+    let system = rendersim::systems::read_model(&p.source, &p.table)
+        .map_err(err)?
+        .to_string();
+    let toml_text = toml::to_string(&p.table).map_err(err)?;
+    let json = serde_json::to_string(&p.table).map_err(err)?;
+    Ok((p.source.name.clone(), system, toml_text, json))
+}
+
 /// `rendersim.run(...)`: (summary JSON, frames CSV or "", resolved model
 /// TOML, notes).
 #[pyfunction]
-#[pyo3(signature = (model, sets, seed, frames, command))]
+#[pyo3(signature = (model, text, sets, seed, frames, command))]
 fn run(
     py: Python<'_>,
     model: Option<PathBuf>,
+    text: Option<String>,
     sets: Vec<String>,
     seed: Option<u64>,
     frames: Option<u64>,
@@ -104,7 +169,7 @@ fn run(
 ) -> PyResult<(String, String, String, Vec<String>)> {
     py.detach(move || {
         let overrides = Overrides { sets, seed, frames };
-        let prepared = load_model(model.as_deref(), &overrides).map_err(err)?;
+        let prepared = prepared(model, text, &overrides).map_err(err)?;
         let src = &prepared.source;
         let mut run = run_model(src, &prepared.table, None).map_err(err)?;
         run.summary_mut()["model"] = serde_json::Value::String(src.name.clone());
@@ -203,10 +268,12 @@ fn vcache(py: Python<'_>, mesh: String, policy: String) -> PyResult<String> {
 
 /// `rendersim.isolate(...)`: the isolation as JSON.
 #[pyfunction]
-#[pyo3(signature = (model, sets, factor, keep_vsync, tie_tolerance, fidelity))]
+#[pyo3(signature = (model, text, sets, factor, keep_vsync, tie_tolerance, fidelity))]
+#[allow(clippy::too_many_arguments)]
 fn isolate(
     py: Python<'_>,
     model: Option<PathBuf>,
+    text: Option<String>,
     sets: Vec<String>,
     factor: f64,
     keep_vsync: bool,
@@ -221,7 +288,7 @@ fn isolate(
         other => return Err(usage(format!("fidelity {other:?}: expected draw, triangle or model"))),
     };
     py.detach(move || {
-        let prepared = load_model(model.as_deref(), &Overrides::with_sets(&sets)).map_err(err)?;
+        let prepared = prepared(model, text, &Overrides::with_sets(&sets)).map_err(err)?;
         let (src, table) = (&prepared.source, &prepared.table);
         let system = table.get("system").and_then(|v| v.as_str()).unwrap_or("frame_pipeline");
         if system != "frame_pipeline" {
@@ -284,10 +351,11 @@ fn replay(
 /// to `out` (.png or .svg); returns (first frame, last frame, start ms, end
 /// ms).
 #[pyfunction]
-#[pyo3(signature = (model, sets, first, frames, out))]
+#[pyo3(signature = (model, text, sets, first, frames, out))]
 fn timeline(
     py: Python<'_>,
     model: Option<PathBuf>,
+    text: Option<String>,
     sets: Vec<String>,
     first: u64,
     frames: u64,
@@ -300,7 +368,7 @@ fn timeline(
             return Err(usage(format!("frames: draws 1 to {max} frames, got {frames}")));
         }
         rendersim::plot::ImageFormat::of(&out).map_err(err)?;
-        let prepared = load_model(model.as_deref(), &Overrides::with_sets(&sets)).map_err(err)?;
+        let prepared = prepared(model, text, &Overrides::with_sets(&sets)).map_err(err)?;
         let opts = TimelineOptions { first, frames };
         let (picture, _run) = timeline_of(&prepared.source, &prepared.table, opts).map_err(err)?;
         rendersim::plot::timeline(&out, &picture).map_err(err)?;
@@ -345,6 +413,7 @@ fn version() -> (String, Option<String>) {
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ModelError", m.py().get_type::<ModelError>())?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(resolve, m)?)?;
     m.add_function(wrap_pyfunction!(experiment, m)?)?;
     m.add_function(wrap_pyfunction!(vcache, m)?)?;
     m.add_function(wrap_pyfunction!(isolate, m)?)?;

@@ -96,9 +96,22 @@ def test_errors_carry_file_line_key_and_the_cli_message(tmp_path):
     with pytest.raises(rendersim.ModelError) as e:
         rendersim.run(set={"display.buffers": -1}, frames=5)
     assert e.value.key == "display.buffers"
+    # A value given as an argument is named as the argument, not as a file
+    # or a command-line flag.
     with pytest.raises(rendersim.ModelError) as e:
+        rendersim.run(set={"display.bufers": 3}, frames=5)
+    assert (e.value.key, e.value.file, e.value.line) == ("display.bufers", None, None)
+    assert str(e.value).startswith('set["display.bufers"] = 3 (applied to'), str(e.value)
+    assert "--set" not in str(e.value) and "did you mean `buffers`" in str(e.value)
+    with pytest.raises(rendersim.ModelError) as e:
+        rendersim.run(set={"display": ["144Hz"]}, frames=5)
+    assert "--set" not in str(e.value) and 'set["display"]' in str(e.value), str(e.value)
+    # A file that does not exist is Python's own error.
+    with pytest.raises(FileNotFoundError) as e:
         rendersim.run(tmp_path / "missing.toml")
-    assert e.value.file == str(tmp_path / "missing.toml")
+    assert e.value.filename == str(tmp_path / "missing.toml")
+    with pytest.raises(FileNotFoundError):
+        rendersim.replay(tmp_path / "missing.csv")
     with pytest.raises(rendersim.ModelError):
         rendersim.run(frames=-1)
     with pytest.raises(rendersim.ModelError):
@@ -187,3 +200,77 @@ def test_cli_style_sets_timeline_and_perceived_speed(tmp_path):
     )
     assert p["refreshes"][1] >= p["refreshes"][0]
     assert (tmp_path / "f6.png").is_file() and (tmp_path / "f6.svg").is_file()
+
+
+def test_the_errors_are_a_small_hierarchy():
+    """ModelError and SimulationError are rendersim.Error; a run that fails
+    while running is a SimulationError, also a RuntimeError."""
+    from rendersim.errors import from_native
+
+    assert issubclass(rendersim.ModelError, (rendersim.Error, ValueError))
+    assert issubclass(rendersim.SimulationError, (rendersim.ModelError, RuntimeError))
+
+    class Native(Exception):
+        pass
+
+    n = Native("m.toml: the run stopped at 1 s before frame 3 (cpu idle)")
+    n.kind, n.file, n.line, n.key = "simulation", None, None, None
+    e = from_native(n)
+    assert isinstance(e, rendersim.SimulationError) and isinstance(e, RuntimeError)
+    n = Native('--set "run.frames=abc": run.frames must be a whole number >= 0')
+    n.kind, n.file, n.line, n.key = "model", None, None, "run.frames"
+    e = from_native(n)
+    assert type(e) is rendersim.ModelError
+    assert str(e) == 'set["run.frames"] = abc: run.frames must be a whole number >= 0'
+
+
+def test_a_model_is_a_path_toml_text_a_dict_or_a_model(tmp_path):
+    """Issue 58 item 1: every form of a model gives the same run."""
+    fixed = MODELS / "fixed.toml"
+    by_path = rendersim.run(fixed, frames=30)
+    m = rendersim.Model.load(fixed)
+    assert m.system == "frame_pipeline" and m.name == str(fixed)
+    assert repr(m) == f"<rendersim.Model frame_pipeline from {fixed}>"
+    by_model = rendersim.run(m, frames=30)
+    by_text = rendersim.run(fixed.read_text(), frames=30)
+    by_dict = rendersim.run(m.to_dict(), frames=30)
+    by_back = rendersim.run(by_path.model, frames=30)  # a run's resolved model, passed back
+    for r in (by_model, by_text, by_dict, by_back):
+        pd.testing.assert_frame_equal(r.frames, by_path.frames)
+    # Changes: checked at once, kept in order, shown in the repr, and the
+    # same as set= on the call.
+    m3 = m.set("display.buffers", 3).set("workload.gpu", "12ms")
+    assert m3.changes == {"display.buffers": 3, "workload.gpu": "12ms"} and m.changes == {}
+    assert repr(m3).endswith("changed: display.buffers=3, workload.gpu='12ms'>")
+    assert m3.to_dict()["display"]["buffers"] == 3
+    assert "buffers = 3" in m3.to_toml()
+    a = rendersim.run(m3, frames=30)
+    b = rendersim.run(fixed, set={"display.buffers": 3, "workload.gpu": "12ms"}, frames=30)
+    pd.testing.assert_frame_equal(a.frames, b.frames)
+    assert rendersim.Model.from_toml(m3.to_toml()) == m3
+    with pytest.raises(rendersim.ModelError) as e:
+        m.set("display.bufers", 3)
+    assert e.value.key == "display.bufers" and "--set" not in str(e.value)
+    # A dict model, and the embedded default as Model().
+    d = rendersim.run({"workload": {"kind": "fixed", "cpu": "2ms", "gpu": "5ms"}, "run": {"frames": 20}})
+    assert d.summary["frames"] == 20
+    assert rendersim.Model().system == "frame_pipeline"
+    assert rendersim.isolate(m3)["bottleneck"] == "gpu"
+    with pytest.raises(FileNotFoundError):
+        rendersim.Model.load(tmp_path / "missing.toml")
+    with pytest.raises(TypeError) as e:
+        rendersim.run(42)
+    assert "a path, TOML text, a dict or a rendersim.Model" in str(e.value)
+
+
+def test_the_docstring_examples_run(monkeypatch):
+    """The examples in rendersim.model's and rendersim.errors' docstrings."""
+    import doctest
+
+    import rendersim.errors
+    import rendersim.model
+
+    monkeypatch.chdir(MODELS.parent)
+    for module in (rendersim.model, rendersim.errors):
+        failed, tried = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
+        assert tried > 0 and failed == 0, module.__name__

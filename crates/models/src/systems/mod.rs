@@ -170,6 +170,11 @@ impl<S: SystemModel> System for Registered<S> {
         Ok(Box::new(run))
     }
 
+    fn read(&self, src: &ModelSource, table: &toml::Table) -> Result<(), SimError> {
+        deserialize::<S::Config>(table, src)?;
+        Ok(())
+    }
+
     fn writes_trace(&self) -> bool {
         S::WRITES_TRACE
     }
@@ -190,6 +195,11 @@ pub trait System: Sync {
         table: &toml::Table,
         trace: Option<TraceWriter>,
     ) -> Result<Box<dyn Outcome>, SimError>;
+
+    /// Reads the model's typed config from its table without running it:
+    /// an unknown key, a misspelt one or a value of the wrong type is the
+    /// error [`System::run`] would give first.
+    fn read(&self, src: &ModelSource, table: &toml::Table) -> Result<(), SimError>;
 
     /// Whether a run writes trace events (`rendersim run --trace`); the
     /// systems that do not are refused a trace before they run, rather than
@@ -380,6 +390,40 @@ pub fn run_among(
     table: &toml::Table,
     trace: Option<TraceWriter>,
 ) -> Result<SystemRun, SimError> {
+    system_of(systems, src, table)?.run(src, table, trace).map(SystemRun)
+}
+
+/// Reads a model as [`run_model`] would, without running it: the system
+/// it names, and that system's typed config from its table.
+///
+/// ```
+/// use rendersim_models::config::ModelSource;
+/// use rendersim_models::systems::read_model;
+///
+/// let typo = ModelSource::from_text("m.toml", "[display]\nbufers = 3\n");
+/// let e = read_model(&typo, &typo.table().unwrap()).unwrap_err().to_string();
+/// assert!(e.starts_with("m.toml:2: key `display.bufers`"), "{e}");
+/// let ok = ModelSource::embedded_default();
+/// assert_eq!(read_model(&ok, &ok.table().unwrap()).unwrap(), "frame_pipeline");
+/// ```
+pub fn read_model(src: &ModelSource, table: &toml::Table) -> Result<&'static str, SimError> {
+    read_among(SYSTEMS, src, table)
+}
+
+/// [`read_model`] among `systems`; returns the system's name.
+pub fn read_among(systems: &[&dyn System], src: &ModelSource, table: &toml::Table) -> Result<&'static str, SimError> {
+    let system = system_of(systems, src, table)?;
+    system.read(src, table)?;
+    Ok(system.name())
+}
+
+/// The system a model's table names (`system = `; the frame pipeline
+/// without one) among `systems`.
+fn system_of<'a>(
+    systems: &[&'a dyn System],
+    src: &ModelSource,
+    table: &toml::Table,
+) -> Result<&'a dyn System, SimError> {
     let name = match table.get("system") {
         None => "frame_pipeline",
         Some(toml::Value::String(s)) => s.as_str(),
@@ -397,7 +441,7 @@ pub fn run_among(
         }
     };
     match systems.iter().find(|s| s.name() == name) {
-        Some(system) => system.run(src, table, trace).map(SystemRun),
+        Some(system) => Ok(*system),
         None => Err(SimError::Config(invalid(
             src,
             "system",
