@@ -84,6 +84,10 @@ step "Python package: built from source (pip install ./python) and its tests (py
 # reused: PyO3, the bindings and rendersim's own crates are compiled.
 .venv/bin/pip install --quiet --disable-pip-version-check ./python
 .venv/bin/pytest -q -p no:cacheprovider --basetemp "$ci_out/pytest" python/tests
+# The native module's stubs against the module, and the package's own
+# annotations type-checked (mypy's stubtest; its cache in the temp folder).
+.venv/bin/pip install --quiet --disable-pip-version-check -r python/requirements-check.txt
+(cd "$ci_out" && "$root/.venv/bin/python" -m mypy.stubtest rendersim)
 
 step "Browser: rendersim explore in headless Chromium (Debian's chromium and chromium-driver, driven by Selenium)"
 if [ ! -x /usr/bin/chromium ] || [ ! -x /usr/bin/chromedriver ]; then

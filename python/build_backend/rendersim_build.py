@@ -70,8 +70,8 @@ def _checkout_habits() -> Iterator[None]:
         os.write(
             2,
             (
-                f"rendersim: compiling the native module with cargo ({shared}): on 2 cores about a minute "
-                "after `cargo build --release`, 1-2 minutes on a fresh checkout (maturin's warning that the "
+                f"rendersim: compiling the native module with cargo ({shared}): on 2 cores about 1.5 minutes "
+                "after `cargo build --release`, 2 on a fresh checkout (maturin's warning that the "
                 "build backend is not maturin can be ignored: this one calls it)\n"
             ).encode(),
         )

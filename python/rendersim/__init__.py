@@ -108,17 +108,61 @@ def _path(p: Optional[PathLike]) -> Optional[str]:
     return None if p is None else os.fspath(p)
 
 
+def _given(p: PathLike) -> str:
+    return os.fspath(p)
+
+
 def _command(name: str, **kwargs: Any) -> list[str]:
     shown = ", ".join(f"{k}={v!r}" for k, v in kwargs.items() if v not in (None, {}, [], ()))
     return ["python", f"rendersim.{name}({shown})"]
 
 
+# Columns of 0/1 that mean yes or no: read as booleans.
+_FLAGS = ("Displayed", "Dropped")
+
+
 def _csv(text: str):
+    """A frames-like CSV as a DataFrame: ``NA`` as NaN,
+    ``Displayed``/``Dropped`` as booleans."""
     import pandas as pd
 
     if not text:
         return pd.DataFrame()
-    return pd.read_csv(io.StringIO(text), na_values=["NA"], keep_default_na=False)
+    df = pd.read_csv(io.StringIO(text), na_values=["NA"], keep_default_na=False)
+    for flag in _FLAGS:
+        if flag in df.columns and df[flag].dtype.kind in "iu" and df[flag].isin((0, 1)).all():
+            df[flag] = df[flag].astype(bool)
+    return df
+
+
+def _frames(native: Any):
+    """A run's frames as a DataFrame, from the numbers the native module
+    holds (no CSV text in between); the same frame ``_csv`` reads from its
+    ``frames.csv``, column for column and bit for bit."""
+    import numpy as np
+    import pandas as pd
+
+    table = native.table()
+    if table is None:
+        return _csv(native.csv())
+    text, kinds, names, values, rows = table
+    numbers = np.frombuffer(values, dtype="<f8").reshape(rows, len(names))
+    columns: dict = {}
+    for name, value in text:
+        # As a CSV reader types a column holding one value on every row.
+        v: Any = int(value) if value.lstrip("-").isdigit() else value
+        columns[name] = pd.Series([v], dtype=None).repeat(rows).reset_index(drop=True)
+    generated = np.frombuffer(kinds, dtype=np.uint8).astype(bool)
+    columns["FrameType"] = pd.Series(np.where(generated, "Generated", "Application"), dtype="str")
+    for i, name in enumerate(names):
+        col = numbers[:, i]
+        if name in _FLAGS:
+            columns[name] = col.astype(bool)
+        elif name == "Frame":
+            columns[name] = col.astype(np.int64)
+        else:
+            columns[name] = col.copy()
+    return pd.DataFrame(columns)
 
 
 @dataclass
@@ -133,7 +177,13 @@ class Run:
     model: str
     notes: list = field(default_factory=list)
     summary_json: str = field(default="", repr=False)
-    frames_csv: str = field(default="", repr=False)
+    native: Any = field(default=None, repr=False)
+
+    @property
+    def frames_csv(self) -> str:
+        """The run's ``frames.csv`` as the command line writes it (made
+        when asked: the DataFrame does not go through it)."""
+        return "" if self.native is None else self.native.csv()
 
     def save(self, out: PathLike) -> Path:
         """Writes ``summary.json``, ``frames.csv`` and ``model.toml`` into
@@ -173,14 +223,15 @@ def run(
     shown = repr(model) if isinstance(model, Model) else (path or ("<model text>" if text else None))
     command = _command("run", model=shown, set=dict(set or {}), sets=list(sets), seed=seed, frames=frames)
     with _native_errors():
-        summary, csv, model_text, notes = _native.run(path, text, own + _sets(set, sets), seed, frames, command)
+        summary, native, model_text, notes = _native.run(path, text, own + _sets(set, sets), seed, frames, command)
+        table = _frames(native)
     return Run(
         summary=json.loads(summary),
-        frames=_csv(csv),
+        frames=table,
         model=model_text,
         notes=list(notes),
         summary_json=summary,
-        frames_csv=csv,
+        native=native,
     )
 
 
@@ -222,9 +273,9 @@ def experiment(
 
     command = _command("experiment", path=_path(path), set=dict(set or {}), sets=list(sets), out=_path(out))
     with _native_errors():
-        out_dir, result = _native.experiment(_path(path), _sets(set, sets), _path(out), bool(force), command)
+        written, result = _native.experiment(_given(path), _sets(set, sets), _path(out), bool(force), command)
     res = json.loads(result)
-    out_dir = Path(out_dir)
+    out_dir = Path(written)
     files = [out_dir / f for f in res["files"]]
     return ExperimentResult(
         name=res["name"],
@@ -299,7 +350,7 @@ def replay(
     capture does not say (``{"display.buffers": 3}``)."""
     with _native_errors():
         summary, comparison, frames, whatif = _native.replay(
-            _path(capture), app, swapchain, _sets(set, sets), _sets(assume, assumes)
+            _given(capture), app, swapchain, _sets(set, sets), _sets(assume, assumes)
         )
     return ReplayResult(
         summary=json.loads(summary),
@@ -323,7 +374,7 @@ def timeline(
     frames and the time range drawn (ms)."""
     path, text, own = model_args(model)
     with _native_errors():
-        f0, f1, t0, t1 = _native.timeline(path, text, own + _sets(set, sets), int(first), int(frames), _path(out))
+        f0, f1, t0, t1 = _native.timeline(path, text, own + _sets(set, sets), int(first), int(frames), _given(out))
     return {"out": Path(out), "frames": (f0, f1), "range_ms": (t0, t1)}
 
 
@@ -338,5 +389,5 @@ def perceived_speed(
     displayed refresh around the first frame skip, drawn to ``out`` (its
     ``.png`` and ``.svg``), as ``rendersim perceived-speed``."""
     with _native_errors():
-        skip, r0, r1, skips = _native.perceived_speed(_path(model), _sets(set, sets), int(around), _path(out))
+        skip, r0, r1, skips = _native.perceived_speed(_given(model), _sets(set, sets), int(around), _given(out))
     return {"out": Path(out), "first_skip": skip, "refreshes": (r0, r1), "skips": skips}

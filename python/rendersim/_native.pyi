@@ -1,6 +1,20 @@
 """rendersim's native module (PyO3); use the functions of ``rendersim``."""
 
-from typing import Optional
+from typing import Optional, final
+
+__all__ = [
+    "ModelError",
+    "RunFrames",
+    "run",
+    "resolve",
+    "experiment",
+    "vcache",
+    "isolate",
+    "replay",
+    "timeline",
+    "perceived_speed",
+    "version",
+]
 
 class ModelError(ValueError):
     file: Optional[str]
@@ -9,9 +23,16 @@ class ModelError(ValueError):
     kind: str  # "model", "missing" or "simulation"
     filename: Optional[str]
 
+@final
+class RunFrames:
+    def table(
+        self,
+    ) -> Optional[tuple[list[tuple[str, str]], bytes, list[str], bytes, int]]: ...
+    def csv(self) -> str: ...
+
 def run(
     model: Optional[str], text: Optional[str], sets: list[str], seed: Optional[int], frames: Optional[int], command: list[str]
-) -> tuple[str, str, str, list[str]]: ...
+) -> tuple[str, RunFrames, str, list[str]]: ...
 def resolve(model: Optional[str], text: Optional[str], sets: list[str]) -> tuple[str, str, str, str]: ...
 def experiment(
     path: str, sets: list[str], out: Optional[str], force: bool, command: list[str]

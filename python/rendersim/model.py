@@ -94,13 +94,18 @@ class Model:
     :class:`ModelError` there, naming it). Every function that takes a
     ``model`` takes a ``Model``."""
 
+    _path: Optional[str]
+    _text: Optional[str]
+    _changes: dict
+    _resolved: Tuple[str, str, str, str]
+
     def __init__(self, source: ModelLike = None) -> None:
         if isinstance(source, Model):
             self._path, self._text, self._changes = source._path, source._text, dict(source._changes)
         else:
             path, text, _ = model_args(source, "Model")
             self._path, self._text = path, text
-            self._changes: dict = {}
+            self._changes = {}
         self._resolve()
 
     @classmethod
@@ -169,7 +174,7 @@ class Model:
 
     def _resolve(self) -> None:
         try:
-            self._resolved: Tuple[str, str, str, str] = _native.resolve(self._path, self._text, self._assignments())
+            self._resolved = _native.resolve(self._path, self._text, self._assignments())
         except _native.ModelError as e:
             raise from_native(e) from None
 

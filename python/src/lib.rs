@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyBytes;
 
 use rendersim::config::{ConfigError, ModelSource, Overrides, PreparedModel, load_model, prepare};
 use rendersim::output::result_set::ResultSet;
@@ -154,7 +155,7 @@ fn resolve(
     Ok((p.source.name.clone(), system, toml_text, json))
 }
 
-/// `rendersim.run(...)`: (summary JSON, frames CSV or "", resolved model
+/// `rendersim.run(...)`: (summary JSON, the finished run, resolved model
 /// TOML, notes).
 #[pyfunction]
 #[pyo3(signature = (model, text, sets, seed, frames, command))]
@@ -166,7 +167,7 @@ fn run(
     seed: Option<u64>,
     frames: Option<u64>,
     command: Vec<String>,
-) -> PyResult<(String, String, String, Vec<String>)> {
+) -> PyResult<(String, RunFrames, String, Vec<String>)> {
     py.detach(move || {
         let overrides = Overrides { sets, seed, frames };
         let prepared = prepared(model, text, &overrides).map_err(err)?;
@@ -176,16 +177,82 @@ fn run(
         let provenance = rendersim::provenance(command);
         run.summary_mut()["provenance"] = serde_json::to_value(&provenance).map_err(err)?;
         let summary = serde_json::to_string_pretty(run.summary()).map_err(err)?;
-        let mut csv = Vec::new();
-        run.write_frames_csv(&mut csv).map_err(err)?;
         let model_text = provenance.toml_comment() + &run.resolved_model(&src.base_dir);
         Ok((
             summary,
-            String::from_utf8(csv).map_err(err)?,
+            RunFrames(std::sync::Mutex::new(run)),
             model_text,
             prepared.notes.clone(),
         ))
     })
+}
+
+/// A finished run's frames, kept in Rust until Python asks: as numbers
+/// (`table`, no text in between: a 200,000-frame run's 66 MB of CSV is
+/// never written) or as the `frames.csv` the command line writes (`csv`,
+/// for `Run.save()`).
+#[pyclass(frozen, module = "rendersim._native")]
+struct RunFrames(std::sync::Mutex<rendersim::systems::SystemRun>);
+
+#[pymethods]
+impl RunFrames {
+    /// The frame pipeline's frames: (the text columns as (name, value),
+    /// one byte a row saying whether it is a generated frame, the numeric
+    /// column names, their values row by row as little-endian `f64`
+    /// bytes, the rows); `None` for another system (read `csv`).
+    #[allow(clippy::type_complexity)]
+    fn table<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<
+        Option<(
+            Vec<(String, String)>,
+            Bound<'py, PyBytes>,
+            Vec<String>,
+            Bound<'py, PyBytes>,
+            usize,
+        )>,
+    > {
+        use rendersim::systems::frame_pipeline::PipelineRun;
+        use rendersim::systems::frame_pipeline::records::{COLUMNS, TEXT_COLUMNS};
+        let values = py.detach(|| {
+            let run = self
+                .0
+                .lock()
+                .map_err(|_| usage("the run's frames are unreadable (a panic)".into()))?;
+            Ok::<_, PyErr>(
+                run.as_any()
+                    .downcast_ref::<PipelineRun>()
+                    .map(PipelineRun::frame_values),
+            )
+        })?;
+        let Some((text, kinds, values)) = values else {
+            return Ok(None);
+        };
+        let text: Vec<(String, String)> = TEXT_COLUMNS.iter().map(|n| n.to_string()).zip(text).collect();
+        let kinds: Vec<u8> = kinds.iter().map(|&g| u8::from(g)).collect();
+        let bytes = PyBytes::new_with(py, values.len() * 8, |buf| {
+            for (cell, v) in buf.chunks_exact_mut(8).zip(&values) {
+                cell.copy_from_slice(&v.to_le_bytes());
+            }
+            Ok(())
+        })?;
+        let columns = COLUMNS.iter().map(|c| c.to_string()).collect();
+        Ok(Some((text, PyBytes::new(py, &kinds), columns, bytes, kinds.len())))
+    }
+
+    /// The frames as the command line's `frames.csv`.
+    fn csv(&self, py: Python<'_>) -> PyResult<String> {
+        py.detach(|| {
+            let run = self
+                .0
+                .lock()
+                .map_err(|_| usage("the run's frames are unreadable (a panic)".into()))?;
+            let mut csv = Vec::new();
+            run.write_frames_csv(&mut csv).map_err(err)?;
+            String::from_utf8(csv).map_err(err)
+        })
+    }
 }
 
 /// `(key, TOML literal)` pairs as an experiment's `[set]` entries.
@@ -412,6 +479,7 @@ fn version() -> (String, Option<String>) {
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ModelError", m.py().get_type::<ModelError>())?;
+    m.add_class::<RunFrames>()?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(resolve, m)?)?;
     m.add_function(wrap_pyfunction!(experiment, m)?)?;

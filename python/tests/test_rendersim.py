@@ -274,3 +274,25 @@ def test_the_docstring_examples_run(monkeypatch):
     for module in (rendersim.model, rendersim.errors):
         failed, tried = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
         assert tried > 0 and failed == 0, module.__name__
+
+
+@pytest.mark.parametrize(
+    "model,changes",
+    [
+        ("fixed.toml", {}),
+        ("fixed.toml", {"frame_generation.enabled": True}),
+        ("fixed.toml", {"display.vsync": False, "display.present_mode": "immediate"}),
+        ("walkthrough-city.toml", {}),
+    ],
+)
+def test_frames_reach_pandas_without_text_and_equal_the_csv(model, changes):
+    """Issue 58 item 1: Run.frames is built from the numbers the native
+    module holds, no CSV in between; it equals frames.csv as read back,
+    value for value and type for type (Displayed and Dropped booleans),
+    with generated frames, NA cells and another system's table."""
+    from rendersim import _csv
+
+    r = rendersim.run(MODELS / model, set=changes, frames=80)
+    pd.testing.assert_frame_equal(r.frames, _csv(r.frames_csv))
+    if "Displayed" in r.frames:
+        assert r.frames["Displayed"].dtype == bool and r.frames["Dropped"].dtype == bool

@@ -474,6 +474,12 @@ impl SystemRun {
         self.0.write_table(w)
     }
 
+    /// The run as `Any`, to read a system's own run type without taking it
+    /// (`downcast_ref::<PipelineRun>()`).
+    pub fn as_any(&self) -> &dyn std::any::Any {
+        self.0.as_any()
+    }
+
     /// The per-row table (columns and rows), for experiments.
     pub fn frame_table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
         self.0.table()

@@ -299,6 +299,18 @@ impl Cell {
         }
     }
 
+    /// The number [`Cell::text`] writes, as a reader of `frames.csv`
+    /// parses it: milliseconds (the nearest `f64` to the exact nine
+    /// decimals), a count, a fraction to six decimals, NaN for `NA`.
+    fn value(self) -> f64 {
+        match self {
+            // Through the text: `x * 1e6` rounds ties the binary value
+            // does not have (0.1234565 is 0.12345649...).
+            Cell::Fraction(_) => self.text().parse().unwrap_or(f64::NAN),
+            c => c.ms(),
+        }
+    }
+
     /// Exact text: picoseconds as milliseconds with nine decimals.
     fn text(self) -> String {
         match self {
@@ -491,16 +503,7 @@ pub fn write_frames_csv<W: std::io::Write>(
     offset_ps: i64,
     w: W,
 ) -> std::io::Result<()> {
-    let text = [
-        chain.application.clone(),
-        chain.process_id.clone(),
-        chain.swap_chain.clone(),
-        chain.runtime.clone(),
-        chain.sync_interval.to_string(),
-        "0".into(),
-        u8::from(chain.allows_tearing).to_string(),
-        chain.present_mode.clone(),
-    ];
+    let text = chain.text();
     let header: Vec<&str> = TEXT_COLUMNS.iter().chain(COLUMNS.iter()).copied().collect();
     let rows = cells(records, generated, offset_ps)
         .into_iter()
@@ -515,9 +518,58 @@ pub fn write_frames_csv<W: std::io::Write>(
     crate::output::table::write_table(std::io::BufWriter::new(w), &header, rows)
 }
 
+impl ChainInfo {
+    /// The first eight [`TEXT_COLUMNS`] (all but `FrameType`), as
+    /// `frames.csv` writes them on every row.
+    pub fn text(&self) -> [String; 8] {
+        [
+            self.application.clone(),
+            self.process_id.clone(),
+            self.swap_chain.clone(),
+            self.runtime.clone(),
+            self.sync_interval.to_string(),
+            "0".into(),
+            u8::from(self.allows_tearing).to_string(),
+            self.present_mode.clone(),
+        ]
+    }
+}
+
+/// The rows of `frames.csv` as numbers, for a caller that wants them typed
+/// rather than as text (the Python package's DataFrames): whether each row
+/// is a generated frame, and [`COLUMNS`] row by row, flattened, each the
+/// number a reader of the file parses (NaN for `NA`). The text columns are
+/// [`ChainInfo::text`], the same on every row.
+pub fn frame_values(records: &[FrameRecord], generated: &[GeneratedRecord], offset_ps: i64) -> (Vec<bool>, Vec<f64>) {
+    let rows = cells(records, generated, offset_ps);
+    let mut kinds = Vec::with_capacity(rows.len());
+    let mut values = Vec::with_capacity(rows.len() * COLUMNS.len());
+    for (generated_row, row) in rows {
+        kinds.push(generated_row);
+        values.extend(row.iter().map(|c| c.value()));
+    }
+    (kinds, values)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_cell_s_value_is_what_its_text_parses_to() {
+        for c in [
+            Cell::Ps(16_666_666_667),
+            Cell::Ps(-1),
+            Cell::Ps(3_600_000_000_000_001),
+            Cell::Ps(123_456_789),
+            Cell::Count(7),
+            Cell::Fraction(0.123_456_5),
+            Cell::Fraction(2.0 / 3.0),
+        ] {
+            assert_eq!(c.value(), c.text().parse::<f64>().unwrap(), "{c:?}");
+        }
+        assert!(Cell::Na.value().is_nan());
+    }
 
     #[test]
     fn picoseconds_are_written_exactly() {

@@ -7,7 +7,7 @@ use crate::output::trace::TraceWriter;
 use crate::systems::{Outcome, SystemError, SystemModel, outcome_basics, resolved_toml};
 
 use super::config::{FramePipelineConfig, WorkloadConfig};
-use super::records::{COLUMNS, ChainInfo, frame_rows, write_frames_csv};
+use super::records::{COLUMNS, ChainInfo, frame_rows, frame_values, write_frames_csv};
 use super::run::{PipelineRun, run_pipeline};
 
 /// `system = "frame_pipeline"` (the default).
@@ -33,6 +33,14 @@ impl PipelineRun {
             0,
             w,
         )
+    }
+
+    /// The rows of its `frames.csv` as numbers: the text columns (the same
+    /// on every row), whether each row is a generated frame, and
+    /// [`COLUMNS`] row by row, flattened ([`frame_values`]).
+    pub fn frame_values(&self) -> ([String; 8], Vec<bool>, Vec<f64>) {
+        let (kinds, values) = frame_values(&self.records, &self.generated, 0);
+        (ChainInfo::of_display(&self.config.display).text(), kinds, values)
     }
 }
 
