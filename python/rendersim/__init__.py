@@ -31,6 +31,7 @@ from typing import Any, Iterator, Mapping, Optional, Sequence, Union
 from . import _native
 from .errors import Error, ModelError, SimulationError, from_native
 from .model import Model, ModelLike, model_args
+from .progress import ProgressLike, reporter
 
 __all__ = [
     "Error",
@@ -135,18 +136,16 @@ def _csv(text: str):
     return df
 
 
-def _frames(native: Any):
-    """A run's frames as a DataFrame, from the numbers the native module
-    holds (no CSV text in between); the same frame ``_csv`` reads from its
-    ``frames.csv``, column for column and bit for bit."""
+def _frames(table: Any):
+    """A frames table from the native module (a run's or a replay's; no
+    CSV text in between) as a DataFrame: the same frame ``_csv`` reads from
+    its ``frames.csv``, column for column and bit for bit."""
     import numpy as np
     import pandas as pd
 
-    table = native.table()
-    if table is None:
-        return _csv(native.csv())
     text, kinds, names, values, rows = table
-    numbers = np.frombuffer(values, dtype="<f8").reshape(rows, len(names))
+    # Column by column in a bytearray: each column a writable view, no copy.
+    numbers = np.frombuffer(values, dtype="<f8").reshape(len(names), rows)
     columns: dict = {}
     for name, value in text:
         # As a CSV reader types a column holding one value on every row.
@@ -154,15 +153,96 @@ def _frames(native: Any):
         columns[name] = pd.Series([v], dtype=None).repeat(rows).reset_index(drop=True)
     generated = np.frombuffer(kinds, dtype=np.uint8).astype(bool)
     columns["FrameType"] = pd.Series(np.where(generated, "Generated", "Application"), dtype="str")
-    for i, name in enumerate(names):
-        col = numbers[:, i]
+    for name, col in zip(names, numbers):
         if name in _FLAGS:
             columns[name] = col.astype(bool)
         elif name == "Frame":
             columns[name] = col.astype(np.int64)
         else:
-            columns[name] = col.copy()
-    return pd.DataFrame(columns)
+            columns[name] = col
+    return pd.DataFrame(columns, copy=False)
+
+
+# The comparison's yes-or-no columns.
+_COMPARISON_FLAGS = ("Displayed", "PredictedDisplayed", "WhatIfDisplayed")
+
+
+def _numbers(table: Any):
+    """A table of numbers from the native module (the replay's comparison)
+    as a DataFrame: ``Line`` as integers, the yes-or-no columns
+    (``Displayed``, ``PredictedDisplayed``, ``WhatIfDisplayed``) as booleans (pandas' nullable ``boolean`` where a
+    row has no value), the rest as floats (NaN where a value does not
+    exist)."""
+    import numpy as np
+    import pandas as pd
+
+    names, values, rows = table
+    numbers = np.frombuffer(values, dtype="<f8").reshape(len(names), rows)
+    columns: dict = {}
+    for name, col in zip(names, numbers):
+        missing = np.isnan(col)
+        if name == "Line" and not missing.any():
+            columns[name] = col.astype(np.int64)
+        elif name in _COMPARISON_FLAGS:
+            flags = pd.array(col == 1, dtype="boolean")
+            flags[missing] = pd.NA
+            columns[name] = flags if missing.any() else col == 1
+        else:
+            columns[name] = col
+    return pd.DataFrame(columns, copy=False)
+
+
+# Units a sweep value may carry, to the unit its column is given in.
+_TIME_MS = {"s": 1e3, "ms": 1.0, "us": 1e-3, "µs": 1e-3, "μs": 1e-3, "ns": 1e-6, "ps": 1e-9}
+_RATE_HZ = {"Hz": 1.0, "hz": 1.0, "kHz": 1e3, "khz": 1e3, "MHz": 1e6}
+
+
+def _unit_number(v: Any) -> Optional[tuple[float, str]]:
+    """``"12.5ms"`` as (12.5, "ms"); ``"0"`` as (0.0, ""); None for text
+    that is not a number with a unit."""
+    if not isinstance(v, str):
+        return None
+    t = v.strip()
+    i = 0
+    while i < len(t) and (t[i].isdigit() or t[i] in ".+-_"):
+        i += 1
+    try:
+        number = float(t[:i].replace("_", ""))
+    except ValueError:
+        return None
+    return (number, t[i:].strip()) if math.isfinite(number) else None
+
+
+def _typed_sweeps(df: Any, keys: Sequence[str]) -> Any:
+    """Swept columns whose values are durations (``"10ms"``) or rates
+    (``"60Hz"``) as numbers, renamed with their unit as the summary's names
+    are (``workload.gpu`` -> ``workload.gpu_ms``, ``display.refresh`` ->
+    ``display.refresh_hz``); ``df.attrs["units"]`` maps each to its unit
+    and ``df.attrs["swept"]`` lists the swept columns. Columns of other
+    values (numbers, names, paths, a mix) are left as they are."""
+    units: dict = {}
+    swept: list = []
+    renames: dict = {}
+    for key in keys:
+        if key not in df.columns:
+            continue
+        parsed = [_unit_number(v) for v in df[key]]
+        swept.append(key)
+        if not parsed or any(p is None for p in parsed):
+            continue
+        given = {u for _, u in parsed if u}  # type: ignore[misc]
+        for table, unit, suffix in ((_TIME_MS, "ms", "_ms"), (_RATE_HZ, "Hz", "_hz")):
+            # "0" is a duration of any unit; a rate needs one.
+            if given and given <= table.keys() and (unit == "ms" or all(u for _, u in parsed)):  # type: ignore[misc]
+                df[key] = [n * table.get(u, 1.0) for n, u in parsed]  # type: ignore[misc]
+                renames[key] = key + suffix
+                units[key + suffix] = unit
+                swept[-1] = key + suffix
+                break
+    df = df.rename(columns=renames)
+    df.attrs["units"] = units
+    df.attrs["swept"] = swept
+    return df
 
 
 @dataclass
@@ -185,16 +265,19 @@ class Run:
         when asked: the DataFrame does not go through it)."""
         return "" if self.native is None else self.native.csv()
 
-    def save(self, out: PathLike) -> Path:
+    def save(self, out: PathLike, force: bool = False) -> Path:
         """Writes ``summary.json``, ``frames.csv`` and ``model.toml`` into
-        the folder ``out`` (made if missing), the bytes ``rendersim run
-        --out`` writes; returns the folder."""
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "summary.json").write_text(self.summary_json)
-        (out / "frames.csv").write_text(self.frames_csv)
-        (out / "model.toml").write_text(self.model)
-        return out
+        the folder ``out`` as ``rendersim run --out`` does: the same files,
+        written beside it and swapped in whole, so ``out`` holds the old
+        run or the new one, never a mix; the folder is marked as a run's,
+        so this and the command line may write there again. A folder
+        holding other files is refused (:class:`ModelError`), and an
+        experiment's or a replay's results unless ``force``. Returns the
+        folder."""
+        if self.native is None:
+            raise ModelError("save: this Run holds no frames (made by hand?); run the model again")
+        with _native_errors():
+            return Path(self.native.save(_given(out), self.summary_json, self.model, bool(force)))
 
     def __repr__(self) -> str:
         m = self.summary.get("metrics", {}).get("frame_time_ms", {}).get("mean")
@@ -224,7 +307,8 @@ def run(
     command = _command("run", model=shown, set=dict(set or {}), sets=list(sets), seed=seed, frames=frames)
     with _native_errors():
         summary, native, model_text, notes = _native.run(path, text, own + _sets(set, sets), seed, frames, command)
-        table = _frames(native)
+        numbers = native.table()
+        table = _frames(numbers) if numbers is not None else _csv(native.csv())
     return Run(
         summary=json.loads(summary),
         frames=table,
@@ -239,8 +323,11 @@ def run(
 class ExperimentResult:
     """An experiment's results, written to ``out`` as ``rendersim experiment
     --out`` writes them: ``points`` and ``runs`` (DataFrames of
-    ``points.csv`` and ``runs.csv``), ``plots`` (paths of the PNG and SVG
-    plots), ``report`` (``report.md``), ``checks_failed``."""
+    ``points.csv`` and ``runs.csv``, swept durations and rates as numbers
+    with their unit in the column's name, ``workload.gpu_ms``, and in
+    ``attrs["units"]``; ``points_long``, the points in tidy form),
+    ``plots`` (paths of the PNG and SVG plots), ``report``
+    (``report.md``), ``checks_failed``."""
 
     name: str
     out: Path
@@ -250,6 +337,27 @@ class ExperimentResult:
     report: str
     checks_failed: int
     wall_seconds: float
+
+    @property
+    def points_long(self) -> Any:
+        """``points`` in tidy (long) form: one row per point, metric and
+        statistic, with the point's swept values: columns ``point``, the
+        swept keys, ``metric`` (``metrics.frame_time_ms.mean``, or a
+        derived value's name), ``stat`` (``mean``, ``ci_low``, ``ci_high``,
+        ``n``; ``derived`` for a derived value) and ``value``; what
+        ``groupby``, ``pivot`` and seaborn take."""
+        p = self.points
+        ids = ["point"] + [c for c in p.attrs.get("swept", []) if c in p.columns]
+        measured = [c for c in p.columns if c not in ids]
+        long = p.melt(id_vars=ids, value_vars=measured, var_name="metric:stat", value_name="value")
+        named = long["metric:stat"].astype(str)
+        has_stat = named.str.contains(":", regex=False)
+        parts = named.str.rsplit(":", n=1, expand=True).reindex(columns=[0, 1])
+        long["metric"] = parts[0].where(has_stat, named)
+        long["stat"] = parts[1].where(has_stat, "derived")
+        long = long[ids + ["metric", "stat", "value"]]
+        long.attrs = dict(p.attrs)
+        return long
 
     def __repr__(self) -> str:
         return (
@@ -264,24 +372,33 @@ def experiment(
     out: Optional[PathLike] = None,
     force: bool = False,
     sets: Sequence[str] = (),
+    progress: ProgressLike = None,
 ) -> ExperimentResult:
     """Runs an experiment file (sweeps, replications, checks, plots) with
     ``set`` added to its ``[set]`` table, into ``out`` (default
     ``out/<name>``, as the command line). A failed reference check does not
-    raise: see ``checks_failed``."""
+    raise: see ``checks_failed``.
+
+    ``progress``: ``None`` shows a bar in a notebook or on a terminal,
+    ``False`` nothing, ``True`` always; a function ``f(done, total)`` is
+    called after each run (``rendersim.progress``). An exception it raises,
+    or an interrupt (Ctrl-C), stops the runs not yet started and is raised
+    here; ``out`` then keeps what it held before."""
     import pandas as pd
 
+    report = reporter(progress)
     command = _command("experiment", path=_path(path), set=dict(set or {}), sets=list(sets), out=_path(out))
     with _native_errors():
-        written, result = _native.experiment(_given(path), _sets(set, sets), _path(out), bool(force), command)
+        written, result = _native.experiment(_given(path), _sets(set, sets), _path(out), bool(force), command, report)
     res = json.loads(result)
     out_dir = Path(written)
     files = [out_dir / f for f in res["files"]]
+    swept = res.get("swept", [])
     return ExperimentResult(
         name=res["name"],
         out=out_dir,
-        points=pd.read_csv(out_dir / "points.csv"),
-        runs=pd.read_csv(out_dir / "runs.csv"),
+        points=_typed_sweeps(pd.read_csv(out_dir / "points.csv"), swept),
+        runs=_typed_sweeps(pd.read_csv(out_dir / "runs.csv"), swept),
         plots=[f for f in files if f.suffix in (".png", ".svg")],
         report=(out_dir / "report.md").read_text(),
         checks_failed=res["checks_failed"],
@@ -326,9 +443,12 @@ def isolate(
 class ReplayResult:
     """A PresentMon capture replayed through the frame pipeline:
     ``summary`` (the ``replay`` object of ``rendersim replay --json``),
-    ``comparison`` (measured against predicted per frame), ``frames`` (the
-    replay as captured, PresentMon columns) and ``whatif_frames`` (with a
-    what-if, its frames; else None)."""
+    ``comparison`` (measured against predicted per frame: ``Line`` of the
+    capture, times in ms, ``Displayed``-like columns as booleans),
+    ``frames`` (the replay as captured, PresentMon columns, as
+    ``Run.frames``) and ``whatif_frames`` (with a what-if, its frames;
+    else None). The tables come from the replay's numbers, not from CSV
+    text."""
 
     summary: dict
     comparison: Any
@@ -354,9 +474,9 @@ def replay(
         )
     return ReplayResult(
         summary=json.loads(summary),
-        comparison=_csv(comparison),
-        frames=_csv(frames),
-        whatif_frames=_csv(whatif) if whatif else None,
+        comparison=_numbers(comparison),
+        frames=_frames(frames),
+        whatif_frames=_frames(whatif) if whatif is not None else None,
     )
 
 

@@ -1,6 +1,13 @@
 """rendersim's native module (PyO3); use the functions of ``rendersim``."""
 
-from typing import Optional, final
+from typing import Callable, Optional, final
+
+# (text columns as (name, value), generated-frame flags (one byte a row),
+# numeric column names, their values column by column as little-endian f64
+# bytes, rows)
+_FramesTable = tuple[list[tuple[str, str]], bytes, list[str], bytearray, int]
+# (column names, values column by column as little-endian f64 bytes, rows)
+_NumberTable = tuple[list[str], bytearray, int]
 
 __all__ = [
     "ModelError",
@@ -25,17 +32,21 @@ class ModelError(ValueError):
 
 @final
 class RunFrames:
-    def table(
-        self,
-    ) -> Optional[tuple[list[tuple[str, str]], bytes, list[str], bytes, int]]: ...
+    def table(self) -> Optional[_FramesTable]: ...
     def csv(self) -> str: ...
+    def save(self, out: str, summary: str, model: str, force: bool = False) -> str: ...
 
 def run(
     model: Optional[str], text: Optional[str], sets: list[str], seed: Optional[int], frames: Optional[int], command: list[str]
 ) -> tuple[str, RunFrames, str, list[str]]: ...
 def resolve(model: Optional[str], text: Optional[str], sets: list[str]) -> tuple[str, str, str, str]: ...
 def experiment(
-    path: str, sets: list[str], out: Optional[str], force: bool, command: list[str]
+    path: str,
+    sets: list[str],
+    out: Optional[str],
+    force: bool,
+    command: list[str],
+    progress: Optional[Callable[[int, int], object]] = None,
 ) -> tuple[str, str]: ...
 def vcache(mesh: str, policy: str) -> str: ...
 def isolate(
@@ -46,7 +57,7 @@ def isolate(
 ) -> str: ...
 def replay(
     capture: str, app: Optional[str], swapchain: Optional[str], sets: list[str], assume: list[str]
-) -> tuple[str, str, str, str]: ...
+) -> tuple[str, _NumberTable, _FramesTable, Optional[_FramesTable]]: ...
 def timeline(
     model: Optional[str], text: Optional[str], sets: list[str], first: int, frames: int, out: str
 ) -> tuple[int, int, float, float]: ...

@@ -1,6 +1,7 @@
 //! `rendersim._native`: the library calls behind the Python package
-//! (`python/rendersim/__init__.py`), each returning text (JSON, CSV, TOML)
-//! that the package turns into dicts and pandas DataFrames. The simulation
+//! (`python/rendersim/__init__.py`), each returning JSON or TOML text for
+//! dicts and tables of numbers as bytes (no CSV in between) that the
+//! package turns into dicts and pandas DataFrames. The simulation
 //! runs with the GIL released, so Python threads go on meanwhile.
 //!
 //! Every error is raised as `_native.ModelError` with the message the
@@ -16,7 +17,7 @@ use std::path::{Path, PathBuf};
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyBytes;
+use pyo3::types::{PyByteArray, PyBytes};
 
 use rendersim::config::{ConfigError, ModelSource, Overrides, PreparedModel, load_model, prepare};
 use rendersim::output::result_set::ResultSet;
@@ -196,49 +197,38 @@ struct RunFrames(std::sync::Mutex<rendersim::systems::SystemRun>);
 
 #[pymethods]
 impl RunFrames {
-    /// The frame pipeline's frames: (the text columns as (name, value),
-    /// one byte a row saying whether it is a generated frame, the numeric
-    /// column names, their values row by row as little-endian `f64`
-    /// bytes, the rows); `None` for another system (read `csv`).
-    #[allow(clippy::type_complexity)]
-    fn table<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<
-        Option<(
-            Vec<(String, String)>,
-            Bound<'py, PyBytes>,
-            Vec<String>,
-            Bound<'py, PyBytes>,
-            usize,
-        )>,
-    > {
+    /// The frame pipeline's frames as a [`FramesTable`]; `None` for
+    /// another system (read `csv`). The numbers are written straight into
+    /// the `bytearray` NumPy then views, without the GIL.
+    fn table<'py>(&self, py: Python<'py>) -> PyResult<Option<FramesTable<'py>>> {
         use rendersim::systems::frame_pipeline::PipelineRun;
-        use rendersim::systems::frame_pipeline::records::{COLUMNS, TEXT_COLUMNS};
-        let values = py.detach(|| {
-            let run = self
-                .0
+        use rendersim::systems::frame_pipeline::records::COLUMNS;
+        let lock = || {
+            self.0
                 .lock()
-                .map_err(|_| usage("the run's frames are unreadable (a panic)".into()))?;
-            Ok::<_, PyErr>(
-                run.as_any()
-                    .downcast_ref::<PipelineRun>()
-                    .map(PipelineRun::frame_values),
-            )
-        })?;
-        let Some((text, kinds, values)) = values else {
+                .map_err(|_| usage("the run's frames are unreadable (a panic)".into()))
+        };
+        let Some(rows) = lock()?
+            .as_any()
+            .downcast_ref::<PipelineRun>()
+            .map(PipelineRun::table_rows)
+        else {
             return Ok(None);
         };
-        let text: Vec<(String, String)> = TEXT_COLUMNS.iter().map(|n| n.to_string()).zip(text).collect();
-        let kinds: Vec<u8> = kinds.iter().map(|&g| u8::from(g)).collect();
-        let bytes = PyBytes::new_with(py, values.len() * 8, |buf| {
-            for (cell, v) in buf.chunks_exact_mut(8).zip(&values) {
-                cell.copy_from_slice(&v.to_le_bytes());
-            }
-            Ok(())
+        let mut parts = None;
+        let values = PyByteArray::new_with(py, rows * COLUMNS.len() * 8, |buf| {
+            py.detach(|| {
+                let run = lock()?;
+                let Some(run) = run.as_any().downcast_ref::<PipelineRun>() else {
+                    return Err(usage("the run changed while read".into()));
+                };
+                parts = Some(run.frame_values_with(|k, v| buf[8 * k..8 * k + 8].copy_from_slice(&v.to_le_bytes())));
+                Ok(())
+            })
         })?;
-        let columns = COLUMNS.iter().map(|c| c.to_string()).collect();
-        Ok(Some((text, PyBytes::new(py, &kinds), columns, bytes, kinds.len())))
+        let (text, kinds) = parts.ok_or_else(|| usage("the run's frames were not read".into()))?;
+        let (text, kinds, columns) = table_parts(text, &kinds);
+        Ok(Some((text, PyBytes::new(py, &kinds), columns, values, rows)))
     }
 
     /// The frames as the command line's `frames.csv`.
@@ -253,7 +243,84 @@ impl RunFrames {
             String::from_utf8(csv).map_err(err)
         })
     }
+
+    /// Writes the run into the folder `out` as `rendersim run --out`
+    /// does: `summary.json` (`summary`), `frames.csv` and `model.toml`
+    /// (`model`), staged beside it and swapped in whole, with the marker
+    /// that lets the command line (and this) write there again. A folder
+    /// holding files rendersim did not write is refused, and another
+    /// kind's result set unless `force`. Returns the folder.
+    #[pyo3(signature = (out, summary, model, force=false))]
+    fn save(&self, py: Python<'_>, out: PathBuf, summary: String, model: String, force: bool) -> PyResult<String> {
+        const RUN_FILES: [&str; 3] = ["summary.json", "frames.csv", "model.toml"];
+        py.detach(|| {
+            let run = self
+                .0
+                .lock()
+                .map_err(|_| usage("the run's frames are unreadable (a panic)".into()))?;
+            let set = ResultSet::begin_kind(&out, Some("run"), |name| RUN_FILES.contains(&name), force).map_err(err)?;
+            let dir = set.dir();
+            let io = |what: &str, e: std::io::Error| usage(format!("writing {what} into {}: {e}", out.display()));
+            std::fs::write(dir.join("summary.json"), &summary).map_err(|e| io("summary.json", e))?;
+            let mut frames = std::fs::File::create(dir.join("frames.csv")).map_err(|e| io("frames.csv", e))?;
+            run.write_frames_csv(&mut frames).map_err(|e| io("frames.csv", e))?;
+            drop(frames);
+            std::fs::write(dir.join("model.toml"), &model).map_err(|e| io("model.toml", e))?;
+            set.commit().map_err(err)?;
+            Ok(out.display().to_string())
+        })
+    }
 }
+
+/// A frames table for Python, with no text in between: (the text columns
+/// as (name, value), the same on every row; one byte a row, 1 for a
+/// generated frame; the numeric column names; their values column by
+/// column as little-endian `f64` bytes, NaN where `frames.csv` has `NA`, in
+/// a `bytearray` so that NumPy's views of it are writable; the rows).
+type FramesTable<'py> = (
+    Vec<(String, String)>,
+    Bound<'py, PyBytes>,
+    Vec<String>,
+    Bound<'py, PyByteArray>,
+    usize,
+);
+
+/// `frame_values`' three parts (a pipeline run's or a replay's) as a
+/// [`FramesTable`].
+fn frames_table<'py>(
+    py: Python<'py>,
+    (text, kinds, values): ([String; 8], Vec<bool>, Vec<f64>),
+) -> PyResult<FramesTable<'py>> {
+    let rows = kinds.len();
+    let (text, kinds, columns) = table_parts(text, &kinds);
+    Ok((text, PyBytes::new(py, &kinds), columns, f64_bytes(py, &values)?, rows))
+}
+
+/// A frames table's text columns named, its generated-frame flags as
+/// bytes, and its numeric column names.
+fn table_parts(text: [String; 8], kinds: &[bool]) -> (Vec<(String, String)>, Vec<u8>, Vec<String>) {
+    use rendersim::systems::frame_pipeline::records::{COLUMNS, TEXT_COLUMNS};
+    let text = TEXT_COLUMNS.iter().map(|n| n.to_string()).zip(text).collect();
+    let kinds = kinds.iter().map(|&g| u8::from(g)).collect();
+    let columns = COLUMNS.iter().map(|c| c.to_string()).collect();
+    (text, kinds, columns)
+}
+
+/// Numbers as little-endian `f64` bytes, for `numpy.frombuffer` (a
+/// `bytearray`: the arrays over it are writable, no copy needed).
+fn f64_bytes<'py>(py: Python<'py>, values: &[f64]) -> PyResult<Bound<'py, PyByteArray>> {
+    PyByteArray::new_with(py, values.len() * 8, |buf| {
+        for (cell, v) in buf.chunks_exact_mut(8).zip(values) {
+            cell.copy_from_slice(&v.to_le_bytes());
+        }
+        Ok(())
+    })
+}
+
+/// A table of numbers (the replay's comparison): (column names, values
+/// column by column as little-endian `f64` bytes in a `bytearray`, NaN
+/// where a value does not exist, the rows).
+type NumberTable<'py> = (Vec<String>, Bound<'py, PyByteArray>, usize);
 
 /// `(key, TOML literal)` pairs as an experiment's `[set]` entries.
 fn set_entries(sets: &[String]) -> PyResult<Vec<(String, toml::Value)>> {
@@ -274,9 +341,12 @@ fn set_entries(sets: &[String]) -> PyResult<Vec<(String, toml::Value)>> {
 
 /// `rendersim.experiment(...)`: runs the experiment file into `out` (a
 /// result set, as `rendersim experiment --out`); returns (out, the result
-/// as JSON: checks failed, wall seconds, files).
+/// as JSON: checks failed, wall seconds, files). `progress(done, total)` is
+/// called after each run; an exception it raises, or an interrupt
+/// (Ctrl-C, a notebook's stop), stops the runs not yet started and is
+/// raised here, the folder left as it was.
 #[pyfunction]
-#[pyo3(signature = (path, sets, out, force, command))]
+#[pyo3(signature = (path, sets, out, force, command, progress=None))]
 fn experiment(
     py: Python<'_>,
     path: PathBuf,
@@ -284,10 +354,30 @@ fn experiment(
     out: Option<PathBuf>,
     force: bool,
     command: Vec<String>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<(String, String)> {
+    use rendersim::experiment::{Progress, SimRunner, load_experiment, run_experiment};
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicBool, Ordering};
     let entries = set_entries(&sets)?;
-    py.detach(move || {
-        use rendersim::experiment::{SimRunner, load_experiment, run_experiment};
+    let stop = AtomicBool::new(false);
+    let raised: Mutex<Option<PyErr>> = Mutex::new(None);
+    let keep = |e: PyErr| {
+        if let Ok(mut r) = raised.lock() {
+            r.get_or_insert(e);
+        }
+        stop.store(true, Ordering::Relaxed);
+    };
+    let observe = |done: u64, total: u64| {
+        if let Some(cb) = &progress
+            && !stop.load(Ordering::Relaxed)
+            && let Err(e) = Python::attach(|py| cb.call1(py, (done, total)).map(drop))
+        {
+            keep(e);
+        }
+        !stop.load(Ordering::Relaxed)
+    };
+    let body = || {
         let mut exp = load_experiment(&path).map_err(err)?;
         exp.set.extend(entries);
         let default = ModelSource::embedded_default().table().map_err(err)?;
@@ -296,7 +386,7 @@ fn experiment(
         let ours = |n: &str| [".csv", ".md", ".svg", ".png"].iter().any(|e| n.ends_with(e));
         let set = ResultSet::begin_kind(&out, Some("experiment"), ours, force).map_err(err)?;
         let runner = SimRunner::for_experiment(&exp);
-        let result = run_experiment(&exp, &base, &runner, set.dir(), false).map_err(err)?;
+        let result = run_experiment(&exp, &base, &runner, set.dir(), Progress::Observe(&observe)).map_err(err)?;
         rendersim::experiment::add_provenance(set.dir(), &rendersim::provenance(command)).map_err(err)?;
         set.commit().map_err(err)?;
         let json = serde_json::json!({
@@ -305,10 +395,29 @@ fn experiment(
             "checks_failed": result.checks_failed,
             "wall_seconds": result.wall_seconds,
             "sim_wall_seconds": result.sim_wall_seconds,
+            "swept": exp.point_keys(),
             "files": result.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>(),
         });
-        Ok((out.display().to_string(), json.to_string()))
-    })
+        Ok::<_, PyErr>((out.display().to_string(), json.to_string()))
+    };
+    // The experiment runs on a thread of its own; this one waits without
+    // the GIL and looks for Python's signals between waits (only the main
+    // thread sees them), so Ctrl-C stops it.
+    let result = std::thread::scope(|s| {
+        let worker = s.spawn(body);
+        while !worker.is_finished() {
+            py.detach(|| std::thread::sleep(std::time::Duration::from_millis(20)));
+            if let Err(e) = py.check_signals() {
+                keep(e);
+            }
+        }
+        worker.join()
+    });
+    let result = result.map_err(|_| usage("the experiment panicked".into()))?;
+    match raised.into_inner().ok().flatten() {
+        Some(e) => Err(e),
+        None => result,
+    }
 }
 
 /// `rendersim.vcache(mesh, policy)`: the cache statistics as JSON.
@@ -378,40 +487,46 @@ fn isolate(
     })
 }
 
-/// `rendersim.replay(...)`: (summary JSON, comparison CSV, replayed frames
-/// CSV, what-if frames CSV or "").
+/// `rendersim.replay(...)`: (summary JSON, the comparison as a
+/// [`NumberTable`], the replayed frames and the what-if's frames (or
+/// `None`) as [`FramesTable`]s; no CSV text in between).
 #[pyfunction]
 #[pyo3(signature = (capture, app, swapchain, sets, assume))]
-fn replay(
-    py: Python<'_>,
+fn replay<'py>(
+    py: Python<'py>,
     capture: PathBuf,
     app: Option<String>,
     swapchain: Option<String>,
     sets: Vec<String>,
     assume: Vec<String>,
-) -> PyResult<(String, String, String, String)> {
-    py.detach(move || {
-        use rendersim::studies::replay::{ReplayOptions, replay};
-        let opts = ReplayOptions {
-            app,
-            swap_chain: swapchain,
-            sets,
-            assume,
-            from_tables: false,
-        };
-        let r = replay(&capture, &opts).map_err(err)?;
-        let summary = serde_json::to_string(&r.summary).map_err(err)?;
-        let mut comparison = Vec::new();
-        rendersim::output::table::write_number_table(&mut comparison, &r.columns(), &r.rows()).map_err(err)?;
-        let mut frames = Vec::new();
-        r.replayed.write_csv(&mut frames).map_err(err)?;
-        let mut whatif = Vec::new();
-        if let Some(w) = &r.whatif_replayed {
-            w.write_csv(&mut whatif).map_err(err)?;
-        }
-        let text = |b: Vec<u8>| String::from_utf8(b).map_err(err);
-        Ok((summary, text(comparison)?, text(frames)?, text(whatif)?))
-    })
+) -> PyResult<(String, NumberTable<'py>, FramesTable<'py>, Option<FramesTable<'py>>)> {
+    type Values = ([String; 8], Vec<bool>, Vec<f64>);
+    let (summary, names, rows, frames, whatif): (String, Vec<String>, Vec<f64>, Values, Option<Values>) =
+        py.detach(move || {
+            use rendersim::studies::replay::{ReplayOptions, replay};
+            let opts = ReplayOptions {
+                app,
+                swap_chain: swapchain,
+                sets,
+                assume,
+                from_tables: false,
+            };
+            let r = replay(&capture, &opts).map_err(err)?;
+            let summary = serde_json::to_string(&r.summary).map_err(err)?;
+            let table = r.rows();
+            let width = r.columns().len();
+            // Column by column, as the frames.
+            let rows: Vec<f64> = (0..width)
+                .flat_map(|c| table.iter().map(move |row| row.get(c).copied().unwrap_or(f64::NAN)))
+                .collect();
+            let whatif = r.whatif_replayed.as_ref().map(|w| w.frame_values());
+            Ok::<_, PyErr>((summary, r.columns(), rows, r.replayed.frame_values(), whatif))
+        })?;
+    let n = rows.len() / names.len().max(1);
+    let comparison = (names, f64_bytes(py, &rows)?, n);
+    let frames = frames_table(py, frames)?;
+    let whatif = whatif.map(|w| frames_table(py, w)).transpose()?;
+    Ok((summary, comparison, frames, whatif))
 }
 
 /// `rendersim.timeline(...)`: paper 000 Figure 4 for a few frames, drawn

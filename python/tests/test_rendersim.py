@@ -9,6 +9,7 @@ import threading
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -62,6 +63,22 @@ def test_same_seed_same_frames_and_the_model_text_reproduces_the_run(tmp_path):
         assert (saved / "frames.csv").read_bytes() == (out / "frames.csv").read_bytes()
         body = lambda p: [l for l in p.read_text().splitlines() if not l.startswith(("# Written by", "# Command:"))]
         assert body(saved / "model.toml") == body(out / "model.toml")
+        # The saved folder is a run's result set: the command line writes
+        # there again, and save() over the command line's folder too.
+        ours = (saved / "frames.csv").read_bytes()
+        subprocess.run([exe, "run", str(MODELS / "fixed.toml"), "--frames", "5", "--out", str(saved)],
+                       check=True, capture_output=True)
+        assert (saved / "frames.csv").read_bytes() != ours
+        a.save(out)
+        assert (out / "frames.csv").read_bytes() == ours
+    assert a.save(saved) == saved and (saved / ".rendersim-set").is_file()
+    # A folder holding someone else's files is refused, and left as it was.
+    other = tmp_path / "mine"
+    other.mkdir()
+    (other / "notes.txt").write_text("keep me")
+    with pytest.raises(rendersim.ModelError, match="notes.txt|not.*rendersim|refus"):
+        a.save(other)
+    assert (other / "notes.txt").read_text() == "keep me" and not (other / "frames.csv").exists()
     assert a.summary["metrics"]["gpu_time_ms"]["mean"] == pytest.approx(9.0)
 
 
@@ -134,8 +151,75 @@ def test_experiment_writes_its_folder_and_returns_dataframes(tmp_path):
     assert r.checks_failed == 0
     assert r.plots and all(p.is_file() for p in r.plots)
     assert "## Provenance" in r.report
-    # The runs carry the added [set].
-    assert (r.runs.filter(like="workload.gpu").shape[1]) >= 1
+    # Swept durations as numbers in ms, the unit in the name and attrs.
+    assert list(r.points["workload.gpu_ms"]) == [5.0, 20.0]
+    assert list(r.runs["workload.gpu_ms"]) == [5.0, 5.0, 20.0, 20.0]
+    assert r.points.attrs["units"] == {"workload.gpu_ms": "ms"}
+    assert r.points.attrs["swept"] == ["workload.gpu_ms"]
+    # The points in tidy form: one row per point, metric and statistic,
+    # each value the wide table's.
+    long = r.points_long
+    assert list(long.columns) == ["point", "workload.gpu_ms", "metric", "stat", "value"]
+    stats = [c for c in r.points.columns if ":" in c]
+    assert len(long) == len(r.points) * len(stats)
+    mean = long[(long.metric == "metrics.frame_time_ms.mean") & (long.stat == "mean")]
+    assert list(mean.value) == list(r.points["metrics.frame_time_ms.mean:mean"])
+    assert long.attrs["units"] == {"workload.gpu_ms": "ms"}
+
+
+def test_typed_sweeps_convert_units_and_leave_other_values():
+    from rendersim import _typed_sweeps
+
+    df = pd.DataFrame(
+        {
+            "point": [0, 1, 2],
+            "workload.gpu": ["500us", "2ms", "0"],
+            "display.refresh": ["60Hz", "1kHz", "144Hz"],
+            "model": ["a.toml", "b.toml", "c.toml"],
+            "mixed": ["60Hz", "16ms", "1s"],
+            "display.buffers": [2, 3, 4],
+            "m:mean": [1.0, 2.0, 3.0],
+        }
+    )
+    out = _typed_sweeps(df, ["workload.gpu", "display.refresh", "model", "mixed", "display.buffers"])
+    assert list(out["workload.gpu_ms"]) == [0.5, 2.0, 0.0]
+    assert list(out["display.refresh_hz"]) == [60.0, 1000.0, 144.0]
+    assert list(out["model"]) == ["a.toml", "b.toml", "c.toml"]
+    assert list(out["mixed"]) == ["60Hz", "16ms", "1s"]
+    assert list(out["display.buffers"]) == [2, 3, 4]
+    assert out.attrs["units"] == {"workload.gpu_ms": "ms", "display.refresh_hz": "Hz"}
+    assert out.attrs["swept"] == ["workload.gpu_ms", "display.refresh_hz", "model", "mixed", "display.buffers"]
+
+
+def test_experiment_progress_reports_every_run_and_a_raise_stops_it(tmp_path):
+    exp = tmp_path / "e.toml"
+    exp.write_text(
+        f'name = "py"\nmodel = "{MODELS / "fixed.toml"}"\nreplications = 3\n'
+        '[set]\n"run.frames" = 80\n'
+        '[[sweep]]\nkey = "workload.gpu"\nvalues = ["5ms", "10ms", "20ms"]\n'
+        '[[metric]]\npath = "metrics.frame_time_ms.mean"\n'
+    )
+    seen = []
+    lock = threading.Lock()
+
+    def note(done, total):
+        with lock:
+            seen.append((done, total))
+
+    rendersim.experiment(exp, out=tmp_path / "a", progress=note)
+    assert sorted(seen) == [(d, 9) for d in range(1, 10)]
+
+    class Enough(Exception):
+        pass
+
+    def stop(done, total):
+        raise Enough(f"{done} of {total}")
+
+    with pytest.raises(Enough):
+        rendersim.experiment(exp, out=tmp_path / "b", progress=stop)
+    assert not (tmp_path / "b").exists(), "a stopped experiment leaves no folder"
+    with pytest.raises(TypeError):
+        rendersim.experiment(exp, out=tmp_path / "c", progress="yes")
 
 
 def test_vcache_isolate_and_replay():
@@ -149,8 +233,33 @@ def test_vcache_isolate_and_replay():
     assert rp.summary["agreement"]["displayed"] >= 0.99
     assert len(rp.comparison) == rp.summary["frames"]
     assert rp.whatif_frames is None
+    assert rp.comparison["Line"].dtype == "int64" and rp.comparison["Displayed"].dtype == bool
+    assert rp.comparison["MsUntilDisplayed"].dtype == float
     w = rendersim.replay(CAPTURE, set={"display.refresh": "120Hz"})
     assert w.whatif_frames is not None and len(w.whatif_frames) > 0
+
+
+def test_replay_tables_equal_the_command_line_files(tmp_path):
+    """The replay's DataFrames, built from its numbers, hold what the
+    command line's CSV files hold, read back."""
+    from rendersim import _csv
+
+    exe = cli()
+    if exe is None:
+        pytest.skip("no rendersim binary (cargo build --release)")
+    out = tmp_path / "r"
+    subprocess.run(
+        [exe, "replay", str(CAPTURE), "--set", "display.refresh=120Hz", "--out", str(out)],
+        check=True,
+        capture_output=True,
+    )
+    w = rendersim.replay(CAPTURE, set={"display.refresh": "120Hz"})
+    pd.testing.assert_frame_equal(w.frames, _csv((out / "frames.csv").read_text()))
+    pd.testing.assert_frame_equal(w.whatif_frames, _csv((out / "whatif-frames.csv").read_text()))
+    measured = pd.read_csv(out / "comparison.csv")
+    assert list(measured.columns) == list(w.comparison.columns)
+    for c in measured.columns:
+        np.testing.assert_array_equal(measured[c].to_numpy(dtype=float), w.comparison[c].to_numpy(dtype=float))
 
 
 def test_the_gil_is_released_while_simulating():
@@ -296,3 +405,39 @@ def test_frames_reach_pandas_without_text_and_equal_the_csv(model, changes):
     pd.testing.assert_frame_equal(r.frames, _csv(r.frames_csv))
     if "Displayed" in r.frames:
         assert r.frames["Displayed"].dtype == bool and r.frames["Dropped"].dtype == bool
+
+
+def test_progress_reporters(capsys, monkeypatch):
+    """``rendersim.progress``: its examples, the terminal line, the
+    notebook bar (over stand-in widgets) and what it refuses."""
+    import doctest
+    import sys
+    import types
+
+    from rendersim import progress
+
+    assert doctest.testmod(progress).failed == 0
+    line = progress.reporter(True)
+    line(1, 4)
+    line(4, 4)
+    err = capsys.readouterr().err
+    assert "\r[#######" in err and "1/4 runs" in err
+    assert err.rstrip("\n").rsplit("\r", 1)[1].startswith("[" + "#" * 30 + "] 4/4 runs") and err.endswith("\n")
+    # Not a terminal: nothing unless asked.
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: False)
+    assert progress.reporter(None) is None
+
+    class Widget:
+        def __init__(self, *args, **kw):
+            self.__dict__.update(kw)
+            self.value = kw.get("value", args[0] if args else None)
+
+    shown = []
+    widgets = types.SimpleNamespace(IntProgress=Widget, Label=Widget, HBox=Widget)
+    bar = progress._NotebookBar(widgets, shown.append)
+    bar(3, 10)
+    assert (bar.bar.value, bar.bar.max) == (3, 10) and bar.label.value.startswith("3/10 runs")
+    bar(10, 10)
+    assert bar.bar.bar_style == "success" and len(shown) == 1
+    with pytest.raises(TypeError):
+        progress.reporter("yes")

@@ -65,6 +65,15 @@ pub enum ExperimentError {
         /// The runner's message.
         message: String,
     },
+    /// The caller's progress report asked to stop ([`super::Progress`]):
+    /// the runs not yet started were left out.
+    #[error("stopped after {done} of {total} runs, as asked")]
+    Stopped {
+        /// Runs that had ended when it stopped.
+        done: u64,
+        /// Runs the experiment has.
+        total: u64,
+    },
     /// A plot could not be written.
     #[error("plot `{file}`: {source}")]
     Plot {

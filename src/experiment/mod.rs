@@ -47,7 +47,7 @@ pub use dotted::{MetricPathError, json_number, json_path};
 pub use error::ExperimentError;
 pub use report::{add_provenance, lexically_normal};
 pub use results::{ExperimentResult, PathStat, PointResult, RunRecord, ShardCost};
-pub use run::{point_model, run_experiment};
+pub use run::{Progress, point_model, run_experiment};
 pub use runner::{FrameTable, RunError, RunOutput, Runner};
 pub use shard::{SHARD_FORMAT, SHARDS_DIR, ShardId, ShardIdError, ShardOutcome, merge_shards, run_shard};
 pub use sim_runner::SimRunner;

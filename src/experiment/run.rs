@@ -2,6 +2,7 @@
 //! seed) job in parallel, aggregate, and write CSVs, plots and the report.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -70,19 +71,29 @@ impl Plan {
             .collect()
     }
 
-    /// Runs `jobs` in parallel (a progress bar on stderr if `progress`);
-    /// the results are in the order of `jobs`.
+    /// Runs `jobs` in parallel, reporting to `progress` as each ends; the
+    /// results are in the order of `jobs`. Once `progress` asks to stop,
+    /// the jobs not yet started end in [`ExperimentError::Stopped`].
     pub(crate) fn run(
         &self,
         runner: &dyn Runner,
         jobs: &[(usize, u64)],
-        progress: bool,
+        progress: &Progress<'_>,
     ) -> Vec<Result<JobOutput, ExperimentError>> {
         let want_frames = !self.columns.is_empty();
-        let bar = progress_bar(jobs.len() as u64, progress);
+        let total = jobs.len() as u64;
+        let bar = progress_bar(total, matches!(progress, Progress::Bar));
+        let done = AtomicU64::new(0);
+        let stopped = AtomicBool::new(false);
         let results = jobs
             .par_iter()
             .map(|&(pi, seed)| {
+                if stopped.load(Ordering::Relaxed) {
+                    return Err(ExperimentError::Stopped {
+                        done: done.load(Ordering::Relaxed),
+                        total,
+                    });
+                }
                 let r = run_job(
                     runner,
                     self.sources[pi].as_ref(),
@@ -94,11 +105,47 @@ impl Plan {
                     want_frames,
                 );
                 bar.inc(1);
+                let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+                if let Progress::Observe(observe) = progress
+                    && !observe(n, total)
+                {
+                    stopped.store(true, Ordering::Relaxed);
+                }
                 r
             })
             .collect();
         bar.finish_and_clear();
         results
+    }
+}
+
+/// How an experiment reports its runs as they end.
+///
+/// ```
+/// use rendersim::experiment::Progress;
+///
+/// let quiet: Progress = false.into(); // as `run_experiment(.., false)`
+/// assert!(matches!(quiet, Progress::Hidden));
+/// // A caller's own report; `false` stops the runs not yet started.
+/// let report = |done: u64, total: u64| done * 2 < total;
+/// let _half = Progress::Observe(&report);
+/// ```
+pub enum Progress<'a> {
+    /// Nothing is shown.
+    Hidden,
+    /// A bar on standard error (the command line on a terminal).
+    Bar,
+    /// `f(done, total)` after each run, from the thread that ran it;
+    /// returning `false` stops the runs not yet started, and the
+    /// experiment then fails with [`ExperimentError::Stopped`] (the Python
+    /// package's callbacks and its interrupt).
+    Observe(&'a (dyn Fn(u64, u64) -> bool + Sync)),
+}
+
+impl From<bool> for Progress<'_> {
+    /// `true`: a bar; `false`: nothing.
+    fn from(bar: bool) -> Self {
+        if bar { Progress::Bar } else { Progress::Hidden }
     }
 }
 
@@ -117,12 +164,12 @@ pub(crate) enum Timing {
 /// files do not depend on thread scheduling. If a run fails, the runs that
 /// finished are still written to `runs.csv` and the first failure (in point,
 /// seed order) is returned, naming the point and seed.
-pub fn run_experiment(
+pub fn run_experiment<'a>(
     exp: &Experiment,
     base_model: &toml::Table,
     runner: &dyn Runner,
     out_dir: &Path,
-    progress: bool,
+    progress: impl Into<Progress<'a>>,
 ) -> Result<ExperimentResult, ExperimentError> {
     let started = Instant::now();
     let plan = Plan::new(exp, base_model)?;
@@ -131,7 +178,7 @@ pub fn run_experiment(
         source,
     })?;
     let jobs = plan.jobs(exp);
-    let results = plan.run(runner, &jobs, progress);
+    let results = plan.run(runner, &jobs, &progress.into());
 
     let mut outputs = Vec::with_capacity(results.len());
     let mut first_error = None;

@@ -390,6 +390,54 @@ fn results_do_not_depend_on_scheduling() {
 }
 
 #[test]
+fn an_observer_sees_every_run_and_can_stop_the_rest() {
+    let exp = parse(BASIC);
+    let dir = tempfile::tempdir().unwrap();
+    let seen = std::sync::Mutex::new(Vec::new());
+    let all = |done: u64, total: u64| {
+        seen.lock().unwrap().push((done, total));
+        true
+    };
+    run_experiment(
+        &exp,
+        &base_model(),
+        &Fake::default(),
+        dir.path(),
+        Progress::Observe(&all),
+    )
+    .unwrap();
+    let mut seen = seen.into_inner().unwrap();
+    seen.sort();
+    let total = read(dir.path(), "runs.csv").lines().count() as u64 - 1;
+    assert_eq!(seen, (1..=total).map(|d| (d, total)).collect::<Vec<_>>());
+    // Stopping after the first run: on one thread, the rest never start.
+    let stop = |_: u64, _: u64| false;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let other = tempfile::tempdir().unwrap();
+    let e = pool
+        .install(|| {
+            run_experiment(
+                &exp,
+                &base_model(),
+                &Fake::default(),
+                other.path(),
+                Progress::Observe(&stop),
+            )
+        })
+        .unwrap_err();
+    assert!(
+        matches!(e, ExperimentError::Stopped { done: 1, total: t } if t == total),
+        "{e}"
+    );
+    assert_eq!(e.to_string(), format!("stopped after 1 of {total} runs, as asked"));
+    assert_eq!(
+        read(other.path(), "runs.csv").lines().count(),
+        2,
+        "the one finished run is kept"
+    );
+}
+
+#[test]
 fn run_error_names_point_and_seed_and_keeps_finished_runs() {
     let fake = Fake {
         fail: true,

@@ -209,7 +209,7 @@ pub fn run_shard(
         None
     };
     let mut outputs = Vec::with_capacity(mine.len());
-    for r in plan.run(runner, &mine, progress) {
+    for r in plan.run(runner, &mine, &progress.into()) {
         outputs.push(r?);
     }
     let cpu = process_cpu_seconds();

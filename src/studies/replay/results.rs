@@ -11,7 +11,9 @@ use crate::capture::presentmon::Columns;
 use crate::components::swap_chain::Composition;
 use crate::stats::quantile::quantile;
 use crate::systems::frame_pipeline::FramePipelineConfig;
-use crate::systems::frame_pipeline::records::{ChainInfo, FrameRecord, GeneratedRecord, write_frames_csv};
+use crate::systems::frame_pipeline::records::{
+    ChainInfo, FrameRecord, GeneratedRecord, frame_values, write_frames_csv,
+};
 
 /// |predicted - measured| over the frames where both exist, in ms.
 #[derive(Debug, Clone, Serialize)]
@@ -356,6 +358,14 @@ impl ReplayedFrames {
     /// Writes them as `frames.csv` (PresentMon 2 columns, the capture's clock).
     pub fn write_csv(&self, w: impl std::io::Write) -> std::io::Result<()> {
         write_frames_csv(&self.records, &self.generated, &self.chain, self.origin_ps, w)
+    }
+
+    /// The rows of that `frames.csv` as numbers: the text columns (the
+    /// same on every row), whether each row is a generated frame, and the
+    /// numeric columns column by column, flattened ([`frame_values`]).
+    pub fn frame_values(&self) -> ([String; 8], Vec<bool>, Vec<f64>) {
+        let (kinds, values) = frame_values(&self.records, &self.generated, self.origin_ps);
+        (self.chain.text(), kinds, values)
     }
 }
 

@@ -384,6 +384,20 @@ fn rows_of<'a>(records: &'a [FrameRecord], generated: &'a [GeneratedRecord]) -> 
 /// generated frame; `offset_ps` is added to `CPUStartTime`. Display
 /// changes run over every frame shown, generated ones too.
 fn cells(records: &[FrameRecord], generated: &[GeneratedRecord], offset_ps: i64) -> Vec<(bool, [Cell; 23])> {
+    let mut out = Vec::with_capacity(records.len() + generated.len());
+    each_row(records, generated, offset_ps, |generated_row, row| {
+        out.push((generated_row, *row))
+    });
+    out
+}
+
+/// [`cells`]' rows handed to `f` one by one, in order, none kept.
+fn each_row(
+    records: &[FrameRecord],
+    generated: &[GeneratedRecord],
+    offset_ps: i64,
+    mut f: impl FnMut(bool, &[Cell; 23]),
+) {
     let order = rows_of(records, generated);
     let opt = |a: Option<Time>, b: Option<Time>| match (a, b) {
         (Some(a), Some(b)) => span(a, b),
@@ -398,7 +412,6 @@ fn cells(records: &[FrameRecord], generated: &[GeneratedRecord], offset_ps: i64)
             later = row.displayed();
         }
     }
-    let mut out = Vec::with_capacity(order.len());
     let mut prev_display: Option<Time> = None;
     for (k, row) in order.iter().enumerate() {
         let shown = row.displayed();
@@ -418,17 +431,12 @@ fn cells(records: &[FrameRecord], generated: &[GeneratedRecord], offset_ps: i64)
                 c
             }
         };
-        out.push((matches!(row, Row::Generated(_)), cells));
+        debug_assert!(COUNT_COLUMNS.iter().all(|&c| !matches!(cells[c], Cell::Ps(_))));
+        f(matches!(row, Row::Generated(_)), &cells);
         if shown.is_some() {
             prev_display = shown;
         }
     }
-    debug_assert!(
-        COUNT_COLUMNS
-            .iter()
-            .all(|&c| out.iter().all(|(_, r)| !matches!(r[c], Cell::Ps(_))))
-    );
-    out
 }
 
 /// A rendered frame's cells (`between`, `on_screen`: its display change and
@@ -537,18 +545,38 @@ impl ChainInfo {
 
 /// The rows of `frames.csv` as numbers, for a caller that wants them typed
 /// rather than as text (the Python package's DataFrames): whether each row
-/// is a generated frame, and [`COLUMNS`] row by row, flattened, each the
-/// number a reader of the file parses (NaN for `NA`). The text columns are
+/// is a generated frame, and [`COLUMNS`] column by column (each column's
+/// rows in order, one column after another), each the number a reader of
+/// the file parses (NaN for `NA`). The text columns are
 /// [`ChainInfo::text`], the same on every row.
 pub fn frame_values(records: &[FrameRecord], generated: &[GeneratedRecord], offset_ps: i64) -> (Vec<bool>, Vec<f64>) {
-    let rows = cells(records, generated, offset_ps);
-    let mut kinds = Vec::with_capacity(rows.len());
-    let mut values = Vec::with_capacity(rows.len() * COLUMNS.len());
-    for (generated_row, row) in rows {
-        kinds.push(generated_row);
-        values.extend(row.iter().map(|c| c.value()));
-    }
+    let n = records.len() + generated.len();
+    let mut values = vec![0.0; n * COLUMNS.len()];
+    let kinds = frame_values_with(records, generated, offset_ps, |k, v| values[k] = v);
     (kinds, values)
+}
+
+/// [`frame_values`] handed to `put(k, value)`, `k` the value's place in
+/// [`frame_values`]' vector (column `c`, row `r` of `n` rows: `c * n + r`),
+/// for a caller that owns the memory the numbers go to (the Python package
+/// writes them straight into the buffer its arrays view). Returns whether
+/// each row is a generated frame.
+pub fn frame_values_with(
+    records: &[FrameRecord],
+    generated: &[GeneratedRecord],
+    offset_ps: i64,
+    mut put: impl FnMut(usize, f64),
+) -> Vec<bool> {
+    let n = records.len() + generated.len();
+    let mut kinds = Vec::with_capacity(n);
+    each_row(records, generated, offset_ps, |generated_row, row| {
+        let r = kinds.len();
+        kinds.push(generated_row);
+        for (c, cell) in row.iter().enumerate() {
+            put(c * n + r, cell.value());
+        }
+    });
+    kinds
 }
 
 #[cfg(test)]

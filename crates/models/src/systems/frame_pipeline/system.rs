@@ -7,7 +7,7 @@ use crate::output::trace::TraceWriter;
 use crate::systems::{Outcome, SystemError, SystemModel, outcome_basics, resolved_toml};
 
 use super::config::{FramePipelineConfig, WorkloadConfig};
-use super::records::{COLUMNS, ChainInfo, frame_rows, frame_values, write_frames_csv};
+use super::records::{COLUMNS, ChainInfo, frame_rows, frame_values, frame_values_with, write_frames_csv};
 use super::run::{PipelineRun, run_pipeline};
 
 /// `system = "frame_pipeline"` (the default).
@@ -37,10 +37,22 @@ impl PipelineRun {
 
     /// The rows of its `frames.csv` as numbers: the text columns (the same
     /// on every row), whether each row is a generated frame, and
-    /// [`COLUMNS`] row by row, flattened ([`frame_values`]).
+    /// [`COLUMNS`] column by column, flattened ([`frame_values`]).
     pub fn frame_values(&self) -> ([String; 8], Vec<bool>, Vec<f64>) {
         let (kinds, values) = frame_values(&self.records, &self.generated, 0);
         (ChainInfo::of_display(&self.config.display).text(), kinds, values)
+    }
+
+    /// The rows of its `frames.csv`: rendered frames and generated ones.
+    pub fn table_rows(&self) -> usize {
+        self.records.len() + self.generated.len()
+    }
+
+    /// [`PipelineRun::frame_values`] with the numbers handed to `put(k,
+    /// value)` rather than collected ([`frame_values_with`]).
+    pub fn frame_values_with(&self, put: impl FnMut(usize, f64)) -> ([String; 8], Vec<bool>) {
+        let kinds = frame_values_with(&self.records, &self.generated, 0, put);
+        (ChainInfo::of_display(&self.config.display).text(), kinds)
     }
 }
 
