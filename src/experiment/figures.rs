@@ -31,6 +31,7 @@ pub(crate) fn draw(
             log_y,
             filter,
             y_bounds,
+            y_axis,
             paper,
             levels,
         } => {
@@ -66,6 +67,7 @@ pub(crate) fn draw(
                     log_y: *log_y,
                     x_categories: x_categories(&exp.sweeps[xi]),
                     y_bounds: *y_bounds,
+                    y_axis: *y_axis,
                     reference: paper_reference(exp, points, xi, paper, &spec.paper_label),
                 },
             )?;

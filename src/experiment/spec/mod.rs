@@ -96,6 +96,9 @@ pub enum PlotKind {
         /// `y_bounds`: the values the quantity can take; intervals are cut
         /// there (a fraction's `[0, 1]`).
         y_bounds: Option<(f64, f64)>,
+        /// `y_axis`: the y axis's range, drawn whole whatever the data (an
+        /// axis from 0 so a small difference looks small).
+        y_axis: Option<(f64, f64)>,
         /// `paper`: published values, each at the points its `where`
         /// selects (it fixes the x key), drawn as crosses.
         paper: Vec<PaperValue>,

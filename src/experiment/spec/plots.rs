@@ -71,6 +71,9 @@ impl Validator<'_> {
             if p.y_bounds.is_some() && !matches!(kind, PlotKind::Line { .. }) {
                 return Err(self.err(format!("{key}.y_bounds"), "only line plots take `y_bounds`"));
             }
+            if p.y_axis.is_some() && !matches!(kind, PlotKind::Line { .. }) {
+                return Err(self.err(format!("{key}.y_axis"), "only line plots take `y_axis`"));
+            }
             if p.filter.is_some() && matches!(kind, PlotKind::Scatter { .. }) {
                 return Err(self.err(format!("{key}.where"), "only histogram and line plots take `where`"));
             }
@@ -119,18 +122,20 @@ impl Validator<'_> {
         if f.iter().any(|(k, _)| *k == x) {
             return Err(self.err(format!("{key}.where"), format!("must not fix the x axis key `{x}`")));
         }
-        let y_bounds = match &p.y_bounds {
-            None => None,
+        let range = |b: &Option<Vec<f64>>, name: &str| {
+            match b {
+            None => Ok(None),
             Some(b) => match b.as_slice() {
-                [lo, hi] if lo.is_finite() && hi.is_finite() && lo < hi && !(p.log_y && *lo <= 0.0) => Some((*lo, *hi)),
-                _ => {
-                    return Err(self.err(
-                        format!("{key}.y_bounds"),
-                        format!("needs [lowest, highest]: two finite numbers, the first below the second (and above 0 on a log axis); got {b:?}"),
-                    ));
-                }
+                [lo, hi] if lo.is_finite() && hi.is_finite() && lo < hi && !(p.log_y && *lo <= 0.0) => Ok(Some((*lo, *hi))),
+                _ => Err(self.err(
+                    format!("{key}.{name}"),
+                    format!("needs [lowest, highest]: two finite numbers, the first below the second (and above 0 on a log axis); got {b:?}"),
+                )),
             },
+        }
         };
+        let y_bounds = range(&p.y_bounds, "y_bounds")?;
+        let y_axis = range(&p.y_axis, "y_axis")?;
         let paper = self.paper_values(p, key, sweeps, &x)?;
         let levels = match p.paper_levels.clone() {
             None => Vec::new(),
@@ -153,6 +158,7 @@ impl Validator<'_> {
             log_y: p.log_y,
             filter: f,
             y_bounds,
+            y_axis,
             paper,
             levels,
         })

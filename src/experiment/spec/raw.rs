@@ -131,6 +131,8 @@ pub(super) struct RawPlot {
     pub(super) range: Option<Vec<f64>>,
     /// Line plots: `[lowest, highest]` the quantity can take.
     pub(super) y_bounds: Option<Vec<f64>>,
+    /// Line plots: `[lowest, highest]` of the y axis, drawn whole.
+    pub(super) y_axis: Option<Vec<f64>>,
     #[serde(default)]
     pub(super) log_x: bool,
     #[serde(default)]

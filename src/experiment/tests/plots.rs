@@ -317,6 +317,49 @@ fn y_bounds_belong_to_line_plots_and_must_be_an_ordered_pair() {
 }
 
 #[test]
+fn a_y_axis_is_checked_as_bounds_are_and_drawn_whole() {
+    let line = |extra: &str| {
+        format!(
+            "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[plot]]\nfile = \"p\"\nkind = \"line\"\nx = \"a\"\ny = \"m\"\n{extra}"
+        )
+    };
+    let exp = parse(&line("y_axis = [0, 300]\n"));
+    assert!(matches!(
+        exp.plots[0].kind,
+        PlotKind::Line {
+            y_axis: Some((0.0, 300.0)),
+            y_bounds: None,
+            ..
+        }
+    ));
+    let e = parse_err(&line("y_axis = [5, 5]\n"));
+    assert!(
+        e.contains("plot[0] (p).y_axis") && e.contains("the first below the second"),
+        "{e}"
+    );
+    let e = parse_err(
+        "name = \"x\"\n[[plot]]\nfile = \"h\"\nkind = \"histogram\"\ncolumn = \"FrameTime\"\ny_axis = [0, 1]\n",
+    );
+    assert!(e.contains("only line plots take `y_axis`"), "{e}");
+    // Drawn: the axis runs from 0 though the data lie between 264 and 280.
+    let plot = |y_axis| crate::plot::LinePlot {
+        title: "t".into(),
+        series: vec![crate::plot::Series {
+            name: "s".into(),
+            points: vec![(1.0, 264.0), (2.0, 280.0)],
+            ..Default::default()
+        }],
+        y_axis,
+        ..Default::default()
+    };
+    let svg = |y_axis| crate::plot::line_plot_svg(&plot(y_axis)).unwrap();
+    let (free, whole) = (svg(None), svg(Some((0.0, 300.0))));
+    let tick = |svg: &str, label: &str| svg.contains(&format!(">\n{label}\n</text>"));
+    assert!(tick(&whole, "0") && tick(&whole, "300"), "the whole axis is labelled");
+    assert!(!tick(&free, "0"), "a free axis hugs the data");
+}
+
+#[test]
 fn paper_values_are_drawn_as_crosses_at_their_points() {
     let text = format!(
         "{BASIC}\n[[plot]]\nfile = \"ref\"\nkind = \"line\"\nx = \"workload.gpu\"\n\

@@ -53,6 +53,10 @@ pub struct LinePlot {
     /// `(0, 1)`): intervals are cut there, so the y axis never runs past
     /// what the data could be. `None`: unbounded.
     pub y_bounds: Option<(f64, f64)>,
+    /// The y axis's range, drawn whole whatever the data (`None`: the
+    /// data's, padded): an axis from 0, so that a difference of a few
+    /// percent looks like one. Points outside it are clipped.
+    pub y_axis: Option<(f64, f64)>,
     /// Published values to compare with (a paper's numbers): drawn as black
     /// crosses without a line, one legend entry.
     pub reference: Option<Reference>,
@@ -298,8 +302,8 @@ fn place_legend(
         return legend;
     }
     let (bw, bh) = legend_box(series, entries);
-    if plot.y_bounds.is_some_and(|(lo, hi)| lo < hi) {
-        // A bounded quantity (a fraction) keeps its axis: the legend goes
+    if plot.y_bounds.is_some_and(|(lo, hi)| lo < hi) || plot.y_axis.is_some() {
+        // A bounded quantity (a fraction), or an axis given, keeps its axis: the legend goes
         // to the middle of an edge if that covers fewer points.
         let (m, n) = legend::middle(&occupied(series, xr, *yr), bw, bh);
         if n < covered {
@@ -345,6 +349,9 @@ fn draw<DB: DrawingBackend>(
     };
     let entries = series.iter().filter(|s| !s.name.is_empty()).count();
     let beside = entries > legend::IN_PLOT_ENTRIES;
+    if let Some(axis) = plot.y_axis {
+        yr = axis;
+    }
     let legend = place_legend(plot, series, xr, &mut yr, entries, beside);
     let yt = ticks(yr.0, yr.1, plot.log_y, false);
     let panel_w = if beside {
@@ -389,7 +396,18 @@ fn draw<DB: DrawingBackend>(
         .map_err(e)?;
     let mut any_legend = false;
     let twins = coinciding(series);
+    // On a categorical axis the series stand side by side within each
+    // category (dodged), so equal values do not hide one another.
+    let drawn: Vec<usize> = (0..series.len()).filter(|&i| !series[i].reference).collect();
+    let dodge = |i: usize| match drawn.iter().position(|&d| d == i) {
+        Some(k) if categorical && drawn.len() > 1 => {
+            let step = (0.5 / drawn.len() as f64).min(0.08);
+            (k as f64 - (drawn.len() - 1) as f64 / 2.0) * step
+        }
+        _ => 0.0,
+    };
     for (i, s) in series.iter().enumerate() {
+        let dx = dodge(i);
         if s.reference {
             let cross = |p: (f64, f64)| EmptyElement::at(p) + Cross::new((0, 0), 6, BLACK.stroke_width(2));
             let marks = chart.draw_series(s.points.iter().map(|&p| cross(p))).map_err(e)?;
@@ -407,31 +425,50 @@ fn draw<DB: DrawingBackend>(
                 .draw_series(DashedLineSeries::new([(xr.0, l), (xr.1, l)], 10, 6, c.stroke_width(1)))
                 .map_err(e)?;
         }
+        // On a categorical axis (architectures, policies) nothing lies
+        // between two categories: the points stand alone, no line joins them.
+        if categorical {
+            let marks = chart
+                .draw_series(s.points.iter().map(|&(x, y)| Circle::new((x + dx, y), 5, c.filled())))
+                .map_err(e)?;
+            if !s.name.is_empty() {
+                any_legend = true;
+                marks
+                    .label(s.name.as_str())
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
+            }
+        }
         // A series drawn exactly over an earlier one is dashed, with open
         // square markers, so that both stay visible (and a note says so).
-        let line = if twins[i].is_some() {
-            chart
-                .draw_series(DashedLineSeries::new(s.points.iter().copied(), 8, 6, c.stroke_width(2)))
-                .map_err(e)?
+        let line = if categorical {
+            None
+        } else if twins[i].is_some() {
+            Some(
+                chart
+                    .draw_series(DashedLineSeries::new(s.points.iter().copied(), 8, 6, c.stroke_width(2)))
+                    .map_err(e)?,
+            )
         } else {
-            chart
-                .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
-                .map_err(e)?
+            Some(
+                chart
+                    .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
+                    .map_err(e)?,
+            )
         };
-        if !s.name.is_empty() {
+        if let Some(line) = line
+            && !s.name.is_empty()
+        {
             any_legend = true;
             line.label(s.name.as_str())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
         }
         if twins[i].is_some() {
             chart
-                .draw_series(
-                    s.points
-                        .iter()
-                        .map(|&p| EmptyElement::at(p) + Rectangle::new([(-6, -6), (6, 6)], c.stroke_width(2))),
-                )
+                .draw_series(s.points.iter().map(|&(x, y)| {
+                    EmptyElement::at((x + dx, y)) + Rectangle::new([(-6, -6), (6, 6)], c.stroke_width(2))
+                }))
                 .map_err(e)?;
-        } else {
+        } else if !categorical {
             chart
                 .draw_series(s.points.iter().map(|&p| Circle::new(p, 3, c.filled())))
                 .map_err(e)?;
@@ -440,7 +477,7 @@ fn draw<DB: DrawingBackend>(
             .draw_series(
                 s.bars
                     .iter()
-                    .map(|&(x, lo, y, hi)| ErrorBar::new_vertical(x, lo, y, hi, c.stroke_width(1), 8)),
+                    .map(|&(x, lo, y, hi)| ErrorBar::new_vertical(x + dx, lo, y, hi, c.stroke_width(1), 8)),
             )
             .map_err(e)?;
     }
@@ -927,6 +964,54 @@ mod tests {
         assert_eq!(t.positions, vec![0.0, 1.0, 2.0]);
         assert_eq!(r, (-0.5, 2.5));
         assert_eq!(t.label_at(1.1), "1280x1024");
+    }
+
+    #[test]
+    fn categories_are_points_side_by_side_not_joined_by_lines() {
+        let series = |name: &str, y: f64| Series {
+            name: name.into(),
+            points: vec![(0.0, y), (1.0, y)],
+            ..Default::default()
+        };
+        let cats = vec![(0.0, "standard".into()), (1.0, "pre-sorting".into())];
+        let svg = |x_categories: Vec<(f64, String)>| {
+            line_plot_svg(&LinePlot {
+                x_categories,
+                ..plot(vec![series("a", 10.0), series("b", 10.0)])
+            })
+            .unwrap()
+        };
+        let (numeric, categorical) = (svg(Vec::new()), svg(cats));
+        // The numeric axis joins each series' points with a line (and its
+        // legend swatch is one); the categorical one draws none in the
+        // series' colours.
+        let lines = |svg: &str| {
+            (0..2)
+                .map(|i| {
+                    let RGBColor(r, g, b) = color(i);
+                    let stroke = format!("stroke=\"#{r:02X}{g:02X}{b:02X}\"");
+                    svg.split("<polyline")
+                        .skip(1)
+                        .filter(|l| l.split('>').next().is_some_and(|a| a.contains(&stroke)))
+                        .count()
+                })
+                .sum::<usize>()
+        };
+        assert!(lines(&numeric) >= 2, "{}", lines(&numeric));
+        assert_eq!(lines(&categorical), 0);
+        // Equal values in a category stand apart: the circles' centres differ.
+        let centres = |svg: &str| -> Vec<String> {
+            svg.split("<circle")
+                .skip(1)
+                .map(|c| c.split(" r=").next().unwrap_or("").to_string())
+                .collect()
+        };
+        let c = centres(&categorical);
+        assert_eq!(c.len(), 4 + 2, "four points and two legend swatches");
+        let mut unique = c.clone();
+        unique.sort();
+        unique.dedup();
+        assert_eq!(unique.len(), c.len(), "no two circles at one place: {c:?}");
     }
 
     #[test]
