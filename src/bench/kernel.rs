@@ -259,6 +259,7 @@ pub fn plot_kernel(cases: &[KernelBench], path: &std::path::Path) -> Result<(), 
                 points: mine.iter().map(|(x, s)| (*x, s.median)).collect(),
                 ci: Some(mine.iter().map(|(_, s)| (s.min, s.max)).collect()),
                 level: None,
+                ..Default::default()
             }
         };
         series.push(of(|c| c.engine_events_per_s, "engine (radix heap)"));

@@ -42,7 +42,10 @@ pub(crate) fn draw(
                 let is_derived = exp.derived.iter().any(|d| &d.name == path);
                 // The path's published level, named in the legend.
                 let level = levels.get(k).copied();
-                for (_, members) in &groups {
+                // Several quantities under several settings: a colour a
+                // quantity, a line pattern a setting (up to four).
+                let styled = y.len() > 1 && groups.len() > 1 && groups.len() <= 4;
+                for (g, (_, members)) in groups.iter().enumerate() {
                     let (pts, ci) = series_points(exp, points, results, xi, path, members);
                     let name = series_name(exp, points, xi, filter, path, y.len() > 1, members);
                     series.push(Series {
@@ -53,6 +56,8 @@ pub(crate) fn draw(
                         points: pts,
                         ci: (!is_derived).then_some(ci),
                         level,
+                        color: styled.then_some(k),
+                        pattern: if styled { g as u8 } else { 0 },
                     });
                 }
             }

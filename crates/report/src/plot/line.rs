@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::PlotError;
@@ -27,6 +28,12 @@ pub struct Series {
     /// plot. Not drawn where the y axis cannot show it (not finite, or not
     /// positive on a logarithmic axis; counted in the omitted note).
     pub level: Option<f64>,
+    /// Its colour, an index into the palette (`None`: the series' own
+    /// place in the plot). Series of one quantity share a colour.
+    pub color: Option<usize>,
+    /// Its line: 0 solid; 1, 2, 3 dashes ever shorter (the same quantity
+    /// under a second, third, fourth setting, in its colour).
+    pub pattern: u8,
 }
 
 /// A line plot description.
@@ -100,6 +107,10 @@ struct Prepared {
     bars: Vec<(f64, f64, f64, f64)>,
     /// The series' published level, in axis coordinates.
     level: Option<f64>,
+    /// Palette index.
+    color: usize,
+    /// Line pattern ([`Series::pattern`]).
+    pattern: u8,
 }
 
 /// Cuts every interval at `bounds` (the values the quantity can take), so
@@ -139,6 +150,8 @@ fn prepare(plot: &LinePlot) -> (Vec<Prepared>, usize) {
             name: s.name.clone(),
             reference: false,
             level,
+            color: s.color.unwrap_or(out.len()),
+            pattern: s.pattern,
             points: rows.iter().map(|r| (r.0, r.1)).collect(),
             bars: rows
                 .iter()
@@ -162,6 +175,8 @@ fn prepare(plot: &LinePlot) -> (Vec<Prepared>, usize) {
                 points: pts,
                 bars: Vec::new(),
                 level: None,
+                color: 0,
+                pattern: 0,
             });
         }
     }
@@ -419,7 +434,7 @@ fn draw<DB: DrawingBackend>(
             }
             continue;
         }
-        let c = color(i);
+        let c = color(s.color);
         if let Some(l) = s.level {
             chart
                 .draw_series(DashedLineSeries::new([(xr.0, l), (xr.1, l)], 10, 6, c.stroke_width(1)))
@@ -448,6 +463,17 @@ fn draw<DB: DrawingBackend>(
                     .draw_series(DashedLineSeries::new(s.points.iter().copied(), 8, 6, c.stroke_width(2)))
                     .map_err(e)?,
             )
+        } else if let Some((dash, gap)) = dashes(s.pattern) {
+            Some(
+                chart
+                    .draw_series(DashedLineSeries::new(
+                        s.points.iter().copied(),
+                        dash,
+                        gap,
+                        c.stroke_width(2),
+                    ))
+                    .map_err(e)?,
+            )
         } else {
             Some(
                 chart
@@ -459,8 +485,9 @@ fn draw<DB: DrawingBackend>(
             && !s.name.is_empty()
         {
             any_legend = true;
+            let pattern = s.pattern;
             line.label(s.name.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+                .legend(move |(x, y)| swatch((x, y), pattern, c));
         }
         if twins[i].is_some() {
             chart
@@ -496,6 +523,23 @@ fn draw<DB: DrawingBackend>(
     draw_notes(root, notes)
 }
 
+/// A line pattern's (dash, gap) in pixels; `None` for a solid line.
+fn dashes(pattern: u8) -> Option<(u32, u32)> {
+    match pattern {
+        0 => None,
+        1 => Some((10, 5)),
+        2 => Some((4, 4)),
+        _ => Some((2, 6)),
+    }
+}
+
+/// A legend swatch 20 pixels long from `(x, y)` in the series' pattern
+/// (a dash longer than the swatch for a solid line).
+fn swatch((x, y): (i32, i32), pattern: u8, c: RGBColor) -> DashedPathElement<std::vec::IntoIter<(i32, i32)>, u32> {
+    let (dash, gap) = dashes(pattern).unwrap_or((24, 1));
+    DashedPathElement::new(vec![(x, y), (x + 20, y)], dash, gap, c.stroke_width(2))
+}
+
 /// Width of a legend row's swatch (line, dash or cross) and its gap.
 const SWATCH_PX: i32 = 32;
 
@@ -524,14 +568,14 @@ fn draw_legend_beside<DB: DrawingBackend>(
     let shown = if named.len() > fits { fits - 1 } else { named.len() };
     for (n, &i) in named.iter().take(shown).enumerate() {
         let y = top + row * n as i32;
-        let c = color(i);
+        let c = color(series[i].color);
         if series[i].reference {
             panel.draw(&Cross::new((14, y), 6, BLACK.stroke_width(2)))?;
         } else if twins[i].is_some() {
             panel.draw(&PathElement::new(vec![(4, y), (10, y)], c.stroke_width(2)))?;
             panel.draw(&PathElement::new(vec![(16, y), (24, y)], c.stroke_width(2)))?;
         } else {
-            panel.draw(&PathElement::new(vec![(4, y), (24, y)], c.stroke_width(2)))?;
+            panel.draw(&swatch((4, y), series[i].pattern, c))?;
         }
         let text = legend::fit_text(panel, &series[i].name, &font, w - SWATCH_PX - 4)?;
         panel.draw_text(&text, &font, (SWATCH_PX, y))?;
@@ -615,6 +659,8 @@ mod tests {
             points: points.to_vec(),
             bars: Vec::new(),
             level: None,
+            color: 0,
+            pattern: 0,
         }
     }
 
@@ -626,6 +672,7 @@ mod tests {
                 points: vec![(1.0, 1.0), (2.0, 2.0)],
                 ci: None,
                 level: Some(level),
+                ..Default::default()
             }],
             log_y,
             ..Default::default()
@@ -656,6 +703,8 @@ mod tests {
             points: vec![(1.0, 0.5), (2.0, 0.9)],
             bars: vec![(1.0, -0.4, 0.5, 1.6), (2.0, 0.8, 0.9, 1.0)],
             level: None,
+            color: 0,
+            pattern: 0,
         }];
         bound_bars(&mut s, None);
         assert_eq!(s[0].bars[0], (1.0, -0.4, 0.5, 1.6));
@@ -728,6 +777,7 @@ mod tests {
                     points: s.points.clone(),
                     ci: None,
                     level: None,
+                    ..Default::default()
                 })
                 .collect(),
             ..LinePlot::default()
@@ -761,6 +811,7 @@ mod tests {
                     points: points.to_vec(),
                     ci: None,
                     level: None,
+                    ..Default::default()
                 })
                 .collect(),
             ..LinePlot::default()
@@ -831,12 +882,14 @@ mod tests {
                 points: vec![(1.0, 2.0), (2.0, 3.0), (3.0, 2.5)],
                 ci: Some(vec![(1.5, 2.5), (2.8, 3.2), (2.0, 3.0)]),
                 level: None,
+                ..Default::default()
             },
             Series {
                 name: "b".into(),
                 points: vec![(3.0, 1.0), (1.0, 1.5)],
                 ci: None,
                 level: None,
+                ..Default::default()
             },
         ]);
         line_plot(&base, &p).unwrap();
@@ -860,6 +913,7 @@ mod tests {
                     points: vec![(0.0, k as f64), (10.0, k as f64)],
                     ci: None,
                     level: None,
+                    ..Default::default()
                 })
                 .collect();
             line_plot(&base, &plot(series)).unwrap();
@@ -896,6 +950,7 @@ mod tests {
                     points: vec![(1.0, 1.0)],
                     ci: None,
                     level: None,
+                    ..Default::default()
                 }]),
             ),
             (
@@ -905,6 +960,7 @@ mod tests {
                     points: vec![(0.0, 0.0), (0.0, 0.0)],
                     ci: Some(vec![(0.0, 0.0)]),
                     level: None,
+                    ..Default::default()
                 }]),
             ),
             (
@@ -914,6 +970,7 @@ mod tests {
                     points: vec![(f64::NAN, 1.0), (1.0, f64::INFINITY), (2.0, 2.0)],
                     ci: None,
                     level: None,
+                    ..Default::default()
                 }]),
             ),
             (
@@ -926,6 +983,7 @@ mod tests {
                         points: vec![(0.0, 1.0), (10.0, 100.0), (1000.0, 0.1)],
                         ci: Some(vec![(-1.0, 2.0), (50.0, 150.0), (0.05, 0.2)]),
                         level: None,
+                        ..Default::default()
                     }])
                 },
             ),
@@ -952,6 +1010,7 @@ mod tests {
                 points: vec![(0.0, 300.0), (1.0, 400.0), (2.0, 500.0)],
                 ci: None,
                 level: None,
+                ..Default::default()
             }])
         };
         line_plot(&base, &p).unwrap();
@@ -1012,6 +1071,33 @@ mod tests {
         unique.sort();
         unique.dedup();
         assert_eq!(unique.len(), c.len(), "no two circles at one place: {c:?}");
+    }
+
+    #[test]
+    fn one_quantity_keeps_its_colour_and_a_setting_its_line_pattern() {
+        let series = |name: &str, y: f64, pattern: u8| Series {
+            name: name.into(),
+            points: vec![(0.0, y), (10.0, y + 1.0)],
+            color: Some(3),
+            pattern,
+            ..Default::default()
+        };
+        let svg = line_plot_svg(&plot(vec![series("a", 1.0, 0), series("b", 5.0, 1)])).unwrap();
+        let RGBColor(r, g, b) = color(3);
+        let stroke = format!("stroke=\"#{r:02X}{g:02X}{b:02X}\"");
+        let others = (0..10).filter(|&i| i != 3).map(|i| {
+            let RGBColor(r, g, b) = color(i);
+            format!("stroke=\"#{r:02X}{g:02X}{b:02X}\"")
+        });
+        let strokes = |s: &str| svg.matches(s).count();
+        // Both in the palette's fourth colour, none in another; the dashed
+        // one drawn as many short pieces, its swatch too.
+        assert!(strokes(&stroke) > 6, "{}", strokes(&stroke));
+        for o in others {
+            assert_eq!(strokes(&o), 0, "{o}");
+        }
+        assert_eq!(dashes(0), None);
+        assert!(dashes(1).is_some() && dashes(2) != dashes(1) && dashes(3) != dashes(2));
     }
 
     #[test]

@@ -154,6 +154,7 @@ pub fn figure6(src: &ModelSource, table: &toml::Table, around: u64, out: &Path) 
         points: window.iter().map(|r| (r.index as f64, v(r))).collect(),
         ci: None,
         level: None,
+        ..Default::default()
     };
     let title = match first {
         Some(i) => format!(
