@@ -7,7 +7,7 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::PlotError;
-use super::axis::{Ticks, all_integers, coord, omitted_note, padded_range, ticks, to_axis};
+use super::axis::{TickedAxis, Ticks, all_integers, coord, omitted_note, padded_range, ticks, to_axis};
 use super::font::{AXIS_PX, FAMILY, TICK_PX, TITLE_PX};
 use super::legend::{self, Occupied};
 use super::output::{Sink, draw_notes, render_to, svg_of};
@@ -422,91 +422,13 @@ fn draw<DB: DrawingBackend>(
         _ => 0.0,
     };
     for (i, s) in series.iter().enumerate() {
-        let dx = dodge(i);
-        if s.reference {
-            let cross = |p: (f64, f64)| EmptyElement::at(p) + Cross::new((0, 0), 6, BLACK.stroke_width(2));
-            let marks = chart.draw_series(s.points.iter().map(|&p| cross(p))).map_err(e)?;
-            if !s.name.is_empty() {
-                any_legend = true;
-                marks
-                    .label(s.name.as_str())
-                    .legend(move |(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
-            }
-            continue;
-        }
-        let c = color(s.color);
-        if let Some(l) = s.level {
-            chart
-                .draw_series(DashedLineSeries::new([(xr.0, l), (xr.1, l)], 10, 6, c.stroke_width(1)))
-                .map_err(e)?;
-        }
-        // On a categorical axis (architectures, policies) nothing lies
-        // between two categories: the points stand alone, no line joins them.
-        if categorical {
-            let marks = chart
-                .draw_series(s.points.iter().map(|&(x, y)| Circle::new((x + dx, y), 5, c.filled())))
-                .map_err(e)?;
-            if !s.name.is_empty() {
-                any_legend = true;
-                marks
-                    .label(s.name.as_str())
-                    .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
-            }
-        }
-        // A series drawn exactly over an earlier one is dashed, with open
-        // square markers, so that both stay visible (and a note says so).
-        let line = if categorical {
-            None
-        } else if twins[i].is_some() {
-            Some(
-                chart
-                    .draw_series(DashedLineSeries::new(s.points.iter().copied(), 8, 6, c.stroke_width(2)))
-                    .map_err(e)?,
-            )
-        } else if let Some((dash, gap)) = dashes(s.pattern) {
-            Some(
-                chart
-                    .draw_series(DashedLineSeries::new(
-                        s.points.iter().copied(),
-                        dash,
-                        gap,
-                        c.stroke_width(2),
-                    ))
-                    .map_err(e)?,
-            )
-        } else {
-            Some(
-                chart
-                    .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
-                    .map_err(e)?,
-            )
+        let how = Placement {
+            twin: twins[i].is_some(),
+            categorical,
+            dx: dodge(i),
+            xr,
         };
-        if let Some(line) = line
-            && !s.name.is_empty()
-        {
-            any_legend = true;
-            let pattern = s.pattern;
-            line.label(s.name.as_str())
-                .legend(move |(x, y)| swatch((x, y), pattern, c));
-        }
-        if twins[i].is_some() {
-            chart
-                .draw_series(s.points.iter().map(|&(x, y)| {
-                    EmptyElement::at((x + dx, y)) + Rectangle::new([(-6, -6), (6, 6)], c.stroke_width(2))
-                }))
-                .map_err(e)?;
-        } else if !categorical {
-            chart
-                .draw_series(s.points.iter().map(|&p| Circle::new(p, 3, c.filled())))
-                .map_err(e)?;
-        }
-        chart
-            .draw_series(
-                s.bars
-                    .iter()
-                    .map(|&(x, lo, y, hi)| ErrorBar::new_vertical(x + dx, lo, y, hi, c.stroke_width(1), 8)),
-            )
-            .map_err(e)?;
+        any_legend |= draw_one(&mut chart, s, how)?;
     }
     if any_legend && beside {
         draw_legend_beside(&panel, series, &twins).map_err(e)?;
@@ -521,6 +443,122 @@ fn draw<DB: DrawingBackend>(
             .map_err(e)?;
     }
     draw_notes(root, notes)
+}
+
+/// Where and how one series is drawn: over an earlier one (`twin`), on a
+/// categorical axis, shifted by `dx` within its category, across `xr`.
+#[derive(Clone, Copy)]
+struct Placement {
+    twin: bool,
+    categorical: bool,
+    dx: f64,
+    xr: (f64, f64),
+}
+
+/// Draws one series (its level, line or points, markers and intervals);
+/// returns whether it made a legend entry.
+fn draw_one<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<TickedAxis, TickedAxis>>,
+    s: &Prepared,
+    how: Placement,
+) -> Result<bool, String> {
+    let mut legend = false;
+    if s.reference {
+        let cross = |p: (f64, f64)| EmptyElement::at(p) + Cross::new((0, 0), 6, BLACK.stroke_width(2));
+        let marks = chart
+            .draw_series(s.points.iter().map(|&p| cross(p)))
+            .map_err(|e| e.to_string())?;
+        if !s.name.is_empty() {
+            legend = true;
+            marks
+                .label(s.name.as_str())
+                .legend(move |(x, y)| Cross::new((x + 10, y), 6, BLACK.stroke_width(2)));
+        }
+        return Ok(legend);
+    }
+    let c = color(s.color);
+    if let Some(l) = s.level {
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(how.xr.0, l), (how.xr.1, l)],
+                10,
+                6,
+                c.stroke_width(1),
+            ))
+            .map_err(|e| e.to_string())?;
+    }
+    // On a how.categorical axis (architectures, policies) nothing lies
+    // between two categories: the points stand alone, no line joins them.
+    if how.categorical {
+        let marks = chart
+            .draw_series(
+                s.points
+                    .iter()
+                    .map(|&(x, y)| Circle::new((x + how.dx, y), 5, c.filled())),
+            )
+            .map_err(|e| e.to_string())?;
+        if !s.name.is_empty() {
+            legend = true;
+            marks
+                .label(s.name.as_str())
+                .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
+        }
+    }
+    // A series drawn exactly over an earlier one is dashed, with open
+    // square markers, so that both stay visible (and a note says so).
+    let line = if how.categorical {
+        None
+    } else if how.twin {
+        Some(
+            chart
+                .draw_series(DashedLineSeries::new(s.points.iter().copied(), 8, 6, c.stroke_width(2)))
+                .map_err(|e| e.to_string())?,
+        )
+    } else if let Some((dash, gap)) = dashes(s.pattern) {
+        Some(
+            chart
+                .draw_series(DashedLineSeries::new(
+                    s.points.iter().copied(),
+                    dash,
+                    gap,
+                    c.stroke_width(2),
+                ))
+                .map_err(|e| e.to_string())?,
+        )
+    } else {
+        Some(
+            chart
+                .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
+                .map_err(|e| e.to_string())?,
+        )
+    };
+    if let Some(line) = line
+        && !s.name.is_empty()
+    {
+        legend = true;
+        let pattern = s.pattern;
+        line.label(s.name.as_str())
+            .legend(move |(x, y)| swatch((x, y), pattern, c));
+    }
+    if how.twin {
+        chart
+            .draw_series(s.points.iter().map(|&(x, y)| {
+                EmptyElement::at((x + how.dx, y)) + Rectangle::new([(-6, -6), (6, 6)], c.stroke_width(2))
+            }))
+            .map_err(|e| e.to_string())?;
+    } else if !how.categorical {
+        chart
+            .draw_series(s.points.iter().map(|&p| Circle::new(p, 3, c.filled())))
+            .map_err(|e| e.to_string())?;
+    }
+    chart
+        .draw_series(
+            s.bars
+                .iter()
+                .map(|&(x, lo, y, hi)| ErrorBar::new_vertical(x + how.dx, lo, y, hi, c.stroke_width(1), 8)),
+        )
+        .map_err(|e| e.to_string())?;
+    Ok(legend)
 }
 
 /// A line pattern's (dash, gap) in pixels; `None` for a solid line.
