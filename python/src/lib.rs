@@ -198,11 +198,9 @@ struct RunFrames(std::sync::Mutex<rendersim::systems::SystemRun>);
 #[pymethods]
 impl RunFrames {
     /// The frame pipeline's frames as a [`FramesTable`]; `None` for
-    /// another system (read `csv`). The numbers are written straight into
-    /// the `bytearray` NumPy then views, without the GIL.
+    /// another system (read `csv`).
     fn table<'py>(&self, py: Python<'py>) -> PyResult<Option<FramesTable<'py>>> {
         use rendersim::systems::frame_pipeline::PipelineRun;
-        use rendersim::systems::frame_pipeline::records::COLUMNS;
         let lock = || {
             self.0
                 .lock()
@@ -215,20 +213,15 @@ impl RunFrames {
         else {
             return Ok(None);
         };
-        let mut parts = None;
-        let values = PyByteArray::new_with(py, rows * COLUMNS.len() * 8, |buf| {
-            py.detach(|| {
-                let run = lock()?;
-                let Some(run) = run.as_any().downcast_ref::<PipelineRun>() else {
-                    return Err(usage("the run changed while read".into()));
-                };
-                parts = Some(run.frame_values_with(|k, v| buf[8 * k..8 * k + 8].copy_from_slice(&v.to_le_bytes())));
-                Ok(())
-            })
-        })?;
-        let (text, kinds) = parts.ok_or_else(|| usage("the run's frames were not read".into()))?;
-        let (text, kinds, columns) = table_parts(text, &kinds);
-        Ok(Some((text, PyBytes::new(py, &kinds), columns, values, rows)))
+        frames_table(py, rows, |put| {
+            let run = lock()?;
+            let run = run
+                .as_any()
+                .downcast_ref::<PipelineRun>()
+                .ok_or_else(|| usage("the run changed while read".into()))?;
+            Ok(run.frame_values_with(put))
+        })
+        .map(Some)
     }
 
     /// The frames as the command line's `frames.csv`.
@@ -285,15 +278,27 @@ type FramesTable<'py> = (
     usize,
 );
 
-/// `frame_values`' three parts (a pipeline run's or a replay's) as a
-/// [`FramesTable`].
-fn frames_table<'py>(
-    py: Python<'py>,
-    (text, kinds, values): ([String; 8], Vec<bool>, Vec<f64>),
-) -> PyResult<FramesTable<'py>> {
-    let rows = kinds.len();
+/// A [`FramesTable`] of `rows` rows (a pipeline run's or a replay's):
+/// `fill` hands every number to `put(k, value)` and returns the text
+/// columns and the generated-frame flags; the numbers go straight into the
+/// `bytearray` NumPy then views, without the GIL.
+fn frames_table<'py, F>(py: Python<'py>, rows: usize, fill: F) -> PyResult<FramesTable<'py>>
+where
+    F: FnOnce(&mut dyn FnMut(usize, f64)) -> PyResult<([String; 8], Vec<bool>)> + Send,
+{
+    use rendersim::systems::frame_pipeline::records::COLUMNS;
+    let mut parts = None;
+    let values = PyByteArray::new_with(py, rows * COLUMNS.len() * 8, |buf| {
+        py.detach(|| {
+            parts = Some(fill(&mut |k, v| {
+                buf[8 * k..8 * k + 8].copy_from_slice(&v.to_le_bytes())
+            })?);
+            Ok(())
+        })
+    })?;
+    let (text, kinds) = parts.ok_or_else(|| usage("the frames were not read".into()))?;
     let (text, kinds, columns) = table_parts(text, &kinds);
-    Ok((text, PyBytes::new(py, &kinds), columns, f64_bytes(py, &values)?, rows))
+    Ok((text, PyBytes::new(py, &kinds), columns, values, rows))
 }
 
 /// A frames table's text columns named, its generated-frame flags as
@@ -500,32 +505,30 @@ fn replay<'py>(
     sets: Vec<String>,
     assume: Vec<String>,
 ) -> PyResult<(String, NumberTable<'py>, FramesTable<'py>, Option<FramesTable<'py>>)> {
-    type Values = ([String; 8], Vec<bool>, Vec<f64>);
-    let (summary, names, rows, frames, whatif): (String, Vec<String>, Vec<f64>, Values, Option<Values>) =
-        py.detach(move || {
-            use rendersim::studies::replay::{ReplayOptions, replay};
-            let opts = ReplayOptions {
-                app,
-                swap_chain: swapchain,
-                sets,
-                assume,
-                from_tables: false,
-            };
-            let r = replay(&capture, &opts).map_err(err)?;
-            let summary = serde_json::to_string(&r.summary).map_err(err)?;
-            let table = r.rows();
-            let width = r.columns().len();
-            // Column by column, as the frames.
-            let rows: Vec<f64> = (0..width)
-                .flat_map(|c| table.iter().map(move |row| row.get(c).copied().unwrap_or(f64::NAN)))
-                .collect();
-            let whatif = r.whatif_replayed.as_ref().map(|w| w.frame_values());
-            Ok::<_, PyErr>((summary, r.columns(), rows, r.replayed.frame_values(), whatif))
-        })?;
-    let n = rows.len() / names.len().max(1);
-    let comparison = (names, f64_bytes(py, &rows)?, n);
-    let frames = frames_table(py, frames)?;
-    let whatif = whatif.map(|w| frames_table(py, w)).transpose()?;
+    let (r, summary) = py.detach(move || {
+        use rendersim::studies::replay::{ReplayOptions, replay};
+        let opts = ReplayOptions {
+            app,
+            swap_chain: swapchain,
+            sets,
+            assume,
+            from_tables: false,
+        };
+        let r = replay(&capture, &opts).map_err(err)?;
+        let summary = serde_json::to_string(&r.summary).map_err(err)?;
+        Ok::<_, PyErr>((r, summary))
+    })?;
+    let (names, table) = (r.columns(), r.rows());
+    // Column by column, as the frames.
+    let values: Vec<f64> = (0..names.len())
+        .flat_map(|c| table.iter().map(move |row| row.get(c).copied().unwrap_or(f64::NAN)))
+        .collect();
+    let comparison = (names, f64_bytes(py, &values)?, table.len());
+    let frames_of = |f: &rendersim::studies::replay::ReplayedFrames| {
+        frames_table(py, f.table_rows(), |put| Ok(f.frame_values_with(put)))
+    };
+    let frames = frames_of(&r.replayed)?;
+    let whatif = r.whatif_replayed.as_ref().map(frames_of).transpose()?;
     Ok((summary, comparison, frames, whatif))
 }
 

@@ -393,7 +393,7 @@ fn results_do_not_depend_on_scheduling() {
 fn an_observer_sees_every_run_and_can_stop_the_rest() {
     let exp = parse(BASIC);
     let dir = tempfile::tempdir().unwrap();
-    let seen = std::sync::Mutex::new(Vec::new());
+    let seen = Mutex::new(Vec::new());
     let all = |done: u64, total: u64| {
         seen.lock().unwrap().push((done, total));
         true

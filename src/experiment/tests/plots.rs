@@ -286,13 +286,16 @@ path = "metrics.display_interval_ms.mean"
     );
 }
 
+/// An experiment with one line plot of `m` over sweep `a`, `extra` added
+/// to the plot.
+fn line(extra: &str) -> String {
+    format!(
+        "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[plot]]\nfile = \"p\"\nkind = \"line\"\nx = \"a\"\ny = \"m\"\n{extra}"
+    )
+}
+
 #[test]
 fn y_bounds_belong_to_line_plots_and_must_be_an_ordered_pair() {
-    let line = |extra: &str| {
-        format!(
-            "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[plot]]\nfile = \"p\"\nkind = \"line\"\nx = \"a\"\ny = \"m\"\n{extra}"
-        )
-    };
     let exp = parse(&line("y_bounds = [0, 1]\n"));
     assert!(matches!(
         exp.plots[0].kind,
@@ -318,11 +321,6 @@ fn y_bounds_belong_to_line_plots_and_must_be_an_ordered_pair() {
 
 #[test]
 fn a_y_axis_is_checked_as_bounds_are_and_drawn_whole() {
-    let line = |extra: &str| {
-        format!(
-            "name = \"x\"\n[[sweep]]\nkey = \"a\"\nvalues = [1, 2]\n[[plot]]\nfile = \"p\"\nkind = \"line\"\nx = \"a\"\ny = \"m\"\n{extra}"
-        )
-    };
     let exp = parse(&line("y_axis = [0, 300]\n"));
     assert!(matches!(
         exp.plots[0].kind,

@@ -12,7 +12,7 @@ use crate::components::swap_chain::Composition;
 use crate::stats::quantile::quantile;
 use crate::systems::frame_pipeline::FramePipelineConfig;
 use crate::systems::frame_pipeline::records::{
-    ChainInfo, FrameRecord, GeneratedRecord, frame_values, write_frames_csv,
+    ChainInfo, FrameRecord, GeneratedRecord, frame_values_with, write_frames_csv,
 };
 
 /// |predicted - measured| over the frames where both exist, in ms.
@@ -360,12 +360,17 @@ impl ReplayedFrames {
         write_frames_csv(&self.records, &self.generated, &self.chain, self.origin_ps, w)
     }
 
-    /// The rows of that `frames.csv` as numbers: the text columns (the
-    /// same on every row), whether each row is a generated frame, and the
-    /// numeric columns column by column, flattened ([`frame_values`]).
-    pub fn frame_values(&self) -> ([String; 8], Vec<bool>, Vec<f64>) {
-        let (kinds, values) = frame_values(&self.records, &self.generated, self.origin_ps);
-        (self.chain.text(), kinds, values)
+    /// The rows of that `frames.csv`: rendered frames and generated ones.
+    pub fn table_rows(&self) -> usize {
+        self.records.len() + self.generated.len()
+    }
+
+    /// The rows of that `frames.csv` as numbers handed to `put(k, value)`
+    /// ([`frame_values_with`]): the text columns (the same on every row)
+    /// and whether each row is a generated frame.
+    pub fn frame_values_with(&self, put: impl FnMut(usize, f64)) -> ([String; 8], Vec<bool>) {
+        let kinds = frame_values_with(&self.records, &self.generated, self.origin_ps, put);
+        (self.chain.text(), kinds)
     }
 }
 

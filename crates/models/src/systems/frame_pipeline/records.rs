@@ -544,23 +544,13 @@ impl ChainInfo {
 }
 
 /// The rows of `frames.csv` as numbers, for a caller that wants them typed
-/// rather than as text (the Python package's DataFrames): whether each row
-/// is a generated frame, and [`COLUMNS`] column by column (each column's
-/// rows in order, one column after another), each the number a reader of
-/// the file parses (NaN for `NA`). The text columns are
-/// [`ChainInfo::text`], the same on every row.
-pub fn frame_values(records: &[FrameRecord], generated: &[GeneratedRecord], offset_ps: i64) -> (Vec<bool>, Vec<f64>) {
-    let n = records.len() + generated.len();
-    let mut values = vec![0.0; n * COLUMNS.len()];
-    let kinds = frame_values_with(records, generated, offset_ps, |k, v| values[k] = v);
-    (kinds, values)
-}
-
-/// [`frame_values`] handed to `put(k, value)`, `k` the value's place in
-/// [`frame_values`]' vector (column `c`, row `r` of `n` rows: `c * n + r`),
-/// for a caller that owns the memory the numbers go to (the Python package
-/// writes them straight into the buffer its arrays view). Returns whether
-/// each row is a generated frame.
+/// rather than as text (the Python package's DataFrames): [`COLUMNS`]
+/// column by column, each the number a reader of the file parses (NaN for
+/// `NA`), handed to `put(k, value)` with `k` its place in the flattened
+/// table (column `c`, row `r` of `n` rows: `c * n + r`), so the caller
+/// writes them where it wants them (the Python package: straight into the
+/// buffer its arrays view). Returns whether each row is a generated frame;
+/// the text columns are [`ChainInfo::text`], the same on every row.
 pub fn frame_values_with(
     records: &[FrameRecord],
     generated: &[GeneratedRecord],

@@ -7,7 +7,7 @@ use crate::output::trace::TraceWriter;
 use crate::systems::{Outcome, SystemError, SystemModel, outcome_basics, resolved_toml};
 
 use super::config::{FramePipelineConfig, WorkloadConfig};
-use super::records::{COLUMNS, ChainInfo, frame_rows, frame_values, frame_values_with, write_frames_csv};
+use super::records::{COLUMNS, ChainInfo, frame_rows, frame_values_with, write_frames_csv};
 use super::run::{PipelineRun, run_pipeline};
 
 /// `system = "frame_pipeline"` (the default).
@@ -35,21 +35,14 @@ impl PipelineRun {
         )
     }
 
-    /// The rows of its `frames.csv` as numbers: the text columns (the same
-    /// on every row), whether each row is a generated frame, and
-    /// [`COLUMNS`] column by column, flattened ([`frame_values`]).
-    pub fn frame_values(&self) -> ([String; 8], Vec<bool>, Vec<f64>) {
-        let (kinds, values) = frame_values(&self.records, &self.generated, 0);
-        (ChainInfo::of_display(&self.config.display).text(), kinds, values)
-    }
-
     /// The rows of its `frames.csv`: rendered frames and generated ones.
     pub fn table_rows(&self) -> usize {
         self.records.len() + self.generated.len()
     }
 
-    /// [`PipelineRun::frame_values`] with the numbers handed to `put(k,
-    /// value)` rather than collected ([`frame_values_with`]).
+    /// The rows of its `frames.csv` as numbers handed to `put(k, value)`
+    /// ([`frame_values_with`]): the text columns (the same on every row)
+    /// and whether each row is a generated frame.
     pub fn frame_values_with(&self, put: impl FnMut(usize, f64)) -> ([String; 8], Vec<bool>) {
         let kinds = frame_values_with(&self.records, &self.generated, 0, put);
         (ChainInfo::of_display(&self.config.display).text(), kinds)
