@@ -40,8 +40,11 @@ fn display_interval(gpu: &str) -> f64 {
     assert_eq!(r.clocks.cpu.iter().sum::<u64>(), r.clocks.elapsed);
     assert_eq!(r.clocks.gpu.iter().sum::<u64>(), r.clocks.elapsed);
     assert_eq!(r.records.len(), 120);
-    r.summary["metrics"]["display_interval_ms"]["mean"]
-        .as_f64()
+    // The typed summary (`summary.json` writes the same fields).
+    r.results
+        .metrics
+        .display_interval_ms
+        .mean
         .expect("a mean display interval")
 }
 

@@ -17,7 +17,6 @@
 use rendersim::config::ModelSource;
 use rendersim::systems::multi_rate::MultiRateRun;
 use rendersim::systems::run_model;
-use serde_json::Value;
 
 /// Runs a multi-rate model and returns its typed run.
 fn run(name: &str, text: &str) -> MultiRateRun {
@@ -26,36 +25,37 @@ fn run(name: &str, text: &str) -> MultiRateRun {
     run.downcast::<MultiRateRun>().expect("a multi_rate model")
 }
 
-fn num(v: &Value, k: &str) -> f64 {
-    v[k].as_f64().unwrap_or_else(|| panic!("{k} in {v}"))
-}
-
 /// Prints one path and checks it against its closed form; returns (paper's
 /// best case, simulated mean) in ms.
 fn check(system: &str, path: &str, r: &MultiRateRun) -> (f64, f64) {
-    let m = &r.summary["metrics"];
-    let sim = &m["event_latency_ms"][path];
-    let cf = &m["analytic_latency_ms"][path];
-    let (mean, min, max) = (num(sim, "mean"), num(sim, "min"), num(sim, "max"));
+    // The typed summary (`summary.json` writes the same fields).
+    let m = &r.summary.metrics;
+    let (lat, bounds) = (&m.event_latency_ms, &m.analytic_latency_ms);
+    let (sim, cf) = match path {
+        "fast" => (&lat.fast, &bounds.fast),
+        "slow" => (&lat.slow, &bounds.slow),
+        _ => (
+            lat.conventional.as_ref().expect("the model has the conventional path"),
+            bounds
+                .conventional
+                .as_ref()
+                .expect("the model has the conventional path"),
+        ),
+    };
+    let got = |v: Option<f64>| v.expect("5000 events were measured");
+    let (mean, min, max) = (got(sim.mean), got(sim.min), got(sim.max));
     println!(
         "{system:>9} {path:>12}: paper {:6.1} ms (worst {:6.1}); simulated {min:6.1} .. {max:6.1}, mean {mean:6.1}; \
          phase mean {:6.1}",
-        num(cf, "best"),
-        num(cf, "worst"),
-        num(cf, "phase_mean")
+        cf.best, cf.worst, cf.phase_mean
     );
-    assert_eq!(
-        cf["holds"],
-        Value::Bool(true),
-        "{system} {path}: {}",
-        m["closed_form_caveats"]
-    );
+    assert!(cf.holds, "{system} {path}: {:?}", m.closed_form_caveats);
     // Every event within the bounds over all phases (1 us of rounding).
-    assert!(min >= num(cf, "phase_min") - 1e-3 && max <= num(cf, "bound_max") + 1e-3);
+    assert!(min >= cf.phase_min - 1e-3 && max <= cf.bound_max + 1e-3);
     // 5000 events at random phases average to the phase mean (the tracker's
     // sampling adds a little on top).
-    assert!((mean - num(cf, "phase_mean")).abs() < 2.0, "{system} {path}: {mean}");
-    (num(cf, "best"), mean)
+    assert!((mean - cf.phase_mean).abs() < 2.0, "{system} {path}: {mean}");
+    (cf.best, mean)
 }
 
 fn main() {

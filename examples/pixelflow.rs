@@ -26,37 +26,35 @@ fn run(primitives: u64, fidelity: &str) -> PixelFlowRun {
     run.downcast::<PixelFlowRun>().expect("a pixelflow model")
 }
 
-fn ms(r: &PixelFlowRun, key: &str) -> f64 {
-    r.summary["metrics"][key]
-        .as_f64()
-        .unwrap_or_else(|| panic!("{key} in {}", r.summary))
-}
-
 fn main() {
     println!("primitives   closed form ms (front + back, back-end bound)   event simulation ms   difference");
     let mut fronts = Vec::new();
     for n in [10_000u64, 50_000, 100_000, 200_000] {
         let a = run(n, "analytic");
         let e = run(n, "event");
-        let (closed, sim) = (ms(&a, "analytic_latency_ms"), ms(&e, "latency_ms"));
-        let (front, back) = (ms(&a, "analytic_front_end_ms"), ms(&a, "analytic_back_end_ms"));
-        let terms = &a.summary["metrics"]["analytic"];
-        let term = |k: &str| terms[k].as_f64().expect("a closed-form term");
+        // The summary, typed: `metrics` is what `summary.json` writes.
+        let (am, em) = (&a.summary.metrics, &e.summary.metrics);
+        let (closed, sim) = (am.analytic_latency_ms, em.latency_ms);
+        let (front, back) = (am.analytic_front_end_ms, am.analytic_back_end_ms);
         // The back end is its slowest stage: loading the 40 regions into
         // the frame buffer (40 x 52 us) for few primitives, rasterizing for many.
-        let bound = if back == term("t_load_ms") { "load" } else { "rasterize" };
+        let bound = if back == am.analytic.t_load_ms {
+            "load"
+        } else {
+            "rasterize"
+        };
         println!(
             "{n:>10}   {closed:8.3} ({front:6.3} + {back:6.3}, {bound:>9})     {sim:8.3}             {:+.3} ms",
             sim - closed
         );
         // The analytic fidelity is the closed form.
-        assert!((ms(&a, "latency_ms") - closed).abs() < 1e-9);
+        assert!((am.latency_ms - closed).abs() < 1e-9);
         assert!((front + back - closed).abs() < 1e-9);
         assert_eq!(e.records.len(), 40, "40 screen regions of 128 x 64");
         // The event simulation also sends the regions' colours to the
         // frame-buffer node (40 x 3 bytes x 1.28 us = 0.154 ms), which the
         // closed form leaves out, and drains the pipeline's last regions.
-        let colour = e.summary["metrics"]["stages_ms"]["color"].as_f64().unwrap();
+        let colour = em.stages_ms.color.expect("the event simulation sends colours");
         assert!((colour - 0.1536).abs() < 1e-9);
         assert!(
             sim > closed && sim - closed < colour + 0.06,

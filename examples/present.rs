@@ -23,10 +23,11 @@ fn run(text: &str) -> PresentRun {
 
 /// (simulated, closed form) mean display interval in ms.
 fn interval(r: &PresentRun) -> (f64, f64) {
-    let m = &r.summary["metrics"];
+    // The typed summary (`summary.json` writes the same fields).
+    let m = &r.summary.metrics;
     (
-        m["display_interval_ms"]["mean"].as_f64().expect("frames were shown"),
-        m["analytic_interval_ms"].as_f64().expect("a closed form"),
+        m.display_interval_ms.mean.expect("frames were shown"),
+        m.analytic_interval_ms,
     )
 }
 
@@ -53,8 +54,8 @@ fn main() {
         20_000,
     ));
     let (sim, closed) = interval(&r);
-    let d = &r.summary["metrics"]["display_interval_ms"];
-    let se = d["std"].as_f64().unwrap() / d["count"].as_f64().unwrap().sqrt();
+    let d = &r.summary.metrics.display_interval_ms;
+    let se = d.std.expect("frames were shown") / (d.count as f64).sqrt();
     println!(
         "lognormal render times (median 14 ms, sigma 0.4), double buffered: {sim:.3} ms simulated, \
          {closed:.3} ms closed form ({:.1} standard errors apart)",

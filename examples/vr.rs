@@ -16,7 +16,7 @@
 use rendersim::config::ModelSource;
 use rendersim::systems::run_model;
 use rendersim::systems::vr::VrRun;
-use serde_json::Value;
+use rendersim::systems::vr::run::VrSummary;
 
 /// Runs a VR model and returns its typed run.
 fn run(name: &str, text: &str) -> VrRun {
@@ -27,17 +27,20 @@ fn run(name: &str, text: &str) -> VrRun {
 
 /// Prints one motion kind and checks it against its closed form; returns
 /// the simulated mean latency (ms).
-fn check(scheme: &str, motion: &str, s: &Value) -> f64 {
-    let m = &s["metrics"];
-    let sim = &m["motion_to_photon_ms"][motion];
-    let cf = &m["analytic_latency_ms"][motion];
-    let f = |v: &Value, k: &str| v[k].as_f64().unwrap_or_else(|| panic!("{k} in {v}"));
-    let (mean, min, max) = (f(sim, "mean"), f(sim, "min"), f(sim, "max"));
-    let (lo, hi, cf_mean) = (f(cf, "phase_min"), f(cf, "phase_max"), f(cf, "phase_mean"));
+fn check(scheme: &str, motion: &str, s: &VrSummary) -> f64 {
+    // The typed summary: `metrics` is what `summary.json` writes.
+    let m = &s.metrics;
+    let (sim, cf) = match motion {
+        "head" => (&m.motion_to_photon_ms.head, &m.analytic_latency_ms.head),
+        _ => (&m.motion_to_photon_ms.object, &m.analytic_latency_ms.object),
+    };
+    let got = |v: Option<f64>| v.expect("5000 motions were measured");
+    let (mean, min, max) = (got(sim.mean), got(sim.min), got(sim.max));
+    let (lo, hi, cf_mean) = (cf.phase_min, cf.phase_max, cf.phase_mean);
     println!(
         "{scheme:>5} {motion:>6}: simulated {min:7.2} .. {max:7.2} ms, mean {mean:7.2}; \
          closed form {lo:7.2} .. {hi:7.2} ms, mean {cf_mean:7.2} (slides' best case {:.2})",
-        f(cf, "best")
+        cf.best
     );
     // Every motion lies within the bounds over all phases (1 us of rounding).
     assert!(

@@ -36,25 +36,28 @@ fn main() {
     }
     let run = run_model(&src, &table, None).expect("the model runs");
     let r = run.downcast::<WalkthroughRun>().expect("a walkthrough model");
+    // The typed summary: its fields are what `summary.json` writes.
     let s = &r.summary;
-    let num = |v: &serde_json::Value| v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"));
-    let objects = num(&s["scene"]["objects"]);
-    let frame_ms = num(&s["metrics"]["gpu_time_ms"]["mean"]);
+    let objects = s.scene.objects;
+    let frame_ms = s.metrics.gpu_time_ms.mean.expect("60 frames were measured");
     println!(
         "{objects} buildings, {} triangles, {} frames of {frame_ms:.3} ms of GPU time on average",
-        s["scene"]["triangles"], s["frames"]
+        s.scene.triangles, s.frames
     );
     // 5% of the city's 5609 buildings (Table 5), one table row per frame.
-    assert_eq!(objects, (5609.0_f64 * 0.05).round());
+    assert_eq!(objects as f64, (5609.0_f64 * 0.05).round());
     assert_eq!(r.rows.len(), 60);
-    let est = &s["metrics"]["estimation"];
+    let est = &s.metrics.estimation;
+    let scores = [&est.h1, &est.h2, &est.h3, &est.h4, &est.pos];
     let mse: Vec<f64> = ["h1", "h2", "h3", "h4", "pos"]
         .iter()
-        .map(|e| {
-            let m = num(&est[e]["mse_ms2"]);
+        .zip(scores)
+        .map(|(e, score)| {
+            let score = score.as_ref().expect("the model asks for every estimator");
+            let m = score.mse_ms2.expect("frames were estimated");
             println!(
                 "{e:>4}: mean squared error {m:8.5} ms^2, mean error {:+.3} ms",
-                num(&est[e]["mean_error_ms"])
+                score.mean_error_ms.expect("frames were estimated")
             );
             m
         })

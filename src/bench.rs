@@ -26,6 +26,7 @@ use std::time::Instant;
 use crate::config::{ConfigError, ModelSource, Overrides, deserialize, load_model};
 use crate::systems::frame_pipeline::PipelineSummary;
 use crate::systems::frame_pipeline::{FramePipelineConfig, run_pipeline};
+use crate::systems::pixelflow::PixelFlowRun;
 use crate::systems::{SimError, run_model};
 
 pub mod build;
@@ -57,6 +58,15 @@ pub enum BenchError {
     /// The replay benchmark's capture did not replay.
     #[error("replay benchmark: {0}")]
     Replay(String),
+    /// A benchmark's model ran as another system than the one whose typed
+    /// results the benchmark reads.
+    #[error("{model}: not a {system} model")]
+    System {
+        /// The model's name.
+        model: String,
+        /// The system the benchmark reads.
+        system: &'static str,
+    },
 }
 
 /// One of the benchmarks of `rendersim bench`.
@@ -233,8 +243,14 @@ pub fn pixelflow_figures_at(counts: u32, fidelity: &str) -> Result<(u64, u64, f6
                         format!("fidelity=\"{fidelity}\""),
                     ])
                     .apply(&mut run_src, &mut t)?;
-                    let r = run_model(&run_src, &t, None)?;
-                    events += r.summary()["events"]["total"].as_u64().unwrap_or(0);
+                    let r =
+                        run_model(&run_src, &t, None)?
+                            .downcast::<PixelFlowRun>()
+                            .map_err(|_| BenchError::System {
+                                model: run_src.name.clone(),
+                                system: "pixelflow",
+                            })?;
+                    events += r.summary.events.total;
                     runs += 1;
                 }
             }

@@ -173,11 +173,12 @@ fn run(
         let overrides = Overrides { sets, seed, frames };
         let prepared = prepared(model, text, &overrides).map_err(err)?;
         let src = &prepared.source;
-        let mut run = run_model(src, &prepared.table, None).map_err(err)?;
-        run.summary_mut()["model"] = serde_json::Value::String(src.name.clone());
+        let run = run_model(src, &prepared.table, None).map_err(err)?;
+        let mut summary = run.summary();
+        summary["model"] = serde_json::Value::String(src.name.clone());
         let provenance = rendersim::provenance(command);
-        run.summary_mut()["provenance"] = serde_json::to_value(&provenance).map_err(err)?;
-        let summary = serde_json::to_string_pretty(run.summary()).map_err(err)?;
+        summary["provenance"] = serde_json::to_value(&provenance).map_err(err)?;
+        let summary = serde_json::to_string_pretty(&summary).map_err(err)?;
         let model_text = provenance.toml_comment() + &run.resolved_model(&src.base_dir);
         Ok((
             summary,

@@ -19,6 +19,7 @@ use super::spread::{Spread, paired_ratio};
 use crate::config::{ModelSource, Overrides};
 use crate::scene::generators::mesh_from_spec;
 use crate::scene::optimize::{optimize_vertex_cache, optimize_vertex_cache_reference};
+use crate::systems::frame_pipeline::run::PipelineRun;
 use crate::systems::run_model;
 
 /// One mesh reordered by both forms.
@@ -131,12 +132,16 @@ fn model_run(name: &str, text: &str, fidelity: &str, reps: usize) -> Result<Mode
             format!("fidelity=\"{fidelity}\""),
         ])
         .apply(&mut src, &mut table)?;
-        let r = run_model(&src, &table, None)?;
-        let s = r.summary();
-        let f = |k: &str| s[k].as_f64().unwrap_or(f64::NAN);
-        build.push(f("build_seconds"));
-        simulate.push(f("simulate_seconds"));
-        wall.push(f("wall_seconds"));
+        let r = run_model(&src, &table, None)?
+            .downcast::<PipelineRun>()
+            .map_err(|_| BenchError::System {
+                model: src.name.clone(),
+                system: "frame_pipeline",
+            })?;
+        let s = &r.results;
+        build.push(s.build_seconds);
+        simulate.push(s.simulate_seconds);
+        wall.push(s.wall_seconds);
     }
     Ok(ModelRun {
         build_s: Spread::of(&build),

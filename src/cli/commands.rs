@@ -103,12 +103,14 @@ pub fn run(args: RunArgs) -> Result<()> {
         None => (None, None),
     };
     let mut run = run_model(src, &model.table, writer)?;
-    run.summary_mut()["model"] = json!(src.name);
     let provenance = command_provenance();
-    run.summary_mut()["provenance"] = serde_json::to_value(&provenance)?;
-    // The summary as written (summary.json, --json): wall times fixed when asked.
+    // The summary as written (summary.json, --json): the run's typed summary
+    // as JSON, with the model's name and the provenance; wall times fixed
+    // when asked.
     let summary_text = {
-        let mut summary = run.summary().clone();
+        let mut summary = run.summary();
+        summary["model"] = json!(src.name);
+        summary["provenance"] = serde_json::to_value(&provenance)?;
         rendersim::output::timing::fix_wall_times(&mut summary);
         serde_json::to_string_pretty(&summary)?
     };
@@ -140,7 +142,7 @@ pub fn run(args: RunArgs) -> Result<()> {
             say!("{summary_text}");
         }
     } else if !trace_on_stdout {
-        super::progress::suspend(|| run.write_report(&mut std::io::stdout().lock()))?;
+        super::progress::suspend(|| run.write_report(&src.name, &mut std::io::stdout().lock()))?;
     }
     Ok(())
 }

@@ -100,7 +100,7 @@ impl Runner for SimRunner {
             let (columns, rows) = run.frame_table();
             without_warmup(FrameTable { columns, rows }, warmup)
         });
-        let mut summary = run.summary().clone();
+        let mut summary = run.summary();
         crate::output::timing::fix_wall_times(&mut summary);
         Ok(RunOutput { summary, frames })
     }

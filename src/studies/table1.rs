@@ -28,6 +28,7 @@ use serde::Serialize;
 use crate::config::{ConfigError, ModelSource, apply_set};
 use crate::scene::config::SizeOrder;
 use crate::systems::frame_pipeline::Fidelity;
+use crate::systems::frame_pipeline::run::PipelineRun;
 use crate::systems::{SimError, run_model};
 
 /// `models/terrain.toml`: the terrain viewpoint of Table 1 (86,400
@@ -225,7 +226,8 @@ pub enum CalibrationError {
     /// A run failed.
     #[error(transparent)]
     Sim(#[from] SimError),
-    /// The run's summary lacks a number.
+    /// The run's summary lacks a number (or the model is not a frame
+    /// pipeline).
     #[error("the run's summary has no number at {0}")]
     Metric(String),
     /// The geometry share is not in [0, 1].
@@ -273,14 +275,6 @@ struct Times {
     fragment: f64,
 }
 
-fn number(summary: &serde_json::Value, path: &str) -> Result<f64, CalibrationError> {
-    let mut v = summary;
-    for p in path.split('.') {
-        v = &v[p];
-    }
-    v.as_f64().ok_or_else(|| CalibrationError::Metric(path.to_string()))
-}
-
 impl<'a> CellModel<'a> {
     /// The model `table` (already patched) read from `src`.
     pub fn new(src: &'a ModelSource, table: toml::Table) -> CellModel<'a> {
@@ -296,13 +290,18 @@ impl<'a> CellModel<'a> {
         let mut t = self.table.clone();
         apply_set(&mut t, &format!("{VERTEX_KEY}=\"{vertex_ps}ps\""))?;
         apply_set(&mut t, &format!("{FRAGMENT_KEY}=\"{fragment_ps}ps\""))?;
-        let run = run_model(self.src, &t, None)?;
+        let run = run_model(self.src, &t, None)?
+            .downcast::<PipelineRun>()
+            .map_err(|_| CalibrationError::Metric(format!("{METRIC} (the model is not a frame pipeline)")))?;
         self.runs += 1;
-        let s = run.summary();
+        let m = &run.results.metrics;
         Ok(Times {
-            gpu: number(s, METRIC)?,
-            geometry: number(s, "metrics.analytic.geometry_ms")?,
-            fragment: number(s, "metrics.analytic.fragment_ms")?,
+            gpu: m
+                .gpu_time_ms
+                .mean
+                .ok_or_else(|| CalibrationError::Metric(METRIC.to_string()))?,
+            geometry: m.analytic.geometry_ms,
+            fragment: m.analytic.fragment_ms,
         })
     }
 

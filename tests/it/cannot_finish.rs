@@ -144,7 +144,7 @@ fn the_latency_estimate_is_a_lower_bound_of_real_runs() {
         let cap = format!("run.max_events={events}");
         sets.push(&cap);
         let again = try_run_any(&text, &sets).unwrap_or_else(|e| panic!("{model} {extra:?}: {e}"));
-        assert_eq!(num(again.summary(), "events.total") as u64, events, "{model}");
+        assert_eq!(num(&again.summary(), "events.total") as u64, events, "{model}");
     }
 }
 

@@ -64,7 +64,7 @@ pub fn run(text: &str, sets: &[&str]) -> PipelineRun {
 
 /// A metric by dotted path.
 pub fn metric(r: &PipelineRun, path: &str) -> f64 {
-    num(&r.summary, path)
+    num(&r.summary(), path)
 }
 
 /// The fixed teaching model.

@@ -230,7 +230,7 @@ proptest! {
         let shown: Vec<_> = r.records.iter().filter_map(|f| f.displayed).collect();
         prop_assert!(shown.windows(2).all(|w| w[0] <= w[1]));
         let mut nulls = vec![];
-        null_paths(&r.summary, "", &mut nulls);
+        null_paths(&r.summary(), "", &mut nulls);
         prop_assert!(nulls.is_empty(), "NaN/null in summary: {:?}", nulls);
     }
 }

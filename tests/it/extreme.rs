@@ -7,7 +7,7 @@ use common::{FIXED, null_paths, run, scene_model, try_run};
 
 fn no_nulls(r: &rendersim::systems::frame_pipeline::PipelineRun) {
     let mut n = vec![];
-    null_paths(&r.summary, "", &mut n);
+    null_paths(&r.summary(), "", &mut n);
     assert!(n.is_empty(), "{n:?}");
 }
 
@@ -26,7 +26,7 @@ fn picosecond_costs_beside_a_one_hertz_period_stay_exact() {
     }
     // Stage times are exact in picoseconds: 1 ps per transformed vertex and
     // 1 ps per triangle of fragments (128 triangles), over 30 frames.
-    let tv = r.summary["scene"]["transformed_vertices"].as_u64().unwrap();
+    let tv = r.summary()["scene"]["transformed_vertices"].as_u64().unwrap();
     assert_eq!(r.clocks.geometry[0], 30 * tv);
     assert_eq!(r.clocks.fragment[0], 30 * 128);
     no_nulls(&r);
@@ -110,7 +110,7 @@ fn frames_that_take_no_time_stop_at_run_max_events() {
     assert_eq!(r.stats.stopped_by, rendersim::engine::StopReason::EventLimit);
     assert_eq!(r.stats.events, 500);
     assert!(r.records.len() < 600, "{}", r.records.len());
-    assert_eq!(r.summary["stopped_by"], "event_limit");
+    assert_eq!(r.summary()["stopped_by"], "event_limit");
     assert_eq!(r.clocks.elapsed, 0);
     no_nulls(&r);
     // Without a limit, a run of such frames ends by itself (a few events
@@ -139,7 +139,7 @@ fn frames_that_take_no_time_stop_at_run_until() {
         ],
     );
     assert_eq!(r.stats.stopped_by, rendersim::engine::StopReason::TimeLimit);
-    assert_eq!(r.summary["stopped_by"], "time_limit");
+    assert_eq!(r.summary()["stopped_by"], "time_limit");
     assert!((55..=61).contains(&r.records.len()), "{}", r.records.len());
     // Without vsync no time passes, so run.until cannot end the run; the
     // frames' records are bounded by run.max_memory instead: 10^8 frames

@@ -59,7 +59,7 @@ fn a_generated_frame_before_every_rendered_one_doubles_the_frames_shown() {
     // The same GPU time per frame without generation: 2 T = 36 ms.
     let plain = fixed(&["workload.gpu=\"18ms\""]);
     assert_eq!(metric(&plain, "metrics.display_latency_ms.mean"), 36.0);
-    assert!(plain.summary["metrics"].get("frame_generation").is_none());
+    assert!(plain.summary()["metrics"].get("frame_generation").is_none());
 }
 
 #[test]

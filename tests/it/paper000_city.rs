@@ -16,7 +16,7 @@ fn gpu_ms(sets: &[String]) -> f64 {
     let src = ModelSource::from_file(std::path::Path::new(MODEL)).unwrap();
     let m = prepare(src, &Overrides::with_sets(sets)).unwrap();
     let run = run_model(&m.source, &m.table, None).unwrap();
-    num(run.summary(), "metrics.gpu_time_ms.mean")
+    num(&run.summary(), "metrics.gpu_time_ms.mean")
 }
 
 /// Table 2's geometry-limited, presorted setting with `count` buildings.

@@ -35,7 +35,7 @@ fn frame_ms(order: &str, setting: &str, sets: &[String]) -> f64 {
     let src = ModelSource::from_file(std::path::Path::new(MODEL)).unwrap();
     let m = prepare(src, &Overrides::with_sets(&all)).unwrap();
     let run = run_model(&m.source, &m.table, None).unwrap();
-    let s = run.summary();
+    let s = &run.summary();
     num(s, "metrics.frame_time_ms.mean")
 }
 
@@ -194,7 +194,7 @@ fn changes_give_exactly_the_counts_asked() {
         let src = ModelSource::from_file(std::path::Path::new(MODEL)).unwrap();
         let m = prepare(src, &Overrides::with_sets(&all)).unwrap();
         let run = run_model(&m.source, &m.table, None).unwrap();
-        let s = run.summary();
+        let s = &run.summary();
         let got = ["texture_changes", "material_changes", "alpha_changes", "matrix_changes"]
             .map(|k| num(s, &format!("scene.{k}")) as u64);
         assert_eq!(got, want, "{order}");

@@ -208,7 +208,7 @@ fn vertex_cache_changes_geometry_time_by_actually_transformed_vertices() {
     let shuffled = run(&g("grid:32x32:shuffled:3"), &[]);
     let optimized = run(&g("grid:32x32:optimized"), &[]);
     let tv = |r: &rendersim::systems::frame_pipeline::PipelineRun| {
-        r.summary["scene"]["transformed_vertices"].as_u64().unwrap() as f64
+        r.summary()["scene"]["transformed_vertices"].as_u64().unwrap() as f64
     };
     let geo = |r: &rendersim::systems::frame_pipeline::PipelineRun| metric(r, "metrics.analytic.geometry_ms");
     assert!(tv(&optimized) < 0.5 * tv(&shuffled));
@@ -321,7 +321,7 @@ fn tracing_does_not_change_results_at_either_fidelity() {
         assert_eq!(a.clocks.geometry, b.clocks.geometry, "{fid}");
         assert_eq!(a.clocks.fragment, b.clocks.fragment, "{fid}");
         assert_eq!(a.clocks.bottleneck, b.clocks.bottleneck, "{fid}");
-        assert_eq!(a.summary["metrics"], b.summary["metrics"], "{fid}");
+        assert_eq!(a.summary()["metrics"], b.summary()["metrics"], "{fid}");
         assert_eq!(a.clocks.cpu, b.clocks.cpu, "{fid}");
         assert_eq!(a.clocks.front, b.clocks.front, "{fid}");
         assert_eq!(a.clocks.gpu, b.clocks.gpu, "{fid}");
@@ -412,7 +412,7 @@ fn state_changes_cost_per_kind_and_sorting_reduces_their_count() {
     };
     let changes = |r: &rendersim::systems::frame_pipeline::PipelineRun| {
         ["shader", "texture", "material", "matrix"]
-            .map(|k| r.summary["scene"][format!("{k}_changes")].as_u64().unwrap())
+            .map(|k| r.summary()["scene"][format!("{k}_changes")].as_u64().unwrap())
     };
     // Front-end busy time over the run (ps); gpu.command, clear and swap cost nothing here.
     let front_busy = |r: &rendersim::systems::frame_pipeline::PipelineRun| r.clocks.front[0];
@@ -454,7 +454,7 @@ fn upload_time_is_bytes_over_bus_bandwidth_exactly() {
         run(&m, &s)
     };
     let up = with("4GB/s");
-    assert_eq!(up.summary["scene"]["upload_bytes"], 4_000_000);
+    assert_eq!(up.summary()["scene"]["upload_bytes"], 4_000_000);
     assert_eq!(cpu_work(&up).0, vec![10 * US + 1_000 * US; 3]);
     assert!((metric(&up, "metrics.analytic.cpu_ms") - metric(&none, "metrics.analytic.cpu_ms") - 1.0).abs() < 1e-12);
     // Half the bandwidth, twice the time; binary units are exact too (4 MiB at 4 GiB/s = 0.9765625 ms).

@@ -58,7 +58,7 @@ fn agp_fetch_alone_is_the_longer_of_vertex_work_and_bytes_over_the_bus() {
     assert!((gpu(&video) - 0.5).abs() < 1e-3, "{}", gpu(&video));
     assert!((gpu(&agp40) - gpu(&video)).abs() < 1e-9, "{}", gpu(&agp40));
     assert!((gpu(&agp80) - 0.8).abs() < 1e-3, "{}", gpu(&agp80));
-    assert_eq!(agp80.summary["scene"]["agp_fetch_bytes"], 800_000);
+    assert_eq!(agp80.summary()["scene"]["agp_fetch_bytes"], 800_000);
     // The closed-form geometry term is the longer one too.
     assert!((metric(&agp80, "metrics.analytic.geometry_ms") - 0.8).abs() < 1e-9);
     assert!((metric(&agp40, "metrics.analytic.geometry_ms") - 0.5).abs() < 1e-9);
@@ -138,7 +138,7 @@ fn a_shared_bus_under_system_tasks_is_deterministic_and_never_copies_faster() {
     );
     let a = run(&text, &[]);
     let b = run(&text, &[]);
-    assert_eq!(a.summary["metrics"], b.summary["metrics"]);
+    assert_eq!(a.summary()["metrics"], b.summary()["metrics"]);
     let copy = metric(&a, "metrics.copy_ms.min");
     assert!(copy >= 0.2 - 1e-9, "copy {copy}");
     assert!(

@@ -68,7 +68,7 @@ fn the_written_out_terrain_is_the_preset() {
     let group = run(&terrain_variant(SizeOrder::Random, 0.8), &SPLIT_ONE_FRAME);
     let path = "metrics.gpu_time_ms.mean";
     assert_eq!(metric(&preset, path), metric(&group, path));
-    assert_eq!(preset.summary["scene"], group.summary["scene"]);
+    assert_eq!(preset.summary()["scene"], group.summary()["scene"]);
 }
 
 #[test]

@@ -92,7 +92,7 @@ fn a_flip_in_the_blanking_interval_shows_whole() {
 #[test]
 fn vsync_leaves_no_tear_and_bad_blanking_names_the_key() {
     let r = run(FIXED, &[]);
-    assert!(r.summary["metrics"].get("tearing").is_none());
+    assert!(r.summary()["metrics"].get("tearing").is_none());
     assert!(r.records.iter().all(|f| f.tear_line.is_none()));
     for bad in ["1.0", "-0.1", "nan"] {
         let e = try_run(FIXED, &["display.vsync=false", &format!("display.blanking={bad}")]).unwrap_err();

@@ -181,7 +181,7 @@ fn draw_fidelity_follows_the_triangle_simulation_within_two_percent() {
                 .collect();
             let m = rendersim::config::prepare(src, &rendersim::config::Overrides::with_sets(&sets)).unwrap();
             let r = rendersim::systems::run_model(&m.source, &m.table, None).unwrap();
-            crate::common::num(r.summary(), "metrics.gpu_time_ms.mean")
+            crate::common::num(&r.summary(), "metrics.gpu_time_ms.mean")
         };
         let (t, d) = (gpu_ms("triangle"), gpu_ms("draw"));
         assert!((d - t).abs() / t < 0.02, "{name}: draw {d} ms vs triangle {t} ms");

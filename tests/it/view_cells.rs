@@ -96,7 +96,7 @@ fn without_wall(mut v: Value) -> Value {
 #[test]
 fn per_view_cell_estimates_match_the_closed_form() {
     let run = try_run_any(AHEAD, &[]).unwrap();
-    let s = run.summary();
+    let s = &run.summary();
     assert_eq!(num(s, "metrics.visible_objects.min"), 1.0, "a is always drawn, b never");
     assert_eq!(num(s, "metrics.visible_objects.max"), 1.0);
     let actual = column(&run, "ActualMs");
@@ -142,7 +142,7 @@ fn per_view_cell_estimation_bounds_pos_on_every_frame() {
     for (f, (p, v)) in pos.iter().zip(&pvc).enumerate() {
         assert!(v >= p, "frame {f}: pvc {v} below pos {p}");
     }
-    let s = run.summary();
+    let s = &run.summary();
     for k in [
         "mse_ms2",
         "mean_error_ms",
@@ -188,7 +188,7 @@ fn the_point_reading_of_pvc_lies_below_the_bound() {
     for (f, (b, p)) in b.iter().zip(&p).enumerate() {
         assert!(p <= &(b + 1e-9), "frame {f}: point {p} above bound {b}");
     }
-    let err = |r: &rendersim::systems::SystemRun| num(r.summary(), "metrics.estimation.pvc.mean_error_ms");
+    let err = |r: &rendersim::systems::SystemRun| num(&r.summary(), "metrics.estimation.pvc.mean_error_ms");
     assert!(err(&point) < err(&bound), "{} vs {}", err(&point), err(&bound));
     assert_eq!(
         column(&bound, "ActualMs"),
@@ -226,8 +226,8 @@ fn a_cpu_clock_without_overhead_or_jitter_reads_the_time_stamps() {
     let (p0, p1) = (column(&stamps, "EstPOSMs"), column(&slow, "EstPOSMs"));
     assert!(p0.iter().zip(&p1).all(|(a, b)| b >= a));
     assert!(
-        num(slow.summary(), "metrics.estimation.pos.mean_error_ms")
-            > num(stamps.summary(), "metrics.estimation.pos.mean_error_ms")
+        num(&slow.summary(), "metrics.estimation.pos.mean_error_ms")
+            > num(&stamps.summary(), "metrics.estimation.pos.mean_error_ms")
     );
 }
 
@@ -320,7 +320,7 @@ fn the_models_doc_states_the_four_section_7_3_figures_of_one_run() {
         "estimation.view_cells.pvc=\"point\"",
     ];
     let run = crate::common::run_shipped("models/walkthrough-city-geforce3.toml", &sets);
-    let s = run.summary();
+    let s = &run.summary();
     let e = |k: &str, m: &str| num(s, &format!("metrics.estimation.{k}.{m}"));
     let none = |k: &str| e(k, "underestimated_fraction") == 0.0;
     assert!(

@@ -60,7 +60,7 @@ struct Summary {
 /// A finished run.
 #[derive(Debug)]
 pub struct DevicePredictionsRun {
-    summary: Value,
+    summary: Summary,
     config: DevicePredictionsConfig,
     /// Every row predicted.
     pub predictions: DevicePredictions,
@@ -147,7 +147,6 @@ pub fn run_device_predictions(
         simulate_seconds: predictions.simulating_seconds,
         metrics,
     };
-    let summary = serde_json::to_value(&summary).map_err(|e| invalid("device", e.to_string()))?;
     Ok(DevicePredictionsRun {
         summary,
         config: cfg,
@@ -176,15 +175,11 @@ impl SystemModel for DevicePredictionsSystem {
 }
 
 impl Outcome for DevicePredictionsRun {
-    fn summary(&self) -> &Value {
-        &self.summary
+    fn summary(&self) -> Value {
+        crate::systems::summary::to_json(&self.summary)
     }
 
-    fn summary_mut(&mut self) -> &mut Value {
-        &mut self.summary
-    }
-
-    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
+    fn write_report(&self, _model: &str, w: &mut dyn Write) -> std::io::Result<()> {
         w.write_all(
             self.predictions
                 .markdown("the `device_predictions` system (`rendersim run`, `experiments/device-predictions.toml`)")

@@ -38,7 +38,6 @@ struct Summary<'a> {
 /// A finished run.
 #[derive(Debug)]
 pub struct ReplayRun {
-    summary: Value,
     config: ReplayConfig,
     /// The replay.
     pub replay: Replay,
@@ -76,17 +75,7 @@ impl SystemModel for ReplaySystem {
             })?;
             replay.summary.compare = Some(c);
         }
-        let s = &replay.summary;
-        let summary = Summary {
-            system: "replay",
-            seed: cfg.run.seed,
-            wall_seconds: s.wall_seconds,
-            simulate_seconds: s.simulate_seconds,
-            replay: s,
-        };
-        let summary = serde_json::to_value(&summary).map_err(|e| invalid("capture", e.to_string()))?;
         Ok(ReplayRun {
-            summary,
             config: cfg,
             replay,
             trace,
@@ -95,15 +84,20 @@ impl SystemModel for ReplaySystem {
 }
 
 impl Outcome for ReplayRun {
-    fn summary(&self) -> &Value {
-        &self.summary
+    /// The replay's typed summary under `replay`, with the run's seed and
+    /// times, as JSON.
+    fn summary(&self) -> Value {
+        let s = &self.replay.summary;
+        crate::systems::summary::to_json(&Summary {
+            system: "replay",
+            seed: self.config.run.seed,
+            wall_seconds: s.wall_seconds,
+            simulate_seconds: s.simulate_seconds,
+            replay: s,
+        })
     }
 
-    fn summary_mut(&mut self) -> &mut Value {
-        &mut self.summary
-    }
-
-    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
+    fn write_report(&self, _model: &str, w: &mut dyn Write) -> std::io::Result<()> {
         let mut text = Vec::new();
         crate::studies::replay::report::write_text(&self.replay.summary, &mut text)?;
         w.write_all(&text)

@@ -212,14 +212,14 @@ pub trait System: Sync {
 /// What a finished run of any system offers: its summary, its per-row
 /// table, its human report, its resolved model and its trace.
 pub trait Outcome: std::fmt::Debug + Send {
-    /// The summary as JSON (`summary.json`; experiments read it by dotted path).
-    fn summary(&self) -> &Value;
+    /// The summary as JSON (`summary.json`; experiments read it by dotted
+    /// path), made here from the run's typed summary: the run keeps the
+    /// typed one, and JSON is made only where it is written.
+    fn summary(&self) -> Value;
 
-    /// The summary, to add to (the CLI adds the model's name).
-    fn summary_mut(&mut self) -> &mut Value;
-
-    /// Writes the human-readable report (`rendersim run` without `--json`).
-    fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()>;
+    /// Writes the human-readable report (`rendersim run` without `--json`)
+    /// of the run of the model named `model`, from the typed summary.
+    fn write_report(&self, model: &str, w: &mut dyn Write) -> std::io::Result<()>;
 
     /// The per-row table's columns and rows: per frame, per input event
     /// (latency systems) or per screen region (PixelFlow).
@@ -243,25 +243,30 @@ pub trait Outcome: std::fmt::Debug + Send {
 }
 
 /// The [`Outcome`] methods every run type implements alike, for a run struct
-/// with `summary: Value` and `trace: Option<TraceWriter>` fields: used
-/// inside `impl Outcome for ...` in each system. The report is
-/// `super::report::write_report(&Value, w)`, or the function named in
-/// `outcome_basics!(report = PATH)`.
+/// with a typed summary field (`summary` unless named) and a
+/// `trace: Option<TraceWriter>` field: used inside `impl Outcome for ...` in
+/// each system. The report is `super::report::write_report(&summary, model,
+/// w)`, or the function named in `outcome_basics!(report = PATH)`; the JSON
+/// is [`summary::to_json`] of the typed summary, or the function named in
+/// `json = PATH`.
 macro_rules! outcome_basics {
     () => {
         outcome_basics!(report = super::report::write_report);
     };
     (report = $report:path) => {
-        fn summary(&self) -> &serde_json::Value {
-            &self.summary
+        outcome_basics!(
+            summary = summary,
+            report = $report,
+            json = crate::systems::summary::to_json
+        );
+    };
+    (summary = $field:ident, report = $report:path, json = $json:path) => {
+        fn summary(&self) -> serde_json::Value {
+            $json(&self.$field)
         }
 
-        fn summary_mut(&mut self) -> &mut serde_json::Value {
-            &mut self.summary
-        }
-
-        fn write_report(&self, w: &mut dyn std::io::Write) -> std::io::Result<()> {
-            $report(&self.summary, w)
+        fn write_report(&self, model: &str, w: &mut dyn std::io::Write) -> std::io::Result<()> {
+            $report(&self.$field, model, w)
         }
 
         fn take_trace(&mut self) -> Option<crate::output::trace::TraceWriter> {
@@ -452,20 +457,16 @@ fn system_of<'a>(
 }
 
 impl SystemRun {
-    /// The JSON summary.
-    pub fn summary(&self) -> &Value {
+    /// The summary as JSON (made from the run's typed summary each call:
+    /// the CLI adds the model's name and the provenance to it, then writes it).
+    pub fn summary(&self) -> Value {
         self.0.summary()
     }
 
-    /// Mutable summary (the CLI adds the model's name).
-    pub fn summary_mut(&mut self) -> &mut Value {
-        self.0.summary_mut()
-    }
-
-    /// Writes the human-readable report of the run (what `rendersim run`
-    /// prints without `--json`).
-    pub fn write_report(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        self.0.write_report(w)
+    /// Writes the human-readable report of the run of the model named
+    /// `model` (what `rendersim run` prints without `--json`).
+    pub fn write_report(&self, model: &str, w: &mut dyn Write) -> std::io::Result<()> {
+        self.0.write_report(model, w)
     }
 
     /// Writes the per-row table as CSV (per frame; per input event for

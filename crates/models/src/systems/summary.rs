@@ -72,6 +72,12 @@ impl Dist {
         }
     }
 
+    /// `[min, mean, p99, max]`, as a report's latency line shows them
+    /// ([`crate::output::text::latency_row`]).
+    pub fn row(&self) -> [Option<f64>; 4] {
+        [self.min, self.mean, self.p99, self.max]
+    }
+
     /// The statistics of the finite values among `values`.
     pub fn of_finite(values: &[f64]) -> Self {
         let v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
@@ -104,6 +110,16 @@ pub fn events_per_second(stats: &RunStats) -> f64 {
         stats.events as f64 / stats.wall_seconds
     } else {
         0.0
+    }
+}
+
+/// The name a unit enum value is written as in `summary.json` (its serde
+/// name: `Scheme::Warp` -> `warp`), for the human reports.
+pub fn name_of<T: Serialize>(value: &T) -> String {
+    match serde_json::to_value(value) {
+        Ok(Value::String(s)) => s,
+        Ok(v) => v.to_string(),
+        Err(_) => String::new(),
     }
 }
 

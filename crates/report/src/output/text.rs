@@ -15,44 +15,47 @@ pub fn fixed(x: f64, decimals: usize) -> String {
     }
 }
 
-/// A summary number, NaN when it is missing or `null`.
-fn number(v: &serde_json::Value) -> f64 {
-    v.as_f64().unwrap_or(f64::NAN)
+/// A summary statistic, NaN when it is missing (`None`: a statistic of an
+/// empty sample), which [`fixed`] writes as "n/a".
+pub fn number(v: Option<f64>) -> f64 {
+    v.unwrap_or(f64::NAN)
 }
 
 /// One latency line of a report: `  {head} min .. mean .. p99 .. max .. ms
-/// {bound} best .. worst ..`, from a distribution (`min`, `mean`, `p99`,
-/// `max`) and its bounds (`best`, `worst`) in a summary; the distribution's
-/// numbers take `width` columns.
+/// {bound} best .. worst ..`, from a distribution's `[min, mean, p99, max]`
+/// and its bounds `(best, worst)`; the distribution's numbers take `width`
+/// columns.
 pub fn latency_row(
     w: &mut dyn std::io::Write,
     head: &str,
     width: usize,
-    dist: &serde_json::Value,
-    bounds: &serde_json::Value,
+    dist: [Option<f64>; 4],
+    (best, worst): (Option<f64>, Option<f64>),
     bound: &str,
 ) -> std::io::Result<()> {
-    let d = |k: &str| fixed(number(&dist[k]), 1);
+    let d = |k: usize| fixed(number(dist[k]), 1);
     writeln!(
         w,
         "  {head} min {:>width$} mean {:>width$} p99 {:>width$} max {:>width$} ms   {bound} best {:>6} worst {:>6}",
-        d("min"),
-        d("mean"),
-        d("p99"),
-        d("max"),
-        fixed(number(&bounds["best"]), 1),
-        fixed(number(&bounds["worst"]), 1)
+        d(0),
+        d(1),
+        d(2),
+        d(3),
+        fixed(number(best), 1),
+        fixed(number(worst), 1)
     )
 }
 
 /// A latency report's last line: kernel events, wall and simulated time.
-pub fn events_line(w: &mut dyn std::io::Write, s: &serde_json::Value) -> std::io::Result<()> {
+pub fn events_line(
+    w: &mut dyn std::io::Write,
+    events: u64,
+    wall_seconds: f64,
+    simulated_seconds: f64,
+) -> std::io::Result<()> {
     writeln!(
         w,
-        "  {} events in {:.3} s wall, {:.3} s simulated",
-        s["events"]["total"],
-        number(&s["wall_seconds"]),
-        number(&s["simulated_seconds"])
+        "  {events} events in {wall_seconds:.3} s wall, {simulated_seconds:.3} s simulated"
     )
 }
 

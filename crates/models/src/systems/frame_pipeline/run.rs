@@ -3,8 +3,6 @@
 
 use std::path::Path;
 
-use serde_json::Value;
-
 use crate::engine::{Duration, Limits, RunStats, Scheduler, StopReason, Time, run};
 
 use super::config::FramePipelineConfig;
@@ -13,11 +11,10 @@ use super::records::{FrameRecord, GeneratedRecord};
 use super::workload::SceneStats;
 use crate::output::trace::TraceWriter;
 use crate::systems::error::SystemError;
-use crate::systems::summary::to_json;
 
 use super::analytic::AnalyticTerms;
 use super::plan::{PipelinePlan, PlannedWork};
-use super::summary::{PipelineSummary, positive_zeros, summarize};
+use super::summary::{PipelineSummary, summarize};
 /// Everything a run produced.
 #[derive(Debug)]
 pub struct PipelineRun {
@@ -33,11 +30,9 @@ pub struct PipelineRun {
     /// With frame generation, each rendered frame its present thread
     /// presented: (frame, from its GPU end to its present, the hold-back).
     pub hold_backs: Vec<(u64, Duration)>,
-    /// The summary, typed: what reports and studies read.
+    /// The summary, typed: what reports and studies read (`summary.json`
+    /// is made from it where it is written, [`crate::systems::Outcome::summary`]).
     pub results: PipelineSummary,
-    /// The summary as written (`summary.json`: [`PipelineRun::results`] as
-    /// JSON, with what the CLI adds).
-    pub summary: Value,
     /// The trace, when one was asked for: every event written, not yet
     /// closed ([`TraceWriter::finish`]).
     pub trace: Option<TraceWriter>,
@@ -162,8 +157,6 @@ fn finish(
     build_seconds: f64,
 ) -> Result<PipelineRun, SystemError> {
     let results = summarize(&model, &stats, analytic, scene_stats, build_seconds);
-    let mut summary = to_json(&results);
-    positive_zeros(&mut summary);
     let refresh = model.display.refresh();
     let end = stats.end_time;
     let a = &model.acct;
@@ -184,7 +177,6 @@ fn finish(
     Ok(PipelineRun {
         stats,
         results,
-        summary,
         trace,
         refresh,
         clocks,

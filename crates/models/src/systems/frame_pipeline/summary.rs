@@ -29,6 +29,14 @@ pub(super) fn positive_zeros(v: &mut Value) {
     }
 }
 
+/// The summary as written (`summary.json`): its JSON with every -0.0 made
+/// 0.0.
+pub(super) fn as_json(summary: &PipelineSummary) -> Value {
+    let mut v = crate::systems::summary::to_json(summary);
+    positive_zeros(&mut v);
+    v
+}
+
 pub(super) fn ms(ps: u64) -> f64 {
     ps as f64 / PS_PER_MS as f64
 }

@@ -35,6 +35,13 @@ impl PipelineRun {
         )
     }
 
+    /// The summary as written (`summary.json`, without what the CLI adds),
+    /// made from [`PipelineRun::results`]; reports and studies read the
+    /// typed one.
+    pub fn summary(&self) -> serde_json::Value {
+        super::summary::as_json(&self.results)
+    }
+
     /// The rows of its `frames.csv`: rendered frames and generated ones.
     pub fn table_rows(&self) -> usize {
         self.records.len() + self.generated.len()
@@ -50,7 +57,11 @@ impl PipelineRun {
 }
 
 impl Outcome for PipelineRun {
-    outcome_basics!();
+    outcome_basics!(
+        summary = results,
+        report = super::report::write_report,
+        json = super::summary::as_json
+    );
 
     fn table(&self) -> (Vec<String>, Vec<Vec<f64>>) {
         (

@@ -5,11 +5,10 @@ use std::io::Write;
 use std::collections::BTreeMap;
 
 use serde::Serialize;
-use serde_json::Value;
 
 use crate::engine::{Duration, Limits, RunStats, Scheduler, StopReason, Time, run};
 use crate::output::trace::TraceWriter;
-use crate::systems::summary::{Dist, EventCounts, events_per_second, mean_stages, to_json};
+use crate::systems::summary::{Dist, EventCounts, events_per_second, mean_stages};
 
 use super::analytic::{Analytic, Bounds, Terms, analytic};
 use super::config::MultiRateConfig;
@@ -32,8 +31,8 @@ pub struct MultiRateRun {
     pub events: Vec<EventRecord>,
     /// Closed forms.
     pub analytic: Analytic,
-    /// The JSON summary.
-    pub summary: Value,
+    /// The summary, typed (`summary.json` is made from it where it is written).
+    pub summary: MultiRateSummary,
     /// The trace, when one was asked for: written, not yet closed.
     pub trace: Option<TraceWriter>,
 }
@@ -353,7 +352,13 @@ pub struct MultiRateSummary {
     pub metrics: MultiRateMetrics,
 }
 
-fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &Analytic, stats: &RunStats) -> Value {
+fn summarize(
+    cfg: &MultiRateConfig,
+    m: &MultiRate,
+    events: &[EventRecord],
+    a: &Analytic,
+    stats: &RunStats,
+) -> MultiRateSummary {
     let latencies = |path: fn(&EventRecord) -> Option<&Vec<u64>>| -> Vec<f64> {
         events.iter().filter_map(|e| path(e).map(|g| total_ms(g))).collect()
     };
@@ -368,7 +373,7 @@ fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &A
     }
     let conventional = cfg.conventional.enabled;
     let t = &m.terms;
-    let summary = MultiRateSummary {
+    MultiRateSummary {
         system: "multi_rate",
         description: cfg.description.clone(),
         seed: cfg.run.seed,
@@ -430,8 +435,7 @@ fn summarize(cfg: &MultiRateConfig, m: &MultiRate, events: &[EventRecord], a: &A
             closed_form_caveats: a.caveats(t),
             migration: m.migration.as_ref().map(|x| x.counts()),
         },
-    };
-    to_json(&summary)
+    }
 }
 
 /// Writes the per-event table as CSV.

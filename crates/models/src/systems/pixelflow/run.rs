@@ -1,7 +1,6 @@
 //! Validating, running and summarizing a PixelFlow model.
 
 use serde::Serialize;
-use serde_json::Value;
 
 use crate::engine::{Duration, Limits, PS_PER_MS, RunStats, Scheduler, run};
 use crate::output::trace::TraceWriter;
@@ -11,7 +10,7 @@ use super::config::{Architecture, Fidelity, PixelFlowConfig, Placement, Size};
 use super::layout::{Layout, build};
 use super::model::{PixelFlow, RegionRecord, Span};
 use crate::systems::error::{SystemError, invalid as bad};
-use crate::systems::summary::{EventCounts, to_json};
+use crate::systems::summary::EventCounts;
 
 /// Everything a run produced.
 #[derive(Debug)]
@@ -26,8 +25,8 @@ pub struct PixelFlowRun {
     pub records: Vec<RegionRecord>,
     /// Region entries per region.
     pub region_entries: Vec<u64>,
-    /// The JSON summary.
-    pub summary: Value,
+    /// The summary, typed (`summary.json` is made from it where it is written).
+    pub summary: PixelFlowSummary,
     /// Timeline, when asked for.
     pub spans: Option<Vec<Span>>,
     /// The trace, when one was asked for: written, not yet closed.
@@ -574,7 +573,7 @@ fn summary(
     wall: f64,
     simulate: f64,
     frames: &[(f64, f64, f64)],
-) -> Value {
+) -> PixelFlowSummary {
     let events = match stats {
         Some(s) => EventCounts::of(s),
         None => EventCounts {
@@ -600,7 +599,7 @@ fn summary(
     };
     let lat: Vec<f64> = frames.iter().map(|f| f.2 - f.0).collect();
     let intervals: Vec<f64> = frames.windows(2).map(|w| w[1].2 - w[0].2).collect();
-    let summary = PixelFlowSummary {
+    PixelFlowSummary {
         system: "pixelflow",
         description: cfg.description.clone(),
         fidelity: cfg.fidelity,
@@ -647,8 +646,7 @@ fn summary(
             analytic_primitives_at_30ms: super::analytic::primitives_at(cfg, 30.0),
             analytic_primitives_at_40ms: super::analytic::primitives_at(cfg, 40.0),
         },
-    };
-    to_json(&summary)
+    }
 }
 
 /// Columns of the per-region table.

@@ -6,15 +6,14 @@ use std::path::Path;
 use std::time::Instant;
 
 use serde::Serialize;
-use serde_json::Value;
 
 use crate::components::swap_chain::PresentMode;
 use crate::engine::{Limits, RngStreams, RunStats, Scheduler, StopReason, Time, run};
 use crate::output::table::write_number_table;
-use crate::output::text::fixed;
+use crate::output::text::{fixed, number};
 use crate::output::trace::TraceWriter;
 use crate::systems::error::invalid;
-use crate::systems::summary::{Dist, EventCounts, to_json};
+use crate::systems::summary::{Dist, EventCounts};
 use crate::systems::{Outcome, SystemError, SystemModel, outcome_basics, resolved_toml};
 
 use super::config::PresentConfig;
@@ -36,8 +35,8 @@ impl SystemModel for PresentSystem {
 /// A finished run.
 #[derive(Debug)]
 pub struct PresentRun {
-    /// The summary (`summary.json`).
-    pub summary: Value,
+    /// The summary, typed (`summary.json` is made from it where it is written).
+    pub summary: PresentSummary,
     /// The model as run.
     pub config: PresentConfig,
     /// Every frame, in order.
@@ -224,7 +223,7 @@ pub struct PresentSummary {
     pub metrics: PresentMetrics,
 }
 
-fn summarize(cfg: &PresentConfig, done: &super::model::Finished, stats: &RunStats) -> Value {
+fn summarize(cfg: &PresentConfig, done: &super::model::Finished, stats: &RunStats) -> PresentSummary {
     let measured = &done.frames[(cfg.run.warmup_frames as usize).min(done.frames.len())..];
     let ms = |a: Time, b: Time| b.since(a).as_ms_f64();
     // The displayed frames, each with the time it reached the screen.
@@ -232,7 +231,7 @@ fn summarize(cfg: &PresentConfig, done: &super::model::Finished, stats: &RunStat
     let of_shown =
         |f: &dyn Fn(&FrameTimes, Time) -> f64| Dist::of(&shown.iter().map(|&(fr, t)| f(fr, t)).collect::<Vec<_>>());
     let end = stats.end_time.0 as f64;
-    let summary = PresentSummary {
+    PresentSummary {
         system: "present",
         description: cfg.description.clone(),
         seed: cfg.run.seed,
@@ -259,8 +258,7 @@ fn summarize(cfg: &PresentConfig, done: &super::model::Finished, stats: &RunStat
             repeated_refreshes: done.repeated,
             renderer_wait_share: if end > 0.0 { done.waited.0 as f64 / end } else { 0.0 },
         },
-    };
-    to_json(&summary)
+    }
 }
 
 /// Columns of the per-frame table.
@@ -285,43 +283,36 @@ pub fn frame_rows(frames: &[FrameTimes]) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// Writes the human-readable report of the run whose summary is `s`.
-pub fn write_report(s: &Value, w: &mut dyn Write) -> std::io::Result<()> {
-    let m = &s["metrics"];
-    let n = |v: &Value| v.as_f64().unwrap_or(f64::NAN);
-    writeln!(
-        w,
-        "{} (present), {} frames, seed {}",
-        s["model"].as_str().unwrap_or(""),
-        m["frames"],
-        s["seed"]
-    )?;
+/// Writes the human-readable report of the run of the model named `model`
+/// whose summary is `s`.
+pub fn write_report(s: &PresentSummary, model: &str, w: &mut dyn Write) -> std::io::Result<()> {
+    let m = &s.metrics;
+    writeln!(w, "{model} (present), {} frames, seed {}", m.frames, s.seed)?;
     writeln!(
         w,
         "  displayed {} dropped {}   repeated refreshes {} of {}",
-        m["displayed_frames"], m["dropped_frames"], m["repeated_refreshes"], m["vblanks"]
+        m.displayed_frames, m.dropped_frames, m.repeated_refreshes, m.vblanks
     )?;
-    for (label, key) in [
-        ("render time     ", "render_ms"),
-        ("display interval", "display_interval_ms"),
-        ("latency         ", "latency_ms"),
+    for (label, d) in [
+        ("render time     ", &m.render_ms),
+        ("display interval", &m.display_interval_ms),
+        ("latency         ", &m.latency_ms),
     ] {
-        let d = &m[key];
         writeln!(
             w,
             "  {label} mean {:>8} p99 {:>8} max {:>8} ms",
-            fixed(n(&d["mean"]), 3),
-            fixed(n(&d["p99"]), 3),
-            fixed(n(&d["max"]), 3)
+            fixed(number(d.mean), 3),
+            fixed(number(d.p99), 3),
+            fixed(number(d.max), 3)
         )?;
     }
     writeln!(
         w,
         "  closed form mean interval {} ms (paper 004 §4.2); renderer waited {}% of the run",
-        fixed(n(&m["analytic_interval_ms"]), 3),
-        fixed(100.0 * n(&m["renderer_wait_share"]), 1)
+        fixed(m.analytic_interval_ms, 3),
+        fixed(100.0 * m.renderer_wait_share, 1)
     )?;
-    crate::output::text::events_line(w, s)
+    crate::output::text::events_line(w, s.events.total, s.wall_seconds, s.simulated_seconds)
 }
 
 impl Outcome for PresentRun {

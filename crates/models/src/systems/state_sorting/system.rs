@@ -9,7 +9,6 @@ use std::path::Path;
 use std::time::Instant;
 
 use serde::Serialize;
-use serde_json::Value;
 
 use crate::components::sorting_buffer::{
     MAX_OFFLINE_LEN, SortBufferError, StateId, Strategy, check_buffer, distinct_states, input_runs, lower_bound,
@@ -26,47 +25,58 @@ use super::config::StateSortingConfig;
 pub struct StateSortingSystem;
 
 /// The summary's numbers.
-#[derive(Debug, Serialize)]
-struct Metrics {
-    sequence_length: usize,
-    distinct_states: usize,
+#[derive(Debug, Clone, Serialize)]
+pub struct StateSortingMetrics {
+    /// Elements in the sequence.
+    pub sequence_length: usize,
+    /// Distinct states among them.
+    pub distinct_states: usize,
     /// State changes without a buffer (runs of the input).
-    input_runs: u64,
-    buffer: usize,
+    pub input_runs: u64,
+    /// The sorting buffer's slots.
+    pub buffer: usize,
     /// A lower bound of the offline optimum.
-    lower_bound: u64,
+    pub lower_bound: u64,
     /// The exact offline optimum (sequences of at most `MAX_OFFLINE_LEN`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    offline_optimum: Option<u64>,
+    pub offline_optimum: Option<u64>,
     /// State changes per strategy.
-    state_changes: BTreeMap<&'static str, u64>,
+    pub state_changes: BTreeMap<&'static str, u64>,
     /// State changes over the lower bound, per strategy.
-    over_bound: BTreeMap<&'static str, f64>,
+    pub over_bound: BTreeMap<&'static str, f64>,
     /// State changes over the changes without a buffer, per strategy.
-    over_input: BTreeMap<&'static str, f64>,
+    pub over_input: BTreeMap<&'static str, f64>,
     /// Overflows (the strategy's choices), per strategy.
-    overflows: BTreeMap<&'static str, u64>,
+    pub overflows: BTreeMap<&'static str, u64>,
     /// State changes over the fewest any of the strategies run sent, per
     /// strategy (1 for the best).
-    over_best: BTreeMap<&'static str, f64>,
+    pub over_best: BTreeMap<&'static str, f64>,
 }
 
-/// The summary.
-#[derive(Debug, Serialize)]
-struct Summary {
-    system: &'static str,
-    description: String,
-    sequence: String,
-    seed: u64,
-    wall_seconds: f64,
-    simulate_seconds: f64,
-    metrics: Metrics,
+/// The summary of a state-sorting run (`summary.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct StateSortingSummary {
+    /// `"state_sorting"`.
+    pub system: &'static str,
+    /// The model's description.
+    pub description: String,
+    /// The sequence spec.
+    pub sequence: String,
+    /// Master seed.
+    pub seed: u64,
+    /// Wall time of the run.
+    pub wall_seconds: f64,
+    /// Wall time of the strategies' runs.
+    pub simulate_seconds: f64,
+    /// The results.
+    pub metrics: StateSortingMetrics,
 }
 
 /// A finished run.
 #[derive(Debug)]
 pub struct StateSortingRun {
-    summary: Value,
+    /// The summary, typed (`summary.json` is made from it where it is written).
+    pub summary: StateSortingSummary,
     config: StateSortingConfig,
     /// (strategy, state changes, overflows), in the model's order.
     rows: Vec<(Strategy, u64, u64)>,
@@ -126,7 +136,7 @@ pub fn run_state_sorting(cfg: StateSortingConfig, base_dir: &Path) -> Result<Sta
     let seq = resolve_sequence(&cfg.sequence, base_dir).map_err(|e| invalid("sequence", e.to_string()))?;
     let sim_start = Instant::now();
     let mut rows = Vec::new();
-    let mut metrics = Metrics {
+    let mut metrics = StateSortingMetrics {
         sequence_length: seq.len(),
         distinct_states: distinct_states(&seq),
         input_runs: input_runs(&seq),
@@ -168,7 +178,7 @@ pub fn run_state_sorting(cfg: StateSortingConfig, base_dir: &Path) -> Result<Sta
     }
     let simulate_seconds = sim_start.elapsed().as_secs_f64();
     let lower = metrics.lower_bound;
-    let summary = Summary {
+    let summary = StateSortingSummary {
         system: "state_sorting",
         description: cfg.description.clone(),
         sequence: cfg.sequence.clone(),
@@ -177,7 +187,6 @@ pub fn run_state_sorting(cfg: StateSortingConfig, base_dir: &Path) -> Result<Sta
         simulate_seconds,
         metrics,
     };
-    let summary = serde_json::to_value(&summary).map_err(|e| invalid("sequence", e.to_string()))?;
     Ok(StateSortingRun {
         summary,
         config: cfg,

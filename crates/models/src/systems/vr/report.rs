@@ -1,32 +1,35 @@
 //! The human-readable report of a VR-pipeline run (`rendersim run`), from
-//! its JSON summary.
+//! its typed summary.
 
 use std::io::{self, Write};
 
-use serde_json::Value;
-
 use crate::output::text::{events_line, latency_row};
+use crate::systems::summary::name_of;
 
-/// Writes the report of the run whose summary is `s`.
-pub fn write_report(s: &Value, w: &mut dyn Write) -> io::Result<()> {
-    let m = &s["metrics"];
+use super::run::VrSummary;
+
+/// Writes the report of the run of the model named `model` whose summary is `s`.
+pub fn write_report(s: &VrSummary, model: &str, w: &mut dyn Write) -> io::Result<()> {
+    let m = &s.metrics;
     writeln!(
         w,
-        "{} (vr, {} scheme), {} motion events, seed {}",
-        s["model"].as_str().unwrap_or(""),
-        s["scheme"].as_str().unwrap_or(""),
-        s["input_events"],
-        s["seed"]
+        "{model} (vr, {} scheme), {} motion events, seed {}",
+        name_of(&s.scheme),
+        s.input_events,
+        s.seed
     )?;
-    for kind in ["head", "object"] {
+    for (kind, dist, bounds) in [
+        ("head", &m.motion_to_photon_ms.head, &m.analytic_latency_ms.head),
+        ("object", &m.motion_to_photon_ms.object, &m.analytic_latency_ms.object),
+    ] {
         latency_row(
             w,
             &format!("{kind:<7} motion-to-photon"),
             6,
-            &m["motion_to_photon_ms"][kind],
-            &m["analytic_latency_ms"][kind],
+            dist.row(),
+            (Some(bounds.best), Some(bounds.worst)),
             "closed form",
         )?;
     }
-    events_line(w, s)
+    events_line(w, s.events.total, s.wall_seconds, s.simulated_seconds)
 }

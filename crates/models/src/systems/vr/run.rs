@@ -7,11 +7,10 @@ use std::io::Write;
 use std::collections::BTreeMap;
 
 use serde::Serialize;
-use serde_json::Value;
 
 use crate::engine::{Duration, Limits, RunStats, Scheduler, StopReason, run};
 use crate::output::trace::TraceWriter;
-use crate::systems::summary::{Dist, EventCounts, mean_stages, to_json};
+use crate::systems::summary::{Dist, EventCounts, mean_stages};
 
 use super::analytic::{Analytic, Bounds, analytic};
 use super::config::{Scheme, VrConfig};
@@ -32,8 +31,8 @@ pub struct VrRun {
     pub motions: Vec<MotionRecord>,
     /// Closed forms.
     pub analytic: Analytic,
-    /// JSON summary.
-    pub summary: Value,
+    /// The summary, typed (`summary.json` is made from it where it is written).
+    pub summary: VrSummary,
     /// The trace, when one was asked for: written, not yet closed.
     pub trace: Option<TraceWriter>,
 }
@@ -221,7 +220,7 @@ pub struct VrSummary {
     pub metrics: VrMetrics,
 }
 
-fn summarize(cfg: &VrConfig, m: &Vr, motions: &[MotionRecord], a: &Analytic, stats: &RunStats) -> Value {
+fn summarize(cfg: &VrConfig, m: &Vr, motions: &[MotionRecord], a: &Analytic, stats: &RunStats) -> VrSummary {
     let head: Vec<f64> = motions.iter().filter_map(|r| r.head.as_deref().map(total_ms)).collect();
     let object: Vec<f64> = motions
         .iter()
@@ -236,7 +235,7 @@ fn summarize(cfg: &VrConfig, m: &Vr, motions: &[MotionRecord], a: &Analytic, sta
         .iter()
         .filter_map(|r| r.app_age.map(|v| v as f64 / 1e9))
         .collect();
-    let summary = VrSummary {
+    VrSummary {
         system: "vr",
         scheme: cfg.scheme,
         description: cfg.description.clone(),
@@ -266,8 +265,7 @@ fn summarize(cfg: &VrConfig, m: &Vr, motions: &[MotionRecord], a: &Analytic, sta
             application_frames: warp.then_some(m.apps),
             simulation_steps: warp.then_some(m.sims),
         },
-    };
-    to_json(&summary)
+    }
 }
 
 /// Columns of the per-motion table.

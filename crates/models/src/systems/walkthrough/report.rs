@@ -1,132 +1,134 @@
 //! The human-readable report of a walkthrough (`rendersim run`), from its
-//! summary.
+//! typed summary.
 
 use std::io::{self, Write};
 
-use serde_json::Value;
+use crate::output::text::{fixed, number};
+use crate::systems::summary::name_of;
 
-use crate::output::text::fixed;
+use super::summary::WalkthroughSummary;
 
-/// Writes the report of the run whose summary is `s`.
-pub fn write_report(s: &Value, w: &mut dyn Write) -> io::Result<()> {
-    let f = |v: &Value| v.as_f64().unwrap_or(f64::NAN);
-    let m = &s["metrics"];
-    let sc = &s["scene"];
+/// Writes the report of the run of the model named `model` whose summary is `s`.
+pub fn write_report(s: &WalkthroughSummary, model: &str, w: &mut dyn Write) -> io::Result<()> {
+    let m = &s.metrics;
+    let sc = &s.scene;
     writeln!(
         w,
-        "{} (walkthrough, {}), {} frames along a {} path of {} m, seed {}",
-        s["model"].as_str().unwrap_or(""),
-        s["fidelity"].as_str().unwrap_or(""),
-        s["frames"],
-        s["camera"]["path"].as_str().unwrap_or(""),
-        fixed(f(&s["camera"]["length_m"]), 1),
-        s["seed"]
+        "{model} (walkthrough, {}), {} frames along a {} path of {} m, seed {}",
+        name_of(&s.fidelity),
+        s.frames,
+        s.camera.path,
+        fixed(s.camera.length_m, 1),
+        s.seed
     )?;
     writeln!(
         w,
         "scene: {} ({} objects, {} triangles, {} transformed vertices/triangle, {} view cells visited)",
-        s["preset"].as_str().unwrap_or("listed objects"),
-        sc["objects"],
-        sc["triangles"],
-        fixed(f(&sc["transformed_per_triangle"]), 2),
-        s["camera"]["view_cells_visited"]
+        s.preset.as_deref().unwrap_or("listed objects"),
+        sc.objects,
+        sc.triangles,
+        fixed(sc.transformed_per_triangle, 2),
+        s.camera.view_cells_visited
     )?;
     writeln!(
         w,
         "frame time: mean {} ms, p99 {} ms, max {} ms; budget {} ms, {} frames over budget; {} objects drawn per frame on average",
-        fixed(f(&m["frame_time_ms"]["mean"]), 3),
-        fixed(f(&m["frame_time_ms"]["p99"]), 3),
-        fixed(f(&m["frame_time_ms"]["max"]), 3),
-        fixed(f(&m["budget_ms"]), 3),
-        m["frames_over_budget"],
-        fixed(f(&m["visible_objects"]["mean"]), 1)
+        fixed(number(m.frame_time_ms.mean), 3),
+        fixed(number(m.frame_time_ms.p99), 3),
+        fixed(number(m.frame_time_ms.max), 3),
+        fixed(m.budget_ms, 3),
+        m.frames_over_budget,
+        fixed(number(m.visible_objects.mean), 1)
     )?;
-    let e = &m["estimation"];
+    write_estimation(s, w)?;
+    let l = &m.lod;
+    writeln!(
+        w,
+        "lod: policy {} (target {} ms); {} frame skips ({} per minute of {} s displayed); benefit {} per frame ({} of all finest); {} level switches per second; mean level {}, {} dropped per frame",
+        l.policy,
+        fixed(l.target_ms, 3),
+        m.frame_skips,
+        fixed(m.frame_skips_per_minute, 2),
+        fixed(m.displayed_seconds, 2),
+        fixed(m.benefit_mean, 0),
+        fixed(m.benefit_fraction, 3),
+        fixed(m.lod_switches_per_second, 1),
+        fixed(l.mean_level, 2),
+        fixed(l.dropped_per_frame, 2)
+    )?;
+    if let Some(b) = &l.branch {
+        writeln!(
+            w,
+            "  conditional branch: {} tokens per frame, {} objects switched in {} frames ({} prefix runs)",
+            fixed(b.tokens_per_frame, 2),
+            b.switched_objects,
+            b.frames_with_switch,
+            b.prefix_runs
+        )?;
+    }
+    for n in &l.notes {
+        writeln!(w, "  note: {n}")?;
+    }
+    writeln!(
+        w,
+        "{} events in {} frame-pipeline runs, {} s wall ({} s preprocess, {} s frames)",
+        s.events.total,
+        s.pipeline_runs,
+        fixed(s.wall_seconds, 3),
+        fixed(s.build_seconds, 3),
+        fixed(s.simulate_seconds, 3)
+    )
+}
+
+/// The estimators' table, the view-cell preprocess and the clock it was
+/// timed with.
+fn write_estimation(s: &WalkthroughSummary, w: &mut dyn Write) -> io::Result<()> {
+    let e = &s.metrics.estimation;
     writeln!(
         w,
         "estimation (empty frame {} ms, {} fit samples):",
-        fixed(f(&e["empty_frame_ms"]), 3),
-        e["fit_samples"]
+        fixed(e.empty_frame_ms, 3),
+        e.fit_samples
     )?;
     writeln!(
         w,
         "  estimator   mse (ms^2)   mean error (ms)   underestimated   cost (us/frame)"
     )?;
-    for name in super::estimators::ESTIMATORS {
-        let x = &e[name];
-        if x.is_null() {
+    let scores = [&e.h1, &e.h2, &e.h3, &e.h4, &e.pos, &e.vcs, &e.pvc];
+    for (name, x) in super::estimators::ESTIMATORS.iter().zip(scores) {
+        let Some(x) = x else {
             continue;
-        }
+        };
         writeln!(
             w,
             "  {name:<9} {:>12} {:>17} {:>16} {:>17}",
-            fixed(f(&x["mse_ms2"]), 4),
-            fixed(f(&x["mean_error_ms"]), 4),
-            fixed(f(&x["underestimated_fraction"]), 3),
-            fixed(f(&x["cost_us_per_frame"]), 2)
+            fixed(number(x.mse_ms2), 4),
+            fixed(number(x.mean_error_ms), 4),
+            fixed(number(x.underestimated_fraction), 3),
+            fixed(x.cost_us_per_frame, 2)
         )?;
     }
-    let v = &e["view_cells"];
-    if !v.is_null() {
+    if let Some(v) = &e.view_cells {
         writeln!(
             w,
             "view cells: {} of {} cells built (those the path visits), {} directions; vcs {} sample views ({} s), pvc {} object bounds ({} s)",
-            v["cells"],
-            v["cells_in_grid"],
-            v["directions"],
-            v["vcs_renders"],
-            fixed(f(&v["vcs_preprocess_seconds"]), 3),
-            v["pvc_bounds"],
-            fixed(f(&v["pvc_preprocess_seconds"]), 3)
+            v.cells,
+            v.cells_in_grid,
+            v.directions,
+            v.vcs_renders,
+            fixed(v.vcs_preprocess_seconds, 3),
+            v.pvc_bounds,
+            fixed(v.pvc_preprocess_seconds, 3)
         )?;
     }
-    let t = &e["timing"];
-    if !t.is_null() {
+    if let Some(t) = &e.timing {
         writeln!(
             w,
             "preprocess timed with a CPU clock around a finish: overhead {} ms, jitter {} ms, {} readings",
-            fixed(f(&t["overhead_ms"]), 4),
-            fixed(f(&t["noise_ms"]), 4),
-            t["readings"]
+            fixed(t.overhead_ms, 4),
+            fixed(t.noise_ms, 4),
+            t.readings
         )?;
     }
-    let l = &m["lod"];
-    writeln!(
-        w,
-        "lod: policy {} (target {} ms); {} frame skips ({} per minute of {} s displayed); benefit {} per frame ({} of all finest); {} level switches per second; mean level {}, {} dropped per frame",
-        l["policy"].as_str().unwrap_or(""),
-        fixed(f(&l["target_ms"]), 3),
-        m["frame_skips"],
-        fixed(f(&m["frame_skips_per_minute"]), 2),
-        fixed(f(&m["displayed_seconds"]), 2),
-        fixed(f(&m["benefit_mean"]), 0),
-        fixed(f(&m["benefit_fraction"]), 3),
-        fixed(f(&m["lod_switches_per_second"]), 1),
-        fixed(f(&l["mean_level"]), 2),
-        fixed(f(&l["dropped_per_frame"]), 2)
-    )?;
-    if let Some(b) = l.get("branch") {
-        writeln!(
-            w,
-            "  conditional branch: {} tokens per frame, {} objects switched in {} frames ({} prefix runs)",
-            fixed(f(&b["tokens_per_frame"]), 2),
-            b["switched_objects"],
-            b["frames_with_switch"],
-            b["prefix_runs"]
-        )?;
-    }
-    if let Some(notes) = l["notes"].as_array() {
-        for n in notes {
-            writeln!(w, "  note: {}", n.as_str().unwrap_or(""))?;
-        }
-    }
-    writeln!(
-        w,
-        "{} events in {} frame-pipeline runs, {} s wall ({} s preprocess, {} s frames)",
-        s["events"]["total"],
-        s["pipeline_runs"],
-        fixed(f(&s["wall_seconds"]), 3),
-        fixed(f(&s["build_seconds"]), 3),
-        fixed(f(&s["simulate_seconds"]), 3)
-    )
+    Ok(())
 }

@@ -284,7 +284,7 @@ mod tests {
             let runs = Runs::of(&cfg, &scene, cfg.run.frames, &wants, exact.model(), actual.model());
             let floor: f64 = runs.events_floor().0.iter().map(|p| p.2).sum();
             let run = run_walkthrough(cfg).unwrap();
-            let events = run.summary["events"]["total"].as_f64().unwrap();
+            let events = run.summary.events.total as f64;
             assert!(
                 floor <= events,
                 "{sets:?}: floor {floor} above the {events} events taken"

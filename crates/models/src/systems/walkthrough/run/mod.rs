@@ -16,12 +16,10 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use serde_json::Value;
-
 use crate::engine::{PS_PER_MS, StreamRng};
 use crate::output::trace::TraceWriter;
 use crate::systems::error::SystemError;
-use crate::systems::summary::{EventCounts, to_json};
+use crate::systems::summary::EventCounts;
 
 use super::branch::BranchStats;
 use super::camera::{self, Pose};
@@ -51,8 +49,8 @@ pub use super::summary::{
 pub struct WalkthroughRun {
     /// The model as run.
     pub config: WalkthroughConfig,
-    /// The summary.
-    pub summary: Value,
+    /// The summary, typed (`summary.json` is made from it where it is written).
+    pub summary: WalkthroughSummary,
     /// Per-frame table columns.
     pub columns: Vec<String>,
     /// Per-frame rows.
@@ -169,7 +167,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
     let columns = columns(&wants, max_levels);
     Ok(WalkthroughRun {
         config: cfg,
-        summary: to_json(&summary),
+        summary,
         columns,
         rows,
         trace: None,
