@@ -1,5 +1,5 @@
 //! The walkthrough's model file: the frame pipeline's hardware sections
-//! (`[cpu]`, `[bus]`, `[command_fifo]`, `[gpu]`, `[display]`, `[noise]`,
+//! (`[cpu]`, `[bus]`, `[command_fifo]`, `[gpu]`, `[display]`, `[noise]`, `[variation]`,
 //! the same structs and keys), plus the scene, the camera path, the
 //! estimators and the level-of-detail policy (paper 000 §5-7). Lengths are
 //! metres, angles degrees, speeds metres per second.
@@ -10,7 +10,7 @@ use crate::config::Bytes;
 use crate::engine::Duration;
 use crate::scene::config::DepthOrder;
 use crate::systems::frame_pipeline::config::{
-    BusConfig, CommandFifoConfig, CpuConfig, DisplayConfig, Fidelity, GpuConfig, NoiseConfig,
+    BusConfig, CommandFifoConfig, CpuConfig, DisplayConfig, Fidelity, GpuConfig, NoiseConfig, VariationConfig,
 };
 
 use super::timing::TimingMode;
@@ -49,6 +49,14 @@ pub struct WalkthroughConfig {
     /// System tasks (frame pipeline keys).
     #[serde(default)]
     pub noise: NoiseConfig,
+    /// Per-frame variation of the CPU's and the GPU's work (frame pipeline
+    /// keys, `[variation]`): the frames' own spread beside the system tasks
+    /// (paper 000 §4.2, Figure 3). Every render takes it, the walk's
+    /// frames and the preprocess's (whose fits then carry its mean, as
+    /// measured fits do); system tasks stay out of the preprocess. Off
+    /// unless given.
+    #[serde(default, skip_serializing_if = "VariationConfig::is_off")]
+    pub variation: VariationConfig,
     /// The scene.
     #[serde(default)]
     pub scene: SceneConfig,

@@ -69,7 +69,8 @@ pub struct Renderer {
 
 impl Renderer {
     /// A renderer for `scene` on the model's hardware; `noise = false` turns
-    /// system tasks off (the preprocess's exact timings).
+    /// system tasks off (the preprocess's timings). The per-frame variation
+    /// (`[variation]`) is in every render.
     pub fn new(cfg: &WalkthroughConfig, scene: &Scene, noise: bool) -> Result<Renderer, SystemError> {
         let mut noise_cfg = cfg.noise.clone();
         if !noise {
@@ -93,7 +94,7 @@ impl Renderer {
             gpu: cfg.gpu.clone(),
             display: cfg.display.clone(),
             noise: noise_cfg,
-            variation: Default::default(),
+            variation: cfg.variation.clone(),
             pacing: Default::default(),
             frame_generation: Default::default(),
             workload: WorkloadConfig::Scene(SceneWorkload {
