@@ -460,17 +460,9 @@ fn bookkeeping_removes_the_release_artifact_and_over_prediction_the_selection_ar
 fn records_past_run_max_memory_end_the_run_with_an_error_naming_the_key() {
     use rendersim::engine::{Limits, Scheduler, run};
     use rendersim::systems::SystemError;
-    use rendersim::systems::multi_rate::analytic::Terms;
     use rendersim::systems::multi_rate::{MultiRate, MultiRateConfig};
     let cfg: MultiRateConfig = toml::from_str(CLUSTER).unwrap();
-    let mut m = MultiRate::new(
-        Terms::of(&cfg),
-        cfg.run.events,
-        cfg.run.warmup,
-        cfg.input.mean_interval,
-        true,
-        1,
-    );
+    let mut m = MultiRate::new(&rendersim::systems::checked::Checked::new(cfg).unwrap());
     // The input records grow with the input events; 4 KiB is too little for
     // the model's 5000 (the run itself refuses this up front; the model
     // checks as it goes too).

@@ -207,7 +207,7 @@ fn records_past_run_max_memory_end_the_run_with_an_error_naming_the_key() {
     use rendersim::systems::vr::{Vr, VrConfig};
     for text in [NAIVE, WARP] {
         let cfg: VrConfig = toml::from_str(text).unwrap();
-        let mut m = Vr::new(cfg);
+        let mut m = Vr::new(rendersim::systems::checked::Checked::new(cfg).unwrap());
         m.max_memory = 4096;
         let mut s = Scheduler::new();
         m.start(&mut s).unwrap();

@@ -3,6 +3,7 @@
 //! `frame_pipeline`); [`run_model`] is the one entry point the CLI and the
 //! experiment runner use.
 
+pub mod checked;
 pub mod error;
 pub mod frame_pipeline;
 pub mod multi_rate;

@@ -19,11 +19,13 @@
 use rand::Rng;
 
 use crate::engine::{Control, Duration, EventKind, Model, RngStreams, Scheduler, StreamRng, Time};
+use crate::systems::checked::Checked;
 use crate::systems::error::SystemError;
 
 use crate::output::trace::TraceWriter;
 
 use super::analytic::Terms;
+use super::config::MultiRateConfig;
 use super::latency::Follower;
 use super::migration::Artifacts;
 
@@ -162,15 +164,12 @@ pub struct MultiRate {
 }
 
 impl MultiRate {
-    /// A model ready to start.
-    pub fn new(
-        terms: Terms,
-        events: u64,
-        warmup: Duration,
-        mean_interval: Duration,
-        conventional: bool,
-        seed: u64,
-    ) -> Self {
+    /// A model ready to start, from a checked config (its terms, input
+    /// events, warm-up, arrival rate, conventional path and seed).
+    pub fn new(cfg: &Checked<MultiRateConfig>) -> Self {
+        let terms = Terms::of(cfg);
+        let (events, warmup) = (cfg.run.events, cfg.run.warmup);
+        let (mean_interval, conventional, seed) = (cfg.input.mean_interval, cfg.conventional.enabled, cfg.run.seed);
         let rng = RngStreams::new(seed);
         let phase = |name: &str, frame: Duration| {
             let mut r = rng.stream(name);

@@ -15,6 +15,7 @@ use super::config::MultiRateConfig;
 use super::latency::{CONV_STAGES, EventRecord, FAST_STAGES, SLOW_STAGES, event_rows, total_ms};
 use super::migration::ArtifactCounts;
 use super::model::MultiRate;
+use crate::systems::checked::{Check, Checked};
 use crate::systems::error::{SystemError, invalid as bad};
 
 /// Everything a run produced.
@@ -37,7 +38,13 @@ pub struct MultiRateRun {
     pub trace: Option<TraceWriter>,
 }
 
-/// Checks values serde cannot.
+impl Check for MultiRateConfig {
+    fn check(&self) -> Result<(), SystemError> {
+        validate(self)
+    }
+}
+
+/// Checks values serde cannot ([`Checked::new`] runs it).
 pub fn validate(cfg: &MultiRateConfig) -> Result<(), SystemError> {
     let [w, h] = cfg.resolution;
     if w == 0 || h == 0 || w > 65536 || h > 65536 {
@@ -167,18 +174,10 @@ pub fn estimate_memory(cfg: &MultiRateConfig) -> (u64, String) {
 /// the link, input events as instants on the master's track) and handed
 /// back in [`MultiRateRun::trace`], to be closed by the caller.
 pub fn run_multi_rate(cfg: MultiRateConfig, trace: Option<TraceWriter>) -> Result<MultiRateRun, SystemError> {
-    validate(&cfg)?;
+    let cfg = Checked::new(cfg)?;
     let max_memory = cfg.run.memory_budget(estimate_memory(&cfg))?;
-    let terms = Terms::of(&cfg);
-    let a = analytic(&terms);
-    let mut model = MultiRate::new(
-        terms,
-        cfg.run.events,
-        cfg.run.warmup,
-        cfg.input.mean_interval,
-        cfg.conventional.enabled,
-        cfg.run.seed,
-    );
+    let a = analytic(&Terms::of(&cfg));
+    let mut model = MultiRate::new(&cfg);
     model.max_memory = max_memory;
     model.trace = trace;
     if !cfg.migration.script.is_empty() {
@@ -207,7 +206,7 @@ pub fn run_multi_rate(cfg: MultiRateConfig, trace: Option<TraceWriter>) -> Resul
     let summary = summarize(&cfg, &model, &events, &a, &stats);
     let trace = model.trace.take();
     Ok(MultiRateRun {
-        config: cfg,
+        config: cfg.into_inner(),
         stats,
         model,
         events,

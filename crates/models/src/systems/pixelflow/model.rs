@@ -25,6 +25,7 @@
 use std::collections::VecDeque;
 
 use crate::engine::{Control, Duration, EventKind, Model, Scheduler, Time, TimeError};
+use crate::systems::checked::Checked;
 use crate::systems::error::SystemError;
 
 use super::config::{Architecture, PixelFlowConfig};
@@ -216,7 +217,8 @@ fn mul(d: Duration, k: u64, what: &str) -> Result<Duration, SystemError> {
 
 impl PixelFlow {
     /// A machine about to start the frame.
-    pub fn new(cfg: PixelFlowConfig, layout: Layout, trace: bool) -> Self {
+    pub fn new(cfg: Checked<PixelFlowConfig>, layout: Layout, trace: bool) -> Self {
+        let cfg = cfg.into_inner();
         let nodes = layout.nodes;
         let regions = layout.regions;
         let shaders = cfg.shaders().max(1) as usize;

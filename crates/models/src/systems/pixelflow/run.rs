@@ -9,6 +9,7 @@ use super::analytic::{Analytic, closed_form};
 use super::config::{Architecture, Fidelity, PixelFlowConfig, Placement, Size};
 use super::layout::{Layout, build};
 use super::model::{PixelFlow, RegionRecord, Span};
+use crate::systems::checked::{Check, Checked};
 use crate::systems::error::{SystemError, invalid as bad};
 use crate::systems::summary::EventCounts;
 
@@ -43,6 +44,12 @@ fn check_size(key: &str, s: &Size) -> Result<(), SystemError> {
         }
     }
     Ok(())
+}
+
+impl Check for PixelFlowConfig {
+    fn check(&self) -> Result<(), SystemError> {
+        validate(self)
+    }
 }
 
 /// Checks what serde cannot.
@@ -291,7 +298,7 @@ fn max_ms(v: &[Duration]) -> f64 {
 
 /// Validates, builds and runs the model at its fidelity.
 pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, SystemError> {
-    validate(&cfg)?;
+    let cfg = Checked::new(cfg)?;
     let t0 = std::time::Instant::now();
     let analytic = closed_form(&cfg);
     finite_closed_form(&cfg, &analytic)?;
@@ -320,7 +327,7 @@ pub fn run_pixelflow(cfg: PixelFlowConfig, trace: bool) -> Result<PixelFlowRun, 
             &[(0.0, a.front_end_ms, a.latency_ms)],
         );
         return Ok(PixelFlowRun {
-            config: cfg,
+            config: cfg.into_inner(),
             analytic,
             stats: None,
             records: Vec::new(),

@@ -7,9 +7,12 @@
 
 use crate::components::distribution::Dist;
 use crate::components::swap_chain::{Flip, PresentMode, SwapChain};
-use crate::engine::{Control, Duration, EventKind, Model, Scheduler, StreamRng, Time};
+use crate::engine::{Control, Duration, EventKind, Model, RngStreams, Scheduler, StreamRng, Time};
 use crate::output::trace::TraceWriter;
 use crate::systems::SystemError;
+use crate::systems::checked::Checked;
+
+use super::config::PresentConfig;
 
 /// Events of the present system.
 #[derive(Debug, Clone, Copy)]
@@ -87,18 +90,17 @@ pub struct Finished {
 }
 
 impl Present {
-    /// A renderer of `frames` frames with render times from `render`
-    /// (drawn from `rng`), presenting into `buffers` images shown in
-    /// `mode` at every `refresh`.
-    pub fn new(
-        frames: u64,
-        render: Dist<Duration>,
-        rng: StreamRng,
-        buffers: u32,
-        mode: PresentMode,
-        refresh: Duration,
-        trace: Option<TraceWriter>,
-    ) -> Present {
+    /// The checked model's renderer: `run.frames` frames with render times
+    /// from `render.time` (drawn from the `render` stream of `run.seed`),
+    /// presenting into `display.buffers` images shown in the display's
+    /// present mode at every refresh.
+    pub fn new(cfg: &Checked<PresentConfig>, trace: Option<TraceWriter>) -> Present {
+        let frames = cfg.run.frames;
+        let render = cfg.render.time.clone();
+        let rng = RngStreams::new(cfg.run.seed).stream("render");
+        let buffers = cfg.display.buffers;
+        let mode = cfg.display.effective_mode();
+        let refresh = cfg.display.refresh.period;
         let mut trace = trace;
         if let Some(t) = trace.as_mut() {
             t.process(PID, "present");

@@ -8,10 +8,11 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::components::swap_chain::PresentMode;
-use crate::engine::{Limits, RngStreams, RunStats, Scheduler, StopReason, Time, run};
+use crate::engine::{Limits, RunStats, Scheduler, StopReason, Time, run};
 use crate::output::table::write_number_table;
 use crate::output::text::{fixed, number};
 use crate::output::trace::TraceWriter;
+use crate::systems::checked::{Check, Checked};
 use crate::systems::error::invalid;
 use crate::systems::summary::{Dist, EventCounts};
 use crate::systems::{Outcome, SystemError, SystemModel, outcome_basics, resolved_toml};
@@ -80,7 +81,13 @@ pub fn analytic_interval_ms(
     }
 }
 
-/// Checks what the simulator cannot run: a render-time distribution with
+impl Check for PresentConfig {
+    fn check(&self) -> Result<(), SystemError> {
+        validate(self)
+    }
+}
+
+/// Checks what the simulator cannot run ([`Checked::new`] runs it): a render-time distribution with
 /// bad parameters, the display ([`crate::components::swap_chain::DisplayConfig::check`]),
 /// warm-up frames that leave none, and work that could not finish.
 pub fn validate(cfg: &PresentConfig) -> Result<(), SystemError> {
@@ -134,17 +141,8 @@ pub fn validate(cfg: &PresentConfig) -> Result<(), SystemError> {
 
 /// Validates and runs a model, writing its trace into `trace` if given.
 pub fn run_present(cfg: PresentConfig, trace: Option<TraceWriter>) -> Result<PresentRun, SystemError> {
-    validate(&cfg)?;
-    let streams = RngStreams::new(cfg.run.seed);
-    let mut model = Present::new(
-        cfg.run.frames,
-        cfg.render.time.clone(),
-        streams.stream("render"),
-        cfg.display.buffers,
-        cfg.display.effective_mode(),
-        cfg.display.refresh.period,
-        trace,
-    );
+    let cfg = Checked::new(cfg)?;
+    let mut model = Present::new(&cfg, trace);
     let mut sched = Scheduler::new();
     let start = Instant::now();
     model.start(&mut sched)?;
@@ -165,7 +163,7 @@ pub fn run_present(cfg: PresentConfig, trace: Option<TraceWriter>) -> Result<Pre
     let summary = summarize(&cfg, &done, &stats);
     Ok(PresentRun {
         summary,
-        config: cfg,
+        config: cfg.into_inner(),
         frames: done.frames,
         trace: done.trace,
     })

@@ -17,6 +17,7 @@
 use rand::Rng;
 
 use crate::engine::{Control, Duration, EventKind, Model, RngStreams, Scheduler, StreamRng, Time};
+use crate::systems::checked::Checked;
 use crate::systems::error::SystemError;
 
 use crate::output::trace::TraceWriter;
@@ -168,8 +169,9 @@ pub struct Vr {
 }
 
 impl Vr {
-    /// A model ready to start.
-    pub fn new(cfg: VrConfig) -> Self {
+    /// A model ready to start, from a checked config.
+    pub fn new(cfg: Checked<VrConfig>) -> Self {
+        let cfg = cfg.into_inner();
         let rng = RngStreams::new(cfg.run.seed);
         let phase = |name: &str, span: Duration| {
             let mut r = rng.stream(name);

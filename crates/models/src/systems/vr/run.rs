@@ -16,6 +16,7 @@ use super::analytic::{Analytic, Bounds, analytic};
 use super::config::{Scheme, VrConfig};
 use super::latency::{MotionRecord, NAIVE_STAGES, WARP_HEAD_STAGES, WARP_OBJECT_STAGES};
 use super::model::Vr;
+use crate::systems::checked::{Check, Checked};
 use crate::systems::error::{SystemError, invalid as bad};
 
 /// Everything a run produced.
@@ -37,7 +38,13 @@ pub struct VrRun {
     pub trace: Option<TraceWriter>,
 }
 
-/// Checks values serde cannot.
+impl Check for VrConfig {
+    fn check(&self) -> Result<(), SystemError> {
+        validate(self)
+    }
+}
+
+/// Checks values serde cannot ([`Checked::new`] runs it).
 pub fn validate(cfg: &VrConfig) -> Result<(), SystemError> {
     for (key, d) in [
         ("tracker.period", cfg.tracker.period),
@@ -120,10 +127,11 @@ pub fn estimate_memory(cfg: &VrConfig) -> (u64, String) {
 /// renderer, warping renderer, display; motions as instants) and handed back
 /// in [`VrRun::trace`], to be closed by the caller.
 pub fn run_vr(cfg: VrConfig, trace: Option<TraceWriter>) -> Result<VrRun, SystemError> {
-    validate(&cfg)?;
+    let cfg = Checked::new(cfg)?;
     let max_memory = cfg.run.memory_budget(estimate_memory(&cfg))?;
     let a = analytic(&cfg);
     let mut model = Vr::new(cfg.clone());
+
     model.max_memory = max_memory;
     model.trace = trace;
     let mut sched = Scheduler::new();
@@ -144,7 +152,7 @@ pub fn run_vr(cfg: VrConfig, trace: Option<TraceWriter>) -> Result<VrRun, System
     let summary = summarize(&cfg, &model, &motions, &a, &stats);
     let trace = model.finish_trace();
     Ok(VrRun {
-        config: cfg,
+        config: cfg.into_inner(),
         stats,
         model,
         motions,

@@ -17,6 +17,7 @@ use rand::Rng;
 use crate::components::distribution::Dist;
 use crate::engine::{Duration, RngStreams, StreamRng};
 use crate::scene::config::{SceneWorkload, StateOrder, View};
+use crate::systems::checked::Checked;
 use crate::systems::error::SystemError;
 use crate::systems::frame_pipeline::config::{FramePipelineConfig, RunConfig, WorkloadConfig};
 use crate::systems::frame_pipeline::workload::{
@@ -71,7 +72,7 @@ impl Renderer {
     /// A renderer for `scene` on the model's hardware; `noise = false` turns
     /// system tasks off (the preprocess's timings). The per-frame variation
     /// (`[variation]`) is in every render.
-    pub fn new(cfg: &WalkthroughConfig, scene: &Scene, noise: bool) -> Result<Renderer, SystemError> {
+    pub fn new(cfg: &Checked<WalkthroughConfig>, scene: &Scene, noise: bool) -> Result<Renderer, SystemError> {
         let mut noise_cfg = cfg.noise.clone();
         if !noise {
             noise_cfg.enabled = false;

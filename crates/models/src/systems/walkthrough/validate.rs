@@ -4,6 +4,7 @@
 //! and the memory the run would take.
 
 use crate::limits::EventPart;
+use crate::systems::checked::Check;
 use crate::systems::error::{SystemError, invalid};
 use crate::systems::frame_pipeline::CheckedPipeline;
 
@@ -13,6 +14,12 @@ use super::scene::Scene;
 
 /// Most frames and fit samples a run may ask for.
 pub const MAX_FRAMES: u64 = 10_000_000;
+
+impl Check for WalkthroughConfig {
+    fn check(&self) -> Result<(), SystemError> {
+        validate(self)
+    }
+}
 
 /// Checks the keys serde cannot.
 pub fn validate(cfg: &WalkthroughConfig) -> Result<(), SystemError> {
@@ -273,9 +280,10 @@ mod tests {
             let m = load_model(Some(&path), &Overrides::with_sets(&sets)).unwrap();
             let cfg: WalkthroughConfig = deserialize(&m.table, &m.source).unwrap();
             let scene = build_scene(&cfg.scene, cfg.run.seed).unwrap();
+            let checked = crate::systems::checked::Checked::new(cfg.clone()).unwrap();
             let (actual, exact) = (
-                Renderer::new(&cfg, &scene, true).unwrap(),
-                Renderer::new(&cfg, &scene, false).unwrap(),
+                Renderer::new(&checked, &scene, true).unwrap(),
+                Renderer::new(&checked, &scene, false).unwrap(),
             );
             let wants: Vec<bool> = ESTIMATORS
                 .iter()

@@ -18,6 +18,7 @@ use std::time::Instant;
 
 use crate::engine::{PS_PER_MS, StreamRng};
 use crate::output::trace::TraceWriter;
+use crate::systems::checked::Checked;
 use crate::systems::error::SystemError;
 use crate::systems::summary::EventCounts;
 
@@ -31,7 +32,7 @@ use super::pos::PosTable;
 use super::preprocess::{Preprocess, preprocess};
 use super::render::{Counter, Draw, Renderer, frame_seeds};
 use super::scene::{Prototype, Scene, build_scene};
-use super::validate::validate;
+
 use super::view_cells::ViewCellTables;
 use crate::components::lod_select::Algorithm;
 
@@ -69,7 +70,7 @@ fn ms(ps: f64) -> f64 {
 
 /// Runs the walkthrough.
 pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemError> {
-    validate(&cfg)?;
+    let cfg = Checked::new(cfg)?;
     let t0 = Instant::now();
     let scene = build_scene(&cfg.scene, cfg.run.seed)?;
     camera::validate(&cfg.camera, &scene)?;
@@ -166,7 +167,7 @@ pub fn run_walkthrough(cfg: WalkthroughConfig) -> Result<WalkthroughRun, SystemE
     };
     let columns = columns(&wants, max_levels);
     Ok(WalkthroughRun {
-        config: cfg,
+        config: cfg.into_inner(),
         summary,
         columns,
         rows,
