@@ -47,13 +47,11 @@ fn main() {
     // 5% of the city's 5609 buildings (Table 5), one table row per frame.
     assert_eq!(objects as f64, (5609.0_f64 * 0.05).round());
     assert_eq!(r.rows.len(), 60);
-    let est = &s.metrics.estimation;
-    let scores = [&est.h1, &est.h2, &est.h3, &est.h4, &est.pos];
-    let mse: Vec<f64> = ["h1", "h2", "h3", "h4", "pos"]
+    // h1-h4 and pos, the first five of the estimators' scores.
+    let mse: Vec<f64> = s.metrics.estimation.scores()[..5]
         .iter()
-        .zip(scores)
-        .map(|(e, score)| {
-            let score = score.as_ref().expect("the model asks for every estimator");
+        .map(|&(e, score)| {
+            let score = score.expect("the model asks for every estimator");
             let m = score.mse_ms2.expect("frames were estimated");
             println!(
                 "{e:>4}: mean squared error {m:8.5} ms^2, mean error {:+.3} ms",

@@ -91,8 +91,9 @@ impl Runner for SimRunner {
             overrides: self.origins.iter().chain(origins).cloned().collect(),
         };
         let run = run_model(&src, &table, None)?;
-        let warmup = run
-            .summary()
+        // Made once: each call makes the JSON from the typed summary.
+        let mut summary = run.summary();
+        let warmup = summary
             .get("warmup_frames")
             .and_then(serde_json::Value::as_u64)
             .unwrap_or(0);
@@ -100,7 +101,6 @@ impl Runner for SimRunner {
             let (columns, rows) = run.frame_table();
             without_warmup(FrameTable { columns, rows }, warmup)
         });
-        let mut summary = run.summary();
         crate::output::timing::fix_wall_times(&mut summary);
         Ok(RunOutput { summary, frames })
     }

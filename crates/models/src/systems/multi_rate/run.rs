@@ -176,8 +176,8 @@ pub fn estimate_memory(cfg: &MultiRateConfig) -> (u64, String) {
 pub fn run_multi_rate(cfg: MultiRateConfig, trace: Option<TraceWriter>) -> Result<MultiRateRun, SystemError> {
     let cfg = Checked::new(cfg)?;
     let max_memory = cfg.run.memory_budget(estimate_memory(&cfg))?;
-    let a = analytic(&Terms::of(&cfg));
     let mut model = MultiRate::new(&cfg);
+    let a = analytic(&model.terms);
     model.max_memory = max_memory;
     model.trace = trace;
     if !cfg.migration.script.is_empty() {

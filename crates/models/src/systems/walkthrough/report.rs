@@ -94,8 +94,7 @@ fn write_estimation(s: &WalkthroughSummary, w: &mut dyn Write) -> io::Result<()>
         w,
         "  estimator   mse (ms^2)   mean error (ms)   underestimated   cost (us/frame)"
     )?;
-    let scores = [&e.h1, &e.h2, &e.h3, &e.h4, &e.pos, &e.vcs, &e.pvc];
-    for (name, x) in super::estimators::ESTIMATORS.iter().zip(scores) {
+    for (name, x) in e.scores() {
         let Some(x) = x else {
             continue;
         };

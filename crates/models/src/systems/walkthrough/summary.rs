@@ -5,7 +5,7 @@ use serde::Serialize;
 
 use crate::systems::summary::{Dist, EventCounts};
 
-use super::estimators::{Constants, Score};
+use super::estimators::{Constants, ESTIMATORS, Score};
 use super::scene::SceneTotals;
 use super::timing::TimingSummary;
 use super::view_cells::ViewCellSummary;
@@ -64,6 +64,15 @@ pub struct EstimationSummary {
     /// The CPU clock the preprocess was timed with (absent with time stamps).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub timing: Option<TimingSummary>,
+}
+
+impl EstimationSummary {
+    /// Each estimator's score by name, in [`ESTIMATORS`]' order (`None` for
+    /// an estimator the model did not ask for).
+    pub fn scores(&self) -> [(&'static str, Option<&Score>); 7] {
+        let s = [&self.h1, &self.h2, &self.h3, &self.h4, &self.pos, &self.vcs, &self.pvc];
+        std::array::from_fn(|i| (ESTIMATORS[i], s[i].as_ref()))
+    }
 }
 
 /// `metrics` of a walkthrough summary.
